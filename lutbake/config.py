@@ -1,0 +1,199 @@
+"""TOML batch configs -> validated, frozen table specs.
+
+Every key is checked at load, before any kernel runs; an error names the file, the table, the key,
+the bad value and the allowed values (lutbake.errors.ConfigError). Unknown keys are errors.
+A config holds one or more ``[[table]]`` entries (docs/config.md lists every key).
+"""
+from __future__ import annotations
+
+import math
+import re
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+from types import MappingProxyType
+from typing import Any, Mapping
+
+from .errors import ConfigError
+from .tables import KINDS, lookup_kind
+from .tables.base import Key
+
+NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,128}$")
+MAX_TEXELS = 1 << 26  # 64 Mi texels; float64 accumulation of 4 channels = 2 GiB
+PRESET_DIR = Path(__file__).parent / "presets"
+
+
+@dataclass(frozen=True)
+class TableSpec:
+    """One validated ``[[table]]``: its kind, its options (every key of the kind, defaults filled in),
+    where it came from, and its canonical TOML text (written into the EXR)."""
+
+    name: str
+    kind: str
+    options: Mapping[str, Any]
+    source: str
+    index: int
+
+    def toml(self) -> str:
+        return "[[table]]\n" + "".join(f"{k} = {_toml_value(v)}\n" for k, v in self.options.items() if v is not None)
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    return repr(v)
+
+
+def presets() -> dict[str, Path]:
+    """Preset name -> its TOML file (presets are configs shipped in the package)."""
+    return {p.stem: p for p in sorted(PRESET_DIR.glob("*.toml"))}
+
+
+def preset_path(name: str) -> Path:
+    ps = presets()
+    if name not in ps:
+        raise ConfigError("--preset", None, message=f"unknown preset {name!r}", allowed=", ".join(ps))
+    return ps[name]
+
+
+def _check_value(key: Key, value, file, table) -> Any:
+    def fail(msg, allowed=None):
+        raise ConfigError(file, key.name, value, allowed, msg, table)
+
+    if key.type in ("str", "name"):
+        if not isinstance(value, str):
+            fail("must be a string", ", ".join(key.choices) if key.choices else None)
+        if key.type == "name" and not NAME_RE.match(value):
+            fail("must be 1-128 letters, digits, '-' or '_' (it names the output file)")
+        if key.choices is not None and value not in key.choices:
+            fail("is not a known value", ", ".join(key.choices))
+        return value
+    if key.type == "int":
+        if isinstance(value, bool) or not isinstance(value, int):
+            fail("must be an integer")
+        if key.minimum is not None and value < key.minimum:
+            fail(f"must be >= {key.minimum:g}")
+        if key.maximum is not None and value > key.maximum:
+            fail(f"must be <= {key.maximum:g}")
+        return value
+    if key.type == "int_pair":
+        if not isinstance(value, list) or len(value) != 2 or any(isinstance(x, bool) or not isinstance(x, int) for x in value):
+            fail("must be a list of two integers, e.g. [128, 128]")
+        if any(x < (key.minimum or 1) for x in value):
+            fail("sizes must be >= 1")
+        return list(value)
+    if key.type == "float_range":
+        if (not isinstance(value, list) or len(value) != 2
+                or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in value)):
+            fail("must be a list of two numbers [lo, hi]")
+        lo, hi = (float(x) for x in value)
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            fail("must be finite")
+        if lo < key.minimum or hi > key.maximum or lo > hi:
+            fail(f"must satisfy {key.minimum:g} <= lo <= hi <= {key.maximum:g}")
+        return [lo, hi]
+    raise AssertionError(key.type)
+
+
+def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
+    """Validate one ``[[table]]`` mapping against its kind's keys."""
+    label = f"#{index + 1}" + (f" ({raw['name']!r})" if isinstance(raw.get("name"), str) else "")
+    if not isinstance(raw, Mapping):
+        raise ConfigError(file, None, message=f"table {label} must be a TOML table")
+    if "kind" not in raw:
+        raise ConfigError(file, "kind", message="is missing", allowed=", ".join(KINDS), table=label)
+    if not isinstance(raw["kind"], str):
+        raise ConfigError(file, "kind", raw["kind"], ", ".join(KINDS), "must be a string", label)
+    try:
+        kind = lookup_kind(raw["kind"])
+    except KeyError:
+        raise ConfigError(file, "kind", raw["kind"], ", ".join(KINDS), "is not a known table kind", label) from None
+    unknown = sorted(set(raw) - set(kind.keys))
+    if unknown:
+        raise ConfigError(file, unknown[0], raw[unknown[0]], ", ".join(kind.keys),
+                          f"is not a key of kind '{kind.name}'", label)
+    options: dict[str, Any] = {}
+    for k in kind.keys.values():
+        if k.name in raw:
+            options[k.name] = _check_value(k, raw[k.name], file, label)
+        elif k.required:
+            raise ConfigError(file, k.name, message="is missing", table=label)
+        else:
+            options[k.name] = list(k.default) if isinstance(k.default, list) else k.default
+    options["kind"] = kind.name
+    spec = TableSpec(options["name"], kind.name, MappingProxyType(options), str(file), index)
+    texels = math.prod(options.get("size", [1]))
+    if texels > MAX_TEXELS:
+        raise ConfigError(file, "size", options["size"], f"at most {MAX_TEXELS} texels",
+                          f"{texels} texels would need {texels * 32 / 2**30:.1f} GiB while baking", label)
+    if kind.check is not None:
+        msg = kind.check(spec)
+        if msg:
+            raise ConfigError(file, None, message=msg, table=label)
+    return spec
+
+
+def parse_overrides(items: tuple[str, ...] | list[str]) -> list[tuple[str | None, str, Any]]:
+    """``--set KEY=VALUE`` (every table) or ``--set NAME.KEY=VALUE`` (one table); VALUE is TOML."""
+    out = []
+    for item in items:
+        if "=" not in item:
+            raise ConfigError("--set", item, message="must look like KEY=VALUE or TABLE.KEY=VALUE")
+        lhs, rhs = item.split("=", 1)
+        table, _, key = lhs.strip().rpartition(".")
+        try:
+            value = tomllib.loads(f"v = {rhs.strip()}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = rhs.strip()  # a bare word: a string
+        out.append((table or None, key, value))
+    return out
+
+
+def load_config(path, overrides=()) -> list[TableSpec]:
+    """Read and validate one TOML config; ``overrides`` from parse_overrides() are applied first."""
+    path = Path(path)
+    if not path.is_file():
+        raise ConfigError(path, None, message="no such config file")
+    try:
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
+        raise ConfigError(path, None, message=f"invalid TOML: {e}") from None
+    extra = sorted(set(doc) - {"table"})
+    if extra:
+        raise ConfigError(path, extra[0], doc[extra[0]], "table", "is not a top-level key")
+    tables = doc.get("table")
+    if not isinstance(tables, list) or not tables:
+        raise ConfigError(path, "table", message="a config needs at least one [[table]]")
+    specs = []
+    for i, raw in enumerate(tables):
+        if not isinstance(raw, dict):
+            raise ConfigError(path, "table", raw, message=f"entry #{i + 1} must be a [[table]]")
+        raw = dict(raw)
+        for table, key, value in overrides:
+            if table is None or table == raw.get("name"):
+                raw[key] = value
+        specs.append(validate_table(raw, path, i))
+    return specs
+
+
+def load_configs(paths, overrides=()) -> list[TableSpec]:
+    """Validate every config before anything runs; table names must be unique across the batch."""
+    ovr = parse_overrides(overrides)
+    specs: list[TableSpec] = []
+    seen: dict[str, str] = {}
+    for p in paths:
+        for s in load_config(p, ovr):
+            if s.name in seen:
+                raise ConfigError(s.source, "name", s.name, None,
+                                  f"duplicate table name (also in {seen[s.name]}): outputs would collide")
+            seen[s.name] = s.source
+            specs.append(s)
+    names = {n for n, _, _ in ovr if n is not None}
+    missing = names - set(seen)
+    if missing:
+        raise ConfigError("--set", sorted(missing)[0], None, ", ".join(seen), "names no table of the batch")
+    return specs

@@ -1,0 +1,37 @@
+"""Deterministic point sets on [0, 1) and [0, 1)^2, computed in float64 on the host."""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+
+@functools.lru_cache(maxsize=64)
+def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """n-point Gauss-Legendre rule mapped to [0, 1]: nodes x_i, weights w_i with sum w_i = 1.
+    Exact for polynomials of degree 2n - 1 (numpy.polynomial.legendre.leggauss)."""
+    x, w = np.polynomial.legendre.leggauss(n)
+    return 0.5 * (x + 1.0), 0.5 * w
+
+
+@functools.lru_cache(maxsize=64)
+def sobol(n: int, seed: int) -> np.ndarray:
+    """n points of the 2D Sobol' sequence with Owen scrambling (scipy.stats.qmc), seeded:
+    deterministic for a given (n, seed). n is rounded up to a power of two (balance properties)."""
+    from scipy.stats import qmc
+
+    m = max(0, int(np.ceil(np.log2(max(n, 1)))))
+    return qmc.Sobol(d=2, scramble=True, rng=np.random.default_rng(seed)).random_base2(m)
+
+
+@functools.lru_cache(maxsize=64)
+def hammersley(n: int) -> np.ndarray:
+    """The 2D Hammersley set (i/n, radical inverse base 2 of i), as Filament's cmgen uses."""
+    i = np.arange(n, dtype=np.uint64)
+    bits = np.zeros(n, dtype=np.float64)
+    scale, k = 0.5, i.copy()
+    while np.any(k):
+        bits += (k & 1).astype(np.float64) * scale
+        k >>= np.uint64(1)
+        scale *= 0.5
+    return np.stack([i.astype(np.float64) / n, bits], axis=1)

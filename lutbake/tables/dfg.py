@@ -1,0 +1,110 @@
+"""Kind ``dfg``: the split-sum specular table (Karis 2013), NoV x roughness.
+
+    E(NoV, r) = ∫ f(l, v) (n.l) dω_l,   f = D F G2 / (4 (n.l)(n.v)),   F = f0 + (1 - f0) Fc, Fc = (1 - v.h)^5
+Schlick F makes f0 factor out, so two channels hold the whole table:
+    scale_bias   R = ∫ f/F (1 - Fc) (n.l) dω,  G = ∫ f/F Fc (n.l) dω       E = f0 R + G
+    multiscatter R = ∫ f/F Fc (n.l) dω,        G = ∫ f/F (n.l) dω          E = mix(R, G, f0); E(F=1) = G
+Axes: x (columns) = NoV, y (rows) = roughness; image row 0 is the first roughness value (smoothest).
+The integral and its estimators are derived in lutbake.sampling.estimators.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..axes import ROUGHNESS_PARAMS, TEXELS, Axis
+from ..terms.sets import MASKINGS, NDFS
+from . import specular
+from .base import Key, Kind, Plan
+
+LAYOUTS = {
+    "scale_bias": "R = scale, G = bias: E = f0 * R + G (Karis 2013)",
+    "multiscatter": "R = ∫Fc·f, G = ∫f: E = mix(R, G, f0), E(F=1) = G (Filament)",
+}
+CHANNELS = {
+    "scale_bias": {"scale": "∫ f/F (1 - (1 - v.h)^5) (n.l) dω_l: multiplies f0",
+                   "bias": "∫ f/F (1 - v.h)^5 (n.l) dω_l: added"},
+    "multiscatter": {"fc": "∫ f/F (1 - v.h)^5 (n.l) dω_l: the f90 = 1 weight",
+                     "e_ss": "∫ f/F (n.l) dω_l: single-scattering directional albedo with F = 1"},
+}
+RECONSTRUCTION = {
+    "scale_bias": "uv = vec2(NoV, roughness) (texel centres per lutbake:axes); t = texture(lut, uv).rg; "
+                  "specular = prefiltered * (f0 * t.r + t.g)",
+    "multiscatter": "uv = vec2(NoV, roughness); t = texture(lut, uv).rg; E = mix(t.r, t.g, f0) = (1 - f0) t.r + f0 t.g; "
+                    "specular = prefiltered * E; energy compensation = 1 + f0 (1 / t.g - 1)",
+}
+
+COMMON_KEYS = {
+    "name": Key("name", "name", None, "output stem: <out-dir>/<name>.exr; letters, digits, - and _ only", required=True),
+    "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
+    "samples": Key("samples", "int", None, "integrand evaluations per texel; omitted: the estimator's default "
+                   "quality", minimum=1),
+    "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}),
+    "estimator": Key("estimator", "str", "gauss_legendre", "how the integral is estimated", specular.ESTIMATORS),
+    "seed": Key("seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0),
+}
+
+KEYS = {
+    **COMMON_KEYS,
+    "size": Key("size", "int_pair", [128, 128], "[NoV, roughness] texel counts", minimum=1),
+    "roughness": Key("roughness", "str", "perceptual", "what the roughness axis holds", ROUGHNESS_PARAMS),
+    "ndf": Key("ndf", "str", "ggx", "normal distribution function", {k: v.description for k, v in NDFS.items()}),
+    "masking": Key("masking", "str", "smith_height_correlated", "masking-shadowing G2", MASKINGS),
+    "layout": Key("layout", "str", "scale_bias", "channel layout", LAYOUTS),
+    "texel": Key("texel", "str", "center", "texel convention of both axes", TEXELS),
+    "nov_range": Key("nov_range", "float_range", [0.0, 1.0], "NoV at t = 0 and t = 1", minimum=0.0, maximum=1.0),
+    "roughness_range": Key("roughness_range", "float_range", [0.0, 1.0], "roughness at t = 0 and t = 1",
+                           minimum=0.0, maximum=1.0),
+}
+
+
+def check_spec(spec) -> str | None:
+    """Cross-key rules, checked at config load; returns a message or None."""
+    o = spec.options
+    if o["estimator"] == "sobol_vndf" and NDFS[o["ndf"]].vndf is None:
+        return f"estimator 'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not {o['ndf']!r}"
+    return None
+
+
+def axes_for(o: dict) -> list[Axis]:
+    n_nov, n_rough = o["size"]
+    rname = "perceptual_roughness" if o["roughness"] == "perceptual" else "alpha"
+    return [Axis(rname, "y", n_rough, *o["roughness_range"], texel=o["texel"]),
+            Axis("NoV", "x", n_nov, *o["nov_range"], texel=o["texel"])]
+
+
+def plan(spec) -> Plan:
+    o = spec.options
+    axes = axes_for(o)
+    rough, nov_axis = axes
+    est = o["estimator"]
+    samples = o["samples"] or specular.DEFAULT_SAMPLES[est]
+    key = (o["ndf"], o["masking"], o["layout"], est)
+    # texel t = iy * nx + ix: y (roughness) slowest
+    nov = np.tile(nov_axis.values(), rough.count)
+    alpha = np.repeat(rough.alpha(), nov_axis.count)
+
+    def prepare(device: str) -> None:
+        specular.load(specular.kernel_for(*key), device)
+
+    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
+        k = specular.kernel_for(*key)
+        return specular.integrate(k, nov[start:stop], alpha[start:stop], est, samples, o["seed"], 2, device)
+
+    eff = specular.effective_samples(est, samples)
+    return Plan(
+        axes=axes,
+        channels=CHANNELS[o["layout"]],
+        reconstruction=RECONSTRUCTION[o["layout"]],
+        n_texels=len(nov),
+        n_channels=2,
+        run_tile=run_tile,
+        prepare=prepare,
+        samples=eff,
+        estimator=est,
+        terms={"ndf": o["ndf"], "masking": o["masking"], "fresnel": "schlick", "layout": o["layout"]},
+        cost=float(len(nov)) * eff,
+    )
+
+
+DFG = Kind("dfg", "split-sum specular DFG: NoV x roughness, scale/bias or multiscatter (Σ Fc·V, Σ V) channels",
+           KEYS, plan, aliases=("split_sum",), check=check_spec)

@@ -1,0 +1,7 @@
+"""BRDF terms as ``@wp.func``s, one module per family (ndf, masking, fresnel, frame).
+
+Naming follows the math: ``D_`` normal distributions, ``Lambda_``/``G1_``/``G2_`` masking-shadowing,
+``F_`` Fresnel, ``Fd_`` diffuse. Arguments are cosines named ``NoV``, ``NoL``, ``NoH``, ``VoH``
+(docs/notation.md); ``alpha`` is always the NDF parameter, never a perceptual roughness.
+Host code picks terms by name through the registries in :mod:`lutbake.registry`.
+"""

@@ -1,0 +1,63 @@
+"""Masking-shadowing: Smith's Lambda per NDF, G1, the two Smith G2 forms, and the V-cavity G.
+
+Smith G1(v) = 1 / (1 + Lambda(v)) (Heitz 2014, JCGT 3(2), Eq. 43). G2 takes Lambda values, so any
+Smith form composes with any NDF's Lambda. Every function returns 0 for a back-facing direction
+(cosine <= COS_EPS); at n.v -> 0, Lambda -> alpha / (2 n.v) and G -> 0 linearly.
+"""
+import warp as wp
+
+from ..edge import COS_EPS
+
+LAMBDA_INF = wp.constant(1.0e30)
+
+
+@wp.func
+def Lambda_ggx(NoX: float, alpha: float):
+    """Smith Lambda for GGX (Heitz 2014, Eq. 72): (-1 + sqrt(1 + alpha^2 tan^2 theta)) / 2,
+    written as (sqrt(c^2 + alpha^2 (1 - c^2)) / c - 1) / 2 with c = n.x to avoid tan at grazing."""
+    if NoX <= COS_EPS:
+        return LAMBDA_INF
+    c2 = NoX * NoX
+    return 0.5 * (wp.sqrt(c2 + alpha * alpha * (1.0 - c2)) / NoX - 1.0)
+
+
+@wp.func
+def Lambda_beckmann(NoX: float, alpha: float):
+    """Smith Lambda for Beckmann (Heitz 2014, Eq. 69), a = 1 / (alpha tan theta):
+    (erf(a) - 1) / 2 + exp(-a^2) / (2 a sqrt(pi)). Exact erf, not Walter's rational fit."""
+    if NoX <= COS_EPS:
+        return LAMBDA_INF
+    s = wp.sqrt(wp.max(1.0 - NoX * NoX, 0.0))
+    if s <= 0.0:
+        return 0.0
+    a = NoX / (alpha * s)
+    if a > 9.0:  # erfc(9) < 1e-36: Lambda is 0 to float precision
+        return 0.0
+    return 0.5 * (wp.erf(a) - 1.0) + wp.exp(-a * a) / (2.0 * a * wp.sqrt(wp.pi))
+
+
+@wp.func
+def G1_smith(Lambda_x: float):
+    """Smith masking G1 = 1 / (1 + Lambda) (Heitz 2014, Eq. 43)."""
+    return 1.0 / (1.0 + Lambda_x)
+
+
+@wp.func
+def G2_smith_height_correlated(Lambda_v: float, Lambda_l: float):
+    """Height-correlated Smith G2 = 1 / (1 + Lambda(v) + Lambda(l)) (Heitz 2014, Eq. 99)."""
+    return 1.0 / (1.0 + Lambda_v + Lambda_l)
+
+
+@wp.func
+def G2_smith_separable(Lambda_v: float, Lambda_l: float):
+    """Separable (uncorrelated) Smith G2 = G1(v) G1(l) (Heitz 2014, Eq. 98)."""
+    return 1.0 / ((1.0 + Lambda_v) * (1.0 + Lambda_l))
+
+
+@wp.func
+def G2_v_cavity(NoH: float, NoV: float, NoL: float, VoH: float, LoH: float):
+    """Torrance-Sparrow V-cavity (Cook & Torrance 1982; lecture 003):
+    G = min(1, 2 (n.h)(n.v) / (v.h), 2 (n.h)(n.l) / (l.h)). 0 for back-facing v.h or l.h."""
+    if VoH <= COS_EPS or LoH <= COS_EPS:
+        return 0.0
+    return wp.min(1.0, wp.min(2.0 * NoH * NoV / VoH, 2.0 * NoH * NoL / LoH))
