@@ -36,12 +36,14 @@ def F_dielectric_f0(f0: float, cos_theta: float):
     """Gotanda 2014 course notes, Eq. 2: the exact dielectric Fresnel written with f0, s = sqrt(f0):
     F = 1/2 {[((s+1)c + (s-1)a) / ((s+1)c - (s-1)a)]^2 + [((s-1)c + (s+1)a) / ((s-1)c - (s+1)a)]^2},
     a = sqrt(1 - (s-1)^2 (1-c^2) / (s+1)^2). Equals F_dielectric with eta = (1+s)/(1-s).
+    a is evaluated as sqrt(4 s + (s-1)^2 c^2) / (s+1) (the same, since (s+1)^2 - (s-1)^2 = 4s): the
+    printed form cancels in float32 at grazing c and returned 1 instead of 0 for f0 = 0.
     Domain f0 in [0, 1): at f0 -> 1 (eta -> inf) it returns 1."""
     s = wp.sqrt(wp.clamp(f0, 0.0, 1.0))
     c = wp.clamp(cos_theta, 0.0, 1.0)
     sp = s + 1.0
     sm = s - 1.0
-    a = wp.sqrt(wp.max(1.0 - sm * sm * (1.0 - c * c) / (sp * sp), 0.0))
+    a = wp.sqrt(4.0 * s + sm * sm * c * c) / sp
     d1 = sp * c - sm * a
     d2 = sm * c - sp * a
     if d1 == 0.0 or d2 == 0.0:

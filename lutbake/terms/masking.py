@@ -57,7 +57,7 @@ def G2_smith_separable(Lambda_v: float, Lambda_l: float):
 @wp.func
 def G2_v_cavity(NoH: float, NoV: float, NoL: float, VoH: float, LoH: float):
     """Torrance-Sparrow V-cavity (Cook & Torrance 1982; lecture 003):
-    G = min(1, 2 (n.h)(n.v) / (v.h), 2 (n.h)(n.l) / (l.h)). 0 for back-facing v.h or l.h."""
-    if VoH <= COS_EPS or LoH <= COS_EPS:
+    G = min(1, 2 (n.h)(n.v) / (v.h), 2 (n.h)(n.l) / (l.h)). 0 for back-facing v.h, l.h or n.h."""
+    if VoH <= COS_EPS or LoH <= COS_EPS or NoH <= 0.0:
         return 0.0
     return wp.min(1.0, wp.min(2.0 * NoH * NoV / VoH, 2.0 * NoH * NoL / LoH))

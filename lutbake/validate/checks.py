@@ -1,0 +1,300 @@
+"""Named checks: analytic reductions and invariants of the terms and of the specular tables.
+
+Each check returns a :class:`CheckResult` (measured error, tolerance, pass/fail, a one-line detail).
+``CHECKS`` maps every check name to a zero-argument callable; ``run_all()`` runs them all.
+Parametrised checks carry their parameters in the name: ``weak_white_furnace[ggx]``.
+
+The host-side quadratures here are deliberately NOT the estimators of :mod:`lutbake.sampling`: they are
+composite Gauss-Legendre rules in plain spherical coordinates (no importance sampling, no change of
+variables), with panels graded geometrically towards every point where the integrand changes scale
+(the NDF peak) or loses smoothness (a cut where v.m = 0), and the term values come from the Warp
+``@wp.func``s themselves (:mod:`.probe`).
+"""
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..edge import ALPHA_MIN, NOV_MIN
+from ..sampling import points
+from ..tables import specular
+from ..terms.sets import NDFS
+from .probe import BRDF_PAIRS, evaluate_brdfs, evaluate_terms
+
+# Tolerances (absolute unless said otherwise). The terms run in float32: ~1e-7 is the floor.
+PROJECTED_AREA_TOL = 1.0e-6  # |∫ D(m)(n.m) dω_m - 1|
+WEAK_FURNACE_TOL = 1.0e-6  # |∫ G1(v) max(0, v.m) D(m) dω_m - n.v|
+# E(F = 1) <= 1 + tol everywhere, and |E - 1| <= tol at alpha = ALPHA_MIN, n.v >= 0.05. At alpha > 0 the limit
+# is not exact: GGX's tail puts a fraction ~alpha^2 / theta_a^2 of the normals where l falls below the horizon
+# (theta_a = (pi/2 - theta_v)/2), 2e-6 at alpha = 1e-4, n.v = 0.05, shrinking as alpha^2.
+ALBEDO_TOL = 1.0e-5
+# |scale - (1 - (1 - n.v)^5)|, |bias - (1 - n.v)^5| at alpha = ALPHA_MIN, n.v >= 0.05: the same tail plus the
+# spread of v.h about n.v give 7e-6 at n.v = 0.05 (it shrinks as alpha^2: 5e-7 at alpha = 3e-5).
+DFG_MIRROR_TOL = 2.0e-5
+RECIPROCITY_RTOL = 1.0e-6  # |f(l, v) - f(v, l)| / max(f(l, v), f(v, l)), relative: a few float32 roundings
+FRESNEL_EQ2_TOL = 2.0e-6  # |Eq. 2 (f0, c) - F_dielectric((1 + sqrt f0) / (1 - sqrt f0), c)|, f0 <= 0.95
+SCHLICK_ENDPOINT_TOL = 2.4e-7  # |F_schlick(f0, 1) - f0|, |F_schlick(f0, 0) - 1|: two float32 ulps at 1
+ESTIMATOR_AGREEMENT_TOL = 5.0e-5  # |gauss_legendre - sobol_vndf (2^16 samples)| per channel
+
+# Grids.
+PROJECTED_AREA_ALPHAS = (1.0e-3, 1.0e-2, 0.1, 0.5, 1.0)
+FURNACE_NOVS = (0.01, 0.1, 0.3, 0.5, 0.7, 0.9, 1.0)
+FURNACE_ALPHAS = (1.0e-3, 1.0e-2, 0.1, 0.5, 1.0)
+ALBEDO_COUNT = 24  # texel-centre grid in n.v and perceptual roughness, plus the clamped edges
+MIRROR_NOVS = tuple(np.linspace(0.05, 1.0, 20))  # below ~0.05, Lambda(alpha = 1e-4) is not yet negligible
+ALBEDO_MASKINGS = ("smith_height_correlated", "smith_separable")
+DFG_MIRROR_PAIRS = (("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"))
+RECIPROCITY_SAMPLES = 4096
+ESTIMATOR_TEXELS = ((0.1, 0.04), (0.3, 1.0), (0.5, 0.25), (0.9, 0.64), (1.0, 0.01))  # (n.v, alpha)
+ESTIMATOR_QMC_SAMPLES = 1 << 16
+SEED = 20240607
+
+GL_NODES = 16  # Gauss-Legendre nodes per panel
+PANEL_RATIO = 2.0  # geometric panel growth away from an anchor
+CUT_FIRST_PANEL = 1.0e-6  # first panel width next to a cut (rad)
+
+
+@dataclass(frozen=True)
+class CheckResult:
+    name: str
+    measured: float
+    tolerance: float
+    passed: bool
+    detail: str
+
+    def __str__(self) -> str:
+        status = "PASS" if self.passed else "FAIL"
+        return f"{status} {self.name}: measured {self.measured:.3e} (tolerance {self.tolerance:.1e}) {self.detail}"
+
+
+def _result(name: str, measured: float, tolerance: float, detail: str) -> CheckResult:
+    measured = float(measured)
+    return CheckResult(name, measured, tolerance, bool(np.isfinite(measured) and measured <= tolerance), detail)
+
+
+# --- quadrature helpers --------------------------------------------------------------------------
+
+def _graded_edges(lo: float, hi: float, anchors: list[tuple[float, float]]) -> np.ndarray:
+    """Panel edges on [lo, hi]: the ends, every anchor a, and a +- first * PANEL_RATIO^j inside [lo, hi]
+    for each (a, first) in ``anchors``."""
+    pts = [lo, hi]
+    for a, first in anchors:
+        if not lo <= a <= hi:
+            continue
+        pts.append(a)
+        d = first
+        while d < hi - lo:
+            pts += [a - d, a + d]
+            d *= PANEL_RATIO
+    return np.unique(np.clip(np.asarray(pts, dtype=np.float64), lo, hi))
+
+
+def _composite_gl(edges: np.ndarray, n: int = GL_NODES) -> tuple[np.ndarray, np.ndarray]:
+    """Composite n-point Gauss-Legendre on the panels between ``edges`` -> (nodes, weights)."""
+    x, w = points.gauss_legendre(n)
+    a, b = edges[:-1], edges[1:]
+    return (a[:, None] + (b - a)[:, None] * x).ravel(), ((b - a)[:, None] * w).ravel()
+
+
+def _h(theta: np.ndarray, phi: np.ndarray | float = 0.0) -> np.ndarray:
+    st = np.sin(theta)
+    return np.stack(np.broadcast_arrays(st * np.cos(phi), st * np.sin(phi), np.cos(theta)), axis=-1)
+
+
+# --- NDF normalisation -----------------------------------------------------------------------------
+
+def ndf_projected_area_is_one(ndf_name: str) -> CheckResult:
+    """∫ D(m)(n.m) dω_m = 2 pi ∫_0^{pi/2} D(theta) cos(theta) sin(theta) dtheta = 1 (Walter et al. 2007, Eq. 4),
+    composite GL in theta, panels graded geometrically from the pole at the NDF's scale atan(alpha)."""
+    errors = []
+    for alpha in PROJECTED_AREA_ALPHAS:
+        theta, w = _composite_gl(_graded_edges(0.0, np.pi / 2, [(0.0, np.arctan(alpha) / 16.0)]))
+        D = evaluate_terms(h=_h(theta), alpha=alpha)[f"D_{ndf_name}"].astype(np.float64)
+        errors.append(abs(2.0 * np.pi * np.sum(w * D * np.cos(theta) * np.sin(theta)) - 1.0))
+    k = int(np.argmax(errors))
+    return _result(f"ndf_projected_area_is_one[{ndf_name}]", errors[k], PROJECTED_AREA_TOL,
+                   f"max |∫D(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS}; worst at alpha={PROJECTED_AREA_ALPHAS[k]}")
+
+
+def weak_white_furnace(ndf_name: str) -> CheckResult:
+    """∫ G1(v) max(0, v.m) D(m) dω_m = n.v: the visible microsurface projects onto the view as the
+    geometric surface does (Heitz 2014, JCGT 3(2), Sec. 3), with G1 = 1/(1 + Lambda(v)).
+
+    v = (sin theta_v, 0, cos theta_v), m at (theta, phi). v.m > 0 iff cos(phi) > c(theta) = -cot(theta_v) cot(theta):
+    for theta < pi/2 - theta_v every phi, beyond it phi in [0, acos c] (by symmetry, twice the integral
+    over phi in [0, pi]). Composite GL in theta (panels at the NDF scale from the pole, and graded on
+    both sides of the cut start pi/2 - theta_v) times GL in phi over the exact visible interval."""
+    errors = []
+    where = []
+    for nov in FURNACE_NOVS:
+        sin_v = np.sqrt(max(1.0 - nov * nov, 0.0))
+        theta_c = np.pi / 2 - np.arccos(nov)
+        for alpha in FURNACE_ALPHAS:
+            edges = _graded_edges(0.0, np.pi / 2, [(0.0, np.arctan(alpha) / 16.0), (theta_c, CUT_FIRST_PANEL)])
+            theta, wt = _composite_gl(edges)
+            with np.errstate(divide="ignore"):
+                c = np.where(theta < theta_c, -1.0, -nov / max(sin_v, 1e-300) / np.tan(theta))
+            phimax = np.arccos(np.clip(c, -1.0, 1.0))
+            s, ws = points.gauss_legendre(GL_NODES)
+            phi = phimax[:, None] * s
+            wphi = phimax[:, None] * ws
+            h = _h(theta[:, None], phi)
+            terms = evaluate_terms(h=h, alpha=alpha, nov=nov)
+            D = terms[f"D_{ndf_name}"].astype(np.float64)
+            G1 = float(terms[f"G1_smith_{ndf_name}"].ravel()[0])
+            vom = sin_v * h[..., 0].astype(np.float64) + nov * h[..., 2].astype(np.float64)
+            inner = np.sum(wphi * np.maximum(vom, 0.0) * D, axis=1)
+            integral = 2.0 * G1 * np.sum(wt * np.sin(theta) * inner)
+            errors.append(abs(integral - nov))
+            where.append((nov, alpha))
+    k = int(np.argmax(errors))
+    return _result(f"weak_white_furnace[{ndf_name}]", errors[k], WEAK_FURNACE_TOL,
+                   f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over n.v in {FURNACE_NOVS} x alpha in {FURNACE_ALPHAS}; "
+                   f"worst at (n.v, alpha)={where[k]}")
+
+
+# --- tables ------------------------------------------------------------------------------------------
+
+def _integrate(ndf_name: str, masking_name: str, channels: str, nov, alpha, estimator: str = "gauss_legendre",
+               samples: int | None = None) -> np.ndarray:
+    kernel = specular.kernel_for(ndf_name, masking_name, channels, estimator)
+    samples = specular.DEFAULT_SAMPLES[estimator] if samples is None else samples
+    return specular.integrate(kernel, np.asarray(nov, np.float32), np.asarray(alpha, np.float32), estimator,
+                              samples, SEED, 2)
+
+
+def albedo_le_one_and_mirror_limit(ndf_name: str, masking_name: str) -> CheckResult:
+    """Directional albedo with F = 1, E(n.v, alpha) = ∫ f (n.l) dω_l (channels "albedo", gauss_legendre):
+    E <= 1 on a texel-centre grid (plus n.v = NOV_MIN and alpha in {ALPHA_MIN, 1}), and E -> 1 at
+    alpha = ALPHA_MIN for n.v in [0.05, 1]. Measured: the larger of max(E - 1) and max |E(ALPHA_MIN) - 1|."""
+    t = (np.arange(ALBEDO_COUNT) + 0.5) / ALBEDO_COUNT
+    novs = np.concatenate([[NOV_MIN], t, [1.0]])
+    alphas = np.concatenate([[ALPHA_MIN], t * t, [1.0]])
+    N, A = np.meshgrid(novs, alphas, indexing="ij")
+    E = _integrate(ndf_name, masking_name, "albedo", N.ravel(), A.ravel())[:, 0].reshape(N.shape)
+    excess = float(np.max(E - 1.0))
+    i, j = np.unravel_index(np.argmax(E), E.shape)
+    mirror = _integrate(ndf_name, masking_name, "albedo", MIRROR_NOVS, np.full(len(MIRROR_NOVS), ALPHA_MIN))[:, 0]
+    mirror_err = float(np.max(np.abs(mirror - 1.0)))
+    return _result(f"albedo_le_one_and_mirror_limit[{ndf_name},{masking_name}]", max(excess, mirror_err), ALBEDO_TOL,
+                   f"max(E - 1) = {excess:.3e} at (n.v, alpha)=({N[i, j]:.4g}, {A[i, j]:.4g}) on a "
+                   f"{len(novs)}x{len(alphas)} grid; max |E(alpha={ALPHA_MIN}) - 1| = {mirror_err:.3e} for n.v in [0.05, 1]")
+
+
+def dfg_mirror_limit(ndf_name: str, masking_name: str) -> CheckResult:
+    """alpha -> 0 (alpha = ALPHA_MIN): D -> delta at n, h = n, v.h = n.v, G2 -> 1, so the split-sum
+    channels reduce to Schlick at the mirror direction: scale -> 1 - (1 - n.v)^5, bias -> (1 - n.v)^5."""
+    nov = np.asarray(MIRROR_NOVS)
+    sb = _integrate(ndf_name, masking_name, "scale_bias", nov, np.full(len(nov), ALPHA_MIN))
+    fc = (1.0 - nov.astype(np.float32).astype(np.float64)) ** 5
+    err = np.maximum(np.abs(sb[:, 0] - (1.0 - fc)), np.abs(sb[:, 1] - fc))
+    k = int(np.argmax(err))
+    return _result(f"dfg_mirror_limit[{ndf_name},{masking_name}]", err[k], DFG_MIRROR_TOL,
+                   f"max over n.v in [0.05, 1] of |scale - (1-(1-n.v)^5)|, |bias - (1-n.v)^5| at alpha={ALPHA_MIN}; "
+                   f"worst at n.v={nov[k]:.4g}")
+
+
+def estimators_agree() -> CheckResult:
+    """The default DFG table (GGX, height-correlated Smith, scale/bias) under two unrelated estimators:
+    product Gauss-Legendre vs scrambled Sobol' with visible-normal sampling, 2^16 points."""
+    nov, alpha = (np.array(a) for a in zip(*ESTIMATOR_TEXELS))
+    gl = _integrate("ggx", "smith_height_correlated", "scale_bias", nov, alpha)
+    qmc = _integrate("ggx", "smith_height_correlated", "scale_bias", nov, alpha, "sobol_vndf", ESTIMATOR_QMC_SAMPLES)
+    err = np.abs(gl - qmc)
+    k = int(np.argmax(err.max(axis=1)))
+    return _result("estimators_agree", err.max(), ESTIMATOR_AGREEMENT_TOL,
+                   f"max |gauss_legendre - sobol_vndf(2^16)| over (n.v, alpha) in {ESTIMATOR_TEXELS}, "
+                   f"channels scale, bias; worst at {ESTIMATOR_TEXELS[k]}")
+
+
+# --- BRDF and Fresnel identities ---------------------------------------------------------------------
+
+@functools.lru_cache(maxsize=1)
+def _reciprocity_brdfs() -> tuple[dict, dict]:
+    rng = np.random.default_rng(SEED)
+    n = RECIPROCITY_SAMPLES
+
+    def directions():
+        cos_t = rng.uniform(0.0, 1.0, n) ** 2  # biased towards grazing
+        phi = rng.uniform(0.0, 2.0 * np.pi, n)
+        s = np.sqrt(1.0 - cos_t * cos_t)
+        return np.stack([s * np.cos(phi), s * np.sin(phi), cos_t], axis=-1)
+
+    l, v = directions(), directions()
+    alpha = rng.uniform(0.1, 1.0, n) ** 2
+    f0 = rng.uniform(0.0, 1.0, n)
+    return evaluate_brdfs(l, v, alpha, f0), evaluate_brdfs(v, l, alpha, f0)
+
+
+def reciprocity(ndf_name: str, masking_name: str) -> CheckResult:
+    """Helmholtz reciprocity f(l, v) = f(v, l) of the assembled specular BRDF (probe.brdf_for) at
+    random direction pairs (n.l, n.v biased towards grazing), alpha = r^2, r in [0.1, 1], f0 in [0, 1]."""
+    fwd, bwd = _reciprocity_brdfs()
+    a = fwd[(ndf_name, masking_name)].astype(np.float64)
+    b = bwd[(ndf_name, masking_name)].astype(np.float64)
+    scale = np.maximum(np.maximum(np.abs(a), np.abs(b)), np.finfo(np.float64).tiny)
+    rel = np.where((a == 0.0) & (b == 0.0), 0.0, np.abs(a - b) / scale)
+    nonzero = int(np.count_nonzero(a))
+    return _result(f"reciprocity[{ndf_name},{masking_name}]", rel.max(), RECIPROCITY_RTOL,
+                   f"max relative |f(l,v) - f(v,l)| over {RECIPROCITY_SAMPLES} random pairs ({nonzero} nonzero)")
+
+
+def fresnel_eq2_is_exact_dielectric() -> CheckResult:
+    """Gotanda 2014, Eq. 2 (F_dielectric_f0) equals the exact dielectric Fresnel with eta = (1 + s)/(1 - s),
+    s = sqrt(f0), on f0 in [0, 0.95] x cos in [0, 1]."""
+    f0 = np.linspace(0.0, 0.95, 96)[:, None]
+    c = np.linspace(0.0, 1.0, 101)[None, :]
+    s = np.sqrt(f0.astype(np.float32).astype(np.float64))
+    eq2 = evaluate_terms(f0=f0, cos_theta=c)["F_dielectric_f0"].astype(np.float64)
+    exact = evaluate_terms(eta=(1.0 + s) / (1.0 - s), cos_theta=c)["F_dielectric"].astype(np.float64)
+    err = np.abs(eq2 - exact)
+    i, j = np.unravel_index(np.argmax(err), err.shape)
+    return _result("fresnel_eq2_is_exact_dielectric", err.max(), FRESNEL_EQ2_TOL,
+                   f"max |F_dielectric_f0(f0, c) - F_dielectric(eta(f0), c)| on 96 f0 x 101 c; "
+                   f"worst at (f0, c)=({f0[i, 0]:.3g}, {c[0, j]:.3g})")
+
+
+def schlick_endpoints() -> CheckResult:
+    """F_schlick(f0, 1) = f0 and F_schlick(f0, 0) = 1 for f0 in [0, 1]."""
+    f0 = np.linspace(0.0, 1.0, 101)
+    at_normal = evaluate_terms(f0=f0, cos_theta=1.0)["F_schlick"].astype(np.float64)
+    at_grazing = evaluate_terms(f0=f0, cos_theta=0.0)["F_schlick"].astype(np.float64)
+    err_n = np.max(np.abs(at_normal - f0.astype(np.float32)))
+    err_g = np.max(np.abs(at_grazing - 1.0))
+    return _result("schlick_endpoints", max(err_n, err_g), SCHLICK_ENDPOINT_TOL,
+                   f"max |F(f0,1) - f0| = {err_n:.3e}, max |F(f0,0) - 1| = {err_g:.3e} over 101 f0 in [0, 1]")
+
+
+# --- registry ------------------------------------------------------------------------------------------
+
+def _registry() -> dict:
+    checks = {}
+    for n in NDFS:
+        checks[f"ndf_projected_area_is_one[{n}]"] = functools.partial(ndf_projected_area_is_one, n)
+    for n in NDFS:
+        checks[f"weak_white_furnace[{n}]"] = functools.partial(weak_white_furnace, n)
+    for n in NDFS:
+        for m in ALBEDO_MASKINGS:
+            checks[f"albedo_le_one_and_mirror_limit[{n},{m}]"] = functools.partial(albedo_le_one_and_mirror_limit, n, m)
+    for n, m in DFG_MIRROR_PAIRS:
+        checks[f"dfg_mirror_limit[{n},{m}]"] = functools.partial(dfg_mirror_limit, n, m)
+    for n, m in BRDF_PAIRS:
+        checks[f"reciprocity[{n},{m}]"] = functools.partial(reciprocity, n, m)
+    checks["fresnel_eq2_is_exact_dielectric"] = fresnel_eq2_is_exact_dielectric
+    checks["schlick_endpoints"] = schlick_endpoints
+    checks["estimators_agree"] = estimators_agree
+    return checks
+
+
+CHECKS: dict = _registry()
+
+
+def run_all(names=None) -> list[CheckResult]:
+    """Run the named checks (all of ``CHECKS`` by default) in registry order."""
+    names = list(CHECKS) if names is None else list(names)
+    unknown = [n for n in names if n not in CHECKS]
+    if unknown:
+        raise KeyError(f"unknown check(s) {unknown}; valid: {', '.join(CHECKS)}")
+    return [CHECKS[n]() for n in names]

@@ -1,0 +1,237 @@
+"""Evaluate the ``@wp.func`` terms at arrays of host inputs, for checks and tests.
+
+Everything here lives in ONE Warp module (this Python module), compiled once: a kernel that evaluates
+every term at each input record, and a kernel that evaluates the full specular BRDF of every
+(NDF, masking) pair. The terms run exactly as the table kernels run them (float32 in, float32 out);
+what is measured is the Warp code, not a host re-implementation.
+
+Host API (inputs broadcast against each other; ``h``, ``l``, ``v`` carry a trailing axis of 3):
+
+    evaluate_terms(h=..., alpha=..., nov=..., nol=..., voh=..., loh=..., f0=..., eta=..., cos_theta=...)
+        -> {term name: array}, names in ``TERM_NAMES``:
+        D_<ndf>            D(h, alpha)                                  for every NDF in sets.NDFS
+        Lambda_<ndf>       Lambda(nov, alpha)
+        G1_smith_<ndf>     G1_smith(Lambda(nov, alpha))
+        G2[<ndf>,<masking>]  sets.G2_for(ndf, masking)(nov, nol, h.z, voh, alpha)  (the composed G2 tables use)
+        G2_v_cavity        G2_v_cavity(h.z, nov, nol, voh, loh)          (with its own l.h)
+        F_schlick          F_schlick(f0, cos_theta);   Fc_schlick  Fc_schlick(cos_theta)
+        F_dielectric       F_dielectric(eta, cos_theta)
+        F_dielectric_f0    F_dielectric_f0(f0, cos_theta)
+    evaluate_brdfs(l, v, alpha, f0) -> {(ndf, masking): f(l, v)} for every pair in ``BRDF_PAIRS``:
+        f(l, v) = D(h) G2(n.v, n.l, n.h, v.h) F_schlick(f0, v.h) / (4 (n.l)(n.v)),  h = normalize(l + v),
+        v.h = |l + v| / 2 (= l.h), so h and v.h are bitwise the same for f(v, l) and the only asymmetry
+        left to a reciprocity check is the order of G2's and the denominator's arguments
+        (Gotanda 2014 course notes, Eq. 1), 0 where n.l or n.v <= COS_EPS.
+"""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import warp as wp
+
+from ..edge import COS_EPS
+from ..terms import fresnel, masking
+from ..terms.sets import MASKINGS, NDFS, G2_for
+
+wp.set_module_options({"enable_backward": False})
+
+
+@wp.struct
+class TermInputs:
+    """One input record: every term reads the fields it needs (see the module docstring)."""
+    h: wp.vec3
+    alpha: float
+    nov: float
+    nol: float
+    voh: float
+    loh: float
+    f0: float
+    eta: float
+    cos_theta: float
+
+
+# --- one probe per term: a wp.func TermInputs -> float, paired with its output name ---------------
+
+def _ndf_probes(ndf_name: str) -> list:
+    nd = NDFS[ndf_name]
+    D, Lam = nd.D, nd.Lambda
+
+    @wp.func
+    def probe_D(x: TermInputs):
+        return D(x.h, x.alpha)
+
+    @wp.func
+    def probe_Lambda(x: TermInputs):
+        return Lam(x.nov, x.alpha)
+
+    @wp.func
+    def probe_G1(x: TermInputs):
+        return masking.G1_smith(Lam(x.nov, x.alpha))
+
+    return [(f"D_{ndf_name}", probe_D), (f"Lambda_{ndf_name}", probe_Lambda), (f"G1_smith_{ndf_name}", probe_G1)]
+
+
+def _g2_probe(ndf_name: str, masking_name: str) -> tuple:
+    G2 = G2_for(ndf_name, masking_name)
+
+    @wp.func
+    def probe_G2(x: TermInputs):
+        return G2(x.nov, x.nol, x.h[2], x.voh, x.alpha)
+
+    return (f"G2[{ndf_name},{masking_name}]", probe_G2)
+
+
+@wp.func
+def _probe_G2_v_cavity(x: TermInputs):
+    return masking.G2_v_cavity(x.h[2], x.nov, x.nol, x.voh, x.loh)
+
+
+@wp.func
+def _probe_F_schlick(x: TermInputs):
+    return fresnel.F_schlick(x.f0, x.cos_theta)
+
+
+@wp.func
+def _probe_Fc_schlick(x: TermInputs):
+    return fresnel.Fc_schlick(x.cos_theta)
+
+
+@wp.func
+def _probe_F_dielectric(x: TermInputs):
+    return fresnel.F_dielectric(x.eta, x.cos_theta)
+
+
+@wp.func
+def _probe_F_dielectric_f0(x: TermInputs):
+    return fresnel.F_dielectric_f0(x.f0, x.cos_theta)
+
+
+BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS)
+
+_PROBES = (
+    [p for n in NDFS for p in _ndf_probes(n)]
+    + [_g2_probe(n, m) for n, m in BRDF_PAIRS]
+    + [("G2_v_cavity", _probe_G2_v_cavity), ("F_schlick", _probe_F_schlick), ("Fc_schlick", _probe_Fc_schlick),
+       ("F_dielectric", _probe_F_dielectric), ("F_dielectric_f0", _probe_F_dielectric_f0)]
+)
+TERM_NAMES: tuple[str, ...] = tuple(name for name, _ in _PROBES)
+_PROBE_FUNCS = [f for _, f in _PROBES]
+
+
+@wp.kernel
+def _terms_kernel(
+    h: wp.array(dtype=wp.vec3),
+    alpha: wp.array(dtype=float),
+    nov: wp.array(dtype=float),
+    nol: wp.array(dtype=float),
+    voh: wp.array(dtype=float),
+    loh: wp.array(dtype=float),
+    f0: wp.array(dtype=float),
+    eta: wp.array(dtype=float),
+    cos_theta: wp.array(dtype=float),
+    out: wp.array2d(dtype=float),
+):
+    i = wp.tid()
+    x = TermInputs()
+    x.h = h[i]
+    x.alpha = alpha[i]
+    x.nov = nov[i]
+    x.nol = nol[i]
+    x.voh = voh[i]
+    x.loh = loh[i]
+    x.f0 = f0[i]
+    x.eta = eta[i]
+    x.cos_theta = cos_theta[i]
+    for k in range(wp.static(len(_PROBE_FUNCS))):
+        out[i, k] = wp.static(_PROBE_FUNCS[k])(x)
+
+
+# --- full specular BRDFs ------------------------------------------------------------------------
+
+@functools.lru_cache(maxsize=None)
+def brdf_for(ndf_name: str, masking_name: str):
+    """``f(l, v, alpha, f0)``: the Cook-Torrance specular BRDF of one (NDF, masking) pair with Schlick F,
+    assembled from the terms exactly as tables assemble it (module docstring)."""
+    D = NDFS[ndf_name].D
+    G2 = G2_for(ndf_name, masking_name)
+
+    @wp.func
+    def brdf(l: wp.vec3, v: wp.vec3, alpha: float, f0: float):
+        NoL = l[2]
+        NoV = v[2]
+        s = l + v
+        if NoL <= COS_EPS or NoV <= COS_EPS or wp.length_sq(s) <= 0.0:
+            return 0.0
+        h = wp.normalize(s)
+        # v.h = l.h = |l + v| / 2 for unit l, v: bitwise symmetric in (l, v), and free of the float32
+        # cancellation of dot(v, h) when l ~ -v (relative error ~1e-7 / v.h there)
+        VoH = 0.5 * wp.length(s)
+        F = fresnel.F_schlick(f0, VoH)
+        return D(h, alpha) * G2(NoV, NoL, h[2], VoH, alpha) * F / (4.0 * NoL * NoV)
+
+    return brdf
+
+
+_BRDF_FUNCS = [brdf_for(n, m) for n, m in BRDF_PAIRS]
+
+
+@wp.kernel
+def _brdf_kernel(
+    l: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
+    alpha: wp.array(dtype=float),
+    f0: wp.array(dtype=float),
+    out: wp.array2d(dtype=float),
+):
+    i = wp.tid()
+    for k in range(wp.static(len(_BRDF_FUNCS))):
+        out[i, k] = wp.static(_BRDF_FUNCS[k])(l[i], v[i], alpha[i], f0[i])
+
+
+# --- host side ------------------------------------------------------------------------------------
+
+def _vec_and_scalars(vecs: dict, scalars: dict) -> tuple[tuple, dict]:
+    """Broadcast (..., 3) vectors and (...) scalars to one shape; return it and flat float32 arrays."""
+    vecs = {k: np.asarray(a, dtype=np.float32) for k, a in vecs.items()}
+    scalars = {k: np.asarray(a, dtype=np.float32) for k, a in scalars.items()}
+    for k, a in vecs.items():
+        if a.shape[-1:] != (3,):
+            raise ValueError(f"{k} must have a trailing axis of 3, got shape {a.shape}")
+    shape = np.broadcast_shapes(*(a.shape[:-1] for a in vecs.values()), *(a.shape for a in scalars.values()))
+    flat = {k: np.ascontiguousarray(np.broadcast_to(a, shape + (3,)).reshape(-1, 3)) for k, a in vecs.items()}
+    flat.update({k: np.ascontiguousarray(np.broadcast_to(a, shape).reshape(-1)) for k, a in scalars.items()})
+    return shape, flat
+
+
+def evaluate_terms(*, h=(0.0, 0.0, 1.0), alpha=0.5, nov=1.0, nol=1.0, voh=1.0, loh=1.0, f0=0.04, eta=1.5,
+                   cos_theta=1.0, device: str = "cpu") -> dict[str, np.ndarray]:
+    """Every term of ``TERM_NAMES`` at the broadcast inputs (module docstring) -> {name: float32 array}.
+    ``h`` is in the shading frame (n = +z) and is used as given (not normalised); n.h for G2 is h.z."""
+    shape, x = _vec_and_scalars(
+        {"h": h},
+        {"alpha": alpha, "nov": nov, "nol": nol, "voh": voh, "loh": loh, "f0": f0, "eta": eta, "cos_theta": cos_theta},
+    )
+    n = int(np.prod(shape, dtype=np.int64))
+    out = wp.zeros((n, len(TERM_NAMES)), dtype=float, device=device)
+    inputs = [wp.array(x["h"], dtype=wp.vec3, device=device)]
+    inputs += [wp.array(x[k], dtype=float, device=device)
+               for k in ("alpha", "nov", "nol", "voh", "loh", "f0", "eta", "cos_theta")]
+    if n:
+        wp.launch(_terms_kernel, dim=n, inputs=inputs + [out], device=device)
+    res = out.numpy()
+    return {name: res[:, k].reshape(shape) for k, name in enumerate(TERM_NAMES)}
+
+
+def evaluate_brdfs(l, v, alpha, f0=0.04, device: str = "cpu") -> dict[tuple[str, str], np.ndarray]:
+    """f(l, v) of every (NDF, masking) pair in ``BRDF_PAIRS`` -> {(ndf, masking): float32 array}.
+    ``l`` and ``v`` are unit vectors in the shading frame (n = +z)."""
+    shape, x = _vec_and_scalars({"l": l, "v": v}, {"alpha": alpha, "f0": f0})
+    n = int(np.prod(shape, dtype=np.int64))
+    out = wp.zeros((n, len(BRDF_PAIRS)), dtype=float, device=device)
+    inputs = [wp.array(x["l"], dtype=wp.vec3, device=device), wp.array(x["v"], dtype=wp.vec3, device=device),
+              wp.array(x["alpha"], dtype=float, device=device), wp.array(x["f0"], dtype=float, device=device)]
+    if n:
+        wp.launch(_brdf_kernel, dim=n, inputs=inputs + [out], device=device)
+    res = out.numpy()
+    return {pair: res[:, k].reshape(shape) for k, pair in enumerate(BRDF_PAIRS)}
