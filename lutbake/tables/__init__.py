@@ -2,9 +2,10 @@
 from __future__ import annotations
 
 from .base import Kind
+from .albedo import ALBEDO, ALBEDO_AVG
 from .dfg import DFG
 
-KINDS: dict[str, Kind] = {k.name: k for k in (DFG,)}
+KINDS: dict[str, Kind] = {k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG)}
 ALIASES: dict[str, str] = {alias: k.name for k in KINDS.values() for alias in k.aliases}
 
 
