@@ -118,7 +118,12 @@ def list_():
                                          for k in KINDS.values()})
     section("NDFs (ndf = ...)", {k: v.description for k, v in NDFS.items()})
     section("Masking-shadowing (masking = ...)", MASKINGS)
-    section("Fresnel", {"schlick": "f0 + (1 - f0)(1 - v.h)^5: factored out by the dfg layouts"})
+    from .tables.fresnel import FRESNELS
+    from .terms.metals import METALS
+
+    section("Fresnel (specular_3d: fresnel = ...; dfg factors Schlick out)", FRESNELS)
+    section("Metals (specular_3d: metal = ...)", {k: f"n+ik R,G,B = {m.n} + i{m.k}; {m.source}"
+                                                  for k, m in METALS.items()})
     section("DFG layouts (layout = ...)", LAYOUTS)
     section("Estimators (estimator = ...)", ESTIMATORS)
     section("Texel conventions (texel = ...)", TEXELS)

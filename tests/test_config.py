@@ -98,3 +98,23 @@ def test_spec_toml_round_trips(tmp_path):
     (spec,) = load_configs([write(tmp_path, GOOD)])
     again = tomllib.loads(spec.toml())["table"][0]
     assert again["size"] == [16, 8] and again["kind"] == "dfg"
+
+
+def test_every_key_of_every_kind_is_documented():
+    from pathlib import Path
+
+    from lutbake.tables import KINDS
+
+    doc = (Path(__file__).parent.parent / "docs" / "config.md").read_text()
+    for kind in KINDS.values():
+        assert f"## Kind `{kind.name}`" in doc, kind.name
+        for key in kind.keys:
+            assert f"`{key}`" in doc, (kind.name, key)
+
+
+def test_shipped_configs_are_valid():
+    from pathlib import Path
+
+    paths = sorted((Path(__file__).parent.parent / "configs").glob("*.toml"))
+    specs = load_configs(paths)
+    assert {s.kind for s in specs} >= {"dfg", "albedo", "albedo_avg", "specular_3d"}

@@ -5,7 +5,8 @@ normal h (dω_l = 4 (v.h) dω_h, Walter et al. 2007, Eq. 14):
 
     I = ∫ f(l, v) (n.l) dω_l = ∫ g(h) dω_h,        g(h) = f(l(h), v) (n.l) 4 (v.h),   l = reflect(v, h)
 
-``integrand(v, h, alpha) -> vec`` returns g(h) for every channel (0 where n.l <= 0). Sampling h with
+``integrand(v, h, alpha, param) -> vec`` returns g(h) for every channel (0 where n.l <= 0); ``param`` is a
+per-texel scalar the integrand may use (f0 for specular_3d; ignored by the others). Sampling h with
 the NDF's density p(h) = D(h)(n.h) gives I = E[g / p]; for a microfacet BRDF D cancels and the
 per-sample weight is G2 F (v.h) / ((n.v)(n.h)).
 
@@ -92,7 +93,7 @@ def make_gauss_legendre(integrand, pdf, tan2_from_u, u_from_tan2, vec_type, acc_
       du = 2 pi D cos sin dtheta); a panel in region B has its outer variable smoothstep-mapped;
     - the inner variable phi runs over [0, pi] in region A and [0, acos c*] in region B, through a
       sinh map that resolves G2's pole at n.l = -horizon_scale next to the cut.
-    Kernel inputs: per-texel n.v and alpha; GL nodes/weights on [0, 1] for the outer (xu, wu) and
+    Kernel inputs: per-texel n.v, alpha and param; GL nodes/weights on [0, 1] for the outer (xu, wu) and
     inner (xp, wq) variables."""
     nch = vec_type._length_
 
@@ -100,6 +101,7 @@ def make_gauss_legendre(integrand, pdf, tan2_from_u, u_from_tan2, vec_type, acc_
     def gauss_legendre_kernel(
         nov: wp.array(dtype=float),
         alpha: wp.array(dtype=float),
+        param: wp.array(dtype=float),
         xu: wp.array(dtype=wp.float64),
         wu: wp.array(dtype=wp.float64),
         xp: wp.array(dtype=wp.float64),
@@ -108,6 +110,7 @@ def make_gauss_legendre(integrand, pdf, tan2_from_u, u_from_tan2, vec_type, acc_
     ):
         i = wp.tid()
         a = alpha[i]
+        prm = param[i]
         a64 = wp.float64(a)
         v = view_dir(nov[i])
         cos_v = wp.float64(v[2])
@@ -163,7 +166,7 @@ def make_gauss_legendre(integrand, pdf, tan2_from_u, u_from_tan2, vec_type, acc_
                     phi = phimax - eps * wp.sinh(arg)
                     w = wk * wq[j] * eps * wp.cosh(arg) * big_a
                     h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
-                    g = integrand(v, h, a)
+                    g = integrand(v, h, a, prm)
                     if in_u:
                         p = pdf(v, h, a)
                         if p > 0.0:
@@ -188,19 +191,21 @@ def make_qmc(integrand, pdf, sample, vec_type, acc_type):
     def qmc_kernel(
         nov: wp.array(dtype=float),
         alpha: wp.array(dtype=float),
+        param: wp.array(dtype=float),
         pts: wp.array2d(dtype=float),
         wts: wp.array(dtype=wp.float64),
         out: wp.array2d(dtype=wp.float64),
     ):
         i = wp.tid()
         a = alpha[i]
+        prm = param[i]
         v = view_dir(nov[i])
         acc = acc_type()
         for k in range(pts.shape[0]):
             h = sample(v, a, pts[k, 0], pts[k, 1])
             p = pdf(v, h, a)
             if p > 0.0:
-                g = integrand(v, h, a)
+                g = integrand(v, h, a, prm)
                 for c in range(wp.static(nch)):
                     acc[c] = acc[c] + wts[k] * wp.float64(g[c] / p)
         for c in range(wp.static(nch)):

@@ -2,9 +2,11 @@
 from __future__ import annotations
 
 from .base import Kind
+from .albedo import ALBEDO, ALBEDO_AVG
 from .dfg import DFG
+from .specular3d import SPECULAR_3D
 
-KINDS: dict[str, Kind] = {k.name: k for k in (DFG,)}
+KINDS: dict[str, Kind] = {k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D)}
 ALIASES: dict[str, str] = {alias: k.name for k in KINDS.values() for alias in k.aliases}
 
 

@@ -47,7 +47,11 @@ class Plan:
 
     @property
     def shape(self) -> tuple[int, ...]:
-        return tuple(a.count for a in self.axes) + (self.n_channels,)
+        """(z,) y, x, C; a 1D table (one x axis) is one image row: (1, x, C)."""
+        counts = tuple(a.count for a in self.axes)
+        if len(counts) == 1:
+            counts = (1,) + counts
+        return counts + (self.n_channels,)
 
 
 @dataclass(frozen=True)

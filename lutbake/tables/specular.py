@@ -19,47 +19,89 @@ import warp as wp
 from ..edge import COS_EPS
 from ..sampling import points
 from ..sampling.estimators import make_gauss_legendre, make_qmc
-from ..terms import fresnel, sets
+from ..terms import fresnel, metals, sets
 from ..terms.frame import reflect
 
 
 @wp.func
-def channels_scale_bias(VoH: float):
+def channels_scale_bias(VoH: float, f0: float):
     Fc = fresnel.Fc_schlick(VoH)
     return wp.vec2(1.0 - Fc, Fc)
 
 
 @wp.func
-def channels_multiscatter(VoH: float):
+def channels_multiscatter(VoH: float, f0: float):
     return wp.vec2(fresnel.Fc_schlick(VoH), 1.0)
 
 
 @wp.func
-def channels_albedo(VoH: float):
+def channels_albedo(VoH: float, f0: float):
     return wp.vec2(1.0, 0.0)
 
 
+# specular_3d: R = F(f0, v.h) for the texel's f0 (the kernel's per-texel param); G unused (0)
+@wp.func
+def channels_F_schlick(VoH: float, f0: float):
+    return wp.vec2(fresnel.F_schlick(f0, VoH), 0.0)
+
+
+@wp.func
+def channels_F_schlick_sg(VoH: float, f0: float):
+    return wp.vec2(fresnel.F_schlick_sg(f0, VoH), 0.0)
+
+
+@wp.func
+def channels_F_improved_sg(VoH: float, f0: float):
+    return wp.vec2(fresnel.F_improved_sg(f0, VoH), 0.0)
+
+
+@wp.func
+def channels_F_dielectric_f0(VoH: float, f0: float):
+    return wp.vec2(fresnel.F_dielectric_f0(f0, VoH), 0.0)
+
+
 CHANNEL_FUNCS = {"scale_bias": channels_scale_bias, "multiscatter": channels_multiscatter,
-                 "albedo": channels_albedo}
+                 "albedo": channels_albedo, "F:schlick": channels_F_schlick, "F:schlick_sg": channels_F_schlick_sg,
+                 "F:improved_sg": channels_F_improved_sg, "F:dielectric_f0": channels_F_dielectric_f0}
+
+
+@functools.lru_cache(maxsize=None)
+def channels_for(channels_name: str):
+    """(channel wp.func (VoH, param) -> vec, vec type): a name of CHANNEL_FUNCS, or "metal:<name>"
+    for RGB = F_conductor(n_c, k_c, v.h) of a metal of lutbake.terms.metals (constants closed over)."""
+    if channels_name in CHANNEL_FUNCS:
+        return CHANNEL_FUNCS[channels_name], wp.vec2
+    if channels_name.startswith("metal:"):
+        m = metals.lookup_metal(channels_name[len("metal:"):])
+        nr, ng, nb = (float(x) for x in m.n)
+        kr, kg, kb = (float(x) for x in m.k)
+
+        @wp.func
+        def channels_metal(VoH: float, f0: float):
+            return wp.vec3(fresnel.F_conductor(nr, kr, VoH), fresnel.F_conductor(ng, kg, VoH),
+                           fresnel.F_conductor(nb, kb, VoH))
+
+        return channels_metal, wp.vec3
+    raise KeyError(channels_name)
 
 
 @functools.lru_cache(maxsize=None)
 def integrand_for(ndf_name: str, masking_name: str, channels_name: str):
-    """g(h) = D G2 (v.h)/(n.v) * channels(v.h), 0 where n.l or v.h <= COS_EPS (back-facing)."""
+    """g(h) = D G2 (v.h)/(n.v) * channels(v.h, param), 0 where n.l or v.h <= COS_EPS (back-facing)."""
     D = sets.NDFS[ndf_name].D
     G2 = sets.G2_for(ndf_name, masking_name)
-    ch = CHANNEL_FUNCS[channels_name]
+    ch, vec = channels_for(channels_name)
 
     @wp.func
-    def integrand(v: wp.vec3, h: wp.vec3, alpha: float):
+    def integrand(v: wp.vec3, h: wp.vec3, alpha: float, param: float):
         l = reflect(v, h)
         NoL = l[2]
         NoV = v[2]
         VoH = wp.dot(v, h)
         if NoL <= COS_EPS or VoH <= COS_EPS or NoV <= COS_EPS:
-            return wp.vec2(0.0, 0.0)
+            return vec()
         NoH = h[2]
-        return ch(VoH) * (D(h, alpha) * G2(NoV, NoL, NoH, VoH, alpha) * VoH / NoV)
+        return ch(VoH, param) * (D(h, alpha) * G2(NoV, NoL, NoH, VoH, alpha) * VoH / NoV)
 
     return integrand
 
@@ -79,7 +121,8 @@ def kernel_for(ndf_name: str, masking_name: str, channels_name: str, estimator: 
     """The table kernel for a (terms, channels, estimator) key; compiled once per Warp cache."""
     nd = sets.NDFS[ndf_name]
     g = integrand_for(ndf_name, masking_name, channels_name)
-    vec, acc = wp.vec2, wp.vec2d
+    vec = channels_for(channels_name)[1]
+    acc = wp.vec3d if vec is wp.vec3 else wp.vec2d
     if estimator == "gauss_legendre":
         return make_gauss_legendre(g, sets.pdf_ndf_for(ndf_name), nd.tan2_from_u, nd.u_from_tan2, vec, acc)
     if estimator == "sobol_vndf":
@@ -117,12 +160,16 @@ def point_arrays(estimator: str, samples: int, seed: int, device: str) -> list:
 
 
 def integrate(kernel, nov: np.ndarray, alpha: np.ndarray, estimator: str, samples: int, seed: int,
-              nch: int, device: str = "cpu") -> np.ndarray:
-    """Run one launch over texels (nov[i], alpha[i]) -> float64 array (len, nch)."""
+              nch: int, device: str = "cpu", param: np.ndarray | None = None) -> np.ndarray:
+    """Run one launch over texels (nov[i], alpha[i], param[i]) -> float64 array (len, nch);
+    ``param`` (the integrand's per-texel scalar, e.g. f0) defaults to 0."""
     n = len(nov)
     out = wp.zeros((n, nch), dtype=wp.float64, device=device)
+    if param is None:
+        param = np.zeros(n, dtype=np.float32)
     inputs = [wp.array(np.ascontiguousarray(nov, dtype=np.float32), dtype=float, device=device),
-              wp.array(np.ascontiguousarray(alpha, dtype=np.float32), dtype=float, device=device)]
+              wp.array(np.ascontiguousarray(alpha, dtype=np.float32), dtype=float, device=device),
+              wp.array(np.ascontiguousarray(param, dtype=np.float32), dtype=float, device=device)]
     inputs += point_arrays(estimator, samples, seed, device)
     wp.launch(kernel, dim=n, inputs=inputs + [out], device=device)
     return out.numpy()
