@@ -42,22 +42,11 @@ AVG_RECONSTRUCTION = "E_avg = texture(albedo_avg, vec2(roughness, 0.5)).r (one r
 def plan_albedo(spec) -> Plan:
     o = spec.options
     axes = dfg.axes_for(o)
-    rough, nov_axis = axes
-    est = o["estimator"]
-    samples = o["samples"] or specular.DEFAULT_SAMPLES[est]
-    key = (o["ndf"], o["masking"], "albedo", est)
-    nov = np.tile(nov_axis.values(), rough.count)
-    alpha = np.repeat(rough.alpha(), nov_axis.count)
-
-    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
-        k = specular.kernel_for(*key)
-        return specular.integrate(k, nov[start:stop], alpha[start:stop], est, samples, o["seed"], 2, device)[:, :1]
-
-    eff = specular.effective_samples(est, samples)
-    return Plan(axes=axes, channels=ALBEDO_CHANNELS, reconstruction=ALBEDO_RECONSTRUCTION, n_texels=len(nov),
-                n_channels=1, run_tile=run_tile, prepare=lambda d: specular.load(specular.kernel_for(*key), d),
-                samples=eff, estimator=est, terms={"ndf": o["ndf"], "masking": o["masking"], "fresnel": "none (F = 1)"},
-                cost=float(len(nov)) * eff)
+    nov, alpha = dfg.texel_grid(axes)
+    return specular.hemisphere_plan(
+        key=(o["ndf"], o["masking"], "albedo", o["estimator"]), nov=nov, alpha=alpha, param=None,
+        samples=o["samples"], seed=o["seed"], nch=1, axes=axes, channels=ALBEDO_CHANNELS,
+        reconstruction=ALBEDO_RECONSTRUCTION, terms={"ndf": o["ndf"], "masking": o["masking"], "fresnel": "none (F = 1)"})
 
 
 def avg_roughness_axis(o: dict) -> Axis:

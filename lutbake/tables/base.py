@@ -44,6 +44,8 @@ class Plan:
     terms: dict[str, str]
     cost: float  # integrand evaluations in total, for the progress bar
     extra: dict[str, str] = field(default_factory=dict)
+    # (flat float64 data (n_texels, n_channels), device) -> (estimated max abs error, how it was estimated)
+    error_estimate: Callable[[np.ndarray, str], tuple[float, str]] | None = None
 
     @property
     def shape(self) -> tuple[int, ...]:

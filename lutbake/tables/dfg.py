@@ -72,38 +72,21 @@ def axes_for(o: dict) -> list[Axis]:
             Axis("NoV", "x", n_nov, *o["nov_range"], texel=o["texel"])]
 
 
+def texel_grid(axes: list[Axis]) -> tuple[np.ndarray, np.ndarray]:
+    """Per-texel (NoV, alpha) of a [roughness (y), NoV (x)] grid, row-major: texel t = iy * nx + ix."""
+    rough, nov_axis = axes
+    return np.tile(nov_axis.values(), rough.count), np.repeat(rough.alpha(), nov_axis.count)
+
+
 def plan(spec) -> Plan:
     o = spec.options
     axes = axes_for(o)
-    rough, nov_axis = axes
-    est = o["estimator"]
-    samples = o["samples"] or specular.DEFAULT_SAMPLES[est]
-    key = (o["ndf"], o["masking"], o["layout"], est)
-    # texel t = iy * nx + ix: y (roughness) slowest
-    nov = np.tile(nov_axis.values(), rough.count)
-    alpha = np.repeat(rough.alpha(), nov_axis.count)
-
-    def prepare(device: str) -> None:
-        specular.load(specular.kernel_for(*key), device)
-
-    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
-        k = specular.kernel_for(*key)
-        return specular.integrate(k, nov[start:stop], alpha[start:stop], est, samples, o["seed"], 2, device)
-
-    eff = specular.effective_samples(est, samples)
-    return Plan(
-        axes=axes,
-        channels=CHANNELS[o["layout"]],
+    nov, alpha = texel_grid(axes)
+    return specular.hemisphere_plan(
+        key=(o["ndf"], o["masking"], o["layout"], o["estimator"]), nov=nov, alpha=alpha, param=None,
+        samples=o["samples"], seed=o["seed"], nch=2, axes=axes, channels=CHANNELS[o["layout"]],
         reconstruction=RECONSTRUCTION[o["layout"]],
-        n_texels=len(nov),
-        n_channels=2,
-        run_tile=run_tile,
-        prepare=prepare,
-        samples=eff,
-        estimator=est,
-        terms={"ndf": o["ndf"], "masking": o["masking"], "fresnel": "schlick", "layout": o["layout"]},
-        cost=float(len(nov)) * eff,
-    )
+        terms={"ndf": o["ndf"], "masking": o["masking"], "fresnel": "schlick", "layout": o["layout"]})
 
 
 DFG = Kind("dfg", "split-sum specular DFG: NoV x roughness, scale/bias or multiscatter (Σ Fc·V, Σ V) channels",

@@ -21,6 +21,7 @@ from ..sampling import points
 from ..sampling.estimators import make_gauss_legendre, make_qmc
 from ..terms import fresnel, metals, sets
 from ..terms.frame import reflect
+from .base import Plan
 
 
 @wp.func
@@ -178,3 +179,49 @@ def integrate(kernel, nov: np.ndarray, alpha: np.ndarray, estimator: str, sample
 def load(kernel, device: str = "cpu") -> None:
     """Compile (or load from Warp's cache) a kernel's module before worker threads launch it."""
     wp.load_module(kernel.module, device=device)
+
+
+ERROR_PROBE_TEXELS = 256  # texels re-integrated at a higher budget for lutbake:error_estimate
+
+
+def probe_indices(nov: np.ndarray) -> np.ndarray:
+    """A strided subset of texels plus the most grazing ones (where every estimator converges slowest)."""
+    n = len(nov)
+    strided = np.arange(0, n, max(1, n // ERROR_PROBE_TEXELS))
+    grazing = np.flatnonzero(nov <= nov.min())
+    return np.unique(np.concatenate([strided, grazing[:: max(1, len(grazing) // 64)]]))
+
+
+def hemisphere_plan(*, key: tuple, nov: np.ndarray, alpha: np.ndarray, param: np.ndarray | None, samples: int | None,
+                    seed: int, nch: int, kernel_channels: int = 2, **plan_fields) -> Plan:
+    """The plan of every table that is a per-texel integral of ``kernel_for(*key)``: texel i integrates
+    (nov[i], alpha[i], param[i]); the first ``nch`` of the kernel's channels are kept.
+
+    Its error estimate re-integrates probe_indices() at a higher budget: Gauss-Legendre at order n + 4
+    (the difference bounds the error of order n, the higher rule being far more accurate), QMC with
+    another scrambling seed (the difference is ~sqrt(2) times the error)."""
+    est = key[-1]
+    samples = samples or DEFAULT_SAMPLES[est]
+    param = np.zeros(len(nov), np.float32) if param is None else param
+
+    def run(idx, budget, s, device):
+        k = kernel_for(*key)
+        return integrate(k, nov[idx], alpha[idx], est, budget, s, kernel_channels, device, param[idx])[:, :nch]
+
+    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
+        return run(slice(start, stop), samples, seed, device)
+
+    def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
+        idx = probe_indices(nov)
+        if est == "gauss_legendre":
+            n = gl_order(samples)
+            other, how = run(idx, 3 * (n + 4) ** 2, seed, device), f"max |order {n} - order {n + 4}|"
+        else:
+            other, how = run(idx, samples, seed + 1, device), "max |seed - (seed + 1)| (two scramblings)"
+        err = float(np.max(np.abs(data.reshape(len(nov), nch)[idx] - other)))
+        return err, f"{how} over {len(idx)} probe texels (strided + most grazing NoV)"
+
+    eff = effective_samples(est, samples)
+    return Plan(n_texels=len(nov), n_channels=nch, run_tile=run_tile,
+                prepare=lambda d: load(kernel_for(*key), d), samples=eff, estimator=est,
+                cost=float(len(nov)) * eff, error_estimate=error_estimate, **plan_fields)

@@ -56,21 +56,11 @@ def plan(spec) -> Plan:
     channels_name = f"metal:{metal}" if metal else f"F:{o['fresnel']}"
     key = (o["ndf"], o["masking"], channels_name, est)
     rough, nov_axis = axes[-2:]
-    ny, nx = rough.count, nov_axis.count
     nz = 1 if metal else axes[0].count
     # texel t = (iz * ny + iy) * nx + ix: z (f0) slowest, then roughness, then NoV
-    nov = np.tile(nov_axis.values(), ny * nz)
-    alpha = np.tile(np.repeat(rough.alpha(), nx), nz)
-    f0 = np.zeros(len(nov), np.float32) if metal else np.repeat(axes[0].values(), ny * nx)
+    nov, alpha = (np.tile(x, nz) for x in dfg.texel_grid([rough, nov_axis]))
+    f0 = None if metal else np.repeat(axes[0].values(), rough.count * nov_axis.count)
     nch = 3 if metal else 1
-
-    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
-        k = specular.kernel_for(*key)
-        out = specular.integrate(k, nov[start:stop], alpha[start:stop], est, samples, o["seed"], nch if metal else 2,
-                                 device, param=f0[start:stop])
-        return out[:, :nch]
-
-    eff = specular.effective_samples(est, samples)
     if metal:
         m = METALS[metal]
         channels = {f"e_{c}": f"E with F_conductor({n} + {k}i) at {w:g} nm" for c, n, k, w in
@@ -81,10 +71,10 @@ def plan(spec) -> Plan:
         channels = {"e": f"E = ∫ f (n.l) dω_l with F = {o['fresnel']}(f0 of the slice, v.h)"}
         terms = {"ndf": o["ndf"], "masking": o["masking"], "fresnel": o["fresnel"]}
         extra = {}
-    return Plan(axes=axes, channels=channels, reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D,
-                n_texels=len(nov), n_channels=nch, run_tile=run_tile,
-                prepare=lambda d: specular.load(specular.kernel_for(*key), d), samples=eff, estimator=est,
-                terms=terms, cost=float(len(nov)) * eff, extra=extra)
+    return specular.hemisphere_plan(
+        key=key, nov=nov, alpha=alpha, param=f0, samples=o["samples"], seed=o["seed"], nch=nch,
+        kernel_channels=nch if metal else 2, axes=axes, channels=channels,
+        reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D, terms=terms, extra=extra)
 
 
 def check_spec(spec) -> str | None:
