@@ -186,7 +186,9 @@ def run(jobs: list[Job], workers: int | None = None, device: str = "cpu", progre
         on_done: Callable[[Job], None] | None = None, poll: float = 0.2) -> int | None:
     """Bake every ``pending`` job; ``on_done(job)`` is called in the calling thread as each finishes.
 
-    Tables run on min(workers, pending) threads, each with workers // threads tile workers.
+    Tables run on min(workers, pending) threads, each on the tile executor with ``workers`` tile threads:
+    a big table keeps every core busy after the small ones are done (the OS shares the cores while
+    several tables run; the result is bit-identical either way).
     Returns None, or the signal number if the run was interrupted (the unfinished jobs are then marked
     ``interrupted``; finished files are kept).
     """
@@ -197,7 +199,7 @@ def run(jobs: list[Job], workers: int | None = None, device: str = "cpu", progre
     if not pending:
         return None
     threads = max(1, min(workers, len(pending)))
-    per_table = max(1, workers // threads)
+    per_table = workers
     if threads > 1 and progress is None:
         progress = False  # several bars at once would interleave
     cancel = threading.Event()

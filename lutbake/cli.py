@@ -92,6 +92,9 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     except ConfigError as e:
         click.echo(f"error: {e}", err=True)
         sys.exit(EXIT_CONFIG)
+    except KeyboardInterrupt:
+        click.echo("interrupted (SIGINT) while planning: nothing was baked or written", err=True)
+        sys.exit(batch.EXIT_SIGINT)
 
     def on_done(job):
         if job.status == "baked":
