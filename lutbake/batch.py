@@ -204,10 +204,12 @@ def run(jobs: list[Job], workers: int | None = None, device: str = "cpu", progre
         progress = False  # several bars at once would interleave
     cancel = threading.Event()
     pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="lutbake-table")
-    futures = {pool.submit(_bake_one, j, per_table, device, progress, cancel): j for j in pending}
+    futures: dict = {}
     signum = None
     reported: set = set()
     try:
+        for j in pending:
+            futures[pool.submit(_bake_one, j, per_table, device, progress, cancel)] = j
         remaining = set(futures)
         while remaining:
             done, remaining = wait(remaining, timeout=poll, return_when=FIRST_COMPLETED)
@@ -223,9 +225,10 @@ def run(jobs: list[Job], workers: int | None = None, device: str = "cpu", progre
     finally:
         pool.shutdown(wait=True)  # running tables stop at their next tile (or finish writing)
     if signum is not None:
-        for f, j in futures.items():
+        for j in pending:
             if j.status == "pending":  # cancelled before it started
                 j.status, j.message = "interrupted", "not started; nothing written"
+        for f, j in futures.items():
             if f not in reported and on_done:
                 on_done(j)
     return signum
