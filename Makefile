@@ -9,8 +9,10 @@ OUT    ?= outputs
 CONFIGS := $(wildcard configs/*.toml)
 SOURCES := $(shell find lutbake -name '*.py' -o -name '*.toml' 2>/dev/null)
 WORKERS ?=
+FORCE   ?=
+LUTS_STAMP := $(OUT)/.luts.stamp
 
-.PHONY: luts test validate bench clean venv help
+.PHONY: luts test validate bench clean venv help force-luts
 
 help:
 	@echo "make luts | test | validate | clean"
@@ -23,8 +25,17 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install -q -e '.[test,plot]'
 	touch $(STAMP)
 
-luts: $(STAMP)
-	$(BIN)/lutbake bake $(CONFIGS) --out-dir $(OUT) $(if $(WORKERS),--workers $(WORKERS))
+# `make luts` re-runs lutbake only when a config, a lutbake source or this Makefile changed; lutbake then
+# rebakes only the tables whose content hash changed (the others print "skipped ... (up to date)").
+# `make luts FORCE=1` rebakes every table.
+luts: $(LUTS_STAMP)
+
+$(LUTS_STAMP): $(STAMP) $(CONFIGS) $(SOURCES) Makefile $(if $(FORCE),force-luts)
+	$(BIN)/lutbake bake $(CONFIGS) --out-dir $(OUT) --report $(OUT)/report.json \
+		$(if $(WORKERS),--workers $(WORKERS)) $(if $(FORCE),--force)
+	touch $@
+
+force-luts:
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

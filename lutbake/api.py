@@ -30,11 +30,15 @@ def _warp_version() -> str:
     return wp.config.version
 
 
-def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: bool | None = None) -> tuple[Table, float, int]:
-    """Bake one spec into a Table (nothing written). Raises TableError if a value is not finite."""
+def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: bool | None = None,
+               cancel=None) -> tuple[Table, float, int]:
+    """Bake one spec into a Table (nothing written). Raises TableError if a value is not finite;
+    executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
+    from .batch import content_hash
+
     plan = lookup_kind(spec.kind).plan(spec)
     with Timer() as t:
-        data = execute(plan, workers=workers, device=device, progress=progress, label=spec.name)
+        data = execute(plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel)
     if not np.all(np.isfinite(data)):
         bad = int(np.size(data) - np.count_nonzero(np.isfinite(data)))
         raise TableError(f"{spec.source}: table '{spec.name}': {bad} non-finite values; nothing written")
@@ -48,6 +52,7 @@ def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu",
         "version": __version__,
         "warp_version": _warp_version(),
         **plan.extra,
+        "content_hash": content_hash(spec),  # what makes the file current (lutbake.batch)
     }
     table = Table(spec.name, spec.kind, data.astype(np.float32), plan.axes, plan.channels, plan.reconstruction,
                   attributes)

@@ -48,21 +48,30 @@ def main():
 @click.option("--device", type=click.Choice(["cpu", "cuda"]), default="cpu", show_default=True,
               help="Warp device the kernels run on.")
 @click.option("--progress/--no-progress", default=None, help="Progress bar (default: on a terminal, for long bakes).")
-def bake(configs, presets, out_dir, overrides, workers, device, progress):
+@click.option("--force", is_flag=True, help="Rebake every table, even those whose output is up to date.")
+@click.option("--report", type=click.Path(path_type=Path, dir_okay=False), default=None, metavar="FILE.json",
+              help="Write a JSON summary: per table status, path, content hash, seconds, samples, error estimate.")
+def bake(configs, presets, out_dir, overrides, workers, device, progress, force, report):
     """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.exr.
 
     All configs are validated before any kernel runs; a bad config exits with status 2 and writes
-    nothing. Each table prints one line: path, shape, seconds, samples per texel. A table that fails
-    does not stop the others; the exit status is then 1. Outputs are replaced atomically.
+    nothing. A table whose output exists with the same content hash (its config, the lutbake version
+    and the kernels' source) is skipped ("skipped PATH (up to date)"); --force rebakes it. Tables bake
+    in parallel; each prints one line: path, shape, seconds, samples per texel. A table that fails
+    does not stop the others; the exit status is then 1. Outputs are replaced atomically: Ctrl-C
+    (exit 130) or SIGTERM (exit 143) keeps finished tables, writes no unfinished one, and lists the
+    tables that did not finish; the next run bakes only those.
 
     \b
     Examples:
       lutbake bake configs/dfg.toml
-      lutbake bake configs/dfg.toml --set size=[64,64] --set layout=multiscatter
+      lutbake bake configs/*.toml --report outputs/report.json
+      lutbake bake configs/dfg.toml --force --set size=[64,64] --set layout=multiscatter
       lutbake bake configs/dfg.toml --set dfg.estimator=sobol_vndf --set dfg.samples=4096
     """
+    from . import batch
     from .config import load_configs, preset_path
-    from .errors import ConfigError, LutbakeError
+    from .errors import ConfigError
 
     _quiet_warp()
     try:
@@ -70,32 +79,53 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress):
         if not paths:
             raise ConfigError("<command line>", None, message="give at least one CONFIG or --preset")
         specs = load_configs(paths, overrides)
+        if out_dir.exists() and not out_dir.is_dir():
+            raise ConfigError("--out-dir", "out-dir", str(out_dir), message="exists and is not a directory")
+        if report is not None and report.is_dir():
+            raise ConfigError("--report", "report", str(report), message="is a directory")
         if device == "cuda":
             import warp as wp
 
             if not wp.is_cuda_available():
                 raise ConfigError("--device", "device", "cuda", "cpu", "no CUDA device is available")
+        jobs = batch.plan(specs, out_dir, force=force)
     except ConfigError as e:
         click.echo(f"error: {e}", err=True)
         sys.exit(EXIT_CONFIG)
+    except KeyboardInterrupt:
+        click.echo("interrupted (SIGINT) while planning: nothing was baked or written", err=True)
+        sys.exit(batch.EXIT_SIGINT)
 
-    from .api import bake_table
-    from .io.exr import write_exr
+    def on_done(job):
+        if job.status == "baked":
+            click.echo(f"{job.path}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel")
+        elif job.status == "failed":
+            click.echo(f"FAILED {job.name}: {job.message}", err=True)
 
-    failed = []
-    for spec in specs:
-        try:
-            table, seconds, samples = bake_table(spec, workers, device, progress)
-            path = write_exr(table, out_dir / f"{spec.name}.exr", dtype=spec.options["dtype"])
-        except (LutbakeError, ValueError, OSError) as e:
-            failed.append(spec.name)
-            click.echo(f"FAILED {spec.name}: {e}", err=True)
-            continue
-        shape = "x".join(str(a.count) for a in table.axes) + f"x{len(table.channels)}"
-        click.echo(f"{path}  {shape}  {seconds:.2f} s  {samples} samples/texel")
+    for job in jobs:
+        if job.status == "skipped":
+            click.echo(f"skipped {job.path} (up to date)")
+    signum = None
+    try:
+        with batch.signal_handlers():
+            signum = batch.run(jobs, workers, device, progress, on_done=on_done)
+    except (KeyboardInterrupt, batch.Interrupted) as e:  # a second Ctrl-C while tables wind down
+        signum = getattr(e, "signum", 2)
+        for job in jobs:
+            if job.status == "pending":
+                job.status, job.message = "interrupted", "interrupted; nothing written"
+    status = batch.exit_status(jobs, signum)
+    if report is not None:
+        batch.write_report(report, jobs, status, signum)
+    failed = [j.name for j in jobs if j.status == "failed"]
+    unfinished = [j.name for j in jobs if j.status in ("interrupted", "pending")]
     if failed:
-        click.echo(f"{len(failed)} of {len(specs)} tables failed: {', '.join(failed)}", err=True)
-        sys.exit(1)
+        click.echo(f"{len(failed)} of {len(jobs)} tables failed: {', '.join(failed)}", err=True)
+    if signum is not None:
+        click.echo(f"interrupted ({batch.signal_name(signum)}): {len(unfinished)} of {len(jobs)} tables did not "
+                   f"finish: {', '.join(unfinished) or '-'}; run the same command again to bake only those",
+                   err=True)
+    sys.exit(status)
 
 
 @main.command("list")

@@ -20,6 +20,18 @@ from .tables.base import Key
 
 NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,128}$")
 MAX_TEXELS = 1 << 26  # 64 Mi texels; float64 accumulation of 4 channels = 2 GiB
+BYTES_PER_TEXEL = 32  # float64 x 4 channels while baking
+
+
+def human_bytes(n: int) -> str:
+    """1536 -> '1.5 KiB'; exact integer arithmetic, so any size (even 10**400 bytes) prints."""
+    units = ("B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB")
+    k = 0
+    while n >= 1024 ** (k + 1) and k < len(units) - 1:
+        k += 1
+    if k == len(units) - 1 and n >= 1024 ** (k + 1):
+        return f"~2^{n.bit_length() - 1} B"
+    return f"{n / 1024 ** k:.1f} {units[k]}" if k else f"{n} B"
 PRESET_DIR = Path(__file__).parent / "presets"
 
 
@@ -60,6 +72,10 @@ def preset_path(name: str) -> Path:
     return ps[name]
 
 
+def _num(x) -> str:
+    return str(x) if isinstance(x, int) else f"{x:g}"
+
+
 def _check_value(key: Key, value, file, table) -> Any:
     def fail(msg, allowed=None):
         raise ConfigError(file, key.name, value, allowed, msg, table)
@@ -76,9 +92,9 @@ def _check_value(key: Key, value, file, table) -> Any:
         if isinstance(value, bool) or not isinstance(value, int):
             fail("must be an integer")
         if key.minimum is not None and value < key.minimum:
-            fail(f"must be >= {key.minimum:g}")
+            fail(f"must be >= {_num(key.minimum)}")
         if key.maximum is not None and value > key.maximum:
-            fail(f"must be <= {key.maximum:g}")
+            fail(f"must be <= {_num(key.maximum)}")
         return value
     if key.type == "int_pair":
         if not isinstance(value, list) or len(value) != 2 or any(isinstance(x, bool) or not isinstance(x, int) for x in value):
@@ -128,12 +144,17 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
     spec = TableSpec(options["name"], kind.name, MappingProxyType(options), str(file), index)
     texels = math.prod(options.get("size", [1]))
     if texels > MAX_TEXELS:
-        raise ConfigError(file, "size", options["size"], f"at most {MAX_TEXELS} texels",
-                          f"{texels} texels would need {texels * 32 / 2**30:.1f} GiB while baking", label)
+        raise ConfigError(file, "size", options["size"],
+                          f"at most {MAX_TEXELS} texels = {human_bytes(MAX_TEXELS * BYTES_PER_TEXEL)}",
+                          f"{texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} of memory while "
+                          "baking", label)
     if kind.check is not None:
         msg = kind.check(spec)
         if msg:
-            raise ConfigError(file, None, message=msg, table=label)
+            key = None
+            if isinstance(msg, tuple):  # (key, message)
+                key, msg = msg
+            raise ConfigError(file, key, options.get(key) if key else None, message=msg, table=label)
     return spec
 
 
@@ -160,8 +181,10 @@ def load_config(path, overrides=()) -> list[TableSpec]:
         raise ConfigError(path, None, message="no such config file")
     try:
         doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError, ValueError) as e:
         raise ConfigError(path, None, message=f"invalid TOML: {e}") from None
+    except OSError as e:
+        raise ConfigError(path, None, message=f"cannot read: {e.strerror or e}") from None
     extra = sorted(set(doc) - {"table"})
     if extra:
         raise ConfigError(path, extra[0], doc[extra[0]], "table", "is not a top-level key")

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import sys
+import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
 
@@ -17,6 +18,11 @@ from .tables.base import Plan
 
 TILE_TEXELS = 512
 PROGRESS_MIN_EVALS = 2.0e7  # about a second of work on one core: show a bar above it
+_PREPARE_LOCK = threading.Lock()  # kernels compile/load one at a time when tables bake in parallel
+
+
+class Cancelled(Exception):
+    """Raised inside execute() when its ``cancel`` event is set: the remaining tiles are not run."""
 
 
 def default_workers() -> int:
@@ -28,12 +34,15 @@ def tiles(n: int, size: int = TILE_TEXELS) -> list[tuple[int, int]]:
 
 
 def execute(plan: Plan, workers: int | None = None, device: str = "cpu", progress: bool | None = None,
-            label: str = "") -> np.ndarray:
-    """Evaluate every tile of ``plan``; returns float64 data of shape plan.shape."""
+            label: str = "", cancel: threading.Event | None = None) -> np.ndarray:
+    """Evaluate every tile of ``plan``; returns float64 data of shape plan.shape.
+
+    ``cancel``: when set (by another thread), no further tile starts and Cancelled is raised."""
     import click
 
     workers = workers or default_workers()
-    plan.prepare(device)
+    with _PREPARE_LOCK:
+        plan.prepare(device)
     parts = tiles(plan.n_texels)
     out = np.empty((plan.n_texels, plan.n_channels), dtype=np.float64)
     if progress is None:
@@ -41,6 +50,8 @@ def execute(plan: Plan, workers: int | None = None, device: str = "cpu", progres
 
     def work(bounds):
         s, e = bounds
+        if cancel is not None and cancel.is_set():
+            raise Cancelled(label)
         out[s:e] = plan.run_tile(s, e, device)
         return e - s
 

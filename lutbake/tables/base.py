@@ -63,4 +63,4 @@ class Kind:
     keys: dict[str, Key]
     plan: Callable[[Any], Plan]
     aliases: tuple[str, ...] = ()
-    check: Callable[[Any], str | None] | None = None  # cross-key rules, at config load
+    check: Callable[[Any], str | tuple[str, str] | None] | None = None  # cross-key rules: message or (key, message)

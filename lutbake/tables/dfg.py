@@ -16,6 +16,9 @@ from ..terms.sets import MASKINGS, NDFS
 from . import specular
 from .base import Key, Kind, Plan
 
+MAX_SAMPLES = 1 << 24  # per texel; beyond this a point set alone needs > 128 MiB and a table takes days
+MAX_SEED = (1 << 64) - 1
+
 LAYOUTS = {
     "scale_bias": "R = scale, G = bias: E = f0 * R + G (Karis 2013)",
     "multiscatter": "R = ∫Fc·f, G = ∫f: E = mix(R, G, f0), E(F=1) = G (Filament)",
@@ -37,10 +40,11 @@ COMMON_KEYS = {
     "name": Key("name", "name", None, "output stem: <out-dir>/<name>.exr; letters, digits, - and _ only", required=True),
     "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
     "samples": Key("samples", "int", None, "integrand evaluations per texel; omitted: the estimator's default "
-                   "quality", minimum=1),
+                   "quality", minimum=1, maximum=MAX_SAMPLES),
     "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}),
     "estimator": Key("estimator", "str", "gauss_legendre", "how the integral is estimated", specular.ESTIMATORS),
-    "seed": Key("seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0),
+    "seed": Key("seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0,
+                maximum=MAX_SEED),
 }
 
 KEYS = {
@@ -57,11 +61,12 @@ KEYS = {
 }
 
 
-def check_spec(spec) -> str | None:
-    """Cross-key rules, checked at config load; returns a message or None."""
+def check_spec(spec) -> tuple[str, str] | None:
+    """Cross-key rules, checked at config load; returns (key, message) or None."""
     o = spec.options
     if o["estimator"] == "sobol_vndf" and NDFS[o["ndf"]].vndf is None:
-        return f"estimator 'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not {o['ndf']!r}"
+        return ("estimator", f"'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), "
+                             f"not ndf = {o['ndf']!r}")
     return None
 
 

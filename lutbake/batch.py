@@ -1,0 +1,287 @@
+"""Batch runs that never lose work: content hashes, planning, parallel tables, interrupts, reports.
+
+- **Content hash.** Every output records ``lutbake:content_hash`` = sha256 of the table's canonical
+  TOML (``TableSpec.toml()``), the lutbake version and the source text of the modules that define
+  the kernels and terms (``HASH_SOURCES``). A table whose output exists with the same hash is
+  *skipped*; anything else (no file, unreadable file, other hash) is baked again.
+- **Plan first.** ``plan()`` takes already-validated specs (``config.load_configs`` validates every
+  config before anything runs) and decides, per table, its output path, its hash and whether it is
+  up to date. Nothing is baked while planning.
+- **Run.** ``run()`` bakes the pending tables on a small thread pool (tables in parallel, each on the
+  tile executor; the result is bit-identical for any worker count). One failing table (a NaN, an
+  exception in a kernel, a MemoryError) is marked ``failed`` and does not stop the others.
+- **Interrupts.** A KeyboardInterrupt (SIGINT) or ``Interrupted`` (raised by the SIGTERM handler of
+  ``signal_handlers()``) while the main thread waits cancels every table that has not written its
+  file: those are marked ``interrupted``; finished files stay. Writes are atomic (io.exr.write_exr),
+  so an unfinished table never appears or replaces a good file, and the next run resumes only the
+  tables that did not finish (their outputs are missing or stale).
+"""
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import signal
+import threading
+import time
+import uuid
+from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+from . import __version__
+from .config import TableSpec
+
+PACKAGE = Path(__file__).parent
+# the modules whose source defines what a table holds (kernels, terms, estimators, axes, edge policy)
+HASH_SOURCES = ("terms/*.py", "sampling/*.py", "tables/*.py", "axes.py", "edge.py")
+HASH_ATTRIBUTE = "content_hash"
+STATUSES = ("baked", "skipped", "failed", "interrupted")
+EXIT_OK, EXIT_FAILED, EXIT_SIGINT, EXIT_SIGTERM = 0, 1, 130, 143
+
+
+class Interrupted(BaseException):
+    """Raised in the main thread by the SIGTERM handler (KeyboardInterrupt stands for SIGINT)."""
+
+    def __init__(self, signum: int = signal.SIGTERM):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+def source_files() -> list[Path]:
+    """The source files that enter every content hash, sorted by their path in the package."""
+    files = {f for pattern in HASH_SOURCES for f in PACKAGE.glob(pattern) if f.is_file()}
+    return sorted(files, key=lambda f: f.relative_to(PACKAGE).as_posix())
+
+
+def sources_digest() -> bytes:
+    """sha256 over (relative path, text) of every file in source_files()."""
+    h = hashlib.sha256()
+    for f in source_files():
+        data = f.read_bytes()
+        h.update(f.relative_to(PACKAGE).as_posix().encode() + b"\0" + str(len(data)).encode() + b"\0" + data)
+    return h.digest()
+
+
+def content_hash(spec: TableSpec, digest: bytes | None = None) -> str:
+    """The hex sha256 of (spec.toml(), lutbake version, source digest): what makes an output current."""
+    h = hashlib.sha256()
+    for part in (b"lutbake-content-hash-v1", spec.toml().encode(), __version__.encode(),
+                 digest if digest is not None else sources_digest()):
+        h.update(str(len(part)).encode() + b"\0" + part)
+    return h.hexdigest()
+
+
+def read_header(path) -> dict[str, str] | None:
+    """The ``lutbake:*`` attributes of an existing EXR's first part (prefix removed), or None if the
+    file is missing or not a readable EXR. Reads the header only."""
+    path = Path(path)
+    if not path.is_file():
+        return None
+    try:
+        import OpenImageIO as oiio
+
+        inp = oiio.ImageInput.open(str(path))
+        if inp is None:
+            oiio.geterror()
+            return None
+        try:
+            spec = inp.spec()
+            return {p.name[len("lutbake:"):]: str(p.value) for p in spec.extra_attribs
+                    if p.name.startswith("lutbake:")}
+        finally:
+            inp.close()
+    except Exception:  # a corrupt or foreign file is simply not up to date
+        return None
+
+
+@dataclass
+class Job:
+    """One table of a batch and, once run, its outcome."""
+
+    spec: TableSpec
+    path: Path
+    content_hash: str
+    status: str = "pending"  # then one of STATUSES
+    seconds: float | None = None
+    samples: int | None = None
+    error_estimate: float | None = None
+    message: str = ""
+    shape: str = ""
+
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+    def report(self) -> dict:
+        return {"name": self.name, "status": self.status, "path": str(self.path), "content_hash": self.content_hash,
+                "seconds": self.seconds, "samples": self.samples, "error_estimate": self.error_estimate,
+                "message": self.message}
+
+
+def _float_or_none(text) -> float | None:
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return None
+
+
+def plan(specs: list[TableSpec], out_dir, force: bool = False) -> list[Job]:
+    """One Job per (validated) spec: output path, content hash, and ``skipped`` if the output exists
+    with that hash (unless ``force``). Runs no kernel."""
+    digest = sources_digest()
+    jobs = []
+    for spec in specs:
+        job = Job(spec, Path(out_dir) / f"{spec.name}.exr", content_hash(spec, digest))
+        header = None if force else read_header(job.path)
+        if header is not None and header.get(HASH_ATTRIBUTE) == job.content_hash:
+            job.status = "skipped"
+            job.seconds = 0.0
+            job.samples = int(header["samples"]) if header.get("samples", "").isdigit() else None
+            job.error_estimate = _float_or_none(header.get("error_estimate"))
+            job.message = "up to date"
+        jobs.append(job)
+    return jobs
+
+
+def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.Event) -> Job:
+    """Bake and write one table; any failure is recorded on the job, never raised."""
+    from .api import bake_table
+    from .errors import LutbakeError
+    from .executor import Cancelled
+    from .io.exr import write_exr
+
+    t0 = time.perf_counter()
+    try:
+        if cancel.is_set():
+            raise Cancelled(job.name)
+        table, seconds, samples = bake_table(job.spec, workers, device, progress, cancel=cancel)
+        if table.attributes.get(HASH_ATTRIBUTE) != job.content_hash:  # sources changed under a running batch
+            raise RuntimeError("the lutbake sources changed while the batch ran; run it again")
+        if cancel.is_set():
+            raise Cancelled(job.name)
+        write_exr(table, job.path, dtype=job.spec.options.get("dtype", "float32"))
+    except Cancelled:
+        job.status, job.message = "interrupted", "interrupted before its file was written; nothing written"
+    except MemoryError as e:
+        job.status = "failed"
+        job.message = f"{job.spec.source}: table '{job.name}': out of memory{': ' + str(e) if str(e) else ''}; nothing written"
+    except LutbakeError as e:
+        job.status, job.message = "failed", str(e)
+    except Exception as e:  # a kernel error, an I/O error, anything: this table fails, the others go on
+        job.status = "failed"
+        job.message = f"{job.spec.source}: table '{job.name}': {type(e).__name__}: {e}; nothing written"
+    else:
+        job.status, job.seconds, job.samples = "baked", seconds, samples
+        job.error_estimate = _float_or_none(table.attributes.get("error_estimate"))
+        job.shape = "x".join(str(a.count) for a in table.axes) + f"x{len(table.channels)}"
+        return job
+    job.seconds = time.perf_counter() - t0
+    return job
+
+
+def run(jobs: list[Job], workers: int | None = None, device: str = "cpu", progress: bool | None = None,
+        on_done: Callable[[Job], None] | None = None, poll: float = 0.2) -> int | None:
+    """Bake every ``pending`` job; ``on_done(job)`` is called in the calling thread as each finishes.
+
+    Tables run on min(workers, pending) threads, each on the tile executor with ``workers`` tile threads:
+    a big table keeps every core busy after the small ones are done (the OS shares the cores while
+    several tables run; the result is bit-identical either way).
+    Returns None, or the signal number if the run was interrupted (the unfinished jobs are then marked
+    ``interrupted``; finished files are kept).
+    """
+    from .executor import default_workers
+
+    workers = workers or default_workers()
+    pending = [j for j in jobs if j.status == "pending"]
+    if not pending:
+        return None
+    threads = max(1, min(workers, len(pending)))
+    per_table = workers
+    if threads > 1 and progress is None:
+        progress = False  # several bars at once would interleave
+    cancel = threading.Event()
+    pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="lutbake-table")
+    futures: dict = {}
+    signum = None
+    reported: set = set()
+    try:
+        for j in pending:
+            futures[pool.submit(_bake_one, j, per_table, device, progress, cancel)] = j
+        remaining = set(futures)
+        while remaining:
+            done, remaining = wait(remaining, timeout=poll, return_when=FIRST_COMPLETED)
+            for f in done:
+                reported.add(f)
+                if on_done:
+                    on_done(f.result())
+    except (KeyboardInterrupt, Interrupted) as e:
+        signum = getattr(e, "signum", int(signal.SIGINT))
+        cancel.set()
+        for f in futures:
+            f.cancel()
+    finally:
+        pool.shutdown(wait=True)  # running tables stop at their next tile (or finish writing)
+    if signum is not None:
+        for j in pending:
+            if j.status == "pending":  # cancelled before it started
+                j.status, j.message = "interrupted", "not started; nothing written"
+        for f, j in futures.items():
+            if f not in reported and on_done:
+                on_done(j)
+    return signum
+
+
+def signal_name(signum: int) -> str:
+    try:
+        return signal.Signals(signum).name
+    except ValueError:
+        return f"signal {signum}"
+
+
+def exit_status(jobs: list[Job], signum: int | None) -> int:
+    """130 after SIGINT, 143 after SIGTERM, 1 if any table failed, else 0."""
+    if signum is not None:
+        return EXIT_SIGTERM if signum == signal.SIGTERM else EXIT_SIGINT
+    return EXIT_FAILED if any(j.status == "failed" for j in jobs) else EXIT_OK
+
+
+def write_report(path, jobs: list[Job], status: int, signum: int | None = None) -> Path:
+    """``--report FILE.json``: the run's summary, one entry per table, written atomically."""
+    path = Path(path)
+    doc = {
+        "lutbake_version": __version__,
+        "exit_status": status,
+        "interrupted_by": signal_name(signum) if signum is not None else None,
+        "counts": {s: sum(j.status == s for j in jobs) for s in STATUSES},
+        "tables": [j.report() for j in jobs],
+    }
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp")
+    try:
+        tmp.write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return path
+
+
+@contextlib.contextmanager
+def signal_handlers():
+    """While active (main thread only), SIGTERM raises Interrupted in the main thread, as Ctrl-C
+    raises KeyboardInterrupt, so run() can cancel cleanly. Restores the previous handlers."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def on_term(signum, frame):
+        raise Interrupted(signum)
+
+    old = signal.signal(signal.SIGTERM, on_term)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
