@@ -42,6 +42,10 @@ def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu",
     if not np.all(np.isfinite(data)):
         bad = int(np.size(data) - np.count_nonzero(np.isfinite(data)))
         raise TableError(f"{spec.source}: table '{spec.name}': {bad} non-finite values; nothing written")
+    extra = dict(plan.extra)
+    if plan.error_estimate is not None:
+        err, how = plan.error_estimate(data.reshape(plan.n_texels, plan.n_channels), device)
+        extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)
     attributes = {
         "terms": json.dumps(plan.terms),
         "estimator": plan.estimator,
@@ -51,7 +55,7 @@ def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu",
         "config_file": Path(spec.source).name,
         "version": __version__,
         "warp_version": _warp_version(),
-        **plan.extra,
+        **extra,
         "content_hash": content_hash(spec),  # what makes the file current (lutbake.batch)
     }
     table = Table(spec.name, spec.kind, data.astype(np.float32), plan.axes, plan.channels, plan.reconstruction,
