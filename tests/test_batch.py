@@ -172,7 +172,7 @@ def test_report_has_every_field(three):
     for t in doc["tables"]:
         assert set(t) == keys
         assert Path(t["path"]).is_file() and len(t["content_hash"]) == 64
-        assert t["samples"] in (48, 64) and t["error_estimate"] is None and t["seconds"] >= 0
+        assert t["samples"] in (48, 64) and t["error_estimate"] >= 0 and t["seconds"] >= 0
     assert [t["status"] for t in doc["tables"]] == ["skipped", "skipped", "skipped", "baked"]
 
 
