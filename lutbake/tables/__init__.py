@@ -3,8 +3,9 @@ from __future__ import annotations
 
 from .base import Kind
 from .dfg import DFG
+from .diffuse import DIFFUSE
 
-KINDS: dict[str, Kind] = {k.name: k for k in (DFG,)}
+KINDS: dict[str, Kind] = {k.name: k for k in (DFG, DIFFUSE)}
 ALIASES: dict[str, str] = {alias: k.name for k in KINDS.values() for alias in k.aliases}
 
 

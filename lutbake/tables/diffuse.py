@@ -338,3 +338,89 @@ def albedo(model: str, nov: np.ndarray, sigma: np.ndarray, f0: float = 0.0, face
                                        wp.array(a, dtype=float, device=device), float(f0),
                                        *_gl(outer_order or order, device), *_gl(order, device), out], device=device)
     return out.numpy()[:, 0]
+
+
+# ---- the table kind ----
+
+DEFAULT_ORDER = {"microfacet": 8}  # GL points per panel per dimension; closed forms: CLOSED_ORDER
+CLOSED_ORDER = 24
+
+KEYS = {
+    "name": Key("name", "name", None, "output stem: <out-dir>/<name>.exr; letters, digits, - and _ only", required=True),
+    "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
+    "size": Key("size", "int_pair", [64, 64], "[NoV, sigma] texel counts", minimum=1),
+    "model": Key("model", "str", "microfacet", "the diffuse model integrated", MODELS),
+    "f0": Key("f0", "float", 0.0, "Fresnel reflectance at normal incidence the table is baked for; every model is "
+              "g(f0) times an f0-free function (metadata lutbake:f0_factor), so f0 = 0 bakes the f0-free table",
+              minimum=0.0, maximum=0.999),
+    "sigma_to_alpha": Key("sigma_to_alpha", "str", "sigma", "GGX alpha from sigma (microfacet model)", SIGMA_TO_ALPHA),
+    "facet_fresnel": Key("facet_fresnel", "str", "eq6", "Fresnel transmission on each facet (microfacet model)",
+                         FACET_FRESNEL),
+    "samples": Key("samples", "int", None, "Gauss-Legendre order n per panel and dimension (outer 4 n^2 directions "
+                   "l; microfacet: 12 n^2 facet normals each); omitted: 8 for microfacet, 24 otherwise", minimum=2,
+                   maximum=64),
+    "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}),
+    "texel": Key("texel", "str", "center", "texel convention of both axes", TEXELS),
+    "nov_range": Key("nov_range", "float_range", [0.0, 1.0], "NoV at t = 0 and t = 1", minimum=0.0, maximum=1.0),
+    "sigma_range": Key("sigma_range", "float_range", [0.0, 1.0], "sigma at t = 0 and t = 1", minimum=0.0, maximum=1.0),
+}
+
+RECONSTRUCTION = ("uv = vec2(NoV, sigma) (texel centres per lutbake:axes); E = texture(lut, uv).r; "
+                  "diffuse = albedo * irradiance * E * g(f0) / g(f0_baked) (g = lutbake:f0_factor; "
+                  "with f0_baked = 0: diffuse = albedo * irradiance * E * g(f0))")
+
+
+def order_for(o: dict) -> int:
+    return o["samples"] or DEFAULT_ORDER.get(o["model"], CLOSED_ORDER)
+
+
+def plan(spec) -> Plan:
+    import json
+
+    o = spec.options
+    n_nov, n_sigma = o["size"]
+    axes = [Axis("sigma", "y", n_sigma, *o["sigma_range"], texel=o["texel"]),
+            Axis("NoV", "x", n_nov, *o["nov_range"], texel=o["texel"])]
+    sig_axis, nov_axis = axes
+    nov = np.tile(nov_axis.values(), n_sigma)
+    sigma = np.repeat(sig_axis.values(), n_nov)
+    model = o["model"]
+    ff = o["facet_fresnel"]
+    order = order_for(o)
+    key = (model, ff)
+
+    def prepare(device: str) -> None:
+        wp.load_module(albedo_kernel_for(*key).module, device=device)
+
+    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
+        return albedo(model, nov[start:stop], sigma[start:stop], o["f0"], ff, o["sigma_to_alpha"], order,
+                      device=device)[:, None]
+
+    per_l = 12 * order * order if model == "microfacet" else 1
+    evals = 4 * order * order * per_l
+    terms = {"model": model, "f0": str(o["f0"]), "f0_factor": f0_factor(model, ff)}
+    if model == "microfacet":
+        terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff,
+                     sigma_to_alpha=o["sigma_to_alpha"])
+    extra = {"f0_factor": f0_factor(model, ff), "f0": repr(o["f0"]), "rho": "1",
+             "sigma_alpha": json.dumps([float(a) for a in alpha_from_sigma(sig_axis.values(), o["sigma_to_alpha"])])}
+    return Plan(
+        axes=axes,
+        channels={"E": "∫ f_r (n.l) dω_l for rho = 1 at the baked f0: directional diffuse reflectance under "
+                       "uniform white light"},
+        reconstruction=RECONSTRUCTION,
+        n_texels=len(nov),
+        n_channels=1,
+        run_tile=run_tile,
+        prepare=prepare,
+        samples=evals,
+        estimator="gauss_legendre",
+        terms=terms,
+        cost=float(len(nov)) * evals,
+        extra=extra,
+    )
+
+
+DIFFUSE = Kind("diffuse", "diffuse AmbientBRDF: NoV x sigma, E = ∫ f_r (n.l) dω_l for Lambert, Oren-Nayar variants, "
+               "Gotanda's fitted model or the integrated microfacet model (Eq. 4)", KEYS, plan,
+               aliases=("ambient_brdf_diffuse",))
