@@ -10,7 +10,7 @@ CONFIGS := $(wildcard configs/*.toml)
 SOURCES := $(shell find lutbake -name '*.py' -o -name '*.toml' 2>/dev/null)
 WORKERS ?=
 
-.PHONY: luts test validate bench clean venv help
+.PHONY: luts test validate bench clean venv help figures
 
 help:
 	@echo "make luts | test | validate | clean"
@@ -25,6 +25,9 @@ $(STAMP): pyproject.toml
 
 luts: $(STAMP)
 	$(BIN)/lutbake bake $(CONFIGS) --out-dir $(OUT) $(if $(WORKERS),--workers $(WORKERS))
+
+figures: $(STAMP)
+	$(BIN)/lutbake plot --out-dir $(OUT)/figures
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

@@ -214,3 +214,13 @@ def test_microfacet_is_reciprocal():
     f_lv = tdiff.eval_brdf("microfacet", l, v, s, f0=0.04, order=8)
     f_vl = tdiff.eval_brdf("microfacet", v, l, s, f0=0.04, order=8)
     np.testing.assert_allclose(f_lv, f_vl, rtol=RECIP_RTOL)
+
+
+def test_fitted_model_matches_integrated_at_sigma_0_normal_view():
+    from lutbake.figures import FIGURES, curves
+
+    fig = FIGURES[0]  # Fig. 11a: n.e = 1, sigma = 0
+    assert (fig.fixed_cos, fig.sigma) == (1.0, 0.0)
+    theta = np.linspace(0.0, 1.5, 16)
+    c = curves(fig, theta, ("microfacet", "fitted"), order=8)
+    np.testing.assert_allclose(c["fitted"], c["microfacet"], rtol=LIMIT_RTOL, atol=1e-6)
