@@ -28,12 +28,12 @@ FIGURES = [
     Figure("11a", "theta_l", 1.0, 1.0, 0.0),
     Figure("11b", "theta_l", 1.0, 1.0, 0.5),
     Figure("11c", "theta_l", 1.0, 1.0, 1.0),
-    Figure("12", "theta_l", 0.5, 1.0, 0.8),
-    Figure("15", "theta_l", 0.342, 0.5, 0.6),
+    Figure("12a", "theta_l", 0.5, 1.0, 0.8),
+    Figure("12b", "theta_l", 0.342, 0.5, 0.6),
     Figure("13", "theta_v", 0.866, 1.0, 0.0),
     Figure("14a", "theta_v", 0.866, 1.0, 0.3),
     Figure("14b", "theta_v", 0.866, 1.0, 0.7),
-    Figure("14c", "theta_v", 0.259, 0.985, 0.8),
+    Figure("15", "theta_v", 0.259, 0.985, 0.8),
 ]
 MODELS = ("oren_nayar", "oren_nayar_fresnel", "microfacet", "fitted")
 
