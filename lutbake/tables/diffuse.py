@@ -366,8 +366,8 @@ KEYS = {
 }
 
 RECONSTRUCTION = ("uv = vec2(NoV, sigma) (texel centres per lutbake:axes); E = texture(lut, uv).r; "
-                  "diffuse = albedo * irradiance * E * g(f0) / g(f0_baked) (g = lutbake:f0_factor; "
-                  "with f0_baked = 0: diffuse = albedo * irradiance * E * g(f0))")
+                  "diffuse = albedo * (irradiance / pi) * E * g(f0) / g(f0_baked), irradiance = ∫ L cos dω "
+                  "(g = lutbake:f0_factor; with f0_baked = 0: diffuse = albedo * (irradiance / pi) * E * g(f0))")
 
 
 def order_for(o: dict) -> int:
