@@ -12,7 +12,7 @@ WORKERS ?=
 FORCE   ?=
 LUTS_STAMP := $(OUT)/.luts.stamp
 
-.PHONY: luts test validate bench clean venv help force-luts
+.PHONY: luts test validate bench clean venv help force-luts figures
 
 help:
 	@echo "make luts | test | validate | clean"
@@ -36,6 +36,9 @@ $(LUTS_STAMP): $(STAMP) $(CONFIGS) $(SOURCES) Makefile $(if $(FORCE),force-luts)
 	touch $@
 
 force-luts:
+
+figures: $(STAMP)
+	$(BIN)/lutbake plot --out-dir $(OUT)/figures
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q

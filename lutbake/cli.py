@@ -135,6 +135,7 @@ def list_():
     from .config import presets
     from .tables import KINDS
     from .tables.dfg import LAYOUTS
+    from .tables.diffuse import MODELS as DIFFUSE_MODELS
     from .tables.specular import ESTIMATORS
     from .terms.sets import MASKINGS, NDFS
 
@@ -156,6 +157,7 @@ def list_():
                                                   for k, m in METALS.items()})
     section("DFG layouts (layout = ...)", LAYOUTS)
     section("Estimators (estimator = ...)", ESTIMATORS)
+    section("Diffuse models (kind = diffuse, model = ...)", DIFFUSE_MODELS)
     section("Texel conventions (texel = ...)", TEXELS)
     section("Presets (--preset NAME)", {k: _first_comment(p) for k, p in presets().items()})
 
@@ -184,6 +186,37 @@ def inspect(file):
     except (OSError, ValueError) as e:
         click.echo(f"error: {file}: {e}", err=True)
         sys.exit(EXIT_CONFIG)
+
+
+@main.command()
+@click.option("--out-dir", type=click.Path(path_type=Path), default=Path("outputs/figures"), show_default=True,
+              help="Directory the PNGs are written to.")
+@click.option("--sigma-to-alpha", type=click.Choice(["sigma", "sigma_squared"]), default="sigma", show_default=True,
+              help="GGX alpha from sigma for the integrated microfacet model.")
+@click.option("--order", type=click.IntRange(min=2, max=64), default=12, show_default=True,
+              help="Gauss-Legendre order of the microfacet integral over m.")
+@click.option("--no-png", is_flag=True, help="Only print the error table.")
+def plot(out_dir, sigma_to_alpha, order, no_png):
+    """Reproduce the seed's Figures 11-15 (settings of Figures 6-10): Oren-Nayar, Oren-Nayar with Fresnel,
+    the integrated microfacet model and the fitted model; print the fitted model's error per figure.
+
+    \b
+    Example:
+      lutbake plot --out-dir outputs/figures
+    """
+    from .figures import error_table, plot_all
+
+    _quiet_warp()
+    if not no_png:
+        for p in plot_all(out_dir, sigma_to_alpha, order):
+            click.echo(str(p))
+    click.echo(f"fitted (Eq. 8) vs integrated (Eq. 4), alpha from sigma: {sigma_to_alpha}; errors in units of the "
+               "integrated curve's maximum")
+    click.echo(f"{'figure':<7}{'abscissa':<9}{'fixed cos':>10}{'cos phi':>9}{'sigma':>7}{'max err':>9}{'rms err':>9}"
+               f"{'at deg':>8}")
+    for r in error_table(sigma_to_alpha=sigma_to_alpha, order=order):
+        click.echo(f"{r['figure']:<7}{r['vary']:<9}{r['fixed_cos']:>10.3f}{r['cos_phi']:>9.3f}{r['sigma']:>7.2f}"
+                   f"{r['max_err']:>9.3f}{r['rms_err']:>9.3f}{r['argmax_deg']:>8.0f}")
 
 
 @main.command()

@@ -102,6 +102,14 @@ def _check_value(key: Key, value, file, table) -> Any:
         if any(x < (key.minimum or 1) for x in value):
             fail("sizes must be >= 1")
         return list(value)
+    if key.type == "float":
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            fail("must be a finite number")
+        if key.minimum is not None and value < key.minimum:
+            fail(f"must be >= {key.minimum:g}")
+        if key.maximum is not None and value > key.maximum:
+            fail(f"must be <= {key.maximum:g}")
+        return float(value)
     if key.type == "float_range":
         if (not isinstance(value, list) or len(value) != 2
                 or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in value)):

@@ -1,0 +1,164 @@
+"""Diffuse BRDF terms: Lambert, Oren-Nayar (classic, improved, with Fresnel), the diffuse Fresnel
+factor and Gotanda's fitted microfacet-diffuse model; the microfacet model itself (Eq. 4), which has
+no closed form, is integrated in lutbake.tables.diffuse.
+
+Convention (all ``Fd_*``): the value returned is the **BRDF** f_r (1/sr), for albedo ``rho``. The seeds
+write radiance L_r for an irradiance E0 from direction l (L_r = f_r E0 (n.l)); those forms are divided by
+E0 (n.l) here, so the cosine of the light is *not* included, as for the specular terms.
+Arguments are cosines in the shading frame: NoL, NoV and LoV = l.v, whence
+    s = LoV - NoL NoV = sin(theta_l) sin(theta_v) cos(phi)
+(phi the azimuth between l and v; s >= 0 exactly when cos(phi) >= 0).
+Edge policy (lutbake.edge): every term returns 0 when NoL or NoV <= COS_EPS (light or view below the
+horizon). sigma is the roughness of Gotanda's models, in [0, 1].
+"""
+import warp as wp
+
+from ..edge import COS_EPS
+
+INV_PI = wp.constant(0.31830988618379067)
+
+
+@wp.func
+def pow5_weight(c: float):
+    """1 - (1 - c)^5 for c in [0, 1] (clamped): the diffuse Fresnel transmission shape."""
+    m = wp.clamp(1.0 - c, 0.0, 1.0)
+    m2 = m * m
+    return 1.0 - m2 * m2 * m
+
+
+@wp.func
+def F_diff(NoL: float, NoV: float, f0: float):
+    """Diffuse Fresnel factor (Gotanda 2014 course notes, Eq. 6, after Shirley et al. 1997):
+    F_diff = 21/20 (1 - f0) (1 - (1 - n.l)^5) (1 - (1 - n.v)^5).
+    Dimensionless; 21/20 (1 - f0) at NoL = NoV = 1, 0 at either horizon. Its cosine-weighted mean
+    over l at NoV = 1 is exactly 1 - f0 (the 21/20 normalises it)."""
+    return 1.05 * (1.0 - f0) * pow5_weight(NoL) * pow5_weight(NoV)
+
+
+@wp.func
+def Fd_lambert(rho: float):
+    """Lambert: f = rho / pi. Directional albedo rho for every view."""
+    return rho * INV_PI
+
+
+@wp.func
+def Fd_oren_nayar(rho: float, NoL: float, NoV: float, LoV: float, sigma: float):
+    """Classic Oren-Nayar, qualitative model as taught in lecture 003 (Oren & Nayar 1994, Eq. 30):
+    f = rho/pi (A + B max(0, cos phi) sin(a) tan(b)), a = max(theta_l, theta_v), b = min(theta_l, theta_v),
+    A = 1 - 0.5 sigma^2/(sigma^2 + 0.57), B = 0.45 sigma^2/(sigma^2 + 0.09).
+    Computed without angles: max(0, cos phi) sin(a) tan(b) = max(0, s) / max(NoL, NoV).
+    The lecture's slide multiplies (A + B max(0, cos phi)) by C = sin(a) tan(b); that reading does not
+    reduce to Lambert at sigma = 0 and is taken as a layout slip. sigma = 0: exactly Lambert."""
+    if NoL <= COS_EPS or NoV <= COS_EPS:
+        return 0.0
+    s2 = sigma * sigma
+    A = 1.0 - 0.5 * s2 / (s2 + 0.57)
+    B = 0.45 * s2 / (s2 + 0.09)
+    s = LoV - NoL * NoV
+    return rho * INV_PI * (A + B * wp.max(s, 0.0) / wp.max(NoL, NoV))
+
+
+@wp.func
+def Fd_oren_nayar_improved(rho: float, NoL: float, NoV: float, LoV: float, sigma: float):
+    """Improved Oren-Nayar (Gotanda 2014 course notes, Eq. 5, from Gotanda 2012), radiance form
+    L_r / (rho E0 / pi) = (n.l) A + B s min(1, n.l / n.v)   if s >= 0,
+                        = (n.l) A + B s                      otherwise,
+    A = 1 - 0.5 sigma^2/(sigma^2 + 0.65), B = 0.45 sigma^2/(sigma^2 + 0.09). Returned as the BRDF
+    L_r / (E0 n.l): rho/pi (A + B s / max(n.l, n.v)) for s >= 0, rho/pi (A + B s / n.l) otherwise.
+    The second branch is taken as printed; its radiance goes negative for a grazing light behind the
+    viewer (n.l -> 0, cos phi < 0), so the radiance is clamped at 0. sigma = 0: exactly Lambert."""
+    if NoL <= COS_EPS or NoV <= COS_EPS:
+        return 0.0
+    s2 = sigma * sigma
+    A = 1.0 - 0.5 * s2 / (s2 + 0.65)
+    B = 0.45 * s2 / (s2 + 0.09)
+    s = LoV - NoL * NoV
+    radiance = NoL * A + B * s
+    if s >= 0.0:
+        radiance = NoL * A + B * s * wp.min(1.0, NoL / NoV)
+    return rho * INV_PI * wp.max(radiance, 0.0) / NoL
+
+
+@wp.func
+def Fd_oren_nayar_fresnel(rho: float, NoL: float, NoV: float, LoV: float, sigma: float, f0: float):
+    """Oren-Nayar with Fresnel (Gotanda 2014 course notes, Eq. 7), radiance form
+    L_r / (rho E0 / pi) = (1 - f0) [F'(l, v) (n.l) A + B s min(1, n.l / n.v)],
+    F'(l, v) = 21/20 (1 - (1 - n.l)^5)(1 - (1 - n.v)^5) = F_diff / (1 - f0),
+    A, B as Eq. 5 (0.65, 0.09). The seed prints (1 - f0) twice (outside and inside F_diff); lutbake
+    counts it **once**: only then does sigma = 0 give Lambert x Eq. 6, the sigma = 0 limit of the
+    microfacet model (Eq. 4), and the same (1 - f0) prefactor as the fitted model (Eq. 8). Eq. 7 has a
+    single branch (no s < 0 case), used as printed; the radiance is clamped at 0 (see Eq. 5).
+    Returned as the BRDF L_r / (E0 n.l)."""
+    if NoL <= COS_EPS or NoV <= COS_EPS:
+        return 0.0
+    s2 = sigma * sigma
+    A = 1.0 - 0.5 * s2 / (s2 + 0.65)
+    B = 0.45 * s2 / (s2 + 0.09)
+    s = LoV - NoL * NoV
+    radiance = 1.05 * pow5_weight(NoL) * pow5_weight(NoV) * NoL * A + B * s * wp.min(1.0, NoL / NoV)
+    return rho * INV_PI * (1.0 - f0) * wp.max(radiance, 0.0) / NoL
+
+
+@wp.func
+def gotanda_fitted_radiance(NoL: float, NoV: float, LoV: float, sigma: float, slides_reading: int):
+    """F_r L_m + V_d B_p of Eq. 8 (Gotanda 2014 course notes), the bracket of the fitted model; it
+    contains the light cosine. ``slides_reading`` = 0: F_r's second factor is the course notes'
+    (1 - (1 - n.v)^(5 - 4 sigma^2) / (sigma^2 + 1.36053)); 1: the slides' layout
+    (1 - (1 - n.v)^(5 - 4 sigma^2)) / (sigma^2 + 1.36053)."""
+    s1 = sigma
+    s2 = sigma * sigma
+    s3 = s2 * sigma
+    s4 = s2 * s2
+    omv = wp.clamp(1.0 - NoV, 0.0, 1.0)
+    oml = wp.clamp(1.0 - NoL, 0.0, 1.0)
+    k = s2 + 1.36053
+    fr1 = 1.0 - (0.542026 * s2 + 0.303573 * s1) / k
+    fr2 = 1.0 - wp.pow(omv, 5.0 - 4.0 * s2) / k
+    if slides_reading != 0:
+        fr2 = (1.0 - wp.pow(omv, 5.0 - 4.0 * s2)) / k
+    fr3 = (-0.733996 * s3 + 1.50912 * s2 - 1.16402 * s1) * wp.pow(omv, 1.0 + 1.0 / (39.0 * s4 + 1.0)) + 1.0
+    Fr = fr1 * fr2 * fr3
+    Lm = (wp.max(1.0 - 2.0 * s1, 0.0) * pow5_weight(NoL) + wp.min(2.0 * s1, 1.0)) * (
+        (1.0 - 0.5 * s1) * NoL + 0.5 * s1 * NoL * NoL)
+    Vd = s2 / ((s2 + 0.09) * (1.31072 + 0.995584 * NoV)) * (
+        1.0 - wp.pow(oml, (1.0 - 0.3726732 * NoV * NoV) / (0.188566 + 0.388410 * NoV)))
+    s = LoV - NoL * NoV
+    Bp = s
+    if s < 0.0:
+        Bp = 1.4 * NoV * NoL * s
+    return Fr * Lm + Vd * Bp
+
+
+@wp.func
+def Fd_gotanda_fitted(rho: float, NoL: float, NoV: float, LoV: float, sigma: float, f0: float):
+    """Gotanda's fitted microfacet diffuse (Gotanda 2014 course notes, Eq. 8; course-notes reading of F_r):
+    L_r = 21/(20 pi) (1 - f0) (F_r(v, l, sigma) L_m(l, sigma) + V_d(v, l, sigma) B_p(v, l)) for unit
+    irradiance, returned as the BRDF L_r / (n.l) times rho (the bracket vanishes like n.l as n.l -> 0, so
+    the quotient stays finite). sigma in [0, 1]; the seed states it is inaccurate when both l and v
+    are near grazing, and that it must not be used to compute AmbientBRDF tables."""
+    if NoL <= COS_EPS or NoV <= COS_EPS:
+        return 0.0
+    return rho * 1.05 * INV_PI * (1.0 - f0) * gotanda_fitted_radiance(NoL, NoV, LoV, sigma, 0) / NoL
+
+
+@wp.func
+def Fd_gotanda_fitted_slides(rho: float, NoL: float, NoV: float, LoV: float, sigma: float, f0: float):
+    """Fd_gotanda_fitted with the slides' reading of F_r's second factor,
+    (1 - (1 - n.v)^(5 - 4 sigma^2)) / (sigma^2 + 1.36053) (docs: EQUATIONS.md, Eq. 8 ambiguity)."""
+    if NoL <= COS_EPS or NoV <= COS_EPS:
+        return 0.0
+    return rho * 1.05 * INV_PI * (1.0 - f0) * gotanda_fitted_radiance(NoL, NoV, LoV, sigma, 1) / NoL
+
+
+@wp.func
+def F_facet_eq6(MoL: float, MoV: float, f0: float):
+    """Per-facet transmission of the microfacet diffuse model, Eq. 6 with m in place of n:
+    21/20 (1 - f0)(1 - (1 - m.l)^5)(1 - (1 - m.v)^5) (the form whose sigma = 0 limit Eq. 8 fits)."""
+    return F_diff(MoL, MoV, f0)
+
+
+@wp.func
+def F_facet_schlick(MoL: float, MoV: float, f0: float):
+    """Per-facet transmission (1 - F(m.l))(1 - F(m.v)), F Schlick; equals (1 - f0)^2 (1 - (1 - m.l)^5)(1 - (1 - m.v)^5):
+    light refracted into the facet and back out, each once."""
+    return (1.0 - f0) * (1.0 - f0) * pow5_weight(MoL) * pow5_weight(MoV)

@@ -1,0 +1,56 @@
+"""Kind ``diffuse`` (AmbientBRDF, NoV x sigma): albedo invariants, the sigma = 0 limit, f0 factoring."""
+import numpy as np
+import pytest
+
+from lutbake.api import bake_table
+from lutbake.config import validate_table
+from lutbake.errors import ConfigError
+
+LIMIT_ATOL = 2e-4  # sigma = 0 row of the microfacet table vs (1 - f0)(1 - (1 - NoV)^5)
+
+
+def spec(**kw):
+    return validate_table({"name": "d", "kind": "diffuse", "size": [6, 4], **kw}, "<test>", 0)
+
+
+def test_lambert_albedo_is_one():
+    t = bake_table(spec(model="lambert"), workers=1)[0]
+    assert t.data.shape == (4, 6, 1)
+    np.testing.assert_allclose(t.data, 1.0, atol=1e-6)
+
+
+def test_oren_nayar_row_at_sigma_0_is_lambert():
+    t = bake_table(spec(model="oren_nayar", texel="endpoint", size=[5, 3]), workers=1)[0]
+    np.testing.assert_allclose(t.data[0, :, 0], 1.0, atol=1e-6)
+    # the qualitative model is not energy conserving: at grazing view its albedo exceeds 1 (1.013 at sigma = 0.5)
+    assert np.all(t.data > 0) and t.data[1, 0, 0] > 1.0
+
+
+@pytest.fixture(scope="module")
+def microfacet():
+    return bake_table(spec(model="microfacet", texel="endpoint", size=[5, 4], samples=8), workers=2)[0]
+
+
+def test_microfacet_sigma_0_row_is_lambert_times_eq6_albedo(microfacet):
+    nov = microfacet.axes[1].values().astype(np.float64)
+    # column 0 (NoV = NOV_MIN = 1e-4) is left out: the limit needs alpha << NoV, and alpha = ALPHA_MIN = 1e-4 there
+    # ∫ 21/20 (1 - (1 - NoL)^5) NoL dω_l / pi = 20/21 x 21/20 = 1: E = (1 - f0)(1 - (1 - NoV)^5)
+    np.testing.assert_allclose(microfacet.data[0, 1:, 0], 1 - (1 - nov[1:]) ** 5, atol=LIMIT_ATOL)
+
+
+def test_microfacet_albedo_is_at_most_one_and_positive(microfacet):
+    assert np.all(microfacet.data <= 1.0 + 1e-6)
+    assert np.all(microfacet.data[:, 1:] > 0.0)
+
+
+def test_microfacet_f0_factors_out(microfacet):
+    t = bake_table(spec(model="microfacet", texel="endpoint", size=[5, 4], samples=8, f0=0.04), workers=1)[0]
+    np.testing.assert_allclose(t.data, 0.96 * microfacet.data, rtol=1e-5, atol=1e-7)
+    assert t.attributes["f0_factor"] == "(1 - f0)"
+
+
+@pytest.mark.parametrize("kv, fragment", [({"model": "phong"}, "lambert"), ({"f0": 1.5}, "<="),
+                                           ({"sigma_to_alpha": "cube"}, "sigma_squared"), ({"samples": 1}, ">= 2")])
+def test_bad_diffuse_keys_are_rejected(kv, fragment):
+    with pytest.raises(ConfigError, match=fragment):
+        spec(**kv)
