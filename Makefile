@@ -48,3 +48,6 @@ validate: $(STAMP)
 
 clean:
 	rm -rf $(OUT) .pytest_cache
+
+bench: $(STAMP)
+	$(BIN)/python benchmarks/bench.py

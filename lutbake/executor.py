@@ -17,7 +17,7 @@ import numpy as np
 from .tables.base import Plan
 
 TILE_TEXELS = 512
-PROGRESS_MIN_EVALS = 2.0e7  # about a second of work on one core: show a bar above it
+PROGRESS_MIN_EVALS = 1.5e7  # about a second of work on two busy cores: show a bar above it
 _PREPARE_LOCK = threading.Lock()  # kernels compile/load one at a time when tables bake in parallel
 
 
