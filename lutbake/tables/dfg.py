@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import ROUGHNESS_PARAMS, TEXELS, Axis
-from ..terms.sets import MASKINGS, NDFS
+from ..terms.sets import MASKINGS, MODELS, NDFS, model_terms, pair_allowed
 from . import specular
 from .base import Key, Kind, Plan
 
@@ -49,6 +49,8 @@ KEYS = {
     "roughness": Key("roughness", "str", "perceptual", "what the roughness axis holds", ROUGHNESS_PARAMS),
     "ndf": Key("ndf", "str", "ggx", "normal distribution function", {k: v.description for k, v in NDFS.items()}),
     "masking": Key("masking", "str", "smith_height_correlated", "masking-shadowing G2", MASKINGS),
+    "model": Key("model", "str", "microfacet", "the BRDF's term set (lecture 003); other than microfacet, it fixes "
+                  "ndf and masking (leave them unset)", MODELS),
     "layout": Key("layout", "str", "scale_bias", "channel layout", LAYOUTS),
     "texel": Key("texel", "str", "center", "texel convention of both axes", TEXELS),
     "nov_range": Key("nov_range", "float_range", [0.0, 1.0], "NoV at t = 0 and t = 1", minimum=0.0, maximum=1.0),
@@ -60,9 +62,33 @@ KEYS = {
 def check_spec(spec) -> str | None:
     """Cross-key rules, checked at config load; returns a message or None."""
     o = spec.options
-    if o["estimator"] == "sobol_vndf" and NDFS[o["ndf"]].vndf is None:
-        return f"estimator 'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not {o['ndf']!r}"
+    model = o.get("model", "microfacet")
+    if model != "microfacet" and (o["ndf"], o["masking"]) != (KEYS["ndf"].default, KEYS["masking"].default):
+        return (f"model {model!r} fixes the NDF and the masking; ndf and masking are only for model = 'microfacet' "
+                f"(got ndf = {o['ndf']!r}, masking = {o['masking']!r})")
+    form, nd, mk = terms_of(o)
+    if form == "microfacet" and not pair_allowed(nd, mk):
+        return f"ndf {nd!r} has no Smith Lambda: use masking = 'v_cavity' with it, not {mk!r}"
+    if o["estimator"] == "sobol_vndf" and NDFS[nd].vndf is None:
+        return (f"estimator 'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not {nd!r}"
+                + (f" (model {model!r})" if model != "microfacet" else ""))
     return None
+
+
+def terms_of(o: dict) -> tuple[str, str, str]:
+    """(integrand form, ndf, masking) of a spec's options (lutbake.terms.sets.model_terms)."""
+    return model_terms(o.get("model", "microfacet"), o["ndf"], o["masking"])
+
+
+def terms_record(o: dict, fresnel: str) -> dict:
+    """The EXR's lutbake:terms record: model, ndf, masking (as integrated) and Fresnel."""
+    form, nd, mk = terms_of(o)
+    model = o.get("model", "microfacet")
+    if form == "microfacet":
+        return {"model": model, "ndf": nd, "masking": mk, "fresnel": fresnel}
+    return {"model": model, "ndf": f"{model} lobe (sampled with the blinn_phong CDF)",
+            "masking": "none (implicit in the lobe)", "fresnel": fresnel,
+            "shininess": "s = 2 / alpha^2 - 2"}
 
 
 def axes_for(o: dict) -> list[Axis]:
@@ -78,7 +104,8 @@ def plan(spec) -> Plan:
     rough, nov_axis = axes
     est = o["estimator"]
     samples = o["samples"] or specular.DEFAULT_SAMPLES[est]
-    key = (o["ndf"], o["masking"], o["layout"], est)
+    form, nd, mk = terms_of(o)
+    key = (nd, mk, o["layout"], est, form)
     # texel t = iy * nx + ix: y (roughness) slowest
     nov = np.tile(nov_axis.values(), rough.count)
     alpha = np.repeat(rough.alpha(), nov_axis.count)
@@ -101,7 +128,7 @@ def plan(spec) -> Plan:
         prepare=prepare,
         samples=eff,
         estimator=est,
-        terms={"ndf": o["ndf"], "masking": o["masking"], "fresnel": "schlick", "layout": o["layout"]},
+        terms={**terms_record(o, "schlick"), "layout": o["layout"]},
         cost=float(len(nov)) * eff,
     )
 

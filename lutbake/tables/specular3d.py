@@ -54,7 +54,8 @@ def plan(spec) -> Plan:
     samples = o["samples"] or specular.DEFAULT_SAMPLES[est]
     metal = o["metal"]
     channels_name = f"metal:{metal}" if metal else f"F:{o['fresnel']}"
-    key = (o["ndf"], o["masking"], channels_name, est)
+    form, nd, mk = dfg.terms_of(o)
+    key = (nd, mk, channels_name, est, form)
     rough, nov_axis = axes[-2:]
     ny, nx = rough.count, nov_axis.count
     nz = 1 if metal else axes[0].count
@@ -75,11 +76,11 @@ def plan(spec) -> Plan:
         m = METALS[metal]
         channels = {f"e_{c}": f"E with F_conductor({n} + {k}i) at {w:g} nm" for c, n, k, w in
                     zip("rgb", m.n, m.k, m.wavelengths_nm)}
-        terms = {"ndf": o["ndf"], "masking": o["masking"], "fresnel": "conductor", "metal": metal}
+        terms = {**dfg.terms_record(o, "conductor"), "metal": metal}
         extra = {"metal_source": m.source}
     else:
         channels = {"e": f"E = ∫ f (n.l) dω_l with F = {o['fresnel']}(f0 of the slice, v.h)"}
-        terms = {"ndf": o["ndf"], "masking": o["masking"], "fresnel": o["fresnel"]}
+        terms = dfg.terms_record(o, o["fresnel"])
         extra = {}
     return Plan(axes=axes, channels=channels, reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D,
                 n_texels=len(nov), n_channels=nch, run_tile=run_tile,

@@ -20,7 +20,7 @@ import numpy as np
 from ..edge import ALPHA_MIN, NOV_MIN
 from ..sampling import points
 from ..tables import specular
-from ..terms.sets import NDFS
+from ..terms.sets import NDFS, SMITH_NDFS
 from .probe import BRDF_PAIRS, evaluate_brdfs, evaluate_terms
 
 # Tolerances (absolute unless said otherwise). The terms run in float32: ~1e-7 is the floor.
@@ -273,9 +273,9 @@ def _registry() -> dict:
     checks = {}
     for n in NDFS:
         checks[f"ndf_projected_area_is_one[{n}]"] = functools.partial(ndf_projected_area_is_one, n)
-    for n in NDFS:
+    for n in SMITH_NDFS:
         checks[f"weak_white_furnace[{n}]"] = functools.partial(weak_white_furnace, n)
-    for n in NDFS:
+    for n in SMITH_NDFS:
         for m in ALBEDO_MASKINGS:
             checks[f"albedo_le_one_and_mirror_limit[{n},{m}]"] = functools.partial(albedo_le_one_and_mirror_limit, n, m)
     for n, m in DFG_MIRROR_PAIRS:

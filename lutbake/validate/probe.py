@@ -32,7 +32,7 @@ import warp as wp
 
 from ..edge import COS_EPS
 from ..terms import fresnel, masking
-from ..terms.sets import MASKINGS, NDFS, G2_for
+from ..terms.sets import MASKINGS, NDFS, G2_for, pair_allowed
 
 wp.set_module_options({"enable_backward": False})
 
@@ -60,6 +60,9 @@ def _ndf_probes(ndf_name: str) -> list:
     @wp.func
     def probe_D(x: TermInputs):
         return D(x.h, x.alpha)
+
+    if Lam is None:  # no Smith Lambda (blinn_phong)
+        return [(f"D_{ndf_name}", probe_D)]
 
     @wp.func
     def probe_Lambda(x: TermInputs):
@@ -107,7 +110,7 @@ def _probe_F_dielectric_f0(x: TermInputs):
     return fresnel.F_dielectric_f0(x.f0, x.cos_theta)
 
 
-BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS)
+BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS if pair_allowed(n, m))
 
 _PROBES = (
     [p for n in NDFS for p in _ndf_probes(n)]
