@@ -5,8 +5,9 @@ from .base import Kind
 from .albedo import ALBEDO, ALBEDO_AVG
 from .dfg import DFG
 from .specular3d import SPECULAR_3D
+from .aniso import SPECULAR_ANISO
 
-KINDS: dict[str, Kind] = {k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D)}
+KINDS: dict[str, Kind] = {k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D, SPECULAR_ANISO)}
 ALIASES: dict[str, str] = {alias: k.name for k in KINDS.values() for alias in k.aliases}
 
 
