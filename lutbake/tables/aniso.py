@@ -96,12 +96,6 @@ def view_at(nov: float, phi_v: float):
     return wp.vec3(s * wp.cos(phi_v), s * wp.sin(phi_v), nov)
 
 
-@wp.func
-def as_exponent(a: float):
-    """Ashikhmin-Shirley exponent of an axis alpha: max(2 / a^2 - 2, 0)."""
-    return wp.max(2.0 / (a * a) - 2.0, 0.0)
-
-
 @functools.lru_cache(maxsize=None)
 def kernel_for(model: str, layout: str):
     """QMC kernel over texels (nov, alpha_x, alpha_y, phi_v; phi_v < 0: averaged) with 3D points (module docstring)."""
@@ -122,8 +116,8 @@ def kernel_for(model: str, layout: str):
         i = wp.tid()
         ax = alpha_x[i]
         ay = alpha_y[i]
-        nu = as_exponent(wp.min(ax, 1.0))
-        nv = as_exponent(wp.min(ay, 1.0))
+        nu = ndf.as_exponent(wp.min(ax, 1.0))
+        nv = ndf.as_exponent(wp.min(ay, 1.0))
         acc = acc_type()
         n = pts.shape[0]
         for k in range(n):

@@ -187,6 +187,12 @@ def D_ashikhmin_shirley(h: wp.vec3, nu: float, nv: float):
 
 
 @wp.func
+def as_exponent(a: float):
+    """Ashikhmin-Shirley exponent of an axis alpha by the Blinn-Phong mapping: max(2 / a^2 - 2, 0)."""
+    return wp.max(2.0 / (a * a) - 2.0, 0.0)
+
+
+@wp.func
 def sample_ashikhmin_shirley(nu: float, nv: float, u1: float, u2: float):
     """h from p_h (Ashikhmin & Shirley 2000, Eq. 9): in the first quadrant
     phi = atan(sqrt((nu + 1)/(nv + 1)) tan(pi xi / 2)), cos theta = (1 - u2)^(1 / (nu cos^2 phi + nv sin^2 phi + 1));
