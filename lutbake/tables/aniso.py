@@ -57,7 +57,7 @@ VIEW_AZIMUTHS = {
 PHI_V = {"average": -1.0, "tangent": 0.0, "bitangent": 0.5 * np.pi}
 ESTIMATORS = {"sobol": "scrambled 3D Sobol' points: h by anisotropic GGX VNDF sampling (microfacet) or the "
                        "Ashikhmin-Shirley h sampling; phi_v = 2 pi u3 when averaged"}
-DEFAULT_SAMPLES = 4096
+DEFAULT_SAMPLES = 16384
 
 KEYS = {
     **{k: v for k, v in dfg.COMMON_KEYS.items() if k != "estimator"},
