@@ -106,7 +106,8 @@ def list_():
     from .tables import KINDS
     from .tables.dfg import LAYOUTS
     from .tables.specular import ESTIMATORS
-    from .terms.sets import MASKINGS, NDFS
+    from .tables import aniso
+    from .terms.sets import MASKINGS, MODELS, NDFS
 
     def section(title, items):
         click.echo(click.style(title, bold=True))
@@ -118,6 +119,9 @@ def list_():
                                          for k in KINDS.values()})
     section("NDFs (ndf = ...)", {k: v.description for k, v in NDFS.items()})
     section("Masking-shadowing (masking = ...)", MASKINGS)
+    section("Models (dfg, albedo, albedo_avg, specular_3d: model = ...)", MODELS)
+    section("Anisotropic models (specular_aniso: model = ...)", aniso.MODELS)
+    section("View azimuth (specular_aniso: view_azimuth = ...)", aniso.VIEW_AZIMUTHS)
     from .tables.fresnel import FRESNELS
     from .terms.metals import METALS
 
@@ -126,6 +130,7 @@ def list_():
                                                   for k, m in METALS.items()})
     section("DFG layouts (layout = ...)", LAYOUTS)
     section("Estimators (estimator = ...)", ESTIMATORS)
+    section("Estimators (specular_aniso: estimator = ...)", aniso.ESTIMATORS)
     section("Texel conventions (texel = ...)", TEXELS)
     section("Presets (--preset NAME)", {k: _first_comment(p) for k, p in presets().items()})
 
