@@ -60,7 +60,8 @@ FURNACE_ALPHAS = (1.0e-3, 1.0e-2, 0.1, 0.5, 1.0)
 ALBEDO_COUNT = 24  # texel-centre grid in n.v and perceptual roughness, plus the clamped edges
 MIRROR_NOVS = tuple(np.linspace(0.05, 1.0, 20))  # below ~0.05, Lambda(alpha = 1e-4) is not yet negligible
 ALBEDO_MASKINGS = ("smith_height_correlated", "smith_separable")
-DFG_MIRROR_PAIRS = (("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"))
+DFG_MIRROR_PAIRS = (("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"), ("beckmann", "v_cavity"),
+                    ("blinn_phong", "v_cavity"))
 RECIPROCITY_SAMPLES = 4096
 ESTIMATOR_TEXELS = ((0.1, 0.04), (0.3, 1.0), (0.5, 0.25), (0.9, 0.64), (1.0, 0.01))  # (n.v, alpha)
 ESTIMATOR_QMC_SAMPLES = 1 << 16
