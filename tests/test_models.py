@@ -32,12 +32,13 @@ def test_blinn_phong_lobe_at_shininess_zero_is_lambertian():
 
 
 def test_blinn_phong_lobe_energy():
-    """(s + 8)/(8 pi) is an approximate normalisation: E(F = 1) is within a few percent of <= 1, and the
-    microfacet form with the normalized Blinn-Phong NDF and V-cavity stays <= 1."""
-    lobe = bake(kind="albedo", model="blinn_phong", size=SIZE)
-    mf = bake(kind="albedo", ndf="blinn_phong", masking="v_cavity", size=SIZE)
+    """(s + 8)/(8 pi) is an approximate normalisation: E(F = 1) exceeds 1 by a few percent (measured max 1.075 at
+    n.v = 1, alpha = 0.42 on a 64 x 64 endpoint grid), and the microfacet form with the normalized Blinn-Phong NDF
+    and V-cavity stays <= 1."""
+    lobe = bake(kind="albedo", model="blinn_phong", size=SIZE, texel="endpoint")
+    mf = bake(kind="albedo", ndf="blinn_phong", masking="v_cavity", size=SIZE, texel="endpoint")
     print(f"\nBlinn-Phong lobe: max E(F = 1) = {lobe.data.max():.5f}; microfacet + V-cavity: {mf.data.max():.6f}")
-    assert 1.0 < lobe.data.max() < 1.06
+    assert 1.05 < lobe.data.max() < 1.08
     assert mf.data.max() <= 1.0 + 1e-6
 
 
