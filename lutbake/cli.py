@@ -137,7 +137,8 @@ def list_():
     from .tables.dfg import LAYOUTS
     from .tables.diffuse import MODELS as DIFFUSE_MODELS
     from .tables.specular import ESTIMATORS
-    from .terms.sets import MASKINGS, NDFS
+    from .tables import aniso
+    from .terms.sets import MASKINGS, MODELS, NDFS
 
     def section(title, items):
         click.echo(click.style(title, bold=True))
@@ -149,6 +150,9 @@ def list_():
                                          for k in KINDS.values()})
     section("NDFs (ndf = ...)", {k: v.description for k, v in NDFS.items()})
     section("Masking-shadowing (masking = ...)", MASKINGS)
+    section("Models (dfg, albedo, albedo_avg, specular_3d: model = ...)", MODELS)
+    section("Anisotropic models (specular_aniso: model = ...)", aniso.MODELS)
+    section("View azimuth (specular_aniso: view_azimuth = ...)", aniso.VIEW_AZIMUTHS)
     from .tables.fresnel import FRESNELS
     from .terms.metals import METALS
 
@@ -158,6 +162,7 @@ def list_():
     section("DFG layouts (layout = ...)", LAYOUTS)
     section("Estimators (estimator = ...)", ESTIMATORS)
     section("Diffuse models (kind = diffuse, model = ...)", DIFFUSE_MODELS)
+    section("Estimators (specular_aniso: estimator = ...)", aniso.ESTIMATORS)
     section("Texel conventions (texel = ...)", TEXELS)
     section("Presets (--preset NAME)", {k: _first_comment(p) for k, p in presets().items()})
 

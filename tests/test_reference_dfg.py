@@ -65,7 +65,11 @@ def Lambda_beckmann(c, alpha):
 NDF = {"ggx": (D_ggx, Lambda_ggx), "beckmann": (D_beckmann, Lambda_beckmann)}
 
 
-def G2(masking, lv, ll):
+def G2(masking, lv, ll, noh=None, nov=None, nol=None, voh=None):
+    if masking == "v_cavity":  # Cook & Torrance 1982 (l.h = v.h for the reflected l)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            g = np.minimum(1.0, np.minimum(2.0 * noh * nov / voh, 2.0 * noh * nol / voh))
+        return np.where((voh > 0) & (noh > 0), g, 0.0)
     if masking == "smith_height_correlated":
         return 1.0 / (1.0 + lv + ll)
     assert masking == "smith_separable"
@@ -107,7 +111,8 @@ def reference_dfg(nov, alpha, ndf, masking, n=GL_NODES):
     h = s / np.linalg.norm(s, axis=-1, keepdims=True)
     voh = h @ v
     nol = l[..., 2]
-    fnol = D(h[..., 2], alpha) * G2(masking, Lam(nov, alpha), Lam(nol, alpha)) / (4.0 * nov)
+    lam = (None, None) if masking == "v_cavity" else (Lam(nov, alpha), Lam(nol, alpha))
+    fnol = D(h[..., 2], alpha) * G2(masking, *lam, h[..., 2], nov, nol, voh) / (4.0 * nov)
     fc = (1.0 - voh) ** 5
     w = 2.0 * (wt * np.sin(theta))[:, None] * wp_[None, :]
     return np.array([np.sum(w * (1.0 - fc) * fnol), np.sum(w * fc * fnol)])
@@ -118,20 +123,23 @@ def references():
     """Reference (scale, bias) per texel for both term sets, computed once."""
     nov, alpha = texels()
     return {key: np.array([reference_dfg(n, a, *key) for n, a in zip(nov, alpha)])
-            for key in [("ggx", "smith_height_correlated"), ("beckmann", "smith_separable")]}
+            for key in [("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"), ("beckmann", "v_cavity")]}
 
 
 def test_reference_integrator_is_converged():
     """Doubling the GL nodes per panel changes the reference by far less than REFERENCE_ATOL."""
     for n, a in [(0.05, 0.04), (0.6, 0.3), (1.0, 1.0)]:
-        for key in [("ggx", "smith_height_correlated"), ("beckmann", "smith_separable")]:
+        for key in [("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"), ("beckmann", "v_cavity")]:
+            # V-cavity's min() has kinks inside the domain that the panels do not follow: algebraic convergence,
+            # measured 5e-6 (16 nodes) and 3e-6 (32 nodes) from 64 nodes per panel
+            atol = REFERENCE_ATOL / (10 if key[1] == "v_cavity" else 100)
             np.testing.assert_allclose(reference_dfg(n, a, *key), reference_dfg(n, a, *key, n=2 * GL_NODES),
-                                       rtol=0.0, atol=REFERENCE_ATOL / 100)
+                                       rtol=0.0, atol=atol)
 
 
-def table(ndf, masking, estimator, samples):
+def table(ndf, masking, estimator, samples, form="microfacet"):
     nov, alpha = texels()
-    return integrate(kernel_for(ndf, masking, "scale_bias", estimator), nov, alpha, estimator, samples, SEED, 2)
+    return integrate(kernel_for(ndf, masking, "scale_bias", estimator, form), nov, alpha, estimator, samples, SEED, 2)
 
 
 def report(got, want):
@@ -156,3 +164,17 @@ def test_dfg_beckmann_separable_gauss_legendre_matches_reference(references):
     got = table("beckmann", "smith_separable", "gauss_legendre", 1152)
     report(got, references[("beckmann", "smith_separable")])
     np.testing.assert_allclose(got, references[("beckmann", "smith_separable")], rtol=0.0, atol=REFERENCE_ATOL)
+
+
+def test_dfg_cook_torrance_gauss_legendre_matches_reference(references):
+    """The lecture's Cook-Torrance (Beckmann D with 1/pi, V-cavity G, Schlick F): the table kernel of
+    model = "cook_torrance" (lutbake.terms.sets.model_terms) against the reference with the V-cavity G written here."""
+    from lutbake.config import validate_table
+    from lutbake.tables.dfg import terms_of
+
+    form, ndf, masking = terms_of(validate_table({"name": "t", "kind": "dfg", "model": "cook_torrance"}, "<test>", 0).options)
+    # the same kinks slow the table's Gauss-Legendre too: measured max error 8.4e-4 at 432 samples (the default),
+    # 8.4e-5 at 1152, 4.2e-5 at 4608; scrambled Sobol' NDF sampling with 2^20 points agrees with the reference to 3.5e-7
+    got = table(ndf, masking, "gauss_legendre", 4608, form)
+    report(got, references[("beckmann", "v_cavity")])
+    np.testing.assert_allclose(got, references[("beckmann", "v_cavity")], rtol=0.0, atol=REFERENCE_ATOL)

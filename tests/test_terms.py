@@ -84,11 +84,21 @@ def ref_Lambda_beckmann(c, alpha):
     return np.where(np.isfinite(a), lam, 0.0)
 
 
-REF_D = {"ggx": ref_D_ggx, "beckmann": ref_D_beckmann}
+def ref_D_blinn_phong(h, alpha):
+    """Normalized Blinn-Phong (s + 2)/(2 pi) cos^s, s = 2/alpha^2 - 2 (Walter et al. 2007, Eq. 30 and Sec. 5.2);
+    cos^s as (cos^2)^(s/2) with cos^2 = 1 / (1 + tan^2)."""
+    a2 = f32(alpha) ** 2
+    s = 2.0 / a2 - 2.0
+    return (s + 2.0) / (2.0 * np.pi) * (1.0 + tan2_of(h)) ** (-s / 2.0)
+
+
+REF_D = {"ggx": ref_D_ggx, "beckmann": ref_D_beckmann, "blinn_phong": ref_D_blinn_phong}
 REF_LAMBDA = {"ggx": ref_Lambda_ggx, "beckmann": ref_Lambda_beckmann}
 
 
 def ref_G2(ndf, masking, nov, nol, noh, voh, alpha):
+    if masking == "v_cavity":
+        return ref_G2_v_cavity(noh, nov, nol, voh, voh)
     lv, ll = REF_LAMBDA[ndf](nov, alpha), REF_LAMBDA[ndf](nol, alpha)
     if masking == "smith_height_correlated":
         return 1.0 / (1.0 + lv + ll)
@@ -136,7 +146,27 @@ def test_D_beckmann_matches_numpy():
     assert np.all(ok), f"max relative error {np.max(err[~ok] / want[~ok]):.3e}"
 
 
-@pytest.mark.parametrize("ndf", ["ggx", "beckmann"])
+def test_D_blinn_phong_matches_numpy():
+    """Relative error ~ eps times the exponent x = (s/2) log(1 + tan^2), as for Beckmann's exp(-x)."""
+    h, alpha = half_vectors()[:, None, :], ALPHAS[None, :]
+    got = evaluate_terms(h=h, alpha=alpha)["D_blinn_phong"].astype(np.float64)
+    want = ref_D_blinn_phong(h, alpha)
+    x = (1.0 / f32(alpha) ** 2 - 1.0) * np.log1p(tan2_of(h))
+    rtol = D_RTOL + D_BECKMANN_RTOL_PER_EXPONENT * np.minimum(x, 110.0)
+    err = np.abs(got - want)
+    ok = err <= rtol * want + D_BECKMANN_ATOL
+    assert np.all(ok), f"max relative error {np.max(err[~ok] / want[~ok]):.3e}"
+
+
+def test_blinn_phong_is_close_to_beckmann_at_small_alpha():
+    """s = 2/alpha^2 - 2 is the mapping under which (n.h)^s ~ exp(-tan^2/alpha^2) (Walter et al. 2007, Sec. 5.2)."""
+    theta = np.linspace(0.0, 2.0 * 0.05, 50)  # within 2 alpha of the pole: cos^4 and tan^4 alpha^-2 terms ~2% each
+    h = np.stack([np.sin(theta), 0 * theta, np.cos(theta)], axis=-1)
+    t = evaluate_terms(h=h, alpha=0.05)
+    np.testing.assert_allclose(t["D_blinn_phong"], t["D_beckmann"], rtol=0.05)
+
+
+@pytest.mark.parametrize("ndf", ["ggx", "beckmann", "blinn_phong"])
 def test_D_is_zero_for_back_facing_normals(ndf):
     h = np.array([[0.0, 0.0, -1.0], [0.6, 0.0, -0.8], [1.0, 0.0, 0.0]])
     got = evaluate_terms(h=h, alpha=0.5)[f"D_{ndf}"]
@@ -144,7 +174,7 @@ def test_D_is_zero_for_back_facing_normals(ndf):
     assert np.all(np.isfinite(got))
 
 
-@pytest.mark.parametrize("ndf", ["ggx", "beckmann"])
+@pytest.mark.parametrize("ndf", ["ggx", "beckmann", "blinn_phong"])
 def test_D_peak_value_is_one_over_pi_alpha2(ndf):
     got = evaluate_terms(h=(0.0, 0.0, 1.0), alpha=ALPHAS)[f"D_{ndf}"]
     np.testing.assert_allclose(got, 1.0 / (np.pi * f32(ALPHAS) ** 2), rtol=D_RTOL)

@@ -35,3 +35,12 @@ def hammersley(n: int) -> np.ndarray:
         k >>= np.uint64(1)
         scale *= 0.5
     return np.stack([i.astype(np.float64) / n, bits], axis=1)
+
+
+@functools.lru_cache(maxsize=64)
+def sobol3(n: int, seed: int) -> np.ndarray:
+    """n points of the 3D Owen-scrambled Sobol' sequence (as ``sobol``, d = 3; n rounded up to a power of two)."""
+    from scipy.stats import qmc
+
+    m = max(0, int(np.ceil(np.log2(max(n, 1)))))
+    return qmc.Sobol(d=3, scramble=True, rng=np.random.default_rng(seed)).random_base2(m)

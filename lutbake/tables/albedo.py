@@ -33,7 +33,7 @@ AVG_KEYS = {
     "roughness_size": Key("roughness_size", "int", 128, "roughness texel count (the table is one row)", minimum=1),
     "mu_order": Key("mu_order", "int", 24, "Gauss-Legendre nodes in mu = n.v per panel (two panels, split at 0.2)",
                     minimum=2, maximum=256),
-    **{k: dfg.KEYS[k] for k in ("roughness", "ndf", "masking", "texel", "roughness_range")},
+    **{k: dfg.KEYS[k] for k in ("roughness", "ndf", "masking", "model", "texel", "roughness_range")},
 }
 AVG_CHANNELS = {"e_avg": "E_avg = 2 ∫ E(mu) mu dmu: hemispherical albedo with F = 1"}
 AVG_RECONSTRUCTION = "E_avg = texture(albedo_avg, vec2(roughness, 0.5)).r (one row; x = roughness)"
@@ -43,10 +43,11 @@ def plan_albedo(spec) -> Plan:
     o = spec.options
     axes = dfg.axes_for(o)
     nov, alpha = dfg.texel_grid(axes)
+    form, nd, mk = dfg.terms_of(o)
     return specular.hemisphere_plan(
-        key=(o["ndf"], o["masking"], "albedo", o["estimator"]), nov=nov, alpha=alpha, param=None,
+        key=(nd, mk, "albedo", o["estimator"], form), nov=nov, alpha=alpha, param=None,
         samples=o["samples"], seed=o["seed"], nch=1, axes=axes, channels=ALBEDO_CHANNELS,
-        reconstruction=ALBEDO_RECONSTRUCTION, terms={"ndf": o["ndf"], "masking": o["masking"], "fresnel": "none (F = 1)"})
+        reconstruction=ALBEDO_RECONSTRUCTION, terms=dfg.terms_record(o, "none (F = 1)"))
 
 
 def avg_roughness_axis(o: dict) -> Axis:
@@ -59,7 +60,8 @@ def plan_albedo_avg(spec) -> Plan:
     rough = avg_roughness_axis(o)
     est = o["estimator"]
     samples = o["samples"] or specular.DEFAULT_SAMPLES[est]
-    key = (o["ndf"], o["masking"], "albedo", est)
+    form, nd, mk = dfg.terms_of(o)
+    key = (nd, mk, "albedo", est, form)
     mu, w = mu_nodes(o["mu_order"])
     alphas = rough.alpha()
 
@@ -75,7 +77,7 @@ def plan_albedo_avg(spec) -> Plan:
     return Plan(axes=[rough], channels=AVG_CHANNELS, reconstruction=AVG_RECONSTRUCTION, n_texels=rough.count,
                 n_channels=1, run_tile=run_tile, prepare=lambda d: specular.load(specular.kernel_for(*key), d),
                 samples=eff * len(mu), estimator=est,
-                terms={"ndf": o["ndf"], "masking": o["masking"], "fresnel": "none (F = 1)"},
+                terms=dfg.terms_record(o, "none (F = 1)"),
                 cost=float(rough.count) * len(mu) * eff, extra={"mu_nodes": str(len(mu))})
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import ROUGHNESS_PARAMS, TEXELS, Axis
-from ..terms.sets import MASKINGS, NDFS
+from ..terms.sets import MASKINGS, MODELS, NDFS, model_terms, pair_allowed
 from . import specular
 from .base import Key, Kind, Plan
 
@@ -53,6 +53,8 @@ KEYS = {
     "roughness": Key("roughness", "str", "perceptual", "what the roughness axis holds", ROUGHNESS_PARAMS),
     "ndf": Key("ndf", "str", "ggx", "normal distribution function", {k: v.description for k, v in NDFS.items()}),
     "masking": Key("masking", "str", "smith_height_correlated", "masking-shadowing G2", MASKINGS),
+    "model": Key("model", "str", "microfacet", "the BRDF's term set (lecture 003); other than microfacet, it fixes "
+                  "ndf and masking (leave them unset)", MODELS),
     "layout": Key("layout", "str", "scale_bias", "channel layout", LAYOUTS),
     "texel": Key("texel", "str", "center", "texel convention of both axes", TEXELS),
     "nov_range": Key("nov_range", "float_range", [0.0, 1.0], "NoV at t = 0 and t = 1", minimum=0.0, maximum=1.0),
@@ -64,10 +66,33 @@ KEYS = {
 def check_spec(spec) -> tuple[str, str] | None:
     """Cross-key rules, checked at config load; returns (key, message) or None."""
     o = spec.options
-    if o["estimator"] == "sobol_vndf" and NDFS[o["ndf"]].vndf is None:
-        return ("estimator", f"'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), "
-                             f"not ndf = {o['ndf']!r}")
+    model = o.get("model", "microfacet")
+    if model != "microfacet" and (o["ndf"], o["masking"]) != (KEYS["ndf"].default, KEYS["masking"].default):
+        return ("model", f"{model!r} fixes the NDF and the masking; ndf and masking are only for model = 'microfacet' "
+                         f"(got ndf = {o['ndf']!r}, masking = {o['masking']!r})")
+    form, nd, mk = terms_of(o)
+    if form == "microfacet" and not pair_allowed(nd, mk):
+        return ("masking", f"ndf {nd!r} has no Smith Lambda: use masking = 'v_cavity' with it, not {mk!r}")
+    if o["estimator"] == "sobol_vndf" and NDFS[nd].vndf is None:
+        return ("estimator", f"'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not ndf = {nd!r}"
+                             + (f" (model {model!r})" if model != "microfacet" else ""))
     return None
+
+
+def terms_of(o: dict) -> tuple[str, str, str]:
+    """(integrand form, ndf, masking) of a spec's options (lutbake.terms.sets.model_terms)."""
+    return model_terms(o.get("model", "microfacet"), o["ndf"], o["masking"])
+
+
+def terms_record(o: dict, fresnel: str) -> dict:
+    """The EXR's lutbake:terms record: model, ndf, masking (as integrated) and Fresnel."""
+    form, nd, mk = terms_of(o)
+    model = o.get("model", "microfacet")
+    if form == "microfacet":
+        return {"model": model, "ndf": nd, "masking": mk, "fresnel": fresnel}
+    return {"model": model, "ndf": f"{model} lobe (sampled with the blinn_phong CDF)",
+            "masking": "none (implicit in the lobe)", "fresnel": fresnel,
+            "shininess": "s = 2 / alpha^2 - 2"}
 
 
 def axes_for(o: dict) -> list[Axis]:
@@ -87,11 +112,11 @@ def plan(spec) -> Plan:
     o = spec.options
     axes = axes_for(o)
     nov, alpha = texel_grid(axes)
+    form, nd, mk = terms_of(o)
     return specular.hemisphere_plan(
-        key=(o["ndf"], o["masking"], o["layout"], o["estimator"]), nov=nov, alpha=alpha, param=None,
+        key=(nd, mk, o["layout"], o["estimator"], form), nov=nov, alpha=alpha, param=None,
         samples=o["samples"], seed=o["seed"], nch=2, axes=axes, channels=CHANNELS[o["layout"]],
-        reconstruction=RECONSTRUCTION[o["layout"]],
-        terms={"ndf": o["ndf"], "masking": o["masking"], "fresnel": "schlick", "layout": o["layout"]})
+        reconstruction=RECONSTRUCTION[o["layout"]], terms={**terms_record(o, "schlick"), "layout": o["layout"]})
 
 
 DFG = Kind("dfg", "split-sum specular DFG: NoV x roughness, scale/bias or multiscatter (Σ Fc·V, Σ V) channels",

@@ -19,7 +19,7 @@ import warp as wp
 from ..edge import COS_EPS
 from ..sampling import points
 from ..sampling.estimators import make_gauss_legendre, make_qmc
-from ..terms import fresnel, metals, sets
+from ..terms import fresnel, metals, ndf, sets
 from ..terms.frame import reflect
 from .base import Plan
 
@@ -87,11 +87,34 @@ def channels_for(channels_name: str):
 
 
 @functools.lru_cache(maxsize=None)
-def integrand_for(ndf_name: str, masking_name: str, channels_name: str):
-    """g(h) = D G2 (v.h)/(n.v) * channels(v.h, param), 0 where n.l or v.h <= COS_EPS (back-facing)."""
-    D = sets.NDFS[ndf_name].D
-    G2 = sets.G2_for(ndf_name, masking_name)
+def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: str = "microfacet"):
+    """g(h) = f(l, v) (n.l) 4 (v.h) * channels(v.h, param), 0 where n.l, v.h or n.v <= COS_EPS (back-facing).
+    ``form`` (lutbake.terms.sets.model_terms):
+        microfacet         f = D G2 / (4 (n.l)(n.v)) [x F]:          g = D G2 (v.h) / (n.v)
+        blinn_phong        f = (s + 8)/(8 pi) (n.h)^s [x F]:          g = (s + 8)/(8 pi) (n.h)^s 4 (n.l)(v.h)
+        ashikhmin_shirley  f = (s + 1)/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v)) [x F]:
+                                                                      g = (s + 1)/(2 pi) (n.h)^s (n.l) / max(n.l, n.v)
+    with s = 2 / alpha^2 - 2 for the last two (ndf_name, masking_name are then unused)."""
     ch, vec = channels_for(channels_name)
+    if form == "microfacet":
+        D = sets.NDFS[ndf_name].D
+        G2 = sets.G2_for(ndf_name, masking_name)
+
+        @wp.func
+        def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
+            return D(h, alpha) * G2(v[2], l[2], h[2], VoH, alpha) * VoH / v[2]
+    elif form == "blinn_phong":
+        @wp.func
+        def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
+            s = ndf.shininess_from_alpha(alpha)
+            return (s + 8.0) / (8.0 * wp.pi) * wp.exp(s * ndf.log_cos(h)) * 4.0 * l[2] * VoH
+    elif form == "ashikhmin_shirley":
+        @wp.func
+        def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
+            s = ndf.shininess_from_alpha(alpha)
+            return (s + 1.0) / (2.0 * wp.pi) * wp.exp(s * ndf.log_cos(h)) * l[2] / wp.max(l[2], v[2])
+    else:
+        raise KeyError(form)
 
     @wp.func
     def integrand(v: wp.vec3, h: wp.vec3, alpha: float, param: float):
@@ -99,10 +122,9 @@ def integrand_for(ndf_name: str, masking_name: str, channels_name: str):
         NoL = l[2]
         NoV = v[2]
         VoH = wp.dot(v, h)
-        if NoL <= COS_EPS or VoH <= COS_EPS or NoV <= COS_EPS:
+        if NoL <= COS_EPS or VoH <= COS_EPS or NoV <= COS_EPS or h[2] <= 0.0:
             return vec()
-        NoH = h[2]
-        return ch(VoH, param) * (D(h, alpha) * G2(NoV, NoL, NoH, VoH, alpha) * VoH / NoV)
+        return ch(VoH, param) * weight(v, h, l, VoH, alpha)
 
     return integrand
 
@@ -117,11 +139,19 @@ ESTIMATORS = {
 DEFAULT_SAMPLES = {"gauss_legendre": 432, "sobol_vndf": 4096, "sobol_ndf": 4096, "hammersley_ndf": 1024}
 
 
+def kernel_for(ndf_name: str, masking_name: str, channels_name: str, estimator: str, form: str = "microfacet"):
+    """The table kernel for a (terms, channels, estimator, integrand form) key; compiled once per Warp cache.
+    For the forms blinn_phong and ashikhmin_shirley ``ndf_name`` names the NDF the estimator samples
+    (blinn_phong) and ``masking_name`` is ignored."""
+    if form != "microfacet":
+        masking_name = "none"
+    return _kernel_for(ndf_name, masking_name, channels_name, estimator, form)
+
+
 @functools.lru_cache(maxsize=None)
-def kernel_for(ndf_name: str, masking_name: str, channels_name: str, estimator: str):
-    """The table kernel for a (terms, channels, estimator) key; compiled once per Warp cache."""
+def _kernel_for(ndf_name: str, masking_name: str, channels_name: str, estimator: str, form: str):
     nd = sets.NDFS[ndf_name]
-    g = integrand_for(ndf_name, masking_name, channels_name)
+    g = integrand_for(ndf_name, masking_name, channels_name, form)
     vec = channels_for(channels_name)[1]
     acc = wp.vec3d if vec is wp.vec3 else wp.vec2d
     if estimator == "gauss_legendre":
@@ -200,7 +230,7 @@ def hemisphere_plan(*, key: tuple, nov: np.ndarray, alpha: np.ndarray, param: np
     Its error estimate re-integrates probe_indices() at a higher budget: Gauss-Legendre at order n + 4
     (the difference bounds the error of order n, the higher rule being far more accurate), QMC with
     another scrambling seed (the difference is ~sqrt(2) times the error)."""
-    est = key[-1]
+    est = key[3]  # kernel_for(ndf, masking, channels, estimator[, form])
     samples = samples or DEFAULT_SAMPLES[est]
     param = np.zeros(len(nov), np.float32) if param is None else param
 

@@ -54,7 +54,8 @@ def plan(spec) -> Plan:
     samples = o["samples"] or specular.DEFAULT_SAMPLES[est]
     metal = o["metal"]
     channels_name = f"metal:{metal}" if metal else f"F:{o['fresnel']}"
-    key = (o["ndf"], o["masking"], channels_name, est)
+    form, nd, mk = dfg.terms_of(o)
+    key = (nd, mk, channels_name, est, form)
     rough, nov_axis = axes[-2:]
     nz = 1 if metal else axes[0].count
     # texel t = (iz * ny + iy) * nx + ix: z (f0) slowest, then roughness, then NoV
@@ -65,11 +66,11 @@ def plan(spec) -> Plan:
         m = METALS[metal]
         channels = {f"e_{c}": f"E with F_conductor({n} + {k}i) at {w:g} nm" for c, n, k, w in
                     zip("rgb", m.n, m.k, m.wavelengths_nm)}
-        terms = {"ndf": o["ndf"], "masking": o["masking"], "fresnel": "conductor", "metal": metal}
+        terms = {**dfg.terms_record(o, "conductor"), "metal": metal}
         extra = {"metal_source": m.source}
     else:
         channels = {"e": f"E = ∫ f (n.l) dω_l with F = {o['fresnel']}(f0 of the slice, v.h)"}
-        terms = {"ndf": o["ndf"], "masking": o["masking"], "fresnel": o["fresnel"]}
+        terms = dfg.terms_record(o, o["fresnel"])
         extra = {}
     return specular.hemisphere_plan(
         key=key, nov=nov, alpha=alpha, param=f0, samples=o["samples"], seed=o["seed"], nch=nch,
@@ -77,14 +78,14 @@ def plan(spec) -> Plan:
         reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D, terms=terms, extra=extra)
 
 
-def check_spec(spec) -> str | None:
+def check_spec(spec) -> tuple[str, str] | None:
     msg = dfg.check_spec(spec)
     if msg:
         return msg
     o = spec.options
     n = o["size"][0] * o["size"][1] * (1 if o["metal"] else o["f0_size"])
     if n > 1 << 26:
-        return f"size x f0_size = {n} texels: at most {1 << 26}"
+        return ("size", f"size x f0_size = {n} texels: at most {1 << 26}")
     return None
 
 

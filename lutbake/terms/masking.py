@@ -61,3 +61,12 @@ def G2_v_cavity(NoH: float, NoV: float, NoL: float, VoH: float, LoH: float):
     if VoH <= COS_EPS or LoH <= COS_EPS or NoH <= 0.0:
         return 0.0
     return wp.min(1.0, wp.min(2.0 * NoH * NoV / VoH, 2.0 * NoH * NoL / LoH))
+
+
+@wp.func
+def Lambda_ggx_aniso(v: wp.vec3, alpha_x: float, alpha_y: float):
+    """Smith Lambda for anisotropic GGX (Heitz 2014, Eq. 86 with alpha(phi_v)^2 = cos^2 ax^2 + sin^2 ay^2):
+    (sqrt(v.z^2 + ax^2 v.x^2 + ay^2 v.y^2) / v.z - 1) / 2; ax = ay = alpha gives Lambda_ggx."""
+    if v[2] <= COS_EPS:
+        return LAMBDA_INF
+    return 0.5 * (wp.sqrt(v[2] * v[2] + alpha_x * alpha_x * v[0] * v[0] + alpha_y * alpha_y * v[1] * v[1]) / v[2] - 1.0)

@@ -75,3 +75,149 @@ def sample_vndf_ggx(v: wp.vec3, alpha: float, u1: float, u2: float):
     s = wp.sqrt(wp.clamp(1.0 - z * z, 0.0, 1.0))
     nh = wp.vec3(s * wp.cos(phi), s * wp.sin(phi), z) + vh
     return wp.normalize(wp.vec3(alpha * nh[0], alpha * nh[1], wp.max(nh[2], 0.0)))
+
+
+# --- normalized Blinn-Phong ---------------------------------------------------------------------------
+# Shininess s <-> alpha: alpha = sqrt(2 / (s + 2)), s = 2 / alpha^2 - 2 (Walter et al. 2007, Sec. 5.2; the
+# lecture's "roughness = sqrt(2 / (2 + shininess))"): with it Blinn-Phong and Beckmann of the same alpha nearly
+# coincide, and (s + 2) / (2 pi) = 1 / (pi alpha^2).
+
+@wp.func
+def log1p64(x: wp.float64):
+    if wp.abs(x) < wp.float64(1.0e-4):
+        return x * (wp.float64(1.0) - x * (wp.float64(0.5) - x / wp.float64(3.0)))
+    return wp.log(wp.float64(1.0) + x)
+
+
+@wp.func
+def expm1_64(y: wp.float64):
+    if wp.abs(y) < wp.float64(1.0e-4):
+        return y * (wp.float64(1.0) + y * (wp.float64(0.5) + y / wp.float64(6.0)))
+    return wp.exp(y) - wp.float64(1.0)
+
+
+@wp.func
+def log_cos(h: wp.vec3):
+    """log(n.h) for a unit h, as 0.5 log(1 - x) with x = h.x^2 + h.y^2 in float64: float32 n.h rounds to 1
+    within ~3e-4 rad of the pole, where (n.h)^s with s ~ 1e8 still varies, and log(n.h) from a rounded n.h
+    has a relative error ~6e-8 / |log(n.h)| that the exponent s amplifies."""
+    x = wp.float64(h[0]) * wp.float64(h[0]) + wp.float64(h[1]) * wp.float64(h[1])
+    if x > wp.float64(0.5):  # n.h < 0.71: log(n.h) directly (|log| > 0.34, no cancellation; finite at n.h -> 0+)
+        return wp.log(wp.max(h[2], 1.0e-30))
+    return float(wp.float64(0.5) * log1p64(-x))
+
+
+@wp.func
+def shininess_from_alpha(alpha: float):
+    """Blinn-Phong exponent s = 2 / alpha^2 - 2 (>= 0 for alpha <= 1; clamped to 0 above)."""
+    return wp.max(2.0 / (alpha * alpha) - 2.0, 0.0)
+
+
+@wp.func
+def D_blinn_phong(h: wp.vec3, alpha: float):
+    """Normalized Blinn-Phong NDF (Blinn 1977; normalisation as in Walter et al. 2007, Eq. 30):
+    D = (s + 2) / (2 pi) (n.h)^s, s = 2 / alpha^2 - 2, so (s + 2) / (2 pi) = 1 / (pi alpha^2).
+    Projected area ∫ D (n.h) dω = 1. Returns 0 for n.h <= 0. Domain alpha in (0, 1] (s >= 0)."""
+    if h[2] <= 0.0:
+        return 0.0
+    a = wp.min(alpha, 1.0)
+    s = shininess_from_alpha(a)
+    return INV_PI / (a * a) * wp.exp(s * log_cos(h))
+
+
+@wp.func
+def tan2_from_u_blinn_phong(u: wp.float64, alpha: wp.float64):
+    """Inverse CDF of Blinn-Phong's D(m)(n.m) in the polar angle: u = 1 - cos^(s+2) theta, i.e.
+    cos theta = (1 - u)^(1/(s+2)) (the lecture's / Ashikhmin-Shirley's cos = xi^(1/(s+2)) with xi = 1 - u),
+    written as tan^2 = expm1(-alpha^2 log(1 - u)) since 2 / (s + 2) = alpha^2."""
+    return expm1_64(-alpha * alpha * wp.log(wp.float64(1.0) - u))
+
+
+@wp.func
+def u_from_tan2_blinn_phong(tan2: wp.float64, alpha: wp.float64):
+    """CDF of Blinn-Phong's D(m)(n.m): u = 1 - (1 + tan^2)^(-1/alpha^2)."""
+    return -expm1_64(-log1p64(tan2) / (alpha * alpha))
+
+
+# --- anisotropic GGX (Heitz 2014, JCGT 3(2), Eq. 85; tangent = +x, bitangent = +y) -----------------------
+
+@wp.func
+def D_ggx_aniso(h: wp.vec3, alpha_x: float, alpha_y: float):
+    """Anisotropic GGX: D = 1 / (pi ax ay ((h.x/ax)^2 + (h.y/ay)^2 + (h.z)^2)^2); 0 for n.h <= 0.
+    ax = ay = alpha gives D_ggx."""
+    if h[2] <= 0.0:
+        return 0.0
+    x = h[0] / alpha_x
+    y = h[1] / alpha_y
+    d = x * x + y * y + h[2] * h[2]
+    return INV_PI / (alpha_x * alpha_y * d * d)
+
+
+@wp.func
+def sample_vndf_ggx_aniso(v: wp.vec3, alpha_x: float, alpha_y: float, u1: float, u2: float):
+    """Visible-normal sample of anisotropic GGX (Heitz 2018, JCGT 7(4); spherical caps, Dupuy & Benyoub 2023):
+    stretch v by (ax, ay, 1), sample the visible hemisphere, unstretch. pdf = G1(v) max(0, v.h) D(h) / (n.v)."""
+    vh = wp.normalize(wp.vec3(alpha_x * v[0], alpha_y * v[1], v[2]))
+    phi = 2.0 * wp.pi * u1
+    z = (1.0 - u2) * (1.0 + vh[2]) - vh[2]
+    s = wp.sqrt(wp.clamp(1.0 - z * z, 0.0, 1.0))
+    nh = wp.vec3(s * wp.cos(phi), s * wp.sin(phi), z) + vh
+    return wp.normalize(wp.vec3(alpha_x * nh[0], alpha_y * nh[1], wp.max(nh[2], 0.0)))
+
+
+# --- Ashikhmin-Shirley 2000 ("An anisotropic Phong BRDF model", JGT 5(2)) -------------------------------
+
+@wp.func
+def D_ashikhmin_shirley(h: wp.vec3, nu: float, nv: float):
+    """The half-vector density of Ashikhmin & Shirley 2000 (their p_h, Sec. 3):
+    p_h = sqrt((nu + 1)(nv + 1)) / (2 pi) (n.h)^((nu h.x^2 + nv h.y^2) / (1 - (n.h)^2)),
+    nu along the tangent (+x), nv along the bitangent (+y). Normalised as a solid-angle density,
+    ∫ p_h dω = 1 (NOT the projected area: isotropic nu = nv = s gives (s+1)/(2 pi) cos^s, vs (s+2)/(2 pi) for
+    Blinn-Phong). The exponent is computed as (nu h.x^2 + nv h.y^2) * log(n.h) / x, x = h.x^2 + h.y^2, with a
+    series for small x (no 0/0 at the pole)."""
+    if h[2] <= 0.0:
+        return 0.0
+    x = h[0] * h[0] + h[1] * h[1]
+    r = 0.0  # log(n.h) / x
+    if x < 0.01:
+        r = -0.5 * (1.0 + x * (0.5 + x * (1.0 / 3.0 + x * (0.25 + x * (0.2 + x / 6.0)))))
+    else:
+        r = wp.log(h[2]) / x
+    return wp.sqrt((nu + 1.0) * (nv + 1.0)) * 0.5 * INV_PI * wp.exp((nu * h[0] * h[0] + nv * h[1] * h[1]) * r)
+
+
+@wp.func
+def as_exponent(a: float):
+    """Ashikhmin-Shirley exponent of an axis alpha by the Blinn-Phong mapping: max(2 / a^2 - 2, 0)."""
+    return wp.max(2.0 / (a * a) - 2.0, 0.0)
+
+
+@wp.func
+def sample_ashikhmin_shirley(nu: float, nv: float, u1: float, u2: float):
+    """h from p_h (Ashikhmin & Shirley 2000, Eq. 9): in the first quadrant
+    phi = atan(sqrt((nu + 1)/(nv + 1)) tan(pi xi / 2)), cos theta = (1 - u2)^(1 / (nu cos^2 phi + nv sin^2 phi + 1));
+    u1 picks the quadrant (4 u1 = q + xi) and the lobe's symmetry in x and y mirrors phi into it."""
+    t = 4.0 * u1
+    q = wp.min(wp.floor(t), 3.0)
+    xi = t - q
+    phi = wp.atan(wp.sqrt((nu + 1.0) / (nv + 1.0)) * wp.tan(0.5 * wp.pi * xi))
+    if q == 1.0:
+        phi = wp.pi - phi
+    elif q == 2.0:
+        phi = wp.pi + phi
+    elif q == 3.0:
+        phi = 2.0 * wp.pi - phi
+    cp = wp.cos(phi)
+    sp = wp.sin(phi)
+    e = nu * cp * cp + nv * sp * sp + 1.0
+    # cos = exp(L), L = log(1 - u2) / e; sin^2 = 1 - exp(2 L) = -expm1(2 L), by its series for small |2 L|
+    # (with e ~ 1e8, float32 cos rounds to 1 and 1 - cos^2 would lose the whole lobe)
+    L2 = 2.0 * wp.log(wp.max(1.0 - u2, 1.0e-30)) / e
+    s2 = 0.0
+    if L2 > -1.0e-3:
+        s2 = -L2 * (1.0 + L2 * (0.5 + L2 / 6.0))
+    else:
+        s2 = 1.0 - wp.exp(L2)
+    c = wp.exp(0.5 * L2)
+    s = wp.sqrt(wp.clamp(s2, 0.0, 1.0))
+    return wp.vec3(s * cp, s * sp, c)

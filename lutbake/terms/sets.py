@@ -27,13 +27,49 @@ NDFS = {
                ndf.tan2_from_u_ggx, ndf.u_from_tan2_ggx, ndf.sample_vndf_ggx),
     "beckmann": Ndf("beckmann", "Beckmann, normalised with 1/pi (Walter et al. 2007, Eq. 25)", ndf.D_beckmann,
                     masking.Lambda_beckmann, ndf.tan2_from_u_beckmann, ndf.u_from_tan2_beckmann),
+    # Blinn-Phong has no closed-form Smith Lambda. Walter et al. 2007 (Sec. 5.2) suggest Beckmann's at the same
+    # alpha, but that is only close for small alpha: at alpha = 1 (s = 0, D = 1/pi) it gave E(F = 1) = 1.77 at
+    # grazing view. So Blinn-Phong pairs with the V-cavity G only (Lambda = None; dfg.check_spec enforces it).
+    "blinn_phong": Ndf("blinn_phong", "normalized Blinn-Phong (s + 2)/(2 pi) (n.h)^s, s = 2/alpha^2 - 2 "
+                       "(masking = v_cavity only: no closed-form Smith Lambda)", ndf.D_blinn_phong,
+                       None, ndf.tan2_from_u_blinn_phong, ndf.u_from_tan2_blinn_phong),
 }
+SMITH_NDFS = tuple(n for n, d in NDFS.items() if d.Lambda is not None)
+
+# The lecture's models (003) as term sets of the dfg-like kinds (key ``model``). "microfacet" takes ``ndf`` and
+# ``masking`` from the config; the others fix them: (integrand form, NDF whose CDF the estimators sample, masking).
+MODELS = {
+    "microfacet": "D G2 F / (4 (n.l)(n.v)) with the config's ndf and masking (default)",
+    "cook_torrance": "Cook & Torrance 1982 as in the lecture: Beckmann D (with 1/pi), V-cavity G, Schlick F; "
+                     "the same as model = microfacet, ndf = beckmann, masking = v_cavity",
+    "blinn_phong": "the lecture's normalized Blinn-Phong lobe f = F (s + 8)/(8 pi) (n.h)^s, s = 2/alpha^2 - 2 "
+                   "(no G; the lecture's (s + 8)/8 is this times pi, per unit irradiance)",
+    "ashikhmin_shirley": "Ashikhmin & Shirley 2000, isotropic (nu = nv = s = 2/alpha^2 - 2): "
+                         "f = F sqrt((nu+1)(nv+1))/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v))",
+}
+
+
+def model_terms(model: str, ndf_name: str, masking_name: str) -> tuple[str, str, str]:
+    """(integrand form, ndf, masking) a model integrates: the form is "microfacet", "blinn_phong" or
+    "ashikhmin_shirley"; Cook-Torrance is the microfacet form with Beckmann and V-cavity."""
+    if model == "microfacet":
+        return "microfacet", ndf_name, masking_name
+    if model == "cook_torrance":
+        return "microfacet", "beckmann", "v_cavity"
+    if model in ("blinn_phong", "ashikhmin_shirley"):
+        return model, "blinn_phong", "none"
+    raise KeyError(model)
 
 MASKINGS = {
     "smith_height_correlated": "Smith G2 = 1/(1 + Lambda(v) + Lambda(l)), height-correlated (Heitz 2014, Eq. 99)",
     "smith_separable": "Smith G2 = G1(v) G1(l), separable (Heitz 2014, Eq. 98)",
     "v_cavity": "Cook-Torrance V-cavity min(1, 2 NoH NoV / VoH, 2 NoH NoL / VoH) (lecture 003)",
 }
+
+
+def pair_allowed(ndf_name: str, masking_name: str) -> bool:
+    """Smith masking needs the NDF's Lambda; V-cavity goes with any NDF."""
+    return masking_name == "v_cavity" or NDFS[ndf_name].Lambda is not None
 
 
 @functools.lru_cache(maxsize=None)

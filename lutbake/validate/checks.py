@@ -20,7 +20,7 @@ import numpy as np
 from ..edge import ALPHA_MIN, NOV_MIN
 from ..sampling import points
 from ..tables import specular
-from ..terms.sets import NDFS
+from ..terms.sets import NDFS, SMITH_NDFS
 from .probe import BRDF_PAIRS, evaluate_brdfs, evaluate_terms
 
 # Tolerances (absolute unless said otherwise). The terms run in float32: ~1e-7 is the floor.
@@ -37,15 +37,31 @@ RECIPROCITY_RTOL = 1.0e-6  # |f(l, v) - f(v, l)| / max(f(l, v), f(v, l)), relati
 FRESNEL_EQ2_TOL = 2.0e-6  # |Eq. 2 (f0, c) - F_dielectric((1 + sqrt f0) / (1 - sqrt f0), c)|, f0 <= 0.95
 SCHLICK_ENDPOINT_TOL = 2.4e-7  # |F_schlick(f0, 1) - f0|, |F_schlick(f0, 0) - 1|: two float32 ulps at 1
 ESTIMATOR_AGREEMENT_TOL = 5.0e-5  # |gauss_legendre - sobol_vndf (2^16 samples)| per channel
+ANISO_AREA_TOL = 1.0e-6  # |∫ D_ggx_aniso(m)(n.m) dω_m - 1|
+AS_DENSITY_TOL = 1.0e-6  # |∫ p_h(m) dω_m - 1| of Ashikhmin-Shirley's half-vector density
+ANISO_FURNACE_TOL = 1.0e-6  # |∫ G1(v) max(0, v.m) D_ggx_aniso(m) dω_m - n.v|
+# Kulla-Conty: |E + E_ms - 1| with E_ms integrated over the albedo table's own midpoint grid in n.l (as a shader
+# would). For r >= 0.1 the residual is the midpoint rule's error; on the smoothest row (alpha ~ 2e-3) the whole
+# loss 1 - E sits within n.l < alpha, inside the first texel, so the midpoint estimate of ∫(1 - E) mu dmu is off by a
+# few percent of a 2e-5 loss: a limit of the 96-column grid, not of the model.
+KC_FURNACE_TOL = 2.0e-5  # rows with r >= 0.1
+KC_FURNACE_TOL_SMOOTHEST = 5.0e-3  # every row
 
 # Grids.
 PROJECTED_AREA_ALPHAS = (1.0e-3, 1.0e-2, 0.1, 0.5, 1.0)
+ANISOTROPIES = (0.5, 1.0, -1.0)  # with PROJECTED_AREA_ALPHAS, through the Burley mapping (tables.aniso.alpha_xy)
+ANISO_FURNACE_NOVS = (0.1, 0.5, 1.0)
+ANISO_FURNACE_PHIS = (0.0, np.pi / 4, np.pi / 2)
+ANISO_FURNACE_ALPHAS = (1.0e-2, 0.3)
+ANISO_PHI_PANELS = 24  # equal panels in the azimuth (GL_NODES each)
+KC_N_MU, KC_N_ROUGH = 96, 12  # the Kulla-Conty furnace's albedo table: [NoV, roughness] texels
 FURNACE_NOVS = (0.01, 0.1, 0.3, 0.5, 0.7, 0.9, 1.0)
 FURNACE_ALPHAS = (1.0e-3, 1.0e-2, 0.1, 0.5, 1.0)
 ALBEDO_COUNT = 24  # texel-centre grid in n.v and perceptual roughness, plus the clamped edges
 MIRROR_NOVS = tuple(np.linspace(0.05, 1.0, 20))  # below ~0.05, Lambda(alpha = 1e-4) is not yet negligible
 ALBEDO_MASKINGS = ("smith_height_correlated", "smith_separable")
-DFG_MIRROR_PAIRS = (("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"))
+DFG_MIRROR_PAIRS = (("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"), ("beckmann", "v_cavity"),
+                    ("blinn_phong", "v_cavity"))
 RECIPROCITY_SAMPLES = 4096
 ESTIMATOR_TEXELS = ((0.1, 0.04), (0.3, 1.0), (0.5, 0.25), (0.9, 0.64), (1.0, 0.01))  # (n.v, alpha)
 ESTIMATOR_QMC_SAMPLES = 1 << 16
@@ -153,6 +169,132 @@ def weak_white_furnace(ndf_name: str) -> CheckResult:
     return _result(f"weak_white_furnace[{ndf_name}]", errors[k], WEAK_FURNACE_TOL,
                    f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over n.v in {FURNACE_NOVS} x alpha in {FURNACE_ALPHAS}; "
                    f"worst at (n.v, alpha)={where[k]}")
+
+
+def _aniso_pairs(alphas=PROJECTED_AREA_ALPHAS) -> list[tuple[float, float, float, float]]:
+    """(alpha, a, alpha_x, alpha_y) through the Burley mapping of the specular_aniso kind."""
+    from ..tables.aniso import alpha_xy
+
+    out = []
+    for alpha in alphas:
+        for a in ANISOTROPIES:
+            ax, ay = alpha_xy(np.array([alpha]), np.array([a]))
+            out.append((alpha, a, float(ax[0]), float(ay[0])))
+    return out
+
+
+def _sphere_quadrature(scale: float, theta_cut: float | None = None, horizon: bool = False):
+    """Composite GL nodes in theta on [0, pi/2] graded from the pole at ``scale``, about a cut start if given,
+    and towards the horizon if ``horizon`` (where (n.h)^e with a non-integer e is not analytic)."""
+    anchors = [(0.0, np.arctan(scale) / 16.0)] + ([(np.pi / 2, CUT_FIRST_PANEL)] if horizon else [])
+    if theta_cut is not None:
+        anchors.append((theta_cut, CUT_FIRST_PANEL))
+    return _composite_gl(_graded_edges(0.0, np.pi / 2, anchors))
+
+
+def _aniso_measure(term: str, weight, horizon: bool = False) -> tuple[float, tuple]:
+    """max over _aniso_pairs of |2D integral of term(m) weight(theta) over the hemisphere - 1|; the azimuth on
+    [0, pi/2] (the lobes are symmetric in x and y) graded from both ends, times 4."""
+    errors, where = [], []
+    phi, wphi = _composite_gl(_graded_edges(0.0, np.pi / 2, [(0.0, 1.0e-3), (np.pi / 2, 1.0e-3)]))
+    for alpha, a, ax, ay in _aniso_pairs():
+        theta, wt = _sphere_quadrature(min(ax, ay), horizon=horizon)
+        h = _h(theta[:, None], phi[None, :])
+        D = evaluate_terms(h=h, alpha=ax, alpha_y=ay)[term].astype(np.float64)
+        val = 4.0 * np.sum((wt * weight(theta))[:, None] * wphi[None, :] * D)
+        errors.append(abs(val - 1.0))
+        where.append((alpha, a))
+    k = int(np.argmax(errors))
+    return errors[k], where[k]
+
+
+def ndf_projected_area_is_one_aniso() -> CheckResult:
+    """Anisotropic GGX: ∫ D(m)(n.m) dω_m = ∫∫ D cos(theta) sin(theta) dtheta dphi = 1 for (alpha_x, alpha_y) of
+    alpha in PROJECTED_AREA_ALPHAS x anisotropy in ANISOTROPIES (Burley mapping); composite GL in theta graded
+    from the pole at atan(min(alpha_x, alpha_y)) and in phi graded towards both axes."""
+    err, where = _aniso_measure("D_ggx_aniso", lambda t: np.cos(t) * np.sin(t))
+    return _result("ndf_projected_area_is_one[ggx_aniso]", err, ANISO_AREA_TOL,
+                   f"max |∫D(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS} x anisotropy in {ANISOTROPIES}; "
+                   f"worst at (alpha, a)={where}")
+
+
+def ashikhmin_shirley_density_is_one() -> CheckResult:
+    """Ashikhmin & Shirley 2000's half-vector density, p_h = sqrt((nu+1)(nv+1))/(2 pi) (n.h)^(...), integrates to
+    1 over the hemisphere (a solid-angle density: ∫ p_h dω = 1, not the projected area), for nu, nv of the
+    same (alpha_x, alpha_y) pairs (nu = max(2/alpha_x^2 - 2, 0))."""
+    err, where = _aniso_measure("D_ashikhmin_shirley", lambda t: np.sin(t), horizon=True)
+    return _result("ashikhmin_shirley_density_is_one", err, AS_DENSITY_TOL,
+                   f"max |∫p_h dω - 1| over alpha in {PROJECTED_AREA_ALPHAS} x anisotropy in {ANISOTROPIES}; "
+                   f"worst at (alpha, a)={where}")
+
+
+def weak_white_furnace_aniso() -> CheckResult:
+    """Anisotropic GGX with its anisotropic Smith Lambda: ∫ G1(v) max(0, v.m) D(m) dω_m = n.v for v at
+    n.v in ANISO_FURNACE_NOVS and azimuth phi_v in ANISO_FURNACE_PHIS (from the tangent).
+    v.m > 0 iff cos(phi - phi_v) > c(theta) = -cot(theta_v) cot(theta): with psi = phi - phi_v the visible
+    azimuths are |psi| < acos(c) (all of them below theta = pi/2 - theta_v); composite GL in theta (graded
+    from the pole and about the cut start) times ANISO_PHI_PANELS equal GL panels in psi over the exact interval."""
+    errors, where = [], []
+    s, ws = _composite_gl(np.linspace(-1.0, 1.0, ANISO_PHI_PANELS + 1))
+    for alpha, a, ax, ay in _aniso_pairs(ANISO_FURNACE_ALPHAS):
+        for nov in ANISO_FURNACE_NOVS:
+            sin_v = np.sqrt(max(1.0 - nov * nov, 0.0))
+            theta_c = np.pi / 2 - np.arccos(nov)
+            theta, wt = _sphere_quadrature(min(ax, ay), theta_c)
+            with np.errstate(divide="ignore"):
+                c = np.where(theta < theta_c, -1.0, -nov / max(sin_v, 1e-300) / np.tan(theta))
+            psimax = np.arccos(np.clip(c, -1.0, 1.0))
+            for phi_v in ANISO_FURNACE_PHIS:
+                v = np.array([sin_v * np.cos(phi_v), sin_v * np.sin(phi_v), nov])
+                psi = psimax[:, None] * s[None, :]
+                h = _h(theta[:, None], phi_v + psi)
+                terms = evaluate_terms(h=h, v=v, alpha=ax, alpha_y=ay)
+                D = terms["D_ggx_aniso"].astype(np.float64)
+                lam = float(terms["Lambda_ggx_aniso"].ravel()[0])
+                vom = np.maximum(h.astype(np.float32).astype(np.float64) @ v, 0.0)
+                inner = np.sum(psimax[:, None] * ws[None, :] * vom * D, axis=1)
+                integral = np.sum(wt * np.sin(theta) * inner) / (1.0 + lam)
+                errors.append(abs(integral - nov))
+                where.append((nov, round(phi_v, 4), alpha, a))
+    k = int(np.argmax(errors))
+    return _result("weak_white_furnace[ggx_aniso]", errors[k], ANISO_FURNACE_TOL,
+                   f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over n.v in {ANISO_FURNACE_NOVS} x phi_v in {{0, pi/4, pi/2}} "
+                   f"x alpha in {ANISO_FURNACE_ALPHAS} x anisotropy in {ANISOTROPIES}; worst at (n.v, phi_v, alpha, a)={where[k]}")
+
+
+def kulla_conty_residual(E: np.ndarray, E_avg: np.ndarray, mu: np.ndarray) -> np.ndarray:
+    """E(mu_o) + ∫ f_ms(mu_o, mu_i) mu_i dω_i - 1 for every texel of an albedo table E (rows = roughness,
+    columns = mu = n.v), with f_ms = (1 - E(mu_o))(1 - E(mu_i)) / (pi (1 - E_avg)) (Kulla & Conty 2017) and the
+    mu_i integral by the midpoint rule on the table's texel centres (as a shader would sum it)."""
+    E = E.astype(np.float64)
+    dmu = 1.0 / len(mu)
+    loss = 2.0 * np.pi * np.sum((1.0 - E) * mu * dmu, axis=1) / np.pi  # ∫(1 - E(mu_i)) mu_i dω_i / pi
+    E_ms = (1.0 - E) * (loss / np.maximum(1.0 - E_avg.astype(np.float64), 1e-12))[:, None]
+    return E + E_ms - 1.0
+
+
+def kulla_conty_white_furnace() -> CheckResult:
+    """The energy-compensated BRDF (single scattering + Kulla-Conty's f_ms) reflects everything at F = 1:
+    E + E_ms = 1 for every n.v and roughness. Bakes the default ``albedo`` (GGX, height-correlated Smith;
+    KC_N_MU x KC_N_ROUGH) and ``albedo_avg`` tables and measures max |E + E_ms - 1| per roughness row
+    (kulla_conty_residual). Measured: the worst row with r >= 0.1 (tolerance KC_FURNACE_TOL); the smoothest rows
+    must stay within KC_FURNACE_TOL_SMOOTHEST (module constants)."""
+    from ..api import bake_table
+    from ..config import validate_table
+
+    e = bake_table(validate_table({"name": "e", "kind": "albedo", "size": [KC_N_MU, KC_N_ROUGH]}, "<check>", 0))[0]
+    avg = bake_table(validate_table({"name": "a", "kind": "albedo_avg", "roughness_size": KC_N_ROUGH}, "<check>", 0))[0]
+    mu = e.axes[1].values().astype(np.float64)
+    worst = np.max(np.abs(kulla_conty_residual(e.data[..., 0], avg.data[0, :, 0], mu)), axis=1)
+    rough = e.axes[0].values()
+    measured = float(np.max(worst[rough >= 0.1]))
+    if np.max(worst) > KC_FURNACE_TOL_SMOOTHEST:
+        measured = float("inf")
+    loss = float(np.max(1.0 - e.data[..., 0]))
+    rows = ", ".join(f"r={r:.3f}: {w:.1e}" for r, w in zip(rough, worst))
+    return _result("kulla_conty_white_furnace", measured, KC_FURNACE_TOL,
+                   f"max |E + E_ms - 1| per roughness row ({rows}); all rows <= {KC_FURNACE_TOL_SMOOTHEST:.0e}: "
+                   f"{bool(np.max(worst) <= KC_FURNACE_TOL_SMOOTHEST)}; uncompensated max loss 1 - E = {loss:.3f}")
 
 
 # --- tables ------------------------------------------------------------------------------------------
@@ -273,9 +415,12 @@ def _registry() -> dict:
     checks = {}
     for n in NDFS:
         checks[f"ndf_projected_area_is_one[{n}]"] = functools.partial(ndf_projected_area_is_one, n)
-    for n in NDFS:
+    checks["ndf_projected_area_is_one[ggx_aniso]"] = ndf_projected_area_is_one_aniso
+    checks["ashikhmin_shirley_density_is_one"] = ashikhmin_shirley_density_is_one
+    for n in SMITH_NDFS:
         checks[f"weak_white_furnace[{n}]"] = functools.partial(weak_white_furnace, n)
-    for n in NDFS:
+    checks["weak_white_furnace[ggx_aniso]"] = weak_white_furnace_aniso
+    for n in SMITH_NDFS:
         for m in ALBEDO_MASKINGS:
             checks[f"albedo_le_one_and_mirror_limit[{n},{m}]"] = functools.partial(albedo_le_one_and_mirror_limit, n, m)
     for n, m in DFG_MIRROR_PAIRS:
@@ -285,6 +430,7 @@ def _registry() -> dict:
     checks["fresnel_eq2_is_exact_dielectric"] = fresnel_eq2_is_exact_dielectric
     checks["schlick_endpoints"] = schlick_endpoints
     checks["estimators_agree"] = estimators_agree
+    checks["kulla_conty_white_furnace"] = kulla_conty_white_furnace
     return checks
 
 

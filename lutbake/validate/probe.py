@@ -14,6 +14,9 @@ Host API (inputs broadcast against each other; ``h``, ``l``, ``v`` carry a trail
         G1_smith_<ndf>     G1_smith(Lambda(nov, alpha))
         G2[<ndf>,<masking>]  sets.G2_for(ndf, masking)(nov, nol, h.z, voh, alpha)  (the composed G2 tables use)
         G2_v_cavity        G2_v_cavity(h.z, nov, nol, voh, loh)          (with its own l.h)
+        D_ggx_aniso        D_ggx_aniso(h, alpha, alpha_y)               (alpha = alpha_x along the tangent +x)
+        Lambda_ggx_aniso   Lambda_ggx_aniso(v, alpha, alpha_y)
+        D_ashikhmin_shirley  D_ashikhmin_shirley(h, as_exponent(alpha), as_exponent(alpha_y))
         F_schlick          F_schlick(f0, cos_theta);   Fc_schlick  Fc_schlick(cos_theta)
         F_dielectric       F_dielectric(eta, cos_theta)
         F_dielectric_f0    F_dielectric_f0(f0, cos_theta)
@@ -31,8 +34,8 @@ import numpy as np
 import warp as wp
 
 from ..edge import COS_EPS
-from ..terms import fresnel, masking
-from ..terms.sets import MASKINGS, NDFS, G2_for
+from ..terms import fresnel, masking, ndf
+from ..terms.sets import MASKINGS, NDFS, G2_for, pair_allowed
 
 wp.set_module_options({"enable_backward": False})
 
@@ -41,7 +44,9 @@ wp.set_module_options({"enable_backward": False})
 class TermInputs:
     """One input record: every term reads the fields it needs (see the module docstring)."""
     h: wp.vec3
+    v: wp.vec3
     alpha: float
+    alpha_y: float
     nov: float
     nol: float
     voh: float
@@ -60,6 +65,9 @@ def _ndf_probes(ndf_name: str) -> list:
     @wp.func
     def probe_D(x: TermInputs):
         return D(x.h, x.alpha)
+
+    if Lam is None:  # no Smith Lambda (blinn_phong)
+        return [(f"D_{ndf_name}", probe_D)]
 
     @wp.func
     def probe_Lambda(x: TermInputs):
@@ -88,6 +96,21 @@ def _probe_G2_v_cavity(x: TermInputs):
 
 
 @wp.func
+def _probe_D_ggx_aniso(x: TermInputs):
+    return ndf.D_ggx_aniso(x.h, x.alpha, x.alpha_y)
+
+
+@wp.func
+def _probe_Lambda_ggx_aniso(x: TermInputs):
+    return masking.Lambda_ggx_aniso(x.v, x.alpha, x.alpha_y)
+
+
+@wp.func
+def _probe_D_ashikhmin_shirley(x: TermInputs):
+    return ndf.D_ashikhmin_shirley(x.h, ndf.as_exponent(x.alpha), ndf.as_exponent(x.alpha_y))
+
+
+@wp.func
 def _probe_F_schlick(x: TermInputs):
     return fresnel.F_schlick(x.f0, x.cos_theta)
 
@@ -107,11 +130,13 @@ def _probe_F_dielectric_f0(x: TermInputs):
     return fresnel.F_dielectric_f0(x.f0, x.cos_theta)
 
 
-BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS)
+BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS if pair_allowed(n, m))
 
 _PROBES = (
     [p for n in NDFS for p in _ndf_probes(n)]
     + [_g2_probe(n, m) for n, m in BRDF_PAIRS]
+    + [("D_ggx_aniso", _probe_D_ggx_aniso), ("Lambda_ggx_aniso", _probe_Lambda_ggx_aniso),
+       ("D_ashikhmin_shirley", _probe_D_ashikhmin_shirley)]
     + [("G2_v_cavity", _probe_G2_v_cavity), ("F_schlick", _probe_F_schlick), ("Fc_schlick", _probe_Fc_schlick),
        ("F_dielectric", _probe_F_dielectric), ("F_dielectric_f0", _probe_F_dielectric_f0)]
 )
@@ -122,7 +147,9 @@ _PROBE_FUNCS = [f for _, f in _PROBES]
 @wp.kernel
 def _terms_kernel(
     h: wp.array(dtype=wp.vec3),
+    v: wp.array(dtype=wp.vec3),
     alpha: wp.array(dtype=float),
+    alpha_y: wp.array(dtype=float),
     nov: wp.array(dtype=float),
     nol: wp.array(dtype=float),
     voh: wp.array(dtype=float),
@@ -135,7 +162,9 @@ def _terms_kernel(
     i = wp.tid()
     x = TermInputs()
     x.h = h[i]
+    x.v = v[i]
     x.alpha = alpha[i]
+    x.alpha_y = alpha_y[i]
     x.nov = nov[i]
     x.nol = nol[i]
     x.voh = voh[i]
@@ -204,19 +233,23 @@ def _vec_and_scalars(vecs: dict, scalars: dict) -> tuple[tuple, dict]:
     return shape, flat
 
 
-def evaluate_terms(*, h=(0.0, 0.0, 1.0), alpha=0.5, nov=1.0, nol=1.0, voh=1.0, loh=1.0, f0=0.04, eta=1.5,
-                   cos_theta=1.0, device: str = "cpu") -> dict[str, np.ndarray]:
+def evaluate_terms(*, h=(0.0, 0.0, 1.0), v=(0.0, 0.0, 1.0), alpha=0.5, alpha_y=None, nov=1.0, nol=1.0, voh=1.0,
+                   loh=1.0, f0=0.04, eta=1.5, cos_theta=1.0, device: str = "cpu") -> dict[str, np.ndarray]:
     """Every term of ``TERM_NAMES`` at the broadcast inputs (module docstring) -> {name: float32 array}.
-    ``h`` is in the shading frame (n = +z) and is used as given (not normalised); n.h for G2 is h.z."""
+    ``h`` is in the shading frame (n = +z) and is used as given (not normalised); n.h for G2 is h.z.
+    The anisotropic terms read ``alpha`` as alpha_x (tangent, +x), ``alpha_y`` (default: alpha) and the
+    direction ``v``; D_ashikhmin_shirley has exponents nu, nv = max(2/alpha^2 - 2, 0) of alpha, alpha_y."""
+    alpha_y = alpha if alpha_y is None else alpha_y
     shape, x = _vec_and_scalars(
-        {"h": h},
-        {"alpha": alpha, "nov": nov, "nol": nol, "voh": voh, "loh": loh, "f0": f0, "eta": eta, "cos_theta": cos_theta},
+        {"h": h, "v": v},
+        {"alpha": alpha, "alpha_y": alpha_y, "nov": nov, "nol": nol, "voh": voh, "loh": loh, "f0": f0, "eta": eta,
+         "cos_theta": cos_theta},
     )
     n = int(np.prod(shape, dtype=np.int64))
     out = wp.zeros((n, len(TERM_NAMES)), dtype=float, device=device)
-    inputs = [wp.array(x["h"], dtype=wp.vec3, device=device)]
+    inputs = [wp.array(x[k], dtype=wp.vec3, device=device) for k in ("h", "v")]
     inputs += [wp.array(x[k], dtype=float, device=device)
-               for k in ("alpha", "nov", "nol", "voh", "loh", "f0", "eta", "cos_theta")]
+               for k in ("alpha", "alpha_y", "nov", "nol", "voh", "loh", "f0", "eta", "cos_theta")]
     if n:
         wp.launch(_terms_kernel, dim=n, inputs=inputs + [out], device=device)
     res = out.numpy()
