@@ -103,6 +103,14 @@ def u_visible_ggx(cos_x: wp.float64, alpha: wp.float64):
     return c2 / (alpha * alpha * (wp.float64(1.0) - c2) + c2)
 
 
+@wp.func
+def om_visible_ggx(cos_x: wp.float64, alpha: wp.float64):
+    """1 - u_visible_ggx, without cancellation: alpha^2 (1 - (n.x)^2) / (alpha^2 (1 - (n.x)^2) + (n.x)^2)."""
+    c2 = cos_x * cos_x
+    t = alpha * alpha * (wp.float64(1.0) - c2)
+    return t / (t + c2)
+
+
 @functools.lru_cache(maxsize=None)
 def fd_microfacet_for(facet_fresnel: str):
     """The microfacet diffuse BRDF ``fd_microfacet(l, v, alpha, f0, xg, wg) -> float64`` (rho = 1), Eq. 4,
@@ -127,80 +135,102 @@ def fd_microfacet_for(facet_fresnel: str):
         phv = wp.atan2(wp.float64(v[1]), wp.float64(v[0]))
         ul = u_visible_ggx(cl, a64)
         uv = u_visible_ggx(cv, a64)
+        oml = om_visible_ggx(cl, a64)
+        omv = om_visible_ggx(cv, a64)
         u1 = wp.min(ul, uv)
         u2 = wp.max(ul, uv)
+        om1 = wp.max(oml, omv)  # 1 - u1
+        om2 = wp.min(oml, omv)  # 1 - u2
         n = xg.shape[0]
         acc = wp.float64(0.0)
-        for p in range(3):
-            lo = wp.float64(0.0)
-            hi = u1
-            if p == 1:
-                lo = u1
-                hi = u2
-            if p == 2:
-                lo = u2
-                hi = one
-            du = hi - lo
-            if du > wp.float64(0.0):
-                for k in range(n):
-                    s = xg[k]
-                    u = lo + du * s * s * (wp.float64(3.0) - wp.float64(2.0) * s)
-                    wu = wg[k] * du * wp.float64(6.0) * s * (one - s)
-                    # 1 - u without cancellation (u_l -> 1 for n.l -> 1 and small alpha)
-                    omu = (one - hi) + du * (one - s) * (one - s) * (one + wp.float64(2.0) * s)
-                    tan2 = a64 * a64 * u / omu
-                    cm = one / wp.sqrt(one + tan2)
-                    sm = wp.sqrt(tan2) * cm
-                    wl = arc_half_width(cm, sm, cl, sl)
-                    wv = arc_half_width(cm, sm, cv, sv)
-                    b0 = wrap_2pi(phl - wl)
-                    b1 = wrap_2pi(phl + wl)
-                    b2 = wrap_2pi(phv - wv)
-                    b3 = wrap_2pi(phv + wv)
-                    # sorting network for four values
-                    if b0 > b1:
-                        t = b0
-                        b0 = b1
-                        b1 = t
-                    if b2 > b3:
-                        t = b2
-                        b2 = b3
-                        b3 = t
-                    if b0 > b2:
-                        t = b0
-                        b0 = b2
-                        b2 = t
-                    if b1 > b3:
-                        t = b1
-                        b1 = b3
-                        b3 = t
-                    if b1 > b2:
-                        t = b1
-                        b1 = b2
-                        b2 = t
-                    row = wp.float64(0.0)
-                    for q in range(4):
-                        a = b0
-                        b = b1
-                        if q == 1:
-                            a = b1
-                            b = b2
-                        if q == 2:
-                            a = b2
-                            b = b3
-                        if q == 3:
-                            a = b3
-                            b = b0 + TWO_PI64
-                        dphi = b - a
-                        if dphi > wp.float64(0.0):
-                            for j in range(n):
-                                phi = a + dphi * xg[j]
-                                m = wp.vec3(float(sm * wp.cos(phi)), float(sm * wp.sin(phi)), float(cm))
-                                MoL = wp.dot(m, l)
-                                MoV = wp.dot(m, v)
-                                if MoL > 0.0 and MoV > 0.0:
-                                    row = row + wg[j] * dphi * wp.float64(MoL * MoV * Ff(MoL, MoV, f0))
-                    acc = acc + wu * row / cm
+        n_geo = diffuse_albedo.n_tail_cuts(a64)
+        prev = wp.float64(0.0)
+        om_prev = one
+        for g in range(n_geo + 1):
+            cut = one
+            om_cut = wp.float64(0.0)
+            if g < n_geo:
+                r2 = wp.pow(diffuse_albedo.TAIL_RATIO64, wp.float64(2 * (g + 1)))
+                om_cut = one / (one + r2)
+                cut = r2 / (one + r2)
+            # the segment [prev, cut] cut at u1 and u2 where they fall inside it
+            om_a = wp.clamp(om1, om_cut, om_prev)
+            om_b = wp.clamp(om2, om_cut, om_prev)
+            for p in range(3):
+                lo = prev
+                om_lo = om_prev
+                om_hi = om_a
+                if p == 1:
+                    om_lo = om_a
+                    om_hi = om_b
+                if p == 2:
+                    om_lo = om_b
+                    om_hi = om_cut
+                if p > 0:
+                    lo = one - om_lo
+                du = om_lo - om_hi
+                if du > wp.float64(0.0):
+                    for k in range(n):
+                        s = xg[k]
+                        u = lo + du * s * s * (wp.float64(3.0) - wp.float64(2.0) * s)
+                        wu = wg[k] * du * wp.float64(6.0) * s * (one - s)
+                        # 1 - u without cancellation (u_l -> 1 for n.l -> 1 and small alpha)
+                        omu = om_hi + du * (one - s) * (one - s) * (one + wp.float64(2.0) * s)
+                        tan2 = a64 * a64 * u / omu
+                        cm = one / wp.sqrt(one + tan2)
+                        sm = wp.sqrt(tan2) * cm
+                        wl = arc_half_width(cm, sm, cl, sl)
+                        wv = arc_half_width(cm, sm, cv, sv)
+                        b0 = wrap_2pi(phl - wl)
+                        b1 = wrap_2pi(phl + wl)
+                        b2 = wrap_2pi(phv - wv)
+                        b3 = wrap_2pi(phv + wv)
+                        # sorting network for four values
+                        if b0 > b1:
+                            t = b0
+                            b0 = b1
+                            b1 = t
+                        if b2 > b3:
+                            t = b2
+                            b2 = b3
+                            b3 = t
+                        if b0 > b2:
+                            t = b0
+                            b0 = b2
+                            b2 = t
+                        if b1 > b3:
+                            t = b1
+                            b1 = b3
+                            b3 = t
+                        if b1 > b2:
+                            t = b1
+                            b1 = b2
+                            b2 = t
+                        row = wp.float64(0.0)
+                        for q in range(4):
+                            a = b0
+                            b = b1
+                            if q == 1:
+                                a = b1
+                                b = b2
+                            if q == 2:
+                                a = b2
+                                b = b3
+                            if q == 3:
+                                a = b3
+                                b = b0 + TWO_PI64
+                            dphi = b - a
+                            if dphi > wp.float64(0.0):
+                                for j in range(n):
+                                    phi = a + dphi * xg[j]
+                                    m = wp.vec3(float(sm * wp.cos(phi)), float(sm * wp.sin(phi)), float(cm))
+                                    MoL = wp.dot(m, l)
+                                    MoV = wp.dot(m, v)
+                                    if MoL > 0.0 and MoV > 0.0:
+                                        row = row + wg[j] * dphi * wp.float64(MoL * MoV * Ff(MoL, MoV, f0))
+                        acc = acc + wu * row / cm
+            prev = cut
+            om_prev = om_cut
         return wp.float64(G2) * acc / (TWO_PI64 * PI64 * cl * cv)
 
     return fd_microfacet
