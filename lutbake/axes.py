@@ -18,6 +18,8 @@ import numpy as np
 
 from .edge import ALPHA_MIN, NOV_MIN
 
+IMAGE_DIMS = {"x": "columns", "y": "rows", "z": "slices",
+              "y_block": "row blocks: image row = (y_block index) * (count of the y axis) + (y index)"}
 TEXELS = {"center": "t = (i + 0.5) / N", "endpoint": "t = i / (N - 1)"}
 MAPPINGS = {"linear": "value = lo + (hi - lo) * t"}
 ROUGHNESS_PARAMS = {
@@ -29,7 +31,7 @@ ROUGHNESS_PARAMS = {
 @dataclass(frozen=True)
 class Axis:
     name: str  # NoV, perceptual_roughness, alpha, ...
-    dim: str  # x = columns, y = rows, z = slices
+    dim: str  # x = columns, y = rows, z = slices, y_block = blocks of rows (a 4th axis flattened into the rows)
     count: int
     lo: float = 0.0
     hi: float = 1.0
@@ -63,7 +65,7 @@ class Axis:
         d = {
             "name": self.name,
             "dim": self.dim,
-            "image": {"x": "columns", "y": "rows", "z": "slices"}[self.dim],
+            "image": IMAGE_DIMS[self.dim],
             "count": self.count,
             "range": [self.lo, self.hi],
             "texel": self.texel,
