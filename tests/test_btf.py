@@ -72,3 +72,21 @@ def test_exr_round_trip_has_a_part_per_sigma_slice(cosines, tmp_path):
 def test_too_many_texels_is_rejected():
     with pytest.raises(ConfigError, match="phi_size"):
         spec(size=[1024, 1024], phi_size=1024, sigma_size=64)
+
+
+def test_explicit_sigma_values_make_a_listed_axis(tmp_path):
+    t = bake_table(spec(model="fitted", sigma_values=[0.0, 0.3, 0.35]), workers=1)[0]
+    assert t.data.shape == (3, 15, 5, 1)
+    assert t.axes[0].mapping == "listed"
+    np.testing.assert_allclose(t.axes[0].values(), [0.0, 0.3, 0.35], rtol=1e-7)
+    data, attrs = read_exr(write_exr(t, tmp_path / "b.exr"))
+    ax = json.loads(attrs["axes"])[0]
+    assert ax["mapping"] == "listed" and ax["values"] == pytest.approx([0.0, 0.3, 0.35])
+    assert json.loads(attrs["sigma_values"]) == pytest.approx([0.0, 0.3, 0.35])
+
+
+@pytest.mark.parametrize("bad, fragment", [([0.3, 0.2], "increasing"), ([0.1, 1.5], "<= 1"), ([], "list of 1"),
+                                           ([0.1, "x"], "list of 1"), (0.5, "list of 1"), ([0.1, float("nan")], "finite")])
+def test_bad_sigma_values_are_rejected(bad, fragment):
+    with pytest.raises(ConfigError, match=fragment):
+        spec(sigma_values=bad)

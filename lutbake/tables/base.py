@@ -21,7 +21,7 @@ class Key:
     """One config key: its type, default, allowed values (or a range) and a line of documentation."""
 
     name: str
-    type: str  # "str", "int", "float", "int_pair", "float_range", "name"
+    type: str  # "str", "int", "float", "int_pair", "float_range", "float_list", "name"
     default: Any
     doc: str
     choices: dict[str, str] | None = None  # value -> description

@@ -38,6 +38,9 @@ KEYS = {
     "phi_size": Key("phi_size", "int", 32, "azimuth texel count (row blocks)", minimum=1, maximum=4096),
     "sigma_size": Key("sigma_size", "int", 16, "sigma slice count (z, one EXR part each)", minimum=1, maximum=1024),
     "sigma_range": diffuse.KEYS["sigma_range"],
+    "sigma_values": Key("sigma_values", "float_list", None, "explicit sigma of every slice, strictly increasing "
+                        "(replaces sigma_size and sigma_range; the axis mapping is then 'listed')",
+                        minimum=0.0, maximum=1.0),
     "parametrisation": Key("parametrisation", "str", "cosines", "what the light, view and azimuth axes hold",
                            PARAMETRISATIONS),
     "model": Key("model", "str", "microfacet", "the diffuse BRDF tabulated", diffuse.MODELS),
@@ -62,7 +65,11 @@ RECONSTRUCTION = (
 def axes_for(o: dict) -> list[Axis]:
     nl, nv = o["size"]
     tx = o["texel"]
-    sig = Axis("sigma", "z", o["sigma_size"], *o["sigma_range"], texel=tx)
+    if o["sigma_values"] is not None:
+        vals = tuple(float(x) for x in o["sigma_values"])
+        sig = Axis("sigma", "z", len(vals), vals[0], vals[-1], texel=tx, mapping="listed", listed=vals)
+    else:
+        sig = Axis("sigma", "z", o["sigma_size"], *o["sigma_range"], texel=tx)
     if o["parametrisation"] == "cosines":
         return [sig, Axis("cos_phi", "y_block", o["phi_size"], -1.0, 1.0, texel=tx),
                 Axis("NoV", "y", nv, 0.0, 1.0, texel=tx), Axis("NoL", "x", nl, 0.0, 1.0, texel=tx)]
@@ -152,7 +159,8 @@ def plan(spec) -> Plan:
 
 def check_spec(spec) -> str | None:
     o = spec.options
-    n = o["size"][0] * o["size"][1] * o["phi_size"] * o["sigma_size"]
+    ns = o["sigma_size"] if o["sigma_values"] is None else len(o["sigma_values"])
+    n = o["size"][0] * o["size"][1] * o["phi_size"] * ns
     if n > 1 << 26:
         return f"size x phi_size x sigma_size = {n} texels: at most {1 << 26}"
     return None
