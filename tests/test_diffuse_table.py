@@ -72,3 +72,15 @@ def test_swapped_albedo_matches_the_nested_rule():
 def test_microfacet_table_records_its_error_estimate(microfacet):
     assert float(microfacet.attributes["error_estimate"]) < 1e-5
     assert "probe texels" in microfacet.attributes["error_estimate_method"]
+
+
+def test_grazing_small_sigma_corner_is_converged():
+    """The corner the old nested rule missed by 2.9e-3 (NoV = sigma = 1/128): the default orders against order 32."""
+    from lutbake.tables import diffuse_albedo as A
+
+    t = bake_table(spec(model="microfacet", size=[4, 4], nov_range=[0.0, 0.0625], sigma_range=[0.0, 0.0625]),
+                   workers=1)[0]
+    nov = np.tile(t.axes[1].values(), 4).astype(np.float64)
+    alpha = np.repeat(t.axes[0].values(), 4).astype(np.float64)
+    ref = A.albedo(nov, alpha, orders=np.full((16, 3), 32))
+    np.testing.assert_allclose(t.data[..., 0].reshape(-1), ref, atol=1e-6)
