@@ -19,9 +19,10 @@ Quadrature (every rule Gauss-Legendre, every panel smoothstep-mapped, float64 th
 - u: panels geometric in θ_m, ending where tan θ_m = α 4^k (k = 1 .. K, until tan θ_m >= 4; the last runs to
   90 degrees), so that the wide-angle tail (tiny D mass, but V and H vary there on their own, α-free, scale)
   gets as many nodes as the peak; the panel holding u_v is cut there (beyond it the facet no longer sees v
-  for every φ_m). The cut points u_k = r / (1 + r), r = 16^k, do not depend on α, only their number does;
-- H: μ = n.l on up to three panels cut at sin θ_m (beyond it m.l > 0 for every φ_l) and at 2α (the
-  shoulder of G2 ~ 2μ/α at grazing light); in φ only the visible arc |φ| <= acos(-cot θ_m cot θ_l) (its
+  for every φ_m). The cut points u_k = r / (1 + r), r = 16^k, do not depend on α, only their number K does
+  (lutbake.tables.diffuse.fd_microfacet_for uses the same panels for the BRDF itself);
+- H: μ = n.l on four panels cut at sin θ_m (beyond it m.l > 0 for every φ_l), 2α and 16α (the shoulder of
+  G2 ~ 2μ/α at grazing light and its slow approach to 1); in φ only the visible arc |φ| <= acos(-cot θ_m cot θ_l) (its
   ends are zeros of (m.x)+ T(m.x), no kink inside); the arc is symmetric, so 2 ∫_0^w.
 Cost per texel: P n_u (4 n_μ n_φ + n_φ) evaluations (P u panels), against 48 n^4 for the
 direct nested rule (n = 8: 196 608). Orders per texel are chosen by ``orders_for`` (1.5 x at grazing
@@ -93,9 +94,8 @@ def half_arc(cos_m: wp.float64, sin_m: wp.float64, cos_x: wp.float64, sin_x: wp.
 
 @functools.lru_cache(maxsize=None)
 def albedo_kernel_for(facet_fresnel: str):
-    """Kernel: E(nov[i]) / c(f0) for alpha[i], f0[i]; GL rules (xu, wu) for u, (xm, wm) for μ = n.l and
-    (xp, wp) for the arcs, each of its own order: row k of the 2D arrays, with nu[i], nm[i], npp[i] the
-    rule index of texel i (per-texel orders)."""
+    """Kernel: E(nov[i]) / c(f0) for alpha[i], f0[i]. rule[i] = (n_u, n_μ, n_φ), the texel's GL orders for u,
+    μ = n.l and the arcs: row n of xs, ws (``rules``) is the n-point rule on [0, 1], ns[n] = n."""
     T = FACET_SPLIT[facet_fresnel][0]
 
     @wp.func
