@@ -12,7 +12,7 @@ WORKERS ?=
 FORCE   ?=
 LUTS_STAMP := $(OUT)/.luts.stamp
 
-.PHONY: luts test validate bench clean venv help force-luts figures
+.PHONY: luts test validate bench clean venv help force-luts figures bench-diffuse
 
 help:
 	@echo "make luts | test | validate | clean"
@@ -42,6 +42,10 @@ figures: $(STAMP)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
+
+# diffuse kinds against converged references (accuracy and wall time): outputs/bench/diffuse.json
+bench-diffuse: $(STAMP)
+	$(BIN)/python benchmarks/bench_diffuse.py
 
 validate: $(STAMP)
 	$(BIN)/lutbake validate

@@ -18,8 +18,12 @@ import numpy as np
 
 from .edge import ALPHA_MIN, NOV_MIN
 
+IMAGE_DIMS = {"x": "columns", "y": "rows", "z": "slices",
+              "y_block": "row blocks: image row = (y_block index) * (count of the y axis) + (y index)"}
 TEXELS = {"center": "t = (i + 0.5) / N", "endpoint": "t = i / (N - 1)"}
-MAPPINGS = {"linear": "value = lo + (hi - lo) * t"}
+MAPPINGS = {"linear": "value = lo + (hi - lo) * t",
+            "listed": "value = values[i], listed in the config (not evenly spaced in general: map a parameter to a "
+                      "fractional index by searching the values)"}
 ROUGHNESS_PARAMS = {
     "perceptual": "the axis holds perceptual roughness r; alpha = r^2",
     "alpha": "the axis holds the NDF alpha directly",
@@ -29,12 +33,13 @@ ROUGHNESS_PARAMS = {
 @dataclass(frozen=True)
 class Axis:
     name: str  # NoV, perceptual_roughness, alpha, ...
-    dim: str  # x = columns, y = rows, z = slices
+    dim: str  # x = columns, y = rows, z = slices, y_block = blocks of rows (a 4th axis flattened into the rows)
     count: int
     lo: float = 0.0
     hi: float = 1.0
     texel: str = "center"
     mapping: str = "linear"
+    listed: tuple[float, ...] = ()  # mapping "listed": the value of every index (count = len(listed))
 
     def t(self) -> np.ndarray:
         i = np.arange(self.count, dtype=np.float64)
@@ -44,7 +49,10 @@ class Axis:
 
     def values(self) -> np.ndarray:
         """The parameter integrated at every index (float32, after the edge policy)."""
-        v = self.lo + (self.hi - self.lo) * self.t()
+        if self.mapping == "listed":
+            v = np.asarray(self.listed, dtype=np.float64)
+        else:
+            v = self.lo + (self.hi - self.lo) * self.t()
         if self.name == "NoV":
             v = np.maximum(v, NOV_MIN)
         return v.astype(np.float32)
@@ -63,7 +71,7 @@ class Axis:
         d = {
             "name": self.name,
             "dim": self.dim,
-            "image": {"x": "columns", "y": "rows", "z": "slices"}[self.dim],
+            "image": IMAGE_DIMS[self.dim],
             "count": self.count,
             "range": [self.lo, self.hi],
             "texel": self.texel,

@@ -21,6 +21,7 @@ from .tables.base import Key
 NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,128}$")
 MAX_TEXELS = 1 << 26  # 64 Mi texels; float64 accumulation of 4 channels = 2 GiB
 BYTES_PER_TEXEL = 32  # float64 x 4 channels while baking
+MAX_LIST = 1024  # entries of a float_list key
 
 
 def human_bytes(n: int) -> str:
@@ -120,6 +121,18 @@ def _check_value(key: Key, value, file, table) -> Any:
         if lo < key.minimum or hi > key.maximum or lo > hi:
             fail(f"must satisfy {key.minimum:g} <= lo <= hi <= {key.maximum:g}")
         return [lo, hi]
+    if key.type == "float_list":
+        if (not isinstance(value, list) or not 1 <= len(value) <= MAX_LIST
+                or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in value)):
+            fail(f"must be a list of 1 to {MAX_LIST} numbers, e.g. [0.0, 0.25, 0.5]")
+        xs = [float(x) for x in value]
+        if not all(math.isfinite(x) for x in xs):
+            fail("must be finite")
+        if any(x < key.minimum or x > key.maximum for x in xs):
+            fail(f"every value must satisfy {key.minimum:g} <= value <= {key.maximum:g}")
+        if any(b <= a for a, b in zip(xs, xs[1:])):
+            fail("must be strictly increasing")
+        return xs
     raise AssertionError(key.type)
 
 

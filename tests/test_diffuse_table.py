@@ -28,7 +28,7 @@ def test_oren_nayar_row_at_sigma_0_is_lambert():
 
 @pytest.fixture(scope="module")
 def microfacet():
-    return bake_table(spec(model="microfacet", texel="endpoint", size=[5, 4], samples=8), workers=2)[0]
+    return bake_table(spec(model="microfacet", texel="endpoint", size=[5, 4]), workers=2)[0]
 
 
 def test_microfacet_sigma_0_row_is_lambert_times_eq6_albedo(microfacet):
@@ -44,7 +44,7 @@ def test_microfacet_albedo_is_at_most_one_and_positive(microfacet):
 
 
 def test_microfacet_f0_factors_out(microfacet):
-    t = bake_table(spec(model="microfacet", texel="endpoint", size=[5, 4], samples=8, f0=0.04), workers=1)[0]
+    t = bake_table(spec(model="microfacet", texel="endpoint", size=[5, 4], f0=0.04), workers=1)[0]
     np.testing.assert_allclose(t.data, 0.96 * microfacet.data, rtol=1e-5, atol=1e-7)
     assert t.attributes["f0_factor"] == "(1 - f0)"
 
@@ -54,3 +54,33 @@ def test_microfacet_f0_factors_out(microfacet):
 def test_bad_diffuse_keys_are_rejected(kv, fragment):
     with pytest.raises(ConfigError, match=fragment):
         spec(**kv)
+
+
+def test_swapped_albedo_matches_the_nested_rule():
+    """The table's integrator (m outside, l inside: lutbake.tables.diffuse_albedo) against the direct nested
+    rule (l outside, Eq. 4's m-integral inside: tables.diffuse.albedo), grazing and small-sigma texels included."""
+    from lutbake.tables import diffuse as D
+    from lutbake.tables import diffuse_albedo as A
+
+    nov = np.array([0.05, 0.2, 0.5, 0.9, 1.0, 0.3], np.float32)
+    sigma = np.array([0.05, 0.5, 0.3, 1.0, 0.1, 0.02], np.float32)
+    nested = D.albedo("microfacet", nov, sigma, 0.04, "eq6", "sigma", order=12)
+    swapped = A.albedo(nov, D.alpha_from_sigma(sigma, "sigma"), 0.04, "eq6")
+    np.testing.assert_allclose(swapped, nested, atol=5e-5)
+
+
+def test_microfacet_table_records_its_error_estimate(microfacet):
+    assert float(microfacet.attributes["error_estimate"]) < 1e-5
+    assert "probe texels" in microfacet.attributes["error_estimate_method"]
+
+
+def test_grazing_small_sigma_corner_is_converged():
+    """The corner the old nested rule missed by 2.9e-3 (NoV = sigma = 1/128): the default orders against order 32."""
+    from lutbake.tables import diffuse_albedo as A
+
+    t = bake_table(spec(model="microfacet", size=[4, 4], nov_range=[0.0, 0.0625], sigma_range=[0.0, 0.0625]),
+                   workers=1)[0]
+    nov = np.tile(t.axes[1].values(), 4).astype(np.float64)
+    alpha = np.repeat(t.axes[0].values(), 4).astype(np.float64)
+    ref = A.albedo(nov, alpha, orders=np.full((16, 3), 32))
+    np.testing.assert_allclose(t.data[..., 0].reshape(-1), ref, atol=1e-6)

@@ -5,7 +5,8 @@ File layout (the contract engines and ``lutbake inspect`` rely on):
 - Channels ``R``, ``G``, ``B``, ``A`` in the order of ``Table.channels`` (1 to 4 channels; a 2-channel
   table is written as ``R``, ``G`` only). Pixel type float32 or half, zip compression (lossless).
 - Image row 0 holds y index 0 and column 0 holds x index 0: no vertical flip, whatever engines do.
-- A 2D table (data (y, x, C)) is one single-part EXR. A 3D table (data (z, y, x, C)) is a multi-part
+- A 2D table (data (y, x, C)) is one single-part EXR. A fourth axis (kind ``btf``) is flattened into the
+  rows: its dim is ``y_block`` and image row = (y_block index) * (count of the y axis) + (y index). A 3D table (data (z, y, x, C)) is a multi-part
   EXR with one part per z index, named ``slice_<k>`` and carrying ``lutbake:slice_index`` and
   ``lutbake:slice_value`` (the z axis value at that index).
 - Every part carries the string attributes ``lutbake:kind``, ``lutbake:table`` (the table's name),
@@ -81,6 +82,14 @@ def _check_table(table: Table, dtype: str) -> np.ndarray:
     dims = [a.dim for a in table.axes]
     if len(set(dims)) != len(dims):
         raise ValueError(f"table {table.name!r}: two axes share an image dimension: {dims}")
+    blocks = [a for a in table.axes if a.dim == "y_block"]
+    if blocks:  # a 4th axis flattened into the rows: row = block index * (y count) + y index
+        y_axes = [a for a in table.axes if a.dim == "y"]
+        if not y_axes or sizes["y"] % blocks[0].count:
+            raise ValueError(f"table {table.name!r}: a y_block axis needs a y axis and {sizes['y']} rows divisible "
+                             f"by its count {blocks[0].count}")
+        sizes["y_block"] = blocks[0].count
+        sizes["y"] //= blocks[0].count
     for axis in table.axes:
         if axis.dim not in sizes:
             raise ValueError(f"table {table.name!r}: axis {axis.name!r} has unknown dim {axis.dim!r}")

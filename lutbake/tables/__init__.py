@@ -7,8 +7,10 @@ from .dfg import DFG
 from .specular3d import SPECULAR_3D
 from .diffuse import DIFFUSE
 from .aniso import SPECULAR_ANISO
+from .diffuse3d import DIFFUSE_3D
+from .btf import BTF
 
-KINDS: dict[str, Kind] = {k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D, SPECULAR_ANISO, DIFFUSE)}
+KINDS: dict[str, Kind] = {k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D, SPECULAR_ANISO, DIFFUSE, DIFFUSE_3D, BTF)}
 ALIASES: dict[str, str] = {alias: k.name for k in KINDS.values() for alias in k.aliases}
 
 

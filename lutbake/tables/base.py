@@ -21,7 +21,7 @@ class Key:
     """One config key: its type, default, allowed values (or a range) and a line of documentation."""
 
     name: str
-    type: str  # "str", "int", "float", "int_pair", "float_range", "name"
+    type: str  # "str", "int", "float", "int_pair", "float_range", "float_list", "name"
     default: Any
     doc: str
     choices: dict[str, str] | None = None  # value -> description
@@ -49,8 +49,13 @@ class Plan:
 
     @property
     def shape(self) -> tuple[int, ...]:
-        """(z,) y, x, C; a 1D table (one x axis) is one image row: (1, x, C)."""
-        counts = tuple(a.count for a in self.axes)
+        """(z,) y, x, C; a 1D table (one x axis) is one image row: (1, x, C). A ``y_block`` axis is
+        flattened into the rows: y = y_block count x y count (row = block * y count + y index)."""
+        counts = tuple(a.count for a in self.axes if a.dim != "y_block")
+        blocks = [a.count for a in self.axes if a.dim == "y_block"]
+        if blocks:
+            dims = [a.dim for a in self.axes if a.dim != "y_block"]
+            counts = tuple(c * blocks[0] if d == "y" else c for c, d in zip(counts, dims))
         if len(counts) == 1:
             counts = (1,) + counts
         return counts + (self.n_channels,)

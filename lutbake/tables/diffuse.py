@@ -35,6 +35,7 @@ from ..edge import ALPHA_MIN, COS_EPS
 from ..sampling import points
 from ..terms import diffuse, masking
 from ..terms.frame import view_dir
+from . import diffuse_albedo
 from .base import Key, Kind, Plan
 
 TWO_PI64 = wp.constant(wp.float64(2.0 * math.pi))
@@ -43,8 +44,11 @@ PI64 = wp.constant(wp.float64(math.pi))
 FACET_FRESNEL = {
     "eq6": "Eq. 6 on each facet: 21/20 (1 - f0)(1 - (1 - m.l)^5)(1 - (1 - m.v)^5); E scales with (1 - f0)",
     "schlick": "(1 - F(m.l))(1 - F(m.v)), F Schlick: (1 - f0)^2 (1 - (1 - m.l)^5)(1 - (1 - m.v)^5); E scales with (1 - f0)^2",
+    "dielectric_f0": "(1 - F(m.l))(1 - F(m.v)), F the exact dielectric Fresnel of Eq. 2 written with f0: f0 does not "
+                     "factor out (kind diffuse_3d bakes an f0 axis; kind diffuse bakes the given f0 only)",
 }
-FACET_FUNCS = {"eq6": diffuse.F_facet_eq6, "schlick": diffuse.F_facet_schlick}
+FACET_FUNCS = {"eq6": diffuse.F_facet_eq6, "schlick": diffuse.F_facet_schlick,
+               "dielectric_f0": diffuse.F_facet_dielectric_f0}
 SIGMA_TO_ALPHA = {
     "sigma": "GGX alpha = sigma",
     "sigma_squared": "GGX alpha = sigma^2 (sigma as a perceptual roughness)",
@@ -60,12 +64,17 @@ MODELS = {
 }
 
 
+F0_NONE = "none: f0 does not factor out; the table holds E at the baked f0 only (kind diffuse_3d has an f0 axis)"
+
+
 def f0_factor(model: str, facet_fresnel: str) -> str:
     """How f0 enters a model: every model here is g(f0) times an f0-free function."""
     if model in ("lambert", "oren_nayar", "oren_nayar_improved"):
         return "1"
     if model == "microfacet" and facet_fresnel == "schlick":
         return "(1 - f0)^2"
+    if model == "microfacet" and facet_fresnel == "dielectric_f0":
+        return F0_NONE
     return "(1 - f0)"
 
 
@@ -94,6 +103,14 @@ def u_visible_ggx(cos_x: wp.float64, alpha: wp.float64):
     return c2 / (alpha * alpha * (wp.float64(1.0) - c2) + c2)
 
 
+@wp.func
+def om_visible_ggx(cos_x: wp.float64, alpha: wp.float64):
+    """1 - u_visible_ggx, without cancellation: alpha^2 (1 - (n.x)^2) / (alpha^2 (1 - (n.x)^2) + (n.x)^2)."""
+    c2 = cos_x * cos_x
+    t = alpha * alpha * (wp.float64(1.0) - c2)
+    return t / (t + c2)
+
+
 @functools.lru_cache(maxsize=None)
 def fd_microfacet_for(facet_fresnel: str):
     """The microfacet diffuse BRDF ``fd_microfacet(l, v, alpha, f0, xg, wg) -> float64`` (rho = 1), Eq. 4,
@@ -118,80 +135,102 @@ def fd_microfacet_for(facet_fresnel: str):
         phv = wp.atan2(wp.float64(v[1]), wp.float64(v[0]))
         ul = u_visible_ggx(cl, a64)
         uv = u_visible_ggx(cv, a64)
+        oml = om_visible_ggx(cl, a64)
+        omv = om_visible_ggx(cv, a64)
         u1 = wp.min(ul, uv)
         u2 = wp.max(ul, uv)
+        om1 = wp.max(oml, omv)  # 1 - u1
+        om2 = wp.min(oml, omv)  # 1 - u2
         n = xg.shape[0]
         acc = wp.float64(0.0)
-        for p in range(3):
-            lo = wp.float64(0.0)
-            hi = u1
-            if p == 1:
-                lo = u1
-                hi = u2
-            if p == 2:
-                lo = u2
-                hi = one
-            du = hi - lo
-            if du > wp.float64(0.0):
-                for k in range(n):
-                    s = xg[k]
-                    u = lo + du * s * s * (wp.float64(3.0) - wp.float64(2.0) * s)
-                    wu = wg[k] * du * wp.float64(6.0) * s * (one - s)
-                    # 1 - u without cancellation (u_l -> 1 for n.l -> 1 and small alpha)
-                    omu = (one - hi) + du * (one - s) * (one - s) * (one + wp.float64(2.0) * s)
-                    tan2 = a64 * a64 * u / omu
-                    cm = one / wp.sqrt(one + tan2)
-                    sm = wp.sqrt(tan2) * cm
-                    wl = arc_half_width(cm, sm, cl, sl)
-                    wv = arc_half_width(cm, sm, cv, sv)
-                    b0 = wrap_2pi(phl - wl)
-                    b1 = wrap_2pi(phl + wl)
-                    b2 = wrap_2pi(phv - wv)
-                    b3 = wrap_2pi(phv + wv)
-                    # sorting network for four values
-                    if b0 > b1:
-                        t = b0
-                        b0 = b1
-                        b1 = t
-                    if b2 > b3:
-                        t = b2
-                        b2 = b3
-                        b3 = t
-                    if b0 > b2:
-                        t = b0
-                        b0 = b2
-                        b2 = t
-                    if b1 > b3:
-                        t = b1
-                        b1 = b3
-                        b3 = t
-                    if b1 > b2:
-                        t = b1
-                        b1 = b2
-                        b2 = t
-                    row = wp.float64(0.0)
-                    for q in range(4):
-                        a = b0
-                        b = b1
-                        if q == 1:
-                            a = b1
-                            b = b2
-                        if q == 2:
-                            a = b2
-                            b = b3
-                        if q == 3:
-                            a = b3
-                            b = b0 + TWO_PI64
-                        dphi = b - a
-                        if dphi > wp.float64(0.0):
-                            for j in range(n):
-                                phi = a + dphi * xg[j]
-                                m = wp.vec3(float(sm * wp.cos(phi)), float(sm * wp.sin(phi)), float(cm))
-                                MoL = wp.dot(m, l)
-                                MoV = wp.dot(m, v)
-                                if MoL > 0.0 and MoV > 0.0:
-                                    row = row + wg[j] * dphi * wp.float64(MoL * MoV * Ff(MoL, MoV, f0))
-                    acc = acc + wu * row / cm
+        n_geo = diffuse_albedo.n_tail_cuts(a64)
+        prev = wp.float64(0.0)
+        om_prev = one
+        for g in range(n_geo + 1):
+            cut = one
+            om_cut = wp.float64(0.0)
+            if g < n_geo:
+                r2 = wp.pow(diffuse_albedo.TAIL_RATIO64, wp.float64(2 * (g + 1)))
+                om_cut = one / (one + r2)
+                cut = r2 / (one + r2)
+            # the segment [prev, cut] cut at u1 and u2 where they fall inside it
+            om_a = wp.clamp(om1, om_cut, om_prev)
+            om_b = wp.clamp(om2, om_cut, om_prev)
+            for p in range(3):
+                lo = prev
+                om_lo = om_prev
+                om_hi = om_a
+                if p == 1:
+                    om_lo = om_a
+                    om_hi = om_b
+                if p == 2:
+                    om_lo = om_b
+                    om_hi = om_cut
+                if p > 0:
+                    lo = one - om_lo
+                du = om_lo - om_hi
+                if du > wp.float64(0.0):
+                    for k in range(n):
+                        s = xg[k]
+                        u = lo + du * s * s * (wp.float64(3.0) - wp.float64(2.0) * s)
+                        wu = wg[k] * du * wp.float64(6.0) * s * (one - s)
+                        # 1 - u without cancellation (u_l -> 1 for n.l -> 1 and small alpha)
+                        omu = om_hi + du * (one - s) * (one - s) * (one + wp.float64(2.0) * s)
+                        tan2 = a64 * a64 * u / omu
+                        cm = one / wp.sqrt(one + tan2)
+                        sm = wp.sqrt(tan2) * cm
+                        wl = arc_half_width(cm, sm, cl, sl)
+                        wv = arc_half_width(cm, sm, cv, sv)
+                        b0 = wrap_2pi(phl - wl)
+                        b1 = wrap_2pi(phl + wl)
+                        b2 = wrap_2pi(phv - wv)
+                        b3 = wrap_2pi(phv + wv)
+                        # sorting network for four values
+                        if b0 > b1:
+                            t = b0
+                            b0 = b1
+                            b1 = t
+                        if b2 > b3:
+                            t = b2
+                            b2 = b3
+                            b3 = t
+                        if b0 > b2:
+                            t = b0
+                            b0 = b2
+                            b2 = t
+                        if b1 > b3:
+                            t = b1
+                            b1 = b3
+                            b3 = t
+                        if b1 > b2:
+                            t = b1
+                            b1 = b2
+                            b2 = t
+                        row = wp.float64(0.0)
+                        for q in range(4):
+                            a = b0
+                            b = b1
+                            if q == 1:
+                                a = b1
+                                b = b2
+                            if q == 2:
+                                a = b2
+                                b = b3
+                            if q == 3:
+                                a = b3
+                                b = b0 + TWO_PI64
+                            dphi = b - a
+                            if dphi > wp.float64(0.0):
+                                for j in range(n):
+                                    phi = a + dphi * xg[j]
+                                    m = wp.vec3(float(sm * wp.cos(phi)), float(sm * wp.sin(phi)), float(cm))
+                                    MoL = wp.dot(m, l)
+                                    MoV = wp.dot(m, v)
+                                    if MoL > 0.0 and MoV > 0.0:
+                                        row = row + wg[j] * dphi * wp.float64(MoL * MoV * Ff(MoL, MoV, f0))
+                        acc = acc + wu * row / cm
+            prev = cut
+            om_prev = om_cut
         return wp.float64(G2) * acc / (TWO_PI64 * PI64 * cl * cv)
 
     return fd_microfacet
@@ -342,7 +381,7 @@ def albedo(model: str, nov: np.ndarray, sigma: np.ndarray, f0: float = 0.0, face
 
 # ---- the table kind ----
 
-DEFAULT_ORDER = {"microfacet": 8}  # GL points per panel per dimension; closed forms: CLOSED_ORDER
+DEFAULT_ORDER = {"microfacet": 12}  # base GL order (lutbake.tables.diffuse_albedo); closed forms: CLOSED_ORDER
 CLOSED_ORDER = 24
 
 KEYS = {
@@ -356,9 +395,10 @@ KEYS = {
     "sigma_to_alpha": Key("sigma_to_alpha", "str", "sigma", "GGX alpha from sigma (microfacet model)", SIGMA_TO_ALPHA),
     "facet_fresnel": Key("facet_fresnel", "str", "eq6", "Fresnel transmission on each facet (microfacet model)",
                          FACET_FRESNEL),
-    "samples": Key("samples", "int", None, "Gauss-Legendre order n per panel and dimension (outer 4 n^2 directions "
-                   "l; microfacet: 12 n^2 facet normals each); omitted: 8 for microfacet, 24 otherwise", minimum=2,
-                   maximum=64),
+    "samples": Key("samples", "int", None, "Gauss-Legendre order n per panel and dimension; microfacet: the base "
+                   "order of the swapped integral (lutbake.tables.diffuse_albedo: 4 n^3 + n^2 evaluations per "
+                   "texel per u panel, 1.5 n in u and n.l where NoV < 0.1), closed forms: outer 4 n^2 directions "
+                   "l; omitted: 12 for microfacet, 24 otherwise", minimum=2, maximum=64),
     "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}),
     "texel": Key("texel", "str", "center", "texel convention of both axes", TEXELS),
     "nov_range": Key("nov_range", "float_range", [0.0, 1.0], "NoV at t = 0 and t = 1", minimum=0.0, maximum=1.0),
@@ -387,38 +427,39 @@ def plan(spec) -> Plan:
     model = o["model"]
     ff = o["facet_fresnel"]
     order = order_for(o)
-    key = (model, ff)
-
-    def prepare(device: str) -> None:
-        wp.load_module(albedo_kernel_for(*key).module, device=device)
-
-    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
-        return albedo(model, nov[start:stop], sigma[start:stop], o["f0"], ff, o["sigma_to_alpha"], order,
-                      device=device)[:, None]
-
-    per_l = 12 * order * order if model == "microfacet" else 1
-    evals = 4 * order * order * per_l
     terms = {"model": model, "f0": str(o["f0"]), "f0_factor": f0_factor(model, ff)}
     if model == "microfacet":
         terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff,
                      sigma_to_alpha=o["sigma_to_alpha"])
     extra = {"f0_factor": f0_factor(model, ff), "f0": repr(o["f0"]), "rho": "1",
              "sigma_alpha": json.dumps([float(a) for a in alpha_from_sigma(sig_axis.values(), o["sigma_to_alpha"])])}
-    return Plan(
-        axes=axes,
-        channels={"E": "∫ f_r (n.l) dω_l for rho = 1 at the baked f0: directional diffuse reflectance under "
-                       "uniform white light"},
-        reconstruction=RECONSTRUCTION,
-        n_texels=len(nov),
-        n_channels=1,
-        run_tile=run_tile,
-        prepare=prepare,
-        samples=evals,
-        estimator="gauss_legendre",
-        terms=terms,
-        cost=float(len(nov)) * evals,
-        extra=extra,
-    )
+    fields = dict(axes=axes, channels={"E": "∫ f_r (n.l) dω_l for rho = 1 at the baked f0: directional diffuse "
+                                            "reflectance under uniform white light"},
+                  reconstruction=RECONSTRUCTION, terms=terms, extra=extra)
+    if model == "microfacet":
+        alpha = alpha_from_sigma(sigma, o["sigma_to_alpha"])
+        return diffuse_albedo.microfacet_albedo_plan(nov=nov, alpha=alpha, f0=np.full(len(nov), o["f0"]),
+                                                     facet_fresnel=ff, order=order, **fields)
+    key = (model, ff)
+
+    def prepare(device: str) -> None:
+        wp.load_module(albedo_kernel_for(*key).module, device=device)
+
+    def run(idx, n, device):
+        return albedo(model, nov[idx], sigma[idx], o["f0"], ff, o["sigma_to_alpha"], n, device=device)[:, None]
+
+    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
+        return run(slice(start, stop), order, device)
+
+    def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
+        idx = np.unique(np.concatenate([np.arange(0, len(nov), max(1, len(nov) // 256)),
+                                        np.flatnonzero(nov <= nov.min())]))
+        err = float(np.max(np.abs(data[idx] - run(idx, order + 8, device))))
+        return err, f"max |order {order} - order {order + 8}| over {len(idx)} probe texels (strided + most grazing NoV)"
+
+    evals = 4 * order * order
+    return Plan(n_texels=len(nov), n_channels=1, run_tile=run_tile, prepare=prepare, samples=evals,
+                estimator="gauss_legendre", cost=float(len(nov)) * evals, error_estimate=error_estimate, **fields)
 
 
 DIFFUSE = Kind("diffuse", "diffuse AmbientBRDF: NoV x sigma, E = ∫ f_r (n.l) dω_l for Lambert, Oren-Nayar variants, "

@@ -14,6 +14,7 @@ horizon). sigma is the roughness of Gotanda's models, in [0, 1].
 import warp as wp
 
 from ..edge import COS_EPS
+from .fresnel import F_dielectric_f0
 
 INV_PI = wp.constant(0.31830988618379067)
 
@@ -162,3 +163,10 @@ def F_facet_schlick(MoL: float, MoV: float, f0: float):
     """Per-facet transmission (1 - F(m.l))(1 - F(m.v)), F Schlick; equals (1 - f0)^2 (1 - (1 - m.l)^5)(1 - (1 - m.v)^5):
     light refracted into the facet and back out, each once."""
     return (1.0 - f0) * (1.0 - f0) * pow5_weight(MoL) * pow5_weight(MoV)
+
+
+@wp.func
+def F_facet_dielectric_f0(MoL: float, MoV: float, f0: float):
+    """Per-facet transmission (1 - F(m.l))(1 - F(m.v)) with F the exact dielectric Fresnel written with f0
+    (Eq. 2): not of the form g(f0) x (an f0-free function), hence kind diffuse_3d (an f0 axis)."""
+    return (1.0 - F_dielectric_f0(f0, MoL)) * (1.0 - F_dielectric_f0(f0, MoV))

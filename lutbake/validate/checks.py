@@ -1,4 +1,5 @@
-"""Named checks: analytic reductions and invariants of the terms and of the specular tables.
+"""Named checks: analytic reductions and invariants of the terms, of the specular tables and of the microfacet
+diffuse model (sigma = 0 limit, reciprocity, albedo <= 1).
 
 Each check returns a :class:`CheckResult` (measured error, tolerance, pass/fail, a one-line detail).
 ``CHECKS`` maps every check name to a zero-argument callable; ``run_all()`` runs them all.
@@ -409,6 +410,75 @@ def schlick_endpoints() -> CheckResult:
                    f"max |F(f0,1) - f0| = {err_n:.3e}, max |F(f0,0) - 1| = {err_g:.3e} over 101 f0 in [0, 1]")
 
 
+# --- microfacet diffuse (Gotanda 2014, Eq. 4) ---------------------------------------------------------
+
+# |f(sigma = 0) - F_diff / pi| / (F_diff / pi), n.l and n.v >= 0.1. The limit is not exact at alpha = ALPHA_MIN:
+# GGX's tail gives E[sin^2 theta_m] ~ alpha^2 ln(1 / alpha^2), and (m.l)(m.v) / ((n.l)(n.v)) deviates from 1 by that
+# times tan(theta_l) tan(theta_v): 7.8e-5 at n.l, n.v ~ 0.07 (converged in the GL order), ~2e-5 at 0.1.
+DIFFUSE_SIGMA0_RTOL = 5.0e-5
+DIFFUSE_RECIPROCITY_RTOL = 1.0e-5  # |f(l, v) - f(v, l)| / max: the quadrature's cuts are symmetric in l, v
+DIFFUSE_ALBEDO_TOL = 1.0e-6  # max(0, max E - 1) over NoV x sigma x f0 and every facet form
+DIFFUSE_PAIRS = 256
+DIFFUSE_ORDER = 12
+
+
+def _random_pairs(n: int, seed: int, min_cos: float = 0.0):
+    rng = np.random.default_rng(seed)
+    cl = rng.uniform(min_cos, 1.0, n)
+    cv = rng.uniform(min_cos, 1.0, n)
+    phi = rng.uniform(0.0, 2.0 * np.pi, n)
+    sl, sv = np.sqrt(1 - cl * cl), np.sqrt(1 - cv * cv)
+    return np.stack([sl * np.cos(phi), sl * np.sin(phi), cl], -1), np.stack([sv, 0 * sv, cv], -1)
+
+
+def diffuse_sigma0_is_lambert_eq6() -> CheckResult:
+    """At sigma = 0 (alpha = ALPHA_MIN) the microfacet diffuse BRDF (Eq. 4, facets with Eq. 6) is Lambert x Eq. 6:
+    F_diff(n.l, n.v, f0) / pi, for every pair with n.l, n.v >= 0.1 (the limit needs alpha << n.x)."""
+    from ..tables.diffuse import eval_brdf
+
+    l, v = _random_pairs(DIFFUSE_PAIRS, SEED, 0.1)
+    worst = 0.0
+    for f0 in (0.0, 0.04, 0.5):
+        f = eval_brdf("microfacet", l, v, 0.0, f0, "eq6", "sigma", DIFFUSE_ORDER)
+        w = lambda c: 1 - (1 - c) ** 5  # noqa: E731
+        ref = 1.05 * (1 - f0) * w(l[:, 2]) * w(v[:, 2]) / np.pi
+        worst = max(worst, float(np.max(np.abs(f - ref) / ref)))
+    return _result("diffuse_sigma0_is_lambert_eq6", worst, DIFFUSE_SIGMA0_RTOL,
+                   f"max relative over {DIFFUSE_PAIRS} random pairs x f0 in (0, 0.04, 0.5), GL order {DIFFUSE_ORDER}")
+
+
+def diffuse_reciprocity() -> CheckResult:
+    """f(l, v) = f(v, l) for the microfacet diffuse BRDF, random pairs (grazing included), sigma 0.05 .. 1."""
+    from ..tables.diffuse import eval_brdf
+
+    l, v = _random_pairs(DIFFUSE_PAIRS, SEED + 1)
+    sigma = np.random.default_rng(SEED + 2).uniform(0.05, 1.0, DIFFUSE_PAIRS)
+    a = eval_brdf("microfacet", l, v, sigma, 0.04, "eq6", "sigma", DIFFUSE_ORDER)
+    b = eval_brdf("microfacet", v, l, sigma, 0.04, "eq6", "sigma", DIFFUSE_ORDER)
+    rel = np.abs(a - b) / np.maximum(np.maximum(a, b), 1e-30)
+    return _result("diffuse_reciprocity", float(rel.max()), DIFFUSE_RECIPROCITY_RTOL,
+                   f"max relative over {DIFFUSE_PAIRS} random pairs, sigma in [0.05, 1]")
+
+
+def diffuse_albedo_le_one() -> CheckResult:
+    """The directional albedo E(v) = ∫ f (n.l) dω_l of the microfacet diffuse model is <= 1 for every NoV, sigma, f0
+    and per-facet Fresnel form (rho = 1): measured max(0, max E - 1)."""
+    from ..tables import diffuse_albedo
+
+    nov = np.array([NOV_MIN, 0.01, 0.05, 0.2, 0.5, 0.8, 1.0])
+    alpha = np.array([ALPHA_MIN, 0.01, 0.1, 0.3, 0.6, 1.0])
+    N, A = (x.ravel() for x in np.meshgrid(nov, alpha))
+    worst, top = 0.0, 0.0
+    for form in ("eq6", "schlick", "dielectric_f0"):
+        for f0 in (0.0, 0.04, 0.5):
+            e = diffuse_albedo.albedo(N, A, f0, form, order=DIFFUSE_ORDER)
+            top = max(top, float(e.max()))
+            worst = max(worst, float(np.max(e - 1.0)))
+    return _result("diffuse_albedo_le_one", max(worst, 0.0), DIFFUSE_ALBEDO_TOL,
+                   f"max E = {top:.7f} over {len(N)} (NoV, alpha) x f0 in (0, 0.04, 0.5) x facet forms eq6, schlick, "
+                   "dielectric_f0")
+
+
 # --- registry ------------------------------------------------------------------------------------------
 
 def _registry() -> dict:
@@ -431,6 +501,9 @@ def _registry() -> dict:
     checks["schlick_endpoints"] = schlick_endpoints
     checks["estimators_agree"] = estimators_agree
     checks["kulla_conty_white_furnace"] = kulla_conty_white_furnace
+    checks["diffuse_sigma0_is_lambert_eq6"] = diffuse_sigma0_is_lambert_eq6
+    checks["diffuse_reciprocity"] = diffuse_reciprocity
+    checks["diffuse_albedo_le_one"] = diffuse_albedo_le_one
     return checks
 
 
