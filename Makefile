@@ -53,5 +53,6 @@ validate: $(STAMP)
 clean:
 	rm -rf $(OUT) .pytest_cache
 
+# every kind against converged references, C and numpy baselines: outputs/bench/report.json + accuracy_vs_time.png
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench.py

@@ -226,7 +226,28 @@ def main(argv=None):
         print(f"{'MET ' if v['met'] else 'MISS'}  {k}: {v}")
 
 
-EXTRA_CASES: list = []  # kinds that register their own benchmark (diffuse, btf)
+def diffuse_cases(report, workers, quick):
+    """The diffuse kinds (benchmarks/bench_diffuse.py): diffuse 64^2 microfacet and the 16 x 32^3 btf."""
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import bench_diffuse
+
+    r = bench_diffuse.bench_diffuse()
+    report["cases"]["diffuse_64"] = [r]
+    report["targets"]["diffuse_64 microfacet: max error <= 1e-4 in <= 30 s"] = {
+        "max_error": r["max_abs_error"], "seconds": r["seconds"],
+        "met": r["max_abs_error"] <= 1e-4 and r["seconds"] <= 30}
+    print(f"diffuse 64^2 microfacet  {r['seconds']:7.2f} s  max {r['max_abs_error']:.2e}")
+    if quick:
+        return
+    b = bench_diffuse.bench_btf()
+    report["cases"]["btf_16x32"] = [b]
+    report["targets"]["btf 16 x 32^3: max relative error <= 1e-4 in <= 600 s"] = {
+        "max_rel_error": b["max_rel_error"], "seconds": b["seconds"],
+        "met": b["max_rel_error"] <= 1e-4 and b["seconds"] <= 600}
+    print(f"btf 16 x 32^3            {b['seconds']:7.2f} s  max rel {b['max_rel_error']:.2e}")
+
+
+EXTRA_CASES: list = [diffuse_cases]
 
 
 def independent_check(ref):
