@@ -4,14 +4,19 @@
 Schlick F makes f0 factor out, so two channels hold the whole table:
     scale_bias   R = ∫ f/F (1 - Fc) (n.l) dω,  G = ∫ f/F Fc (n.l) dω       E = f0 R + G
     multiscatter R = ∫ f/F Fc (n.l) dω,        G = ∫ f/F (n.l) dω          E = mix(R, G, f0); E(F=1) = G
-Axes: x (columns) = NoV, y (rows) = roughness; image row 0 is the first roughness value (smoothest).
+Two layouts add a third channel B: ``scale_bias_f82`` (Blender EEVEE) B = ∫ f/F (v.h)(1 - v.h)^6 (n.l) dω,
+the F82-tint term; ``multiscatter_cloth`` (Filament) B = ∫ D_charlie V_ashikhmin (n.l) dω, the cloth DV.
+Axes, by default: x (columns) = NoV, y (rows) = roughness; image row 0 is the first roughness value
+(smoothest). The engine conventions are explicit keys: ``axis_order`` (which quantity is x),
+``row_order`` (image row 0 = t near 0 or near 1), ``nov_mapping`` / ``roughness_mapping`` (how t maps to
+the value) and ``nov_clamp`` (lutbake.axes).
 The integral and its estimators are derived in lutbake.sampling.estimators.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from ..axes import ROUGHNESS_PARAMS, TEXELS, Axis
+from ..axes import MAPPINGS, ORDERS, ROUGHNESS_PARAMS, TEXELS, Axis
 from ..terms.sets import MASKINGS, NDFS
 from . import specular
 from .base import Key, Kind, Plan
@@ -19,6 +24,8 @@ from .base import Key, Kind, Plan
 LAYOUTS = {
     "scale_bias": "R = scale, G = bias: E = f0 * R + G (Karis 2013)",
     "multiscatter": "R = ∫Fc·f, G = ∫f: E = mix(R, G, f0), E(F=1) = G (Filament)",
+    "scale_bias_f82": "scale_bias + B = ∫ f/F (v.h)(1 - v.h)^6 (n.l): the F82-tint term (Blender EEVEE)",
+    "multiscatter_cloth": "multiscatter + B = ∫ D_charlie V_ashikhmin (n.l): cloth DV (Filament --ibl-dfg-cloth)",
 }
 CHANNELS = {
     "scale_bias": {"scale": "∫ f/F (1 - (1 - v.h)^5) (n.l) dω_l: multiplies f0",
@@ -26,12 +33,31 @@ CHANNELS = {
     "multiscatter": {"fc": "∫ f/F (1 - v.h)^5 (n.l) dω_l: the f90 = 1 weight",
                      "e_ss": "∫ f/F (n.l) dω_l: single-scattering directional albedo with F = 1"},
 }
+CHANNELS["scale_bias_f82"] = {
+    **CHANNELS["scale_bias"],
+    "f82": "∫ f/F (v.h)(1 - v.h)^6 (n.l) dω_l: the F82-tint term (Hoffman 2023 / Blender EEVEE metal_bias)"}
+CHANNELS["multiscatter_cloth"] = {
+    **CHANNELS["multiscatter"],
+    "cloth_dv": "∫ D_charlie(h; alpha) V_ashikhmin (n.l) dω_l, no Fresnel: sheen/cloth directional albedo "
+                "(Estevez & Kulla 2017 NDF, Ashikhmin 2007 visibility 1/(4 (n.l + n.v - (n.l)(n.v))))"}
 RECONSTRUCTION = {
     "scale_bias": "uv = vec2(NoV, roughness) (texel centres per lutbake:axes); t = texture(lut, uv).rg; "
                   "specular = prefiltered * (f0 * t.r + t.g)",
     "multiscatter": "uv = vec2(NoV, roughness); t = texture(lut, uv).rg; E = mix(t.r, t.g, f0) = (1 - f0) t.r + f0 t.g; "
                     "specular = prefiltered * E; energy compensation = 1 + f0 (1 / t.g - 1)",
 }
+RECONSTRUCTION["scale_bias_f82"] = (
+    RECONSTRUCTION["scale_bias"] + "; F82 tint (Blender EEVEE): b = mix(f0, 1, (6/7)^5) * 7/(6/7)^6 * (1 - f82_tint), "
+    "specular = prefiltered * (f0 * t.r + f90 * t.g - b * t.b)")
+RECONSTRUCTION["multiscatter_cloth"] = (
+    RECONSTRUCTION["multiscatter"] + "; cloth/sheen: sheen = prefiltered_charlie * sheen_color * t.b")
+N_CHANNELS = specular.N_CHANNELS
+AXIS_ORDERS = {
+    "nov_x": "columns (x) = NoV, rows (y) = roughness: sample at vec2(NoV, roughness) (Filament, glTF, UE4)",
+    "roughness_x": "columns (x) = roughness, rows (y) = NoV: sample at vec2(roughness, NoV-coordinate) (Blender EEVEE)",
+}
+NOV_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "one_minus_t2")}
+ROUGHNESS_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "texel_offset")}
 
 COMMON_KEYS = {
     "name": Key("name", "name", None, "output stem: <out-dir>/<name>.exr; letters, digits, - and _ only", required=True),
@@ -54,6 +80,12 @@ KEYS = {
     "nov_range": Key("nov_range", "float_range", [0.0, 1.0], "NoV at t = 0 and t = 1", minimum=0.0, maximum=1.0),
     "roughness_range": Key("roughness_range", "float_range", [0.0, 1.0], "roughness at t = 0 and t = 1",
                            minimum=0.0, maximum=1.0),
+    "axis_order": Key("axis_order", "str", "nov_x", "which quantity runs along the columns (x)", AXIS_ORDERS),
+    "row_order": Key("row_order", "str", "lo_first", "which end of the row (y) axis is image row 0", ORDERS),
+    "nov_mapping": Key("nov_mapping", "str", "linear", "how t maps to NoV", NOV_MAPPINGS),
+    "roughness_mapping": Key("roughness_mapping", "str", "linear", "how t maps to roughness", ROUGHNESS_MAPPINGS),
+    "nov_clamp": Key("nov_clamp", "float_range", [0.0, 1.0], "NoV clamped to [lo, hi] after the mapping "
+                     "(Blender EEVEE: [1e-4, 0.9999])", minimum=0.0, maximum=1.0),
 }
 
 
@@ -62,33 +94,48 @@ def check_spec(spec) -> str | None:
     o = spec.options
     if o["estimator"] == "sobol_vndf" and NDFS[o["ndf"]].vndf is None:
         return f"estimator 'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not {o['ndf']!r}"
+    if o["roughness_mapping"] == "texel_offset" and o["texel"] != "center":
+        return "roughness_mapping 'texel_offset' is defined on texel centres (texel = 'center')"
     return None
 
 
 def axes_for(o: dict) -> list[Axis]:
+    """[y axis, x axis] of a dfg table, per axis_order / row_order / mappings."""
     n_nov, n_rough = o["size"]
     rname = "perceptual_roughness" if o["roughness"] == "perceptual" else "alpha"
-    return [Axis(rname, "y", n_rough, *o["roughness_range"], texel=o["texel"]),
-            Axis("NoV", "x", n_nov, *o["nov_range"], texel=o["texel"])]
+    nov_x = o.get("axis_order", "nov_x") == "nov_x"
+    row_order = o.get("row_order", "lo_first")
+    clamp = o.get("nov_clamp", [0.0, 1.0])
+    rough = Axis(rname, "x" if not nov_x else "y", n_rough, *o["roughness_range"], texel=o["texel"],
+                 mapping=o.get("roughness_mapping", "linear"), order="lo_first" if not nov_x else row_order)
+    nov = Axis("NoV", "x" if nov_x else "y", n_nov, *o["nov_range"], texel=o["texel"],
+               mapping=o.get("nov_mapping", "linear"), order=row_order if not nov_x else "lo_first",
+               clamp=None if list(clamp) == [0.0, 1.0] else tuple(clamp))
+    return [rough, nov] if nov_x else [nov, rough]
 
 
 def plan(spec) -> Plan:
     o = spec.options
     axes = axes_for(o)
-    rough, nov_axis = axes
     est = o["estimator"]
     samples = o["samples"] or specular.DEFAULT_SAMPLES[est]
     key = (o["ndf"], o["masking"], o["layout"], est)
-    # texel t = iy * nx + ix: y (roughness) slowest
-    nov = np.tile(nov_axis.values(), rough.count)
-    alpha = np.repeat(rough.alpha(), nov_axis.count)
+    nch = N_CHANNELS[o["layout"]]
+    # texel t = iy * nx + ix: y slowest
+    y_axis, x_axis = axes
+    if x_axis.name == "NoV":
+        nov = np.tile(x_axis.values(), y_axis.count)
+        alpha = np.repeat(y_axis.alpha(), x_axis.count)
+    else:
+        nov = np.repeat(y_axis.values(), x_axis.count)
+        alpha = np.tile(x_axis.alpha(), y_axis.count)
 
     def prepare(device: str) -> None:
         specular.load(specular.kernel_for(*key), device)
 
     def run_tile(start: int, stop: int, device: str) -> np.ndarray:
         k = specular.kernel_for(*key)
-        return specular.integrate(k, nov[start:stop], alpha[start:stop], est, samples, o["seed"], 2, device)
+        return specular.integrate(k, nov[start:stop], alpha[start:stop], est, samples, o["seed"], nch, device)
 
     eff = specular.effective_samples(est, samples)
     return Plan(
@@ -96,12 +143,13 @@ def plan(spec) -> Plan:
         channels=CHANNELS[o["layout"]],
         reconstruction=RECONSTRUCTION[o["layout"]],
         n_texels=len(nov),
-        n_channels=2,
+        n_channels=nch,
         run_tile=run_tile,
         prepare=prepare,
         samples=eff,
         estimator=est,
-        terms={"ndf": o["ndf"], "masking": o["masking"], "fresnel": "schlick", "layout": o["layout"]},
+        terms={"ndf": o["ndf"], "masking": o["masking"], "fresnel": "schlick", "layout": o["layout"],
+               **({"cloth": "D_charlie + V_ashikhmin"} if o["layout"] == "multiscatter_cloth" else {})},
         cost=float(len(nov)) * eff,
     )
 

@@ -8,6 +8,9 @@ A *channel function* replaces F by the weights that make the table's channels; f
 with Schlick F = f0 (1 - Fc) + Fc, Fc = (1 - v.h)^5 (Karis 2013):
     scale_bias:   (1 - Fc, Fc)   -> E = f0 * scale + bias
     multiscatter: (Fc, 1)        -> E = mix(R, G, f0) = (1 - f0) R + f0 G,  E(F = 1) = G
+    scale_bias_f82: (1 - Fc, Fc, (v.h)(1 - v.h)^6)   (Blender EEVEE's F82-tint term)
+The cloth layout adds a channel with its own BRDF, D_charlie V_ashikhmin (no Fresnel), whose integrand
+in the same measure is D_charlie V_ashikhmin (n.l) 4 (v.h) (Filament's DFV_Charlie_Uniform).
 """
 from __future__ import annotations
 
@@ -19,7 +22,7 @@ import warp as wp
 from ..edge import COS_EPS
 from ..sampling import points
 from ..sampling.estimators import make_gauss_legendre, make_qmc
-from ..terms import fresnel, sets
+from ..terms import fresnel, masking, ndf, sets
 from ..terms.frame import reflect
 
 
@@ -39,16 +42,31 @@ def channels_albedo(VoH: float):
     return wp.vec2(1.0, 0.0)
 
 
+@wp.func
+def channels_scale_bias_f82(VoH: float):
+    Fc = fresnel.Fc_schlick(VoH)
+    return wp.vec3(1.0 - Fc, Fc, VoH * Fc * wp.clamp(1.0 - VoH, 0.0, 1.0))
+
+
+@wp.func
+def channels_multiscatter3(VoH: float):
+    return wp.vec3(fresnel.Fc_schlick(VoH), 1.0, 0.0)
+
+
 CHANNEL_FUNCS = {"scale_bias": channels_scale_bias, "multiscatter": channels_multiscatter,
-                 "albedo": channels_albedo}
+                 "albedo": channels_albedo, "scale_bias_f82": channels_scale_bias_f82}
+N_CHANNELS = {"scale_bias": 2, "multiscatter": 2, "albedo": 2, "scale_bias_f82": 3, "multiscatter_cloth": 3}
 
 
 @functools.lru_cache(maxsize=None)
 def integrand_for(ndf_name: str, masking_name: str, channels_name: str):
     """g(h) = D G2 (v.h)/(n.v) * channels(v.h), 0 where n.l or v.h <= COS_EPS (back-facing)."""
+    if channels_name == "multiscatter_cloth":
+        return cloth_integrand_for(ndf_name, masking_name)
     D = sets.NDFS[ndf_name].D
     G2 = sets.G2_for(ndf_name, masking_name)
     ch = CHANNEL_FUNCS[channels_name]
+    vec = wp.vec3 if N_CHANNELS[channels_name] == 3 else wp.vec2
 
     @wp.func
     def integrand(v: wp.vec3, h: wp.vec3, alpha: float):
@@ -57,9 +75,31 @@ def integrand_for(ndf_name: str, masking_name: str, channels_name: str):
         NoV = v[2]
         VoH = wp.dot(v, h)
         if NoL <= COS_EPS or VoH <= COS_EPS or NoV <= COS_EPS:
-            return wp.vec2(0.0, 0.0)
+            return vec()
         NoH = h[2]
         return ch(VoH) * (D(h, alpha) * G2(NoV, NoL, NoH, VoH, alpha) * VoH / NoV)
+
+    return integrand
+
+
+@functools.lru_cache(maxsize=None)
+def cloth_integrand_for(ndf_name: str, masking_name: str):
+    """(Fc s, s, D_charlie V_ashikhmin (n.l) 4 (v.h)) with s = D G2 (v.h)/(n.v): the multiscatter
+    channels plus Filament's cloth DV, 0 where n.l or v.h <= COS_EPS (back-facing)."""
+    D = sets.NDFS[ndf_name].D
+    G2 = sets.G2_for(ndf_name, masking_name)
+
+    @wp.func
+    def integrand(v: wp.vec3, h: wp.vec3, alpha: float):
+        l = reflect(v, h)
+        NoL = l[2]
+        NoV = v[2]
+        VoH = wp.dot(v, h)
+        if NoL <= COS_EPS or VoH <= COS_EPS or NoV <= COS_EPS:
+            return wp.vec3()
+        spec = D(h, alpha) * G2(NoV, NoL, h[2], VoH, alpha) * VoH / NoV
+        cloth = ndf.D_charlie(h, alpha) * masking.V_ashikhmin(NoV, NoL) * NoL * 4.0 * VoH
+        return channels_multiscatter3(VoH) * spec + wp.vec3(0.0, 0.0, cloth)
 
     return integrand
 
@@ -79,7 +119,7 @@ def kernel_for(ndf_name: str, masking_name: str, channels_name: str, estimator: 
     """The table kernel for a (terms, channels, estimator) key; compiled once per Warp cache."""
     nd = sets.NDFS[ndf_name]
     g = integrand_for(ndf_name, masking_name, channels_name)
-    vec, acc = wp.vec2, wp.vec2d
+    vec, acc = (wp.vec3, wp.vec3d) if N_CHANNELS[channels_name] == 3 else (wp.vec2, wp.vec2d)
     if estimator == "gauss_legendre":
         return make_gauss_legendre(g, sets.pdf_ndf_for(ndf_name), nd.tan2_from_u, nd.u_from_tan2, vec, acc)
     if estimator == "sobol_vndf":

@@ -61,3 +61,11 @@ def G2_v_cavity(NoH: float, NoV: float, NoL: float, VoH: float, LoH: float):
     if VoH <= COS_EPS or LoH <= COS_EPS:
         return 0.0
     return wp.min(1.0, wp.min(2.0 * NoH * NoV / VoH, 2.0 * NoH * NoL / LoH))
+
+
+@wp.func
+def V_ashikhmin(NoV: float, NoL: float):
+    """Ashikhmin & Premoze 2007 cloth visibility, 1/(4 NoL NoV) folded in (a V_ term, not a G):
+    V = 1 / (4 (n.l + n.v - (n.l)(n.v))) (Filament's V_Neubelt / Visibility_Ashikhmin). Finite
+    everywhere on the upper hemisphere (1/4 at n.l = 1 or n.v = 1; 1/(4 n.v) at n.l -> 0)."""
+    return 1.0 / (4.0 * (NoL + NoV - NoL * NoV))
