@@ -94,6 +94,9 @@ def check_spec(spec) -> str | None:
     o = spec.options
     if o["estimator"] == "sobol_vndf" and NDFS[o["ndf"]].vndf is None:
         return f"estimator 'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not {o['ndf']!r}"
+    if o["layout"] == "multiscatter_cloth" and o["estimator"] != "gauss_legendre":
+        return ("layout 'multiscatter_cloth' needs estimator 'gauss_legendre': the QMC estimators draw h from "
+                "the GGX NDF and miss the Charlie NDF's grazing lobe of the cloth channel")
     if o["roughness_mapping"] == "texel_offset" and o["texel"] != "center":
         return "roughness_mapping 'texel_offset' is defined on texel centres (texel = 'center')"
     return None
