@@ -48,8 +48,10 @@ def main():
 @click.option("--device", type=click.Choice(["cpu", "cuda"]), default="cpu", show_default=True,
               help="Warp device the kernels run on.")
 @click.option("--progress/--no-progress", default=None, help="Progress bar (default: on a terminal, for long bakes).")
-def bake(configs, presets, out_dir, overrides, workers, device, progress):
-    """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.exr.
+@click.option("--format", "fmt", type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h"]), default=None,
+              help="Output format of every table (same as --set format=...; default: each table's `format`, exr).")
+def bake(configs, presets, out_dir, overrides, workers, device, progress, fmt):
+    """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.<ext> (EXR unless `format` / --format says otherwise).
 
     All configs are validated before any kernel runs; a bad config exits with status 2 and writes
     nothing. Each table prints one line: path, shape, seconds, samples per texel. A table that fails
@@ -60,6 +62,7 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress):
       lutbake bake configs/dfg.toml
       lutbake bake configs/dfg.toml --set size=[64,64] --set layout=multiscatter
       lutbake bake configs/dfg.toml --set dfg.estimator=sobol_vndf --set dfg.samples=4096
+      lutbake bake --preset unreal --format dds        # -> outputs/preintegrated_gf.dds (R16G16_FLOAT)
     """
     from .config import load_configs, preset_path
     from .errors import ConfigError, LutbakeError
@@ -69,6 +72,8 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress):
         paths = [preset_path(p) for p in presets] + list(configs)
         if not paths:
             raise ConfigError("<command line>", None, message="give at least one CONFIG or --preset")
+        if fmt:
+            overrides = tuple(overrides) + (f'format="{fmt}"',)
         specs = load_configs(paths, overrides)
         if device == "cuda":
             import warp as wp
@@ -80,13 +85,13 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress):
         sys.exit(EXIT_CONFIG)
 
     from .api import bake_table
-    from .io.exr import write_exr
+    from .io.formats import write_table
 
     failed = []
     for spec in specs:
         try:
             table, seconds, samples = bake_table(spec, workers, device, progress)
-            path = write_exr(table, out_dir / f"{spec.name}.exr", dtype=spec.options["dtype"])
+            path = write_table(table, out_dir, spec.options["format"], spec.options["dtype"])
         except (LutbakeError, ValueError, OSError) as e:
             failed.append(spec.name)
             click.echo(f"FAILED {spec.name}: {e}", err=True)
@@ -103,6 +108,7 @@ def list_():
     """List table kinds, selectable terms, estimators and presets."""
     from .axes import TEXELS
     from .config import presets
+    from .io.formats import FORMATS
     from .tables import KINDS
     from .tables.dfg import LAYOUTS
     from .tables.specular import ESTIMATORS
@@ -122,6 +128,7 @@ def list_():
     section("DFG layouts (layout = ...)", LAYOUTS)
     section("Estimators (estimator = ...)", ESTIMATORS)
     section("Texel conventions (texel = ...)", TEXELS)
+    section("Output formats (format = ... / --format)", FORMATS)
     section("Presets (--preset NAME)", {k: _first_comment(p) for k, p in presets().items()})
 
 

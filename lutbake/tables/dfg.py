@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..io.formats import FORMATS
 from ..axes import MAPPINGS, ORDERS, ROUGHNESS_PARAMS, TEXELS, Axis
 from ..terms.sets import MASKINGS, NDFS
 from . import specular
@@ -67,6 +68,7 @@ COMMON_KEYS = {
     "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}),
     "estimator": Key("estimator", "str", "gauss_legendre", "how the integral is estimated", specular.ESTIMATORS),
     "seed": Key("seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0),
+    "format": Key("format", "str", "exr", "output file format: <out-dir>/<name>.<ext>", FORMATS),
 }
 
 KEYS = {
