@@ -31,6 +31,7 @@ def main():
       lutbake bake configs/*.toml --out-dir build/luts --workers 2
       lutbake bake --preset default --set samples=2048 --set dtype=half
       lutbake inspect outputs/dfg.exr
+      lutbake preview outputs/dfg.exr                # -> outputs/dfg.preview.png
       lutbake list
       lutbake validate
     """
@@ -156,6 +157,31 @@ def inspect(file):
     except (OSError, ValueError) as e:
         click.echo(f"error: {file}: {e}", err=True)
         sys.exit(EXIT_CONFIG)
+
+
+@main.command()
+@click.argument("file", type=click.Path(path_type=Path))
+@click.option("-o", "--out", type=click.Path(path_type=Path), default=None,
+              help="PNG to write (default: FILE's stem + .preview.png beside it).")
+def preview(file, out):
+    """Render a PNG of a baked table: each channel colour-mapped with labelled axes, and (dfg) a row of
+    spheres lit with the split-sum through the table. Reads EXR, or .npy with its .json sidecar.
+
+    \b
+    Example:
+      lutbake preview outputs/dfg.exr        # -> outputs/dfg.preview.png
+    """
+    from .preview import render
+
+    try:
+        path = render(file, out)
+    except ImportError as e:
+        click.echo(f"error: preview needs matplotlib (pip install 'lutbake[plot]'): {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    except (OSError, ValueError, KeyError) as e:
+        click.echo(f"error: {file}: {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    click.echo(str(path))
 
 
 @main.command()
