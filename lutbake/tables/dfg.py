@@ -14,6 +14,8 @@ The integral and its estimators are derived in lutbake.sampling.estimators.
 """
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from ..io.formats import FORMATS
@@ -119,6 +121,19 @@ def axes_for(o: dict) -> list[Axis]:
     return [rough, nov] if nov_x else [nov, rough]
 
 
+def reconstruction(layout: str, axes: list[Axis]) -> str:
+    """The layout's shader formula, with the uv of this table's axes written out (lutbake.axes.Axis.uv)."""
+    y_axis, x_axis = axes
+
+    def u(a: Axis) -> str:
+        return re.sub(r"\bx\b", {"NoV": "NoV", "alpha": "alpha"}.get(a.name, "roughness"), a.uv_formula())
+
+    uv = f"uv = vec2({u(x_axis)}, {u(y_axis)})"
+    text = RECONSTRUCTION[layout]
+    return text.replace("uv = vec2(NoV, roughness) (texel centres per lutbake:axes)", uv).replace(
+        "uv = vec2(NoV, roughness)", uv)
+
+
 def plan(spec) -> Plan:
     o = spec.options
     axes = axes_for(o)
@@ -146,7 +161,7 @@ def plan(spec) -> Plan:
     return Plan(
         axes=axes,
         channels=CHANNELS[o["layout"]],
-        reconstruction=RECONSTRUCTION[o["layout"]],
+        reconstruction=reconstruction(o["layout"], axes),
         n_texels=len(nov),
         n_channels=nch,
         run_tile=run_tile,
