@@ -1,7 +1,7 @@
 // lutbake: sampling baked tables in HLSL (SM 4.0 and later). Same contract as lutbake.glsl:
 // file row 0 is texture row 0 (v = 0, the top row in D3D: no flip needed for DDS/KTX2 'rd');
 // sample with a LINEAR / CLAMP sampler. Each file's axes metadata (uv_formula) gives the exact formula.
-// (Not compiled by the test suite: no HLSL compiler on the CI machine; it mirrors lutbake.glsl, which is.)
+// tests/test_shaders.py compiles it with glslangValidator's HLSL front end (Debian glslang-tools) where installed.
 
 float lutbake_u_center(float x) { return x; }
 float lutbake_u_endpoint(float t, float N) { return t * ((N - 1.0) / N) + 0.5 / N; }
