@@ -18,8 +18,8 @@ import re
 
 import numpy as np
 
-from ..io.formats import FORMATS
 from ..axes import MAPPINGS, ORDERS, ROUGHNESS_PARAMS, TEXELS, Axis
+from ..io.formats import FORMATS
 from ..terms.sets import MASKINGS, NDFS
 from . import specular
 from .base import Key, Kind, Plan
@@ -63,7 +63,7 @@ NOV_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "one_minus_t2")}
 ROUGHNESS_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "texel_offset")}
 
 COMMON_KEYS = {
-    "name": Key("name", "name", None, "output stem: <out-dir>/<name>.exr; letters, digits, - and _ only", required=True),
+    "name": Key("name", "name", None, "output stem: <out-dir>/<name>.<ext> (ext per format); letters, digits, - and _ only", required=True),
     "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
     "samples": Key("samples", "int", None, "integrand evaluations per texel; omitted: the estimator's default "
                    "quality", minimum=1),
