@@ -1,5 +1,6 @@
 # lutbake — the two commands of the README, and a few more.
-#   make luts      create the venv if missing, install, bake every config in configs/ into outputs/
+#   make luts      create the venv if missing, install, bake every config in configs/ and every engine
+#                  preset (PRESETS) into outputs/
 #   make test      create the venv if missing, install, run the test suite
 PYTHON ?= python3
 VENV   ?= .venv
@@ -7,6 +8,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 OUT    ?= outputs
 CONFIGS := $(wildcard configs/*.toml)
+PRESETS ?= filament filament-corrected gltf blender-eevee unreal
 SOURCES := $(shell find lutbake -name '*.py' -o -name '*.toml' 2>/dev/null)
 WORKERS ?=
 
@@ -24,7 +26,7 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 luts: $(STAMP)
-	$(BIN)/lutbake bake $(CONFIGS) --out-dir $(OUT) $(if $(WORKERS),--workers $(WORKERS))
+	$(BIN)/lutbake bake $(CONFIGS) $(foreach p,$(PRESETS),--preset $(p)) --out-dir $(OUT) $(if $(WORKERS),--workers $(WORKERS))
 
 test: $(STAMP)
 	@$(BIN)/python -c "import moderngl; moderngl.create_standalone_context(backend='egl').release()" 2>/dev/null \
