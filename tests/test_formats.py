@@ -254,3 +254,8 @@ def test_cli_format_option_writes_that_format(tmp_path):
     assert vk == 83 and arr.shape == (8, 16, 2)
     r = CliRunner().invoke(main, ["bake", str(cfg), "--out-dir", str(tmp_path / "o2"), "--set", 'format="dds"'])
     assert r.exit_code == 0 and (tmp_path / "o2" / "small.dds").is_file()
+
+
+def test_cli_format_choices_are_the_writers():
+    opt = next(p for p in main.commands["bake"].params if p.name == "fmt")
+    assert list(opt.type.choices) == list(FORMATS)
