@@ -1,5 +1,6 @@
 # lutbake — the two commands of the README, and a few more.
-#   make luts      create the venv if missing, install, bake every config in configs/ into outputs/
+#   make luts      create the venv if missing, install, bake every config in configs/ and every engine
+#                  preset (PRESETS) into outputs/
 #   make test      create the venv if missing, install, run the test suite
 PYTHON ?= python3
 VENV   ?= .venv
@@ -7,6 +8,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 OUT    ?= outputs
 CONFIGS := $(wildcard configs/*.toml)
+PRESETS ?= filament filament-corrected gltf blender-eevee unreal
 SOURCES := $(shell find lutbake -name '*.py' -o -name '*.toml' 2>/dev/null)
 WORKERS ?=
 FORCE   ?=
@@ -31,7 +33,7 @@ $(STAMP): pyproject.toml
 luts: $(LUTS_STAMP)
 
 $(LUTS_STAMP): $(STAMP) $(CONFIGS) $(SOURCES) Makefile $(if $(FORCE),force-luts)
-	$(BIN)/lutbake bake $(CONFIGS) --out-dir $(OUT) --report $(OUT)/report.json \
+	$(BIN)/lutbake bake $(CONFIGS) $(foreach p,$(PRESETS),--preset $(p)) --out-dir $(OUT) --report $(OUT)/report.json \
 		$(if $(WORKERS),--workers $(WORKERS)) $(if $(FORCE),--force)
 	touch $@
 
@@ -41,6 +43,8 @@ figures: $(STAMP)
 	$(BIN)/lutbake plot --out-dir $(OUT)/figures
 
 test: $(STAMP)
+	@$(BIN)/python -c "import moderngl; moderngl.create_standalone_context(backend='egl').release()" 2>/dev/null \
+		|| echo "note: no EGL OpenGL here; the GL consumer test will skip (Debian: apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri)"
 	$(BIN)/python -m pytest -q
 
 # diffuse kinds against converged references (accuracy and wall time): outputs/bench/diffuse.json

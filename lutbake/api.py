@@ -65,11 +65,12 @@ def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu",
 
 def bake(configs, out_dir="outputs", overrides=(), workers: int | None = None, device: str = "cpu",
          write: bool = True, progress: bool | None = None, on_result=None) -> list[BakeResult]:
-    """Validate every config, then bake each table and write ``out_dir/<name>.exr`` atomically.
+    """Validate every config, then bake each table and write ``out_dir/<name>.<ext>`` (key ``format``,
+    default EXR) atomically.
 
     ``configs``: paths to TOML files, or TableSpecs. Nothing runs unless every config is valid.
     """
-    from .io.exr import write_exr
+    from .io.formats import write_table
 
     specs = [c for c in configs if isinstance(c, TableSpec)]
     paths = [c for c in configs if not isinstance(c, TableSpec)]
@@ -79,7 +80,7 @@ def bake(configs, out_dir="outputs", overrides=(), workers: int | None = None, d
         table, seconds, samples = bake_table(spec, workers, device, progress)
         path = None
         if write:
-            path = write_exr(table, Path(out_dir) / f"{spec.name}.exr", dtype=spec.options.get("dtype", "float32"))
+            path = write_table(table, out_dir, spec.options.get("format", "exr"), spec.options.get("dtype", "float32"))
         r = BakeResult(spec, table, path, seconds, samples)
         if on_result:
             on_result(r)

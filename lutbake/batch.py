@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Callable
 
 from . import __version__
+from .io.formats import output_path, write_table
 from .config import TableSpec
 
 PACKAGE = Path(__file__).parent
@@ -75,11 +76,18 @@ def content_hash(spec: TableSpec, digest: bytes | None = None) -> str:
 
 
 def read_header(path) -> dict[str, str] | None:
-    """The ``lutbake:*`` attributes of an existing EXR's first part (prefix removed), or None if the
-    file is missing or not a readable EXR. Reads the header only."""
+    """The ``lutbake:*`` attributes of an existing output (prefix removed): an EXR's first part header,
+    or for the other formats their ``.json`` sidecar; None if missing or unreadable (not up to date)."""
     path = Path(path)
     if not path.is_file():
         return None
+    if path.suffix != ".exr":
+        try:
+            doc = json.loads(path.with_suffix(".json").read_text(encoding="utf-8"))
+            meta = doc["lutbake"] if doc.get("file") == path.name else None
+            return {k[len("lutbake:"):] if k.startswith("lutbake:") else k: str(v) for k, v in meta.items()}
+        except Exception:  # no sidecar (ktx2, h) or a foreign one: rebake
+            return None
     try:
         import OpenImageIO as oiio
 
@@ -134,7 +142,7 @@ def plan(specs: list[TableSpec], out_dir, force: bool = False) -> list[Job]:
     digest = sources_digest()
     jobs = []
     for spec in specs:
-        job = Job(spec, Path(out_dir) / f"{spec.name}.exr", content_hash(spec, digest))
+        job = Job(spec, output_path(out_dir, spec.name, spec.options.get("format", "exr")), content_hash(spec, digest))
         header = None if force else read_header(job.path)
         if header is not None and header.get(HASH_ATTRIBUTE) == job.content_hash:
             job.status = "skipped"
@@ -151,8 +159,6 @@ def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.E
     from .api import bake_table
     from .errors import LutbakeError
     from .executor import Cancelled
-    from .io.exr import write_exr
-
     t0 = time.perf_counter()
     try:
         if cancel.is_set():
@@ -162,7 +168,8 @@ def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.E
             raise RuntimeError("the lutbake sources changed while the batch ran; run it again")
         if cancel.is_set():
             raise Cancelled(job.name)
-        write_exr(table, job.path, dtype=job.spec.options.get("dtype", "float32"))
+        write_table(table, job.path.parent, job.spec.options.get("format", "exr"),
+                    dtype=job.spec.options.get("dtype", "float32"))
     except Cancelled:
         job.status, job.message = "interrupted", "interrupted before its file was written; nothing written"
     except MemoryError as e:

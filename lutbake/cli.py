@@ -31,6 +31,7 @@ def main():
       lutbake bake configs/*.toml --out-dir build/luts --workers 2
       lutbake bake --preset default --set samples=2048 --set dtype=half
       lutbake inspect outputs/dfg.exr
+      lutbake preview outputs/dfg.exr                # -> outputs/dfg.preview.png
       lutbake list
       lutbake validate
     """
@@ -51,8 +52,10 @@ def main():
 @click.option("--force", is_flag=True, help="Rebake every table, even those whose output is up to date.")
 @click.option("--report", type=click.Path(path_type=Path, dir_okay=False), default=None, metavar="FILE.json",
               help="Write a JSON summary: per table status, path, content hash, seconds, samples, error estimate.")
-def bake(configs, presets, out_dir, overrides, workers, device, progress, force, report):
-    """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.exr.
+@click.option("--format", "fmt", type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h"]), default=None,
+              help="Output format of every table (same as --set format=...; default: each table's `format`, exr).")
+def bake(configs, presets, out_dir, overrides, workers, device, progress, force, report, fmt):
+    """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.<ext> (EXR unless `format` / --format says otherwise).
 
     All configs are validated before any kernel runs; a bad config exits with status 2 and writes
     nothing. A table whose output exists with the same content hash (its config, the lutbake version
@@ -68,6 +71,7 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
       lutbake bake configs/*.toml --report outputs/report.json
       lutbake bake configs/dfg.toml --force --set size=[64,64] --set layout=multiscatter
       lutbake bake configs/dfg.toml --set dfg.estimator=sobol_vndf --set dfg.samples=4096
+      lutbake bake --preset unreal --format dds        # -> outputs/preintegrated_gf.dds (R16G16_FLOAT)
     """
     from . import batch
     from .config import load_configs, preset_path
@@ -78,6 +82,8 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
         paths = [preset_path(p) for p in presets] + list(configs)
         if not paths:
             raise ConfigError("<command line>", None, message="give at least one CONFIG or --preset")
+        if fmt:
+            overrides = tuple(overrides) + (f'format="{fmt}"',)
         specs = load_configs(paths, overrides)
         if out_dir.exists() and not out_dir.is_dir():
             raise ConfigError("--out-dir", "out-dir", str(out_dir), message="exists and is not a directory")
@@ -133,6 +139,7 @@ def list_():
     """List table kinds, selectable terms, estimators and presets."""
     from .axes import TEXELS
     from .config import presets
+    from .io.formats import FORMATS
     from .tables import KINDS
     from .tables.dfg import LAYOUTS
     from .tables.diffuse import MODELS as DIFFUSE_MODELS
@@ -164,6 +171,7 @@ def list_():
     section("Diffuse models (kind = diffuse, model = ...)", DIFFUSE_MODELS)
     section("Estimators (specular_aniso: estimator = ...)", aniso.ESTIMATORS)
     section("Texel conventions (texel = ...)", TEXELS)
+    section("Output formats (format = ... / --format)", FORMATS)
     section("Presets (--preset NAME)", {k: _first_comment(p) for k, p in presets().items()})
 
 
@@ -239,6 +247,31 @@ def validate():
         status = click.style("PASS", fg="green") if r.passed else click.style("FAIL", fg="red")
         click.echo(f"{status}  {r.name:<48} measured {r.measured:.3e}  tolerance {r.tolerance:.1e}  {r.detail}")
     sys.exit(0 if ok else 1)
+
+
+@main.command()
+@click.argument("file", type=click.Path(path_type=Path))
+@click.option("-o", "--out", type=click.Path(path_type=Path), default=None,
+              help="PNG to write (default: FILE's stem + .preview.png beside it).")
+def preview(file, out):
+    """Render a PNG of a baked table: each channel colour-mapped with labelled axes, and (dfg) a row of
+    spheres lit with the split-sum through the table. Reads EXR, or .npy with its .json sidecar.
+
+    \b
+    Example:
+      lutbake preview outputs/dfg.exr        # -> outputs/dfg.preview.png
+    """
+    from .preview import render
+
+    try:
+        path = render(file, out)
+    except ImportError as e:
+        click.echo(f"error: preview needs matplotlib (pip install 'lutbake[plot]'): {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    except (OSError, ValueError, KeyError) as e:
+        click.echo(f"error: {file}: {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    click.echo(str(path))
 
 
 if __name__ == "__main__":

@@ -68,3 +68,22 @@ def test_inspect_missing_file_is_a_clear_error(tmp_path):
 def test_python_m_lutbake_help_has_examples():
     r = subprocess.run([sys.executable, "-m", "lutbake", "bake", "--help"], capture_output=True, text=True)
     assert r.returncode == 0 and "Examples" in r.stdout and "--set" in r.stdout
+
+
+def test_preview_writes_a_png_for_exr_and_npy(tmp_path):
+    import pytest
+
+    pytest.importorskip("matplotlib", reason="lutbake preview needs matplotlib (the plot extra)")
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(CONFIG.replace('size = [16, 8]', 'size = [16, 8]\nlayout = "multiscatter"\n'
+                                  'row_order = "hi_first"\nroughness_mapping = "texel_offset"'))
+    out = tmp_path / "out"
+    for fmt in ("exr", "npy"):
+        r = run("bake", str(cfg), "--out-dir", str(out), "--format", fmt)
+        assert r.exit_code == 0, r.output
+    for name in ("small.exr", "small.npy"):
+        r = run("preview", str(out / name), "-o", str(tmp_path / f"{name}.png"))
+        assert r.exit_code == 0, r.output
+        assert (tmp_path / f"{name}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    r = run("preview", str(tmp_path / "none.exr"))
+    assert r.exit_code != 0 and "none.exr" in r.output

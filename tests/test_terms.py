@@ -96,9 +96,19 @@ REF_D = {"ggx": ref_D_ggx, "beckmann": ref_D_beckmann, "blinn_phong": ref_D_blin
 REF_LAMBDA = {"ggx": ref_Lambda_ggx, "beckmann": ref_Lambda_beckmann}
 
 
+def ref_G2_smith_joint_approx(nov, nol, alpha):
+    """UE4 Vis_SmithJointApprox (Karis 2014 notes; Hammon 2017) times 4 (n.l)(n.v):
+    Vis = 0.5 / (n.l (n.v (1 - a) + a) + n.v (n.l (1 - a) + a))."""
+    a = f32(alpha)
+    vis = 0.5 / (nol * (nov * (1.0 - a) + a) + nov * (nol * (1.0 - a) + a))
+    return 4.0 * nol * nov * vis
+
+
 def ref_G2(ndf, masking, nov, nol, noh, voh, alpha):
     if masking == "v_cavity":
         return ref_G2_v_cavity(noh, nov, nol, voh, voh)
+    if masking == "smith_joint_approx":
+        return ref_G2_smith_joint_approx(nov, nol, alpha)
     lv, ll = REF_LAMBDA[ndf](nov, alpha), REF_LAMBDA[ndf](nol, alpha)
     if masking == "smith_height_correlated":
         return 1.0 / (1.0 + lv + ll)

@@ -374,6 +374,8 @@ def describe_exr(path) -> str:
                      f"mapping {ax.get('mapping')} ({ax.get('mapping_formula')})")
         if values:
             lines.append(f"    index 0 = {_fmt(values[0])}, index {len(values) - 1} = {_fmt(values[-1])}")
+        if ax.get("uv_formula"):
+            lines.append(f"    order {ax.get('order')}; sample at {ax.get('uv_formula')}")
         alpha = ax.get("alpha")
         if alpha:
             lines.append(f"    alpha {_fmt(min(alpha))} .. {_fmt(max(alpha))} ({ax.get('alpha_formula')})")

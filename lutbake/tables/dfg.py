@@ -4,14 +4,22 @@
 Schlick F makes f0 factor out, so two channels hold the whole table:
     scale_bias   R = ∫ f/F (1 - Fc) (n.l) dω,  G = ∫ f/F Fc (n.l) dω       E = f0 R + G
     multiscatter R = ∫ f/F Fc (n.l) dω,        G = ∫ f/F (n.l) dω          E = mix(R, G, f0); E(F=1) = G
-Axes: x (columns) = NoV, y (rows) = roughness; image row 0 is the first roughness value (smoothest).
+Two layouts add a third channel B: ``scale_bias_f82`` (Blender EEVEE) B = ∫ f/F (v.h)(1 - v.h)^6 (n.l) dω,
+the F82-tint term; ``multiscatter_cloth`` (Filament) B = ∫ D_charlie V_ashikhmin (n.l) dω, the cloth DV.
+Axes, by default: x (columns) = NoV, y (rows) = roughness; image row 0 is the first roughness value
+(smoothest). The engine conventions are explicit keys: ``axis_order`` (which quantity is x),
+``row_order`` (image row 0 = t near 0 or near 1), ``nov_mapping`` / ``roughness_mapping`` (how t maps to
+the value) and ``nov_clamp`` (lutbake.axes).
 The integral and its estimators are derived in lutbake.sampling.estimators.
 """
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
-from ..axes import ROUGHNESS_PARAMS, TEXELS, Axis
+from ..axes import MAPPINGS, ORDERS, ROUGHNESS_PARAMS, TEXELS, Axis
+from ..io.formats import FORMATS
 from ..terms.sets import MASKINGS, MODELS, NDFS, model_terms, pair_allowed
 from . import specular
 from .base import Key, Kind, Plan
@@ -22,6 +30,8 @@ MAX_SEED = (1 << 64) - 1
 LAYOUTS = {
     "scale_bias": "R = scale, G = bias: E = f0 * R + G (Karis 2013)",
     "multiscatter": "R = ∫Fc·f, G = ∫f: E = mix(R, G, f0), E(F=1) = G (Filament)",
+    "scale_bias_f82": "scale_bias + B = ∫ f/F (v.h)(1 - v.h)^6 (n.l): the F82-tint term (Blender EEVEE)",
+    "multiscatter_cloth": "multiscatter + B = ∫ D_charlie V_ashikhmin (n.l): cloth DV (Filament --ibl-dfg-cloth)",
 }
 CHANNELS = {
     "scale_bias": {"scale": "∫ f/F (1 - (1 - v.h)^5) (n.l) dω_l: multiplies f0",
@@ -29,15 +39,34 @@ CHANNELS = {
     "multiscatter": {"fc": "∫ f/F (1 - v.h)^5 (n.l) dω_l: the f90 = 1 weight",
                      "e_ss": "∫ f/F (n.l) dω_l: single-scattering directional albedo with F = 1"},
 }
+CHANNELS["scale_bias_f82"] = {
+    **CHANNELS["scale_bias"],
+    "f82": "∫ f/F (v.h)(1 - v.h)^6 (n.l) dω_l: the F82-tint term (Hoffman 2023 / Blender EEVEE metal_bias)"}
+CHANNELS["multiscatter_cloth"] = {
+    **CHANNELS["multiscatter"],
+    "cloth_dv": "∫ D_charlie(h; alpha) V_ashikhmin (n.l) dω_l, no Fresnel: sheen/cloth directional albedo "
+                "(Estevez & Kulla 2017 NDF, Ashikhmin 2007 visibility 1/(4 (n.l + n.v - (n.l)(n.v))))"}
 RECONSTRUCTION = {
     "scale_bias": "uv = vec2(NoV, roughness) (texel centres per lutbake:axes); t = texture(lut, uv).rg; "
                   "specular = prefiltered * (f0 * t.r + t.g)",
     "multiscatter": "uv = vec2(NoV, roughness); t = texture(lut, uv).rg; E = mix(t.r, t.g, f0) = (1 - f0) t.r + f0 t.g; "
                     "specular = prefiltered * E; energy compensation = 1 + f0 (1 / t.g - 1)",
 }
+RECONSTRUCTION["scale_bias_f82"] = (
+    RECONSTRUCTION["scale_bias"] + "; F82 tint (Blender EEVEE): b = mix(f0, 1, (6/7)^5) * 7/(6/7)^6 * (1 - f82_tint), "
+    "specular = prefiltered * (f0 * t.r + f90 * t.g - b * t.b)")
+RECONSTRUCTION["multiscatter_cloth"] = (
+    RECONSTRUCTION["multiscatter"] + "; cloth/sheen: sheen = prefiltered_charlie * sheen_color * t.b")
+N_CHANNELS = specular.N_CHANNELS
+AXIS_ORDERS = {
+    "nov_x": "columns (x) = NoV, rows (y) = roughness: sample at vec2(NoV, roughness) (Filament, glTF, UE4)",
+    "roughness_x": "columns (x) = roughness, rows (y) = NoV: sample at vec2(roughness, NoV-coordinate) (Blender EEVEE)",
+}
+NOV_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "one_minus_t2")}
+ROUGHNESS_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "texel_offset")}
 
 COMMON_KEYS = {
-    "name": Key("name", "name", None, "output stem: <out-dir>/<name>.exr; letters, digits, - and _ only", required=True),
+    "name": Key("name", "name", None, "output stem: <out-dir>/<name>.<ext> (ext per format); letters, digits, - and _ only", required=True),
     "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
     "samples": Key("samples", "int", None, "integrand evaluations per texel; omitted: the estimator's default "
                    "quality", minimum=1, maximum=MAX_SAMPLES),
@@ -45,6 +74,7 @@ COMMON_KEYS = {
     "estimator": Key("estimator", "str", "gauss_legendre", "how the integral is estimated", specular.ESTIMATORS),
     "seed": Key("seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0,
                 maximum=MAX_SEED),
+    "format": Key("format", "str", "exr", "output file format: <out-dir>/<name>.<ext>", FORMATS),
 }
 
 KEYS = {
@@ -60,6 +90,12 @@ KEYS = {
     "nov_range": Key("nov_range", "float_range", [0.0, 1.0], "NoV at t = 0 and t = 1", minimum=0.0, maximum=1.0),
     "roughness_range": Key("roughness_range", "float_range", [0.0, 1.0], "roughness at t = 0 and t = 1",
                            minimum=0.0, maximum=1.0),
+    "axis_order": Key("axis_order", "str", "nov_x", "which quantity runs along the columns (x)", AXIS_ORDERS),
+    "row_order": Key("row_order", "str", "lo_first", "which end of the row (y) axis is image row 0", ORDERS),
+    "nov_mapping": Key("nov_mapping", "str", "linear", "how t maps to NoV", NOV_MAPPINGS),
+    "roughness_mapping": Key("roughness_mapping", "str", "linear", "how t maps to roughness", ROUGHNESS_MAPPINGS),
+    "nov_clamp": Key("nov_clamp", "float_range", [0.0, 1.0], "NoV clamped to [lo, hi] after the mapping "
+                     "(Blender EEVEE: [1e-4, 0.9999])", minimum=0.0, maximum=1.0),
 }
 
 
@@ -76,6 +112,11 @@ def check_spec(spec) -> tuple[str, str] | None:
     if o["estimator"] == "sobol_vndf" and NDFS[nd].vndf is None:
         return ("estimator", f"'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not ndf = {nd!r}"
                              + (f" (model {model!r})" if model != "microfacet" else ""))
+    if o.get("layout") == "multiscatter_cloth" and o["estimator"] != "gauss_legendre":
+        return ("estimator", "layout 'multiscatter_cloth' needs estimator 'gauss_legendre': the QMC estimators draw "
+                             "h from the GGX NDF and miss the Charlie NDF's grazing lobe of the cloth channel")
+    if o.get("roughness_mapping") == "texel_offset" and o["texel"] != "center":
+        return ("roughness_mapping", "'texel_offset' is defined on texel centres (texel = 'center')")
     return None
 
 
@@ -96,16 +137,39 @@ def terms_record(o: dict, fresnel: str) -> dict:
 
 
 def axes_for(o: dict) -> list[Axis]:
+    """[y axis, x axis] of a dfg table, per axis_order / row_order / mappings."""
     n_nov, n_rough = o["size"]
     rname = "perceptual_roughness" if o["roughness"] == "perceptual" else "alpha"
-    return [Axis(rname, "y", n_rough, *o["roughness_range"], texel=o["texel"]),
-            Axis("NoV", "x", n_nov, *o["nov_range"], texel=o["texel"])]
+    nov_x = o.get("axis_order", "nov_x") == "nov_x"
+    row_order = o.get("row_order", "lo_first")
+    clamp = o.get("nov_clamp", [0.0, 1.0])
+    rough = Axis(rname, "x" if not nov_x else "y", n_rough, *o["roughness_range"], texel=o["texel"],
+                 mapping=o.get("roughness_mapping", "linear"), order="lo_first" if not nov_x else row_order)
+    nov = Axis("NoV", "x" if nov_x else "y", n_nov, *o["nov_range"], texel=o["texel"],
+               mapping=o.get("nov_mapping", "linear"), order=row_order if not nov_x else "lo_first",
+               clamp=None if list(clamp) == [0.0, 1.0] else tuple(clamp))
+    return [rough, nov] if nov_x else [nov, rough]
+
+
+def reconstruction(layout: str, axes: list[Axis]) -> str:
+    """The layout's shader formula, with the uv of this table's axes written out (lutbake.axes.Axis.uv)."""
+    y_axis, x_axis = axes
+
+    def u(a: Axis) -> str:
+        return re.sub(r"\bx\b", {"NoV": "NoV", "alpha": "alpha"}.get(a.name, "roughness"), a.uv_formula())
+
+    uv = f"uv = vec2({u(x_axis)}, {u(y_axis)})"
+    text = RECONSTRUCTION[layout]
+    return text.replace("uv = vec2(NoV, roughness) (texel centres per lutbake:axes)", uv).replace(
+        "uv = vec2(NoV, roughness)", uv)
 
 
 def texel_grid(axes: list[Axis]) -> tuple[np.ndarray, np.ndarray]:
-    """Per-texel (NoV, alpha) of a [roughness (y), NoV (x)] grid, row-major: texel t = iy * nx + ix."""
-    rough, nov_axis = axes
-    return np.tile(nov_axis.values(), rough.count), np.repeat(rough.alpha(), nov_axis.count)
+    """Per-texel (NoV, alpha) of a [y, x] grid (either axis order), row-major: texel t = iy * nx + ix."""
+    y_axis, x_axis = axes
+    if x_axis.name == "NoV":
+        return np.tile(x_axis.values(), y_axis.count), np.repeat(y_axis.alpha(), x_axis.count)
+    return np.repeat(y_axis.values(), x_axis.count), np.tile(x_axis.alpha(), y_axis.count)
 
 
 def plan(spec) -> Plan:
@@ -113,10 +177,13 @@ def plan(spec) -> Plan:
     axes = axes_for(o)
     nov, alpha = texel_grid(axes)
     form, nd, mk = terms_of(o)
+    nch = N_CHANNELS[o["layout"]]
+    cloth = {"cloth": "D_charlie + V_ashikhmin"} if o["layout"] == "multiscatter_cloth" else {}
     return specular.hemisphere_plan(
         key=(nd, mk, o["layout"], o["estimator"], form), nov=nov, alpha=alpha, param=None,
-        samples=o["samples"], seed=o["seed"], nch=2, axes=axes, channels=CHANNELS[o["layout"]],
-        reconstruction=RECONSTRUCTION[o["layout"]], terms={**terms_record(o, "schlick"), "layout": o["layout"]})
+        samples=o["samples"], seed=o["seed"], nch=nch, kernel_channels=nch, axes=axes,
+        channels=CHANNELS[o["layout"]], reconstruction=reconstruction(o["layout"], axes),
+        terms={**terms_record(o, "schlick"), "layout": o["layout"], **cloth})
 
 
 DFG = Kind("dfg", "split-sum specular DFG: NoV x roughness, scale/bias or multiscatter (Σ Fc·V, Σ V) channels",

@@ -8,6 +8,9 @@ A *channel function* replaces F by the weights that make the table's channels; f
 with Schlick F = f0 (1 - Fc) + Fc, Fc = (1 - v.h)^5 (Karis 2013):
     scale_bias:   (1 - Fc, Fc)   -> E = f0 * scale + bias
     multiscatter: (Fc, 1)        -> E = mix(R, G, f0) = (1 - f0) R + f0 G,  E(F = 1) = G
+    scale_bias_f82: (1 - Fc, Fc, (v.h)(1 - v.h)^6)   (Blender EEVEE's F82-tint term)
+The cloth layout adds a channel with its own BRDF, D_charlie V_ashikhmin (no Fresnel), whose integrand
+in the same measure is D_charlie V_ashikhmin (n.l) 4 (v.h) (Filament's DFV_Charlie_Uniform).
 """
 from __future__ import annotations
 
@@ -19,7 +22,7 @@ import warp as wp
 from ..edge import COS_EPS
 from ..sampling import points
 from ..sampling.estimators import make_gauss_legendre, make_qmc
-from ..terms import fresnel, metals, ndf, sets
+from ..terms import fresnel, masking, metals, ndf, sets
 from ..terms.frame import reflect
 from .base import Plan
 
@@ -61,9 +64,24 @@ def channels_F_dielectric_f0(VoH: float, f0: float):
     return wp.vec2(fresnel.F_dielectric_f0(f0, VoH), 0.0)
 
 
+# Blender EEVEE's F82-tint layout: (1 - Fc, Fc, (v.h)(1 - v.h)^6)
+@wp.func
+def channels_scale_bias_f82(VoH: float, f0: float):
+    Fc = fresnel.Fc_schlick(VoH)
+    return wp.vec3(1.0 - Fc, Fc, VoH * Fc * wp.clamp(1.0 - VoH, 0.0, 1.0))
+
+
+@wp.func
+def channels_multiscatter3(VoH: float, f0: float):
+    return wp.vec3(fresnel.Fc_schlick(VoH), 1.0, 0.0)
+
+
 CHANNEL_FUNCS = {"scale_bias": channels_scale_bias, "multiscatter": channels_multiscatter,
                  "albedo": channels_albedo, "F:schlick": channels_F_schlick, "F:schlick_sg": channels_F_schlick_sg,
-                 "F:improved_sg": channels_F_improved_sg, "F:dielectric_f0": channels_F_dielectric_f0}
+                 "F:improved_sg": channels_F_improved_sg, "F:dielectric_f0": channels_F_dielectric_f0,
+                 "scale_bias_f82": channels_scale_bias_f82}
+THREE_CHANNELS = {"scale_bias_f82", "multiscatter_cloth"}
+N_CHANNELS = {"scale_bias": 2, "multiscatter": 2, "albedo": 2, "scale_bias_f82": 3, "multiscatter_cloth": 3}
 
 
 @functools.lru_cache(maxsize=None)
@@ -71,7 +89,7 @@ def channels_for(channels_name: str):
     """(channel wp.func (VoH, param) -> vec, vec type): a name of CHANNEL_FUNCS, or "metal:<name>"
     for RGB = F_conductor(n_c, k_c, v.h) of a metal of lutbake.terms.metals (constants closed over)."""
     if channels_name in CHANNEL_FUNCS:
-        return CHANNEL_FUNCS[channels_name], wp.vec2
+        return CHANNEL_FUNCS[channels_name], (wp.vec3 if channels_name in THREE_CHANNELS else wp.vec2)
     if channels_name.startswith("metal:"):
         m = metals.lookup_metal(channels_name[len("metal:"):])
         nr, ng, nb = (float(x) for x in m.n)
@@ -95,6 +113,8 @@ def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: st
         ashikhmin_shirley  f = (s + 1)/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v)) [x F]:
                                                                       g = (s + 1)/(2 pi) (n.h)^s (n.l) / max(n.l, n.v)
     with s = 2 / alpha^2 - 2 for the last two (ndf_name, masking_name are then unused)."""
+    if channels_name == "multiscatter_cloth":
+        return cloth_integrand_for(ndf_name, masking_name)
     ch, vec = channels_for(channels_name)
     if form == "microfacet":
         D = sets.NDFS[ndf_name].D
@@ -129,6 +149,50 @@ def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: st
     return integrand
 
 
+@functools.lru_cache(maxsize=None)
+def cloth_integrand_for(ndf_name: str, masking_name: str):
+    """(Fc s, s, D_charlie V_ashikhmin (n.l) 4 (v.h)) with s = D G2 (v.h)/(n.v): the multiscatter
+    channels plus Filament's cloth DV, 0 where n.l or v.h <= COS_EPS (back-facing)."""
+    D = sets.NDFS[ndf_name].D
+    G2 = sets.G2_for(ndf_name, masking_name)
+
+    @wp.func
+    def integrand(v: wp.vec3, h: wp.vec3, alpha: float):
+        l = reflect(v, h)
+        NoL = l[2]
+        NoV = v[2]
+        VoH = wp.dot(v, h)
+        if NoL <= COS_EPS or VoH <= COS_EPS or NoV <= COS_EPS:
+            return wp.vec3()
+        spec = D(h, alpha) * G2(NoV, NoL, h[2], VoH, alpha) * VoH / NoV
+        cloth = ndf.D_charlie(h, alpha) * masking.V_ashikhmin(NoV, NoL) * NoL * 4.0 * VoH
+        return channels_multiscatter3(VoH) * spec + wp.vec3(0.0, 0.0, cloth)
+
+    return integrand
+
+
+@functools.lru_cache(maxsize=None)
+def cloth_integrand_for(ndf_name: str, masking_name: str):
+    """(Fc s, s, D_charlie V_ashikhmin (n.l) 4 (v.h)) with s = D G2 (v.h)/(n.v): the multiscatter
+    channels plus Filament's cloth DV (DFV_Charlie_Uniform), 0 where n.l or v.h <= COS_EPS (back-facing)."""
+    D = sets.NDFS[ndf_name].D
+    G2 = sets.G2_for(ndf_name, masking_name)
+
+    @wp.func
+    def integrand(v: wp.vec3, h: wp.vec3, alpha: float, param: float):
+        l = reflect(v, h)
+        NoL = l[2]
+        NoV = v[2]
+        VoH = wp.dot(v, h)
+        if NoL <= COS_EPS or VoH <= COS_EPS or NoV <= COS_EPS:
+            return wp.vec3()
+        spec = D(h, alpha) * G2(NoV, NoL, h[2], VoH, alpha) * VoH / NoV
+        cloth = ndf.D_charlie(h, alpha) * masking.V_ashikhmin(NoV, NoL) * NoL * 4.0 * VoH
+        return channels_multiscatter3(VoH, param) * spec + wp.vec3(0.0, 0.0, cloth)
+
+    return integrand
+
+
 ESTIMATORS = {
     "gauss_legendre": "deterministic product Gauss-Legendre over panels in theta_h (or CDF(theta_h)) and phi, "
                       "split exactly at the horizon (default; converges exponentially)",
@@ -152,7 +216,7 @@ def kernel_for(ndf_name: str, masking_name: str, channels_name: str, estimator: 
 def _kernel_for(ndf_name: str, masking_name: str, channels_name: str, estimator: str, form: str):
     nd = sets.NDFS[ndf_name]
     g = integrand_for(ndf_name, masking_name, channels_name, form)
-    vec = channels_for(channels_name)[1]
+    vec = wp.vec3 if channels_name == "multiscatter_cloth" else channels_for(channels_name)[1]
     acc = wp.vec3d if vec is wp.vec3 else wp.vec2d
     if estimator == "gauss_legendre":
         return make_gauss_legendre(g, sets.pdf_ndf_for(ndf_name), nd.tan2_from_u, nd.u_from_tan2, vec, acc)

@@ -70,3 +70,22 @@ def Lambda_ggx_aniso(v: wp.vec3, alpha_x: float, alpha_y: float):
     if v[2] <= COS_EPS:
         return LAMBDA_INF
     return 0.5 * (wp.sqrt(v[2] * v[2] + alpha_x * alpha_x * v[0] * v[0] + alpha_y * alpha_y * v[1] * v[1]) / v[2] - 1.0)
+
+
+@wp.func
+def V_ashikhmin(NoV: float, NoL: float):
+    """Ashikhmin & Premoze 2007 cloth visibility, 1/(4 NoL NoV) folded in (a V_ term, not a G):
+    V = 1 / (4 (n.l + n.v - (n.l)(n.v))) (Filament's V_Neubelt / Visibility_Ashikhmin). Finite
+    everywhere on the upper hemisphere (1/4 at n.l = 1 or n.v = 1; 1/(4 n.v) at n.l -> 0)."""
+    return 1.0 / (4.0 * (NoL + NoV - NoL * NoV))
+
+
+@wp.func
+def G2_smith_joint_approx(NoV: float, NoL: float, alpha: float):
+    """Unreal Engine 4's ``Vis_SmithJointApprox`` written as a G2 (Karis; Hammon 2017's linear
+    approximation of height-correlated Smith for GGX):
+    G2 = 4 (n.l)(n.v) Vis = 2 (n.l)(n.v) / ((n.l)((n.v)(1 - alpha) + alpha) + (n.v)((n.l)(1 - alpha) + alpha)).
+    0 for a back-facing n.l or n.v."""
+    if NoV <= COS_EPS or NoL <= COS_EPS:
+        return 0.0
+    return 2.0 * NoL * NoV / (NoL * (NoV * (1.0 - alpha) + alpha) + NoV * (NoL * (1.0 - alpha) + alpha))

@@ -221,3 +221,15 @@ def sample_ashikhmin_shirley(nu: float, nv: float, u1: float, u2: float):
     c = wp.exp(0.5 * L2)
     s = wp.sqrt(wp.clamp(s2, 0.0, 1.0))
     return wp.vec3(s * cp, s * sp, c)
+
+
+@wp.func
+def D_charlie(h: wp.vec3, alpha: float):
+    """Charlie sheen NDF (Estevez & Kulla 2017, "Production Friendly Microfacet Sheen BRDF", Eq. 2):
+    D = (2 + 1/alpha) sin(theta_h)^(1/alpha) / (2 pi), sin^2 = h.x^2 + h.y^2 (alpha = r^2, as Filament's
+    DistributionCharlie). Peaks at grazing microfacets; 0 at the pole and for n.h <= 0."""
+    if h[2] <= 0.0:
+        return 0.0
+    inv = 1.0 / alpha
+    sin2 = h[0] * h[0] + h[1] * h[1]
+    return (2.0 + inv) * wp.pow(sin2, 0.5 * inv) * INV_PI * 0.5

@@ -64,6 +64,8 @@ MASKINGS = {
     "smith_height_correlated": "Smith G2 = 1/(1 + Lambda(v) + Lambda(l)), height-correlated (Heitz 2014, Eq. 99)",
     "smith_separable": "Smith G2 = G1(v) G1(l), separable (Heitz 2014, Eq. 98)",
     "v_cavity": "Cook-Torrance V-cavity min(1, 2 NoH NoV / VoH, 2 NoH NoL / VoH) (lecture 003)",
+    "smith_joint_approx": "UE4's Vis_SmithJointApprox as G2 = 2 NoL NoV / (NoL (NoV (1-a) + a) + NoV (NoL (1-a) + a)), "
+                          "a = alpha (an approximation of height-correlated Smith GGX; NDF-independent)",
 }
 
 
@@ -88,6 +90,10 @@ def G2_for(ndf_name: str, masking_name: str):
         @wp.func
         def G2(NoV: float, NoL: float, NoH: float, VoH: float, alpha: float):
             return masking.G2_v_cavity(NoH, NoV, NoL, VoH, VoH)
+    elif masking_name == "smith_joint_approx":
+        @wp.func
+        def G2(NoV: float, NoL: float, NoH: float, VoH: float, alpha: float):
+            return masking.G2_smith_joint_approx(NoV, NoL, alpha)
     else:
         raise KeyError(masking_name)
     return G2

@@ -1,0 +1,81 @@
+"""Axis-convention keys of kind dfg: axis order, row order, NoV / roughness mappings, NoV clamp, and
+the texture coordinate each axis records for shaders (uv)."""
+import json
+
+import numpy as np
+import pytest
+
+from lutbake.api import bake_table
+from lutbake.axes import Axis
+from lutbake.config import validate_table
+from lutbake.errors import ConfigError
+
+BASE = {"name": "t", "kind": "dfg", "size": [8, 6], "samples": 48}
+
+
+def bake(**kw):
+    return bake_table(validate_table({**BASE, **kw}, "<test>", 0), workers=1)[0]
+
+
+@pytest.fixture(scope="module")
+def default():
+    return bake()
+
+
+def test_defaults_keep_nov_columns_and_smooth_first_row(default):
+    assert [(a.name, a.dim, a.order, a.mapping) for a in default.axes] == [
+        ("perceptual_roughness", "y", "lo_first", "linear"), ("NoV", "x", "lo_first", "linear")]
+
+
+def test_roughness_x_transposes_the_table(default):
+    t = bake(axis_order="roughness_x")
+    assert [(a.name, a.dim) for a in t.axes] == [("NoV", "y"), ("perceptual_roughness", "x")]
+    np.testing.assert_array_equal(t.data, default.data.transpose(1, 0, 2))
+
+
+def test_hi_first_flips_rows(default):
+    t = bake(row_order="hi_first")
+    np.testing.assert_array_equal(t.data, default.data[::-1])
+    np.testing.assert_allclose(t.axes[0].values()[0], 1 - 0.5 / 6, rtol=1e-6)
+
+
+def test_blender_nov_mapping_one_minus_t2_with_clamp():
+    ax = Axis("NoV", "y", 64, texel="endpoint", mapping="one_minus_t2", clamp=(1e-4, 0.9999))
+    v = np.arange(64) / 63
+    np.testing.assert_allclose(ax.values(), np.clip(1 - v * v, 1e-4, 0.9999), rtol=1e-6)
+    # Blender's runtime lookup: uv = sqrt(1 - NoV) * 63/64 + 0.5/64 hits the texel centres
+    inner = ax.values()[1:-1]
+    np.testing.assert_allclose(ax.uv(inner) * 64, np.arange(1, 63) + 0.5, atol=1e-4)
+
+
+def test_filament_texel_offset_rows():
+    ax = Axis("perceptual_roughness", "y", 128, mapping="texel_offset", order="hi_first")
+    y = np.arange(128)
+    np.testing.assert_allclose(ax.values(), np.clip((128 - y + 0.5) / 128, 0, 1), rtol=1e-6)
+    assert ax.values()[0] == 1.0 and ax.values()[1] == np.float32(127.5 / 128)
+    # the corrected lookup for such a table: u = 1 - (r - 1/128), row y centre at (y + 0.5)/128
+    np.testing.assert_allclose(ax.uv(ax.values()[1:]) * 128, y[1:] + 0.5, atol=1e-4)
+
+
+def test_conventions_are_in_the_axes_metadata():
+    t = bake(axis_order="roughness_x", texel="endpoint", nov_mapping="one_minus_t2", nov_clamp=[1e-4, 0.9999])
+    d = t.axes[0].describe()
+    json.dumps(d)
+    assert d["mapping"] == "one_minus_t2" and d["clamp"] == [1e-4, 0.9999] and d["order"] == "lo_first"
+    assert "sqrt(1 - x)" in d["uv_formula"]
+
+
+def test_texel_offset_needs_texel_centres():
+    with pytest.raises(ConfigError, match="texel_offset"):
+        validate_table({**BASE, "roughness_mapping": "texel_offset", "texel": "endpoint"}, "<test>", 0)
+
+
+def test_three_channel_layouts_extend_the_two_channel_ones(default):
+    f82 = bake(layout="scale_bias_f82")
+    np.testing.assert_allclose(f82.data[..., :2], default.data, atol=1e-6)
+    assert list(f82.channels) == ["scale", "bias", "f82"]
+    assert np.all(f82.data[..., 2] >= 0) and np.all(f82.data[..., 2] < 0.1)
+    cloth = bake(layout="multiscatter_cloth")
+    ms = bake(layout="multiscatter")
+    np.testing.assert_allclose(cloth.data[..., :2], ms.data, atol=1e-6)
+    assert np.all(np.isfinite(cloth.data)) and np.all(cloth.data[..., 2] >= 0)
