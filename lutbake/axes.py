@@ -55,9 +55,9 @@ class Axis:
     hi: float = 1.0
     texel: str = "center"
     mapping: str = "linear"
-    listed: tuple[float, ...] = ()  # mapping "listed": the value of every index (count = len(listed))
     order: str = "lo_first"
     clamp: tuple[float, float] | None = None
+    listed: tuple[float, ...] = ()  # mapping "listed": the value of every index (count = len(listed))
 
     def t(self) -> np.ndarray:
         """The texture-space parameter t in [0, 1] at every index (after ``order``)."""

@@ -25,8 +25,10 @@ SUN_POWER = 1.5  # integral of the sun's radiance over the sphere (its irradianc
 def axis_from_meta(d: dict) -> Axis:
     lo, hi = d.get("range", [0.0, 1.0])
     clamp = d.get("clamp")
-    return Axis(d["name"], d["dim"], int(d["count"]), float(lo), float(hi), d.get("texel", "center"),
-                d.get("mapping", "linear"), d.get("order", "lo_first"), tuple(clamp) if clamp else None)
+    listed = tuple(d["values"]) if d.get("mapping") == "listed" else ()
+    return Axis(d["name"], d["dim"], int(d["count"]), float(lo), float(hi), texel=d.get("texel", "center"),
+                mapping=d.get("mapping", "linear"), order=d.get("order", "lo_first"),
+                clamp=tuple(clamp) if clamp else None, listed=listed)
 
 
 def read_table(path: Path) -> tuple[np.ndarray, dict]:

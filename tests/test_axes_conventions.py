@@ -79,3 +79,20 @@ def test_three_channel_layouts_extend_the_two_channel_ones(default):
     ms = bake(layout="multiscatter")
     np.testing.assert_allclose(cloth.data[..., :2], ms.data, atol=1e-6)
     assert np.all(np.isfinite(cloth.data)) and np.all(cloth.data[..., 2] >= 0)
+
+
+def test_axis_metadata_round_trips_through_the_preview_reader():
+    """An axis rebuilt from its lutbake:axes entry (as `lutbake preview` does) has the same values and uv."""
+    import numpy as np
+
+    from lutbake.axes import Axis
+    from lutbake.preview import axis_from_meta
+
+    for a in (Axis("NoV", "y", 8, texel="endpoint", mapping="one_minus_t2", order="hi_first", clamp=(1e-4, 0.9999)),
+              Axis("perceptual_roughness", "x", 16, mapping="texel_offset"),
+              Axis("sigma", "z", 3, 0.1, 0.9, mapping="listed", listed=(0.1, 0.3, 0.9))):
+        b = axis_from_meta(a.describe())
+        np.testing.assert_array_equal(b.values(), a.values())
+        x = np.linspace(0.0, 1.0, 11)
+        np.testing.assert_allclose(b.uv(x), a.uv(x))
+        assert (b.order, b.clamp, b.mapping) == (a.order, a.clamp, a.mapping)
