@@ -6,6 +6,9 @@ Schlick F makes f0 factor out, so two channels hold the whole table:
     multiscatter R = ∫ f/F Fc (n.l) dω,        G = ∫ f/F (n.l) dω          E = mix(R, G, f0); E(F=1) = G
 Two layouts add a third channel B: ``scale_bias_f82`` (Blender EEVEE) B = ∫ f/F (v.h)(1 - v.h)^6 (n.l) dω,
 the F82-tint term; ``multiscatter_cloth`` (Filament) B = ∫ D_charlie V_ashikhmin (n.l) dω, the cloth DV.
+The sheen layouts integrate the KHR_materials_sheen lobe alone (no GGX, F = 1): ``charlie`` B = ∫ D_charlie
+V_ashikhmin (n.l) dω (the glTF Sample Viewer's lut_charlie), ``sheen_albedo`` R = E = ∫ D_charlie V_charlie (n.l) dω
+(the spec's albedo scaling), G = the same with V_ashikhmin; ``*_clamped`` clamp V to [0, 1] as the viewer does.
 Axes, by default: x (columns) = NoV, y (rows) = roughness; image row 0 is the first roughness value
 (smoothest). The engine conventions are explicit keys: ``axis_order`` (which quantity is x),
 ``row_order`` (image row 0 = t near 0 or near 1), ``nov_mapping`` / ``roughness_mapping`` (how t maps to
