@@ -6,6 +6,9 @@ Schlick F makes f0 factor out, so two channels hold the whole table:
     multiscatter R = ∫ f/F Fc (n.l) dω,        G = ∫ f/F (n.l) dω          E = mix(R, G, f0); E(F=1) = G
 Two layouts add a third channel B: ``scale_bias_f82`` (Blender EEVEE) B = ∫ f/F (v.h)(1 - v.h)^6 (n.l) dω,
 the F82-tint term; ``multiscatter_cloth`` (Filament) B = ∫ D_charlie V_ashikhmin (n.l) dω, the cloth DV.
+The sheen layouts integrate the KHR_materials_sheen lobe alone (no GGX, F = 1): ``charlie`` B = ∫ D_charlie
+V_ashikhmin (n.l) dω (the glTF Sample Viewer's lut_charlie), ``sheen_albedo`` R = E = ∫ D_charlie V_charlie (n.l) dω
+(the spec's albedo scaling), G = the same with V_ashikhmin; ``*_clamped`` clamp V to [0, 1] as the viewer does.
 Axes, by default: x (columns) = NoV, y (rows) = roughness; image row 0 is the first roughness value
 (smoothest). The engine conventions are explicit keys: ``axis_order`` (which quantity is x),
 ``row_order`` (image row 0 = t near 0 or near 1), ``nov_mapping`` / ``roughness_mapping`` (how t maps to
@@ -32,7 +35,14 @@ LAYOUTS = {
     "multiscatter": "R = ∫Fc·f, G = ∫f: E = mix(R, G, f0), E(F=1) = G (Filament)",
     "scale_bias_f82": "scale_bias + B = ∫ f/F (v.h)(1 - v.h)^6 (n.l): the F82-tint term (Blender EEVEE)",
     "multiscatter_cloth": "multiscatter + B = ∫ D_charlie V_ashikhmin (n.l): cloth DV (Filament --ibl-dfg-cloth)",
+    "charlie": "sheen lobe alone: R = G = 0, B = ∫ D_charlie V_ashikhmin (n.l): the glTF Sample Viewer's lut_charlie "
+               "(KHR_materials_sheen IBL; gauss_legendre only)",
+    "sheen_albedo": "sheen lobe alone: R = E = ∫ D_charlie V_charlie (n.l) (KHR_materials_sheen albedo scaling, Charlie "
+                    "visibility), G = the same with V_ashikhmin (gauss_legendre only)",
+    "charlie_clamped": "charlie with V_ashikhmin clamped to [0, 1]: the glTF Sample Viewer's LUT() integrand exactly",
+    "sheen_albedo_clamped": "sheen_albedo with each V clamped to [0, 1], as the glTF Sample Viewer's V_Sheen / V_Ashikhmin",
 }
+SHEEN_LAYOUTS = specular.SHEEN_LAYOUTS
 CHANNELS = {
     "scale_bias": {"scale": "∫ f/F (1 - (1 - v.h)^5) (n.l) dω_l: multiplies f0",
                    "bias": "∫ f/F (1 - v.h)^5 (n.l) dω_l: added"},
@@ -46,6 +56,19 @@ CHANNELS["multiscatter_cloth"] = {
     **CHANNELS["multiscatter"],
     "cloth_dv": "∫ D_charlie(h; alpha) V_ashikhmin (n.l) dω_l, no Fresnel: sheen/cloth directional albedo "
                 "(Estevez & Kulla 2017 NDF, Ashikhmin 2007 visibility 1/(4 (n.l + n.v - (n.l)(n.v))))"}
+CHANNELS["charlie"] = {
+    "zero_r": "0 (the viewer's lut_charlie leaves R empty)",
+    "zero_g": "0",
+    "charlie_dv": "∫ D_charlie(h; alpha) V_ashikhmin (n.l) dω_l, no Fresnel: the sheen lobe's DFG for IBL "
+                  "(Estevez & Kulla 2017 NDF, Ashikhmin & Premoze 2007 visibility 1/(4 (n.l + n.v - (n.l)(n.v))))"}
+CHANNELS["sheen_albedo"] = {
+    "sheen_e": "E(n.v) = ∫ D_charlie V_charlie (n.l) dω_l: directional albedo of the KHR_materials_sheen BRDF with its "
+               "Charlie visibility 1/((1 + Lambda(n.v) + Lambda(n.l)) 4 (n.v)(n.l)) (Estevez & Kulla 2017 fit)",
+    "sheen_e_ashikhmin": "∫ D_charlie V_ashikhmin (n.l) dω_l: the same with the spec's cheaper Ashikhmin visibility "
+                         "(may exceed 1: not energy conserving, as the spec warns)"}
+CHANNELS["charlie_clamped"] = {**CHANNELS["charlie"], "charlie_dv": "∫ D_charlie min(V_ashikhmin, 1) (n.l) dω_l"}
+CHANNELS["sheen_albedo_clamped"] = {"sheen_e": "∫ D_charlie min(V_charlie, 1) (n.l) dω_l",
+                                    "sheen_e_ashikhmin": "∫ D_charlie min(V_ashikhmin, 1) (n.l) dω_l"}
 RECONSTRUCTION = {
     "scale_bias": "uv = vec2(NoV, roughness) (texel centres per lutbake:axes); t = texture(lut, uv).rg; "
                   "specular = prefiltered * (f0 * t.r + t.g)",
@@ -57,6 +80,15 @@ RECONSTRUCTION["scale_bias_f82"] = (
     "specular = prefiltered * (f0 * t.r + f90 * t.g - b * t.b)")
 RECONSTRUCTION["multiscatter_cloth"] = (
     RECONSTRUCTION["multiscatter"] + "; cloth/sheen: sheen = prefiltered_charlie * sheen_color * t.b")
+RECONSTRUCTION["charlie"] = (
+    "uv = vec2(NoV, roughness); KHR_materials_sheen IBL (glTF Sample Viewer getIBLRadianceCharlie): "
+    "sheen = prefiltered_charlie * sheenColor * texture(lut, uv).b, at uv = vec2(NdotV, sheenRoughness)")
+RECONSTRUCTION["sheen_albedo"] = (
+    "uv = vec2(NoV, roughness); KHR_materials_sheen albedo scaling: E = texture(lut, uv).r at uv = vec2(NdotV, "
+    "sheenRoughness); sheenAlbedoScaling = 1 - max3(sheenColor) * E (or min over E(NdotV), E(NdotL)); "
+    "f = f_sheen + (f_diffuse + f_specular) * sheenAlbedoScaling; .g is E with Ashikhmin visibility")
+RECONSTRUCTION["charlie_clamped"] = RECONSTRUCTION["charlie"]
+RECONSTRUCTION["sheen_albedo_clamped"] = RECONSTRUCTION["sheen_albedo"]
 N_CHANNELS = specular.N_CHANNELS
 AXIS_ORDERS = {
     "nov_x": "columns (x) = NoV, rows (y) = roughness: sample at vec2(NoV, roughness) (Filament, glTF, UE4)",
@@ -115,6 +147,13 @@ def check_spec(spec) -> tuple[str, str] | None:
     if o.get("layout") == "multiscatter_cloth" and o["estimator"] != "gauss_legendre":
         return ("estimator", "layout 'multiscatter_cloth' needs estimator 'gauss_legendre': the QMC estimators draw "
                              "h from the GGX NDF and miss the Charlie NDF's grazing lobe of the cloth channel")
+    if o.get("layout") in SHEEN_LAYOUTS:
+        if o["estimator"] != "gauss_legendre":
+            return ("estimator", f"layout {o['layout']!r} needs estimator 'gauss_legendre': the QMC estimators draw h "
+                                 f"from the GGX NDF and miss the Charlie NDF's grazing lobe (got {o['estimator']!r})")
+        if model != "microfacet" or (o["ndf"], o["masking"]) != (KEYS["ndf"].default, KEYS["masking"].default):
+            return ("layout", f"layout {o['layout']!r} integrates the sheen lobe (Charlie NDF) alone: leave model, ndf "
+                              "and masking unset")
     if o.get("roughness_mapping") == "texel_offset" and o["texel"] != "center":
         return ("roughness_mapping", "'texel_offset' is defined on texel centres (texel = 'center')")
     return None
@@ -179,11 +218,19 @@ def plan(spec) -> Plan:
     form, nd, mk = terms_of(o)
     nch = N_CHANNELS[o["layout"]]
     cloth = {"cloth": "D_charlie + V_ashikhmin"} if o["layout"] == "multiscatter_cloth" else {}
+    terms = {**terms_record(o, "schlick"), "layout": o["layout"], **cloth}
+    if o["layout"] in SHEEN_LAYOUTS:
+        vis = ("ashikhmin" if o["layout"].startswith("charlie") else
+               "R: charlie (Estevez-Kulla Lambda fit), G: ashikhmin")
+        if o["layout"].endswith("_clamped"):
+            vis += " (V clamped to [0, 1], as the glTF Sample Viewer)"
+        terms = {"model": "sheen", "ndf": "charlie (alpha = the roughness axis' alpha)", "masking": vis,
+                 "fresnel": "none (F = 1)", "layout": o["layout"],
+                 "gauss_legendre_panels": "the GGX CDF in theta_h (panelling only; the integrand is the sheen lobe)"}
     return specular.hemisphere_plan(
         key=(nd, mk, o["layout"], o["estimator"], form), nov=nov, alpha=alpha, param=None,
-        samples=o["samples"], seed=o["seed"], nch=nch, kernel_channels=nch, axes=axes,
-        channels=CHANNELS[o["layout"]], reconstruction=reconstruction(o["layout"], axes),
-        terms={**terms_record(o, "schlick"), "layout": o["layout"], **cloth})
+        samples=o["samples"], seed=o["seed"], nch=nch, kernel_channels=3 if o["layout"] in SHEEN_LAYOUTS else nch,
+        axes=axes, channels=CHANNELS[o["layout"]], reconstruction=reconstruction(o["layout"], axes), terms=terms)
 
 
 DFG = Kind("dfg", "split-sum specular DFG: NoV x roughness, scale/bias or multiscatter (Σ Fc·V, Σ V) channels",

@@ -80,8 +80,11 @@ CHANNEL_FUNCS = {"scale_bias": channels_scale_bias, "multiscatter": channels_mul
                  "albedo": channels_albedo, "F:schlick": channels_F_schlick, "F:schlick_sg": channels_F_schlick_sg,
                  "F:improved_sg": channels_F_improved_sg, "F:dielectric_f0": channels_F_dielectric_f0,
                  "scale_bias_f82": channels_scale_bias_f82}
-THREE_CHANNELS = {"scale_bias_f82", "multiscatter_cloth"}
-N_CHANNELS = {"scale_bias": 2, "multiscatter": 2, "albedo": 2, "scale_bias_f82": 3, "multiscatter_cloth": 3}
+THREE_CHANNELS = {"scale_bias_f82", "multiscatter_cloth", "charlie", "charlie_clamped"}
+N_CHANNELS = {"scale_bias": 2, "multiscatter": 2, "albedo": 2, "scale_bias_f82": 3, "multiscatter_cloth": 3,
+              "charlie": 3, "sheen_albedo": 2, "charlie_clamped": 3, "sheen_albedo_clamped": 2}
+# the sheen lobe alone: no GGX term (sheen_integrand_for); *_clamped: V clamped to [0, 1] (the viewer's shaders)
+SHEEN_LAYOUTS = ("charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped")
 
 
 @functools.lru_cache(maxsize=None)
@@ -115,6 +118,8 @@ def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: st
     with s = 2 / alpha^2 - 2 for the last two (ndf_name, masking_name are then unused)."""
     if channels_name == "multiscatter_cloth":
         return cloth_integrand_for(ndf_name, masking_name)
+    if channels_name in SHEEN_LAYOUTS:
+        return sheen_integrand_for(channels_name)
     ch, vec = channels_for(channels_name)
     if form == "microfacet":
         D = sets.NDFS[ndf_name].D
@@ -193,6 +198,36 @@ def cloth_integrand_for(ndf_name: str, masking_name: str):
     return integrand
 
 
+@functools.lru_cache(maxsize=None)
+def sheen_integrand_for(layout: str):
+    """The sheen lobe f = D_charlie(h; alpha) V (KHR_materials_sheen, no Fresnel) alone, as g(h) = f (n.l) 4 (v.h):
+        charlie       (0, 0, D_charlie V_ashikhmin (n.l) 4 (v.h))   the glTF Sample Viewer's lut_charlie (read .b)
+        sheen_albedo  (D_charlie V_charlie (n.l) 4 (v.h), D_charlie V_ashikhmin (n.l) 4 (v.h))
+                      R: E(mu) with the spec's Charlie visibility, G: with Ashikhmin's
+    0 where n.l, v.h or n.v <= COS_EPS (back-facing). alpha is the texel's alpha (roughness = "alpha": the
+    sheenRoughness itself, as the KHR spec's D and Lambda fit use it). The ``*_clamped`` layouts clamp each V
+    to [0, 1], as the glTF Sample Viewer's V_Ashikhmin (ibl_filtering.frag) and V_Sheen (brdf.glsl) do."""
+    clamped = layout.endswith("_clamped")
+    vmax = 1.0 if clamped else 1.0e30
+    base = layout.removesuffix("_clamped")
+
+    @wp.func
+    def integrand(v: wp.vec3, h: wp.vec3, alpha: float, param: float):
+        l = reflect(v, h)
+        NoL = l[2]
+        NoV = v[2]
+        VoH = wp.dot(v, h)
+        if NoL <= COS_EPS or VoH <= COS_EPS or NoV <= COS_EPS:
+            return wp.vec3()
+        d = ndf.D_charlie(h, alpha) * NoL * 4.0 * VoH
+        ash = d * wp.min(masking.V_ashikhmin(NoV, NoL), wp.static(vmax))
+        if wp.static(base == "charlie"):
+            return wp.vec3(0.0, 0.0, ash)
+        return wp.vec3(d * wp.min(masking.V_charlie(NoV, NoL, alpha), wp.static(vmax)), ash, 0.0)
+
+    return integrand
+
+
 ESTIMATORS = {
     "gauss_legendre": "deterministic product Gauss-Legendre over panels in theta_h (or CDF(theta_h)) and phi, "
                       "split exactly at the horizon (default; converges exponentially)",
@@ -216,7 +251,7 @@ def kernel_for(ndf_name: str, masking_name: str, channels_name: str, estimator: 
 def _kernel_for(ndf_name: str, masking_name: str, channels_name: str, estimator: str, form: str):
     nd = sets.NDFS[ndf_name]
     g = integrand_for(ndf_name, masking_name, channels_name, form)
-    vec = wp.vec3 if channels_name == "multiscatter_cloth" else channels_for(channels_name)[1]
+    vec = wp.vec3 if channels_name in ("multiscatter_cloth",) + SHEEN_LAYOUTS else channels_for(channels_name)[1]
     acc = wp.vec3d if vec is wp.vec3 else wp.vec2d
     if estimator == "gauss_legendre":
         return make_gauss_legendre(g, sets.pdf_ndf_for(ndf_name), nd.tan2_from_u, nd.u_from_tan2, vec, acc)

@@ -81,6 +81,38 @@ def V_ashikhmin(NoV: float, NoL: float):
 
 
 @wp.func
+def sheen_l(x: float, alpha: float):
+    """Estevez & Kulla 2017's fit l(x) of the Charlie sheen Lambda (their Table 1, interpolated in
+    (1 - alpha)^2), as written in KHR_materials_sheen's "Sheen visibility" and the glTF Sample Viewer's
+    lambdaSheenNumericHelper."""
+    t = (1.0 - alpha) * (1.0 - alpha)
+    a = 21.5473 + (25.3245 - 21.5473) * t
+    b = 3.82987 + (3.32435 - 3.82987) * t
+    c = 0.19823 + (0.16801 - 0.19823) * t
+    d = -1.97760 + (-1.27393 + 1.97760) * t
+    e = -4.32054 + (-4.85967 + 4.32054) * t
+    return a / (1.0 + b * wp.pow(wp.max(x, 0.0), c)) + d * x + e
+
+
+@wp.func
+def lambda_sheen(cos_theta: float, alpha: float):
+    """Charlie sheen Lambda: exp(l(cos)) below cos = 0.5, exp(2 l(0.5) - l(1 - cos)) above (Estevez & Kulla 2017)."""
+    if wp.abs(cos_theta) < 0.5:
+        return wp.exp(sheen_l(cos_theta, alpha))
+    return wp.exp(2.0 * sheen_l(0.5, alpha) - sheen_l(1.0 - cos_theta, alpha))
+
+
+@wp.func
+def V_charlie(NoV: float, NoL: float, alpha: float):
+    """Charlie sheen visibility (KHR_materials_sheen, Estevez & Kulla 2017), 1/(4 NoL NoV) folded in:
+    V = 1 / ((1 + Lambda(n.v) + Lambda(n.l)) 4 (n.v)(n.l)), unclamped (the glTF Sample Viewer clamps V to
+    [0, 1]; only NoV, NoL -> 0 can exceed 1, where the Lambdas are ~e^17). 0 for a back-facing n.l or n.v."""
+    if NoV <= COS_EPS or NoL <= COS_EPS:
+        return 0.0
+    return 1.0 / ((1.0 + lambda_sheen(NoV, alpha) + lambda_sheen(NoL, alpha)) * 4.0 * NoV * NoL)
+
+
+@wp.func
 def G2_smith_joint_approx(NoV: float, NoL: float, alpha: float):
     """Unreal Engine 4's ``Vis_SmithJointApprox`` written as a G2 (Karis; Hammon 2017's linear
     approximation of height-correlated Smith for GGX):

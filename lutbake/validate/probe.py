@@ -130,13 +130,24 @@ def _probe_F_dielectric_f0(x: TermInputs):
     return fresnel.F_dielectric_f0(x.f0, x.cos_theta)
 
 
+@wp.func
+def _probe_D_charlie(x: TermInputs):
+    return ndf.D_charlie(x.h, x.alpha)
+
+
+@wp.func
+def _probe_V_charlie(x: TermInputs):
+    return masking.V_charlie(x.nov, x.nol, x.alpha)
+
+
 BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS if pair_allowed(n, m))
 
 _PROBES = (
     [p for n in NDFS for p in _ndf_probes(n)]
     + [_g2_probe(n, m) for n, m in BRDF_PAIRS]
     + [("D_ggx_aniso", _probe_D_ggx_aniso), ("Lambda_ggx_aniso", _probe_Lambda_ggx_aniso),
-       ("D_ashikhmin_shirley", _probe_D_ashikhmin_shirley)]
+       ("D_ashikhmin_shirley", _probe_D_ashikhmin_shirley), ("D_charlie", _probe_D_charlie),
+       ("V_charlie", _probe_V_charlie)]
     + [("G2_v_cavity", _probe_G2_v_cavity), ("F_schlick", _probe_F_schlick), ("Fc_schlick", _probe_Fc_schlick),
        ("F_dielectric", _probe_F_dielectric), ("F_dielectric_f0", _probe_F_dielectric_f0)]
 )
