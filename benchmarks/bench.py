@@ -294,6 +294,9 @@ def plot(report, path):
     ax.set_title("DFG 128² (GGX, height-correlated Smith): accuracy vs time")
     ax.legend(fontsize=8)
     ax.grid(True, which="both", alpha=0.3)
+    from matplotlib.ticker import NullFormatter
+
+    ax.xaxis.set_minor_formatter(NullFormatter())
     fig.tight_layout()
     fig.savefig(path, dpi=110)
 
