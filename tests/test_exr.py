@@ -13,6 +13,7 @@ pytest.importorskip("OpenImageIO")
 
 from lutbake.axes import Axis  # noqa: E402
 from lutbake.io import describe_exr, read_exr, write_exr  # noqa: E402
+from lutbake.io import atomic as atomic_mod  # noqa: E402
 from lutbake.io import exr as exr_mod  # noqa: E402
 from lutbake.table import Table  # noqa: E402
 
@@ -280,7 +281,7 @@ def test_failure_before_rename_leaves_target_untouched(tmp_path, monkeypatch, ex
         assert os.path.exists(path)  # complete temp file, not yet renamed
         raise exc
 
-    monkeypatch.setattr(exr_mod, "_fsync_file", boom)
+    monkeypatch.setattr(atomic_mod, "_fsync_file", boom)
     with pytest.raises(type(exc)):
         write_exr(table_2d(), target, dtype="float32")
     assert target.read_bytes() == before

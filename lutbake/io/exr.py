@@ -23,13 +23,12 @@ File layout (the contract engines and ``lutbake inspect`` rely on):
 from __future__ import annotations
 
 import json
-import os
-import uuid
 from pathlib import Path
 
 import numpy as np
 
 from ..table import Table
+from .atomic import atomic_write
 
 PREFIX = "lutbake:"
 CHANNEL_LETTERS = ("R", "G", "B", "A")
@@ -176,27 +175,6 @@ def _write_oiio(path: Path, parts: list[tuple[str | None, dict[str, str], np.nda
         raise OSError(f"cannot finish writing {path}: {out.geterror()}")
 
 
-def _fsync_file(path: Path) -> None:
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
-
-
-def _fsync_dir(path: Path) -> None:
-    try:
-        fd = os.open(path, os.O_RDONLY)
-    except OSError:
-        return  # not supported on every platform
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)
-
-
 def write_exr(table: Table, path, dtype: str = "float32") -> Path:
     """Write ``table`` to ``path`` as an EXR (float32 or half), atomically. Returns the path.
 
@@ -222,20 +200,7 @@ def write_exr(table: Table, path, dtype: str = "float32") -> Path:
             for k in range(pixels.shape[0])
         ]
 
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp.exr")
-    try:
-        _write_oiio(tmp, parts, fmt)
-        _fsync_file(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            tmp.unlink()
-        except FileNotFoundError:
-            pass
-        raise
-    _fsync_dir(path.parent)
-    return path
+    return atomic_write(path, lambda tmp: _write_oiio(tmp, parts, fmt))
 
 
 # --------------------------------------------------------------------------------------- reading
