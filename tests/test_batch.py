@@ -289,3 +289,17 @@ def test_ctrl_c_on_a_real_process(tmp_path):
     assert p.returncode == 130, stderr
     assert "Traceback" not in stderr and "did not finish: big" in stderr
     assert sorted(f.name for f in out.iterdir()) == ["first.exr"]
+
+
+@pytest.mark.parametrize("fmt, ext", [("npy", ".npy"), ("dds", ".dds"), ("ktx2", ".ktx2"), ("h", ".h")])
+def test_every_format_is_skipped_when_up_to_date(tmp_path, fmt, ext):
+    """Non-EXR outputs carry the content hash in their .json sidecar, so reruns skip them too."""
+    cfg = write_config(tmp_path, table("t", format=fmt))
+    out = tmp_path / "out"
+    first = bake(cfg, "--out-dir", out)
+    assert first.exit_code == 0, first.output
+    assert (out / f"t{ext}").is_file() and (out / "t.json").is_file()
+    again = bake(cfg, "--out-dir", out)
+    assert again.exit_code == 0 and f"skipped {out / ('t' + ext)} (up to date)" in again.output
+    changed = bake(cfg, "--out-dir", out, "--set", "samples=64")
+    assert changed.exit_code == 0 and "(up to date)" not in changed.output

@@ -111,6 +111,7 @@ def write_ktx2(table: Table, path, dtype: str = "float32", array: bool = False) 
     pixels = _check_table(table, dtype)
     path = Path(path)
     atomic_write_bytes(path, ktx2.encode(pixels, metadata(table), array=array, writer=f"lutbake {__version__}"))
+    _sidecar(table, path, "ktx2", {"array": array})
     return path
 
 
@@ -176,7 +177,9 @@ def header_text(table: Table, dtype: str = "float32") -> str:
 
 def write_header(table: Table, path, dtype: str = "float32") -> Path:
     text = header_text(table, dtype)
-    return atomic_write_bytes(Path(path), text.encode("utf-8"))
+    path = atomic_write_bytes(Path(path), text.encode("utf-8"))
+    _sidecar(table, path, "h")
+    return path
 
 
 WRITERS = {"exr": write_exr, "npy": write_npy, "png16": write_png16, "dds": write_dds, "ktx2": write_ktx2,
