@@ -10,7 +10,7 @@ import numpy as np
 from . import __version__
 from .config import TableSpec, load_configs
 from .errors import TableError
-from .executor import Timer, execute
+from .executor import Timer, estimate_error, execute
 from .table import Table
 from .tables import lookup_kind
 
@@ -38,13 +38,15 @@ def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu",
 
     plan = lookup_kind(spec.kind).plan(spec)
     with Timer() as t:
-        data = execute(plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel)
+        data = execute(plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel,
+                       spec=spec)
     if not np.all(np.isfinite(data)):
         bad = int(np.size(data) - np.count_nonzero(np.isfinite(data)))
         raise TableError(f"{spec.source}: table '{spec.name}': {bad} non-finite values; nothing written")
     extra = dict(plan.extra)
-    if plan.error_estimate is not None:
-        err, how = plan.error_estimate(data.reshape(plan.n_texels, plan.n_channels), device)
+    estimate = estimate_error(plan, data.reshape(plan.n_texels, plan.n_channels), device, spec)
+    if estimate is not None:
+        err, how = estimate
         extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)
     attributes = {
         "terms": json.dumps(plan.terms),

@@ -52,9 +52,12 @@ def main():
 @click.option("--force", is_flag=True, help="Rebake every table, even those whose output is up to date.")
 @click.option("--report", type=click.Path(path_type=Path, dir_okay=False), default=None, metavar="FILE.json",
               help="Write a JSON summary: per table status, path, content hash, seconds, samples, error estimate.")
+@click.option("--scheduler", default=None, metavar="local:N|tcp://HOST:PORT",
+              help="Run the tiles on a Dask cluster: local:N starts N worker processes here, tcp://HOST:8786 uses a "
+                   "running `dask scheduler` (pip install 'lutbake[dask]'; docs/cluster.md). Same files as without.")
 @click.option("--format", "fmt", type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h"]), default=None,
               help="Output format of every table (same as --set format=...; default: each table's `format`, exr).")
-def bake(configs, presets, out_dir, overrides, workers, device, progress, force, report, fmt):
+def bake(configs, presets, out_dir, overrides, workers, device, progress, force, report, scheduler, fmt):
     """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.<ext> (EXR unless `format` / --format says otherwise).
 
     All configs are validated before any kernel runs; a bad config exits with status 2 and writes
@@ -72,10 +75,14 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
       lutbake bake configs/dfg.toml --force --set size=[64,64] --set layout=multiscatter
       lutbake bake configs/dfg.toml --set dfg.estimator=sobol_vndf --set dfg.samples=4096
       lutbake bake --preset unreal --format dds        # -> outputs/preintegrated_gf.dds (R16G16_FLOAT)
+      lutbake bake configs/*.toml --scheduler local:2  # tiles on 2 Dask worker processes
+      lutbake bake configs/*.toml --scheduler tcp://farm:8786 --device cuda
     """
-    from . import batch
+    import contextlib
+
+    from . import batch, cluster
     from .config import load_configs, preset_path
-    from .errors import ConfigError
+    from .errors import ConfigError, LutbakeError
 
     _quiet_warp()
     try:
@@ -89,7 +96,9 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
             raise ConfigError("--out-dir", "out-dir", str(out_dir), message="exists and is not a directory")
         if report is not None and report.is_dir():
             raise ConfigError("--report", "report", str(report), message="is a directory")
-        if device == "cuda":
+        if scheduler is not None:
+            cluster.parse_scheduler(scheduler)
+        elif device == "cuda":  # on a cluster the workers' GPUs count (lutbake.cluster checks them)
             import warp as wp
 
             if not wp.is_cuda_available():
@@ -112,8 +121,16 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
         if job.status == "skipped":
             click.echo(f"skipped {job.path} (up to date)")
     signum = None
+    pending = sum(j.status == "pending" for j in jobs)
     try:
-        with batch.signal_handlers():
+        with batch.signal_handlers(), contextlib.ExitStack() as stack:
+            if scheduler is not None and pending:
+                try:
+                    stack.enter_context(cluster.session(scheduler, device))
+                except LutbakeError as e:  # unreachable scheduler, refused workers: before any tile runs
+                    click.echo(f"error: {e}", err=True)
+                    sys.exit(EXIT_CONFIG)
+                workers = pending  # every table in flight: the client's threads only wait for tiles
             signum = batch.run(jobs, workers, device, progress, on_done=on_done)
     except (KeyboardInterrupt, batch.Interrupted) as e:  # a second Ctrl-C while tables wind down
         signum = getattr(e, "signum", 2)

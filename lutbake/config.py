@@ -50,6 +50,13 @@ class TableSpec:
     def toml(self) -> str:
         return "[[table]]\n" + "".join(f"{k} = {_toml_value(v)}\n" for k, v in self.options.items() if v is not None)
 
+    def __reduce__(self):  # a mappingproxy does not pickle; lutbake.cluster ships specs to Dask workers
+        return (_table_spec, (self.name, self.kind, dict(self.options), self.source, self.index))
+
+
+def _table_spec(name: str, kind: str, options: dict, source: str, index: int) -> TableSpec:
+    return TableSpec(name, kind, MappingProxyType(options), source, index)
+
 
 def _toml_value(v) -> str:
     if isinstance(v, bool):

@@ -34,19 +34,24 @@ def tiles(n: int, size: int = TILE_TEXELS) -> list[tuple[int, int]]:
 
 
 def execute(plan: Plan, workers: int | None = None, device: str = "cpu", progress: bool | None = None,
-            label: str = "", cancel: threading.Event | None = None) -> np.ndarray:
+            label: str = "", cancel: threading.Event | None = None, spec=None) -> np.ndarray:
     """Evaluate every tile of ``plan``; returns float64 data of shape plan.shape.
 
-    ``cancel``: when set (by another thread), no further tile starts and Cancelled is raised."""
-    import click
+    ``cancel``: when set (by another thread), no further tile starts and Cancelled is raised.
+    ``spec``: the TableSpec ``plan`` came from; inside a lutbake.cluster session the tiles run on the
+    cluster's workers instead (as tasks of (spec, tile range)). Tiles are CPU_TILE_TEXELS on the CPU,
+    device-sized on CUDA (lutbake.devices)."""
+    from . import cluster
+    from .devices import plan_tile_texels
 
+    remote = cluster.active() if spec is not None else None
+    if remote is not None:
+        return remote.execute(spec, plan, device, progress=progress, label=label, cancel=cancel)
     workers = workers or default_workers()
     with _PREPARE_LOCK:
         plan.prepare(device)
-    parts = tiles(plan.n_texels)
+    parts = tiles(plan.n_texels, plan_tile_texels(plan, device))
     out = np.empty((plan.n_texels, plan.n_channels), dtype=np.float64)
-    if progress is None:
-        progress = sys.stderr.isatty() and plan.cost > PROGRESS_MIN_EVALS
 
     def work(bounds):
         s, e = bounds
@@ -55,8 +60,7 @@ def execute(plan: Plan, workers: int | None = None, device: str = "cpu", progres
         out[s:e] = plan.run_tile(s, e, device)
         return e - s
 
-    with click.progressbar(length=plan.n_texels, label=label, file=sys.stderr if progress else open(os.devnull, "w"),
-                           show_eta=True) as bar:
+    with progress_bar(plan, progress, label) as bar:
         if workers == 1 or device != "cpu":
             for b in parts:
                 bar.update(work(b))
@@ -65,6 +69,29 @@ def execute(plan: Plan, workers: int | None = None, device: str = "cpu", progres
                 for n in pool.map(work, parts):
                     bar.update(n)
     return out.reshape(plan.shape)
+
+
+def progress_bar(plan: Plan, progress: bool | None, label: str):
+    """A progress bar over the plan's texels; ``progress`` None: shown on a terminal for long bakes."""
+    import click
+
+    if progress is None:
+        progress = sys.stderr.isatty() and plan.cost > PROGRESS_MIN_EVALS
+    return click.progressbar(length=plan.n_texels, label=label, file=sys.stderr if progress else open(os.devnull, "w"),
+                             show_eta=True)
+
+
+def estimate_error(plan: Plan, data: np.ndarray, device: str = "cpu", spec=None) -> tuple[float, str] | None:
+    """``plan.error_estimate`` of baked ``data`` (flat float64, (n_texels, n_channels)), None if the
+    kind has none; inside a lutbake.cluster session it runs on a worker, as the tiles did."""
+    from . import cluster
+
+    if plan.error_estimate is None:
+        return None
+    remote = cluster.active() if spec is not None else None
+    if remote is not None:
+        return remote.estimate_error(spec, data, device)
+    return plan.error_estimate(data, device)
 
 
 class Timer:

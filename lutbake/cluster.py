@@ -1,0 +1,401 @@
+"""Bake on a Dask cluster (``lutbake bake ... --scheduler tcp://HOST:8786`` or ``--scheduler local:N``).
+
+Only tile execution moves. The client (the ``lutbake bake`` process) keeps everything else: config
+validation before any work, content hashes and skipping (lutbake.batch), the plan's axes, channels and
+provenance, the checks for non-finite values, atomic writes, the report, and SIGINT/SIGTERM (a cancelled
+table cancels its futures and writes nothing).
+
+- **A tile task is a pure function of (table spec, tile range)**: ``bake_tile(spec, start, stop, device,
+  token)``. The client ships the TableSpec (a few hundred bytes of plain data) and the worker re-plans it
+  (``lookup_kind(spec.kind).plan(spec)``, cached per spec and device in each worker process); no closure
+  is pickled. Every texel is integrated alone, so the same tile on any worker, in any order, cut in any
+  tile size, gives the same bits: a cluster bake is bit-identical to the local thread executor.
+- **Fault tolerance is Dask's**: tile results are gathered by the client as they finish, so a worker
+  that dies costs only the tiles it held; the scheduler runs them again elsewhere
+  (``distributed.scheduler.allowed-failures`` deaths of one task before it gives up on it; the table
+  then fails with the KilledWorker message, the others go on).
+- **Refusal before any tile runs**: ``check_workers()`` probes every worker (lutbake.cluster_probe, sent
+  by value so it reaches a worker that cannot import lutbake) and refuses the cluster unless each
+  worker has this client's lutbake version and kernel sources digest (the ones in every content hash),
+  Warp, numpy and scipy. Every tile carries a token of that identity, so a worker that joins later with
+  another one fails its tile with the same message instead of baking different bits.
+- **Devices**: ``--device cpu`` runs 512-texel tiles on any worker; ``--device cuda`` runs device-sized
+  tiles (lutbake.devices) on the workers that have a CUDA device, and refuses a cluster with none. A
+  table's tiles all run on one kind of device: its bits never depend on which worker took which tile.
+- **Local clusters** (``local:N``): a distributed.LocalCluster of N single-threaded worker processes on
+  this machine; they ignore SIGINT (Ctrl-C in a terminal reaches the whole process group: the client
+  cancels, then closes them) and initialise Warp without printing.
+
+Python API::
+
+    from lutbake import batch, cluster
+    with cluster.session("local:2"):            # or "tcp://HOST:8786"
+        batch.run(batch.plan(specs, "outputs"))  # lutbake.bake(...) works the same inside the block
+"""
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import logging
+import os
+import pickle
+import queue
+import re
+import signal
+import threading
+import time
+import uuid
+from collections import OrderedDict
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import ConfigError, LutbakeError
+
+SCHEDULER_FORMS = "local:N (a LocalCluster of N worker processes here, N >= 1) or a Dask scheduler address " \
+                  "such as tcp://HOST:8786"
+LOCAL_RE = re.compile(r"^local:(\d+)$")
+ADDRESS_RE = re.compile(r"^(tcp|tls|ucx|ws|wss)://[^\s/]+$")
+MAX_LOCAL_WORKERS = 256
+CONNECT_TIMEOUT_S = 30  # to reach the scheduler, and for its first worker to join
+POLL_S = 0.2  # how often a waiting table looks at its cancel event
+PLAN_CACHE_SIZE = 16  # plans kept per worker process (a plan holds its texel grid: a few MiB at most)
+IDENTITY_KEYS = ("lutbake", "kernel_sources", "warp", "numpy", "scipy")
+
+
+class WorkerRefused(LutbakeError):
+    """A Dask worker cannot bake bit-identical tiles for this client (lutbake missing, another version or
+    other kernel sources, another warp / numpy / scipy), or no worker has the device asked for."""
+
+
+def parse_scheduler(text: str) -> tuple[str, int | str]:
+    """``local:N`` -> ("local", N); ``tcp://HOST:PORT`` (tls, ucx, ws, wss) -> ("address", text).
+    ConfigError (the CLI exits 2) for anything else."""
+    m = LOCAL_RE.match(text)
+    if m:
+        n = int(m.group(1))
+        if not 1 <= n <= MAX_LOCAL_WORKERS:
+            raise ConfigError("--scheduler", "scheduler", text, SCHEDULER_FORMS,
+                              f"a local cluster needs 1 to {MAX_LOCAL_WORKERS} worker processes")
+        return "local", n
+    if ADDRESS_RE.match(text):
+        return "address", text
+    raise ConfigError("--scheduler", "scheduler", text, SCHEDULER_FORMS, "is not a scheduler")
+
+
+# ---------------------------------------------------------------------------------------------- worker side
+
+_WORKER_LOCK = threading.Lock()
+_WARP_READY = False
+_PLANS: OrderedDict = OrderedDict()
+_TOKEN: str | None = None
+
+
+@contextlib.contextmanager
+def _stderr_to_devnull():
+    """Silence file descriptor 2 (C code prints there, e.g. Warp's "CUDA driver not found" line)."""
+    import sys
+
+    sys.stderr.flush()
+    saved = os.dup(2)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(devnull)
+
+
+def init_warp_quietly() -> None:
+    """wp.init() once per process without the banner, the module-load lines or the no-CUDA-driver warning
+    (worker processes share the client's terminal)."""
+    global _WARP_READY
+    if _WARP_READY:
+        return
+    with _WORKER_LOCK:
+        if _WARP_READY:
+            return
+        import warp as wp
+
+        wp.config.log_level = logging.WARNING
+        with _stderr_to_devnull():
+            wp.init()
+        _WARP_READY = True
+
+
+def identity() -> dict[str, str]:
+    """What must be equal on client and worker for a tile to have the same bits: the lutbake version and
+    kernel sources digest (both enter every content hash), and the Warp, numpy and scipy versions (code
+    generation, texel grids, Sobol' points)."""
+    import numpy
+    import scipy
+    import warp
+
+    from . import __version__
+    from .batch import sources_digest
+
+    return {"lutbake": __version__, "kernel_sources": sources_digest().hex()[:16], "warp": warp.config.version,
+            "numpy": numpy.__version__, "scipy": scipy.__version__}
+
+
+def identity_token(ident: dict[str, str]) -> str:
+    return hashlib.sha256(json.dumps(ident, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def worker_info() -> dict:
+    """identity() plus this process's CUDA devices and pid (called on a worker by cluster_probe.probe)."""
+    from .devices import cuda_device_count, cuda_free_bytes
+
+    init_warp_quietly()
+    n = cuda_device_count()
+    return {**identity(), "cuda_devices": n, "cuda_free_bytes": cuda_free_bytes() if n else 0, "pid": os.getpid()}
+
+
+def _check_token(expect: str) -> None:
+    global _TOKEN
+    if _TOKEN is None:
+        _TOKEN = identity_token(identity())
+    if _TOKEN != expect:
+        raise WorkerRefused(f"worker process {os.getpid()} has lutbake {identity()} and cannot bake bit-identical "
+                            "tiles for this client; install the client's lutbake, warp, numpy and scipy there")
+
+
+def worker_plan(spec, device: str):
+    """The plan of ``spec`` in this worker process, built and its kernels loaded for ``device`` once."""
+    from .tables import lookup_kind
+
+    key = (spec.kind, spec.toml(), device)
+    with _WORKER_LOCK:
+        plan = _PLANS.get(key)
+        if plan is None:
+            plan = lookup_kind(spec.kind).plan(spec)
+            plan.prepare(device)
+            _PLANS[key] = plan
+            while len(_PLANS) > PLAN_CACHE_SIZE:
+                _PLANS.popitem(last=False)
+        else:
+            _PLANS.move_to_end(key)
+    return plan
+
+
+def bake_tile(spec, start: int, stop: int, device: str, token: str) -> tuple[np.ndarray, float]:
+    """The Dask task: float64 values of texels [start, stop) of ``spec`` (row-major, (stop - start,
+    channels)) and the seconds their launch took on this worker."""
+    init_warp_quietly()
+    _check_token(token)
+    plan = worker_plan(spec, device)
+    t0 = time.perf_counter()
+    data = plan.run_tile(start, stop, device)
+    return data, time.perf_counter() - t0
+
+
+def estimate_error_task(spec, data: np.ndarray, device: str, token: str) -> tuple[float, str]:
+    """The Dask task of the plan's error estimate (it runs kernels, so it runs where the tiles ran)."""
+    init_warp_quietly()
+    _check_token(token)
+    return worker_plan(spec, device).error_estimate(data, device)
+
+
+def setup_local_worker() -> None:
+    """Registered on LocalCluster workers (now and after a restart): ignore SIGINT, initialise Warp."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    init_warp_quietly()
+
+
+# ---------------------------------------------------------------------------------------------- client side
+
+@dataclass
+class Stats:
+    """What a runner moved and ran, for ``make bench`` and the tests."""
+
+    tiles: int = 0
+    bytes_to_workers: int = 0  # pickled task arguments (spec, range, device, token)
+    bytes_from_workers: int = 0  # tile results (float64 arrays)
+    worker_seconds: float = 0.0  # the tiles' launch time, summed over workers
+    tile_seconds: list = field(default_factory=list)  # (table, texels, seconds) per tile
+    cancelled: int = 0  # tiles cancelled before their result arrived (an interrupt, a failed table)
+    lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
+
+
+class DaskRunner:
+    """Runs tables' tiles on the workers of a distributed.Client (see the module docstring)."""
+
+    def __init__(self, client, device: str = "cpu", name: str = ""):
+        self.client = client
+        self.device = device
+        self.name = name or str(getattr(client, "scheduler", "")) or "the Dask cluster"
+        self.token: str | None = None
+        self.workers: dict[str, dict] = {}
+        self.targets: list[str] | None = None  # workers that run this device's tiles (None: any)
+        self.cuda_free_bytes: int | None = None
+        self.stats = Stats()
+        self.on_tile = None  # called in the client as on_tile(table name, start, stop) when a tile arrives
+
+    def check_workers(self) -> dict[str, dict]:
+        """Probe every worker; raise WorkerRefused unless all can bake this client's bits (and, for
+        ``cuda``, at least one has a GPU). Runs no tile."""
+        import cloudpickle
+
+        from . import cluster_probe
+
+        cloudpickle.register_pickle_by_value(cluster_probe)
+        infos = self.client.run(cluster_probe.probe, on_error="return")
+        here = identity()
+        problems = []
+        for addr, info in sorted(infos.items()):
+            if isinstance(info, BaseException):
+                problems.append(f"worker {addr}: the probe failed ({type(info).__name__}: {info})")
+            elif "error" in info:
+                problems.append(f"worker {addr}: {info['error']}")
+            else:
+                diff = [f"{k} {info.get(k)} there, {here[k]} here" for k in IDENTITY_KEYS if info.get(k) != here[k]]
+                if diff:
+                    problems.append(f"worker {addr}: " + "; ".join(diff))
+        if not infos:
+            problems.append("no worker is connected")
+        if problems:
+            raise WorkerRefused(f"refusing the workers of {self.name}: " + " | ".join(problems)
+                                + ". Every worker needs this client's lutbake (same version and kernel sources), warp, "
+                                "numpy and scipy: pip install the same lutbake[dask] there and restart the worker. "
+                                "No tile ran.")
+        self.workers = infos
+        self.token = identity_token(here)
+        if self.device.startswith("cuda"):
+            gpus = sorted(a for a, i in infos.items() if i["cuda_devices"] > 0)
+            if not gpus:
+                raise WorkerRefused(f"--device cuda: none of the {len(infos)} workers of {self.name} has a CUDA device "
+                                    "(Warp reports 0 on each); bake with --device cpu, or start workers on GPU hosts. "
+                                    "No tile ran.")
+            self.targets = gpus
+            self.cuda_free_bytes = min(infos[a]["cuda_free_bytes"] for a in gpus)
+        return infos
+
+    def _submit(self, fn, *args, key: str):
+        return self.client.submit(fn, *args, key=key, workers=self.targets, allow_other_workers=False, pure=False)
+
+    def execute(self, spec, plan, device: str, progress: bool | None = None, label: str = "",
+                cancel: threading.Event | None = None) -> np.ndarray:
+        """lutbake.executor.execute() on the cluster: float64 data of shape plan.shape."""
+        from .devices import plan_tile_texels
+        from .executor import Cancelled, progress_bar, tiles
+
+        if device != self.device:
+            raise ValueError(f"this runner bakes on {self.device!r}, not {device!r}")
+        parts = tiles(plan.n_texels, plan_tile_texels(plan, device, self.cuda_free_bytes))
+        prefix = f"lutbake-{spec.name}-{uuid.uuid4().hex[:8]}-{device}"
+        futures = {}
+        for s, e in parts:
+            futures[self._submit(bake_tile, spec, s, e, device, self.token, key=f"{prefix}-{s}-{e}")] = (s, e)
+        sent = len(pickle.dumps((spec, 0, plan.n_texels, device, self.token), protocol=5))
+        out = np.empty((plan.n_texels, plan.n_channels), dtype=np.float64)
+        pending = set(futures)
+        finished: queue.Queue = queue.Queue()
+        for f in futures:
+            f.add_done_callback(finished.put)
+        try:
+            with progress_bar(plan, progress, label) as bar:
+                while pending:
+                    if cancel is not None and cancel.is_set():
+                        raise Cancelled(label)
+                    try:
+                        f = finished.get(timeout=POLL_S)
+                    except queue.Empty:
+                        continue
+                    if f in pending:
+                        pending.discard(f)
+                        s, e = futures[f]
+                        data, seconds = f.result()  # a task's exception (a kernel error, KilledWorker) raises here
+                        out[s:e] = data
+                        f.release()
+                        with self.stats.lock:
+                            self.stats.tiles += 1
+                            self.stats.bytes_to_workers += sent
+                            self.stats.bytes_from_workers += data.nbytes
+                            self.stats.worker_seconds += seconds
+                            self.stats.tile_seconds.append((spec.name, e - s, seconds))
+                        bar.update(e - s)
+                        if self.on_tile is not None:
+                            self.on_tile(spec.name, s, e)
+        finally:
+            if pending:  # cancelled or failed: no tile of this table runs any more
+                self.client.cancel(list(pending))
+                with self.stats.lock:
+                    self.stats.cancelled += len(pending)
+        return out.reshape(plan.shape)
+
+    def estimate_error(self, spec, data: np.ndarray, device: str) -> tuple[float, str]:
+        key = f"lutbake-{spec.name}-{uuid.uuid4().hex[:8]}-{device}-error-estimate"
+        fut = self._submit(estimate_error_task, spec, data, device, self.token, key=key)
+        with self.stats.lock:
+            self.stats.bytes_to_workers += data.nbytes
+        return fut.result()
+
+
+_ACTIVE: DaskRunner | None = None
+
+
+def active() -> DaskRunner | None:
+    """The runner of the enclosing session() / activate() block, or None (bake locally)."""
+    return _ACTIVE
+
+
+@contextlib.contextmanager
+def activate(runner: DaskRunner):
+    """Inside this block every bake of this process runs its tiles on ``runner``."""
+    global _ACTIVE
+    previous, _ACTIVE = _ACTIVE, runner
+    try:
+        yield runner
+    finally:
+        _ACTIVE = previous
+
+
+def _distributed():
+    try:
+        import distributed
+    except ImportError:
+        raise ConfigError("--scheduler", "scheduler", None, None,
+                          "needs Dask's distributed package: pip install 'lutbake[dask]'") from None
+    return distributed
+
+
+@contextlib.contextmanager
+def session(scheduler: str, device: str = "cpu"):
+    """Connect to ``scheduler`` (``local:N`` starts a LocalCluster), check its workers, and make every
+    bake inside the block run its tiles there; closes what it opened. Raises ConfigError (bad form,
+    distributed missing, scheduler unreachable) or WorkerRefused before any tile runs."""
+    form, where = parse_scheduler(scheduler)
+    distributed = _distributed()
+    cluster = None
+    try:
+        if form == "local":
+            cluster = distributed.LocalCluster(n_workers=where, threads_per_worker=1, processes=True,
+                                               dashboard_address=":0", silence_logs=logging.ERROR)
+            client = distributed.Client(cluster, set_as_default=False)
+        else:
+            client = distributed.Client(where, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
+    except (OSError, TimeoutError) as e:
+        if cluster is not None:
+            cluster.close()
+        raise ConfigError("--scheduler", "scheduler", scheduler, None, f"cannot connect: {e}") from None
+    try:
+        try:
+            client.wait_for_workers(where if form == "local" else 1, timeout=CONNECT_TIMEOUT_S)
+        except TimeoutError:
+            raise ConfigError("--scheduler", "scheduler", scheduler, None,
+                              f"no worker joined within {CONNECT_TIMEOUT_S} s (start one: dask worker {scheduler})") \
+                from None
+        runner = DaskRunner(client, device, name=scheduler)
+        runner.check_workers()
+        if form == "local":
+            client.register_worker_callbacks(setup=setup_local_worker)
+        with activate(runner):
+            yield runner
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()

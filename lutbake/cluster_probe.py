@@ -1,0 +1,16 @@
+"""The first function lutbake.cluster runs on a Dask worker: it reports what the worker would bake with.
+
+lutbake.cluster registers this module with cloudpickle to be pickled *by value*, so the probe reaches a
+worker that cannot import lutbake (not installed, or broken) and reports that as a refusal, instead of
+failing while unpickling a reference to a module the worker lacks. It must therefore import nothing
+from lutbake at module level.
+"""
+
+
+def probe() -> dict:
+    """lutbake.cluster.worker_info() of this worker, or {"error": why lutbake cannot be imported here}."""
+    try:
+        from lutbake import cluster
+    except Exception as e:  # ImportError, or a broken install raising anything while importing
+        return {"error": f"cannot import lutbake ({type(e).__name__}: {e})"}
+    return cluster.worker_info()

@@ -1,0 +1,256 @@
+"""Baking on a Dask cluster (lutbake.cluster): bit-identical to the thread executor, a killed worker costs
+only its tiles, mismatched or broken workers are refused before any tile runs, interrupts cancel the
+futures and write no unfinished table.
+
+One small LocalCluster (2 single-threaded worker processes) serves the module; small tables."""
+import contextlib
+import json
+import logging
+import os
+import pickle
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+distributed = pytest.importorskip("distributed")
+
+from lutbake import batch, cluster  # noqa: E402
+from lutbake.api import bake_table  # noqa: E402
+from lutbake.cli import main  # noqa: E402
+from lutbake.config import load_configs, validate_table  # noqa: E402
+from lutbake.io.exr import read_exr  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+BAKE_DEADLINE_S = 90  # a cluster test that has not finished by then is interrupted (and fails)
+
+# several kinds, each cut into more than one 512-texel tile
+SPECS = {
+    "dfg_gl": {"kind": "dfg", "size": [40, 24], "samples": 48},
+    "dfg_vndf": {"kind": "dfg", "size": [32, 20], "estimator": "sobol_vndf", "samples": 64, "seed": 3},
+    "btf": {"kind": "btf", "size": [8, 8], "phi_size": 8, "sigma_size": 2, "samples": 2},
+    "spec3d": {"kind": "specular_3d", "size": [16, 8], "f0_size": 6, "fresnel": "dielectric_f0", "samples": 48},
+}
+
+
+def spec(name, **kw):
+    return validate_table({"name": name, **kw}, "<test>", 0)
+
+
+@pytest.fixture(scope="module")
+def client():
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
+                                  silence_logs=logging.ERROR) as lc, distributed.Client(lc, set_as_default=False) as c:
+        c.run(cluster.setup_local_worker)
+        yield c
+
+
+@pytest.fixture
+def runner(client):
+    r = cluster.DaskRunner(client, name="test cluster")
+    r.check_workers()
+    return r
+
+
+@contextlib.contextmanager
+def deadline(seconds=BAKE_DEADLINE_S):
+    """Interrupt the main thread (as Ctrl-C would) if the block runs longer than ``seconds``."""
+    import _thread
+
+    timer = threading.Timer(seconds, _thread.interrupt_main)
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
+
+
+def thread_bake(specs, out) -> dict:
+    """{name: (pixels, lutbake:* header)} of the files a local (thread executor) batch writes."""
+    jobs = batch.plan(specs, out, force=True)
+    assert batch.run(jobs, workers=2) is None
+    return {j.name: read_exr(j.path) for j in jobs}
+
+
+def assert_same_files(got: dict, want: dict):
+    assert sorted(got) == sorted(want)
+    for name, (data, attrs) in want.items():
+        assert np.array_equal(got[name][0], data), name
+        assert got[name][1] == attrs, name  # every lutbake:* attribute: error estimate, content hash, ...
+
+
+def scheduler_transitions(client) -> int:
+    return client.run_on_scheduler(lambda dask_scheduler: dask_scheduler.transition_counter)
+
+
+def test_table_spec_pickles_to_an_equal_spec():
+    s = spec("p", **SPECS["dfg_vndf"])
+    t = pickle.loads(pickle.dumps(s))
+    assert t == s and t.toml() == s.toml() and type(t.options) is type(s.options)
+
+
+@pytest.mark.parametrize("text, parsed", [("local:2", ("local", 2)), ("tcp://farm:8786", ("address", "tcp://farm:8786")),
+                                          ("tls://10.0.0.1:8786", ("address", "tls://10.0.0.1:8786"))])
+def test_scheduler_forms(text, parsed):
+    assert cluster.parse_scheduler(text) == parsed
+
+
+@pytest.mark.parametrize("text", ["local:0", "local:x", "farm:8786", "tcp://", "local:100000"])
+def test_a_bad_scheduler_exits_2_before_any_work(tmp_path, text):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('[[table]]\nname = "t"\nkind = "dfg"\nsize = [8, 4]\n')
+    r = CliRunner().invoke(main, ["bake", str(cfg), "--out-dir", str(tmp_path / "o"), "--scheduler", text])
+    assert r.exit_code == 2, r.output
+    assert "--scheduler" in r.output and "local:N" in r.output and not (tmp_path / "o").exists()
+
+
+def test_cluster_bake_is_bit_identical_to_the_thread_executor(runner):
+    specs = [spec(n, **kw) for n, kw in SPECS.items()]
+    local = {s.name: bake_table(s, workers=2)[0] for s in specs}
+    with deadline(), cluster.activate(runner):
+        remote = {s.name: bake_table(s, workers=2)[0] for s in specs}
+    for s in specs:
+        a, b = local[s.name], remote[s.name]
+        assert a.data.shape == b.data.shape and np.array_equal(a.data, b.data), s.name
+        assert a.attributes == b.attributes, s.name  # error estimate and content hash included
+    texels = [t.data[..., 0].size for t in local.values()]
+    assert min(texels) > 512  # every table was cut into several tiles
+    assert runner.stats.tiles == sum(-(-n // 512) for n in texels)
+    assert runner.stats.bytes_from_workers == sum(t.data.size * 8 for t in local.values())  # float64 results
+    assert runner.stats.cancelled == 0
+
+
+def test_a_killed_worker_costs_only_its_tiles(client, tmp_path):
+    """SIGKILL one worker process when the first tile arrives: Dask runs its tiles again on the other
+    worker, every table is baked, the files equal an undisturbed thread-executor bake."""
+    specs = [spec(f"k{i}", kind="dfg", size=[64, 64], samples=768) for i in range(3)]
+    ref = thread_bake(specs, tmp_path / "ref")
+    r = cluster.DaskRunner(client, name="test cluster")
+    r.check_workers()
+    pids = client.run(os.getpid)
+    killed = {}
+    lock = threading.Lock()
+
+    def kill_one(name, start, stop):
+        with lock:
+            if killed:
+                return
+            processing = {a: ks for a, ks in client.processing().items() if ks}
+            victim = sorted(processing)[0]
+            killed.update(addr=victim, pid=pids[victim], tiles=len(processing[victim]),
+                          remaining=3 * 8 - r.stats.tiles)
+            os.kill(pids[victim], signal.SIGKILL)
+
+    r.on_tile = kill_one
+    jobs = batch.plan(specs, tmp_path / "out")
+    with deadline(), cluster.activate(r):
+        assert batch.run(jobs, workers=len(jobs)) is None
+    assert killed and killed["tiles"] >= 1 and killed["remaining"] > 1  # the kill happened mid-bake, with tiles on it
+    assert [j.status for j in jobs] == ["baked"] * 3, [j.message for j in jobs]
+    assert r.stats.tiles == 3 * 8  # every tile delivered once: the finished ones were never recomputed
+    assert_same_files({j.name: read_exr(j.path) for j in jobs}, ref)
+    client.wait_for_workers(2, timeout=60)  # the nanny restarted it, for the next tests
+    assert killed["pid"] not in client.run(os.getpid).values()
+
+
+@contextlib.contextmanager
+def sabotaged(client, code, undo, workers=None):
+    client.run(exec, code, {}, workers=workers)
+    try:
+        yield
+    finally:
+        client.run(exec, undo, {}, workers=workers)
+
+
+def test_a_worker_with_another_lutbake_version_is_refused_before_any_tile_runs(client, tmp_path):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('[[table]]\nname = "t"\nkind = "dfg"\nsize = [8, 4]\nsamples = 48\n')
+    address = client.scheduler.address
+    victim = sorted(client.scheduler_info()["workers"])[0]
+    before = scheduler_transitions(client)
+    with sabotaged(client, "import lutbake; lutbake._real = lutbake.__version__; lutbake.__version__ = '0.0.0+other'",
+                   "import lutbake; lutbake.__version__ = lutbake._real", workers=[victim]):
+        r = CliRunner().invoke(main, ["bake", str(cfg), "--out-dir", str(tmp_path / "o"), "--scheduler", address])
+    assert r.exit_code == 2, r.output
+    import lutbake
+
+    assert f"worker {victim}: lutbake 0.0.0+other there, {lutbake.__version__} here" in r.output
+    assert "No tile ran" in r.output and not (tmp_path / "o").exists()
+    assert scheduler_transitions(client) == before  # no task was ever submitted
+
+
+def test_a_worker_without_lutbake_is_refused_with_a_clear_message(client):
+    victim = sorted(client.scheduler_info()["workers"])[-1]
+    with sabotaged(client, "import sys; sys.modules['_lutbake'] = sys.modules['lutbake']; sys.modules['lutbake'] = None",
+                   "import sys; sys.modules['lutbake'] = sys.modules.pop('_lutbake')", workers=[victim]):
+        with pytest.raises(cluster.WorkerRefused) as e:
+            cluster.DaskRunner(client, name="test cluster").check_workers()
+    assert f"worker {victim}: cannot import lutbake (ModuleNotFoundError" in str(e.value)
+    assert "pip install the same lutbake[dask]" in str(e.value)
+    cluster.DaskRunner(client).check_workers()  # restored
+
+
+def test_device_cuda_on_workers_without_a_gpu_is_refused(client):
+    if any(i["cuda_devices"] for i in cluster.DaskRunner(client).check_workers().values()):
+        pytest.skip("these workers have a CUDA device")
+    with pytest.raises(cluster.WorkerRefused, match="none of the 2 workers of test cluster has a CUDA device"):
+        cluster.DaskRunner(client, "cuda", name="test cluster").check_workers()
+
+
+@pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_interrupt_cancels_the_futures_and_writes_no_unfinished_table(client, monkeypatch, tmp_path, signum, code):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('[[table]]\nname = "small"\nkind = "dfg"\nsize = [8, 4]\nsamples = 48\n\n'
+                   '[[table]]\nname = "slow"\nkind = "dfg"\nsize = [128, 64]\nsamples = 768\n')
+    out = tmp_path / "out"
+    runners = []
+    real = cluster.session
+
+    def hook(name, start, stop):
+        if name == "slow" and not runners[0].interrupted:
+            runners[0].interrupted = True
+            t0 = time.monotonic()
+            while not (out / "small.exr").exists() and time.monotonic() - t0 < 30:
+                time.sleep(0.02)
+            os.kill(os.getpid(), signum)  # Ctrl-C / SIGTERM arrives while "slow" bakes
+            time.sleep(0.5)  # the main thread sets the cancel event
+
+    @contextlib.contextmanager
+    def session(*a, **kw):
+        with real(*a, **kw) as r:
+            r.on_tile, r.interrupted = hook, False
+            runners.append(r)
+            yield r
+
+    monkeypatch.setattr(cluster, "session", session)
+    with deadline():
+        r = CliRunner().invoke(main, ["bake", str(cfg), "--out-dir", str(out), "--scheduler", client.scheduler.address,
+                                      "--report", str(tmp_path / "r.json")])
+    assert r.exit_code == code, r.output
+    assert "Traceback" not in r.output and "did not finish: slow" in r.output
+    assert sorted(p.name for p in out.iterdir()) == ["small.exr"]  # no unfinished table, no temporary file
+    assert runners[0].stats.cancelled > 0  # the slow table's remaining tiles were cancelled, not run
+    doc = json.loads((tmp_path / "r.json").read_text())
+    assert [t["status"] for t in doc["tables"]] == ["baked", "interrupted"]
+
+
+def test_cli_local_cluster_bakes_the_same_files_without_warp_banners(tmp_path):
+    """`lutbake bake ... --scheduler local:2` from a shell: same pixels and headers as a thread bake; the
+    worker processes print nothing (no Warp banner, no CUDA-driver warning)."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('[[table]]\nname = "a"\nkind = "dfg"\nsize = [32, 24]\nsamples = 48\n\n'
+                   '[[table]]\nname = "b"\nkind = "albedo"\nsize = [16, 8]\nsamples = 48\n')
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    p = subprocess.run([sys.executable, "-m", "lutbake", "bake", str(cfg), "--out-dir", str(tmp_path / "d"),
+                        "--scheduler", "local:2"], env=env, capture_output=True, text=True, timeout=BAKE_DEADLINE_S)
+    assert p.returncode == 0, p.stderr
+    assert "Warp" not in p.stdout + p.stderr and p.stderr == "", p.stderr
+    assert p.stdout.count("samples/texel") == 2
+    assert_same_files({n: read_exr(tmp_path / "d" / f"{n}.exr") for n in "ab"},
+                      thread_bake(load_configs([cfg]), tmp_path / "ref"))
