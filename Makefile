@@ -14,7 +14,7 @@ WORKERS ?=
 FORCE   ?=
 LUTS_STAMP := $(OUT)/.luts.stamp
 
-.PHONY: luts test validate bench clean venv help force-luts figures bench-diffuse
+.PHONY: luts test validate bench clean venv help force-luts figures bench-diffuse bench-cluster
 
 help:
 	@echo "make luts | test | validate | clean"
@@ -57,6 +57,12 @@ validate: $(STAMP)
 clean:
 	rm -rf $(OUT) .pytest_cache
 
-# every kind against converged references, C and numpy baselines: outputs/bench/report.json + accuracy_vs_time.png
+# every kind against converged references, C and numpy baselines: outputs/bench/report.json + accuracy_vs_time.png;
+# then the Dask executor (local:2) against the thread executor on the make-luts batch, and a scaling projection:
+# outputs/bench/cluster.json (docs/cluster.md)
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench.py
+	$(BIN)/python benchmarks/bench_cluster.py
+
+bench-cluster: $(STAMP)
+	$(BIN)/python benchmarks/bench_cluster.py

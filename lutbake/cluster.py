@@ -215,6 +215,7 @@ class Stats:
     tiles: int = 0
     bytes_to_workers: int = 0  # pickled task arguments (spec, range, device, token)
     bytes_from_workers: int = 0  # tile results (float64 arrays)
+    bytes_estimate_inputs: int = 0  # baked tables shipped to a worker for their error estimate
     worker_seconds: float = 0.0  # the tiles' launch time, summed over workers
     tile_seconds: list = field(default_factory=list)  # (table, texels, seconds) per tile
     cancelled: int = 0  # tiles cancelled before their result arrived (an interrupt, a failed table)
@@ -331,7 +332,7 @@ class DaskRunner:
         key = f"lutbake-{spec.name}-{uuid.uuid4().hex[:8]}-{device}-error-estimate"
         fut = self._submit(estimate_error_task, spec, data, device, self.token, key=key)
         with self.stats.lock:
-            self.stats.bytes_to_workers += data.nbytes
+            self.stats.bytes_estimate_inputs += data.nbytes
         return fut.result()
 
 

@@ -254,3 +254,18 @@ def test_cli_local_cluster_bakes_the_same_files_without_warp_banners(tmp_path):
     assert p.stdout.count("samples/texel") == 2
     assert_same_files({n: read_exr(tmp_path / "d" / f"{n}.exr") for n in "ab"},
                       thread_bake(load_configs([cfg]), tmp_path / "ref"))
+
+
+def test_no_cluster_starts_when_every_table_is_up_to_date(tmp_path, monkeypatch):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('[[table]]\nname = "t"\nkind = "dfg"\nsize = [8, 4]\nsamples = 48\n')
+    out = tmp_path / "o"
+    assert CliRunner().invoke(main, ["bake", str(cfg), "--out-dir", str(out)]).exit_code == 0
+
+    def no_session(*a, **kw):
+        raise AssertionError("a cluster was started for a batch with nothing to bake")
+
+    monkeypatch.setattr(cluster, "session", no_session)
+    r = CliRunner().invoke(main, ["bake", str(cfg), "--out-dir", str(out), "--scheduler", "local:2"])
+    assert r.exit_code == 0, r.output
+    assert f"skipped {out / 't.exr'} (up to date)" in r.output

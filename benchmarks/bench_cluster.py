@@ -1,0 +1,188 @@
+"""``make bench`` (cluster part): the Dask executor against the thread executor, and a scaling projection.
+
+1. **Overhead.** The batch of ``make luts`` (configs/*.toml and the engine presets) baked with --force on
+   the thread executor (every core) and on ``--scheduler local:2`` (a LocalCluster of 2 worker processes,
+   its start-up included), alternating, ``--rounds`` times: wall times, their ratio (target <= 1.15 on a
+   2-core machine), tiles, and bytes moved per tile (task arguments to the workers, float64 results back,
+   error-estimate inputs), and the CPU seconds of all processes (client + workers: a measure of the
+   overhead that other load on the machine does not distort). Every file of the Dask bake is compared with the thread bake (pixels and every
+   lutbake:* attribute).
+2. **Scaling on paper** for the largest table of the batch (the 1024^2 glTF DFG, ``lut_ggx``), from what
+   the Dask bake measured: W = the sum of its tiles' launch times on the workers (one core each), n tiles,
+   the client's serial time S (plan, error estimate, float32 conversion, write: the table's bake time
+   minus its tile phase), and the per-tile dispatch cost C (tile phase on 2 workers minus W / 2, per
+   tile: scheduler, transfer and client work; an upper bound here, where client, scheduler and workers
+   share 2 cores). Projected wall on N workers of a running cluster:
+       T(N) = S + C n + B n / BANDWIDTH + W / N
+   (B = bytes per tile over the network, BANDWIDTH an assumed 1 Gbit/s); serial fraction = (T(N) - W / N) / T(N).
+
+Writes outputs/bench/cluster.json and prints a summary.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import warp as wp
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from lutbake import batch, cluster  # noqa: E402
+from lutbake.config import load_configs, preset_path  # noqa: E402
+from lutbake.executor import default_workers  # noqa: E402
+from lutbake.io.exr import read_exr  # noqa: E402
+
+OUT = ROOT / "outputs" / "bench"
+PRESETS = ("filament", "filament-corrected", "gltf", "gltf-charlie", "gltf-sheen-e", "blender-eevee", "unreal")
+LARGEST = "lut_ggx"  # the 1024 x 1024 glTF DFG (preset gltf)
+BANDWIDTH = 125e6  # bytes/s: an assumed 1 Gbit/s network between client and workers
+WORKERS = (1, 8, 64)
+TARGET_RATIO = 1.15
+
+
+class TimedRunner(cluster.DaskRunner):
+    """A DaskRunner that also records each table's tile-phase wall time."""
+
+    def __init__(self, *a, **kw):
+        super().__init__(*a, **kw)
+        self.phase: dict[str, float] = {}
+
+    def execute(self, spec, plan, device, **kw):
+        t0 = time.perf_counter()
+        try:
+            return super().execute(spec, plan, device, **kw)
+        finally:
+            self.phase[spec.name] = time.perf_counter() - t0
+
+
+def specs():
+    paths = [preset_path(p) for p in PRESETS] + sorted((ROOT / "configs").glob("*.toml"))
+    return load_configs(paths)
+
+
+def cpu_seconds() -> float:
+    """User + system CPU seconds of this process (all its threads); also run on each Dask worker."""
+    t = os.times()
+    return t.user + t.system
+
+
+def thread_run(out: Path) -> tuple[float, float, list]:
+    t0, c0 = time.perf_counter(), cpu_seconds()
+    jobs = batch.plan(specs(), out, force=True)
+    assert batch.run(jobs, default_workers(), progress=False) is None
+    return time.perf_counter() - t0, cpu_seconds() - c0, jobs
+
+
+def dask_run(out: Path, scheduler: str) -> tuple[float, float, list, TimedRunner, float]:
+    """Wall and CPU seconds (client + workers, start-up included) of the batch on ``scheduler``."""
+    t0, c0 = time.perf_counter(), cpu_seconds()
+    jobs = batch.plan(specs(), out, force=True)
+    real = cluster.DaskRunner
+    cluster.DaskRunner = TimedRunner  # session() builds its runner from the module attribute
+    try:
+        with cluster.session(scheduler) as runner:
+            started = time.perf_counter() - t0
+            assert batch.run(jobs, len(jobs), progress=False) is None
+            cpu_workers = sum(runner.client.run(cpu_seconds).values())
+    finally:
+        cluster.DaskRunner = real
+    return time.perf_counter() - t0, cpu_seconds() - c0 + cpu_workers, jobs, runner, started
+
+
+def identical(a: list, b: list) -> bool:
+    same = True
+    for ja, jb in zip(a, b):
+        assert ja.name == jb.name and ja.status == jb.status == "baked", (ja.name, ja.message, jb.message)
+        if ja.path.suffix == ".exr":
+            (da, aa), (db, ab) = read_exr(ja.path), read_exr(jb.path)
+            same &= bool(np.array_equal(da, db)) and aa == ab
+        else:  # npy / png16 / dds / ktx2 / h: the bytes (no timestamps), and the sidecar if any
+            same &= ja.path.read_bytes() == jb.path.read_bytes()
+            side_a, side_b = ja.path.with_suffix(".json"), jb.path.with_suffix(".json")
+            if side_a.exists():
+                same &= side_a.read_bytes() == side_b.read_bytes()
+    return same
+
+
+def main(argv=None):
+    import logging
+
+    wp.config.log_level = logging.WARNING  # no banner or module-load lines in the summary
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rounds", type=int, default=1, help="thread / local:2 alternations (default 1)")
+    ap.add_argument("--scheduler", default="local:2")
+    args = ap.parse_args(argv)
+    OUT.mkdir(parents=True, exist_ok=True)
+    rounds = []
+    for r in range(args.rounds):
+        t_thread, cpu_thread, jobs_t = thread_run(OUT / "cluster_thread")
+        t_dask, cpu_dask, jobs_d, runner, started = dask_run(OUT / "cluster_dask", args.scheduler)
+        same = identical(jobs_t, jobs_d)
+        st = runner.stats
+        rounds.append({"thread_seconds": t_thread, "dask_seconds": t_dask, "ratio": t_dask / t_thread,
+                       "thread_cpu_seconds": cpu_thread, "dask_cpu_seconds": cpu_dask, "cpu_ratio": cpu_dask / cpu_thread,
+                       "load_average_after": os.getloadavg()[0],
+                       "cluster_start_seconds": started, "identical_files": same, "tiles": st.tiles,
+                       "bytes_to_workers_per_tile": st.bytes_to_workers / st.tiles,
+                       "bytes_from_workers_per_tile": st.bytes_from_workers / st.tiles,
+                       "bytes_estimate_inputs_per_tile": st.bytes_estimate_inputs / st.tiles,
+                       "worker_seconds": st.worker_seconds})
+        print(f"round {r}: thread {t_thread:.1f} s, {args.scheduler} {t_dask:.1f} s (start {started:.1f} s): "
+              f"ratio {t_dask / t_thread:.3f}; CPU {cpu_thread:.1f} s vs {cpu_dask:.1f} s (client + workers): "
+              f"ratio {cpu_dask / cpu_thread:.3f}; {st.tiles} tiles, {st.bytes_to_workers / st.tiles:.0f} B to and "
+              f"{st.bytes_from_workers / st.tiles:.0f} B from the workers per tile (+ {st.bytes_estimate_inputs / st.tiles:.0f}"
+              f" B of error-estimate inputs); identical files: {same}")
+    # the projection, from the last Dask round
+    job = next(j for j in jobs_d if j.name == LARGEST)
+    tiles = [(n, s) for name, n, s in runner.stats.tile_seconds if name == LARGEST]
+    n = len(tiles)
+    W = sum(s for _, s in tiles)
+    phase = runner.phase[LARGEST]
+    S = max(0.0, job.seconds - phase)
+    C = max(0.0, (phase - W / 2) / n)
+    spec = job.spec
+    texels = sum(t for t, _ in tiles)
+    n_channels = int(job.shape.split("x")[-1])
+    # per tile: its arguments, its float64 result, and its share of the table shipped for the error estimate
+    B = (runner.stats.bytes_to_workers / runner.stats.tiles + 8 * n_channels * texels / n
+         + 8 * n_channels * texels / n)
+    proj = {}
+    for N in WORKERS:
+        serial = S + C * n + B * n / BANDWIDTH
+        T = serial + W / N
+        proj[N] = {"seconds": T, "serial_fraction": serial / T}
+    report = {
+        "machine": {"cpus": os.cpu_count(), "load_average": os.getloadavg(), "python": platform.python_version()},
+        "batch": {"tables": len(jobs_d), "presets": PRESETS, "configs": "configs/*.toml", "scheduler": args.scheduler},
+        "rounds": rounds,
+        "median_ratio": float(np.median([r["ratio"] for r in rounds])),
+        "median_cpu_ratio": float(np.median([r["cpu_ratio"] for r in rounds])),
+        "target_ratio": TARGET_RATIO,
+        "largest_table": {"name": LARGEST, "spec": spec.toml(), "texels": texels, "tiles": n,
+                          "W_sum_tile_seconds": W, "S_client_serial_seconds": S, "C_dispatch_seconds_per_tile": C,
+                          "B_bytes_per_tile": B, "bandwidth_assumed_bytes_per_s": BANDWIDTH,
+                          "tile_phase_seconds_on_2_workers": phase, "bake_seconds_on_2_workers": job.seconds,
+                          "projection": proj,
+                          "model": "T(N) = S + C n + B n / BANDWIDTH + W / N; serial fraction = (T - W/N) / T"},
+    }
+    path = OUT / "cluster.json"
+    path.write_text(json.dumps(report, indent=2) + "\n")
+    print(f"median wall ratio {args.scheduler} / thread: {report['median_ratio']:.3f} (target <= {TARGET_RATIO}); "
+          f"CPU-seconds ratio {report['median_cpu_ratio']:.3f}; load average {os.getloadavg()[0]:.1f} on "
+          f"{os.cpu_count()} cores")
+    print(f"{LARGEST}: {n} tiles, W = {W:.1f} s of tile launches, S = {S:.2f} s client serial, C = {C * 1e3:.2f} ms "
+          f"dispatch per tile, B = {B / 1024:.1f} KiB per tile")
+    for N, p in proj.items():
+        print(f"  projected on {N:>2} workers: {p['seconds']:7.2f} s, serial fraction {p['serial_fraction']:.3f}")
+    print(path)
+
+
+if __name__ == "__main__":
+    main()
