@@ -8,13 +8,13 @@
    overhead that other load on the machine does not distort). Every file of the Dask bake is compared with the thread bake (pixels and every
    lutbake:* attribute).
 2. **Scaling on paper** for the largest table of the batch (the 1024^2 glTF DFG, ``lut_ggx``), from what
-   the Dask bake measured: W = the sum of its tiles' launch times on the workers (one core each), n tiles,
-   the client's serial time S (plan, error estimate, float32 conversion, write: the table's bake time
-   minus its tile phase), and the per-tile dispatch cost C (tile phase on 2 workers minus W / 2, per
-   tile: scheduler, transfer and client work; an upper bound here, where client, scheduler and workers
-   share 2 cores). Projected wall on N workers of a running cluster:
-       T(N) = S + C n + B n / BANDWIDTH + W / N
-   (B = bytes per tile over the network, BANDWIDTH an assumed 1 Gbit/s); serial fraction = (T(N) - W / N) / T(N).
+   the Dask bake measured: W = the CPU seconds of its n tile launches on the workers (thread CPU time, so
+   other load on this machine does not inflate it), S = its serial wall time outside the tiles (the
+   client's plan, the error-estimate task, the write), C = the client process's CPU seconds (client,
+   scheduler, nannies, writes) per tile of the batch (an upper bound on the serial cost of one tile),
+   B = bytes per tile over the network (arguments, result, share of the error-estimate input) at an
+   assumed 1 Gbit/s. Projected wall on N workers of a running cluster, conservatively additive:
+       T(N) = S + C n + B n / BANDWIDTH + W / N,   serial fraction = (T(N) - W / N) / T(N).
 
 Writes outputs/bench/cluster.json and prints a summary.
 """
@@ -38,6 +38,7 @@ from lutbake import batch, cluster  # noqa: E402
 from lutbake.config import load_configs, preset_path  # noqa: E402
 from lutbake.executor import default_workers  # noqa: E402
 from lutbake.io.exr import read_exr  # noqa: E402
+from lutbake.tables import lookup_kind  # noqa: E402
 
 OUT = ROOT / "outputs" / "bench"
 PRESETS = ("filament", "filament-corrected", "gltf", "gltf-charlie", "gltf-sheen-e", "blender-eevee", "unreal")
@@ -48,11 +49,12 @@ TARGET_RATIO = 1.15
 
 
 class TimedRunner(cluster.DaskRunner):
-    """A DaskRunner that also records each table's tile-phase wall time."""
+    """A DaskRunner that also records each table's tile-phase and error-estimate wall times."""
 
     def __init__(self, *a, **kw):
         super().__init__(*a, **kw)
         self.phase: dict[str, float] = {}
+        self.estimate: dict[str, float] = {}
 
     def execute(self, spec, plan, device, **kw):
         t0 = time.perf_counter()
@@ -60,6 +62,28 @@ class TimedRunner(cluster.DaskRunner):
             return super().execute(spec, plan, device, **kw)
         finally:
             self.phase[spec.name] = time.perf_counter() - t0
+
+    def estimate_error(self, spec, data, device):
+        t0 = time.perf_counter()
+        try:
+            return super().estimate_error(spec, data, device)
+        finally:
+            self.estimate[spec.name] = time.perf_counter() - t0
+
+
+WRITES: dict[str, float] = {}
+
+
+def timed_write(table, *a, **kw):
+    t0 = time.perf_counter()
+    try:
+        return REAL_WRITE(table, *a, **kw)
+    finally:
+        WRITES[table.name] = time.perf_counter() - t0
+
+
+REAL_WRITE = batch.write_table
+batch.write_table = timed_write  # the batch writes through lutbake.batch.write_table
 
 
 def specs():
@@ -80,8 +104,8 @@ def thread_run(out: Path) -> tuple[float, float, list]:
     return time.perf_counter() - t0, cpu_seconds() - c0, jobs
 
 
-def dask_run(out: Path, scheduler: str) -> tuple[float, float, list, TimedRunner, float]:
-    """Wall and CPU seconds (client + workers, start-up included) of the batch on ``scheduler``."""
+def dask_run(out: Path, scheduler: str) -> tuple[float, float, float, list, TimedRunner, float]:
+    """Wall, client CPU and workers' CPU seconds (start-up included) of the batch on ``scheduler``."""
     t0, c0 = time.perf_counter(), cpu_seconds()
     jobs = batch.plan(specs(), out, force=True)
     real = cluster.DaskRunner
@@ -93,7 +117,7 @@ def dask_run(out: Path, scheduler: str) -> tuple[float, float, list, TimedRunner
             cpu_workers = sum(runner.client.run(cpu_seconds).values())
     finally:
         cluster.DaskRunner = real
-    return time.perf_counter() - t0, cpu_seconds() - c0 + cpu_workers, jobs, runner, started
+    return time.perf_counter() - t0, cpu_seconds() - c0, cpu_workers, jobs, runner, started
 
 
 def identical(a: list, b: list) -> bool:
@@ -123,11 +147,13 @@ def main(argv=None):
     rounds = []
     for r in range(args.rounds):
         t_thread, cpu_thread, jobs_t = thread_run(OUT / "cluster_thread")
-        t_dask, cpu_dask, jobs_d, runner, started = dask_run(OUT / "cluster_dask", args.scheduler)
+        t_dask, cpu_client, cpu_workers, jobs_d, runner, started = dask_run(OUT / "cluster_dask", args.scheduler)
+        cpu_dask = cpu_client + cpu_workers
         same = identical(jobs_t, jobs_d)
         st = runner.stats
         rounds.append({"thread_seconds": t_thread, "dask_seconds": t_dask, "ratio": t_dask / t_thread,
                        "thread_cpu_seconds": cpu_thread, "dask_cpu_seconds": cpu_dask, "cpu_ratio": cpu_dask / cpu_thread,
+                       "dask_client_cpu_seconds": cpu_client, "dask_workers_cpu_seconds": cpu_workers,
                        "load_average_after": os.getloadavg()[0],
                        "cluster_start_seconds": started, "identical_files": same, "tiles": st.tiles,
                        "bytes_to_workers_per_tile": st.bytes_to_workers / st.tiles,
@@ -141,18 +167,20 @@ def main(argv=None):
               f" B of error-estimate inputs); identical files: {same}")
     # the projection, from the last Dask round
     job = next(j for j in jobs_d if j.name == LARGEST)
-    tiles = [(n, s) for name, n, s in runner.stats.tile_seconds if name == LARGEST]
+    tiles = [(n, c) for name, n, c in runner.stats.tile_seconds if name == LARGEST]
     n = len(tiles)
-    W = sum(s for _, s in tiles)
-    phase = runner.phase[LARGEST]
-    S = max(0.0, job.seconds - phase)
-    C = max(0.0, (phase - W / 2) / n)
+    W = sum(c for _, c in tiles)  # CPU seconds of its tile launches
+    t0 = time.perf_counter()
+    lookup_kind(job.spec.kind).plan(job.spec)
+    S_parts = {"client_plan": time.perf_counter() - t0, "error_estimate_task": runner.estimate[LARGEST],
+               "write": WRITES[LARGEST]}
+    S = sum(S_parts.values())
+    C = cpu_client / runner.stats.tiles  # client + scheduler CPU per tile of the batch (an upper bound)
     spec = job.spec
     texels = sum(t for t, _ in tiles)
     n_channels = int(job.shape.split("x")[-1])
     # per tile: its arguments, its float64 result, and its share of the table shipped for the error estimate
-    B = (runner.stats.bytes_to_workers / runner.stats.tiles + 8 * n_channels * texels / n
-         + 8 * n_channels * texels / n)
+    B = runner.stats.bytes_to_workers / runner.stats.tiles + 2 * 8 * n_channels * texels / n
     proj = {}
     for N in WORKERS:
         serial = S + C * n + B * n / BANDWIDTH
@@ -166,9 +194,9 @@ def main(argv=None):
         "median_cpu_ratio": float(np.median([r["cpu_ratio"] for r in rounds])),
         "target_ratio": TARGET_RATIO,
         "largest_table": {"name": LARGEST, "spec": spec.toml(), "texels": texels, "tiles": n,
-                          "W_sum_tile_seconds": W, "S_client_serial_seconds": S, "C_dispatch_seconds_per_tile": C,
+                          "W_sum_tile_cpu_seconds": W, "S_serial_seconds": S, "S_parts": S_parts,
+                          "C_client_scheduler_cpu_seconds_per_tile": C,
                           "B_bytes_per_tile": B, "bandwidth_assumed_bytes_per_s": BANDWIDTH,
-                          "tile_phase_seconds_on_2_workers": phase, "bake_seconds_on_2_workers": job.seconds,
                           "projection": proj,
                           "model": "T(N) = S + C n + B n / BANDWIDTH + W / N; serial fraction = (T - W/N) / T"},
     }
@@ -177,8 +205,9 @@ def main(argv=None):
     print(f"median wall ratio {args.scheduler} / thread: {report['median_ratio']:.3f} (target <= {TARGET_RATIO}); "
           f"CPU-seconds ratio {report['median_cpu_ratio']:.3f}; load average {os.getloadavg()[0]:.1f} on "
           f"{os.cpu_count()} cores")
-    print(f"{LARGEST}: {n} tiles, W = {W:.1f} s of tile launches, S = {S:.2f} s client serial, C = {C * 1e3:.2f} ms "
-          f"dispatch per tile, B = {B / 1024:.1f} KiB per tile")
+    print(f"{LARGEST}: {n} tiles, W = {W:.1f} CPU s of tile launches ({W / n * 1e3:.1f} ms per tile), S = {S:.2f} s "
+          f"serial ({', '.join(f'{k} {v:.2f} s' for k, v in S_parts.items())}), C = {C * 1e3:.2f} ms client + "
+          f"scheduler CPU per tile, B = {B / 1024:.1f} KiB per tile")
     for N, p in proj.items():
         print(f"  projected on {N:>2} workers: {p['seconds']:7.2f} s, serial fraction {p['serial_fraction']:.3f}")
     print(path)

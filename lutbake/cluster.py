@@ -60,7 +60,7 @@ ADDRESS_RE = re.compile(r"^(tcp|tls|ucx|ws|wss)://[^\s/]+$")
 MAX_LOCAL_WORKERS = 256
 CONNECT_TIMEOUT_S = 30  # to reach the scheduler, and for its first worker to join
 POLL_S = 0.2  # how often a waiting table looks at its cancel event
-PLAN_CACHE_SIZE = 16  # plans kept per worker process (a plan holds its texel grid: a few MiB at most)
+PLAN_CACHE_SIZE = 64  # plans kept per worker process (a plan holds its texel grid; a batch has tens of tables)
 IDENTITY_KEYS = ("lutbake", "kernel_sources", "warp", "numpy", "scipy")
 
 
@@ -183,13 +183,14 @@ def worker_plan(spec, device: str):
 
 def bake_tile(spec, start: int, stop: int, device: str, token: str) -> tuple[np.ndarray, float]:
     """The Dask task: float64 values of texels [start, stop) of ``spec`` (row-major, (stop - start,
-    channels)) and the seconds their launch took on this worker."""
+    channels)) and the CPU seconds of this thread while they ran (a Warp CPU launch runs in the calling
+    thread, so this is the tile's compute time whatever else loads the host)."""
     init_warp_quietly()
     _check_token(token)
     plan = worker_plan(spec, device)
-    t0 = time.perf_counter()
+    t0 = time.thread_time()
     data = plan.run_tile(start, stop, device)
-    return data, time.perf_counter() - t0
+    return data, time.thread_time() - t0
 
 
 def estimate_error_task(spec, data: np.ndarray, device: str, token: str) -> tuple[float, str]:
@@ -216,8 +217,8 @@ class Stats:
     bytes_to_workers: int = 0  # pickled task arguments (spec, range, device, token)
     bytes_from_workers: int = 0  # tile results (float64 arrays)
     bytes_estimate_inputs: int = 0  # baked tables shipped to a worker for their error estimate
-    worker_seconds: float = 0.0  # the tiles' launch time, summed over workers
-    tile_seconds: list = field(default_factory=list)  # (table, texels, seconds) per tile
+    worker_seconds: float = 0.0  # the tiles' CPU time on the workers, summed
+    tile_seconds: list = field(default_factory=list)  # (table, texels, CPU seconds) per tile
     cancelled: int = 0  # tiles cancelled before their result arrived (an interrupt, a failed table)
     lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
@@ -234,6 +235,7 @@ class DaskRunner:
         self.targets: list[str] | None = None  # workers that run this device's tiles (None: any)
         self.cuda_free_bytes: int | None = None
         self.stats = Stats()
+        self.tables = 0  # tables submitted: a later table's tiles get a lower Dask priority
         self.on_tile = None  # called in the client as on_tile(table name, start, stop) when a tile arrives
 
     def check_workers(self) -> dict[str, dict]:
@@ -275,8 +277,9 @@ class DaskRunner:
             self.cuda_free_bytes = min(infos[a]["cuda_free_bytes"] for a in gpus)
         return infos
 
-    def _submit(self, fn, *args, key: str):
-        return self.client.submit(fn, *args, key=key, workers=self.targets, allow_other_workers=False, pure=False)
+    def _submit(self, fn, *args, key: str, priority: int = 0):
+        return self.client.submit(fn, *args, key=key, workers=self.targets, allow_other_workers=False, pure=False,
+                                  priority=priority)
 
     def execute(self, spec, plan, device: str, progress: bool | None = None, label: str = "",
                 cancel: threading.Event | None = None) -> np.ndarray:
@@ -288,9 +291,13 @@ class DaskRunner:
             raise ValueError(f"this runner bakes on {self.device!r}, not {device!r}")
         parts = tiles(plan.n_texels, plan_tile_texels(plan, device, self.cuda_free_bytes))
         prefix = f"lutbake-{spec.name}-{uuid.uuid4().hex[:8]}-{device}"
+        with self.stats.lock:
+            self.tables += 1
+            priority = -self.tables  # tables in submission order: each worker's plan cache stays warm
         futures = {}
         for s, e in parts:
-            futures[self._submit(bake_tile, spec, s, e, device, self.token, key=f"{prefix}-{s}-{e}")] = (s, e)
+            futures[self._submit(bake_tile, spec, s, e, device, self.token, key=f"{prefix}-{s}-{e}",
+                                 priority=priority)] = (s, e)
         sent = len(pickle.dumps((spec, 0, plan.n_texels, device, self.token), protocol=5))
         out = np.empty((plan.n_texels, plan.n_channels), dtype=np.float64)
         pending = set(futures)
@@ -330,7 +337,8 @@ class DaskRunner:
 
     def estimate_error(self, spec, data: np.ndarray, device: str) -> tuple[float, str]:
         key = f"lutbake-{spec.name}-{uuid.uuid4().hex[:8]}-{device}-error-estimate"
-        fut = self._submit(estimate_error_task, spec, data, device, self.token, key=key)
+        [shipped] = self.client.scatter([data], workers=self.targets)  # the table travels as data, not in the graph
+        fut = self._submit(estimate_error_task, spec, shipped, device, self.token, key=key, priority=1)
         with self.stats.lock:
             self.stats.bytes_estimate_inputs += data.nbytes
         return fut.result()
