@@ -19,7 +19,8 @@ table cancels its futures and writes nothing).
   worker has this client's lutbake version and kernel sources digest (the ones in every content hash),
   Warp, numpy and scipy. Every tile carries a token of that identity, so a worker that joins later with
   another one fails its tile with the same message instead of baking different bits.
-- **Devices**: ``--device cpu`` runs 512-texel tiles on any worker; ``--device cuda`` runs device-sized
+- **Devices**: ``--device cpu`` runs CLUSTER_TILE_TEXELS-texel tiles on any worker (any cut gives the same
+  bits; larger than the thread executor's 512 so that Dask's per-task cost stays small); ``--device cuda`` runs device-sized
   tiles (lutbake.devices) on the workers that have a CUDA device, and refuses a cluster with none. A
   table's tiles all run on one kind of device: its bits never depend on which worker took which tile.
 - **Local clusters** (``local:N``): a distributed.LocalCluster of N single-threaded worker processes on
@@ -60,6 +61,7 @@ ADDRESS_RE = re.compile(r"^(tcp|tls|ucx|ws|wss)://[^\s/]+$")
 MAX_LOCAL_WORKERS = 256
 CONNECT_TIMEOUT_S = 30  # to reach the scheduler, and for its first worker to join
 POLL_S = 0.2  # how often a waiting table looks at its cancel event
+CLUSTER_TILE_TEXELS = 4096  # CPU tiles of a cluster bake: 8 executor tiles, so Dask's per-task cost stays small
 PLAN_CACHE_SIZE = 64  # plans kept per worker process (a plan holds its texel grid; a batch has tens of tables)
 IDENTITY_KEYS = ("lutbake", "kernel_sources", "warp", "numpy", "scipy")
 
@@ -289,7 +291,7 @@ class DaskRunner:
 
         if device != self.device:
             raise ValueError(f"this runner bakes on {self.device!r}, not {device!r}")
-        parts = tiles(plan.n_texels, plan_tile_texels(plan, device, self.cuda_free_bytes))
+        parts = tiles(plan.n_texels, max(CLUSTER_TILE_TEXELS, plan_tile_texels(plan, device, self.cuda_free_bytes)))
         prefix = f"lutbake-{spec.name}-{uuid.uuid4().hex[:8]}-{device}"
         with self.stats.lock:
             self.tables += 1

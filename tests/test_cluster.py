@@ -29,8 +29,9 @@ from lutbake.io.exr import read_exr  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 BAKE_DEADLINE_S = 90  # a cluster test that has not finished by then is interrupted (and fails)
+TILE = 512  # small cluster tiles in these tests, so that small tables are cut into several
 
-# several kinds, each cut into more than one 512-texel tile
+# several kinds, each cut into more than one TILE-texel tile
 SPECS = {
     "dfg_gl": {"kind": "dfg", "size": [40, 24], "samples": 48},
     "dfg_vndf": {"kind": "dfg", "size": [32, 20], "estimator": "sobol_vndf", "samples": 64, "seed": 3},
@@ -41,6 +42,13 @@ SPECS = {
 
 def spec(name, **kw):
     return validate_table({"name": name, **kw}, "<test>", 0)
+
+
+@pytest.fixture(scope="module", autouse=True)
+def small_tiles():
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(cluster, "CLUSTER_TILE_TEXELS", TILE)
+        yield
 
 
 @pytest.fixture(scope="module")
@@ -120,8 +128,8 @@ def test_cluster_bake_is_bit_identical_to_the_thread_executor(runner):
         assert a.data.shape == b.data.shape and np.array_equal(a.data, b.data), s.name
         assert a.attributes == b.attributes, s.name  # error estimate and content hash included
     texels = [t.data[..., 0].size for t in local.values()]
-    assert min(texels) > 512  # every table was cut into several tiles
-    assert runner.stats.tiles == sum(-(-n // 512) for n in texels)
+    assert min(texels) > TILE  # every table was cut into several tiles
+    assert runner.stats.tiles == sum(-(-n // TILE) for n in texels)
     assert runner.stats.bytes_from_workers == sum(t.data.size * 8 for t in local.values())  # float64 results
     assert runner.stats.cancelled == 0
 
