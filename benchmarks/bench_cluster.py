@@ -18,6 +18,7 @@
 
 Writes outputs/bench/cluster.json and prints a summary.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -151,20 +152,33 @@ def main(argv=None):
         cpu_dask = cpu_client + cpu_workers
         same = identical(jobs_t, jobs_d)
         st = runner.stats
-        rounds.append({"thread_seconds": t_thread, "dask_seconds": t_dask, "ratio": t_dask / t_thread,
-                       "thread_cpu_seconds": cpu_thread, "dask_cpu_seconds": cpu_dask, "cpu_ratio": cpu_dask / cpu_thread,
-                       "dask_client_cpu_seconds": cpu_client, "dask_workers_cpu_seconds": cpu_workers,
-                       "load_average_after": os.getloadavg()[0],
-                       "cluster_start_seconds": started, "identical_files": same, "tiles": st.tiles,
-                       "bytes_to_workers_per_tile": st.bytes_to_workers / st.tiles,
-                       "bytes_from_workers_per_tile": st.bytes_from_workers / st.tiles,
-                       "bytes_estimate_inputs_per_tile": st.bytes_estimate_inputs / st.tiles,
-                       "worker_seconds": st.worker_seconds})
-        print(f"round {r}: thread {t_thread:.1f} s, {args.scheduler} {t_dask:.1f} s (start {started:.1f} s): "
-              f"ratio {t_dask / t_thread:.3f}; CPU {cpu_thread:.1f} s vs {cpu_dask:.1f} s (client + workers): "
-              f"ratio {cpu_dask / cpu_thread:.3f}; {st.tiles} tiles, {st.bytes_to_workers / st.tiles:.0f} B to and "
-              f"{st.bytes_from_workers / st.tiles:.0f} B from the workers per tile (+ {st.bytes_estimate_inputs / st.tiles:.0f}"
-              f" B of error-estimate inputs); identical files: {same}")
+        rounds.append(
+            {
+                "thread_seconds": t_thread,
+                "dask_seconds": t_dask,
+                "ratio": t_dask / t_thread,
+                "thread_cpu_seconds": cpu_thread,
+                "dask_cpu_seconds": cpu_dask,
+                "cpu_ratio": cpu_dask / cpu_thread,
+                "dask_client_cpu_seconds": cpu_client,
+                "dask_workers_cpu_seconds": cpu_workers,
+                "load_average_after": os.getloadavg()[0],
+                "cluster_start_seconds": started,
+                "identical_files": same,
+                "tiles": st.tiles,
+                "bytes_to_workers_per_tile": st.bytes_to_workers / st.tiles,
+                "bytes_from_workers_per_tile": st.bytes_from_workers / st.tiles,
+                "bytes_estimate_inputs_per_tile": st.bytes_estimate_inputs / st.tiles,
+                "worker_seconds": st.worker_seconds,
+            }
+        )
+        print(
+            f"round {r}: thread {t_thread:.1f} s, {args.scheduler} {t_dask:.1f} s (start {started:.1f} s): "
+            f"ratio {t_dask / t_thread:.3f}; CPU {cpu_thread:.1f} s vs {cpu_dask:.1f} s (client + workers): "
+            f"ratio {cpu_dask / cpu_thread:.3f}; {st.tiles} tiles, {st.bytes_to_workers / st.tiles:.0f} B to and "
+            f"{st.bytes_from_workers / st.tiles:.0f} B from the workers per tile (+ {st.bytes_estimate_inputs / st.tiles:.0f}"
+            f" B of error-estimate inputs); identical files: {same}"
+        )
     # the projection, from the last Dask round
     job = next(j for j in jobs_d if j.name == LARGEST)
     tiles = [(n, c) for name, n, c in runner.stats.tile_seconds if name == LARGEST]
@@ -172,8 +186,11 @@ def main(argv=None):
     W = sum(c for _, c in tiles)  # CPU seconds of its tile launches
     t0 = time.perf_counter()
     lookup_kind(job.spec.kind).plan(job.spec)
-    S_parts = {"client_plan": time.perf_counter() - t0, "error_estimate_task": runner.estimate[LARGEST],
-               "write": WRITES[LARGEST]}
+    S_parts = {
+        "client_plan": time.perf_counter() - t0,
+        "error_estimate_task": runner.estimate[LARGEST],
+        "write": WRITES[LARGEST],
+    }
     S = sum(S_parts.values())
     C = cpu_client / runner.stats.tiles  # client + scheduler CPU per tile of the batch (an upper bound)
     spec = job.spec
@@ -193,21 +210,33 @@ def main(argv=None):
         "median_ratio": float(np.median([r["ratio"] for r in rounds])),
         "median_cpu_ratio": float(np.median([r["cpu_ratio"] for r in rounds])),
         "target_ratio": TARGET_RATIO,
-        "largest_table": {"name": LARGEST, "spec": spec.toml(), "texels": texels, "tiles": n,
-                          "W_sum_tile_cpu_seconds": W, "S_serial_seconds": S, "S_parts": S_parts,
-                          "C_client_scheduler_cpu_seconds_per_tile": C,
-                          "B_bytes_per_tile": B, "bandwidth_assumed_bytes_per_s": BANDWIDTH,
-                          "projection": proj,
-                          "model": "T(N) = S + C n + B n / BANDWIDTH + W / N; serial fraction = (T - W/N) / T"},
+        "largest_table": {
+            "name": LARGEST,
+            "spec": spec.toml(),
+            "texels": texels,
+            "tiles": n,
+            "W_sum_tile_cpu_seconds": W,
+            "S_serial_seconds": S,
+            "S_parts": S_parts,
+            "C_client_scheduler_cpu_seconds_per_tile": C,
+            "B_bytes_per_tile": B,
+            "bandwidth_assumed_bytes_per_s": BANDWIDTH,
+            "projection": proj,
+            "model": "T(N) = S + C n + B n / BANDWIDTH + W / N; serial fraction = (T - W/N) / T",
+        },
     }
     path = OUT / "cluster.json"
     path.write_text(json.dumps(report, indent=2) + "\n")
-    print(f"median wall ratio {args.scheduler} / thread: {report['median_ratio']:.3f} (target <= {TARGET_RATIO}); "
-          f"CPU-seconds ratio {report['median_cpu_ratio']:.3f}; load average {os.getloadavg()[0]:.1f} on "
-          f"{os.cpu_count()} cores")
-    print(f"{LARGEST}: {n} tiles, W = {W:.1f} CPU s of tile launches ({W / n * 1e3:.1f} ms per tile), S = {S:.2f} s "
-          f"serial ({', '.join(f'{k} {v:.2f} s' for k, v in S_parts.items())}), C = {C * 1e3:.2f} ms client + "
-          f"scheduler CPU per tile, B = {B / 1024:.1f} KiB per tile")
+    print(
+        f"median wall ratio {args.scheduler} / thread: {report['median_ratio']:.3f} (target <= {TARGET_RATIO}); "
+        f"CPU-seconds ratio {report['median_cpu_ratio']:.3f}; load average {os.getloadavg()[0]:.1f} on "
+        f"{os.cpu_count()} cores"
+    )
+    print(
+        f"{LARGEST}: {n} tiles, W = {W:.1f} CPU s of tile launches ({W / n * 1e3:.1f} ms per tile), S = {S:.2f} s "
+        f"serial ({', '.join(f'{k} {v:.2f} s' for k, v in S_parts.items())}), C = {C * 1e3:.2f} ms client + "
+        f"scheduler CPU per tile, B = {B / 1024:.1f} KiB per tile"
+    )
     for N, p in proj.items():
         print(f"  projected on {N:>2} workers: {p['seconds']:7.2f} s, serial fraction {p['serial_fraction']:.3f}")
     print(path)

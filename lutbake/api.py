@@ -1,4 +1,5 @@
 """The public Python API: ``bake`` a config (or specs) into tables and files."""
+
 from __future__ import annotations
 
 import json
@@ -30,16 +31,18 @@ def _warp_version() -> str:
     return wp.config.version
 
 
-def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: bool | None = None,
-               cancel=None) -> tuple[Table, float, int]:
+def bake_table(
+    spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: bool | None = None, cancel=None
+) -> tuple[Table, float, int]:
     """Bake one spec into a Table (nothing written). Raises TableError if a value is not finite;
     executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
     from .batch import content_hash
 
     plan = lookup_kind(spec.kind).plan(spec)
     with Timer() as t:
-        data = execute(plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel,
-                       spec=spec)
+        data = execute(
+            plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel, spec=spec
+        )
     if not np.all(np.isfinite(data)):
         bad = int(np.size(data) - np.count_nonzero(np.isfinite(data)))
         raise TableError(f"{spec.source}: table '{spec.name}': {bad} non-finite values; nothing written")
@@ -60,13 +63,22 @@ def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu",
         **extra,
         "content_hash": content_hash(spec),  # what makes the file current (lutbake.batch)
     }
-    table = Table(spec.name, spec.kind, data.astype(np.float32), plan.axes, plan.channels, plan.reconstruction,
-                  attributes)
+    table = Table(
+        spec.name, spec.kind, data.astype(np.float32), plan.axes, plan.channels, plan.reconstruction, attributes
+    )
     return table, t.seconds, plan.samples
 
 
-def bake(configs, out_dir="outputs", overrides=(), workers: int | None = None, device: str = "cpu",
-         write: bool = True, progress: bool | None = None, on_result=None) -> list[BakeResult]:
+def bake(
+    configs,
+    out_dir="outputs",
+    overrides=(),
+    workers: int | None = None,
+    device: str = "cpu",
+    write: bool = True,
+    progress: bool | None = None,
+    on_result=None,
+) -> list[BakeResult]:
     """Validate every config, then bake each table and write ``out_dir/<name>.<ext>`` (key ``format``,
     default EXR) atomically.
 

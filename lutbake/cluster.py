@@ -33,6 +33,7 @@ Python API::
     with cluster.session("local:2"):            # or "tcp://HOST:8786"
         batch.run(batch.plan(specs, "outputs"))  # lutbake.bake(...) works the same inside the block
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -54,8 +55,9 @@ import numpy as np
 
 from .errors import ConfigError, LutbakeError
 
-SCHEDULER_FORMS = "local:N (a LocalCluster of N worker processes here, N >= 1) or a Dask scheduler address " \
-                  "such as tcp://HOST:8786"
+SCHEDULER_FORMS = (
+    "local:N (a LocalCluster of N worker processes here, N >= 1) or a Dask scheduler address such as tcp://HOST:8786"
+)
 LOCAL_RE = re.compile(r"^local:(\d+)$")
 ADDRESS_RE = re.compile(r"^(tcp|tls|ucx|ws|wss)://[^\s/]+$")
 MAX_LOCAL_WORKERS = 256
@@ -78,8 +80,13 @@ def parse_scheduler(text: str) -> tuple[str, int | str]:
     if m:
         n = int(m.group(1))
         if not 1 <= n <= MAX_LOCAL_WORKERS:
-            raise ConfigError("--scheduler", "scheduler", text, SCHEDULER_FORMS,
-                              f"a local cluster needs 1 to {MAX_LOCAL_WORKERS} worker processes")
+            raise ConfigError(
+                "--scheduler",
+                "scheduler",
+                text,
+                SCHEDULER_FORMS,
+                f"a local cluster needs 1 to {MAX_LOCAL_WORKERS} worker processes",
+            )
         return "local", n
     if ADDRESS_RE.match(text):
         return "address", text
@@ -139,8 +146,13 @@ def identity() -> dict[str, str]:
     from . import __version__
     from .batch import sources_digest
 
-    return {"lutbake": __version__, "kernel_sources": sources_digest().hex()[:16], "warp": warp.config.version,
-            "numpy": numpy.__version__, "scipy": scipy.__version__}
+    return {
+        "lutbake": __version__,
+        "kernel_sources": sources_digest().hex()[:16],
+        "warp": warp.config.version,
+        "numpy": numpy.__version__,
+        "scipy": scipy.__version__,
+    }
 
 
 def identity_token(ident: dict[str, str]) -> str:
@@ -161,8 +173,10 @@ def _check_token(expect: str) -> None:
     if _TOKEN is None:
         _TOKEN = identity_token(identity())
     if _TOKEN != expect:
-        raise WorkerRefused(f"worker process {os.getpid()} has lutbake {identity()} and cannot bake bit-identical "
-                            "tiles for this client; install the client's lutbake, warp, numpy and scipy there")
+        raise WorkerRefused(
+            f"worker process {os.getpid()} has lutbake {identity()} and cannot bake bit-identical "
+            "tiles for this client; install the client's lutbake, warp, numpy and scipy there"
+        )
 
 
 def worker_plan(spec, device: str):
@@ -210,6 +224,7 @@ def setup_local_worker() -> None:
 
 
 # ---------------------------------------------------------------------------------------------- client side
+
 
 @dataclass
 class Stats:
@@ -263,28 +278,41 @@ class DaskRunner:
         if not infos:
             problems.append("no worker is connected")
         if problems:
-            raise WorkerRefused(f"refusing the workers of {self.name}: " + " | ".join(problems)
-                                + ". Every worker needs this client's lutbake (same version and kernel sources), warp, "
-                                "numpy and scipy: pip install the same lutbake[dask] there and restart the worker. "
-                                "No tile ran.")
+            raise WorkerRefused(
+                f"refusing the workers of {self.name}: "
+                + " | ".join(problems)
+                + ". Every worker needs this client's lutbake (same version and kernel sources), warp, "
+                "numpy and scipy: pip install the same lutbake[dask] there and restart the worker. "
+                "No tile ran."
+            )
         self.workers = infos
         self.token = identity_token(here)
         if self.device.startswith("cuda"):
             gpus = sorted(a for a, i in infos.items() if i["cuda_devices"] > 0)
             if not gpus:
-                raise WorkerRefused(f"--device cuda: none of the {len(infos)} workers of {self.name} has a CUDA device "
-                                    "(Warp reports 0 on each); bake with --device cpu, or start workers on GPU hosts. "
-                                    "No tile ran.")
+                raise WorkerRefused(
+                    f"--device cuda: none of the {len(infos)} workers of {self.name} has a CUDA device "
+                    "(Warp reports 0 on each); bake with --device cpu, or start workers on GPU hosts. "
+                    "No tile ran."
+                )
             self.targets = gpus
             self.cuda_free_bytes = min(infos[a]["cuda_free_bytes"] for a in gpus)
         return infos
 
     def _submit(self, fn, *args, key: str, priority: int = 0):
-        return self.client.submit(fn, *args, key=key, workers=self.targets, allow_other_workers=False, pure=False,
-                                  priority=priority)
+        return self.client.submit(
+            fn, *args, key=key, workers=self.targets, allow_other_workers=False, pure=False, priority=priority
+        )
 
-    def execute(self, spec, plan, device: str, progress: bool | None = None, label: str = "",
-                cancel: threading.Event | None = None) -> np.ndarray:
+    def execute(
+        self,
+        spec,
+        plan,
+        device: str,
+        progress: bool | None = None,
+        label: str = "",
+        cancel: threading.Event | None = None,
+    ) -> np.ndarray:
         """lutbake.executor.execute() on the cluster: float64 data of shape plan.shape."""
         from .devices import plan_tile_texels
         from .executor import Cancelled, progress_bar, tiles
@@ -298,8 +326,9 @@ class DaskRunner:
             priority = -self.tables  # tables in submission order: each worker's plan cache stays warm
         futures = {}
         for s, e in parts:
-            futures[self._submit(bake_tile, spec, s, e, device, self.token, key=f"{prefix}-{s}-{e}",
-                                 priority=priority)] = (s, e)
+            futures[
+                self._submit(bake_tile, spec, s, e, device, self.token, key=f"{prefix}-{s}-{e}", priority=priority)
+            ] = (s, e)
         sent = len(pickle.dumps((spec, 0, plan.n_texels, device, self.token), protocol=5))
         out = np.empty((plan.n_texels, plan.n_channels), dtype=np.float64)
         pending = set(futures)
@@ -369,8 +398,9 @@ def _distributed():
     try:
         import distributed
     except ImportError:
-        raise ConfigError("--scheduler", "scheduler", None, None,
-                          "needs Dask's distributed package: pip install 'lutbake[dask]'") from None
+        raise ConfigError(
+            "--scheduler", "scheduler", None, None, "needs Dask's distributed package: pip install 'lutbake[dask]'"
+        ) from None
     return distributed
 
 
@@ -384,8 +414,13 @@ def session(scheduler: str, device: str = "cpu"):
     cluster = None
     try:
         if form == "local":
-            cluster = distributed.LocalCluster(n_workers=where, threads_per_worker=1, processes=True,
-                                               dashboard_address=":0", silence_logs=logging.ERROR)
+            cluster = distributed.LocalCluster(
+                n_workers=where,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=":0",
+                silence_logs=logging.ERROR,
+            )
             client = distributed.Client(cluster, set_as_default=False)
         else:
             client = distributed.Client(where, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
@@ -397,9 +432,13 @@ def session(scheduler: str, device: str = "cpu"):
         try:
             client.wait_for_workers(where if form == "local" else 1, timeout=CONNECT_TIMEOUT_S)
         except TimeoutError:
-            raise ConfigError("--scheduler", "scheduler", scheduler, None,
-                              f"no worker joined within {CONNECT_TIMEOUT_S} s (start one: dask worker {scheduler})") \
-                from None
+            raise ConfigError(
+                "--scheduler",
+                "scheduler",
+                scheduler,
+                None,
+                f"no worker joined within {CONNECT_TIMEOUT_S} s (start one: dask worker {scheduler})",
+            ) from None
         runner = DaskRunner(client, device, name=scheduler)
         runner.check_workers()
         if form == "local":

@@ -16,6 +16,7 @@ A CUDA bake is not bit-identical to a CPU bake: both evaluate the integrand in f
 in float64, but the GPU's float32 transcendental functions, fused multiply-adds and code generation
 differ in the last bits of each sample (docs/cluster.md says how that difference is measured).
 """
+
 from __future__ import annotations
 
 from .executor import TILE_TEXELS as CPU_TILE_TEXELS
@@ -25,8 +26,9 @@ CUDA_MEMORY_FRACTION = 0.25  # of the device's free memory, for one launch's per
 BYTES_PER_TEXEL_INPUTS = 64  # per-texel kernel inputs (directions, NoV, alpha, f0, order): a generous bound
 
 
-def tile_texels(n_texels: int, evals_per_texel: float, n_channels: int, device: str = "cpu",
-                free_bytes: int | None = None) -> int:
+def tile_texels(
+    n_texels: int, evals_per_texel: float, n_channels: int, device: str = "cpu", free_bytes: int | None = None
+) -> int:
     """Texels per tile (launch) of a table of ``n_texels`` on ``device``.
 
     ``evals_per_texel``: integrand evaluations per texel (Plan.cost / Plan.n_texels);

@@ -4,6 +4,7 @@ Warp's CPU launches run one kernel on one core and release the GIL (ctypes), so 
 cores busy. A tile is a fixed range of texels (independent of the worker count) and every texel is
 computed alone, so the output is bit-identical for any number of workers.
 """
+
 from __future__ import annotations
 
 import os
@@ -33,8 +34,15 @@ def tiles(n: int, size: int = TILE_TEXELS) -> list[tuple[int, int]]:
     return [(s, min(s + size, n)) for s in range(0, n, size)]
 
 
-def execute(plan: Plan, workers: int | None = None, device: str = "cpu", progress: bool | None = None,
-            label: str = "", cancel: threading.Event | None = None, spec=None) -> np.ndarray:
+def execute(
+    plan: Plan,
+    workers: int | None = None,
+    device: str = "cpu",
+    progress: bool | None = None,
+    label: str = "",
+    cancel: threading.Event | None = None,
+    spec=None,
+) -> np.ndarray:
     """Evaluate every tile of ``plan``; returns float64 data of shape plan.shape.
 
     ``cancel``: when set (by another thread), no further tile starts and Cancelled is raised.
@@ -77,8 +85,9 @@ def progress_bar(plan: Plan, progress: bool | None, label: str):
 
     if progress is None:
         progress = sys.stderr.isatty() and plan.cost > PROGRESS_MIN_EVALS
-    return click.progressbar(length=plan.n_texels, label=label, file=sys.stderr if progress else open(os.devnull, "w"),
-                             show_eta=True)
+    return click.progressbar(
+        length=plan.n_texels, label=label, file=sys.stderr if progress else open(os.devnull, "w"), show_eta=True
+    )
 
 
 def estimate_error(plan: Plan, data: np.ndarray, device: str = "cpu", spec=None) -> tuple[float, str] | None:

@@ -3,6 +3,7 @@ only its tiles, mismatched or broken workers are refused before any tile runs, i
 futures and write no unfinished table.
 
 One small LocalCluster (2 single-threaded worker processes) serves the module; small tables."""
+
 import contextlib
 import json
 import logging
@@ -53,8 +54,12 @@ def small_tiles():
 
 @pytest.fixture(scope="module")
 def client():
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
-                                  silence_logs=logging.ERROR) as lc, distributed.Client(lc, set_as_default=False) as c:
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0", silence_logs=logging.ERROR
+        ) as lc,
+        distributed.Client(lc, set_as_default=False) as c,
+    ):
         c.run(cluster.setup_local_worker)
         yield c
 
@@ -103,8 +108,14 @@ def test_table_spec_pickles_to_an_equal_spec():
     assert t == s and t.toml() == s.toml() and type(t.options) is type(s.options)
 
 
-@pytest.mark.parametrize("text, parsed", [("local:2", ("local", 2)), ("tcp://farm:8786", ("address", "tcp://farm:8786")),
-                                          ("tls://10.0.0.1:8786", ("address", "tls://10.0.0.1:8786"))])
+@pytest.mark.parametrize(
+    "text, parsed",
+    [
+        ("local:2", ("local", 2)),
+        ("tcp://farm:8786", ("address", "tcp://farm:8786")),
+        ("tls://10.0.0.1:8786", ("address", "tls://10.0.0.1:8786")),
+    ],
+)
 def test_scheduler_forms(text, parsed):
     assert cluster.parse_scheduler(text) == parsed
 
@@ -151,8 +162,7 @@ def test_a_killed_worker_costs_only_its_tiles(client, tmp_path):
                 return
             processing = {a: ks for a, ks in client.processing().items() if ks}
             victim = sorted(processing)[0]
-            killed.update(addr=victim, pid=pids[victim], tiles=len(processing[victim]),
-                          remaining=3 * 8 - r.stats.tiles)
+            killed.update(addr=victim, pid=pids[victim], tiles=len(processing[victim]), remaining=3 * 8 - r.stats.tiles)
             os.kill(pids[victim], signal.SIGKILL)
 
     r.on_tile = kill_one
@@ -182,8 +192,12 @@ def test_a_worker_with_another_lutbake_version_is_refused_before_any_tile_runs(c
     address = client.scheduler.address
     victim = sorted(client.scheduler_info()["workers"])[0]
     before = scheduler_transitions(client)
-    with sabotaged(client, "import lutbake; lutbake._real = lutbake.__version__; lutbake.__version__ = '0.0.0+other'",
-                   "import lutbake; lutbake.__version__ = lutbake._real", workers=[victim]):
+    with sabotaged(
+        client,
+        "import lutbake; lutbake._real = lutbake.__version__; lutbake.__version__ = '0.0.0+other'",
+        "import lutbake; lutbake.__version__ = lutbake._real",
+        workers=[victim],
+    ):
         r = CliRunner().invoke(main, ["bake", str(cfg), "--out-dir", str(tmp_path / "o"), "--scheduler", address])
     assert r.exit_code == 2, r.output
     import lutbake
@@ -195,8 +209,12 @@ def test_a_worker_with_another_lutbake_version_is_refused_before_any_tile_runs(c
 
 def test_a_worker_without_lutbake_is_refused_with_a_clear_message(client):
     victim = sorted(client.scheduler_info()["workers"])[-1]
-    with sabotaged(client, "import sys; sys.modules['_lutbake'] = sys.modules['lutbake']; sys.modules['lutbake'] = None",
-                   "import sys; sys.modules['lutbake'] = sys.modules.pop('_lutbake')", workers=[victim]):
+    with sabotaged(
+        client,
+        "import sys; sys.modules['_lutbake'] = sys.modules['lutbake']; sys.modules['lutbake'] = None",
+        "import sys; sys.modules['lutbake'] = sys.modules.pop('_lutbake')",
+        workers=[victim],
+    ):
         with pytest.raises(cluster.WorkerRefused) as e:
             cluster.DaskRunner(client, name="test cluster").check_workers()
     assert f"worker {victim}: cannot import lutbake (ModuleNotFoundError" in str(e.value)
@@ -214,8 +232,10 @@ def test_device_cuda_on_workers_without_a_gpu_is_refused(client):
 @pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_interrupt_cancels_the_futures_and_writes_no_unfinished_table(client, monkeypatch, tmp_path, signum, code):
     cfg = tmp_path / "c.toml"
-    cfg.write_text('[[table]]\nname = "small"\nkind = "dfg"\nsize = [8, 4]\nsamples = 48\n\n'
-                   '[[table]]\nname = "slow"\nkind = "dfg"\nsize = [128, 64]\nsamples = 768\n')
+    cfg.write_text(
+        '[[table]]\nname = "small"\nkind = "dfg"\nsize = [8, 4]\nsamples = 48\n\n'
+        '[[table]]\nname = "slow"\nkind = "dfg"\nsize = [128, 64]\nsamples = 768\n'
+    )
     out = tmp_path / "out"
     runners = []
     real = cluster.session
@@ -238,8 +258,19 @@ def test_interrupt_cancels_the_futures_and_writes_no_unfinished_table(client, mo
 
     monkeypatch.setattr(cluster, "session", session)
     with deadline():
-        r = CliRunner().invoke(main, ["bake", str(cfg), "--out-dir", str(out), "--scheduler", client.scheduler.address,
-                                      "--report", str(tmp_path / "r.json")])
+        r = CliRunner().invoke(
+            main,
+            [
+                "bake",
+                str(cfg),
+                "--out-dir",
+                str(out),
+                "--scheduler",
+                client.scheduler.address,
+                "--report",
+                str(tmp_path / "r.json"),
+            ],
+        )
     assert r.exit_code == code, r.output
     assert "Traceback" not in r.output and "did not finish: slow" in r.output
     assert sorted(p.name for p in out.iterdir()) == ["small.exr"]  # no unfinished table, no temporary file
@@ -252,16 +283,24 @@ def test_cli_local_cluster_bakes_the_same_files_without_warp_banners(tmp_path):
     """`lutbake bake ... --scheduler local:2` from a shell: same pixels and headers as a thread bake; the
     worker processes print nothing (no Warp banner, no CUDA-driver warning)."""
     cfg = tmp_path / "c.toml"
-    cfg.write_text('[[table]]\nname = "a"\nkind = "dfg"\nsize = [32, 24]\nsamples = 48\n\n'
-                   '[[table]]\nname = "b"\nkind = "albedo"\nsize = [16, 8]\nsamples = 48\n')
+    cfg.write_text(
+        '[[table]]\nname = "a"\nkind = "dfg"\nsize = [32, 24]\nsamples = 48\n\n'
+        '[[table]]\nname = "b"\nkind = "albedo"\nsize = [16, 8]\nsamples = 48\n'
+    )
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    p = subprocess.run([sys.executable, "-m", "lutbake", "bake", str(cfg), "--out-dir", str(tmp_path / "d"),
-                        "--scheduler", "local:2"], env=env, capture_output=True, text=True, timeout=BAKE_DEADLINE_S)
+    p = subprocess.run(
+        [sys.executable, "-m", "lutbake", "bake", str(cfg), "--out-dir", str(tmp_path / "d"), "--scheduler", "local:2"],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=BAKE_DEADLINE_S,
+    )
     assert p.returncode == 0, p.stderr
     assert "Warp" not in p.stdout + p.stderr and p.stderr == "", p.stderr
     assert p.stdout.count("samples/texel") == 2
-    assert_same_files({n: read_exr(tmp_path / "d" / f"{n}.exr") for n in "ab"},
-                      thread_bake(load_configs([cfg]), tmp_path / "ref"))
+    assert_same_files(
+        {n: read_exr(tmp_path / "d" / f"{n}.exr") for n in "ab"}, thread_bake(load_configs([cfg]), tmp_path / "ref")
+    )
 
 
 def test_no_cluster_starts_when_every_table_is_up_to_date(tmp_path, monkeypatch):

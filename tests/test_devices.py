@@ -3,6 +3,7 @@
 The sizing logic and the executor's use of it are tested here on the CPU (a fake plan, a stated free
 memory). The CUDA bake itself is compared with the CPU bake only where Warp finds a CUDA device; on a
 machine without one that test is skipped with the reason."""
+
 import numpy as np
 import pytest
 import warp as wp
@@ -34,7 +35,7 @@ def test_a_cuda_tile_is_the_whole_table_when_it_fits():
 
 
 def test_a_cuda_tile_is_capped_by_evaluations_in_whole_cpu_tiles():
-    n, evals = 64 * 64 ** 3, 10_000  # BTF 64 sigma x 64^3 at ~1e4 evaluations per texel
+    n, evals = 64 * 64**3, 10_000  # BTF 64 sigma x 64^3 at ~1e4 evaluations per texel
     size = tile_texels(n, evals, 1, "cuda", free_bytes=80 * GIB)
     assert size % CPU_TILE_TEXELS == 0 and CPU_TILE_TEXELS <= size < n
     assert size * evals <= CUDA_TILE_MAX_EVALS < (size + CPU_TILE_TEXELS) * evals
@@ -57,9 +58,19 @@ def fake_plan(n_texels: int, evals: int, calls: list) -> Plan:
         calls.append((start, stop, device))
         return np.arange(start, stop, dtype=np.float64)[:, None]
 
-    return Plan(axes=[Axis("NoV", "x", n_texels)], channels={"c": ""}, reconstruction="", n_texels=n_texels,
-                n_channels=1, run_tile=run_tile, prepare=lambda d: None, samples=evals, estimator="fake", terms={},
-                cost=float(n_texels * evals))
+    return Plan(
+        axes=[Axis("NoV", "x", n_texels)],
+        channels={"c": ""},
+        reconstruction="",
+        n_texels=n_texels,
+        n_channels=1,
+        run_tile=run_tile,
+        prepare=lambda d: None,
+        samples=evals,
+        estimator="fake",
+        terms={},
+        cost=float(n_texels * evals),
+    )
 
 
 def test_the_executor_launches_device_sized_tiles_on_cuda(monkeypatch):
@@ -92,6 +103,8 @@ def test_cuda_bake_equals_the_cpu_bake_within_float32_evaluation(name):
     cpu = bake_table(spec, workers=2, device="cpu")[0].data.astype(np.float64)
     gpu = bake_table(spec, device="cuda")[0].data.astype(np.float64)
     diff = np.abs(gpu - cpu)
-    print(f"{name}: max |cuda - cpu| = {diff.max():.3e}, max relative = {np.max(diff / np.maximum(np.abs(cpu), 1e-30)):.3e}")
+    print(
+        f"{name}: max |cuda - cpu| = {diff.max():.3e}, max relative = {np.max(diff / np.maximum(np.abs(cpu), 1e-30)):.3e}"
+    )
     assert np.all(np.isfinite(gpu))
     np.testing.assert_allclose(gpu, cpu, rtol=CUDA_VS_CPU_RTOL, atol=CUDA_VS_CPU_ATOL)
