@@ -53,7 +53,7 @@ def directions(fig: Figure, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def curves(fig: Figure, theta: np.ndarray, models=MODELS, sigma_to_alpha: str = "sigma", facet_fresnel: str = "eq6",
            order: int = 12) -> dict[str, np.ndarray]:
     """L_r = f_r (n.l) per model along the figure's abscissa."""
-    from .tables.diffuse import eval_brdf
+    from .integrands.diffuse import eval_brdf
 
     l, v = directions(fig, theta)
     out = {}

@@ -1,6 +1,6 @@
 """Diffuse BRDF terms: Lambert, Oren-Nayar (classic, improved, with Fresnel), the diffuse Fresnel
 factor and Gotanda's fitted microfacet-diffuse model; the microfacet model itself (Eq. 4), which has
-no closed form, is integrated in lutbake.tables.diffuse.
+no closed form, is integrated in lutbake.sampling.facets (the BRDF) and lutbake.sampling.swapped (its albedo).
 
 Convention (all ``Fd_*``): the value returned is the **BRDF** f_r (1/sr), for albedo ``rho``. The seeds
 write radiance L_r for an irradiance E0 from direction l (L_r = f_r E0 (n.l)); those forms are divided by
@@ -170,3 +170,21 @@ def F_facet_dielectric_f0(MoL: float, MoV: float, f0: float):
     """Per-facet transmission (1 - F(m.l))(1 - F(m.v)) with F the exact dielectric Fresnel written with f0
     (Eq. 2): not of the form g(f0) x (an f0-free function), hence kind diffuse_3d (an f0 axis)."""
     return (1.0 - F_dielectric_f0(f0, MoL)) * (1.0 - F_dielectric_f0(f0, MoV))
+
+
+# --- per-facet transmissions in float64, for the swapped-integral albedo (lutbake.sampling.swapped) ----------
+# Every F_facet above is c(f0) T(m.l) T(m.v): Eq. 6 and Schlick with T = 1 - (1 - c)^5 and c(f0) = 21/20 (1 - f0)
+# or (1 - f0)^2; the exact dielectric with T = 1 - F(f0, c) and c(f0) = 1.
+
+@wp.func
+def T_pow5(c: wp.float64, f0: wp.float64):
+    """1 - (1 - c)^5: the transmission shape of Eq. 6 and of 1 - F_Schlick (its f0 factor is in c(f0))."""
+    m = wp.float64(1.0) - c
+    m2 = m * m
+    return wp.float64(1.0) - m2 * m2 * m
+
+
+@wp.func
+def T_dielectric_f0(c: wp.float64, f0: wp.float64):
+    """1 - F(f0, c) with F the exact dielectric Fresnel of Eq. 2 (evaluated in float32, as the terms)."""
+    return wp.float64(1.0) - wp.float64(F_dielectric_f0(float(f0), float(c)))

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..edge import ALPHA_MIN, NOV_MIN
+from ..integrands.specular import hemisphere_integral
 from ..sampling import points
-from ..tables import specular
-from ..terms.sets import NDFS, SMITH_NDFS
+from ..terms.distributions import NDFS, SMITH_NDFS
 from .probe import BRDF_PAIRS, evaluate_brdfs, evaluate_terms
 
 # Tolerances (absolute unless said otherwise). The terms run in float32: ~1e-7 is the floor.
@@ -53,7 +53,7 @@ KC_FURNACE_TOL_SMOOTHEST = 5.0e-3  # every row
 
 # Grids.
 PROJECTED_AREA_ALPHAS = (1.0e-3, 1.0e-2, 0.1, 0.5, 1.0)
-ANISOTROPIES = (0.5, 1.0, -1.0)  # with PROJECTED_AREA_ALPHAS, through the Burley mapping (tables.aniso.alpha_xy)
+ANISOTROPIES = (0.5, 1.0, -1.0)  # with PROJECTED_AREA_ALPHAS, through the Burley mapping (integrands.anisotropic.alpha_xy)
 ANISO_FURNACE_NOVS = (0.1, 0.5, 1.0)
 ANISO_FURNACE_PHIS = (0.0, np.pi / 4, np.pi / 2)
 ANISO_FURNACE_ALPHAS = (1.0e-2, 0.3)
@@ -192,7 +192,7 @@ def weak_white_furnace(ndf_name: str) -> CheckResult:
 
 def _aniso_pairs(alphas=PROJECTED_AREA_ALPHAS) -> list[tuple[float, float, float, float]]:
     """(alpha, a, alpha_x, alpha_y) through the Burley mapping of the specular_aniso kind."""
-    from ..tables.aniso import alpha_xy
+    from ..integrands.anisotropic import alpha_xy
 
     out = []
     for alpha in alphas:
@@ -298,8 +298,8 @@ def kulla_conty_white_furnace() -> CheckResult:
     KC_N_MU x KC_N_ROUGH) and ``albedo_avg`` tables and measures max |E + E_ms - 1| per roughness row
     (kulla_conty_residual). Measured: the worst row with r >= 0.1 (tolerance KC_FURNACE_TOL); the smoothest rows
     must stay within KC_FURNACE_TOL_SMOOTHEST (module constants)."""
-    from ..api import bake_table
     from ..config import validate_table
+    from ..pipeline import bake_table
 
     e = bake_table(validate_table({"name": "e", "kind": "albedo", "size": [KC_N_MU, KC_N_ROUGH]}, "<check>", 0))[0]
     avg = bake_table(validate_table({"name": "a", "kind": "albedo_avg", "roughness_size": KC_N_ROUGH}, "<check>", 0))[0]
@@ -320,10 +320,7 @@ def kulla_conty_white_furnace() -> CheckResult:
 
 def _integrate(ndf_name: str, masking_name: str, channels: str, nov, alpha, estimator: str = "gauss_legendre",
                samples: int | None = None) -> np.ndarray:
-    kernel = specular.kernel_for(ndf_name, masking_name, channels, estimator)
-    samples = specular.DEFAULT_SAMPLES[estimator] if samples is None else samples
-    return specular.integrate(kernel, np.asarray(nov, np.float32), np.asarray(alpha, np.float32), estimator,
-                              samples, SEED, 2)
+    return hemisphere_integral(ndf_name, masking_name, channels, nov, alpha, estimator, samples, SEED)
 
 
 def albedo_le_one_and_mirror_limit(ndf_name: str, masking_name: str) -> CheckResult:
@@ -452,7 +449,7 @@ def _random_pairs(n: int, seed: int, min_cos: float = 0.0):
 def diffuse_sigma0_is_lambert_eq6() -> CheckResult:
     """At sigma = 0 (alpha = ALPHA_MIN) the microfacet diffuse BRDF (Eq. 4, facets with Eq. 6) is Lambert x Eq. 6:
     F_diff(n.l, n.v, f0) / pi, for every pair with n.l, n.v >= 0.1 (the limit needs alpha << n.x)."""
-    from ..tables.diffuse import eval_brdf
+    from ..integrands.diffuse import eval_brdf
 
     l, v = _random_pairs(DIFFUSE_PAIRS, SEED, 0.1)
     worst = 0.0
@@ -467,7 +464,7 @@ def diffuse_sigma0_is_lambert_eq6() -> CheckResult:
 
 def diffuse_reciprocity() -> CheckResult:
     """f(l, v) = f(v, l) for the microfacet diffuse BRDF, random pairs (grazing included), sigma 0.05 .. 1."""
-    from ..tables.diffuse import eval_brdf
+    from ..integrands.diffuse import eval_brdf
 
     l, v = _random_pairs(DIFFUSE_PAIRS, SEED + 1)
     sigma = np.random.default_rng(SEED + 2).uniform(0.05, 1.0, DIFFUSE_PAIRS)
@@ -481,7 +478,7 @@ def diffuse_reciprocity() -> CheckResult:
 def diffuse_albedo_le_one() -> CheckResult:
     """The directional albedo E(v) = ∫ f (n.l) dω_l of the microfacet diffuse model is <= 1 for every NoV, sigma, f0
     and per-facet Fresnel form (rho = 1): measured max(0, max E - 1)."""
-    from ..tables import diffuse_albedo
+    from ..integrands.diffuse import albedo_swapped
 
     nov = np.array([NOV_MIN, 0.01, 0.05, 0.2, 0.5, 0.8, 1.0])
     alpha = np.array([ALPHA_MIN, 0.01, 0.1, 0.3, 0.6, 1.0])
@@ -489,7 +486,7 @@ def diffuse_albedo_le_one() -> CheckResult:
     worst, top = 0.0, 0.0
     for form in ("eq6", "schlick", "dielectric_f0"):
         for f0 in (0.0, 0.04, 0.5):
-            e = diffuse_albedo.albedo(N, A, f0, form, order=DIFFUSE_ORDER)
+            e = albedo_swapped(N, A, f0, form, order=DIFFUSE_ORDER)
             top = max(top, float(e.max()))
             worst = max(worst, float(np.max(e - 1.0)))
     return _result("diffuse_albedo_le_one", max(worst, 0.0), DIFFUSE_ALBEDO_TOL,

@@ -9,10 +9,10 @@ Host API (inputs broadcast against each other; ``h``, ``l``, ``v`` carry a trail
 
     evaluate_terms(h=..., alpha=..., nov=..., nol=..., voh=..., loh=..., f0=..., eta=..., cos_theta=...)
         -> {term name: array}, names in ``TERM_NAMES``:
-        D_<ndf>            D(h, alpha)                                  for every NDF in sets.NDFS
+        D_<ndf>            D(h, alpha)                                  for every NDF in distributions.NDFS
         Lambda_<ndf>       Lambda(nov, alpha)
         G1_smith_<ndf>     G1_smith(Lambda(nov, alpha))
-        G2[<ndf>,<masking>]  sets.G2_for(ndf, masking)(nov, nol, h.z, voh, alpha)  (the composed G2 tables use)
+        G2[<ndf>,<masking>]  NDFS[ndf].G2(masking)(nov, nol, h.z, voh, alpha)  (the composed G2 tables use)
         G2_v_cavity        G2_v_cavity(h.z, nov, nol, voh, loh)          (with its own l.h)
         D_ggx_aniso        D_ggx_aniso(h, alpha, alpha_y)               (alpha = alpha_x along the tangent +x)
         Lambda_ggx_aniso   Lambda_ggx_aniso(v, alpha, alpha_y)
@@ -35,7 +35,7 @@ import warp as wp
 
 from ..edge import COS_EPS
 from ..terms import fresnel, masking, ndf
-from ..terms.sets import MASKINGS, NDFS, G2_for, pair_allowed
+from ..terms.distributions import MASKINGS, NDFS
 
 wp.set_module_options({"enable_backward": False})
 
@@ -81,7 +81,7 @@ def _ndf_probes(ndf_name: str) -> list:
 
 
 def _g2_probe(ndf_name: str, masking_name: str) -> tuple:
-    G2 = G2_for(ndf_name, masking_name)
+    G2 = NDFS[ndf_name].G2(masking_name)
 
     @wp.func
     def probe_G2(x: TermInputs):
@@ -140,7 +140,7 @@ def _probe_V_charlie(x: TermInputs):
     return masking.V_charlie(x.nov, x.nol, x.alpha)
 
 
-BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS if pair_allowed(n, m))
+BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS if NDFS[n].masking_allowed(m))
 
 _PROBES = (
     [p for n in NDFS for p in _ndf_probes(n)]
@@ -194,7 +194,7 @@ def brdf_for(ndf_name: str, masking_name: str):
     """``f(l, v, alpha, f0)``: the Cook-Torrance specular BRDF of one (NDF, masking) pair with Schlick F,
     assembled from the terms exactly as tables assemble it (module docstring)."""
     D = NDFS[ndf_name].D
-    G2 = G2_for(ndf_name, masking_name)
+    G2 = NDFS[ndf_name].G2(masking_name)
 
     @wp.func
     def brdf(l: wp.vec3, v: wp.vec3, alpha: float, f0: float):

@@ -10,7 +10,9 @@ per-texel scalar the integrand may use (f0 for specular_3d; ignored by the other
 the NDF's density p(h) = D(h)(n.h) gives I = E[g / p]; for a microfacet BRDF D cancels and the
 per-sample weight is G2 F (v.h) / ((n.v)(n.h)).
 
-Estimators (each a factory ``make_*(integrand, pdf, ...)`` returning a Warp kernel):
+Estimators (``GaussLegendre``, ``QuasiMonteCarlo``: objects of the lutbake.sampling.plan protocol; their
+kernels come from ``make_gauss_legendre`` / ``make_qmc``, which close over an integrand record of
+lutbake.integrands.specular):
 
 ``gauss_legendre``  (the default) deterministic product Gauss-Legendre after the NDF's change of
     variables u = CDF(theta_h), phi uniform. The reflected direction l = reflect(v, h) is above the
@@ -26,19 +28,27 @@ Estimators (each a factory ``make_*(integrand, pdf, ...)`` returning a Warp kern
     By symmetry in phi,
         I = (1/pi) ∫_0^1 du ∫_0^phimax(u) dphi  g(h) / p(h).
     The integrand is then analytic in both variables and GL converges exponentially.
-``qmc_ndf``  h from the NDF's inverse CDF at scrambled Sobol' points, weight g / p / N.
-``qmc_vndf`` (GGX) h from the visible-normal distribution, p_v(h) = G1(v) max(0, v.h) D(h) / (n.v).
+``sobol_ndf`` / ``hammersley_ndf``  h from the NDF's inverse CDF (Distribution.sample_ndf) at scrambled Sobol'
+    (or Hammersley) points, weight g / p / N with p = D(h)(n.h) (Distribution.pdf_ndf).
+``sobol_vndf`` (GGX) h from the visible-normal distribution (Distribution.sample_vndf),
+    p_v(h) = G1(v) max(0, v.h) D(h) / (n.v) (Distribution.pdf_vndf).
 
 All accumulate in float64; per-sample terms run in float32; the domain maps run in float64 because
 1 - u underflows float32 for small alpha.
+Edge: a texel with alpha = 0 (the integrand has a ``mirror`` and alpha < ALPHA_MIN: lutbake.edge) takes the
+closed-form mirror limit ``mirror(v, param)`` instead of a quadrature.
 """
 from __future__ import annotations
 
+import functools
 import math
+from dataclasses import dataclass, replace
 
+import numpy as np
 import warp as wp
 
 from ..terms.frame import view_dir
+from . import points
 
 PI64 = wp.constant(wp.float64(math.pi))
 TWO_PI = wp.constant(2.0 * math.pi)
@@ -86,7 +96,7 @@ def horizon_scale(cos_v: wp.float64, alpha: wp.float64):
     return alpha * cos_v / wp.sqrt(cos_v * cos_v + alpha * alpha * (wp.float64(1.0) - cos_v * cos_v))
 
 
-def make_gauss_legendre(integrand, pdf, tan2_from_u, u_from_tan2, vec_type, acc_type):
+def make_gauss_legendre(spec):
     """Product Gauss-Legendre over panels in theta_h (module docstring). Per panel [t_lo, t_hi]:
     - the outer variable is u = CDF(theta_h) on the NDF-peak panel [0, atan(alpha)] (the weight is
       g / p, D cancels), and theta_h itself beyond it (the weight is 2 pi sin(theta_h) g, because
@@ -94,8 +104,11 @@ def make_gauss_legendre(integrand, pdf, tan2_from_u, u_from_tan2, vec_type, acc_
     - the inner variable phi runs over [0, pi] in region A and [0, acos c*] in region B, through a
       sinh map that resolves G2's pole at n.l = -horizon_scale next to the cut.
     Kernel inputs: per-texel n.v, alpha and param; GL nodes/weights on [0, 1] for the outer (xu, wu) and
-    inner (xp, wq) variables."""
+    inner (xp, wq) variables. ``spec``: an integrand record (g, vec, acc, distribution, mirror)."""
+    integrand, vec_type, acc_type, mirror = spec.g, spec.vec, spec.acc, spec.mirror
+    pdf, tan2_from_u, u_from_tan2 = spec.distribution.pdf_ndf, spec.distribution.tan2_from_u, spec.distribution.u_from_tan2
     nch = vec_type._length_
+    smooth = mirror is not None
 
     @wp.kernel(enable_backward=False, module="unique")
     def gauss_legendre_kernel(
@@ -124,6 +137,9 @@ def make_gauss_legendre(integrand, pdf, tan2_from_u, u_from_tan2, vec_type, acc_
         theta_peak = wp.atan(a64)
         acc = acc_type()
         t_lo = zero
+        if wp.static(smooth):
+            if a <= 0.0:  # alpha -> 0: the closed-form mirror limit below (lutbake.edge), no quadrature
+                t_lo = theta_b
         while t_lo < theta_b:
             t_hi = next_theta(t_lo, theta_a, theta_peak)
             in_b = t_lo >= theta_a
@@ -178,14 +194,24 @@ def make_gauss_legendre(integrand, pdf, tan2_from_u, u_from_tan2, vec_type, acc_
             t_lo = t_hi
         for c in range(wp.static(nch)):
             out[i, c] = acc[c] / PI64
+        if wp.static(smooth):
+            if a <= 0.0:
+                m = mirror(v, prm)
+                for c in range(wp.static(nch)):
+                    out[i, c] = wp.float64(m[c])
 
     return gauss_legendre_kernel
 
 
-def make_qmc(integrand, pdf, sample, vec_type, acc_type):
-    """Quasi-Monte Carlo: ``sample(v, alpha, u1, u2) -> h`` draws from density ``pdf(v, h, alpha)``;
-    the estimate is sum_k w_k g(h_k) / p(h_k) with w_k = 1/N (points: scrambled Sobol' or Hammersley)."""
+def make_qmc(spec, vndf: bool):
+    """Quasi-Monte Carlo: ``sample(v, alpha, u1, u2) -> h`` draws from density ``pdf(v, h, alpha)`` (the
+    distribution's visible-normal pair if ``vndf``, else its NDF pair); the estimate is sum_k w_k g(h_k) / p(h_k)
+    with w_k = 1/N (points: scrambled Sobol' or Hammersley)."""
+    integrand, vec_type, acc_type, mirror = spec.g, spec.vec, spec.acc, spec.mirror
+    d = spec.distribution
+    pdf, sample = (d.pdf_vndf, d.sample_vndf) if vndf else (d.pdf_ndf, d.sample_ndf)
     nch = vec_type._length_
+    smooth = mirror is not None
 
     @wp.kernel(enable_backward=False, module="unique")
     def qmc_kernel(
@@ -201,7 +227,11 @@ def make_qmc(integrand, pdf, sample, vec_type, acc_type):
         prm = param[i]
         v = view_dir(nov[i])
         acc = acc_type()
-        for k in range(pts.shape[0]):
+        n = pts.shape[0]
+        if wp.static(smooth):
+            if a <= 0.0:  # alpha -> 0: the closed-form mirror limit below (lutbake.edge), no samples
+                n = 0
+        for k in range(n):
             h = sample(v, a, pts[k, 0], pts[k, 1])
             p = pdf(v, h, a)
             if p > 0.0:
@@ -210,5 +240,122 @@ def make_qmc(integrand, pdf, sample, vec_type, acc_type):
                     acc[c] = acc[c] + wts[k] * wp.float64(g[c] / p)
         for c in range(wp.static(nch)):
             out[i, c] = acc[c]
+        if wp.static(smooth):
+            if a <= 0.0:
+                m = mirror(v, prm)
+                for c in range(wp.static(nch)):
+                    out[i, c] = wp.float64(m[c])
 
     return qmc_kernel
+
+
+ESTIMATORS = {
+    "gauss_legendre": "deterministic product Gauss-Legendre over panels in theta_h (or CDF(theta_h)) and phi, "
+                      "split exactly at the horizon (default; converges exponentially)",
+    "sobol_vndf": "scrambled Sobol' points, GGX visible-normal sampling (Dupuy & Benyoub 2023)",
+    "sobol_ndf": "scrambled Sobol' points, NDF importance sampling of D(h)(n.h)",
+    "hammersley_ndf": "Hammersley points, NDF importance sampling (Filament cmgen's estimator)",
+}
+DEFAULT_SAMPLES = {"gauss_legendre": 432, "sobol_vndf": 4096, "sobol_ndf": 4096, "hammersley_ndf": 1024}
+
+
+def gl_order(samples: int) -> int:
+    """GL points per dimension n for a nominal budget of ``samples`` evaluations per texel: 3 regions x n x n
+    (A and B's two halves; grazing texels get more panels, up to 2 log4(pi / (4 theta_a)) + 1)."""
+    return max(2, int(round(np.sqrt(samples / 3.0))))
+
+
+@functools.lru_cache(maxsize=None)
+def gl_kernel(spec):
+    return make_gauss_legendre(spec)
+
+
+@functools.lru_cache(maxsize=None)
+def qmc_kernel(spec, vndf: bool):
+    return make_qmc(spec, vndf)
+
+
+def load(kernel, device: str = "cpu") -> None:
+    """Compile (or load from Warp's cache) a kernel's module before worker threads launch it."""
+    wp.load_module(kernel.module, device=device)
+
+
+def _launch(kernel, inputs: dict, point_arrays: list, kernel_channels: int, device: str) -> np.ndarray:
+    """One launch over texels (nov[i], alpha[i], param[i]) -> float64 array (len, kernel_channels)."""
+    n = len(inputs["nov"])
+    out = wp.zeros((n, kernel_channels), dtype=wp.float64, device=device)
+    arrays = [wp.array(np.ascontiguousarray(inputs[k], dtype=np.float32), dtype=float, device=device)
+              for k in ("nov", "alpha", "param")]
+    wp.launch(kernel, dim=n, inputs=arrays + point_arrays + [out], device=device)
+    return out.numpy()
+
+
+@dataclass(frozen=True)
+class GaussLegendre:
+    """The ``gauss_legendre`` estimator at a nominal budget of ``budget`` evaluations per texel (order gl_order)."""
+
+    budget: int = DEFAULT_SAMPLES["gauss_legendre"]
+    name: str = "gauss_legendre"
+
+    @property
+    def order(self) -> int:
+        return gl_order(self.budget)
+
+    def samples(self, inputs: dict) -> np.ndarray:
+        return np.full(len(inputs["nov"]), 3 * self.order ** 2)
+
+    def prepare(self, integrand, device: str) -> None:
+        load(gl_kernel(integrand), device)
+
+    def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
+        x, w = points.gauss_legendre(self.order)
+        arr = [wp.array(a, dtype=wp.float64, device=device) for a in (x, w)]
+        return _launch(gl_kernel(integrand), inputs, arr + arr, integrand.kernel_channels, device)
+
+    def refined(self):
+        n = self.order
+        return GaussLegendre(3 * (n + 4) ** 2), f"order {n} - order {n + 4}"
+
+
+@dataclass(frozen=True)
+class QuasiMonteCarlo:
+    """``sobol_vndf`` / ``sobol_ndf`` (scrambled Sobol' points, n rounded up to a power of two) or
+    ``hammersley_ndf``: h drawn from the visible-normal or the NDF density, weight g / p / N."""
+
+    name: str
+    budget: int
+    seed: int = 0
+
+    def _n(self) -> int:
+        if self.name.startswith("sobol"):
+            return 1 << int(np.ceil(np.log2(max(self.budget, 1))))
+        return self.budget
+
+    def samples(self, inputs: dict) -> np.ndarray:
+        return np.full(len(inputs["nov"]), self._n())
+
+    def _kernel(self, integrand):
+        return qmc_kernel(integrand, self.name == "sobol_vndf")
+
+    def prepare(self, integrand, device: str) -> None:
+        load(self._kernel(integrand), device)
+
+    def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
+        pts = points.sobol(self.budget, self.seed) if self.name.startswith("sobol") else points.hammersley(self.budget)
+        pts = np.clip(pts, 0.0, np.nextafter(np.float32(1.0), np.float32(0.0))).astype(np.float32)
+        w = np.full(len(pts), 1.0 / len(pts))
+        arr = [wp.array(pts, dtype=float, device=device), wp.array(w, dtype=wp.float64, device=device)]
+        return _launch(self._kernel(integrand), inputs, arr, integrand.kernel_channels, device)
+
+    def refined(self):
+        return replace(self, seed=self.seed + 1), "seed - (seed + 1) (two scramblings)"
+
+
+def estimator_for(name: str, samples: int | None = None, seed: int = 0):
+    """The hemisphere estimator ``name`` (ESTIMATORS) at ``samples`` per texel (None: its default)."""
+    budget = samples or DEFAULT_SAMPLES[name]
+    if name == "gauss_legendre":
+        return GaussLegendre(budget)
+    if name in ESTIMATORS:
+        return QuasiMonteCarlo(name, budget, seed)
+    raise KeyError(name)

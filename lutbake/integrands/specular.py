@@ -1,4 +1,4 @@
-"""Integrands of microfacet specular tables and the estimator plumbing they share.
+"""Integrands of the specular tables: g(h) per texel, for the hemisphere estimators of lutbake.sampling.hemisphere.
 
 Cook-Torrance microfacet BRDF (Gotanda 2014 course notes, Eq. 1):
     f(l, v) = D(h) F(v.h) G2(l, v, h) / (4 (n.l)(n.v))
@@ -15,16 +15,15 @@ in the same measure is D_charlie V_ashikhmin (n.l) 4 (v.h) (Filament's DFV_Charl
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 
 import numpy as np
 import warp as wp
 
-from ..edge import COS_EPS
-from ..sampling import points
-from ..sampling.estimators import make_gauss_legendre, make_qmc
-from ..terms import fresnel, masking, metals, ndf, sets
+from ..edge import COS_EPS, effective_alpha
+from ..terms import fresnel, masking, metals, ndf
+from ..terms.distributions import NDFS, Distribution
 from ..terms.frame import reflect
-from .base import Plan
 
 
 @wp.func
@@ -110,7 +109,7 @@ def channels_for(channels_name: str):
 @functools.lru_cache(maxsize=None)
 def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: str = "microfacet"):
     """g(h) = f(l, v) (n.l) 4 (v.h) * channels(v.h, param), 0 where n.l, v.h or n.v <= COS_EPS (back-facing).
-    ``form`` (lutbake.terms.sets.model_terms):
+    ``form`` (model_terms):
         microfacet         f = D G2 / (4 (n.l)(n.v)) [x F]:          g = D G2 (v.h) / (n.v)
         blinn_phong        f = (s + 8)/(8 pi) (n.h)^s [x F]:          g = (s + 8)/(8 pi) (n.h)^s 4 (n.l)(v.h)
         ashikhmin_shirley  f = (s + 1)/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v)) [x F]:
@@ -122,8 +121,8 @@ def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: st
         return sheen_integrand_for(channels_name)
     ch, vec = channels_for(channels_name)
     if form == "microfacet":
-        D = sets.NDFS[ndf_name].D
-        G2 = sets.G2_for(ndf_name, masking_name)
+        D = NDFS[ndf_name].D
+        G2 = NDFS[ndf_name].G2(masking_name)
 
         @wp.func
         def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
@@ -157,31 +156,9 @@ def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: st
 @functools.lru_cache(maxsize=None)
 def cloth_integrand_for(ndf_name: str, masking_name: str):
     """(Fc s, s, D_charlie V_ashikhmin (n.l) 4 (v.h)) with s = D G2 (v.h)/(n.v): the multiscatter
-    channels plus Filament's cloth DV, 0 where n.l or v.h <= COS_EPS (back-facing)."""
-    D = sets.NDFS[ndf_name].D
-    G2 = sets.G2_for(ndf_name, masking_name)
-
-    @wp.func
-    def integrand(v: wp.vec3, h: wp.vec3, alpha: float):
-        l = reflect(v, h)
-        NoL = l[2]
-        NoV = v[2]
-        VoH = wp.dot(v, h)
-        if NoL <= COS_EPS or VoH <= COS_EPS or NoV <= COS_EPS:
-            return wp.vec3()
-        spec = D(h, alpha) * G2(NoV, NoL, h[2], VoH, alpha) * VoH / NoV
-        cloth = ndf.D_charlie(h, alpha) * masking.V_ashikhmin(NoV, NoL) * NoL * 4.0 * VoH
-        return channels_multiscatter3(VoH) * spec + wp.vec3(0.0, 0.0, cloth)
-
-    return integrand
-
-
-@functools.lru_cache(maxsize=None)
-def cloth_integrand_for(ndf_name: str, masking_name: str):
-    """(Fc s, s, D_charlie V_ashikhmin (n.l) 4 (v.h)) with s = D G2 (v.h)/(n.v): the multiscatter
     channels plus Filament's cloth DV (DFV_Charlie_Uniform), 0 where n.l or v.h <= COS_EPS (back-facing)."""
-    D = sets.NDFS[ndf_name].D
-    G2 = sets.G2_for(ndf_name, masking_name)
+    D = NDFS[ndf_name].D
+    G2 = NDFS[ndf_name].G2(masking_name)
 
     @wp.func
     def integrand(v: wp.vec3, h: wp.vec3, alpha: float, param: float):
@@ -228,129 +205,95 @@ def sheen_integrand_for(layout: str):
     return integrand
 
 
-ESTIMATORS = {
-    "gauss_legendre": "deterministic product Gauss-Legendre over panels in theta_h (or CDF(theta_h)) and phi, "
-                      "split exactly at the horizon (default; converges exponentially)",
-    "sobol_vndf": "scrambled Sobol' points, GGX visible-normal sampling (Dupuy & Benyoub 2023)",
-    "sobol_ndf": "scrambled Sobol' points, NDF importance sampling of D(h)(n.h)",
-    "hammersley_ndf": "Hammersley points, NDF importance sampling (Filament cmgen's estimator)",
+# The lecture's models (003) as term sets of the dfg-like kinds (key ``model``). "microfacet" takes ``ndf`` and
+# ``masking`` from the config; the others fix them: (integrand form, NDF whose CDF the estimators sample, masking).
+SPECULAR_MODELS = {
+    "microfacet": "D G2 F / (4 (n.l)(n.v)) with the config's ndf and masking (default)",
+    "cook_torrance": "Cook & Torrance 1982 as in the lecture: Beckmann D (with 1/pi), V-cavity G, Schlick F; "
+                     "the same as model = microfacet, ndf = beckmann, masking = v_cavity",
+    "blinn_phong": "the lecture's normalized Blinn-Phong lobe f = F (s + 8)/(8 pi) (n.h)^s, s = 2/alpha^2 - 2 "
+                   "(no G; the lecture's (s + 8)/8 is this times pi, per unit irradiance)",
+    "ashikhmin_shirley": "Ashikhmin & Shirley 2000, isotropic (nu = nv = s = 2/alpha^2 - 2): "
+                         "f = F sqrt((nu+1)(nv+1))/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v))",
 }
-DEFAULT_SAMPLES = {"gauss_legendre": 432, "sobol_vndf": 4096, "sobol_ndf": 4096, "hammersley_ndf": 1024}
 
 
-def kernel_for(ndf_name: str, masking_name: str, channels_name: str, estimator: str, form: str = "microfacet"):
-    """The table kernel for a (terms, channels, estimator, integrand form) key; compiled once per Warp cache.
-    For the forms blinn_phong and ashikhmin_shirley ``ndf_name`` names the NDF the estimator samples
-    (blinn_phong) and ``masking_name`` is ignored."""
-    if form != "microfacet":
-        masking_name = "none"
-    return _kernel_for(ndf_name, masking_name, channels_name, estimator, form)
+def model_terms(model: str, ndf_name: str, masking_name: str) -> tuple[str, str, str]:
+    """(integrand form, ndf, masking) a model integrates: the form is "microfacet", "blinn_phong" or
+    "ashikhmin_shirley"; Cook-Torrance is the microfacet form with Beckmann and V-cavity."""
+    if model == "microfacet":
+        return "microfacet", ndf_name, masking_name
+    if model == "cook_torrance":
+        return "microfacet", "beckmann", "v_cavity"
+    if model in ("blinn_phong", "ashikhmin_shirley"):
+        return model, "blinn_phong", "none"
+    raise KeyError(model)
+
+
+@dataclass(frozen=True)
+class SpecularIntegrand:
+    """g(v, h, alpha, param) -> vec of one specular table, and what its estimators need beside it.
+
+    ``distribution``: the NDF whose CDF / pdf / sampler the estimators use; ``kernel_channels``: the length of
+    ``vec``, of which the first ``nch`` are kept; ``mirror(v, param) -> vec``: the exact alpha -> 0 limit where one
+    exists (the microfacet form: D -> delta about n, G2 -> 1 for n.v > 0, so E = channels(n.v, param); lutbake.edge),
+    else None and alpha is clamped to ALPHA_MIN."""
+
+    key: tuple
+    g: object
+    vec: type
+    acc: type
+    kernel_channels: int
+    nch: int
+    distribution: Distribution
+    mirror: object | None
+
+    def alpha_input(self, alpha) -> np.ndarray:
+        """The per-texel alpha the kernels receive (float32): lutbake.edge.effective_alpha."""
+        return effective_alpha(alpha, self.mirror is not None)
 
 
 @functools.lru_cache(maxsize=None)
-def _kernel_for(ndf_name: str, masking_name: str, channels_name: str, estimator: str, form: str):
-    nd = sets.NDFS[ndf_name]
-    g = integrand_for(ndf_name, masking_name, channels_name, form)
-    vec = wp.vec3 if channels_name in ("multiscatter_cloth",) + SHEEN_LAYOUTS else channels_for(channels_name)[1]
-    acc = wp.vec3d if vec is wp.vec3 else wp.vec2d
-    if estimator == "gauss_legendre":
-        return make_gauss_legendre(g, sets.pdf_ndf_for(ndf_name), nd.tan2_from_u, nd.u_from_tan2, vec, acc)
-    if estimator == "sobol_vndf":
-        return make_qmc(g, sets.pdf_vndf_for(ndf_name), nd.vndf, vec, acc)
-    return make_qmc(g, sets.pdf_ndf_for(ndf_name), sets.sample_ndf_for(ndf_name), vec, acc)
+def mirror_for(channels_name: str):
+    """E at alpha = 0 for the microfacet form: the mirror direction l = reflect(v, n), h = n, v.h = n.v, G2 = 1."""
+    ch, vec = channels_for(channels_name)
+
+    @wp.func
+    def mirror(v: wp.vec3, param: float):
+        if v[2] <= COS_EPS:
+            return vec()
+        return ch(v[2], param)
+
+    return mirror
 
 
-def gl_order(samples: int) -> int:
-    """GL points per dimension n for a nominal budget of ``samples`` evaluations per texel: 3 regions x n x n
-    (A and B's two halves; grazing texels get more panels, up to 2 log4(pi / (4 theta_a)) + 1)."""
-    return max(2, int(round(np.sqrt(samples / 3.0))))
+@functools.lru_cache(maxsize=None)
+def specular_integrand(ndf_name: str, masking_name: str, channels_name: str, form: str = "microfacet",
+                       nch: int | None = None) -> SpecularIntegrand:
+    """The integrand record of a (terms, channels, form) key, the first ``nch`` channels kept (all if None).
+    For the forms blinn_phong and ashikhmin_shirley ``ndf_name`` names the NDF the estimators sample and
+    ``masking_name`` is ignored. The layouts with a Charlie channel (cloth, sheen) have no mirror limit."""
+    if form != "microfacet":
+        masking_name = "none"
+    charlie = channels_name == "multiscatter_cloth" or channels_name in SHEEN_LAYOUTS
+    vec = wp.vec3 if charlie else channels_for(channels_name)[1]
+    k = vec._length_
+    mirror = mirror_for(channels_name) if form == "microfacet" and not charlie else None
+    return SpecularIntegrand((ndf_name, masking_name, channels_name, form),
+                             integrand_for(ndf_name, masking_name, channels_name, form), vec,
+                             wp.vec3d if k == 3 else wp.vec2d, k, nch or k, NDFS[ndf_name], mirror)
 
 
-def effective_samples(estimator: str, samples: int) -> int:
-    if estimator == "gauss_legendre":
-        return 3 * gl_order(samples) ** 2
-    if estimator.startswith("sobol"):
-        return 1 << int(np.ceil(np.log2(max(samples, 1))))
-    return samples
+def hemisphere_integral(ndf_name: str, masking_name: str, channels_name: str, nov, alpha, estimator: str =
+                        "gauss_legendre", samples: int | None = None, seed: int = 0, param=None,
+                        form: str = "microfacet", device: str = "cpu") -> np.ndarray:
+    """Host helper (checks, tests, benchmarks): the integrand of (terms, channels, form) at texels (nov[i],
+    alpha[i], param[i]) by a hemisphere estimator (lutbake.sampling.hemisphere), every kernel channel, float64
+    (N, C). alpha goes through the edge policy (lutbake.edge.effective_alpha) as in a table."""
+    from ..sampling.hemisphere import estimator_for
 
-
-def point_arrays(estimator: str, samples: int, seed: int, device: str) -> list:
-    """The estimator's point-set arrays, as kernel inputs after (nov, alpha)."""
-    if estimator == "gauss_legendre":
-        x, w = points.gauss_legendre(gl_order(samples))
-        arr = [wp.array(a, dtype=wp.float64, device=device) for a in (x, w)]
-        return arr + arr
-    if estimator.startswith("sobol"):
-        pts = points.sobol(samples, seed)
-    else:
-        pts = points.hammersley(samples)
-    pts = np.clip(pts, 0.0, np.nextafter(np.float32(1.0), np.float32(0.0))).astype(np.float32)
-    w = np.full(len(pts), 1.0 / len(pts))
-    return [wp.array(pts, dtype=float, device=device), wp.array(w, dtype=wp.float64, device=device)]
-
-
-def integrate(kernel, nov: np.ndarray, alpha: np.ndarray, estimator: str, samples: int, seed: int,
-              nch: int, device: str = "cpu", param: np.ndarray | None = None) -> np.ndarray:
-    """Run one launch over texels (nov[i], alpha[i], param[i]) -> float64 array (len, nch);
-    ``param`` (the integrand's per-texel scalar, e.g. f0) defaults to 0."""
-    n = len(nov)
-    out = wp.zeros((n, nch), dtype=wp.float64, device=device)
-    if param is None:
-        param = np.zeros(n, dtype=np.float32)
-    inputs = [wp.array(np.ascontiguousarray(nov, dtype=np.float32), dtype=float, device=device),
-              wp.array(np.ascontiguousarray(alpha, dtype=np.float32), dtype=float, device=device),
-              wp.array(np.ascontiguousarray(param, dtype=np.float32), dtype=float, device=device)]
-    inputs += point_arrays(estimator, samples, seed, device)
-    wp.launch(kernel, dim=n, inputs=inputs + [out], device=device)
-    return out.numpy()
-
-
-def load(kernel, device: str = "cpu") -> None:
-    """Compile (or load from Warp's cache) a kernel's module before worker threads launch it."""
-    wp.load_module(kernel.module, device=device)
-
-
-ERROR_PROBE_TEXELS = 256  # texels re-integrated at a higher budget for lutbake:error_estimate
-
-
-def probe_indices(nov: np.ndarray) -> np.ndarray:
-    """A strided subset of texels plus the most grazing ones (where every estimator converges slowest)."""
-    n = len(nov)
-    strided = np.arange(0, n, max(1, n // ERROR_PROBE_TEXELS))
-    grazing = np.flatnonzero(nov <= nov.min())
-    return np.unique(np.concatenate([strided, grazing[:: max(1, len(grazing) // 64)]]))
-
-
-def hemisphere_plan(*, key: tuple, nov: np.ndarray, alpha: np.ndarray, param: np.ndarray | None, samples: int | None,
-                    seed: int, nch: int, kernel_channels: int = 2, **plan_fields) -> Plan:
-    """The plan of every table that is a per-texel integral of ``kernel_for(*key)``: texel i integrates
-    (nov[i], alpha[i], param[i]); the first ``nch`` of the kernel's channels are kept.
-
-    Its error estimate re-integrates probe_indices() at a higher budget: Gauss-Legendre at order n + 4
-    (the difference bounds the error of order n, the higher rule being far more accurate), QMC with
-    another scrambling seed (the difference is ~sqrt(2) times the error)."""
-    est = key[3]  # kernel_for(ndf, masking, channels, estimator[, form])
-    samples = samples or DEFAULT_SAMPLES[est]
-    param = np.zeros(len(nov), np.float32) if param is None else param
-
-    def run(idx, budget, s, device):
-        k = kernel_for(*key)
-        return integrate(k, nov[idx], alpha[idx], est, budget, s, kernel_channels, device, param[idx])[:, :nch]
-
-    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
-        return run(slice(start, stop), samples, seed, device)
-
-    def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
-        idx = probe_indices(nov)
-        if est == "gauss_legendre":
-            n = gl_order(samples)
-            other, how = run(idx, 3 * (n + 4) ** 2, seed, device), f"max |order {n} - order {n + 4}|"
-        else:
-            other, how = run(idx, samples, seed + 1, device), "max |seed - (seed + 1)| (two scramblings)"
-        err = float(np.max(np.abs(data.reshape(len(nov), nch)[idx] - other)))
-        return err, f"{how} over {len(idx)} probe texels (strided + most grazing NoV)"
-
-    eff = effective_samples(est, samples)
-    return Plan(n_texels=len(nov), n_channels=nch, run_tile=run_tile,
-                prepare=lambda d: load(kernel_for(*key), d), samples=eff, estimator=est,
-                cost=float(len(nov)) * eff, error_estimate=error_estimate, **plan_fields)
+    integrand = specular_integrand(ndf_name, masking_name, channels_name, form)
+    nov = np.asarray(nov, np.float32)
+    param = np.zeros(len(nov), np.float32) if param is None else np.asarray(param, np.float32)
+    inputs = {"nov": nov, "alpha": integrand.alpha_input(np.asarray(alpha, np.float32)), "param": param}
+    return estimator_for(estimator, samples, seed).evaluate(integrand, inputs, device)

@@ -1,0 +1,70 @@
+"""What a table kind declares: its config keys (with types, defaults and docs), its estimators, and ``plan(spec)``,
+which names the kind's axes, channels, reconstruction text, integrand and estimator and hands them to
+lutbake.sampling.plan.per_texel_plan. The registry (lutbake.kinds) adds the keys every kind has (``COMMON_KEYS``).
+"""
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from ..io.formats import FORMATS
+
+MAX_SAMPLES = 1 << 24  # per texel; beyond this a point set alone needs > 128 MiB and a table takes days
+MAX_SEED = (1 << 64) - 1
+
+
+@dataclass(frozen=True)
+class Key:
+    """One config key: its type, default, allowed values (or a range) and a line of documentation."""
+
+    name: str
+    type: str  # "str", "int", "float", "int_pair", "float_range", "float_list", "name"
+    default: Any
+    doc: str
+    choices: dict[str, str] | None = None  # value -> description
+    minimum: float | None = None
+    maximum: float | None = None
+    required: bool = False
+
+
+@dataclass(frozen=True)
+class Kind:
+    """A table kind. ``keys``: every key (the registry's common keys first; see ``declare``); ``plan(spec)`` ->
+    lutbake.sampling.plan.TexelPlan; ``check(spec)``: cross-key rules, a message or (key, message)."""
+
+    name: str
+    description: str
+    keys: dict[str, Key]
+    plan: Callable[[Any], Any]
+    aliases: tuple[str, ...] = ()
+    check: Callable[[Any], str | tuple[str, str] | None] | None = None
+    texels: Callable[[Any], int] = lambda o: math.prod(o.get("size", [1]))  # texel count, for config.MAX_TEXELS
+
+
+def common_keys(estimators: dict[str, str], default_estimator: str, samples_doc: str, samples_max: int,
+                samples_min: int = 1) -> dict[str, Key]:
+    """The keys every kind has: name, kind, format, dtype, seed, samples, estimator."""
+    return {
+        "name": Key("name", "name", None, "output stem: <out-dir>/<name>.<ext> (ext per format); letters, digits, "
+                    "- and _ only", required=True),
+        "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
+        "samples": Key("samples", "int", None, samples_doc, minimum=samples_min, maximum=samples_max),
+        "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float",
+                                                                      "half": "16-bit float"}),
+        "estimator": Key("estimator", "str", default_estimator, "how the integral is estimated", estimators),
+        "seed": Key("seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0,
+                    maximum=MAX_SEED),
+        "format": Key("format", "str", "exr", "output file format: <out-dir>/<name>.<ext>", FORMATS),
+    }
+
+
+def declare(name: str, description: str, keys: dict[str, Key], plan, *, estimators: dict[str, str],
+            default_estimator: str, samples_doc: str, samples_max: int = MAX_SAMPLES, samples_min: int = 1,
+            aliases: tuple[str, ...] = (), check=None, texels=None) -> Kind:
+    """A Kind with the common keys (``common_keys``) followed by its own ``keys``; ``texels(options)``: the texel
+    count (default: the product of ``size``)."""
+    common = common_keys(estimators, default_estimator, samples_doc, samples_max, samples_min)
+    kind = Kind(name, description, {**common, **keys}, plan, aliases, check)
+    return kind if texels is None else Kind(name, description, kind.keys, plan, aliases, check, texels)
