@@ -25,7 +25,9 @@ wp.config.quiet = True
 
 from lutbake.api import bake_table  # noqa: E402
 from lutbake.config import load_config, validate_table  # noqa: E402
-from lutbake.tables import btf, diffuse as D, diffuse_albedo as A  # noqa: E402
+from lutbake.tables import btf  # noqa: E402
+from lutbake.tables import diffuse as D
+from lutbake.tables import diffuse_albedo as A
 
 OUT = ROOT / "outputs" / "bench"
 

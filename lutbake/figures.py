@@ -35,7 +35,7 @@ FIGURES = [
     Figure("14b", "theta_v", 0.866, 1.0, 0.7),
     Figure("15", "theta_v", 0.259, 0.985, 0.8),
 ]
-MODELS = ("oren_nayar", "oren_nayar_fresnel", "microfacet", "fitted")
+FIGURE_MODELS = ("oren_nayar", "oren_nayar_fresnel", "microfacet", "fitted")
 
 
 def directions(fig: Figure, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -50,7 +50,7 @@ def directions(fig: Figure, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return (moving, fixed) if fig.vary == "theta_l" else (fixed, moving)
 
 
-def curves(fig: Figure, theta: np.ndarray, models=MODELS, sigma_to_alpha: str = "sigma", facet_fresnel: str = "eq6",
+def curves(fig: Figure, theta: np.ndarray, models=FIGURE_MODELS, sigma_to_alpha: str = "sigma", facet_fresnel: str = "eq6",
            order: int = 12) -> dict[str, np.ndarray]:
     """L_r = f_r (n.l) per model along the figure's abscissa."""
     from .integrands.diffuse import eval_brdf

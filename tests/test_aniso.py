@@ -9,7 +9,7 @@ import pytest
 from lutbake.api import bake_table
 from lutbake.config import validate_table
 from lutbake.errors import ConfigError
-from lutbake.tables.aniso import alpha_xy
+from lutbake.integrands.anisotropic import alpha_xy
 
 SIZE = [12, 6]  # [NoV, roughness]
 SAMPLES = 16384

@@ -14,11 +14,11 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from lutbake import api, batch
+from lutbake import batch, pipeline, provenance
 from lutbake.cli import main
 from lutbake.config import load_configs
 from lutbake.io.exr import read_exr
-from lutbake.tables import lookup_kind
+from lutbake.kinds import lookup_kind
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -58,7 +58,7 @@ def test_rerun_skips_up_to_date_tables_and_force_rebakes(three):
     assert sorted(mtimes) == ["a.exr", "b.exr", "c.exr"]
     specs = load_configs([cfg])
     for s in specs:
-        assert lutbake_header(out / f"{s.name}.exr")["content_hash"] == batch.content_hash(s)
+        assert lutbake_header(out / f"{s.name}.exr")["content_hash"] == provenance.content_hash(s)
 
     r = bake(cfg, "--out-dir", out)
     assert r.exit_code == 0, r.output
@@ -87,15 +87,15 @@ def test_a_one_line_config_change_rebakes_only_that_table(three):
 def test_content_hash_covers_config_version_and_kernel_sources(monkeypatch, tmp_path):
     (s,) = load_configs([write_config(tmp_path, table("a"))])
     (s2,) = load_configs([write_config(tmp_path, table("a", samples=49), name="d.toml")])
-    h = batch.content_hash(s)
-    assert len(h) == 64 and h == batch.content_hash(s)
-    assert batch.content_hash(s2) != h
-    assert batch.content_hash(s, b"other sources") != h
+    h = provenance.content_hash(s)
+    assert len(h) == 64 and h == provenance.content_hash(s)
+    assert provenance.content_hash(s2) != h
+    assert provenance.content_hash(s, b"other sources") != h
     monkeypatch.setattr(batch, "__version__", "9.9.9")
-    assert batch.content_hash(s) != h
-    rel = {f.relative_to(batch.PACKAGE).as_posix() for f in batch.source_files()}
-    for f in ("terms/ndf.py", "terms/masking.py", "terms/fresnel.py", "sampling/estimators.py",
-              "tables/dfg.py", "tables/specular.py", "axes.py", "edge.py"):
+    assert provenance.content_hash(s) != h
+    rel = {f.relative_to(provenance.PACKAGE).as_posix() for f in provenance.source_files()}
+    for f in ("terms/ndf.py", "terms/masking.py", "terms/fresnel.py", "sampling/hemisphere.py",
+              "kinds/dfg.py", "integrands/specular.py", "axes.py", "edge.py"):
         assert f in rel
 
 
@@ -110,7 +110,7 @@ def test_a_corrupt_or_foreign_output_is_rebaked(three):
 
 def _sabotage(monkeypatch, how):
     """Make the tables named in ``how`` fail in their run_tile: name -> 'raise' | 'nan' | 'oom'."""
-    real = api.lookup_kind
+    real = pipeline.lookup_kind
 
     def lookup(name):
         kind = real(name)
@@ -133,7 +133,7 @@ def _sabotage(monkeypatch, how):
 
         return dataclasses.replace(kind, plan=plan)
 
-    monkeypatch.setattr(api, "lookup_kind", lookup)
+    monkeypatch.setattr(pipeline, "lookup_kind", lookup)
 
 
 def test_one_failing_table_does_not_stop_the_others(monkeypatch, tmp_path):
@@ -183,7 +183,7 @@ def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatc
     out.mkdir()
     stale = out / "slow.exr"
     stale.write_bytes(b"a good file from an older run")
-    real = api.lookup_kind
+    real = pipeline.lookup_kind
 
     def lookup(name):
         kind = real(name)
@@ -204,7 +204,7 @@ def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatc
 
         return dataclasses.replace(kind, plan=plan)
 
-    monkeypatch.setattr(api, "lookup_kind", lookup)
+    monkeypatch.setattr(pipeline, "lookup_kind", lookup)
     rep = tmp_path / "r.json"
     r = bake(cfg, "--out-dir", out, "--workers", "1", "--report", rep)
     assert r.exit_code == code, r.output
@@ -236,7 +236,7 @@ def test_two_concurrent_runs_never_corrupt_a_file(tmp_path):
         assert p.returncode == 0, stderr
         assert stdout.count("samples/texel") == 4
     assert sorted(p.name for p in out.iterdir()) == [f"t{i}.exr" for i in range(4)]
-    ref = {t.name: t for t, _, _ in (api.bake_table(s, workers=1) for s in load_configs([cfg]))}
+    ref = {t.name: t for t, _, _ in (pipeline.bake_table(s, workers=1) for s in load_configs([cfg]))}
     for i in range(4):
         data, attrs = read_exr(out / f"t{i}.exr")
         assert np.array_equal(data, ref[f"t{i}"].data)
@@ -260,14 +260,14 @@ def test_same_config_gives_identical_pixels_and_headers_for_any_worker_count(tmp
 
 def test_api_plan_and_run_without_the_cli(tmp_path):
     specs = load_configs([write_config(tmp_path, table("p"), table("q"))])
-    jobs = batch.plan(specs, tmp_path / "o")
+    jobs = batch.schedule(specs, tmp_path / "o")
     assert [j.status for j in jobs] == ["pending", "pending"]
     seen = []
     assert batch.run(jobs, workers=2, on_done=seen.append) is None
     assert sorted(j.name for j in seen) == ["p", "q"] and all(j.status == "baked" for j in jobs)
     assert batch.exit_status(jobs, None) == 0
-    assert [j.status for j in batch.plan(specs, tmp_path / "o")] == ["skipped", "skipped"]
-    assert [j.status for j in batch.plan(specs, tmp_path / "o", force=True)] == ["pending", "pending"]
+    assert [j.status for j in batch.schedule(specs, tmp_path / "o")] == ["skipped", "skipped"]
+    assert [j.status for j in batch.schedule(specs, tmp_path / "o", force=True)] == ["pending", "pending"]
     assert lookup_kind("dfg").name == "dfg"
 
 

@@ -9,7 +9,7 @@ from lutbake.api import bake_table
 from lutbake.config import validate_table
 from lutbake.errors import ConfigError
 from lutbake.io.exr import read_exr, write_exr
-from lutbake.tables import diffuse as D
+from lutbake.integrands import diffuse as D
 
 
 def spec(**kw):

@@ -57,15 +57,16 @@ def test_bad_diffuse_keys_are_rejected(kv, fragment):
 
 
 def test_swapped_albedo_matches_the_nested_rule():
-    """The table's integrator (m outside, l inside: lutbake.tables.diffuse_albedo) against the direct nested
-    rule (l outside, Eq. 4's m-integral inside: tables.diffuse.albedo), grazing and small-sigma texels included."""
-    from lutbake.tables import diffuse as D
-    from lutbake.tables import diffuse_albedo as A
+    """The table's integrator (m outside, l inside: lutbake.sampling.swapped) against the direct nested
+    rule (l outside, Eq. 4's m-integral inside: integrands.diffuse.albedo_gl), grazing and small-sigma texels included."""
+    from lutbake.axes import sigma_alpha
+    from lutbake.edge import effective_alpha
+    from lutbake.integrands import diffuse as D
 
     nov = np.array([0.05, 0.2, 0.5, 0.9, 1.0, 0.3], np.float32)
     sigma = np.array([0.05, 0.5, 0.3, 1.0, 0.1, 0.02], np.float32)
-    nested = D.albedo("microfacet", nov, sigma, 0.04, "eq6", "sigma", order=12)
-    swapped = A.albedo(nov, D.alpha_from_sigma(sigma, "sigma"), 0.04, "eq6")
+    nested = D.albedo_gl("microfacet", nov, sigma, 0.04, "eq6", "sigma", order=12)
+    swapped = D.albedo_swapped(nov, effective_alpha(sigma_alpha(sigma, "sigma"), False), 0.04, "eq6")
     np.testing.assert_allclose(swapped, nested, atol=5e-5)
 
 
@@ -76,11 +77,11 @@ def test_microfacet_table_records_its_error_estimate(microfacet):
 
 def test_grazing_small_sigma_corner_is_converged():
     """The corner the old nested rule missed by 2.9e-3 (NoV = sigma = 1/128): the default orders against order 32."""
-    from lutbake.tables import diffuse_albedo as A
+    from lutbake.integrands import diffuse as D
 
     t = bake_table(spec(model="microfacet", size=[4, 4], nov_range=[0.0, 0.0625], sigma_range=[0.0, 0.0625]),
                    workers=1)[0]
     nov = np.tile(t.axes[1].values(), 4).astype(np.float64)
     alpha = np.repeat(t.axes[0].values(), 4).astype(np.float64)
-    ref = A.albedo(nov, alpha, orders=np.full((16, 3), 32))
+    ref = D.albedo_swapped(nov, alpha, orders=np.full((16, 3), 32))
     np.testing.assert_allclose(t.data[..., 0].reshape(-1), ref, atol=1e-6)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import warp as wp
 
-from lutbake.tables import diffuse as tdiff
+from lutbake.integrands import diffuse as tdiff
 from lutbake.terms import diffuse
 
 TERM_RTOL = 2e-5  # float32 terms vs float64 numpy

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 from scipy.special import erf
 
-from lutbake.tables.specular import integrate, kernel_for
+from lutbake.integrands.specular import hemisphere_integral
 
 REFERENCE_ATOL = 1.0e-4  # |table - reference| per channel
 QMC_SAMPLES = 1 << 16
@@ -139,7 +139,7 @@ def test_reference_integrator_is_converged():
 
 def table(ndf, masking, estimator, samples, form="microfacet"):
     nov, alpha = texels()
-    return integrate(kernel_for(ndf, masking, "scale_bias", estimator, form), nov, alpha, estimator, samples, SEED, 2)
+    return hemisphere_integral(ndf, masking, "scale_bias", nov, alpha, estimator, samples, SEED, form=form)
 
 
 def report(got, want):
@@ -170,7 +170,7 @@ def test_dfg_cook_torrance_gauss_legendre_matches_reference(references):
     """The lecture's Cook-Torrance (Beckmann D with 1/pi, V-cavity G, Schlick F): the table kernel of
     model = "cook_torrance" (lutbake.terms.sets.model_terms) against the reference with the V-cavity G written here."""
     from lutbake.config import validate_table
-    from lutbake.tables.dfg import terms_of
+    from lutbake.kinds.dfg import terms_of
 
     form, ndf, masking = terms_of(validate_table({"name": "t", "kind": "dfg", "model": "cook_torrance"}, "<test>", 0).options)
     # the same kinks slow the table's Gauss-Legendre too: measured max error 8.4e-4 at 432 samples (the default),

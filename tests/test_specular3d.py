@@ -4,7 +4,7 @@ import pytest
 
 from lutbake.api import bake_table
 from lutbake.config import validate_table
-from lutbake.tables.fresnel import evaluate
+from lutbake.integrands.fresnel import evaluate
 from lutbake.terms.metals import METALS
 
 SIZE = [20, 10]

@@ -18,7 +18,7 @@ from ..axes import sigma_alpha
 from ..edge import COS_EPS, effective_alpha
 from ..sampling.diffuse import DiffuseGaussLegendre, eval_points
 from ..sampling.facets import fd_microfacet_for
-from ..sampling.swapped import swapped_albedo
+from ..sampling.swapped import integrate_swapped
 from ..terms import diffuse
 
 FACET_FRESNEL = {
@@ -119,13 +119,16 @@ class DiffuseIntegrand:
     brdf: object
     transmission: object | None
     f0_scale: object | None
+    facet: object | None = None  # the microfacet model's F_facet(MoL, MoV, f0) (lutbake.sampling.facets)
     nch: int = 1
 
 
 @functools.lru_cache(maxsize=None)
 def diffuse_integrand(model: str, facet_fresnel: str = "eq6") -> DiffuseIntegrand:
-    T, c = FACET_SPLIT[facet_fresnel] if model == "microfacet" else (None, None)
-    return DiffuseIntegrand(model, facet_fresnel, brdf_for(model, facet_fresnel), T, c)
+    if model != "microfacet":
+        return DiffuseIntegrand(model, facet_fresnel, brdf_for(model, facet_fresnel), None, None)
+    T, c = FACET_SPLIT[facet_fresnel]
+    return DiffuseIntegrand(model, facet_fresnel, brdf_for(model, facet_fresnel), T, c, FACET_FUNCS[facet_fresnel])
 
 
 def _alpha(sigma, sigma_to_alpha: str):
@@ -157,4 +160,4 @@ def albedo_swapped(nov, alpha, f0=0.0, facet_fresnel: str = "eq6", order: int = 
                    device: str = "cpu") -> np.ndarray:
     """Host helper: the microfacet model's E(nov_i) for GGX alpha_i by the swapped integral
     (lutbake.sampling.swapped), float64 (N,)."""
-    return swapped_albedo(diffuse_integrand("microfacet", facet_fresnel), nov, alpha, f0, order, orders, device)
+    return integrate_swapped(diffuse_integrand("microfacet", facet_fresnel), nov, alpha, f0, order, orders, device)

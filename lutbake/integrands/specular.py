@@ -2,7 +2,7 @@
 
 Cook-Torrance microfacet BRDF (Gotanda 2014 course notes, Eq. 1):
     f(l, v) = D(h) F(v.h) G2(l, v, h) / (4 (n.l)(n.v))
-In the half-vector measure (see lutbake.sampling.estimators) the integrand is
+In the half-vector measure (see lutbake.sampling.hemisphere) the integrand is
     g(h) = f (n.l) 4 (v.h) = D G2 F (v.h) / (n.v).
 A *channel function* replaces F by the weights that make the table's channels; for the split sum
 with Schlick F = f0 (1 - Fc) + Fc, Fc = (1 - v.h)^5 (Karis 2013):
@@ -42,25 +42,14 @@ def channels_albedo(VoH: float, f0: float):
     return wp.vec2(1.0, 0.0)
 
 
-# specular_3d: R = F(f0, v.h) for the texel's f0 (the kernel's per-texel param); G unused (0)
-@wp.func
-def channels_F_schlick(VoH: float, f0: float):
-    return wp.vec2(fresnel.F_schlick(f0, VoH), 0.0)
+def fresnel_channels(F):
+    """specular_3d: R = F(f0, v.h) for the texel's f0 (the kernel's per-texel param); G unused (0)."""
 
+    @wp.func
+    def channels_F(VoH: float, f0: float):
+        return wp.vec2(F(f0, VoH), 0.0)
 
-@wp.func
-def channels_F_schlick_sg(VoH: float, f0: float):
-    return wp.vec2(fresnel.F_schlick_sg(f0, VoH), 0.0)
-
-
-@wp.func
-def channels_F_improved_sg(VoH: float, f0: float):
-    return wp.vec2(fresnel.F_improved_sg(f0, VoH), 0.0)
-
-
-@wp.func
-def channels_F_dielectric_f0(VoH: float, f0: float):
-    return wp.vec2(fresnel.F_dielectric_f0(f0, VoH), 0.0)
+    return channels_F
 
 
 # Blender EEVEE's F82-tint layout: (1 - Fc, Fc, (v.h)(1 - v.h)^6)
@@ -76,8 +65,8 @@ def channels_multiscatter3(VoH: float, f0: float):
 
 
 CHANNEL_FUNCS = {"scale_bias": channels_scale_bias, "multiscatter": channels_multiscatter,
-                 "albedo": channels_albedo, "F:schlick": channels_F_schlick, "F:schlick_sg": channels_F_schlick_sg,
-                 "F:improved_sg": channels_F_improved_sg, "F:dielectric_f0": channels_F_dielectric_f0,
+                 "albedo": channels_albedo, **{f"F:{name}": fresnel_channels(getattr(fresnel, f"F_{name}"))
+                                               for name in ("schlick", "schlick_sg", "improved_sg", "dielectric_f0")},
                  "scale_bias_f82": channels_scale_bias_f82}
 THREE_CHANNELS = {"scale_bias_f82", "multiscatter_cloth", "charlie", "charlie_clamped"}
 N_CHANNELS = {"scale_bias": 2, "multiscatter": 2, "albedo": 2, "scale_bias_f82": 3, "multiscatter_cloth": 3,
@@ -106,20 +95,25 @@ def channels_for(channels_name: str):
     raise KeyError(channels_name)
 
 
+def half_vector_integrand(lobe, vec, skip_below_horizon_h: bool):
+    """g(v, h, alpha, param) = lobe(v, h, l, v.h, alpha, param) with l = reflect(v, h), and 0 (``vec()``) where n.l,
+    v.h or n.v <= COS_EPS (back-facing; also n.h <= 0 if ``skip_below_horizon_h``): the common prologue of every
+    specular integrand."""
+
+    @wp.func
+    def integrand(v: wp.vec3, h: wp.vec3, alpha: float, param: float):
+        l = reflect(v, h)
+        VoH = wp.dot(v, h)
+        if l[2] <= COS_EPS or VoH <= COS_EPS or v[2] <= COS_EPS or (wp.static(skip_below_horizon_h) and h[2] <= 0.0):
+            return vec()
+        return lobe(v, h, l, VoH, alpha, param)
+
+    return integrand
+
+
 @functools.lru_cache(maxsize=None)
-def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: str = "microfacet"):
-    """g(h) = f(l, v) (n.l) 4 (v.h) * channels(v.h, param), 0 where n.l, v.h or n.v <= COS_EPS (back-facing).
-    ``form`` (model_terms):
-        microfacet         f = D G2 / (4 (n.l)(n.v)) [x F]:          g = D G2 (v.h) / (n.v)
-        blinn_phong        f = (s + 8)/(8 pi) (n.h)^s [x F]:          g = (s + 8)/(8 pi) (n.h)^s 4 (n.l)(v.h)
-        ashikhmin_shirley  f = (s + 1)/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v)) [x F]:
-                                                                      g = (s + 1)/(2 pi) (n.h)^s (n.l) / max(n.l, n.v)
-    with s = 2 / alpha^2 - 2 for the last two (ndf_name, masking_name are then unused)."""
-    if channels_name == "multiscatter_cloth":
-        return cloth_integrand_for(ndf_name, masking_name)
-    if channels_name in SHEEN_LAYOUTS:
-        return sheen_integrand_for(channels_name)
-    ch, vec = channels_for(channels_name)
+def weight_for(ndf_name: str, masking_name: str, form: str):
+    """f (n.l) 4 (v.h) / F of an integrand form (``integrand_for``) at (v, h, l, v.h, alpha)."""
     if form == "microfacet":
         D = NDFS[ndf_name].D
         G2 = NDFS[ndf_name].G2(masking_name)
@@ -139,40 +133,44 @@ def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: st
             return (s + 1.0) / (2.0 * wp.pi) * wp.exp(s * ndf.log_cos(h)) * l[2] / wp.max(l[2], v[2])
     else:
         raise KeyError(form)
+    return weight
+
+
+@functools.lru_cache(maxsize=None)
+def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: str = "microfacet"):
+    """g(h) = f(l, v) (n.l) 4 (v.h) * channels(v.h, param), 0 where n.l, v.h or n.v <= COS_EPS (back-facing).
+    ``form`` (model_terms):
+        microfacet         f = D G2 / (4 (n.l)(n.v)) [x F]:          g = D G2 (v.h) / (n.v)
+        blinn_phong        f = (s + 8)/(8 pi) (n.h)^s [x F]:          g = (s + 8)/(8 pi) (n.h)^s 4 (n.l)(v.h)
+        ashikhmin_shirley  f = (s + 1)/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v)) [x F]:
+                                                                      g = (s + 1)/(2 pi) (n.h)^s (n.l) / max(n.l, n.v)
+    with s = 2 / alpha^2 - 2 for the last two (ndf_name, masking_name are then unused)."""
+    if channels_name == "multiscatter_cloth":
+        return cloth_integrand_for(ndf_name, masking_name)
+    if channels_name in SHEEN_LAYOUTS:
+        return sheen_integrand_for(channels_name)
+    ch, vec = channels_for(channels_name)
+    weight = weight_for(ndf_name, masking_name, form)
 
     @wp.func
-    def integrand(v: wp.vec3, h: wp.vec3, alpha: float, param: float):
-        l = reflect(v, h)
-        NoL = l[2]
-        NoV = v[2]
-        VoH = wp.dot(v, h)
-        if NoL <= COS_EPS or VoH <= COS_EPS or NoV <= COS_EPS or h[2] <= 0.0:
-            return vec()
+    def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float):
         return ch(VoH, param) * weight(v, h, l, VoH, alpha)
 
-    return integrand
+    return half_vector_integrand(lobe, vec, True)
 
 
 @functools.lru_cache(maxsize=None)
 def cloth_integrand_for(ndf_name: str, masking_name: str):
     """(Fc s, s, D_charlie V_ashikhmin (n.l) 4 (v.h)) with s = D G2 (v.h)/(n.v): the multiscatter
     channels plus Filament's cloth DV (DFV_Charlie_Uniform), 0 where n.l or v.h <= COS_EPS (back-facing)."""
-    D = NDFS[ndf_name].D
-    G2 = NDFS[ndf_name].G2(masking_name)
+    weight = weight_for(ndf_name, masking_name, "microfacet")
 
     @wp.func
-    def integrand(v: wp.vec3, h: wp.vec3, alpha: float, param: float):
-        l = reflect(v, h)
-        NoL = l[2]
-        NoV = v[2]
-        VoH = wp.dot(v, h)
-        if NoL <= COS_EPS or VoH <= COS_EPS or NoV <= COS_EPS:
-            return wp.vec3()
-        spec = D(h, alpha) * G2(NoV, NoL, h[2], VoH, alpha) * VoH / NoV
-        cloth = ndf.D_charlie(h, alpha) * masking.V_ashikhmin(NoV, NoL) * NoL * 4.0 * VoH
-        return channels_multiscatter3(VoH, param) * spec + wp.vec3(0.0, 0.0, cloth)
+    def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float):
+        cloth = ndf.D_charlie(h, alpha) * masking.V_ashikhmin(v[2], l[2]) * l[2] * 4.0 * VoH
+        return channels_multiscatter3(VoH, param) * weight(v, h, l, VoH, alpha) + wp.vec3(0.0, 0.0, cloth)
 
-    return integrand
+    return half_vector_integrand(lobe, wp.vec3, False)
 
 
 @functools.lru_cache(maxsize=None)
@@ -189,20 +187,16 @@ def sheen_integrand_for(layout: str):
     base = layout.removesuffix("_clamped")
 
     @wp.func
-    def integrand(v: wp.vec3, h: wp.vec3, alpha: float, param: float):
-        l = reflect(v, h)
+    def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float):
         NoL = l[2]
         NoV = v[2]
-        VoH = wp.dot(v, h)
-        if NoL <= COS_EPS or VoH <= COS_EPS or NoV <= COS_EPS:
-            return wp.vec3()
         d = ndf.D_charlie(h, alpha) * NoL * 4.0 * VoH
         ash = d * wp.min(masking.V_ashikhmin(NoV, NoL), wp.static(vmax))
         if wp.static(base == "charlie"):
             return wp.vec3(0.0, 0.0, ash)
         return wp.vec3(d * wp.min(masking.V_charlie(NoV, NoL, alpha), wp.static(vmax)), ash, 0.0)
 
-    return integrand
+    return half_vector_integrand(lobe, wp.vec3, False)
 
 
 # The lecture's models (003) as term sets of the dfg-like kinds (key ``model``). "microfacet" takes ``ndf`` and

@@ -22,7 +22,7 @@ import numpy as np
 from ..axes import TEXELS, Axis, sigma_alpha
 from ..edge import effective_alpha
 from ..integrands.diffuse import DIFFUSE_MODELS, diffuse_integrand, f0_factor
-from ..sampling.diffuse import PointEvaluation
+from ..sampling.diffuse import PointEvaluation, PointSobol
 from ..sampling.panels import n_tail_cuts_np
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from . import diffuse
@@ -35,7 +35,6 @@ PARAMETRISATIONS = {
 DEFAULT_ORDER = 12  # GL order of the m-integral (docs/diffuse.md: measured relative errors on the 16 x 32^3 grid)
 GRAZING_COS = 0.15  # texels with n.l and n.v both below it get order + GRAZING_EXTRA
 GRAZING_EXTRA = 8
-ESTIMATE_EXTRA = 8  # the error estimate re-evaluates probe texels at their order + 8
 
 KEYS = {
     "size": Key("size", "int_pair", [32, 32], "[light, view] texel counts (columns, rows per phi block)", minimum=1),
@@ -100,10 +99,29 @@ def texel_count(o: dict) -> int:
     return o["size"][0] * o["size"][1] * o["phi_size"] * ns
 
 
-SAMPLES_DOC = ("Gauss-Legendre order n of the m-integral (microfacet: up to (K + 3) x 4 n^2 facet normals per texel, "
-               "K the tan(theta_m) panels); omitted: 12; closed models ignore it")
-BTF_ESTIMATORS = {"gauss_legendre": "the microfacet model's m-integral by Gauss-Legendre panels (lutbake.sampling."
-                                    "facets); closed models are evaluated in closed form"}
+DEFAULT_SOBOL = 4096
+MAX_GL_ORDER = 64
+
+
+def check_spec(spec) -> tuple[str, str] | None:
+    o = spec.options
+    if o["estimator"] == "sobol_ndf" and o["model"] != "microfacet":
+        return ("estimator", f"'sobol_ndf' samples the microfacet model's m-integral; model {o['model']!r} is closed "
+                             "form (use 'gauss_legendre')")
+    if o["estimator"] == "gauss_legendre" and o["samples"] is not None and o["samples"] > MAX_GL_ORDER:
+        return ("samples", f"with estimator 'gauss_legendre' samples is the GL order: at most {MAX_GL_ORDER}")
+    return None
+
+
+SAMPLES_DOC = ("gauss_legendre: the Gauss-Legendre order n of the m-integral (2 to 64; microfacet: up to (K + 3) x 4 n^2 "
+               "facet normals per texel, K the tan(theta_m) panels); omitted: 12; closed models ignore it. sobol_ndf: "
+               "the number of facet normals (default 4096)")
+BTF_ESTIMATORS = {
+    "gauss_legendre": "the microfacet model's m-integral by Gauss-Legendre panels (lutbake.sampling.facets); closed "
+                      "models are evaluated in closed form",
+    "sobol_ndf": "the microfacet model's m-integral by scrambled Sobol' facet normals from GGX's D(m)(n.m) "
+                 "(samples = points, default 4096): a cross-check",
+}
 
 
 def plan(spec) -> TexelPlan:
@@ -111,7 +129,7 @@ def plan(spec) -> TexelPlan:
     axes = axes_for(o)
     l, v, sigma = directions(axes, o["parametrisation"])
     model, ff = o["model"], o["facet_fresnel"]
-    order = o["samples"] or DEFAULT_ORDER
+    order = (o["samples"] if o["estimator"] == "gauss_legendre" else None) or DEFAULT_ORDER
     integrated = model == "microfacet"
     # texels with light and view both grazing hold the smallest values (f ~ 1e-5 in back-scattering): their
     # relative error converges last, so they get order + GRAZING_EXTRA (about 1 % of the texels)
@@ -133,6 +151,8 @@ def plan(spec) -> TexelPlan:
         a = effective_alpha(sigma_alpha(sig_axis.values(), o["sigma_to_alpha"]), False)
         per = int(round(float(np.mean(n_tail_cuts_np(a) + 3)) * 4 * order * order))
     estimator = PointEvaluation(o["f0"], name="gauss_legendre" if integrated else "closed_form", evaluations=per)
+    if o["estimator"] == "sobol_ndf":
+        estimator = PointSobol(o["f0"], o["samples"] or DEFAULT_SOBOL, o["seed"])
     return per_texel_plan(diffuse_integrand(model, ff), estimator, grid,
                           channels={"f": "the BRDF f_r(l, v) for rho = 1 at the baked f0 (1/sr; radiance = f E0 (n.l))"},
                           reconstruction=RECONSTRUCTION, terms=terms, extra=extra, relative_error=True,
@@ -142,4 +162,4 @@ def plan(spec) -> TexelPlan:
 BTF = declare("btf", "the diffuse BRDF of four scalars as sigma slices of (light, view, azimuth) blocks (cosines or "
               "angles), microfacet (Eq. 4 integrated) or fitted (Eq. 8) or any diffuse model", KEYS, plan,
               estimators=BTF_ESTIMATORS, default_estimator="gauss_legendre", samples_doc=SAMPLES_DOC, samples_min=2,
-              samples_max=64, aliases=("diffuse_btf",), texels=texel_count)
+              aliases=("diffuse_btf",), check=check_spec, texels=texel_count)

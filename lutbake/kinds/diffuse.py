@@ -20,7 +20,7 @@ from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from ..sampling.swapped import SwappedGaussLegendre
 from .base import Key, declare
 
-DEFAULT_ORDER = {"microfacet": 12}  # base GL order (lutbake.tables.diffuse_albedo); closed forms: CLOSED_ORDER
+DEFAULT_ORDER = {"microfacet": 12}  # base GL order (lutbake.sampling.swapped); closed forms: CLOSED_ORDER
 CLOSED_ORDER = 24
 
 KEYS = {

@@ -5,7 +5,7 @@ The view azimuth phi_v (of v about n, from T) is a fourth parameter of an anisot
 out, E = (1/2 pi) ∫ E(phi_v) dphi_v, with phi_v = 2 pi u3 of scrambled 3D Sobol' points (u1, u2, u3), or fixes it.
 - ``sobol`` (``AnisoSobol``, the default): h from the lobe's own sampler, weight = channels(v.h) x the lobe's g / p
   (both bounded by 1, so the QMC error is that of a bounded integrand with a kink at the horizon);
-- ``sobol_cosine``: l cosine-weighted (pdf (n.l) / pi), weight = pi channels(v.h) f (n.l) / F: an independent
+- ``sobol_cosine``: l cosine-weighted (pdf (n.l) / pi), weight = pi channels(v.h) f / F: an independent
   estimator (it does not use the lobe's sampler or its pdf) for cross-checks.
 alpha_x = alpha_y = 0 (the lobe's mirror limit, lutbake.edge): E = channels(n.v), no samples.
 """
@@ -21,6 +21,7 @@ from ..edge import COS_EPS
 from ..terms import ndf
 from ..terms.frame import reflect
 from . import points
+from .hemisphere import store_row
 
 ANISO_ESTIMATORS = {
     "sobol": "scrambled 3D Sobol' points: h by anisotropic GGX VNDF sampling (microfacet) or the Ashikhmin-Shirley "
@@ -46,17 +47,12 @@ def aniso_kernel(lobe, cosine: bool):
     smooth = lobe.mirror
 
     @wp.kernel(enable_backward=False, module="unique")
-    def aniso_qmc_kernel(
-        nov: wp.array(dtype=float),
-        alpha_x: wp.array(dtype=float),
-        alpha_y: wp.array(dtype=float),
-        phi_v: wp.array(dtype=float),
-        pts: wp.array2d(dtype=float),
-        out: wp.array2d(dtype=wp.float64),
-    ):
+    def aniso_qmc_kernel(texel: wp.array(dtype=wp.vec4), pts: wp.array2d(dtype=float), out: wp.array2d(dtype=wp.float64)):
+        """texel[i] = (n.v, alpha_x, alpha_y, phi_v)."""
         i = wp.tid()
-        ax = alpha_x[i]
-        ay = alpha_y[i]
+        nov = texel[i][0]
+        ax = texel[i][1]
+        ay = texel[i][2]
         nu = ndf.as_exponent(wp.min(ax, 1.0))
         nv = ndf.as_exponent(wp.min(ay, 1.0))
         acc = acc_type()
@@ -66,10 +62,10 @@ def aniso_kernel(lobe, cosine: bool):
             if ax <= 0.0:  # alpha -> 0: the mirror limit below, no samples
                 m = 0
         for k in range(m):
-            phi = phi_v[i]
+            phi = texel[i][3]
             if phi < 0.0:
                 phi = 2.0 * wp.pi * pts[k, 2]
-            v = view_at(nov[i], phi)
+            v = view_at(nov, phi)
             w = 0.0
             h = wp.vec3()
             l = wp.vec3()
@@ -85,7 +81,7 @@ def aniso_kernel(lobe, cosine: bool):
             VoH = wp.dot(v, h)
             if l[2] > COS_EPS and VoH > COS_EPS and v[2] > COS_EPS:
                 if wp.static(cosine):
-                    w = wp.pi * f_cos(v, l, h, ax, ay, nu, nv)
+                    w = wp.pi * f_cos(v, l, h, ax, ay, nu, nv) / l[2]  # f (n.l) / pdf, pdf = (n.l) / pi
                 else:
                     w = weight(v, l, ax, ay)
                 g = ch(VoH, 0.0) * w
@@ -94,10 +90,8 @@ def aniso_kernel(lobe, cosine: bool):
         for c in range(wp.static(nch)):
             out[i, c] = acc[c] / wp.float64(n)
         if wp.static(smooth):
-            if ax <= 0.0:
-                e = ch(nov[i], 0.0)
-                for c in range(wp.static(nch)):
-                    out[i, c] = wp.float64(e[c])
+            if ax <= 0.0:  # the mirror limit (lutbake.edge)
+                store_row(out, i, ch(nov, 0.0))
 
     return aniso_qmc_kernel
 
@@ -123,10 +117,10 @@ class AnisoSobol:
         n = len(inputs["nov"])
         pts = np.clip(points.sobol3(self.budget, self.seed), 0.0, np.nextafter(np.float32(1.0), np.float32(0.0)))
         out = wp.zeros((n, 2), dtype=wp.float64, device=device)
-        arrays = [wp.array(np.ascontiguousarray(inputs[k], dtype=np.float32), dtype=float, device=device)
-                  for k in ("nov", "alpha_x", "alpha_y", "phi_v")]
-        wp.launch(self._kernel(lobe), dim=n, inputs=arrays + [wp.array(pts.astype(np.float32), dtype=float,
-                                                                       device=device), out], device=device)
+        texel = np.stack([np.asarray(inputs[k], np.float32) for k in ("nov", "alpha_x", "alpha_y", "phi_v")], axis=1)
+        wp.launch(self._kernel(lobe), dim=n, inputs=[wp.array(np.ascontiguousarray(texel), dtype=wp.vec4, device=device),
+                                                     wp.array(pts.astype(np.float32), dtype=float, device=device), out],
+                  device=device)
         return out.numpy()
 
     def refined(self):

@@ -9,7 +9,8 @@ AmbientBRDF (directional reflectance under uniform white light, rho = 1):
 - ``sobol_cosine`` (``CosineSobol``): scrambled 2D Sobol' points, l cosine-weighted (pdf (n.l) / pi, Malley's
   method), E = (pi / N) sum f(l_k, v): an independent check of the rule above.
 - ``PointEvaluation``: no integral over l: f(l_i, v_i) at given direction pairs (kind btf), the microfacet model
-  at a per-texel inner order.
+  at a per-texel inner order; ``PointSobol``: the same with the microfacet model's m-integral by Sobol' points
+  (lutbake.sampling.facets.fd_microfacet_sobol_for), a cross-check.
 The microfacet model's albedo by default uses the swapped integral (lutbake.sampling.swapped).
 """
 from __future__ import annotations
@@ -23,8 +24,10 @@ import warp as wp
 
 from ..terms.frame import view_dir
 from . import points
+from .facets import fd_microfacet_sobol_for
 
 PI64 = wp.constant(wp.float64(math.pi))
+REFINE_ORDER = 8  # the error estimates re-evaluate probe texels with every GL order + 8
 
 
 @functools.lru_cache(maxsize=None)
@@ -134,7 +137,7 @@ class DiffuseGaussLegendre:
         return out.numpy()
 
     def refined(self):
-        return DiffuseGaussLegendre(self.order + 8), f"order {self.order} - order {self.order + 8}"
+        return DiffuseGaussLegendre(self.order + REFINE_ORDER), f"order {self.order} - order {self.order + REFINE_ORDER}"
 
 
 @dataclass(frozen=True)
@@ -206,5 +209,50 @@ class PointEvaluation:
         return out
 
     def refined(self):
-        e = self.extra + 8
+        e = self.extra + REFINE_ORDER
         return PointEvaluation(self.f0, e, self.name, self.evaluations), f"orders - orders + {e}"
+
+
+@functools.lru_cache(maxsize=None)
+def sobol_point_kernel(facet):
+    """Kernel: the microfacet f(l[i], v[i]) with its m-integral by the 2D points ``pts`` (``PointSobol``)."""
+    f = fd_microfacet_sobol_for(facet)
+
+    @wp.kernel(enable_backward=False, module="unique")
+    def brdf_sobol_kernel(lv: wp.array2d(dtype=wp.vec3), alpha: wp.array(dtype=float), f0: float,
+                          pts: wp.array2d(dtype=float), out: wp.array(dtype=wp.float64)):
+        i = wp.tid()
+        out[i] = f(lv[i, 0], lv[i, 1], alpha[i], f0, pts)
+
+    return brdf_sobol_kernel
+
+
+@dataclass(frozen=True)
+class PointSobol:
+    """The microfacet model's f(l_i, v_i) (kind btf) with Eq. 4's m-integral by ``budget`` scrambled Sobol' points
+    (m from GGX's D(m)(n.m)). Inputs: l, v (N, 3), alpha; ``f0`` is the table's single f0."""
+
+    f0: float
+    budget: int = 4096
+    seed: int = 0
+    name: str = "sobol_ndf"
+
+    def samples(self, inputs: dict) -> np.ndarray:
+        return np.full(len(inputs["alpha"]), len(points.sobol(self.budget, self.seed)))
+
+    def prepare(self, integrand, device: str) -> None:
+        wp.load_module(sobol_point_kernel(integrand.facet).module, device=device)
+
+    def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
+        n = len(inputs["alpha"])
+        lv = np.ascontiguousarray(np.stack([inputs["l"], inputs["v"]], axis=1), dtype=np.float32)
+        pts = np.clip(points.sobol(self.budget, self.seed), 0.0, np.nextafter(np.float32(1.0), np.float32(0.0)))
+        out = wp.zeros(n, dtype=wp.float64, device=device)
+        wp.launch(sobol_point_kernel(integrand.facet), dim=n,
+                  inputs=[wp.array(lv, dtype=wp.vec3, device=device),
+                          wp.array(np.asarray(inputs["alpha"], np.float32), dtype=float, device=device), float(self.f0),
+                          wp.array(pts.astype(np.float32), dtype=float, device=device), out], device=device)
+        return out.numpy()[:, None]
+
+    def refined(self):
+        return PointSobol(self.f0, self.budget, self.seed + 1), "seed - (seed + 1) (two scramblings)"

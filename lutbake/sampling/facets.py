@@ -25,7 +25,19 @@ import warp as wp
 
 from ..edge import COS_EPS
 from ..terms import masking
-from .panels import PI64, TAIL_RATIO64, TWO_PI64, arc_half_width, n_tail_cuts, om_visible_ggx, wrap_2pi
+from ..terms.distributions import GGX
+from .panels import (
+    PI64,
+    TAIL_RATIO64,
+    TWO_PI64,
+    arc_half_width,
+    facet_cos_sin,
+    interval,
+    n_tail_cuts,
+    om_visible_ggx,
+    sort4,
+    wrap_2pi,
+)
 
 
 @functools.lru_cache(maxsize=None)
@@ -73,68 +85,29 @@ def fd_microfacet_for(F_facet):
             om_b = wp.clamp(om2, om_cut, om_prev)
             for p in range(3):
                 lo = prev
-                om_lo = om_prev
-                om_hi = om_a
-                if p == 1:
-                    om_lo = om_a
-                    om_hi = om_b
-                if p == 2:
-                    om_lo = om_b
-                    om_hi = om_cut
+                ends = interval(p, wp.vec4d(om_prev, om_a, om_b, om_cut), om_cut)
+                om_lo = ends[0]
+                om_hi = ends[1]
                 if p > 0:
                     lo = one - om_lo
                 du = om_lo - om_hi
                 if du > wp.float64(0.0):
                     for k in range(n):
                         s = xg[k]
-                        u = lo + du * s * s * (wp.float64(3.0) - wp.float64(2.0) * s)
                         wu = wg[k] * du * wp.float64(6.0) * s * (one - s)
                         # 1 - u without cancellation (u_l -> 1 for n.l -> 1 and small alpha)
-                        omu = om_hi + du * (one - s) * (one - s) * (one + wp.float64(2.0) * s)
-                        tan2 = a64 * a64 * u / omu
-                        cm = one / wp.sqrt(one + tan2)
-                        sm = wp.sqrt(tan2) * cm
+                        csm = facet_cos_sin(lo, du, om_hi, s, a64)
+                        cm = csm[0]
+                        sm = csm[1]
                         wl = arc_half_width(cm, sm, cl, sl)
                         wv = arc_half_width(cm, sm, cv, sv)
-                        b0 = wrap_2pi(phl - wl)
-                        b1 = wrap_2pi(phl + wl)
-                        b2 = wrap_2pi(phv - wv)
-                        b3 = wrap_2pi(phv + wv)
-                        # sorting network for four values
-                        if b0 > b1:
-                            t = b0
-                            b0 = b1
-                            b1 = t
-                        if b2 > b3:
-                            t = b2
-                            b2 = b3
-                            b3 = t
-                        if b0 > b2:
-                            t = b0
-                            b0 = b2
-                            b2 = t
-                        if b1 > b3:
-                            t = b1
-                            b1 = b3
-                            b3 = t
-                        if b1 > b2:
-                            t = b1
-                            b1 = b2
-                            b2 = t
+                        # the four arc ends, sorted, cut [0, 2 pi) into four intervals
+                        bs = sort4(wrap_2pi(phl - wl), wrap_2pi(phl + wl), wrap_2pi(phv - wv), wrap_2pi(phv + wv))
                         row = wp.float64(0.0)
                         for q in range(4):
-                            a = b0
-                            b = b1
-                            if q == 1:
-                                a = b1
-                                b = b2
-                            if q == 2:
-                                a = b2
-                                b = b3
-                            if q == 3:
-                                a = b3
-                                b = b0 + TWO_PI64
-                            dphi = b - a
+                            ab = interval(q, bs, bs[0] + TWO_PI64)
+                            a = ab[0]
+                            dphi = ab[1] - a
                             if dphi > wp.float64(0.0):
                                 for j in range(n):
                                     phi = a + dphi * xg[j]
@@ -149,3 +122,28 @@ def fd_microfacet_for(F_facet):
         return wp.float64(G2) * acc / (TWO_PI64 * PI64 * cl * cv)
 
     return fd_microfacet
+
+
+@functools.lru_cache(maxsize=None)
+def fd_microfacet_sobol_for(F_facet):
+    """Eq. 4 by sampling m from GGX's D(m)(n.m) (inverse CDF, lutbake.terms.distributions.GGX.sample_ndf) at the
+    2D points ``pts``: f = G2 / (pi (n.l)(n.v)) (1/N) sum_k (m.l)+ (m.v)+ F_facet / (n.m)
+    (D dω_m = pdf dω_m / (n.m)): an estimator independent of the panel rule of ``fd_microfacet_for``."""
+    sample = GGX.sample_ndf
+
+    @wp.func
+    def fd_microfacet_sobol(l: wp.vec3, v: wp.vec3, alpha: float, f0: float, pts: wp.array2d(dtype=float)):
+        if l[2] <= COS_EPS or v[2] <= COS_EPS:
+            return wp.float64(0.0)
+        G2 = masking.G2_smith_height_correlated(masking.Lambda_ggx(v[2], alpha), masking.Lambda_ggx(l[2], alpha))
+        acc = wp.float64(0.0)
+        for k in range(pts.shape[0]):
+            m = sample(v, alpha, pts[k, 0], pts[k, 1])
+            MoL = wp.dot(m, l)
+            MoV = wp.dot(m, v)
+            if MoL > 0.0 and MoV > 0.0 and m[2] > 0.0:
+                acc = acc + wp.float64(MoL * MoV * F_facet(MoL, MoV, f0) / m[2])
+        n = wp.float64(pts.shape[0])
+        return wp.float64(G2) * acc / (n * PI64 * wp.float64(l[2]) * wp.float64(v[2]))
+
+    return fd_microfacet_sobol

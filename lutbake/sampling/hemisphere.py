@@ -51,10 +51,23 @@ from ..terms.frame import view_dir
 from . import points
 
 PI64 = wp.constant(wp.float64(math.pi))
-TWO_PI = wp.constant(2.0 * math.pi)
 
 
 PANEL_RATIO = 4.0  # panels grow geometrically in theta_h (and in pi/2 - theta_h) by this factor
+
+
+@wp.func
+def store_row(out: wp.array2d(dtype=wp.float64), i: int, m: wp.vec2):
+    """out[i] = m (float64): a texel's closed-form value (the mirror limit)."""
+    out[i, 0] = wp.float64(m[0])
+    out[i, 1] = wp.float64(m[1])
+
+
+@wp.func
+def store_row(out: wp.array2d(dtype=wp.float64), i: int, m: wp.vec3):  # noqa: F811 (a Warp overload)
+    out[i, 0] = wp.float64(m[0])
+    out[i, 1] = wp.float64(m[1])
+    out[i, 2] = wp.float64(m[2])
 
 
 @wp.func
@@ -103,8 +116,8 @@ def make_gauss_legendre(spec):
       du = 2 pi D cos sin dtheta); a panel in region B has its outer variable smoothstep-mapped;
     - the inner variable phi runs over [0, pi] in region A and [0, acos c*] in region B, through a
       sinh map that resolves G2's pole at n.l = -horizon_scale next to the cut.
-    Kernel inputs: per-texel n.v, alpha and param; GL nodes/weights on [0, 1] for the outer (xu, wu) and
-    inner (xp, wq) variables. ``spec``: an integrand record (g, vec, acc, distribution, mirror)."""
+    Kernel inputs: per-texel (n.v, alpha, param); GL (node, weight) pairs on [0, 1] for the outer (rule_u) and
+    inner (rule_p) variables. ``spec``: an integrand record (g, vec, acc, distribution, mirror)."""
     integrand, vec_type, acc_type, mirror = spec.g, spec.vec, spec.acc, spec.mirror
     pdf, tan2_from_u, u_from_tan2 = spec.distribution.pdf_ndf, spec.distribution.tan2_from_u, spec.distribution.u_from_tan2
     nch = vec_type._length_
@@ -112,20 +125,14 @@ def make_gauss_legendre(spec):
 
     @wp.kernel(enable_backward=False, module="unique")
     def gauss_legendre_kernel(
-        nov: wp.array(dtype=float),
-        alpha: wp.array(dtype=float),
-        param: wp.array(dtype=float),
-        xu: wp.array(dtype=wp.float64),
-        wu: wp.array(dtype=wp.float64),
-        xp: wp.array(dtype=wp.float64),
-        wq: wp.array(dtype=wp.float64),
+        texel: wp.array(dtype=wp.vec3), rule_u: wp.array(dtype=wp.vec2d), rule_p: wp.array(dtype=wp.vec2d),
         out: wp.array2d(dtype=wp.float64),
     ):
         i = wp.tid()
-        a = alpha[i]
-        prm = param[i]
+        a = texel[i][1]
+        prm = texel[i][2]
         a64 = wp.float64(a)
-        v = view_dir(nov[i])
+        v = view_dir(texel[i][0])
         cos_v = wp.float64(v[2])
         sin_v = wp.float64(v[0])
         zero = wp.float64(0.0)
@@ -150,13 +157,13 @@ def make_gauss_legendre(spec):
                 x_lo = u_from_tan2(wp.tan(t_lo) * wp.tan(t_lo), a64)
                 x_hi = u_from_tan2(wp.tan(t_hi) * wp.tan(t_hi), a64)
             dx = x_hi - x_lo
-            for k in range(xu.shape[0]):
-                s = xu[k]
+            for k in range(rule_u.shape[0]):
+                s = rule_u[k][0]
                 x = x_lo + dx * s
-                wk = wu[k] * dx
+                wk = rule_u[k][1] * dx
                 if in_b:  # smoothstep: removes the sqrt-like ends of acos(c*) at c* = +-1
                     x = x_lo + dx * s * s * (wp.float64(3.0) - two * s)
-                    wk = wu[k] * dx * wp.float64(6.0) * s * (one - s)
+                    wk = rule_u[k][1] * dx * wp.float64(6.0) * s * (one - s)
                 cos_h = wp.cos(x)
                 sin_h = wp.sin(x)
                 if in_u:
@@ -176,11 +183,11 @@ def make_gauss_legendre(spec):
                     slope = two * cos_h * sin_v * sin_h * wp.max(wp.sin(phimax), wp.float64(1.0e-12))
                     eps = wp.max(eps_l / slope, wp.float64(1.0e-12))
                 big_a = asinh64(phimax / eps)
-                for j in range(xp.shape[0]):
+                for j in range(rule_p.shape[0]):
                     # sinh map (Johnston & Elliott 2005): phi = phimax - eps sinh(big_a (1 - x))
-                    arg = big_a * (one - xp[j])
+                    arg = big_a * (one - rule_p[j][0])
                     phi = phimax - eps * wp.sinh(arg)
-                    w = wk * wq[j] * eps * wp.cosh(arg) * big_a
+                    w = wk * rule_p[j][1] * eps * wp.cosh(arg) * big_a
                     h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
                     g = integrand(v, h, a, prm)
                     if in_u:
@@ -195,10 +202,8 @@ def make_gauss_legendre(spec):
         for c in range(wp.static(nch)):
             out[i, c] = acc[c] / PI64
         if wp.static(smooth):
-            if a <= 0.0:
-                m = mirror(v, prm)
-                for c in range(wp.static(nch)):
-                    out[i, c] = wp.float64(m[c])
+            if a <= 0.0:  # the mirror limit (lutbake.edge)
+                store_row(out, i, mirror(v, prm))
 
     return gauss_legendre_kernel
 
@@ -215,17 +220,13 @@ def make_qmc(spec, vndf: bool):
 
     @wp.kernel(enable_backward=False, module="unique")
     def qmc_kernel(
-        nov: wp.array(dtype=float),
-        alpha: wp.array(dtype=float),
-        param: wp.array(dtype=float),
-        pts: wp.array2d(dtype=float),
-        wts: wp.array(dtype=wp.float64),
+        texel: wp.array(dtype=wp.vec3), pts: wp.array2d(dtype=float), wts: wp.array(dtype=wp.float64),
         out: wp.array2d(dtype=wp.float64),
     ):
         i = wp.tid()
-        a = alpha[i]
-        prm = param[i]
-        v = view_dir(nov[i])
+        a = texel[i][1]
+        prm = texel[i][2]
+        v = view_dir(texel[i][0])
         acc = acc_type()
         n = pts.shape[0]
         if wp.static(smooth):
@@ -241,10 +242,8 @@ def make_qmc(spec, vndf: bool):
         for c in range(wp.static(nch)):
             out[i, c] = acc[c]
         if wp.static(smooth):
-            if a <= 0.0:
-                m = mirror(v, prm)
-                for c in range(wp.static(nch)):
-                    out[i, c] = wp.float64(m[c])
+            if a <= 0.0:  # the mirror limit (lutbake.edge)
+                store_row(out, i, mirror(v, prm))
 
     return qmc_kernel
 
@@ -284,8 +283,8 @@ def _launch(kernel, inputs: dict, point_arrays: list, kernel_channels: int, devi
     """One launch over texels (nov[i], alpha[i], param[i]) -> float64 array (len, kernel_channels)."""
     n = len(inputs["nov"])
     out = wp.zeros((n, kernel_channels), dtype=wp.float64, device=device)
-    arrays = [wp.array(np.ascontiguousarray(inputs[k], dtype=np.float32), dtype=float, device=device)
-              for k in ("nov", "alpha", "param")]
+    texel = np.stack([np.asarray(inputs[k], dtype=np.float32) for k in ("nov", "alpha", "param")], axis=1)
+    arrays = [wp.array(np.ascontiguousarray(texel), dtype=wp.vec3, device=device)]
     wp.launch(kernel, dim=n, inputs=arrays + point_arrays + [out], device=device)
     return out.numpy()
 
@@ -308,9 +307,8 @@ class GaussLegendre:
         load(gl_kernel(integrand), device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
-        x, w = points.gauss_legendre(self.order)
-        arr = [wp.array(a, dtype=wp.float64, device=device) for a in (x, w)]
-        return _launch(gl_kernel(integrand), inputs, arr + arr, integrand.kernel_channels, device)
+        rule = wp.array(np.stack(points.gauss_legendre(self.order), axis=1), dtype=wp.vec2d, device=device)
+        return _launch(gl_kernel(integrand), inputs, [rule, rule], integrand.kernel_channels, device)
 
     def refined(self):
         n = self.order

@@ -61,3 +61,36 @@ def om_visible_ggx(cos_x: wp.float64, alpha: wp.float64):
     c2 = cos_x * cos_x
     t = alpha * alpha * (wp.float64(1.0) - c2)
     return t / (t + c2)
+
+
+@wp.func
+def sort4(a: wp.float64, b: wp.float64, c: wp.float64, d: wp.float64):
+    """The four values in increasing order (the five compare-exchanges of a sorting network)."""
+    lo1 = wp.min(a, b)
+    hi1 = wp.max(a, b)
+    lo2 = wp.min(c, d)
+    hi2 = wp.max(c, d)
+    mid1 = wp.max(lo1, lo2)
+    mid2 = wp.min(hi1, hi2)
+    return wp.vec4d(wp.min(lo1, lo2), wp.min(mid1, mid2), wp.max(mid1, mid2), wp.max(hi1, hi2))
+
+
+@wp.func
+def interval(q: int, x: wp.vec4d, end: wp.float64):
+    """[x_q, x_(q+1)] of the increasing breakpoints x_0 .. x_3, end (q in 0 .. 3): the q-th panel."""
+    b = end
+    if q < 3:
+        b = x[q + 1]
+    return wp.vec2d(x[q], b)
+
+
+@wp.func
+def facet_cos_sin(lo: wp.float64, du: wp.float64, om_hi: wp.float64, s: wp.float64, alpha: wp.float64):
+    """(cos, sin) of the facet polar angle at the smoothstep node s of the u panel [lo, lo + du] (its upper end's
+    1 - u is om_hi): u = lo + du s^2 (3 - 2 s), 1 - u without cancellation, tan^2 theta_m = alpha^2 u / (1 - u)."""
+    one = wp.float64(1.0)
+    u = lo + du * s * s * (wp.float64(3.0) - wp.float64(2.0) * s)
+    omu = om_hi + du * (one - s) * (one - s) * (one + wp.float64(2.0) * s)
+    tan2 = alpha * alpha * u / omu
+    cm = one / wp.sqrt(one + tan2)
+    return wp.vec2d(cm, wp.sqrt(tan2) * cm)

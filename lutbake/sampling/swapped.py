@@ -38,7 +38,18 @@ import warp as wp
 
 from ..terms.masking import Lambda_ggx64
 from . import points
-from .panels import MAX_TAIL_CUTS, PI64, TAIL_RATIO, TAIL_RATIO64, arc_half_width, n_tail_cuts, n_tail_cuts_np
+from .panels import (
+    MAX_TAIL_CUTS,
+    PI64,
+    TAIL_RATIO,
+    TAIL_RATIO64,
+    arc_half_width,
+    facet_cos_sin,
+    interval,
+    n_tail_cuts,
+    n_tail_cuts_np,
+    sort4,
+)
 
 
 @functools.lru_cache(maxsize=None)
@@ -115,43 +126,20 @@ def swapped_kernel(T):
                 if (h == 0 or split) and du > zero:
                     for q in range(nu):
                         s = xs[ru, q]
-                        u = lo + du * s * s * (wp.float64(3.0) - wp.float64(2.0) * s)
                         wu = ws[ru, q] * du * wp.float64(6.0) * s * (one - s)
-                        omu = om_hi + du * (one - s) * (one - s) * (one + wp.float64(2.0) * s)  # 1 - u
-                        tan2 = a * a * u / omu
-                        cm = one / wp.sqrt(one + tan2)
-                        sm = wp.sqrt(tan2) * cm
+                        csm = facet_cos_sin(lo, du, om_hi, s, a)
+                        cm = csm[0]
+                        sm = csm[1]
                         V = arc_integral(cm, sm, cv, sv, ff, xs, ws, rp, npp)
                         if V > zero:
                             # H(theta_m): mu = n.l on four panels cut at sin(theta_m), 2 alpha and 16 alpha (sorted)
-                            c1 = wp.min(sm, one)
-                            c2 = wp.min(wp.float64(2.0) * a, one)
-                            c3 = wp.min(wp.float64(16.0) * a, one)
-                            if c1 > c2:
-                                t0 = c1
-                                c1 = c2
-                                c2 = t0
-                            if c2 > c3:
-                                t0 = c2
-                                c2 = c3
-                                c3 = t0
-                            if c1 > c2:
-                                t0 = c1
-                                c1 = c2
-                                c2 = t0
+                            cuts = sort4(zero, wp.min(sm, one), wp.min(wp.float64(2.0) * a, one),
+                                         wp.min(wp.float64(16.0) * a, one))
                             H = zero
                             for pm in range(4):
-                                mlo = zero
-                                mhi = c1
-                                if pm == 1:
-                                    mlo = c1
-                                    mhi = c2
-                                if pm == 2:
-                                    mlo = c2
-                                    mhi = c3
-                                if pm == 3:
-                                    mlo = c3
-                                    mhi = one
+                                ends = interval(pm, cuts, one)
+                                mlo = ends[0]
+                                mhi = ends[1]
                                 if mhi > mlo:
                                     for q in range(nm):
                                         t = xs[rm, q]
@@ -194,7 +182,7 @@ def orders_for(nov: np.ndarray, alpha: np.ndarray, base: int) -> np.ndarray:
     return np.minimum(o, MAX_ORDER)
 
 
-def swapped_albedo(integrand, nov, alpha, f0=0.0, order: int = 12, orders: np.ndarray | None = None,
+def integrate_swapped(integrand, nov, alpha, f0=0.0, order: int = 12, orders: np.ndarray | None = None,
                    device: str = "cpu") -> np.ndarray:
     """E(nov_i) for GGX alpha_i and f0 (rho = 1) of the microfacet diffuse ``integrand`` (its ``transmission``
     T and factor c(f0): lutbake.integrands.diffuse), float64 (N,). ``orders``: (N, 3) per texel (u, μ, φ);
@@ -258,7 +246,7 @@ class SwappedGaussLegendre:
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         nov, alpha, f0 = (np.asarray(inputs[k], np.float64) for k in ("nov", "alpha", "f0"))
-        return swapped_albedo(integrand, nov, alpha, f0, orders=self._orders(inputs), device=device)[:, None]
+        return integrate_swapped(integrand, nov, alpha, f0, orders=self._orders(inputs), device=device)[:, None]
 
     def refined(self):
         e = self.extra + ESTIMATE_EXTRA_ORDER

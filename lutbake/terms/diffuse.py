@@ -43,6 +43,14 @@ def Fd_lambert(rho: float):
 
 
 @wp.func
+def oren_nayar_AB(sigma: float, a_denominator: float):
+    """Oren-Nayar's (A, B) = (1 - 0.5 sigma^2 / (sigma^2 + a_denominator), 0.45 sigma^2 / (sigma^2 + 0.09)):
+    a_denominator = 0.57 in the classic model (Oren & Nayar 1994), 0.65 in Gotanda 2014, Eq. 5 and 7."""
+    s2 = sigma * sigma
+    return wp.vec2(1.0 - 0.5 * s2 / (s2 + a_denominator), 0.45 * s2 / (s2 + 0.09))
+
+
+@wp.func
 def Fd_oren_nayar(rho: float, NoL: float, NoV: float, LoV: float, sigma: float):
     """Classic Oren-Nayar, qualitative model as taught in lecture 003 (Oren & Nayar 1994, Eq. 30):
     f = rho/pi (A + B max(0, cos phi) sin(a) tan(b)), a = max(theta_l, theta_v), b = min(theta_l, theta_v),
@@ -52,11 +60,9 @@ def Fd_oren_nayar(rho: float, NoL: float, NoV: float, LoV: float, sigma: float):
     reduce to Lambert at sigma = 0 and is taken as a layout slip. sigma = 0: exactly Lambert."""
     if NoL <= COS_EPS or NoV <= COS_EPS:
         return 0.0
-    s2 = sigma * sigma
-    A = 1.0 - 0.5 * s2 / (s2 + 0.57)
-    B = 0.45 * s2 / (s2 + 0.09)
+    AB = oren_nayar_AB(sigma, 0.57)
     s = LoV - NoL * NoV
-    return rho * INV_PI * (A + B * wp.max(s, 0.0) / wp.max(NoL, NoV))
+    return rho * INV_PI * (AB[0] + AB[1] * wp.max(s, 0.0) / wp.max(NoL, NoV))
 
 
 @wp.func
@@ -70,9 +76,9 @@ def Fd_oren_nayar_improved(rho: float, NoL: float, NoV: float, LoV: float, sigma
     viewer (n.l -> 0, cos phi < 0), so the radiance is clamped at 0. sigma = 0: exactly Lambert."""
     if NoL <= COS_EPS or NoV <= COS_EPS:
         return 0.0
-    s2 = sigma * sigma
-    A = 1.0 - 0.5 * s2 / (s2 + 0.65)
-    B = 0.45 * s2 / (s2 + 0.09)
+    AB = oren_nayar_AB(sigma, 0.65)
+    A = AB[0]
+    B = AB[1]
     s = LoV - NoL * NoV
     radiance = NoL * A + B * s
     if s >= 0.0:
@@ -92,10 +98,10 @@ def Fd_oren_nayar_fresnel(rho: float, NoL: float, NoV: float, LoV: float, sigma:
     Returned as the BRDF L_r / (E0 n.l)."""
     if NoL <= COS_EPS or NoV <= COS_EPS:
         return 0.0
-    s2 = sigma * sigma
-    A = 1.0 - 0.5 * s2 / (s2 + 0.65)
-    B = 0.45 * s2 / (s2 + 0.09)
+    AB = oren_nayar_AB(sigma, 0.65)
     s = LoV - NoL * NoV
+    A = AB[0]
+    B = AB[1]
     radiance = 1.05 * pow5_weight(NoL) * pow5_weight(NoV) * NoL * A + B * s * wp.min(1.0, NoL / NoV)
     return rho * INV_PI * (1.0 - f0) * wp.max(radiance, 0.0) / NoL
 

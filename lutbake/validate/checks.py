@@ -387,7 +387,7 @@ def _reciprocity_brdfs() -> tuple[dict, dict]:
 
 
 def reciprocity(ndf_name: str, masking_name: str) -> CheckResult:
-    """Helmholtz reciprocity f(l, v) = f(v, l) of the assembled specular BRDF (probe.brdf_for) at
+    """Helmholtz reciprocity f(l, v) = f(v, l) of the assembled specular BRDF (probe.specular_brdf_for) at
     random direction pairs (n.l, n.v biased towards grazing), alpha = r^2, r in [0.1, 1], f0 in [0, 1]."""
     fwd, bwd = _reciprocity_brdfs()
     a = fwd[(ndf_name, masking_name)].astype(np.float64)

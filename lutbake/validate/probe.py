@@ -190,7 +190,7 @@ def _terms_kernel(
 # --- full specular BRDFs ------------------------------------------------------------------------
 
 @functools.lru_cache(maxsize=None)
-def brdf_for(ndf_name: str, masking_name: str):
+def specular_brdf_for(ndf_name: str, masking_name: str):
     """``f(l, v, alpha, f0)``: the Cook-Torrance specular BRDF of one (NDF, masking) pair with Schlick F,
     assembled from the terms exactly as tables assemble it (module docstring)."""
     D = NDFS[ndf_name].D
@@ -213,20 +213,15 @@ def brdf_for(ndf_name: str, masking_name: str):
     return brdf
 
 
-_BRDF_FUNCS = [brdf_for(n, m) for n, m in BRDF_PAIRS]
+_BRDF_FUNCS = [specular_brdf_for(n, m) for n, m in BRDF_PAIRS]
 
 
 @wp.kernel
-def _brdf_kernel(
-    l: wp.array(dtype=wp.vec3),
-    v: wp.array(dtype=wp.vec3),
-    alpha: wp.array(dtype=float),
-    f0: wp.array(dtype=float),
-    out: wp.array2d(dtype=float),
-):
+def _brdf_kernel(lv: wp.array2d(dtype=wp.vec3), alpha_f0: wp.array(dtype=wp.vec2), out: wp.array2d(dtype=float)):
+    """lv[i] = (l, v); alpha_f0[i] = (alpha, f0)."""
     i = wp.tid()
     for k in range(wp.static(len(_BRDF_FUNCS))):
-        out[i, k] = wp.static(_BRDF_FUNCS[k])(l[i], v[i], alpha[i], f0[i])
+        out[i, k] = wp.static(_BRDF_FUNCS[k])(lv[i, 0], lv[i, 1], alpha_f0[i][0], alpha_f0[i][1])
 
 
 # --- host side ------------------------------------------------------------------------------------
@@ -273,8 +268,9 @@ def evaluate_brdfs(l, v, alpha, f0=0.04, device: str = "cpu") -> dict[tuple[str,
     shape, x = _vec_and_scalars({"l": l, "v": v}, {"alpha": alpha, "f0": f0})
     n = int(np.prod(shape, dtype=np.int64))
     out = wp.zeros((n, len(BRDF_PAIRS)), dtype=float, device=device)
-    inputs = [wp.array(x["l"], dtype=wp.vec3, device=device), wp.array(x["v"], dtype=wp.vec3, device=device),
-              wp.array(x["alpha"], dtype=float, device=device), wp.array(x["f0"], dtype=float, device=device)]
+    lv = np.ascontiguousarray(np.stack([x["l"], x["v"]], axis=1), dtype=np.float32)
+    af = np.ascontiguousarray(np.stack([x["alpha"], x["f0"]], axis=1), dtype=np.float32)
+    inputs = [wp.array(lv, dtype=wp.vec3, device=device), wp.array(af, dtype=wp.vec2, device=device)]
     if n:
         wp.launch(_brdf_kernel, dim=n, inputs=inputs + [out], device=device)
     res = out.numpy()
