@@ -169,8 +169,8 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
     if texels > MAX_TEXELS:
         raise ConfigError(file, "size", options.get("size"),
                           f"at most {MAX_TEXELS} texels = {human_bytes(MAX_TEXELS * BYTES_PER_TEXEL)}",
-                          f"{texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} of memory while "
-                          "baking", label)
+                          f"{kind.texels_doc} = {texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} "
+                          "of memory while baking", label)
     if kind.check is not None:
         msg = kind.check(spec)
         if msg:

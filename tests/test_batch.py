@@ -91,7 +91,7 @@ def test_content_hash_covers_config_version_and_kernel_sources(monkeypatch, tmp_
     assert len(h) == 64 and h == provenance.content_hash(s)
     assert provenance.content_hash(s2) != h
     assert provenance.content_hash(s, b"other sources") != h
-    monkeypatch.setattr(batch, "__version__", "9.9.9")
+    monkeypatch.setattr(provenance, "__version__", "9.9.9")
     assert provenance.content_hash(s) != h
     rel = {f.relative_to(provenance.PACKAGE).as_posix() for f in provenance.source_files()}
     for f in ("terms/ndf.py", "terms/masking.py", "terms/fresnel.py", "sampling/hemisphere.py",

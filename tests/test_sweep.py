@@ -115,11 +115,12 @@ def test_raw_d_at_alpha_zero_is_the_only_exception(swept):
     assert np.all(np.isfinite(swept[..., other]))
 
 
-def test_tables_clamp_alpha_zero_and_grazing_nov():
+def test_tables_take_the_mirror_at_alpha_zero_and_clamp_grazing_nov():
     t = bake_table(validate_table({"name": "edge", "kind": "dfg", "size": [3, 3], "samples": 48,
                                    "texel": "endpoint", "roughness": "alpha"}, "<test>", 0), workers=1)[0]
     rough, nov = t.axes
-    assert rough.alpha()[0] == pytest.approx(ALPHA_MIN) and nov.values()[0] == pytest.approx(NOV_MIN)
+    assert rough.alpha()[0] == 0.0 and "mirror" in t.attributes["alpha_policy"]
+    assert nov.values()[0] == pytest.approx(NOV_MIN)
 
 
 # (ndf, masking, layout, estimator) of every dfg kernel

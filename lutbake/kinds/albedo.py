@@ -84,4 +84,4 @@ ALBEDO = declare("albedo", "Kulla-Conty directional albedo E(NoV, roughness) wit
 ALBEDO_AVG = declare("albedo_avg", "Kulla-Conty average albedo E_avg(roughness) = 2 ∫ E mu dmu: one row", AVG_KEYS,
                      plan_albedo_avg, estimators=ESTIMATORS, default_estimator="gauss_legendre",
                      samples_doc=dfg.SAMPLES_DOC, aliases=("e_avg",), check=dfg.check_spec,
-                     texels=lambda o: o["roughness_size"])
+                     texels=lambda o: o["roughness_size"], texels_doc="roughness_size")

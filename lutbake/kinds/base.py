@@ -41,6 +41,7 @@ class Kind:
     aliases: tuple[str, ...] = ()
     check: Callable[[Any], str | tuple[str, str] | None] | None = None
     texels: Callable[[Any], int] = lambda o: math.prod(o.get("size", [1]))  # texel count, for config.MAX_TEXELS
+    texels_doc: str = "size"  # the keys whose product ``texels`` is, for the error message
 
 
 def common_keys(estimators: dict[str, str], default_estimator: str, samples_doc: str, samples_max: int,
@@ -62,9 +63,9 @@ def common_keys(estimators: dict[str, str], default_estimator: str, samples_doc:
 
 def declare(name: str, description: str, keys: dict[str, Key], plan, *, estimators: dict[str, str],
             default_estimator: str, samples_doc: str, samples_max: int = MAX_SAMPLES, samples_min: int = 1,
-            aliases: tuple[str, ...] = (), check=None, texels=None) -> Kind:
+            aliases: tuple[str, ...] = (), check=None, texels=None, texels_doc: str = "size") -> Kind:
     """A Kind with the common keys (``common_keys``) followed by its own ``keys``; ``texels(options)``: the texel
     count (default: the product of ``size``)."""
     common = common_keys(estimators, default_estimator, samples_doc, samples_max, samples_min)
     kind = Kind(name, description, {**common, **keys}, plan, aliases, check)
-    return kind if texels is None else Kind(name, description, kind.keys, plan, aliases, check, texels)
+    return kind if texels is None else Kind(name, description, kind.keys, plan, aliases, check, texels, texels_doc)

@@ -162,4 +162,5 @@ def plan(spec) -> TexelPlan:
 BTF = declare("btf", "the diffuse BRDF of four scalars as sigma slices of (light, view, azimuth) blocks (cosines or "
               "angles), microfacet (Eq. 4 integrated) or fitted (Eq. 8) or any diffuse model", KEYS, plan,
               estimators=BTF_ESTIMATORS, default_estimator="gauss_legendre", samples_doc=SAMPLES_DOC, samples_min=2,
-              aliases=("diffuse_btf",), check=check_spec, texels=texel_count)
+              aliases=("diffuse_btf",), check=check_spec, texels=texel_count,
+              texels_doc="size x phi_size x sigma_size (or the sigma_values count)")

@@ -86,8 +86,6 @@ def check_spec(spec) -> tuple[str, str] | None:
     o = spec.options
     if o["estimator"] == "gauss_legendre" and o["samples"] is not None and o["samples"] > MAX_GL_ORDER:
         return ("samples", f"with estimator 'gauss_legendre' samples is the GL order: at most {MAX_GL_ORDER}")
-    if o["estimator"] == "gauss_legendre" and o["samples"] is not None and o["samples"] < 2:
-        return ("samples", "with estimator 'gauss_legendre' samples is the GL order: at least 2")
     return None
 
 
@@ -121,4 +119,4 @@ DIFFUSE_ESTIMATORS = {
 DIFFUSE = declare("diffuse", "diffuse AmbientBRDF: NoV x sigma, E = ∫ f_r (n.l) dω_l for Lambert, Oren-Nayar variants, "
                   "Gotanda's fitted model or the integrated microfacet model (Eq. 4)", KEYS, plan,
                   estimators=DIFFUSE_ESTIMATORS, default_estimator="gauss_legendre", samples_doc=SAMPLES_DOC,
-                  aliases=("ambient_brdf_diffuse",), check=check_spec)
+                  samples_min=2, aliases=("ambient_brdf_diffuse",), check=check_spec)

@@ -63,5 +63,5 @@ def plan(spec) -> TexelPlan:
 DIFFUSE_3D = declare("diffuse_3d", "diffuse AmbientBRDF with an f0 axis: NoV x sigma x f0 slices (R = E), for per-facet "
                      "Fresnel forms where f0 does not factor out (exact dielectric, Eq. 2)", KEYS, plan,
                      estimators=diffuse.DIFFUSE_ESTIMATORS, default_estimator="gauss_legendre",
-                     samples_doc=diffuse.SAMPLES_DOC, aliases=("ambient_brdf_diffuse_3d",), check=diffuse.check_spec,
-                     texels=lambda o: o["size"][0] * o["size"][1] * o["f0_size"])
+                     samples_doc=diffuse.SAMPLES_DOC, samples_min=2, aliases=("ambient_brdf_diffuse_3d",), check=diffuse.check_spec,
+                     texels=lambda o: o["size"][0] * o["size"][1] * o["f0_size"], texels_doc="size x f0_size")

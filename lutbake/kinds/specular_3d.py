@@ -81,4 +81,5 @@ SPECULAR_3D = declare("specular_3d", "specular AmbientBRDF for any Fresnel: NoV 
                       "or NoV x roughness RGB for a named metal", KEYS, plan, estimators=ESTIMATORS,
                       default_estimator="gauss_legendre", samples_doc=dfg.SAMPLES_DOC,
                       aliases=("ambient_brdf_3d",), check=dfg.check_spec,
-                      texels=lambda o: o["size"][0] * o["size"][1] * (1 if o["metal"] else o["f0_size"]))
+                      texels=lambda o: o["size"][0] * o["size"][1] * (1 if o["metal"] else o["f0_size"]),
+                      texels_doc="size x f0_size")

@@ -78,4 +78,5 @@ def plan(spec) -> TexelPlan:
 SPECULAR_ANISO = declare("specular_aniso", "anisotropic split-sum: NoV x roughness x anisotropy slices (anisotropic "
                          "GGX or Ashikhmin-Shirley), scale/bias or multiscatter", KEYS, plan,
                          estimators=ANISO_ESTIMATORS, default_estimator="sobol", samples_doc=dfg.SAMPLES_DOC,
-                         aliases=("aniso",), texels=lambda o: o["size"][0] * o["size"][1] * o["anisotropy_size"])
+                         aliases=("aniso",), texels=lambda o: o["size"][0] * o["size"][1] * o["anisotropy_size"],
+                         texels_doc="size x anisotropy_size")
