@@ -4,8 +4,10 @@
 - ``bake(workers=2, **keys)``: that spec baked to a Table (nothing written).
 - ``bake_preset(name, *overrides)``: a preset, with ``--set``-style overrides, as ``(spec, Table)``.
 - ``shipped(name)``: a published engine table from tests/data/ (values as float64; provenance in its .json).
-- ``charlie_reference(alpha, nov, visibility, clamp=False)``: ∫ D_charlie V (n.l) dω_l by a converged
-  graded Gauss-Legendre rule in numpy, independent of lutbake's @wp.funcs (the sheen tests compare with it).
+- ``graded_rule(a, b, singular)``: nodes and weights of a Gauss-Legendre rule graded toward the points
+  where an integrand is not analytic (a converged reference in a few thousand nodes, not a brute-force grid).
+- ``charlie_reference(alpha, nov, visibility, clamp=False)``: ∫ D_charlie V (n.l) dω_l by that rule in
+  numpy, independent of lutbake's @wp.funcs (the sheen and Filament cloth tests compare with it).
 """
 from pathlib import Path
 
@@ -149,6 +151,12 @@ def integrate_charlie(alpha, nov, visibility, clamp=False, **rule):
     d = (2 + 1 / alpha) * sin2_h ** (0.5 / alpha) / (2 * np.pi)
     v = sheen_visibility(nol, nov, alpha, visibility, clamp)
     return 2 * float(np.einsum("i,ij,j->", w_th, d * v * nol * sin_l, w_ph))
+
+
+@pytest.fixture(scope="session")
+def graded_rule():
+    """``graded_rule(a, b, singular)`` -> (nodes, weights) of graded_gauss_legendre on [a, b]."""
+    return graded_gauss_legendre
 
 
 @pytest.fixture(scope="session")
