@@ -1,7 +1,8 @@
 """Shared test setup and the helpers every test file uses (request them as fixtures; never copy them).
 
-- ``spec(**keys)``: one ``[[table]]`` mapping validated as a config would be (``name`` defaults to "t").
-- ``bake(workers=2, **keys)``: that spec baked to a Table (nothing written).
+- ``spec(defaults={}, **keys)``: one ``[[table]]`` mapping, ``{**defaults, **keys}``, validated as a config
+  would be (``name`` defaults to "t"); a test file keeps its common keys in one dict and passes it first.
+- ``bake(defaults={}, workers=2, **keys)``: that spec baked to a Table (nothing written).
 - ``bake_preset(name, *overrides)``: a preset, with ``--set``-style overrides, as ``(spec, Table)``.
 - ``shipped(name)``: a published engine table from tests/data/ (values as float64; provenance in its .json).
 - ``graded_rule(a, b, singular)``: nodes and weights of a Gauss-Legendre rule graded toward the points
@@ -30,12 +31,12 @@ def warp_quiet():
 # ---------------------------------------------------------------------------------- specs and bakes
 
 
-def make_spec(**keys):
-    return validate_table({"name": "t", **keys}, "<test>", 0)
+def make_spec(defaults=None, /, **keys):
+    return validate_table({"name": "t", **(defaults or {}), **keys}, "<test>", 0)
 
 
-def bake_spec(workers=2, **keys):
-    return bake_table(make_spec(**keys), workers=workers)[0]
+def bake_spec(defaults=None, /, workers=2, **keys):
+    return bake_table(make_spec(defaults, **keys), workers=workers)[0]
 
 
 def bake_named_preset(name, *overrides):
@@ -45,13 +46,13 @@ def bake_named_preset(name, *overrides):
 
 @pytest.fixture(scope="session")
 def spec():
-    """``spec(**keys)`` -> TableSpec: the keys of one [[table]] (``name`` defaults to "t"), validated."""
+    """``spec(defaults={}, **keys)`` -> TableSpec: the keys of one [[table]] (``name`` defaults to "t"), validated."""
     return make_spec
 
 
 @pytest.fixture(scope="session")
 def bake():
-    """``bake(workers=2, **keys)`` -> Table: the spec of ``keys`` baked (output is identical for any workers)."""
+    """``bake(defaults={}, workers=2, **keys)`` -> Table: that spec baked (the output is the same for any workers)."""
     return bake_spec
 
 
