@@ -206,6 +206,7 @@ def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatc
 
     monkeypatch.setattr(api, "lookup_kind", lookup)
     rep = tmp_path / "r.json"
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
     r = bake(cfg, "--out-dir", out, "--workers", "1", "--report", rep)
     assert r.exit_code == code, r.output
     assert "Traceback" not in r.output
@@ -215,7 +216,7 @@ def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatc
     doc = json.loads(rep.read_text())
     assert [t["status"] for t in doc["tables"]] == ["baked", "interrupted", "interrupted"]
     assert doc["exit_status"] == code and doc["interrupted_by"] == signal.Signals(signum).name
-    assert signal.getsignal(signal.SIGTERM) is not None  # handler restored (no exception)
+    assert {s: signal.getsignal(s) for s in handlers} == handlers  # the bake's SIGTERM handler is gone again
     # the next run resumes only the tables that did not finish
     monkeypatch.undo()
     r = bake(cfg, "--out-dir", out)
