@@ -108,8 +108,8 @@ def test_a_corrupt_or_foreign_output_is_rebaked(three):
     assert lutbake_header(out / "a.exr")["kind"] == "dfg"
 
 
-def _sabotage(monkeypatch, how):
-    """Make the tables named in ``how`` fail in their run_tile: name -> 'raise' | 'nan' | 'oom'."""
+def wrap_run_tile(monkeypatch, wrappers):
+    """The tables named in ``wrappers`` bake with ``wrappers[name](run_tile)`` as their plan's run_tile."""
     real = api.lookup_kind
 
     def lookup(name):
@@ -117,11 +117,19 @@ def _sabotage(monkeypatch, how):
 
         def plan(spec):
             p = kind.plan(spec)
-            mode = how.get(spec.name)
-            if mode is None:
-                return p
-            orig = p.run_tile
+            wrap = wrappers.get(spec.name)
+            return p if wrap is None else dataclasses.replace(p, run_tile=wrap(p.run_tile))
 
+        return dataclasses.replace(kind, plan=plan)
+
+    monkeypatch.setattr(api, "lookup_kind", lookup)
+
+
+def _sabotage(monkeypatch, how):
+    """Make the tables named in ``how`` fail in their run_tile: name -> 'raise' | 'nan' | 'oom'."""
+
+    def failing(mode):
+        def wrap(orig):
             def run_tile(s, e, d):
                 if mode == "raise":
                     raise RuntimeError("kernel exploded")
@@ -129,11 +137,11 @@ def _sabotage(monkeypatch, how):
                     raise MemoryError()
                 return np.full_like(orig(s, e, d), np.nan)
 
-            return dataclasses.replace(p, run_tile=run_tile)
+            return run_tile
 
-        return dataclasses.replace(kind, plan=plan)
+        return wrap
 
-    monkeypatch.setattr(api, "lookup_kind", lookup)
+    wrap_run_tile(monkeypatch, {name: failing(mode) for name, mode in how.items()})
 
 
 def test_one_failing_table_does_not_stop_the_others(monkeypatch, tmp_path):
@@ -183,28 +191,17 @@ def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatc
     out.mkdir()
     stale = out / "slow.exr"
     stale.write_bytes(b"a good file from an older run")
-    real = api.lookup_kind
 
-    def lookup(name):
-        kind = real(name)
+    def interrupted(orig):
+        def run_tile(s, e, d):
+            if s == 0:
+                os.kill(os.getpid(), signum)  # Ctrl-C / SIGTERM arrives while this table bakes
+            time.sleep(0.3)
+            return orig(s, e, d)
 
-        def plan(spec):
-            p = kind.plan(spec)
-            if spec.name != "slow":
-                return p
-            orig = p.run_tile
+        return run_tile
 
-            def run_tile(s, e, d):
-                if s == 0:
-                    os.kill(os.getpid(), signum)  # Ctrl-C / SIGTERM arrives while this table bakes
-                time.sleep(0.3)
-                return orig(s, e, d)
-
-            return dataclasses.replace(p, run_tile=run_tile)
-
-        return dataclasses.replace(kind, plan=plan)
-
-    monkeypatch.setattr(api, "lookup_kind", lookup)
+    wrap_run_tile(monkeypatch, {"slow": interrupted})
     rep = tmp_path / "r.json"
     handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
     r = bake(cfg, "--out-dir", out, "--workers", "1", "--report", rep)

@@ -44,21 +44,16 @@ def test_presets_exist_with_the_viewer_axes(charlie, sheen_e):
     assert np.all(charlie[1].data[..., :2] == 0)  # the viewer's lut_charlie: value in .b
 
 
-def test_charlie_channel_agrees_with_an_independent_quadrature(charlie, charlie_reference):
-    _, table = charlie
+@pytest.mark.parametrize("preset, channel, visibility", [("charlie", 2, "ashikhmin"), ("sheen_e", 0, "charlie"),
+                                                          ("sheen_e", 1, "ashikhmin")])
+def test_channel_agrees_with_an_independent_quadrature(request, charlie_reference, preset, channel, visibility):
+    """lut_charlie .b = ∫ D_charlie V_Ashikhmin (n.l); sheen E = the same with the spec's Charlie visibility
+    (channel 0) and with Ashikhmin's (channel 1)."""
+    _, table = request.getfixturevalue(preset)
     rough, nov = table.axes
     for y, x in TEXELS:
         a, c = float(rough.alpha()[y]), float(nov.values()[x])
-        np.testing.assert_allclose(table.data[y, x, 2], charlie_reference(a, c, "ashikhmin"), rtol=CHANNEL_RTOL)
-
-
-def test_sheen_albedo_agrees_with_an_independent_quadrature(sheen_e, charlie_reference):
-    _, table = sheen_e
-    rough, nov = table.axes
-    for y, x in TEXELS:
-        a, c = float(rough.alpha()[y]), float(nov.values()[x])
-        np.testing.assert_allclose(table.data[y, x, 0], charlie_reference(a, c, "charlie"), rtol=CHANNEL_RTOL)
-        np.testing.assert_allclose(table.data[y, x, 1], charlie_reference(a, c, "ashikhmin"), rtol=CHANNEL_RTOL)
+        np.testing.assert_allclose(table.data[y, x, channel], charlie_reference(a, c, visibility), rtol=CHANNEL_RTOL)
 
 
 def test_sheen_albedo_le_one_except_the_grazing_smooth_corner(bake_preset):
