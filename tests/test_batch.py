@@ -184,8 +184,17 @@ def test_report_has_every_field(three):
     assert [t["status"] for t in doc["tables"]] == ["skipped", "skipped", "skipped", "baked"]
 
 
+@pytest.fixture
+def terminal_sigint():
+    """SIGINT raises KeyboardInterrupt, as in a terminal (a shell's background job inherits SIG_IGN for it)."""
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)
+
+
 @pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
-def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatch, tmp_path, signum, code):
+def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatch, tmp_path, signum, code,
+                                                                      terminal_sigint):
     cfg = write_config(tmp_path, table("first"), table("slow", size=[64, 32]), table("last"))
     out = tmp_path / "out"
     out.mkdir()
@@ -275,8 +284,11 @@ def test_ctrl_c_on_a_real_process(tmp_path):
     cfg = write_config(tmp_path, table("first"), table("big", size=[256, 256], samples=432))
     out = tmp_path / "out"
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    # a child inherits SIG_IGN for SIGINT from a shell's background job (`make test &`), and Python then
+    # installs no KeyboardInterrupt handler: restore the default so the signal is delivered as from a terminal
     p = subprocess.Popen([sys.executable, "-m", "lutbake", "bake", str(cfg), "--out-dir", str(out), "--workers", "1"],
-                         env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                         env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 60
     while not (out / "first.exr").exists() and p.poll() is None and time.monotonic() < deadline:
         time.sleep(0.02)
