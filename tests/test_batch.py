@@ -108,8 +108,8 @@ def test_a_corrupt_or_foreign_output_is_rebaked(three):
     assert lutbake_header(out / "a.exr")["kind"] == "dfg"
 
 
-def _sabotage(monkeypatch, how):
-    """Make the tables named in ``how`` fail in their run_tile: name -> 'raise' | 'nan' | 'oom'."""
+def wrap_run_tile(monkeypatch, wrappers):
+    """The tables named in ``wrappers`` bake with ``wrappers[name](run_tile)`` as their plan's run_tile."""
     real = pipeline.lookup_kind
 
     def lookup(name):
@@ -117,11 +117,19 @@ def _sabotage(monkeypatch, how):
 
         def plan(spec):
             p = kind.plan(spec)
-            mode = how.get(spec.name)
-            if mode is None:
-                return p
-            orig = p.run_tile
+            wrap = wrappers.get(spec.name)
+            return p if wrap is None else dataclasses.replace(p, run_tile=wrap(p.run_tile))
 
+        return dataclasses.replace(kind, plan=plan)
+
+    monkeypatch.setattr(pipeline, "lookup_kind", lookup)
+
+
+def _sabotage(monkeypatch, how):
+    """Make the tables named in ``how`` fail in their run_tile: name -> 'raise' | 'nan' | 'oom'."""
+
+    def failing(mode):
+        def wrap(orig):
             def run_tile(s, e, d):
                 if mode == "raise":
                     raise RuntimeError("kernel exploded")
@@ -129,11 +137,11 @@ def _sabotage(monkeypatch, how):
                     raise MemoryError()
                 return np.full_like(orig(s, e, d), np.nan)
 
-            return dataclasses.replace(p, run_tile=run_tile)
+            return run_tile
 
-        return dataclasses.replace(kind, plan=plan)
+        return wrap
 
-    monkeypatch.setattr(pipeline, "lookup_kind", lookup)
+    wrap_run_tile(monkeypatch, {name: failing(mode) for name, mode in how.items()})
 
 
 def test_one_failing_table_does_not_stop_the_others(monkeypatch, tmp_path):
@@ -176,36 +184,35 @@ def test_report_has_every_field(three):
     assert [t["status"] for t in doc["tables"]] == ["skipped", "skipped", "skipped", "baked"]
 
 
+@pytest.fixture
+def terminal_sigint():
+    """SIGINT raises KeyboardInterrupt, as in a terminal (a shell's background job inherits SIG_IGN for it)."""
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)
+
+
 @pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
-def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatch, tmp_path, signum, code):
+def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatch, tmp_path, signum, code,
+                                                                      terminal_sigint):
     cfg = write_config(tmp_path, table("first"), table("slow", size=[64, 32]), table("last"))
     out = tmp_path / "out"
     out.mkdir()
     stale = out / "slow.exr"
     stale.write_bytes(b"a good file from an older run")
-    real = pipeline.lookup_kind
 
-    def lookup(name):
-        kind = real(name)
+    def interrupted(orig):
+        def run_tile(s, e, d):
+            if s == 0:
+                os.kill(os.getpid(), signum)  # Ctrl-C / SIGTERM arrives while this table bakes
+            time.sleep(0.3)
+            return orig(s, e, d)
 
-        def plan(spec):
-            p = kind.plan(spec)
-            if spec.name != "slow":
-                return p
-            orig = p.run_tile
+        return run_tile
 
-            def run_tile(s, e, d):
-                if s == 0:
-                    os.kill(os.getpid(), signum)  # Ctrl-C / SIGTERM arrives while this table bakes
-                time.sleep(0.3)
-                return orig(s, e, d)
-
-            return dataclasses.replace(p, run_tile=run_tile)
-
-        return dataclasses.replace(kind, plan=plan)
-
-    monkeypatch.setattr(pipeline, "lookup_kind", lookup)
+    wrap_run_tile(monkeypatch, {"slow": interrupted})
     rep = tmp_path / "r.json"
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
     r = bake(cfg, "--out-dir", out, "--workers", "1", "--report", rep)
     assert r.exit_code == code, r.output
     assert "Traceback" not in r.output
@@ -215,7 +222,7 @@ def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatc
     doc = json.loads(rep.read_text())
     assert [t["status"] for t in doc["tables"]] == ["baked", "interrupted", "interrupted"]
     assert doc["exit_status"] == code and doc["interrupted_by"] == signal.Signals(signum).name
-    assert signal.getsignal(signal.SIGTERM) is not None  # handler restored (no exception)
+    assert {s: signal.getsignal(s) for s in handlers} == handlers  # the bake's SIGTERM handler is gone again
     # the next run resumes only the tables that did not finish
     monkeypatch.undo()
     r = bake(cfg, "--out-dir", out)
@@ -277,8 +284,11 @@ def test_ctrl_c_on_a_real_process(tmp_path):
     cfg = write_config(tmp_path, table("first"), table("big", size=[256, 256], samples=432))
     out = tmp_path / "out"
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    # a child inherits SIG_IGN for SIGINT from a shell's background job (`make test &`), and Python then
+    # installs no KeyboardInterrupt handler: restore the default so the signal is delivered as from a terminal
     p = subprocess.Popen([sys.executable, "-m", "lutbake", "bake", str(cfg), "--out-dir", str(out), "--workers", "1"],
-                         env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                         env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 60
     while not (out / "first.exr").exists() and p.poll() is None and time.monotonic() < deadline:
         time.sleep(0.02)

@@ -12,16 +12,10 @@ from click.testing import CliRunner
 
 import lutbake
 from lutbake.cli import main
-from lutbake.config import validate_table
 from lutbake.kinds import KINDS
-from lutbake.pipeline import bake_table
 
 REPO = Path(__file__).resolve().parents[1]
 PACKAGE = REPO / "lutbake"
-
-
-def spec(**raw):
-    return validate_table({"name": "t", **raw}, "<test>", 0)
 
 
 # Two estimators per kind, on small grids at moderate roughness (QMC noise ~ 1/N there). Each entry:
@@ -51,11 +45,10 @@ AGREEMENT = [
 
 
 @pytest.mark.parametrize("kind, options, a, b, tol", AGREEMENT, ids=[k for k, *_ in AGREEMENT])
-def test_two_estimators_agree(kind, options, a, b, tol):
-    opts = dict(options)
-    sa = {k: v for k, v in opts.items() if k != "samples" or a != "gauss_legendre"}
-    ta = bake_table(spec(kind=kind, estimator=a, **sa))[0]
-    tb = bake_table(spec(kind=kind, estimator=b, **opts))[0]
+def test_two_estimators_agree(bake, kind, options, a, b, tol):
+    gl = {k: v for k, v in options.items() if k != "samples" or a != "gauss_legendre"}
+    ta = bake(gl, kind=kind, estimator=a)
+    tb = bake(options, kind=kind, estimator=b)
     assert ta.attributes["estimator"] != tb.attributes["estimator"]
     np.testing.assert_allclose(tb.data, ta.data, rtol=0, atol=tol)
 
@@ -64,12 +57,12 @@ def test_every_kind_is_checked_under_two_estimators():
     assert {k for k, *_ in AGREEMENT} == set(KINDS)
 
 
-def test_dfg_mirror_branch_is_exact():
+def test_dfg_mirror_branch_is_exact(bake):
     """alpha -> 0 is the mirror: E = 1 for F = 1 (albedo) at any NoV > 0, grazing included (the ALPHA_MIN clamp gave
     0.89 at NoV = 1e-4); the split-sum channels are (1 - Fc(NoV), Fc(NoV))."""
-    t = bake_table(spec(kind="albedo", size=[8, 4], roughness="alpha", texel="endpoint", nov_range=[0.0, 1.0]))[0]
+    t = bake(kind="albedo", size=[8, 4], roughness="alpha", texel="endpoint", nov_range=[0.0, 1.0])
     np.testing.assert_array_equal(t.data[0, :, 0], 1.0)
-    d = bake_table(spec(kind="dfg", size=[8, 4], roughness="alpha", texel="endpoint"))[0]
+    d = bake(kind="dfg", size=[8, 4], roughness="alpha", texel="endpoint")
     nov = d.axes[1].values().astype(np.float64)
     fc = (1.0 - nov) ** 5
     np.testing.assert_allclose(d.data[0, :, 0], 1.0 - fc, rtol=0, atol=1e-6)
@@ -77,10 +70,10 @@ def test_dfg_mirror_branch_is_exact():
     assert "mirror" in d.attributes["alpha_policy"]
 
 
-def test_btf_edge_policy_is_the_same_on_light_and_view():
+def test_btf_edge_policy_is_the_same_on_light_and_view(bake):
     """Endpoint texels: the light and view axes list (and integrate) the same clamped cosine, so every block is
     symmetric (reciprocity) up to the edge."""
-    t = bake_table(spec(kind="btf", size=[5, 5], phi_size=2, sigma_size=1, model="oren_nayar", texel="endpoint"))[0]
+    t = bake(kind="btf", size=[5, 5], phi_size=2, sigma_size=1, model="oren_nayar", texel="endpoint")
     axes = {a.name: a for a in t.axes}
     np.testing.assert_array_equal(axes["NoL"].values(), axes["NoV"].values())
     block = t.data[0, :5, :, 0]
@@ -88,8 +81,8 @@ def test_btf_edge_policy_is_the_same_on_light_and_view():
     assert float(block[0, 0]) > 0.0  # the grazing corner is the BRDF there, not a stored 0
 
 
-def test_sigma_axis_lists_alpha_per_index():
-    t = bake_table(spec(kind="diffuse", size=[2, 3], model="lambert", sigma_to_alpha="sigma_squared"))[0]
+def test_sigma_axis_lists_alpha_per_index(bake):
+    t = bake(kind="diffuse", size=[2, 3], model="lambert", sigma_to_alpha="sigma_squared")
     sig = next(a for a in t.axes if a.name == "sigma").describe()
     np.testing.assert_allclose(sig["alpha"], np.asarray(sig["values"]) ** 2, rtol=1e-6)
 
@@ -117,7 +110,7 @@ def test_aniso_with_a_sheen_layout_exits_2_naming_the_key(tmp_path, monkeypatch)
     assert not (tmp_path / "o").exists()
 
 
-def test_api_bake_skips_up_to_date_outputs_unless_forced(tmp_path):
+def test_api_bake_skips_up_to_date_outputs_unless_forced(spec, tmp_path):
     s = spec(kind="diffuse", size=[3, 2], model="lambert")
     first = lutbake.bake([s], out_dir=tmp_path)
     assert [r.status for r in first] == ["baked"] and first[0].path.is_file()
