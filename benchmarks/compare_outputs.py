@@ -8,6 +8,7 @@ metadata (content hash, versions, axes text) is ignored. For each table it print
 of differing texels, the largest absolute difference and where the differing texels lie (index ranges per
 array dimension).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -33,8 +34,11 @@ def read_exr(path: Path) -> np.ndarray:
         sub = 0
         while inp.seek_subimage(sub, 0):
             spec = inp.spec()
-            parts.append(np.asarray(inp.read_image(0, spec.nchannels, oiio.FLOAT), np.float64)
-                         .reshape(spec.height, spec.width, spec.nchannels))
+            parts.append(
+                np.asarray(inp.read_image(0, spec.nchannels, oiio.FLOAT), np.float64).reshape(
+                    spec.height, spec.width, spec.nchannels
+                )
+            )
             sub += 1
     finally:
         inp.close()
@@ -59,8 +63,11 @@ def read_dds(path: Path) -> np.ndarray:
     dxgi = struct.unpack_from("<I", blob, 128)[0]
     fmt = {54: ("<f2", 1), 34: ("<f2", 2), 10: ("<f2", 4), 41: ("<f4", 1), 16: ("<f4", 2), 2: ("<f4", 4)}[dxgi]
     data = np.frombuffer(blob, dtype=fmt[0], offset=148, count=depth * height * width * fmt[1])
-    return data.astype(np.float64).reshape(depth, height, width, fmt[1]).squeeze(0) if depth == 1 else \
-        data.astype(np.float64).reshape(depth, height, width, fmt[1])
+    return (
+        data.astype(np.float64).reshape(depth, height, width, fmt[1]).squeeze(0)
+        if depth == 1
+        else data.astype(np.float64).reshape(depth, height, width, fmt[1])
+    )
 
 
 def read_ktx2(path: Path) -> np.ndarray:
@@ -77,7 +84,7 @@ def read_ktx2(path: Path) -> np.ndarray:
 def read_h(path: Path) -> np.ndarray:
     text = path.read_text()
     m = re.search(r"^static const \w+ \w+\[[^\]]*\] = \{", text, flags=re.M)
-    body = text[m.end(): text.index("};", m.end())]
+    body = text[m.end() : text.index("};", m.end())]
     body = re.sub(r"/\*.*?\*/", "", body, flags=re.S)
     tokens = [t.strip().rstrip("fFuU") for t in body.split(",") if t.strip()]
     if "0x" in body:
@@ -86,8 +93,14 @@ def read_h(path: Path) -> np.ndarray:
 
 
 def read(path: Path) -> np.ndarray:
-    return {".exr": read_exr, ".npy": lambda p: np.load(p).astype(np.float64), ".png": read_png, ".dds": read_dds,
-            ".ktx2": read_ktx2, ".h": read_h}[path.suffix](path)
+    return {
+        ".exr": read_exr,
+        ".npy": lambda p: np.load(p).astype(np.float64),
+        ".png": read_png,
+        ".dds": read_dds,
+        ".ktx2": read_ktx2,
+        ".h": read_h,
+    }[path.suffix](path)
 
 
 def ranges(idx: np.ndarray) -> str:
@@ -108,8 +121,14 @@ def compare(a: np.ndarray, b: np.ndarray) -> dict:
         return {"status": "identical", "texels": int(a.size)}
     where = np.nonzero(diff)
     d = np.abs(a - b)[diff]
-    return {"status": "differs", "texels": int(a.size), "differing": int(diff.sum()), "max_abs": float(d.max()),
-            "where": {f"dim{k}": ranges(w) for k, w in enumerate(where)}, "shape": list(a.shape)}
+    return {
+        "status": "differs",
+        "texels": int(a.size),
+        "differing": int(diff.sum()),
+        "max_abs": float(d.max()),
+        "where": {f"dim{k}": ranges(w) for k, w in enumerate(where)},
+        "shape": list(a.shape),
+    }
 
 
 def main(argv=None) -> int:

@@ -3,6 +3,7 @@
     bake(configs) = config.load_configs -> batch.schedule (skip what is up to date unless ``force``) -> batch.run
 Each table goes through lutbake.pipeline.bake_table (``bake_table`` here: one table, nothing written).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -31,8 +32,17 @@ class BakeResult:
     status: str = "baked"
 
 
-def bake(configs, out_dir="outputs", overrides=(), workers: int | None = None, device: str = "cpu",
-         write: bool = True, progress: Progress | None = None, on_result=None, force: bool = False) -> list[BakeResult]:
+def bake(
+    configs,
+    out_dir="outputs",
+    overrides=(),
+    workers: int | None = None,
+    device: str = "cpu",
+    write: bool = True,
+    progress: Progress | None = None,
+    on_result=None,
+    force: bool = False,
+) -> list[BakeResult]:
     """Validate every config, then bake each table and write ``out_dir/<name>.<ext>`` (key ``format``, default
     EXR) atomically; a table whose output is up to date (same content hash, lutbake.provenance) is skipped unless
     ``force``. ``write=False`` bakes every table and writes nothing.

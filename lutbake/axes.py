@@ -19,6 +19,7 @@ bilinear sampler reconstructs the table at a parameter value; ``uv_formula`` say
 A roughness axis also carries the NDF alpha at every index: alpha = r^2 for ``perceptual_roughness``,
 alpha = value for ``alpha``, and a ``sigma`` axis the GGX alpha of its ``alpha_map`` (SIGMA_TO_ALPHA).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -27,16 +28,20 @@ import numpy as np
 
 from .edge import axis_edge, axis_edge_text
 
-IMAGE_DIMS = {"x": "columns", "y": "rows", "z": "slices",
-              "y_block": "row blocks: image row = (y_block index) * (count of the y axis) + (y index)"}
+IMAGE_DIMS = {
+    "x": "columns",
+    "y": "rows",
+    "z": "slices",
+    "y_block": "row blocks: image row = (y_block index) * (count of the y axis) + (y index)",
+}
 TEXELS = {"center": "t = (i + 0.5) / N", "endpoint": "t = i / (N - 1)"}
 MAPPINGS = {
     "linear": "value = lo + (hi - lo) * t",
     "one_minus_t2": "value = lo + (hi - lo) * (1 - t^2), i.e. t = sqrt(1 - value) on [0, 1] (Blender EEVEE NoV)",
     "texel_offset": "value = lo + (hi - lo) * min(t + 1/N, 1): one texel past the texel centre "
-                    "(Filament cmgen's roughness rows, r = clamp((H - y + 0.5)/H, 0, 1) in image row y)",
+    "(Filament cmgen's roughness rows, r = clamp((H - y + 0.5)/H, 0, 1) in image row y)",
     "listed": "value = values[i], listed in the config (not evenly spaced in general: map a parameter to a "
-              "fractional index by searching the values)",
+    "fractional index by searching the values)",
 }
 ORDERS = {
     "lo_first": "index 0 (first row / column) holds t near 0",
@@ -170,6 +175,11 @@ class Axis:
         a = self.alpha()
         if a is not None:
             d["alpha"] = [float(x) for x in a]
-            d["alpha_formula"] = ("alpha = value" if self.name == "alpha" else SIGMA_TO_ALPHA[self.alpha_map]
-                                  if self.name == "sigma" else "alpha = r^2")
+            d["alpha_formula"] = (
+                "alpha = value"
+                if self.name == "alpha"
+                else SIGMA_TO_ALPHA[self.alpha_map]
+                if self.name == "sigma"
+                else "alpha = r^2"
+            )
         return d

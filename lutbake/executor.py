@@ -5,6 +5,7 @@ cores busy. A tile is a fixed range of texels (independent of the worker count) 
 computed alone, so the output is bit-identical for any number of workers. Progress is reported through a
 callback (``Progress``); the command line draws it as a bar (lutbake.cli), the API draws nothing.
 """
+
 from __future__ import annotations
 
 import os
@@ -35,8 +36,14 @@ def tiles(n: int, size: int = TILE_TEXELS) -> list[tuple[int, int]]:
     return [(s, min(s + size, n)) for s in range(0, n, size)]
 
 
-def execute(plan: TexelPlan, workers: int | None = None, device: str = "cpu", progress: Progress | None = None,
-            label: str = "", cancel: threading.Event | None = None) -> np.ndarray:
+def execute(
+    plan: TexelPlan,
+    workers: int | None = None,
+    device: str = "cpu",
+    progress: Progress | None = None,
+    label: str = "",
+    cancel: threading.Event | None = None,
+) -> np.ndarray:
     """Evaluate every tile of ``plan``; returns float64 data of shape plan.shape.
 
     ``progress``: a ``Progress`` factory; its update is called in the calling thread after each tile.

@@ -4,6 +4,7 @@
          -> lutbake.executor.execute -> finite check -> lutbake.table.Table (lutbake.provenance.attributes)
 The batch (lutbake.batch) and the Python API (lutbake.api) both bake through ``bake_table``; writing is theirs.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -16,8 +17,9 @@ from .provenance import attributes
 from .table import Table
 
 
-def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: Progress | None = None,
-               cancel=None) -> tuple[Table, float, int]:
+def bake_table(
+    spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: Progress | None = None, cancel=None
+) -> tuple[Table, float, int]:
     """Bake one spec into a Table (nothing written): (table, seconds, samples per texel). Raises TableError if a
     value is not finite; executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
     plan = lookup_kind(spec.kind).plan(spec)
@@ -30,6 +32,13 @@ def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu",
     if plan.error_estimate is not None:
         err, how = plan.error_estimate(data.reshape(plan.n_texels, plan.n_channels), device)
         extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)
-    table = Table(spec.name, spec.kind, data.astype(np.float32), plan.axes, plan.channels, plan.reconstruction,
-                  attributes(spec, plan, extra))
+    table = Table(
+        spec.name,
+        spec.kind,
+        data.astype(np.float32),
+        plan.axes,
+        plan.channels,
+        plan.reconstruction,
+        attributes(spec, plan, extra),
+    )
     return table, t.seconds, plan.samples

@@ -7,6 +7,7 @@
 - **Provenance.** ``attributes(spec, plan)``: terms, estimator, samples, seed, config text, versions, the plan's
   own records and the content hash, written as ``lutbake:*`` (EXR header or the JSON sidecar).
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -40,8 +41,12 @@ def sources_digest() -> bytes:
 def content_hash(spec: TableSpec, digest: bytes | None = None) -> str:
     """The hex sha256 of (spec.toml(), lutbake version, source digest): what makes an output current."""
     h = hashlib.sha256()
-    for part in (b"lutbake-content-hash-v1", spec.toml().encode(), __version__.encode(),
-                 digest if digest is not None else sources_digest()):
+    for part in (
+        b"lutbake-content-hash-v1",
+        spec.toml().encode(),
+        __version__.encode(),
+        digest if digest is not None else sources_digest(),
+    ):
         h.update(str(len(part)).encode() + b"\0" + part)
     return h.hexdigest()
 
@@ -56,7 +61,7 @@ def read_header(path) -> dict[str, str] | None:
         try:
             doc = json.loads(path.with_suffix(".json").read_text(encoding="utf-8"))
             meta = doc["lutbake"] if doc.get("file") == path.name else None
-            return {k[len("lutbake:"):] if k.startswith("lutbake:") else k: str(v) for k, v in meta.items()}
+            return {k[len("lutbake:") :] if k.startswith("lutbake:") else k: str(v) for k, v in meta.items()}
         except Exception:  # no sidecar (ktx2, h) or a foreign one: rebake
             return None
     try:
@@ -68,8 +73,9 @@ def read_header(path) -> dict[str, str] | None:
             return None
         try:
             spec = inp.spec()
-            return {p.name[len("lutbake:"):]: str(p.value) for p in spec.extra_attribs
-                    if p.name.startswith("lutbake:")}
+            return {
+                p.name[len("lutbake:") :]: str(p.value) for p in spec.extra_attribs if p.name.startswith("lutbake:")
+            }
         finally:
             inp.close()
     except Exception:  # a corrupt or foreign file is simply not up to date

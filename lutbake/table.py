@@ -1,4 +1,5 @@
 """The baked table: one object that writers and checks see, its shape checks and its metadata record."""
+
 from __future__ import annotations
 
 import json
@@ -53,16 +54,13 @@ def pixels(table: Table, dtype: str) -> np.ndarray:
         raise ValueError(f"table {table.name!r}: dtype must be one of {sorted(DTYPES)}, got {dtype!r}")
     data = np.asarray(table.data)
     if data.ndim not in (3, 4):
-        raise ValueError(
-            f"table {table.name!r}: data must be (y, x, C) or (z, y, x, C), got shape {data.shape}"
-        )
+        raise ValueError(f"table {table.name!r}: data must be (y, x, C) or (z, y, x, C), got shape {data.shape}")
     nch = data.shape[-1]
     if not 1 <= nch <= 4:
         raise ValueError(f"table {table.name!r}: a table holds 1 to 4 channels, the data has {nch}")
     if len(table.channels) != nch:
         raise ValueError(
-            f"table {table.name!r}: {len(table.channels)} channel names {list(table.channels)} "
-            f"for {nch} data channels"
+            f"table {table.name!r}: {len(table.channels)} channel names {list(table.channels)} for {nch} data channels"
         )
     if data.dtype.kind not in "fiu":
         raise ValueError(f"table {table.name!r}: data must be numeric, got dtype {data.dtype}")
@@ -74,8 +72,10 @@ def pixels(table: Table, dtype: str) -> np.ndarray:
     if blocks:  # a 4th axis flattened into the rows: row = block index * (y count) + y index
         y_axes = [a for a in table.axes if a.dim == "y"]
         if not y_axes or sizes["y"] % blocks[0].count:
-            raise ValueError(f"table {table.name!r}: a y_block axis needs a y axis and {sizes['y']} rows divisible "
-                             f"by its count {blocks[0].count}")
+            raise ValueError(
+                f"table {table.name!r}: a y_block axis needs a y axis and {sizes['y']} rows divisible "
+                f"by its count {blocks[0].count}"
+            )
         sizes["y_block"] = blocks[0].count
         sizes["y"] //= blocks[0].count
     for axis in table.axes:
@@ -90,9 +90,7 @@ def pixels(table: Table, dtype: str) -> np.ndarray:
         raise ValueError(f"table {table.name!r}: a 3D table needs an axis with dim 'z'")
     clash = RESERVED.intersection(table.attributes)
     if clash:
-        raise ValueError(
-            f"table {table.name!r}: attributes {sorted(clash)} are reserved (lutbake writes them itself)"
-        )
+        raise ValueError(f"table {table.name!r}: attributes {sorted(clash)} are reserved (lutbake writes them itself)")
 
     with np.errstate(over="ignore", invalid="ignore"):
         out = np.ascontiguousarray(data, dtype=DTYPES[dtype])

@@ -10,6 +10,7 @@
 - ``charlie_reference(alpha, nov, visibility, clamp=False)``: ∫ D_charlie V (n.l) dω_l by that rule in
   numpy, independent of lutbake's @wp.funcs (the sheen and Filament cloth tests compare with it).
 """
+
 from pathlib import Path
 
 import numpy as np
@@ -90,7 +91,7 @@ def graded_gauss_legendre(a, b, singular, ratio=0.25, levels=18, order=12):
         if a <= p <= b:
             cuts.add(p)
             for end in (a, b):
-                cuts.update(p + (end - p) * ratio ** k for k in range(1, levels + 1))
+                cuts.update(p + (end - p) * ratio**k for k in range(1, levels + 1))
     cuts = np.array(sorted(cuts))
     cuts = cuts[np.concatenate([[True], np.diff(cuts) > 1e-14])]
     x, w = np.polynomial.legendre.leggauss(order)

@@ -1,7 +1,7 @@
 """The executor: bit-identical output for any worker count; the table's axes and values."""
+
 import numpy as np
 import pytest
-
 
 DFG = {"name": "t", "kind": "dfg", "size": [24, 20]}
 MIRROR_ATOL = 1e-5  # the r = 0 row (alpha = ALPHA_MIN) vs the mirror's closed form away from grazing: measured 2e-7

@@ -1,6 +1,7 @@
 """Batch runs (issue 7): incremental content-hash skips, --force, --report, one failing table does
 not stop the others, Ctrl-C / SIGTERM keep finished tables and write no unfinished one, two
 concurrent runs never corrupt a file, and the output is deterministic for any worker count."""
+
 import dataclasses
 import json
 import os
@@ -94,8 +95,16 @@ def test_content_hash_covers_config_version_and_kernel_sources(monkeypatch, tmp_
     monkeypatch.setattr(provenance, "__version__", "9.9.9")
     assert provenance.content_hash(s) != h
     rel = {f.relative_to(provenance.PACKAGE).as_posix() for f in provenance.source_files()}
-    for f in ("terms/ndf.py", "terms/masking.py", "terms/fresnel.py", "sampling/hemisphere.py",
-              "kinds/dfg.py", "integrands/specular.py", "axes.py", "edge.py"):
+    for f in (
+        "terms/ndf.py",
+        "terms/masking.py",
+        "terms/fresnel.py",
+        "sampling/hemisphere.py",
+        "kinds/dfg.py",
+        "integrands/specular.py",
+        "axes.py",
+        "edge.py",
+    ):
         assert f in rel
 
 
@@ -193,8 +202,9 @@ def terminal_sigint():
 
 
 @pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
-def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatch, tmp_path, signum, code,
-                                                                      terminal_sigint):
+def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(
+    monkeypatch, tmp_path, signum, code, terminal_sigint
+):
     cfg = write_config(tmp_path, table("first"), table("slow", size=[64, 32]), table("last"))
     out = tmp_path / "out"
     out.mkdir()
@@ -236,8 +246,9 @@ def test_two_concurrent_runs_never_corrupt_a_file(tmp_path):
     out = tmp_path / "out"
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     cmd = [sys.executable, "-m", "lutbake", "bake", str(cfg), "--out-dir", str(out), "--force", "--workers", "1"]
-    procs = [subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-             for _ in range(2)]
+    procs = [
+        subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(2)
+    ]
     for p in procs:
         stdout, stderr = p.communicate(timeout=120)
         assert p.returncode == 0, stderr
@@ -251,8 +262,12 @@ def test_two_concurrent_runs_never_corrupt_a_file(tmp_path):
 
 
 def test_same_config_gives_identical_pixels_and_headers_for_any_worker_count(tmp_path):
-    cfg = write_config(tmp_path, table("x", size=[24, 12]), table("y", size=[9, 5], estimator="sobol_ndf"),
-                       table("z", size=[7, 3], texel="endpoint", dtype="half"))
+    cfg = write_config(
+        tmp_path,
+        table("x", size=[24, 12]),
+        table("y", size=[9, 5], estimator="sobol_ndf"),
+        table("z", size=[7, 3], texel="endpoint", dtype="half"),
+    )
     runs = []
     for k, workers in enumerate(["1", "2", "2"]):
         out = tmp_path / f"out{k}"
@@ -286,9 +301,14 @@ def test_ctrl_c_on_a_real_process(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     # a child inherits SIG_IGN for SIGINT from a shell's background job (`make test &`), and Python then
     # installs no KeyboardInterrupt handler: restore the default so the signal is delivered as from a terminal
-    p = subprocess.Popen([sys.executable, "-m", "lutbake", "bake", str(cfg), "--out-dir", str(out), "--workers", "1"],
-                         env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                         preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+    p = subprocess.Popen(
+        [sys.executable, "-m", "lutbake", "bake", str(cfg), "--out-dir", str(out), "--workers", "1"],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     deadline = time.monotonic() + 60
     while not (out / "first.exr").exists() and p.poll() is None and time.monotonic() < deadline:
         time.sleep(0.02)

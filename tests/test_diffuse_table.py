@@ -1,4 +1,5 @@
 """Kind ``diffuse`` (AmbientBRDF, NoV x sigma): albedo invariants, the sigma = 0 limit, f0 factoring."""
+
 import numpy as np
 import pytest
 
@@ -46,8 +47,15 @@ def test_microfacet_f0_factors_out(microfacet, bake):
     assert t.attributes["f0_factor"] == "(1 - f0)"
 
 
-@pytest.mark.parametrize("kv, fragment", [({"model": "phong"}, "lambert"), ({"f0": 1.5}, "<="),
-                                           ({"sigma_to_alpha": "cube"}, "sigma_squared"), ({"samples": 1}, ">= 2")])
+@pytest.mark.parametrize(
+    "kv, fragment",
+    [
+        ({"model": "phong"}, "lambert"),
+        ({"f0": 1.5}, "<="),
+        ({"sigma_to_alpha": "cube"}, "sigma_squared"),
+        ({"samples": 1}, ">= 2"),
+    ],
+)
 def test_bad_diffuse_keys_are_rejected(kv, fragment, spec):
     with pytest.raises(ConfigError, match=fragment):
         spec(DIFFUSE, **kv)
@@ -55,7 +63,8 @@ def test_bad_diffuse_keys_are_rejected(kv, fragment, spec):
 
 def test_swapped_albedo_matches_the_nested_rule():
     """The table's integrator (m outside, l inside: lutbake.sampling.swapped) against the direct nested
-    rule (l outside, Eq. 4's m-integral inside: integrands.diffuse.albedo_gl), grazing and small-sigma texels included."""
+    rule (l outside, Eq. 4's m-integral inside: integrands.diffuse.albedo_gl), grazing and small-sigma texels
+    included."""
     from lutbake.axes import sigma_alpha
     from lutbake.edge import effective_alpha
     from lutbake.integrands import diffuse as D
@@ -76,8 +85,7 @@ def test_grazing_small_sigma_corner_is_converged(bake):
     """The corner the old nested rule missed by 2.9e-3 (NoV = sigma = 1/128): the default orders against order 32."""
     from lutbake.integrands import diffuse as D
 
-    t = bake(DIFFUSE, model="microfacet", size=[4, 4], nov_range=[0.0, 0.0625], sigma_range=[0.0, 0.0625],
-             workers=1)
+    t = bake(DIFFUSE, model="microfacet", size=[4, 4], nov_range=[0.0, 0.0625], sigma_range=[0.0, 0.0625], workers=1)
     nov = np.tile(t.axes[1].values(), 4).astype(np.float64)
     alpha = np.repeat(t.axes[0].values(), 4).astype(np.float64)
     ref = D.albedo_swapped(nov, alpha, orders=np.full((16, 3), 32))

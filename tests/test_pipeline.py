@@ -1,5 +1,6 @@
 """The one pipeline: every kind bakes under two estimators that agree; the reported config bugs exit 2 naming the
 key before any kernel runs; api.bake skips up-to-date outputs like the CLI; the import layers point one way."""
+
 from __future__ import annotations
 
 import ast
@@ -24,23 +25,58 @@ AGREEMENT_TOL_QMC = 2.0e-3  # 4096 scrambled Sobol' points of a bounded integran
 AGREEMENT_TOL_ANISO = 5.0e-3  # lobe sampling vs cosine-weighted l, 65536 points each (measured 1.9e-3)
 AGREEMENT = [
     ("dfg", {"size": [6, 4], "roughness_range": [0.3, 1.0]}, "gauss_legendre", "sobol_vndf", AGREEMENT_TOL_QMC),
-    ("albedo", {"size": [6, 4], "roughness_range": [0.3, 1.0], "nov_range": [0.3, 1.0], "samples": 16384},
-     "gauss_legendre", "sobol_ndf", AGREEMENT_TOL_QMC),
-    ("albedo_avg", {"roughness_size": 4, "roughness_range": [0.3, 1.0], "mu_order": 8}, "gauss_legendre",
-     "sobol_vndf", AGREEMENT_TOL_QMC),
-    ("specular_3d", {"size": [4, 3], "f0_size": 2, "roughness_range": [0.3, 1.0]}, "gauss_legendre", "sobol_vndf",
-     AGREEMENT_TOL_QMC),
+    (
+        "albedo",
+        {"size": [6, 4], "roughness_range": [0.3, 1.0], "nov_range": [0.3, 1.0], "samples": 16384},
+        "gauss_legendre",
+        "sobol_ndf",
+        AGREEMENT_TOL_QMC,
+    ),
+    (
+        "albedo_avg",
+        {"roughness_size": 4, "roughness_range": [0.3, 1.0], "mu_order": 8},
+        "gauss_legendre",
+        "sobol_vndf",
+        AGREEMENT_TOL_QMC,
+    ),
+    (
+        "specular_3d",
+        {"size": [4, 3], "f0_size": 2, "roughness_range": [0.3, 1.0]},
+        "gauss_legendre",
+        "sobol_vndf",
+        AGREEMENT_TOL_QMC,
+    ),
     # cosine-weighted l converges slowly for the peaked lobe at grazing view: measured 2.0e-2 at 4096 points,
     # 1.9e-3 at 65536 (2.7e-3 for Ashikhmin-Shirley)
-    ("specular_aniso", {"size": [4, 3], "anisotropy_size": 2, "roughness_range": [0.4, 1.0], "samples": 65536},
-     "sobol", "sobol_cosine", AGREEMENT_TOL_ANISO),
-    ("diffuse", {"size": [4, 3], "model": "oren_nayar", "sigma_range": [0.2, 1.0], "samples": 4096},
-     "gauss_legendre", "sobol_cosine", AGREEMENT_TOL_QMC),
-    ("diffuse_3d", {"size": [3, 2], "f0_size": 2, "sigma_range": [0.3, 1.0], "samples": 1024}, "gauss_legendre",
-     "sobol_cosine", 5.0e-3),
+    (
+        "specular_aniso",
+        {"size": [4, 3], "anisotropy_size": 2, "roughness_range": [0.4, 1.0], "samples": 65536},
+        "sobol",
+        "sobol_cosine",
+        AGREEMENT_TOL_ANISO,
+    ),
+    (
+        "diffuse",
+        {"size": [4, 3], "model": "oren_nayar", "sigma_range": [0.2, 1.0], "samples": 4096},
+        "gauss_legendre",
+        "sobol_cosine",
+        AGREEMENT_TOL_QMC,
+    ),
+    (
+        "diffuse_3d",
+        {"size": [3, 2], "f0_size": 2, "sigma_range": [0.3, 1.0], "samples": 1024},
+        "gauss_legendre",
+        "sobol_cosine",
+        5.0e-3,
+    ),
     # f itself (values 0.09 .. 0.6): the m-integral by GL panels vs Sobol' facet normals (measured 2.0e-3 at 65536)
-    ("btf", {"size": [4, 4], "phi_size": 2, "sigma_size": 2, "sigma_range": [0.3, 1.0], "samples": 65536},
-     "gauss_legendre", "sobol_ndf", AGREEMENT_TOL_ANISO),
+    (
+        "btf",
+        {"size": [4, 4], "phi_size": 2, "sigma_size": 2, "sigma_range": [0.3, 1.0], "samples": 65536},
+        "gauss_legendre",
+        "sobol_ndf",
+        AGREEMENT_TOL_ANISO,
+    ),
 ]
 
 

@@ -6,6 +6,7 @@ and measures max and mean |baked - shipped| per channel. Tolerances come from th
 precision and noise, stated at each test: lutbake integrates to convergence (~1e-7), the engines used
 1024..262144 quasi-random samples in float32 and stored half floats or 8-bit codes.
 """
+
 import json
 from pathlib import Path
 
@@ -14,7 +15,7 @@ import pytest
 
 from lutbake.config import load_config, preset_path, presets
 
-HALF_ULP_AT_1 = 2.0 ** -11  # half-float rounding error just below 1 (spacing 2^-11 in [0.5, 1))
+HALF_ULP_AT_1 = 2.0**-11  # half-float rounding error just below 1 (spacing 2^-11 in [0.5, 1))
 U8_HALF_STEP = 0.5 / 255  # 8-bit UNORM rounding
 # Filament's cloth channel vs the converged reference (conftest.integrate_charlie), relative: measured 3.4e-5
 # (the preset's own quadrature, smooth rows); was 5e-4 against a 3000x3000 midpoint rule whose error was 2.4e-4.
@@ -33,9 +34,14 @@ def as_written(table, dtype):
 DATA = Path(__file__).resolve().parent / "data"
 
 
-@pytest.mark.parametrize("name, shape, key", [("filament_dfg", (128, 128, 3), None),
-                                              ("blender_eevee_next_brdf_ggx", (64, 64, 3), "sample_values"),
-                                              ("khronos_lut_ggx_u8", (1024, 1024, 2), "sample_values_RG")])
+@pytest.mark.parametrize(
+    "name, shape, key",
+    [
+        ("filament_dfg", (128, 128, 3), None),
+        ("blender_eevee_next_brdf_ggx", (64, 64, 3), "sample_values"),
+        ("khronos_lut_ggx_u8", (1024, 1024, 2), "sample_values_RG"),
+    ],
+)
 def test_shipped_tables_hold_their_provenance_sample_values(shipped, name, shape, key):
     """The arrays in tests/data are the tables their .json notes describe: shape, and every sample value
     listed there ("[row,column]": channels; printed to 5 decimals for the PNG (one 8-bit code is 3.9e-3),
@@ -44,9 +50,9 @@ def test_shipped_tables_hold_their_provenance_sample_values(shipped, name, shape
     table = shipped(name)
     assert table.shape == shape and np.all(np.isfinite(table))
     assert tuple(note["shape"][:2]) == shape[:2]
-    for texel, want in (note[key].items() if key else ()):
+    for texel, want in note[key].items() if key else ():
         row, col = json.loads(texel)
-        np.testing.assert_allclose(table[row, col, :len(want)], want, atol=1e-5 if shape[2] == 2 else 1e-7)
+        np.testing.assert_allclose(table[row, col, : len(want)], want, atol=1e-5 if shape[2] == 2 else 1e-7)
     if key is None:  # Filament's note lists no values; its row order: row 0 = r 1.0 (rough), last row smooth
         assert note["perceptual_roughness_per_row"][0] == pytest.approx(1.0)
         assert table[-1, -1, 1] == pytest.approx(1.0, abs=HALF_ULP_AT_1) and table[0, -1, 1] < 0.5  # G = E(F = 1)

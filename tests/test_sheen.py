@@ -3,6 +3,7 @@
 
 The baked channels are checked against an independent converged quadrature over l in numpy (the terms
 written out again from the KHR spec's GLSL, not lutbake's @wp.funcs): conftest.integrate_charlie."""
+
 import numpy as np
 import pytest
 
@@ -44,8 +45,9 @@ def test_presets_exist_with_the_viewer_axes(charlie, sheen_e):
     assert np.all(charlie[1].data[..., :2] == 0)  # the viewer's lut_charlie: value in .b
 
 
-@pytest.mark.parametrize("preset, channel, visibility", [("charlie", 2, "ashikhmin"), ("sheen_e", 0, "charlie"),
-                                                          ("sheen_e", 1, "ashikhmin")])
+@pytest.mark.parametrize(
+    "preset, channel, visibility", [("charlie", 2, "ashikhmin"), ("sheen_e", 0, "charlie"), ("sheen_e", 1, "ashikhmin")]
+)
 def test_channel_agrees_with_an_independent_quadrature(request, charlie_reference, preset, channel, visibility):
     """lut_charlie .b = ∫ D_charlie V_Ashikhmin (n.l); sheen E = the same with the spec's Charlie visibility
     (channel 0) and with Ashikhmin's (channel 1)."""
@@ -73,8 +75,12 @@ def test_sheen_albedo_le_one_except_the_grazing_smooth_corner(bake_preset):
 def test_sheen_layouts_reject_qmc_and_other_terms(tmp_path):
     p = tmp_path / "s.toml"
     for layout in ("charlie", "sheen_albedo"):
-        for extra, key in (('estimator = "sobol_vndf"', "estimator"), ('estimator = "hammersley_ndf"', "estimator"),
-                           ('ndf = "beckmann"', "layout"), ('model = "blinn_phong"', "layout")):
+        for extra, key in (
+            ('estimator = "sobol_vndf"', "estimator"),
+            ('estimator = "hammersley_ndf"', "estimator"),
+            ('ndf = "beckmann"', "layout"),
+            ('model = "blinn_phong"', "layout"),
+        ):
             p.write_text(f'[[table]]\nname = "s"\nkind = "dfg"\nlayout = "{layout}"\n{extra}\n')
             with pytest.raises(ConfigError) as e:
                 load_config(p)
@@ -101,6 +107,7 @@ def test_clamped_layouts_are_the_viewers_integrand(bake_preset, charlie_referenc
         a, c = float(rough.alpha()[y]), float(nov.values()[x])
         want_charlie = charlie_reference(a, c, "ashikhmin", clamp=True)
         np.testing.assert_allclose(clamped.data[y, x, 2], want_charlie, rtol=CLAMPED_RTOL)
-        np.testing.assert_allclose(e_clamped.data[y, x, 0], charlie_reference(a, c, "charlie", clamp=True),
-                                   rtol=CLAMPED_RTOL)
+        np.testing.assert_allclose(
+            e_clamped.data[y, x, 0], charlie_reference(a, c, "charlie", clamp=True), rtol=CLAMPED_RTOL
+        )
     assert e_clamped.data[..., 0].max() <= 1.0  # the clamp also removes the corner's E > 1 (measured max below)

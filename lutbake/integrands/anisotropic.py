@@ -17,6 +17,7 @@ Lobes (key ``model``), each as ``sample(v, ax, ay, nu, nv, u1, u2) -> h`` (its o
   density; sampled by the paper's Eq. 9, weight = F (n.l) / max(n.l, n.v). alpha clamped to >= ALPHA_MIN.
 The channels are those of the dfg layouts scale_bias / multiscatter (lutbake.integrands.specular.channels_for).
 """
+
 from __future__ import annotations
 
 import functools
@@ -34,7 +35,9 @@ ANISO_MODELS = {
     "ashikhmin_shirley": "Ashikhmin & Shirley 2000, nu = 2/alpha_x^2 - 2 (tangent), nv = 2/alpha_y^2 - 2 (bitangent)",
 }
 ANISO_LAYOUTS = ("scale_bias", "multiscatter")
-AXES_FORMULA = "aspect = sqrt(1 - 0.9 |a|); alpha_x = alpha / aspect, alpha_y = alpha * aspect (a >= 0; swapped for a < 0)"
+AXES_FORMULA = (
+    "aspect = sqrt(1 - 0.9 |a|); alpha_x = alpha / aspect, alpha_y = alpha * aspect (a >= 0; swapped for a < 0)"
+)
 
 
 def alpha_xy(alpha: np.ndarray, aniso: np.ndarray, mirror: bool = False) -> tuple[np.ndarray, np.ndarray]:
@@ -83,8 +86,10 @@ def f_cos_ashikhmin_shirley(v: wp.vec3, l: wp.vec3, h: wp.vec3, ax: float, ay: f
     return ndf.D_ashikhmin_shirley(h, nu, nv) * l[2] / (4.0 * wp.dot(v, h) * wp.max(l[2], v[2]))
 
 
-LOBES = {"microfacet": (sample_microfacet, weight_microfacet, f_cos_microfacet),
-         "ashikhmin_shirley": (sample_ashikhmin_shirley, weight_ashikhmin_shirley, f_cos_ashikhmin_shirley)}
+LOBES = {
+    "microfacet": (sample_microfacet, weight_microfacet, f_cos_microfacet),
+    "ashikhmin_shirley": (sample_ashikhmin_shirley, weight_ashikhmin_shirley, f_cos_ashikhmin_shirley),
+}
 
 
 @dataclass(frozen=True)

@@ -1,11 +1,12 @@
-"""Integrands of the diffuse tables: the diffuse BRDFs f(l, v) for rho = 1, as ``brdf(l, v, sigma, alpha, f0, xg,
-wg) -> float64`` (closed forms ignore alpha and the GL arrays; the microfacet model of Gotanda 2014, Eq. 4, is
+"""Integrands of the diffuse tables: the diffuse BRDFs f(l, v) for rho = 1, as ``brdf(l, v, sigma, alpha, f0,
+rule) -> float64`` (closed forms ignore alpha and the GL arrays; the microfacet model of Gotanda 2014, Eq. 4, is
 integrated over m by lutbake.sampling.facets and ignores sigma).
 
 The record ``DiffuseIntegrand`` also carries, for the microfacet model, its facet transmission split
 F_facet = c(f0) T(m.l) T(m.v) (``transmission`` = T, ``f0_scale`` = c), which the swapped-integral albedo
 (lutbake.sampling.swapped) needs. alpha -> 0 has no closed form here: alpha is clamped to ALPHA_MIN (lutbake.edge).
 """
+
 from __future__ import annotations
 
 import functools
@@ -23,12 +24,16 @@ from ..terms import diffuse
 
 FACET_FRESNEL = {
     "eq6": "Eq. 6 on each facet: 21/20 (1 - f0)(1 - (1 - m.l)^5)(1 - (1 - m.v)^5); E scales with (1 - f0)",
-    "schlick": "(1 - F(m.l))(1 - F(m.v)), F Schlick: (1 - f0)^2 (1 - (1 - m.l)^5)(1 - (1 - m.v)^5); E scales with (1 - f0)^2",
+    "schlick": "(1 - F(m.l))(1 - F(m.v)), F Schlick: (1 - f0)^2 (1 - (1 - m.l)^5)(1 - (1 - m.v)^5); "
+    "E scales with (1 - f0)^2",
     "dielectric_f0": "(1 - F(m.l))(1 - F(m.v)), F the exact dielectric Fresnel of Eq. 2 written with f0: f0 does not "
-                     "factor out (kind diffuse_3d bakes an f0 axis; kind diffuse bakes the given f0 only)",
+    "factor out (kind diffuse_3d bakes an f0 axis; kind diffuse bakes the given f0 only)",
 }
-FACET_FUNCS = {"eq6": diffuse.F_facet_eq6, "schlick": diffuse.F_facet_schlick,
-               "dielectric_f0": diffuse.F_facet_dielectric_f0}
+FACET_FUNCS = {
+    "eq6": diffuse.F_facet_eq6,
+    "schlick": diffuse.F_facet_schlick,
+    "dielectric_f0": diffuse.F_facet_dielectric_f0,
+}
 DIFFUSE_MODELS = {
     "lambert": "Lambert, rho / pi",
     "oren_nayar": "classic Oren-Nayar as taught in lecture 003 (A with 0.57)",
@@ -62,51 +67,52 @@ FACET_SPLIT = {
 }
 
 
+CLOSED_FORMS = {  # model -> (Fd_ term, whether it takes f0)
+    "oren_nayar": (diffuse.Fd_oren_nayar, False),
+    "oren_nayar_improved": (diffuse.Fd_oren_nayar_improved, False),
+    "oren_nayar_fresnel": (diffuse.Fd_oren_nayar_fresnel, True),
+    "fitted": (diffuse.Fd_gotanda_fitted, True),
+    "fitted_slides": (diffuse.Fd_gotanda_fitted_slides, True),
+}
+
+
 @functools.lru_cache(maxsize=None)
 def brdf_for(model: str, facet_fresnel: str = "eq6"):
-    """``brdf(l, v, sigma, alpha, f0, xg, wg) -> float64``: the model's BRDF for rho = 1 (closed forms ignore
-    alpha and the GL arrays; the microfacet model ignores sigma)."""
+    """``brdf(l, v, sigma, alpha, f0, rule) -> float64``: the model's BRDF for rho = 1 (closed forms ignore alpha and
+    the GL rule (node, weight) of the microfacet model's m-integral; the microfacet model ignores sigma)."""
     if model == "microfacet":
         fm = fd_microfacet_for(FACET_FUNCS[facet_fresnel])
 
         @wp.func
-        def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float,
-                 xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64)):
-            return fm(l, v, alpha, f0, xg, wg)
+        def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float, rule: wp.array(dtype=wp.vec2d)):
+            return fm(l, v, alpha, f0, rule)
 
         return brdf
-    closed = {
-        "oren_nayar": diffuse.Fd_oren_nayar,
-        "oren_nayar_improved": diffuse.Fd_oren_nayar_improved,
-    }
-    with_f0 = {
-        "oren_nayar_fresnel": diffuse.Fd_oren_nayar_fresnel,
-        "fitted": diffuse.Fd_gotanda_fitted,
-        "fitted_slides": diffuse.Fd_gotanda_fitted_slides,
-    }
     if model == "lambert":
+
         @wp.func
-        def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float,
-                 xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64)):
+        def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float, rule: wp.array(dtype=wp.vec2d)):
             if l[2] <= COS_EPS or v[2] <= COS_EPS:
                 return wp.float64(0.0)
             return wp.float64(diffuse.Fd_lambert(1.0))
-    elif model in closed:
-        F = closed[model]
+
+        return brdf
+    F, with_f0 = CLOSED_FORMS[model]
+    if with_f0:
 
         @wp.func
-        def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float,
-                 xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64)):
-            return wp.float64(F(1.0, l[2], v[2], wp.dot(l, v), sigma))
-    elif model in with_f0:
-        F = with_f0[model]
-
-        @wp.func
-        def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float,
-                 xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64)):
-            return wp.float64(F(1.0, l[2], v[2], wp.dot(l, v), sigma, f0))
+        def closed(l: wp.vec3, v: wp.vec3, sigma: float, f0: float):
+            return F(1.0, l[2], v[2], wp.dot(l, v), sigma, f0)
     else:
-        raise KeyError(model)
+
+        @wp.func
+        def closed(l: wp.vec3, v: wp.vec3, sigma: float, f0: float):
+            return F(1.0, l[2], v[2], wp.dot(l, v), sigma)
+
+    @wp.func
+    def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float, rule: wp.array(dtype=wp.vec2d)):
+        return wp.float64(closed(l, v, sigma, f0))
+
     return brdf
 
 
@@ -135,29 +141,48 @@ def _alpha(sigma, sigma_to_alpha: str):
     return effective_alpha(sigma_alpha(np.asarray(sigma, np.float32), sigma_to_alpha), False)
 
 
-def eval_brdf(model: str, l: np.ndarray, v: np.ndarray, sigma, f0: float = 0.0, facet_fresnel: str = "eq6",
-              sigma_to_alpha: str = "sigma", order: int = 8, device: str = "cpu") -> np.ndarray:
+def eval_brdf(
+    model: str,
+    l: np.ndarray,
+    v: np.ndarray,
+    sigma,
+    f0: float = 0.0,
+    facet_fresnel: str = "eq6",
+    sigma_to_alpha: str = "sigma",
+    order: int = 8,
+    device: str = "cpu",
+) -> np.ndarray:
     """Host helper: f(l_i, v_i) for unit direction arrays (N, 3) (n = +z), rho = 1, the microfacet model's m-rule
     of ``order``; float64 (N,)."""
     n = len(np.asarray(l).reshape(-1, 3))
     s = np.broadcast_to(np.asarray(sigma, dtype=np.float32), (n,))
-    return eval_points(diffuse_integrand(model, facet_fresnel), l, v, s, _alpha(s, sigma_to_alpha), f0, order,
-                       device)
+    return eval_points(diffuse_integrand(model, facet_fresnel), l, v, s, _alpha(s, sigma_to_alpha), f0, order, device)
 
 
-def albedo_gl(model: str, nov, sigma, f0: float = 0.0, facet_fresnel: str = "eq6", sigma_to_alpha: str = "sigma",
-              order: int = 8, outer_order: int | None = None, device: str = "cpu") -> np.ndarray:
+def albedo_gl(
+    model: str,
+    nov,
+    sigma,
+    f0: float = 0.0,
+    facet_fresnel: str = "eq6",
+    sigma_to_alpha: str = "sigma",
+    order: int = 8,
+    outer_order: int | None = None,
+    device: str = "cpu",
+) -> np.ndarray:
     """Host helper: E(nov_i, sigma_i) = ∫ f (n.l) dω_l (rho = 1) by GL over l on 2 x 2 panels
     (lutbake.sampling.diffuse.DiffuseGaussLegendre), float64 (N,)."""
     nov = np.ascontiguousarray(nov, dtype=np.float32)
     s = np.ascontiguousarray(np.broadcast_to(np.asarray(sigma, dtype=np.float32), nov.shape))
     inputs = {"nov": nov, "sigma": s, "alpha": _alpha(s, sigma_to_alpha), "f0": np.full(len(nov), f0)}
-    return DiffuseGaussLegendre(order, outer_order).evaluate(diffuse_integrand(model, facet_fresnel), inputs,
-                                                             device)[:, 0]
+    return DiffuseGaussLegendre(order, outer_order).evaluate(diffuse_integrand(model, facet_fresnel), inputs, device)[
+        :, 0
+    ]
 
 
-def albedo_swapped(nov, alpha, f0=0.0, facet_fresnel: str = "eq6", order: int = 12, orders=None,
-                   device: str = "cpu") -> np.ndarray:
+def albedo_swapped(
+    nov, alpha, f0=0.0, facet_fresnel: str = "eq6", order: int = 12, orders=None, device: str = "cpu"
+) -> np.ndarray:
     """Host helper: the microfacet model's E(nov_i) for GGX alpha_i by the swapped integral
     (lutbake.sampling.swapped), float64 (N,)."""
     return integrate_swapped(diffuse_integrand("microfacet", facet_fresnel), nov, alpha, f0, order, orders, device)

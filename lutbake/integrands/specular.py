@@ -12,6 +12,7 @@ with Schlick F = f0 (1 - Fc) + Fc, Fc = (1 - v.h)^5 (Karis 2013):
 The cloth layout adds a channel with its own BRDF, D_charlie V_ashikhmin (no Fresnel), whose integrand
 in the same measure is D_charlie V_ashikhmin (n.l) 4 (v.h) (Filament's DFV_Charlie_Uniform).
 """
+
 from __future__ import annotations
 
 import functools
@@ -64,13 +65,28 @@ def channels_multiscatter3(VoH: float, f0: float):
     return wp.vec3(fresnel.Fc_schlick(VoH), 1.0, 0.0)
 
 
-CHANNEL_FUNCS = {"scale_bias": channels_scale_bias, "multiscatter": channels_multiscatter,
-                 "albedo": channels_albedo, **{f"F:{name}": fresnel_channels(getattr(fresnel, f"F_{name}"))
-                                               for name in ("schlick", "schlick_sg", "improved_sg", "dielectric_f0")},
-                 "scale_bias_f82": channels_scale_bias_f82}
+CHANNEL_FUNCS = {
+    "scale_bias": channels_scale_bias,
+    "multiscatter": channels_multiscatter,
+    "albedo": channels_albedo,
+    **{
+        f"F:{name}": fresnel_channels(getattr(fresnel, f"F_{name}"))
+        for name in ("schlick", "schlick_sg", "improved_sg", "dielectric_f0")
+    },
+    "scale_bias_f82": channels_scale_bias_f82,
+}
 THREE_CHANNELS = {"scale_bias_f82", "multiscatter_cloth", "charlie", "charlie_clamped"}
-N_CHANNELS = {"scale_bias": 2, "multiscatter": 2, "albedo": 2, "scale_bias_f82": 3, "multiscatter_cloth": 3,
-              "charlie": 3, "sheen_albedo": 2, "charlie_clamped": 3, "sheen_albedo_clamped": 2}
+N_CHANNELS = {
+    "scale_bias": 2,
+    "multiscatter": 2,
+    "albedo": 2,
+    "scale_bias_f82": 3,
+    "multiscatter_cloth": 3,
+    "charlie": 3,
+    "sheen_albedo": 2,
+    "charlie_clamped": 3,
+    "sheen_albedo_clamped": 2,
+}
 # the sheen lobe alone: no GGX term (sheen_integrand_for); *_clamped: V clamped to [0, 1] (the viewer's shaders)
 SHEEN_LAYOUTS = ("charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped")
 
@@ -82,14 +98,15 @@ def channels_for(channels_name: str):
     if channels_name in CHANNEL_FUNCS:
         return CHANNEL_FUNCS[channels_name], (wp.vec3 if channels_name in THREE_CHANNELS else wp.vec2)
     if channels_name.startswith("metal:"):
-        m = metals.lookup_metal(channels_name[len("metal:"):])
+        m = metals.lookup_metal(channels_name[len("metal:") :])
         nr, ng, nb = (float(x) for x in m.n)
         kr, kg, kb = (float(x) for x in m.k)
 
         @wp.func
         def channels_metal(VoH: float, f0: float):
-            return wp.vec3(fresnel.F_conductor(nr, kr, VoH), fresnel.F_conductor(ng, kg, VoH),
-                           fresnel.F_conductor(nb, kb, VoH))
+            return wp.vec3(
+                fresnel.F_conductor(nr, kr, VoH), fresnel.F_conductor(ng, kg, VoH), fresnel.F_conductor(nb, kb, VoH)
+            )
 
         return channels_metal, wp.vec3
     raise KeyError(channels_name)
@@ -122,11 +139,13 @@ def weight_for(ndf_name: str, masking_name: str, form: str):
         def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
             return D(h, alpha) * G2(v[2], l[2], h[2], VoH, alpha) * VoH / v[2]
     elif form == "blinn_phong":
+
         @wp.func
         def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
             s = ndf.shininess_from_alpha(alpha)
             return (s + 8.0) / (8.0 * wp.pi) * wp.exp(s * ndf.log_cos(h)) * 4.0 * l[2] * VoH
     elif form == "ashikhmin_shirley":
+
         @wp.func
         def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
             s = ndf.shininess_from_alpha(alpha)
@@ -204,11 +223,11 @@ def sheen_integrand_for(layout: str):
 SPECULAR_MODELS = {
     "microfacet": "D G2 F / (4 (n.l)(n.v)) with the config's ndf and masking (default)",
     "cook_torrance": "Cook & Torrance 1982 as in the lecture: Beckmann D (with 1/pi), V-cavity G, Schlick F; "
-                     "the same as model = microfacet, ndf = beckmann, masking = v_cavity",
+    "the same as model = microfacet, ndf = beckmann, masking = v_cavity",
     "blinn_phong": "the lecture's normalized Blinn-Phong lobe f = F (s + 8)/(8 pi) (n.h)^s, s = 2/alpha^2 - 2 "
-                   "(no G; the lecture's (s + 8)/8 is this times pi, per unit irradiance)",
+    "(no G; the lecture's (s + 8)/8 is this times pi, per unit irradiance)",
     "ashikhmin_shirley": "Ashikhmin & Shirley 2000, isotropic (nu = nv = s = 2/alpha^2 - 2): "
-                         "f = F sqrt((nu+1)(nv+1))/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v))",
+    "f = F sqrt((nu+1)(nv+1))/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v))",
 }
 
 
@@ -262,8 +281,9 @@ def mirror_for(channels_name: str):
 
 
 @functools.lru_cache(maxsize=None)
-def specular_integrand(ndf_name: str, masking_name: str, channels_name: str, form: str = "microfacet",
-                       nch: int | None = None) -> SpecularIntegrand:
+def specular_integrand(
+    ndf_name: str, masking_name: str, channels_name: str, form: str = "microfacet", nch: int | None = None
+) -> SpecularIntegrand:
     """The integrand record of a (terms, channels, form) key, the first ``nch`` channels kept (all if None).
     For the forms blinn_phong and ashikhmin_shirley ``ndf_name`` names the NDF the estimators sample and
     ``masking_name`` is ignored. The layouts with a Charlie channel (cloth, sheen) have no mirror limit."""
@@ -273,14 +293,31 @@ def specular_integrand(ndf_name: str, masking_name: str, channels_name: str, for
     vec = wp.vec3 if charlie else channels_for(channels_name)[1]
     k = vec._length_
     mirror = mirror_for(channels_name) if form == "microfacet" and not charlie else None
-    return SpecularIntegrand((ndf_name, masking_name, channels_name, form),
-                             integrand_for(ndf_name, masking_name, channels_name, form), vec,
-                             wp.vec3d if k == 3 else wp.vec2d, k, nch or k, NDFS[ndf_name], mirror)
+    return SpecularIntegrand(
+        (ndf_name, masking_name, channels_name, form),
+        integrand_for(ndf_name, masking_name, channels_name, form),
+        vec,
+        wp.vec3d if k == 3 else wp.vec2d,
+        k,
+        nch or k,
+        NDFS[ndf_name],
+        mirror,
+    )
 
 
-def hemisphere_integral(ndf_name: str, masking_name: str, channels_name: str, nov, alpha, estimator: str =
-                        "gauss_legendre", samples: int | None = None, seed: int = 0, param=None,
-                        form: str = "microfacet", device: str = "cpu") -> np.ndarray:
+def hemisphere_integral(
+    ndf_name: str,
+    masking_name: str,
+    channels_name: str,
+    nov,
+    alpha,
+    estimator: str = "gauss_legendre",
+    samples: int | None = None,
+    seed: int = 0,
+    param=None,
+    form: str = "microfacet",
+    device: str = "cpu",
+) -> np.ndarray:
     """Host helper (checks, tests, benchmarks): the integrand of (terms, channels, form) at texels (nov[i],
     alpha[i], param[i]) by a hemisphere estimator (lutbake.sampling.hemisphere), every kernel channel, float64
     (N, C). alpha goes through the edge policy (lutbake.edge.effective_alpha) as in a table."""

@@ -6,7 +6,8 @@ File layout (the contract engines and ``lutbake inspect`` rely on):
   table is written as ``R``, ``G`` only). Pixel type float32 or half, zip compression (lossless).
 - Image row 0 holds y index 0 and column 0 holds x index 0: no vertical flip, whatever engines do.
 - A 2D table (data (y, x, C)) is one single-part EXR. A fourth axis (kind ``btf``) is flattened into the
-  rows: its dim is ``y_block`` and image row = (y_block index) * (count of the y axis) + (y index). A 3D table (data (z, y, x, C)) is a multi-part
+  rows: its dim is ``y_block`` and image row = (y_block index) * (count of the y axis) + (y index).
+  A 3D table (data (z, y, x, C)) is a multi-part
   EXR with one part per z index, named ``slice_<k>`` and carrying ``lutbake:slice_index`` and
   ``lutbake:slice_value`` (the z axis value at that index).
 - Every part carries the string attributes ``lutbake:kind``, ``lutbake:table`` (the table's name),
@@ -20,6 +21,7 @@ File layout (the contract engines and ``lutbake inspect`` rely on):
 - Writes are atomic: the file is written to a temporary sibling, fsynced, then renamed onto the
   target, so an interrupted or failed write never leaves a half-written file or clobbers the old one.
 """
+
 from __future__ import annotations
 
 import json
@@ -131,7 +133,7 @@ def _open(path: Path):
 
 def _lutbake_attrs(spec) -> dict[str, str]:
     return {
-        p.name[len(PREFIX):]: p.value if isinstance(p.value, str) else attr_text(p.value)
+        p.name[len(PREFIX) :]: p.value if isinstance(p.value, str) else attr_text(p.value)
         for p in spec.extra_attribs
         if p.name.startswith(PREFIX)
     }
@@ -150,8 +152,7 @@ def _read_parts(path) -> tuple[list[np.ndarray], list[dict[str, str]], list[dict
             a = _lutbake_attrs(spec)
             if "kind" not in a:
                 raise ValueError(
-                    f"{path}: not a lutbake EXR (part {k} has no lutbake:kind attribute; "
-                    "was it written by lutbake?)"
+                    f"{path}: not a lutbake EXR (part {k} has no lutbake:kind attribute; was it written by lutbake?)"
                 )
             names = list(spec.channelnames)
             want = [c for c in CHANNEL_LETTERS if c in names]
@@ -228,9 +229,7 @@ def describe_exr(path) -> str:
     lines = [f"{path}"]
     h, w, nch = pixels[0].shape
     layout = f"{len(pixels)} parts (one per z slice) of {w} x {h}" if data.ndim == 4 else f"{w} x {h}"
-    lines.append(
-        f"  kind: {attrs['kind']}" + (f"   table: {attrs['table']}" if "table" in attrs else "")
-    )
+    lines.append(f"  kind: {attrs['kind']}" + (f"   table: {attrs['table']}" if "table" in attrs else ""))
     lines.append(
         f"  image: {layout}, {nch} channel(s) {','.join(facts[0]['channels'])}, "
         f"{facts[0]['format']}, {facts[0]['compression']} compression"
@@ -241,10 +240,14 @@ def describe_exr(path) -> str:
     for ax in axes:
         values = ax.get("values") or []
         rng = ax.get("range", ["?", "?"])
-        lines.append(f"  {ax.get('name')}: {ax.get('dim')} ({ax.get('image')}), count {ax.get('count')}, "
-                     f"range [{_fmt(rng[0])}, {_fmt(rng[1])}]")
-        lines.append(f"    texel {ax.get('texel')} ({ax.get('texel_formula')}), "
-                     f"mapping {ax.get('mapping')} ({ax.get('mapping_formula')})")
+        lines.append(
+            f"  {ax.get('name')}: {ax.get('dim')} ({ax.get('image')}), count {ax.get('count')}, "
+            f"range [{_fmt(rng[0])}, {_fmt(rng[1])}]"
+        )
+        lines.append(
+            f"    texel {ax.get('texel')} ({ax.get('texel_formula')}), "
+            f"mapping {ax.get('mapping')} ({ax.get('mapping_formula')})"
+        )
         if values:
             lines.append(f"    index 0 = {_fmt(values[0])}, index {len(values) - 1} = {_fmt(values[-1])}")
         if ax.get("uv_formula"):
@@ -253,9 +256,7 @@ def describe_exr(path) -> str:
         if alpha:
             lines.append(f"    alpha {_fmt(min(alpha))} .. {_fmt(max(alpha))} ({ax.get('alpha_formula')})")
     if data.ndim == 4:
-        slices = ", ".join(
-            f"{f['name']}={a.get('slice_value', '?')}" for f, a in zip(facts, part_attrs)
-        )
+        slices = ", ".join(f"{f['name']}={a.get('slice_value', '?')}" for f, a in zip(facts, part_attrs))
         lines.append(f"  parts: {slices}")
 
     lines.append("channels:")

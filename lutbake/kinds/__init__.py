@@ -4,6 +4,7 @@ Every kind is one module here that declares its keys, axes, channels and reconst
 integrand (lutbake.integrands) and estimator (lutbake.sampling); ``base.declare`` adds the keys every kind has
 (name, kind, format, dtype, seed, samples, estimator). The texel cap is config.MAX_TEXELS, for every kind.
 """
+
 from __future__ import annotations
 
 from .albedo import ALBEDO, ALBEDO_AVG
@@ -15,8 +16,9 @@ from .diffuse_3d import DIFFUSE_3D
 from .specular_3d import SPECULAR_3D
 from .specular_aniso import SPECULAR_ANISO
 
-KINDS: dict[str, Kind] = {k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D, SPECULAR_ANISO, DIFFUSE,
-                                              DIFFUSE_3D, BTF)}
+KINDS: dict[str, Kind] = {
+    k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D, SPECULAR_ANISO, DIFFUSE, DIFFUSE_3D, BTF)
+}
 ALIASES: dict[str, str] = {alias: k.name for k in KINDS.values() for alias in k.aliases}
 
 __all__ = ["ALIASES", "KINDS", "Key", "Kind", "lookup_kind"]

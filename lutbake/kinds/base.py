@@ -2,6 +2,7 @@
 which names the kind's axes, channels, reconstruction text, integrand and estimator and hands them to
 lutbake.sampling.plan.per_texel_plan. The registry (lutbake.kinds) adds the keys every kind has (``COMMON_KEYS``).
 """
+
 from __future__ import annotations
 
 import math
@@ -44,28 +45,53 @@ class Kind:
     texels_doc: str = "size"  # the keys whose product ``texels`` is, for the error message
 
 
-def common_keys(estimators: dict[str, str], default_estimator: str, samples_doc: str, samples_max: int,
-                samples_min: int = 1) -> dict[str, Key]:
+@dataclass(frozen=True)
+class Estimation:
+    """The estimators a kind offers (name -> description), its default, and what ``samples`` means for it."""
+
+    estimators: dict[str, str]
+    default: str
+    samples_doc: str
+    samples_min: int = 1
+    samples_max: int = MAX_SAMPLES
+
+
+def common_keys(e: Estimation) -> dict[str, Key]:
     """The keys every kind has: name, kind, format, dtype, seed, samples, estimator."""
     return {
-        "name": Key("name", "name", None, "output stem: <out-dir>/<name>.<ext> (ext per format); letters, digits, "
-                    "- and _ only", required=True),
+        "name": Key(
+            "name",
+            "name",
+            None,
+            "output stem: <out-dir>/<name>.<ext> (ext per format); letters, digits, - and _ only",
+            required=True,
+        ),
         "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
-        "samples": Key("samples", "int", None, samples_doc, minimum=samples_min, maximum=samples_max),
-        "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float",
-                                                                      "half": "16-bit float"}),
-        "estimator": Key("estimator", "str", default_estimator, "how the integral is estimated", estimators),
-        "seed": Key("seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0,
-                    maximum=MAX_SEED),
+        "samples": Key("samples", "int", None, e.samples_doc, minimum=e.samples_min, maximum=e.samples_max),
+        "dtype": Key(
+            "dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}
+        ),
+        "estimator": Key("estimator", "str", e.default, "how the integral is estimated", e.estimators),
+        "seed": Key(
+            "seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0, maximum=MAX_SEED
+        ),
         "format": Key("format", "str", "exr", "output file format: <out-dir>/<name>.<ext>", FORMATS),
     }
 
 
-def declare(name: str, description: str, keys: dict[str, Key], plan, *, estimators: dict[str, str],
-            default_estimator: str, samples_doc: str, samples_max: int = MAX_SAMPLES, samples_min: int = 1,
-            aliases: tuple[str, ...] = (), check=None, texels=None, texels_doc: str = "size") -> Kind:
-    """A Kind with the common keys (``common_keys``) followed by its own ``keys``; ``texels(options)``: the texel
-    count (default: the product of ``size``)."""
-    common = common_keys(estimators, default_estimator, samples_doc, samples_max, samples_min)
-    kind = Kind(name, description, {**common, **keys}, plan, aliases, check)
-    return kind if texels is None else Kind(name, description, kind.keys, plan, aliases, check, texels, texels_doc)
+def declare(
+    name: str,
+    description: str,
+    keys: dict[str, Key],
+    plan,
+    estimation: Estimation,
+    *,
+    aliases: tuple[str, ...] = (),
+    check=None,
+    texels=None,
+) -> Kind:
+    """A Kind with the common keys (``common_keys``) followed by its own ``keys``. ``texels(options)``: the texel
+    count (default: the product of ``size``); its docstring names the keys it multiplies (for the error message)."""
+    if texels is None:
+        return Kind(name, description, {**common_keys(estimation), **keys}, plan, aliases, check)
+    return Kind(name, description, {**common_keys(estimation), **keys}, plan, aliases, check, texels, texels.__doc__)

@@ -13,6 +13,7 @@ Reciprocity f(l, v) = f(v, l) makes every (φ, σ) block symmetric when the x an
 Edge policy (lutbake.edge, the same on the light and the view axis): cosines >= NOV_MIN, angles <= acos(NOV_MIN),
 so the endpoint texel convention lists and integrates the same clamped value on both axes.
 """
+
 from __future__ import annotations
 
 import json
@@ -26,7 +27,7 @@ from ..sampling.diffuse import PointEvaluation, PointSobol
 from ..sampling.panels import n_tail_cuts_np
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from . import diffuse
-from .base import Key, declare
+from .base import Estimation, Key, declare
 
 PARAMETRISATIONS = {
     "cosines": "x = NoL in [0, 1], y = NoV in [0, 1], row blocks = cos(phi) in [-1, 1]",
@@ -41,14 +42,27 @@ KEYS = {
     "phi_size": Key("phi_size", "int", 32, "azimuth texel count (row blocks)", minimum=1, maximum=4096),
     "sigma_size": Key("sigma_size", "int", 16, "sigma slice count (z, one EXR part each)", minimum=1, maximum=1024),
     "sigma_range": diffuse.KEYS["sigma_range"],
-    "sigma_values": Key("sigma_values", "float_list", None, "explicit sigma of every slice, strictly increasing "
-                        "(replaces sigma_size and sigma_range; the axis mapping is then 'listed')",
-                        minimum=0.0, maximum=1.0),
-    "parametrisation": Key("parametrisation", "str", "cosines", "what the light, view and azimuth axes hold",
-                           PARAMETRISATIONS),
+    "sigma_values": Key(
+        "sigma_values",
+        "float_list",
+        None,
+        "explicit sigma of every slice, strictly increasing "
+        "(replaces sigma_size and sigma_range; the axis mapping is then 'listed')",
+        minimum=0.0,
+        maximum=1.0,
+    ),
+    "parametrisation": Key(
+        "parametrisation", "str", "cosines", "what the light, view and azimuth axes hold", PARAMETRISATIONS
+    ),
     "model": Key("model", "str", "microfacet", "the diffuse BRDF tabulated", DIFFUSE_MODELS),
-    "f0": Key("f0", "float", 0.0, "Fresnel reflectance at normal incidence baked in (lutbake:f0_factor: how it "
-              "scales)", minimum=0.0, maximum=0.999),
+    "f0": Key(
+        "f0",
+        "float",
+        0.0,
+        "Fresnel reflectance at normal incidence baked in (lutbake:f0_factor: how it scales)",
+        minimum=0.0,
+        maximum=0.999,
+    ),
     "sigma_to_alpha": diffuse.KEYS["sigma_to_alpha"],
     "facet_fresnel": diffuse.KEYS["facet_fresnel"],
     "texel": Key("texel", "str", "center", "texel convention of every axis", TEXELS),
@@ -58,7 +72,8 @@ RECONSTRUCTION = (
     "view_index. Texel centres (t = (i + 0.5) / N) on every axis: x = (light param) * N_l - 0.5, y = (view param) * "
     "N_v - 0.5, p = (phi param) * N_phi - 0.5; fetch bilinearly at row p0 * N_v + clamp(y, 0, N_v - 1) for the two "
     "phi blocks p0 = floor(p), p0 + 1 (clamped), lerp by fract(p), and lerp the two sigma parts: "
-    "f = rho * value * g(f0) / g(f0_baked) (lutbake:f0_factor); radiance = f * E0 * NoL")
+    "f = rho * value * g(f0) / g(f0_baked) (lutbake:f0_factor); radiance = f * E0 * NoL"
+)
 
 
 def axes_for(o: dict) -> list[Axis]:
@@ -71,11 +86,19 @@ def axes_for(o: dict) -> list[Axis]:
     else:
         sig = Axis("sigma", "z", o["sigma_size"], *o["sigma_range"], texel=tx, alpha_map=am)
     if o["parametrisation"] == "cosines":
-        return [sig, Axis("cos_phi", "y_block", o["phi_size"], -1.0, 1.0, texel=tx),
-                Axis("NoV", "y", nv, 0.0, 1.0, texel=tx), Axis("NoL", "x", nl, 0.0, 1.0, texel=tx)]
+        return [
+            sig,
+            Axis("cos_phi", "y_block", o["phi_size"], -1.0, 1.0, texel=tx),
+            Axis("NoV", "y", nv, 0.0, 1.0, texel=tx),
+            Axis("NoL", "x", nl, 0.0, 1.0, texel=tx),
+        ]
     half_pi = float(np.pi / 2)
-    return [sig, Axis("phi", "y_block", o["phi_size"], 0.0, float(np.pi), texel=tx),
-            Axis("theta_v", "y", nv, 0.0, half_pi, texel=tx), Axis("theta_l", "x", nl, 0.0, half_pi, texel=tx)]
+    return [
+        sig,
+        Axis("phi", "y_block", o["phi_size"], 0.0, float(np.pi), texel=tx),
+        Axis("theta_v", "y", nv, 0.0, half_pi, texel=tx),
+        Axis("theta_l", "x", nl, 0.0, half_pi, texel=tx),
+    ]
 
 
 def directions(axes: list[Axis], parametrisation: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -95,6 +118,7 @@ def directions(axes: list[Axis], parametrisation: str) -> tuple[np.ndarray, np.n
 
 
 def texel_count(o: dict) -> int:
+    """size x phi_size x sigma_size (or the sigma_values count)"""
     ns = o["sigma_size"] if o["sigma_values"] is None else len(o["sigma_values"])
     return o["size"][0] * o["size"][1] * o["phi_size"] * ns
 
@@ -106,21 +130,26 @@ MAX_GL_ORDER = 64
 def check_spec(spec) -> tuple[str, str] | None:
     o = spec.options
     if o["estimator"] == "sobol_ndf" and o["model"] != "microfacet":
-        return ("estimator", f"'sobol_ndf' samples the microfacet model's m-integral; model {o['model']!r} is closed "
-                             "form (use 'gauss_legendre')")
+        return (
+            "estimator",
+            f"'sobol_ndf' samples the microfacet model's m-integral; model {o['model']!r} is closed "
+            "form (use 'gauss_legendre')",
+        )
     if o["estimator"] == "gauss_legendre" and o["samples"] is not None and o["samples"] > MAX_GL_ORDER:
         return ("samples", f"with estimator 'gauss_legendre' samples is the GL order: at most {MAX_GL_ORDER}")
     return None
 
 
-SAMPLES_DOC = ("gauss_legendre: the Gauss-Legendre order n of the m-integral (2 to 64; microfacet: up to (K + 3) x 4 n^2 "
-               "facet normals per texel, K the tan(theta_m) panels); omitted: 12; closed models ignore it. sobol_ndf: "
-               "the number of facet normals (default 4096)")
+SAMPLES_DOC = (
+    "gauss_legendre: the Gauss-Legendre order n of the m-integral (2 to 64; microfacet: up to (K + 3) x 4 n^2 "
+    "facet normals per texel, K the tan(theta_m) panels); omitted: 12; closed models ignore it. sobol_ndf: "
+    "the number of facet normals (default 4096)"
+)
 BTF_ESTIMATORS = {
     "gauss_legendre": "the microfacet model's m-integral by Gauss-Legendre panels (lutbake.sampling.facets); closed "
-                      "models are evaluated in closed form",
+    "models are evaluated in closed form",
     "sobol_ndf": "the microfacet model's m-integral by scrambled Sobol' facet normals from GGX's D(m)(n.m) "
-                 "(samples = points, default 4096): a cross-check",
+    "(samples = points, default 4096): a cross-check",
 }
 
 
@@ -136,31 +165,54 @@ def plan(spec) -> TexelPlan:
     orders = np.where((l[:, 2] < GRAZING_COS) & (v[:, 2] < GRAZING_COS), order + GRAZING_EXTRA, order)
     sig_axis = axes[0]
     alpha = sigma_alpha(sigma.astype(np.float32), o["sigma_to_alpha"])
-    grid = Grid(axes, {"l": l, "v": v, "sigma": sigma, "alpha": effective_alpha(alpha, False), "order": orders},
-                grazing=np.minimum(l[:, 2], v[:, 2]), alpha=alpha)
-    terms = {"model": model, "f0": str(o["f0"]), "f0_factor": f0_factor(model, ff),
-             "parametrisation": o["parametrisation"]}
+    grid = Grid(
+        axes,
+        {"l": l, "v": v, "sigma": sigma, "alpha": effective_alpha(alpha, False), "order": orders},
+        grazing=np.minimum(l[:, 2], v[:, 2]),
+        alpha=alpha,
+    )
+    terms = {
+        "model": model,
+        "f0": str(o["f0"]),
+        "f0_factor": f0_factor(model, ff),
+        "parametrisation": o["parametrisation"],
+    }
     if integrated:
         terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff, sigma_to_alpha=o["sigma_to_alpha"])
-    extra = {"f0_factor": f0_factor(model, ff), "f0": repr(o["f0"]), "rho": "1",
-             "parametrisation": o["parametrisation"], "layout": "part = sigma slice; row = phi_index * N_view + "
-             "view_index; column = light_index",
-             "sigma_values": json.dumps([float(s) for s in sig_axis.values()]), **diffuse.sigma_record(sig_axis)}
+    extra = {
+        "f0_factor": f0_factor(model, ff),
+        "f0": repr(o["f0"]),
+        "rho": "1",
+        "parametrisation": o["parametrisation"],
+        "layout": "part = sigma slice; row = phi_index * N_view + view_index; column = light_index",
+        "sigma_values": json.dumps([float(s) for s in sig_axis.values()]),
+        **diffuse.sigma_record(sig_axis),
+    }
     per = 1
     if integrated:  # at most (K + 3) u panels (K + 1 geometric ones, cut at u_l and u_v) x 4 arcs x n^2
         a = effective_alpha(sigma_alpha(sig_axis.values(), o["sigma_to_alpha"]), False)
         per = int(round(float(np.mean(n_tail_cuts_np(a) + 3)) * 4 * order * order))
     estimator = PointEvaluation(o["f0"], name="gauss_legendre" if integrated else "closed_form", evaluations=per)
     if o["estimator"] == "sobol_ndf":
-        estimator = PointSobol(o["f0"], o["samples"] or DEFAULT_SOBOL, o["seed"])
-    return per_texel_plan(diffuse_integrand(model, ff), estimator, grid,
-                          channels={"f": "the BRDF f_r(l, v) for rho = 1 at the baked f0 (1/sr; radiance = f E0 (n.l))"},
-                          reconstruction=RECONSTRUCTION, terms=terms, extra=extra, relative_error=True,
-                          error_estimate=integrated)
+        estimator = PointSobol(o["samples"] or DEFAULT_SOBOL, o["seed"], f0=o["f0"])
+    return per_texel_plan(
+        diffuse_integrand(model, ff),
+        estimator,
+        grid,
+        channels={"f": "the BRDF f_r(l, v) for rho = 1 at the baked f0 (1/sr; radiance = f E0 (n.l))"},
+        reconstruction=RECONSTRUCTION,
+        terms=terms,
+        extra=extra,
+        relative_error=True,
+        error_estimate=integrated,
+    )
 
 
-BTF = declare("btf", "the diffuse BRDF of four scalars as sigma slices of (light, view, azimuth) blocks (cosines or "
-              "angles), microfacet (Eq. 4 integrated) or fitted (Eq. 8) or any diffuse model", KEYS, plan,
-              estimators=BTF_ESTIMATORS, default_estimator="gauss_legendre", samples_doc=SAMPLES_DOC, samples_min=2,
-              aliases=("diffuse_btf",), check=check_spec, texels=texel_count,
-              texels_doc="size x phi_size x sigma_size (or the sigma_values count)")
+DESCRIPTION = (
+    "the diffuse BRDF of four scalars as sigma slices of (light, view, azimuth) blocks (cosines or angles), "
+    "microfacet (Eq. 4 integrated) or fitted (Eq. 8) or any diffuse model"
+)
+ESTIMATION = Estimation(BTF_ESTIMATORS, "gauss_legendre", SAMPLES_DOC, samples_min=2)
+BTF = declare(
+    "btf", DESCRIPTION, KEYS, plan, ESTIMATION, aliases=("diffuse_btf",), check=check_spec, texels=texel_count
+)

@@ -10,6 +10,7 @@ table cannot be rescaled and f0 becomes a z axis. Stored like specular_3d: a mul
 ``schlick``, and every closed model, ``fitted`` included) each slice is the 2D table times g(f0)
 (tests/test_diffuse3d.py), and the kind is a convenience for engines that want one code path.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -22,15 +23,23 @@ from .base import Key, declare
 
 KEYS = {
     **{k: v for k, v in diffuse.KEYS.items() if k != "f0"},
-    "facet_fresnel": Key("facet_fresnel", "str", "dielectric_f0", "Fresnel transmission on each facet (microfacet "
-                         "model); the default is the form where f0 does not factor out", FACET_FRESNEL),
+    "facet_fresnel": Key(
+        "facet_fresnel",
+        "str",
+        "dielectric_f0",
+        "Fresnel transmission on each facet (microfacet model); the default is the form where f0 does not factor out",
+        FACET_FRESNEL,
+    ),
     "f0_size": Key("f0_size", "int", 16, "f0 slice count (z)", minimum=1, maximum=1024),
-    "f0_range": Key("f0_range", "float_range", [0.0, 1.0], "f0 at t = 0 and t = 1 (same texel convention)",
-                    minimum=0.0, maximum=1.0),
+    "f0_range": Key(
+        "f0_range", "float_range", [0.0, 1.0], "f0 at t = 0 and t = 1 (same texel convention)", minimum=0.0, maximum=1.0
+    ),
 }
-RECONSTRUCTION = ("load part k as layer k of a 3D texture; E = texture(lut3d, vec3(NoV, sigma, f0)).r (texel "
-                  "centres on all three axes: trilinear filtering interpolates f0 between slices); "
-                  "diffuse = albedo * (irradiance / pi) * E, irradiance = ∫ L cos dω")
+RECONSTRUCTION = (
+    "load part k as layer k of a 3D texture; E = texture(lut3d, vec3(NoV, sigma, f0)).r (texel "
+    "centres on all three axes: trilinear filtering interpolates f0 between slices); "
+    "diffuse = albedo * (irradiance / pi) * E, irradiance = ∫ L cos dω"
+)
 
 
 def plan(spec) -> TexelPlan:
@@ -47,21 +56,35 @@ def plan(spec) -> TexelPlan:
     model, ff = o["model"], o["facet_fresnel"]
     terms = {"model": model, "f0": "z axis"}
     if model == "microfacet":
-        terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff,
-                     sigma_to_alpha=o["sigma_to_alpha"])
+        terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff, sigma_to_alpha=o["sigma_to_alpha"])
     axes = [f0_axis, sig_axis, nov_axis]
     return per_texel_plan(
-        diffuse_integrand(model, ff), diffuse.estimator_of(o),
+        diffuse_integrand(model, ff),
+        diffuse.estimator_of(o),
         diffuse.diffuse_grid(axes, nov, sigma, f0, o["sigma_to_alpha"]),
-        channels={"E": "∫ f_r (n.l) dω_l for rho = 1 at the slice's f0: directional diffuse reflectance under "
-                       "uniform white light"},
-        reconstruction=RECONSTRUCTION, terms=terms,
-        extra={"rho": "1", "f0_factor": "none: f0 is the z axis (per-slice lutbake:slice_value)",
-               "factoring_form": f0_factor(model, ff), **diffuse.sigma_record(sig_axis)})
+        channels={
+            "E": "∫ f_r (n.l) dω_l for rho = 1 at the slice's f0: directional diffuse reflectance under "
+            "uniform white light"
+        },
+        reconstruction=RECONSTRUCTION,
+        terms=terms,
+        extra={
+            "rho": "1",
+            "f0_factor": "none: f0 is the z axis (per-slice lutbake:slice_value)",
+            "factoring_form": f0_factor(model, ff),
+            **diffuse.sigma_record(sig_axis),
+        },
+    )
 
 
-DIFFUSE_3D = declare("diffuse_3d", "diffuse AmbientBRDF with an f0 axis: NoV x sigma x f0 slices (R = E), for per-facet "
-                     "Fresnel forms where f0 does not factor out (exact dielectric, Eq. 2)", KEYS, plan,
-                     estimators=diffuse.DIFFUSE_ESTIMATORS, default_estimator="gauss_legendre",
-                     samples_doc=diffuse.SAMPLES_DOC, samples_min=2, aliases=("ambient_brdf_diffuse_3d",), check=diffuse.check_spec,
-                     texels=lambda o: o["size"][0] * o["size"][1] * o["f0_size"], texels_doc="size x f0_size")
+def texel_count(o: dict) -> int:
+    """size x f0_size"""
+    return o["size"][0] * o["size"][1] * o["f0_size"]
+
+
+DESCRIPTION = (
+    "diffuse AmbientBRDF with an f0 axis: NoV x sigma x f0 slices (R = E), for per-facet Fresnel forms where "
+    "f0 does not factor out (exact dielectric, Eq. 2)"
+)
+RULES = {"aliases": ("ambient_brdf_diffuse_3d",), "check": diffuse.check_spec, "texels": texel_count}
+DIFFUSE_3D = declare("diffuse_3d", DESCRIPTION, KEYS, plan, diffuse.DIFFUSE_ESTIMATION, **RULES)

@@ -10,13 +10,14 @@ part's lutbake:slice_value). For Schlick it collapses to the dfg table: E = f0 s
 (tests/test_specular3d.py). With ``metal = "<name>"`` the table is 2D, NoV x roughness, and R, G, B hold
 E with F = F_conductor(n_c + i k_c, v.h) for the metal's three wavelengths (lutbake.terms.metals).
 """
+
 from __future__ import annotations
 
 import numpy as np
 
 from ..axes import Axis
 from ..integrands.specular import specular_integrand
-from ..sampling.hemisphere import ESTIMATORS, estimator_for
+from ..sampling.hemisphere import estimator_for
 from ..sampling.plan import TexelPlan, per_texel_plan
 from ..terms.metals import METALS
 from . import dfg
@@ -30,16 +31,26 @@ FRESNEL_CHOICES = {
 }
 KEYS = {
     **{k: v for k, v in dfg.KEYS.items() if k != "layout"},
-    "fresnel": Key("fresnel", "str", "dielectric_f0", "the Fresnel term integrated (ignored with metal)", FRESNEL_CHOICES),
+    "fresnel": Key(
+        "fresnel", "str", "dielectric_f0", "the Fresnel term integrated (ignored with metal)", FRESNEL_CHOICES
+    ),
     "f0_size": Key("f0_size", "int", 16, "f0 slice count (z); ignored with metal", minimum=1, maximum=1024),
-    "f0_range": Key("f0_range", "float_range", [0.0, 1.0], "f0 at t = 0 and t = 1 (same texel convention)",
-                    minimum=0.0, maximum=1.0),
-    "metal": Key("metal", "str", None, "a conductor by name: a 2D NoV x roughness RGB table with exact complex "
-                 "Fresnel instead of the f0 slices", {k: m.source for k, m in METALS.items()}),
+    "f0_range": Key(
+        "f0_range", "float_range", [0.0, 1.0], "f0 at t = 0 and t = 1 (same texel convention)", minimum=0.0, maximum=1.0
+    ),
+    "metal": Key(
+        "metal",
+        "str",
+        None,
+        "a conductor by name: a 2D NoV x roughness RGB table with exact complex Fresnel instead of the f0 slices",
+        {k: m.source for k, m in METALS.items()},
+    ),
 }
-RECONSTRUCTION_3D = ("load part k as layer k of a 3D texture; E = texture(lut3d, vec3(NoV, roughness, f0)).r "
-                     "(texel centres on all three axes: trilinear filtering interpolates f0 between slices); "
-                     "specular = prefiltered * E")
+RECONSTRUCTION_3D = (
+    "load part k as layer k of a 3D texture; E = texture(lut3d, vec3(NoV, roughness, f0)).r "
+    "(texel centres on all three axes: trilinear filtering interpolates f0 between slices); "
+    "specular = prefiltered * E"
+)
 RECONSTRUCTION_METAL = "E = texture(lut, vec2(NoV, roughness)).rgb; specular = prefiltered * E (per channel)"
 
 
@@ -63,23 +74,35 @@ def plan(spec) -> TexelPlan:
     f0 = None if metal else np.repeat(axes[0].values(), axes[-2].count * axes[-1].count)
     if metal:
         m = METALS[metal]
-        channels = {f"e_{c}": f"E with F_conductor({n} + {k}i) at {w:g} nm" for c, n, k, w in
-                    zip("rgb", m.n, m.k, m.wavelengths_nm)}
+        channels = {
+            f"e_{c}": f"E with F_conductor({n} + {k}i) at {w:g} nm"
+            for c, n, k, w in zip("rgb", m.n, m.k, m.wavelengths_nm)
+        }
         terms = {**dfg.terms_record(o, "conductor"), "metal": metal}
         extra = {"metal_source": m.source}
     else:
         channels = {"e": f"E = ∫ f (n.l) dω_l with F = {o['fresnel']}(f0 of the slice, v.h)"}
         terms = dfg.terms_record(o, o["fresnel"])
         extra = {}
-    return per_texel_plan(integrand, estimator_for(o["estimator"], o["samples"], o["seed"]),
-                          dfg.grid_for(axes, integrand, f0, nz), channels=channels,
-                          reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D, terms=terms,
-                          extra={**extra, **dfg.specular_extra(integrand)})
+    return per_texel_plan(
+        integrand,
+        estimator_for(o["estimator"], o["samples"], o["seed"]),
+        dfg.grid_for(axes, integrand, f0, nz),
+        channels=channels,
+        reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D,
+        terms=terms,
+        extra={**extra, **dfg.specular_extra(integrand)},
+    )
 
 
-SPECULAR_3D = declare("specular_3d", "specular AmbientBRDF for any Fresnel: NoV x roughness x f0 slices (R = E), "
-                      "or NoV x roughness RGB for a named metal", KEYS, plan, estimators=ESTIMATORS,
-                      default_estimator="gauss_legendre", samples_doc=dfg.SAMPLES_DOC,
-                      aliases=("ambient_brdf_3d",), check=dfg.check_spec,
-                      texels=lambda o: o["size"][0] * o["size"][1] * (1 if o["metal"] else o["f0_size"]),
-                      texels_doc="size x f0_size")
+def texel_count(o: dict) -> int:
+    """size x f0_size"""
+    return o["size"][0] * o["size"][1] * (1 if o["metal"] else o["f0_size"])
+
+
+DESCRIPTION = (
+    "specular AmbientBRDF for any Fresnel: NoV x roughness x f0 slices (R = E), or NoV x roughness RGB for "
+    "a named metal"
+)
+RULES = {"aliases": ("ambient_brdf_3d",), "check": dfg.check_spec, "texels": texel_count}
+SPECULAR_3D = declare("specular_3d", DESCRIPTION, KEYS, plan, dfg.SPECULAR_ESTIMATION, **RULES)

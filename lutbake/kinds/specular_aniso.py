@@ -10,6 +10,7 @@ Key ``view_azimuth``: ``average`` (default) integrates the view azimuth out, E =
 is what a shader looking up a 3D table without the azimuth should use (at a = 0 it is the isotropic table);
 ``tangent`` fixes phi_v = 0 (v in the T-n plane), ``bitangent`` phi_v = pi/2. Recorded in lutbake:view_azimuth.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -20,7 +21,7 @@ from ..integrands.anisotropic import ANISO_LAYOUTS, ANISO_MODELS, AXES_FORMULA, 
 from ..sampling.anisotropic import ANISO_ESTIMATORS, AnisoSobol
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from . import dfg
-from .base import Key, declare
+from .base import Estimation, Key, declare
 
 VIEW_AZIMUTHS = {
     "average": "E averaged over the view azimuth phi_v in [0, 2 pi) (default)",
@@ -31,20 +32,26 @@ PHI_V = {"average": -1.0, "tangent": 0.0, "bitangent": 0.5 * np.pi}
 
 KEYS = {
     "model": Key("model", "str", "microfacet", "the anisotropic lobe", ANISO_MODELS),
-    "layout": Key("layout", "str", "scale_bias", "channel layout (Schlick split sum)",
-                  {k: dfg.LAYOUTS[k] for k in ANISO_LAYOUTS}),
+    "layout": Key(
+        "layout", "str", "scale_bias", "channel layout (Schlick split sum)", {k: dfg.LAYOUTS[k] for k in ANISO_LAYOUTS}
+    ),
     **{k: dfg.KEYS[k] for k in ("size", "roughness", "texel", "nov_range", "roughness_range")},
     "anisotropy_size": Key("anisotropy_size", "int", 8, "anisotropy slice count (z)", minimum=1, maximum=1024),
-    "anisotropy_range": Key("anisotropy_range", "float_range", [0.0, 1.0],
-                            "anisotropy at t = 0 and t = 1 (same texel convention); a < 0 stretches along B",
-                            minimum=-1.0, maximum=1.0),
+    "anisotropy_range": Key(
+        "anisotropy_range",
+        "float_range",
+        [0.0, 1.0],
+        "anisotropy at t = 0 and t = 1 (same texel convention); a < 0 stretches along B",
+        minimum=-1.0,
+        maximum=1.0,
+    ),
     "view_azimuth": Key("view_azimuth", "str", "average", "the view azimuth about n, from the tangent", VIEW_AZIMUTHS),
 }
 RECONSTRUCTION = {
     "scale_bias": "load part k as layer k of a 3D texture; t = texture(lut3d, vec3(NoV, roughness, anisotropy)).rg; "
-                  "specular = prefiltered * (f0 * t.r + t.g) (texel centres on all three axes)",
+    "specular = prefiltered * (f0 * t.r + t.g) (texel centres on all three axes)",
     "multiscatter": "t = texture(lut3d, vec3(NoV, roughness, anisotropy)).rg; E = mix(t.r, t.g, f0); "
-                    "energy compensation = 1 + f0 (1 / t.g - 1)",
+    "energy compensation = 1 + f0 (1 / t.g - 1)",
 }
 
 
@@ -62,21 +69,45 @@ def plan(spec) -> TexelPlan:
     nov = np.tile(nov_axis.values(), ny * nz)
     alpha = np.tile(np.repeat(rough.alpha(), nx), nz)
     ax, ay = alpha_xy(alpha, np.repeat(an_axis.values(), ny * nx), integrand.mirror)
-    grid = Grid(axes, {"nov": nov, "alpha_x": ax, "alpha_y": ay,
-                       "phi_v": np.full(len(nov), PHI_V[o["view_azimuth"]], np.float32)}, grazing=nov)
-    terms = {"model": o["model"], "ndf": "ggx_aniso" if o["model"] == "microfacet" else "ashikhmin_shirley",
-             "masking": "smith_height_correlated (anisotropic Lambda)" if o["model"] == "microfacet"
-             else "none (implicit in the lobe)", "fresnel": "schlick", "layout": o["layout"]}
-    return per_texel_plan(integrand, AnisoSobol(o["estimator"], o["samples"] or AnisoSobol.budget, o["seed"]), grid,
-                          channels=dfg.CHANNELS[o["layout"]], reconstruction=RECONSTRUCTION[o["layout"]], terms=terms,
-                          extra={"view_azimuth": f"{o['view_azimuth']}: {VIEW_AZIMUTHS[o['view_azimuth']]}",
-                                 "anisotropy_mapping": f"Burley 2012, Addenda B.2: {AXES_FORMULA}",
-                                 "tangent_frame": "T = +x (phi = 0), B = +y, n = +z",
-                                 "alpha_policy": alpha_policy(integrand.mirror)}, error_estimate=False)
+    grid = Grid(
+        axes,
+        {"nov": nov, "alpha_x": ax, "alpha_y": ay, "phi_v": np.full(len(nov), PHI_V[o["view_azimuth"]], np.float32)},
+        grazing=nov,
+    )
+    terms = {
+        "model": o["model"],
+        "ndf": "ggx_aniso" if o["model"] == "microfacet" else "ashikhmin_shirley",
+        "masking": "smith_height_correlated (anisotropic Lambda)"
+        if o["model"] == "microfacet"
+        else "none (implicit in the lobe)",
+        "fresnel": "schlick",
+        "layout": o["layout"],
+    }
+    return per_texel_plan(
+        integrand,
+        AnisoSobol(o["estimator"], o["samples"] or AnisoSobol.budget, o["seed"]),
+        grid,
+        channels=dfg.CHANNELS[o["layout"]],
+        reconstruction=RECONSTRUCTION[o["layout"]],
+        terms=terms,
+        extra={
+            "view_azimuth": f"{o['view_azimuth']}: {VIEW_AZIMUTHS[o['view_azimuth']]}",
+            "anisotropy_mapping": f"Burley 2012, Addenda B.2: {AXES_FORMULA}",
+            "tangent_frame": "T = +x (phi = 0), B = +y, n = +z",
+            "alpha_policy": alpha_policy(integrand.mirror),
+        },
+        error_estimate=False,
+    )
 
 
-SPECULAR_ANISO = declare("specular_aniso", "anisotropic split-sum: NoV x roughness x anisotropy slices (anisotropic "
-                         "GGX or Ashikhmin-Shirley), scale/bias or multiscatter", KEYS, plan,
-                         estimators=ANISO_ESTIMATORS, default_estimator="sobol", samples_doc=dfg.SAMPLES_DOC,
-                         aliases=("aniso",), texels=lambda o: o["size"][0] * o["size"][1] * o["anisotropy_size"],
-                         texels_doc="size x anisotropy_size")
+def texel_count(o: dict) -> int:
+    """size x anisotropy_size"""
+    return o["size"][0] * o["size"][1] * o["anisotropy_size"]
+
+
+DESCRIPTION = (
+    "anisotropic split-sum: NoV x roughness x anisotropy slices (anisotropic GGX or Ashikhmin-Shirley), "
+    "scale/bias or multiscatter"
+)
+ESTIMATION = Estimation(ANISO_ESTIMATORS, "sobol", dfg.SAMPLES_DOC)
+SPECULAR_ANISO = declare("specular_aniso", DESCRIPTION, KEYS, plan, ESTIMATION, aliases=("aniso",), texels=texel_count)

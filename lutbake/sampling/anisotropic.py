@@ -9,6 +9,7 @@ out, E = (1/2 pi) ∫ E(phi_v) dphi_v, with phi_v = 2 pi u3 of scrambled 3D Sobo
   estimator (it does not use the lobe's sampler or its pdf) for cross-checks.
 alpha_x = alpha_y = 0 (the lobe's mirror limit, lutbake.edge): E = channels(n.v), no samples.
 """
+
 from __future__ import annotations
 
 import functools
@@ -21,13 +22,14 @@ from ..edge import COS_EPS
 from ..terms import ndf
 from ..terms.frame import reflect
 from . import points
+from .arrays import Points2, Rows64
 from .hemisphere import store_row
 
 ANISO_ESTIMATORS = {
     "sobol": "scrambled 3D Sobol' points: h by anisotropic GGX VNDF sampling (microfacet) or the Ashikhmin-Shirley "
-             "h sampling; phi_v = 2 pi u3 when averaged",
+    "h sampling; phi_v = 2 pi u3 when averaged",
     "sobol_cosine": "scrambled 3D Sobol' points: l cosine-weighted (independent of the lobe's sampler); "
-                    "phi_v = 2 pi u3 when averaged",
+    "phi_v = 2 pi u3 when averaged",
 }
 DEFAULT_SAMPLES = 16384
 
@@ -47,7 +49,7 @@ def aniso_kernel(lobe, cosine: bool):
     smooth = lobe.mirror
 
     @wp.kernel(enable_backward=False, module="unique")
-    def aniso_qmc_kernel(texel: wp.array(dtype=wp.vec4), pts: wp.array2d(dtype=float), out: wp.array2d(dtype=wp.float64)):
+    def aniso_qmc_kernel(texel: wp.array(dtype=wp.vec4), pts: Points2, out: Rows64):
         """texel[i] = (n.v, alpha_x, alpha_y, phi_v)."""
         i = wp.tid()
         nov = texel[i][0]
@@ -118,9 +120,16 @@ class AnisoSobol:
         pts = np.clip(points.sobol3(self.budget, self.seed), 0.0, np.nextafter(np.float32(1.0), np.float32(0.0)))
         out = wp.zeros((n, 2), dtype=wp.float64, device=device)
         texel = np.stack([np.asarray(inputs[k], np.float32) for k in ("nov", "alpha_x", "alpha_y", "phi_v")], axis=1)
-        wp.launch(self._kernel(lobe), dim=n, inputs=[wp.array(np.ascontiguousarray(texel), dtype=wp.vec4, device=device),
-                                                     wp.array(pts.astype(np.float32), dtype=float, device=device), out],
-                  device=device)
+        wp.launch(
+            self._kernel(lobe),
+            dim=n,
+            inputs=[
+                wp.array(np.ascontiguousarray(texel), dtype=wp.vec4, device=device),
+                wp.array(pts.astype(np.float32), dtype=float, device=device),
+                out,
+            ],
+            device=device,
+        )
         return out.numpy()
 
     def refined(self):

@@ -1,5 +1,6 @@
 """Quadratures of the diffuse tables over the light direction l, for a diffuse BRDF ``brdf(l, v, sigma, alpha, f0,
-xg, wg) -> float64`` (lutbake.integrands.diffuse; xg, wg: the GL rule of the microfacet model's inner m-integral).
+rule) -> float64`` (lutbake.integrands.diffuse; rule: the GL (node, weight) pairs of the microfacet model's inner
+m-integral). Kernel inputs per texel are packed: (n.v, sigma, alpha, f0) as a vec4.
 
 AmbientBRDF (directional reflectance under uniform white light, rho = 1):
     E(v) = ∫ f(l, v) (n.l) dω_l = 2 ∫_0^pi dphi_l ∫_0^1 d(n.l) f (n.l)       (f is even in phi_l)
@@ -13,17 +14,19 @@ AmbientBRDF (directional reflectance under uniform white light, rho = 1):
   (lutbake.sampling.facets.fd_microfacet_sobol_for), a cross-check.
 The microfacet model's albedo by default uses the swapped integral (lutbake.sampling.swapped).
 """
+
 from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import warp as wp
 
 from ..terms.frame import view_dir
 from . import points
+from .arrays import Floats, Points2, Rows64, Rule, Values64
 from .facets import fd_microfacet_sobol_for
 
 PI64 = wp.constant(wp.float64(math.pi))
@@ -32,16 +35,14 @@ REFINE_ORDER = 8  # the error estimates re-evaluate probe texels with every GL o
 
 @functools.lru_cache(maxsize=None)
 def albedo_kernel(brdf):
-    """Kernel: E(v) = ∫ f (n.l) dω_l per texel (nov[i], sigma[i], alpha[i], f0[i]); outer GL (xo, wo) on 2 x 2
-    panels, inner GL (xg, wg) for the microfacet integral (``brdf``: lutbake.integrands.diffuse)."""
+    """Kernel: E(v) = ∫ f (n.l) dω_l per texel (n.v, sigma, alpha, f0); outer GL rule_o on 2 x 2 panels, inner GL
+    rule for the microfacet integral (``brdf``: lutbake.integrands.diffuse)."""
 
     @wp.kernel(enable_backward=False, module="unique")
-    def albedo_gl_kernel(nov: wp.array(dtype=float), sigma: wp.array(dtype=float), alpha: wp.array(dtype=float),
-                         f0: wp.array(dtype=float), xo: wp.array(dtype=wp.float64), wo: wp.array(dtype=wp.float64),
-                      xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64),
-                      out: wp.array2d(dtype=wp.float64)):
+    def albedo_gl_kernel(texel: wp.array(dtype=wp.vec4), rule_o: Rule, rule: Rule, out: Rows64):
         i = wp.tid()
-        v = view_dir(nov[i])
+        t = texel[i]
+        v = view_dir(t[0])
         cv = wp.float64(v[2])
         half_pi = PI64 * wp.float64(0.5)
         acc = wp.float64(0.0)
@@ -53,14 +54,14 @@ def albedo_kernel(brdf):
                 mhi = wp.float64(1.0)
             for pp in range(2):
                 plo = half_pi * wp.float64(pp)
-                for a in range(xo.shape[0]):
-                    mu = mlo + (mhi - mlo) * xo[a]
+                for a in range(rule_o.shape[0]):
+                    mu = mlo + (mhi - mlo) * rule_o[a][0]
                     st = wp.sqrt(wp.max(wp.float64(1.0) - mu * mu, wp.float64(0.0)))
-                    for b in range(xo.shape[0]):
-                        phi = plo + half_pi * xo[b]
+                    for b in range(rule_o.shape[0]):
+                        phi = plo + half_pi * rule_o[b][0]
                         l = wp.vec3(float(st * wp.cos(phi)), float(st * wp.sin(phi)), float(mu))
-                        f = brdf(l, v, sigma[i], alpha[i], f0[i], xg, wg)
-                        acc = acc + wo[a] * wo[b] * (mhi - mlo) * half_pi * f * mu
+                        f = brdf(l, v, t[1], t[2], t[3], rule)
+                        acc = acc + rule_o[a][1] * rule_o[b][1] * (mhi - mlo) * half_pi * f * mu
         out[i, 0] = wp.float64(2.0) * acc
 
     return albedo_gl_kernel
@@ -68,14 +69,14 @@ def albedo_kernel(brdf):
 
 @functools.lru_cache(maxsize=None)
 def brdf_kernel(brdf):
-    """Kernel: f(l[i], v[i]) for given direction pairs (tests, plots, BTF slices)."""
+    """Kernel: f(l, v) at direction pairs lv[i] = (l, v) with sa[i] = (sigma, alpha) (tests, plots, BTF slices)."""
 
     @wp.kernel(enable_backward=False, module="unique")
-    def brdf_point_kernel(l: wp.array(dtype=wp.vec3), v: wp.array(dtype=wp.vec3), sigma: wp.array(dtype=float),
-                          alpha: wp.array(dtype=float), f0: float, xg: wp.array(dtype=wp.float64),
-                          wg: wp.array(dtype=wp.float64), out: wp.array(dtype=wp.float64)):
+    def brdf_point_kernel(
+        lv: wp.array2d(dtype=wp.vec3), sa: wp.array(dtype=wp.vec2), f0: float, rule: Rule, out: Values64
+    ):
         i = wp.tid()
-        out[i] = brdf(l[i], v[i], sigma[i], alpha[i], f0, xg, wg)
+        out[i] = brdf(lv[i, 0], lv[i, 1], sa[i][0], sa[i][1], f0, rule)
 
     return brdf_point_kernel
 
@@ -85,11 +86,10 @@ def cosine_kernel(brdf):
     """Kernel: E(v) = (pi / N) sum_k f(l_k, v), l_k cosine-weighted from the 2D points ``pts``."""
 
     @wp.kernel(enable_backward=False, module="unique")
-    def albedo_cosine_kernel(nov: wp.array(dtype=float), sigma: wp.array(dtype=float), alpha: wp.array(dtype=float),
-                             f0: wp.array(dtype=float), pts: wp.array2d(dtype=float), xg: wp.array(dtype=wp.float64),
-                             wg: wp.array(dtype=wp.float64), out: wp.array2d(dtype=wp.float64)):
+    def albedo_cosine_kernel(texel: wp.array(dtype=wp.vec4), pts: Points2, rule: Rule, out: Rows64):
         i = wp.tid()
-        v = view_dir(nov[i])
+        t = texel[i]
+        v = view_dir(t[0])
         acc = wp.float64(0.0)
         n = pts.shape[0]
         for k in range(n):
@@ -97,21 +97,34 @@ def cosine_kernel(brdf):
             phi = 2.0 * wp.pi * pts[k, 1]
             st = wp.sqrt(r2)
             l = wp.vec3(st * wp.cos(phi), st * wp.sin(phi), wp.sqrt(wp.max(1.0 - r2, 0.0)))
-            acc = acc + brdf(l, v, sigma[i], alpha[i], f0[i], xg, wg)
+            acc = acc + brdf(l, v, t[1], t[2], t[3], rule)
         out[i, 0] = PI64 * acc / wp.float64(n)
 
     return albedo_cosine_kernel
 
 
-def gl_arrays(n: int, device: str) -> list:
-    """The n-point GL rule on [0, 1] as two float64 Warp arrays (nodes, weights)."""
-    x, w = points.gauss_legendre(n)
-    return [wp.array(x, dtype=wp.float64, device=device), wp.array(w, dtype=wp.float64, device=device)]
+def gl_rule(n: int, device: str):
+    """The n-point GL rule on [0, 1] as a Warp array of (node, weight) float64 pairs."""
+    return wp.array(np.stack(points.gauss_legendre(n), axis=1), dtype=wp.vec2d, device=device)
 
 
-def _texel_arrays(inputs: dict, device: str) -> list:
-    return [wp.array(np.ascontiguousarray(inputs[k], dtype=np.float32), dtype=float, device=device)
-            for k in ("nov", "sigma", "alpha", "f0")]
+def sobol_points(budget: int, seed: int, device: str):
+    """``budget`` scrambled 2D Sobol' points (rounded up to a power of two) in [0, 1), float32, as a Warp array."""
+    pts = np.clip(points.sobol(budget, seed), 0.0, np.nextafter(np.float32(1.0), np.float32(0.0)))
+    return wp.array(pts.astype(np.float32), dtype=float, device=device)
+
+
+def launch_rows(kernel, arrays: list, n: int, device: str, shape=None) -> np.ndarray:
+    """Launch ``kernel`` over n texels with ``arrays`` + a float64 output of ``shape`` (default (n, 1))."""
+    out = wp.zeros(shape or (n, 1), dtype=wp.float64, device=device)
+    wp.launch(kernel, dim=n, inputs=[*arrays, out], device=device)
+    return out.numpy()
+
+
+def texel_array(inputs: dict, device: str):
+    """The per-texel (n.v, sigma, alpha, f0) of the diffuse albedo kernels, as a vec4 (float32) array."""
+    t = np.stack([np.asarray(inputs[k], np.float32) for k in ("nov", "sigma", "alpha", "f0")], axis=1)
+    return wp.array(np.ascontiguousarray(t), dtype=wp.vec4, device=device)
 
 
 @dataclass(frozen=True)
@@ -130,58 +143,65 @@ class DiffuseGaussLegendre:
         wp.load_module(albedo_kernel(integrand.brdf).module, device=device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
-        out = wp.zeros((len(inputs["nov"]), 1), dtype=wp.float64, device=device)
-        wp.launch(albedo_kernel(integrand.brdf), dim=len(inputs["nov"]),
-                  inputs=[*_texel_arrays(inputs, device), *gl_arrays(self.outer_order or self.order, device),
-                          *gl_arrays(self.order, device), out], device=device)
-        return out.numpy()
+        rules = [gl_rule(self.outer_order or self.order, device), gl_rule(self.order, device)]
+        return launch_rows(
+            albedo_kernel(integrand.brdf), [texel_array(inputs, device), *rules], len(inputs["nov"]), device
+        )
 
     def refined(self):
-        return DiffuseGaussLegendre(self.order + REFINE_ORDER), f"order {self.order} - order {self.order + REFINE_ORDER}"
+        n = self.order + REFINE_ORDER
+        return DiffuseGaussLegendre(n), f"order {self.order} - order {n}"
 
 
 @dataclass(frozen=True)
-class CosineSobol:
+class ScrambledSobol:
+    """Base of the Sobol' estimators here: ``budget`` points (rounded up to a power of two), scrambled by ``seed``;
+    refined by another scrambling."""
+
+    budget: int = 4096
+    seed: int = 0
+
+    def samples(self, inputs: dict) -> np.ndarray:
+        return np.full(len(next(iter(inputs.values()))), len(points.sobol(self.budget, self.seed)))
+
+    def refined(self):
+        return replace(self, seed=self.seed + 1), "seed - (seed + 1) (two scramblings)"
+
+
+@dataclass(frozen=True)
+class CosineSobol(ScrambledSobol):
     """E(v) by scrambled Sobol' points, l cosine-weighted (module docstring); the microfacet model's inner m-rule
     at ``inner_order``. Inputs: nov, sigma, alpha, f0."""
 
-    budget: int
-    seed: int = 0
     inner_order: int = 12
     name: str = "sobol_cosine"
-
-    def samples(self, inputs: dict) -> np.ndarray:
-        return np.full(len(inputs["nov"]), len(points.sobol(self.budget, self.seed)))
 
     def prepare(self, integrand, device: str) -> None:
         wp.load_module(cosine_kernel(integrand.brdf).module, device=device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
-        pts = np.clip(points.sobol(self.budget, self.seed), 0.0, np.nextafter(np.float32(1.0), np.float32(0.0)))
-        out = wp.zeros((len(inputs["nov"]), 1), dtype=wp.float64, device=device)
-        wp.launch(cosine_kernel(integrand.brdf), dim=len(inputs["nov"]),
-                  inputs=[*_texel_arrays(inputs, device), wp.array(pts.astype(np.float32), dtype=float, device=device),
-                          *gl_arrays(self.inner_order, device), out], device=device)
-        return out.numpy()
-
-    def refined(self):
-        return CosineSobol(self.budget, self.seed + 1, self.inner_order), "seed - (seed + 1) (two scramblings)"
+        arrays = [
+            texel_array(inputs, device),
+            sobol_points(self.budget, self.seed, device),
+            gl_rule(self.inner_order, device),
+        ]
+        return launch_rows(cosine_kernel(integrand.brdf), arrays, len(inputs["nov"]), device)
 
 
-def eval_points(integrand, l: np.ndarray, v: np.ndarray, sigma, alpha, f0: float, order: int,
-                device: str = "cpu") -> np.ndarray:
+def eval_points(
+    integrand, l: np.ndarray, v: np.ndarray, sigma, alpha, f0: float, order: int, device: str = "cpu"
+) -> np.ndarray:
     """f(l_i, v_i) for unit direction arrays (N, 3) (n = +z), rho = 1, inner m-rule of ``order``; float64 (N,)."""
-    l = np.ascontiguousarray(l, dtype=np.float32).reshape(-1, 3)
-    v = np.ascontiguousarray(v, dtype=np.float32).reshape(-1, 3)
-    n = len(l)
-    s = np.ascontiguousarray(np.broadcast_to(np.asarray(sigma, dtype=np.float32), (n,)))
-    a = np.ascontiguousarray(np.broadcast_to(np.asarray(alpha, dtype=np.float32), (n,)))
-    out = wp.zeros(n, dtype=wp.float64, device=device)
-    wp.launch(brdf_kernel(integrand.brdf), dim=n,
-              inputs=[wp.array(l, dtype=wp.vec3, device=device), wp.array(v, dtype=wp.vec3, device=device),
-                      wp.array(s, dtype=float, device=device), wp.array(a, dtype=float, device=device), float(f0),
-                      *gl_arrays(order, device), out], device=device)
-    return out.numpy()
+    lv = np.stack([np.asarray(l, np.float32).reshape(-1, 3), np.asarray(v, np.float32).reshape(-1, 3)], axis=1)
+    n = len(lv)
+    sa = np.stack([np.broadcast_to(np.asarray(x, dtype=np.float32), (n,)) for x in (sigma, alpha)], axis=1)
+    arrays = [
+        wp.array(np.ascontiguousarray(lv), dtype=wp.vec3, device=device),
+        wp.array(np.ascontiguousarray(sa), dtype=wp.vec2, device=device),
+        float(f0),
+        gl_rule(order, device),
+    ]
+    return launch_rows(brdf_kernel(integrand.brdf), arrays, n, device, (n,))
 
 
 @dataclass(frozen=True)
@@ -204,23 +224,22 @@ class PointEvaluation:
         out = np.empty((len(inputs["order"]), 1))
         for n in np.unique(inputs["order"]):
             sel = inputs["order"] == n
-            out[sel, 0] = eval_points(integrand, inputs["l"][sel], inputs["v"][sel], inputs["sigma"][sel],
-                                      inputs["alpha"][sel], self.f0, int(n) + self.extra, device)
+            rows = {k: inputs[k][sel] for k in ("l", "v", "sigma", "alpha")}
+            out[sel, 0] = eval_points(integrand, **rows, f0=self.f0, order=int(n) + self.extra, device=device)
         return out
 
     def refined(self):
         e = self.extra + REFINE_ORDER
-        return PointEvaluation(self.f0, e, self.name, self.evaluations), f"orders - orders + {e}"
+        return replace(self, extra=e), f"orders - orders + {e}"
 
 
 @functools.lru_cache(maxsize=None)
 def sobol_point_kernel(facet):
-    """Kernel: the microfacet f(l[i], v[i]) with its m-integral by the 2D points ``pts`` (``PointSobol``)."""
+    """Kernel: the microfacet f(l, v) at lv[i] = (l, v) with its m-integral by the 2D points ``pts``."""
     f = fd_microfacet_sobol_for(facet)
 
     @wp.kernel(enable_backward=False, module="unique")
-    def brdf_sobol_kernel(lv: wp.array2d(dtype=wp.vec3), alpha: wp.array(dtype=float), f0: float,
-                          pts: wp.array2d(dtype=float), out: wp.array(dtype=wp.float64)):
+    def brdf_sobol_kernel(lv: wp.array2d(dtype=wp.vec3), alpha: Floats, f0: float, pts: Points2, out: Values64):
         i = wp.tid()
         out[i] = f(lv[i, 0], lv[i, 1], alpha[i], f0, pts)
 
@@ -228,31 +247,22 @@ def sobol_point_kernel(facet):
 
 
 @dataclass(frozen=True)
-class PointSobol:
+class PointSobol(ScrambledSobol):
     """The microfacet model's f(l_i, v_i) (kind btf) with Eq. 4's m-integral by ``budget`` scrambled Sobol' points
     (m from GGX's D(m)(n.m)). Inputs: l, v (N, 3), alpha; ``f0`` is the table's single f0."""
 
-    f0: float
-    budget: int = 4096
-    seed: int = 0
+    f0: float = 0.0
     name: str = "sobol_ndf"
-
-    def samples(self, inputs: dict) -> np.ndarray:
-        return np.full(len(inputs["alpha"]), len(points.sobol(self.budget, self.seed)))
 
     def prepare(self, integrand, device: str) -> None:
         wp.load_module(sobol_point_kernel(integrand.facet).module, device=device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
-        n = len(inputs["alpha"])
         lv = np.ascontiguousarray(np.stack([inputs["l"], inputs["v"]], axis=1), dtype=np.float32)
-        pts = np.clip(points.sobol(self.budget, self.seed), 0.0, np.nextafter(np.float32(1.0), np.float32(0.0)))
-        out = wp.zeros(n, dtype=wp.float64, device=device)
-        wp.launch(sobol_point_kernel(integrand.facet), dim=n,
-                  inputs=[wp.array(lv, dtype=wp.vec3, device=device),
-                          wp.array(np.asarray(inputs["alpha"], np.float32), dtype=float, device=device), float(self.f0),
-                          wp.array(pts.astype(np.float32), dtype=float, device=device), out], device=device)
-        return out.numpy()[:, None]
-
-    def refined(self):
-        return PointSobol(self.f0, self.budget, self.seed + 1), "seed - (seed + 1) (two scramblings)"
+        arrays = [
+            wp.array(lv, dtype=wp.vec3, device=device),
+            wp.array(np.asarray(inputs["alpha"], np.float32), dtype=float, device=device),
+            float(self.f0),
+            sobol_points(self.budget, self.seed, device),
+        ]
+        return launch_rows(sobol_point_kernel(integrand.facet), arrays, len(lv), device, (len(lv),))[:, None]

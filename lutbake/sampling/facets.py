@@ -17,6 +17,7 @@ Quadrature (``fd_microfacet_for``), deterministic:
 At sigma -> 0, D -> delta(m - n) / (n.m) and f -> F_facet(n.l, n.v) / pi: Lambert x Eq. 6 for the Eq. 6 facet form.
 Panels: lutbake.sampling.panels.
 """
+
 from __future__ import annotations
 
 import functools
@@ -42,14 +43,13 @@ from .panels import (
 
 @functools.lru_cache(maxsize=None)
 def fd_microfacet_for(F_facet):
-    """The microfacet diffuse BRDF ``fd_microfacet(l, v, alpha, f0, xg, wg) -> float64`` (rho = 1), Eq. 4,
-    integrated as in the module docstring with the n-point GL rule (xg, wg) on [0, 1]; ``F_facet(MoL, MoV, f0)``
-    is the per-facet transmission (lutbake.terms.diffuse.F_facet_*)."""
+    """The microfacet diffuse BRDF ``fd_microfacet(l, v, alpha, f0, rule) -> float64`` (rho = 1), Eq. 4,
+    integrated as in the module docstring with the n-point GL rule ``rule`` (node, weight) on [0, 1];
+    ``F_facet(MoL, MoV, f0)`` is the per-facet transmission (lutbake.terms.diffuse.F_facet_*)."""
     Ff = F_facet
 
     @wp.func
-    def fd_microfacet(l: wp.vec3, v: wp.vec3, alpha: float, f0: float,
-                      xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64)):
+    def fd_microfacet(l: wp.vec3, v: wp.vec3, alpha: float, f0: float, rule: wp.array(dtype=wp.vec2d)):
         NoL = l[2]
         NoV = v[2]
         if NoL <= COS_EPS or NoV <= COS_EPS:
@@ -68,7 +68,7 @@ def fd_microfacet_for(F_facet):
         omv = om_visible_ggx(cv, a64)
         om1 = wp.max(oml, omv)  # 1 - min(u_l, u_v)
         om2 = wp.min(oml, omv)  # 1 - max(u_l, u_v)
-        n = xg.shape[0]
+        n = rule.shape[0]
         acc = wp.float64(0.0)
         n_geo = n_tail_cuts(a64)
         prev = wp.float64(0.0)
@@ -93,8 +93,8 @@ def fd_microfacet_for(F_facet):
                 du = om_lo - om_hi
                 if du > wp.float64(0.0):
                     for k in range(n):
-                        s = xg[k]
-                        wu = wg[k] * du * wp.float64(6.0) * s * (one - s)
+                        s = rule[k][0]
+                        wu = rule[k][1] * du * wp.float64(6.0) * s * (one - s)
                         # 1 - u without cancellation (u_l -> 1 for n.l -> 1 and small alpha)
                         csm = facet_cos_sin(lo, du, om_hi, s, a64)
                         cm = csm[0]
@@ -110,12 +110,12 @@ def fd_microfacet_for(F_facet):
                             dphi = ab[1] - a
                             if dphi > wp.float64(0.0):
                                 for j in range(n):
-                                    phi = a + dphi * xg[j]
+                                    phi = a + dphi * rule[j][0]
                                     m = wp.vec3(float(sm * wp.cos(phi)), float(sm * wp.sin(phi)), float(cm))
                                     MoL = wp.dot(m, l)
                                     MoV = wp.dot(m, v)
                                     if MoL > 0.0 and MoV > 0.0:
-                                        row = row + wg[j] * dphi * wp.float64(MoL * MoV * Ff(MoL, MoV, f0))
+                                        row = row + rule[j][1] * dphi * wp.float64(MoL * MoV * Ff(MoL, MoV, f0))
                         acc = acc + wu * row / cm
             prev = cut
             om_prev = om_cut

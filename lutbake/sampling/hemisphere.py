@@ -24,7 +24,8 @@ lutbake.integrands.specular):
     Integrating each region over its exact domain removes the horizon kink. c* grows monotonically
     in theta_h; near grazing view c* ~ -cot(theta_v) / (2 theta_h) varies on every scale from theta_a
     to pi/4, so B is cut into panels growing geometrically (factor PANEL_RATIO) from both of its ends
-    towards pi/4, and each panel is integrated in u = CDF(theta). The sqrt-like ends of acos c* at c* = -1 and 1 are removed by u = u0 + du smoothstep(s).
+    towards pi/4, and each panel is integrated in u = CDF(theta). The sqrt-like ends of acos c* at c* = -1 and 1
+    are removed by u = u0 + du smoothstep(s).
     By symmetry in phi,
         I = (1/pi) ∫_0^1 du ∫_0^phimax(u) dphi  g(h) / p(h).
     The integrand is then analytic in both variables and GL converges exponentially.
@@ -38,6 +39,7 @@ All accumulate in float64; per-sample terms run in float32; the domain maps run 
 Edge: a texel with alpha = 0 (the integrand has a ``mirror`` and alpha < ALPHA_MIN: lutbake.edge) takes the
 closed-form mirror limit ``mirror(v, param)`` instead of a quadrature.
 """
+
 from __future__ import annotations
 
 import functools
@@ -49,6 +51,7 @@ import warp as wp
 
 from ..terms.frame import view_dir
 from . import points
+from .arrays import Points2, Rows64, Rule, Values64
 
 PI64 = wp.constant(wp.float64(math.pi))
 
@@ -104,8 +107,9 @@ def asinh64(x: wp.float64):
 @wp.func
 def horizon_scale(cos_v: wp.float64, alpha: wp.float64):
     """Distance in n.l from the horizon to the pole of Smith G2 as n.l -> 0:
-    G2 ~ 2 (n.l) / ((n.l)(1 + 2 Lambda(v)) + alpha) puts it at n.l = -alpha (n.v) / sqrt((n.v)^2 + alpha^2 (1 - (n.v)^2)),
-    about min(n.v, alpha). Integrands vary on this scale next to the horizon cut."""
+    G2 ~ 2 (n.l) / ((n.l)(1 + 2 Lambda(v)) + alpha) puts it at
+    n.l = -alpha (n.v) / sqrt((n.v)^2 + alpha^2 (1 - (n.v)^2)), about min(n.v, alpha). Integrands vary on this
+    scale next to the horizon cut."""
     return alpha * cos_v / wp.sqrt(cos_v * cos_v + alpha * alpha * (wp.float64(1.0) - cos_v * cos_v))
 
 
@@ -119,15 +123,16 @@ def make_gauss_legendre(spec):
     Kernel inputs: per-texel (n.v, alpha, param); GL (node, weight) pairs on [0, 1] for the outer (rule_u) and
     inner (rule_p) variables. ``spec``: an integrand record (g, vec, acc, distribution, mirror)."""
     integrand, vec_type, acc_type, mirror = spec.g, spec.vec, spec.acc, spec.mirror
-    pdf, tan2_from_u, u_from_tan2 = spec.distribution.pdf_ndf, spec.distribution.tan2_from_u, spec.distribution.u_from_tan2
+    pdf, tan2_from_u, u_from_tan2 = (
+        spec.distribution.pdf_ndf,
+        spec.distribution.tan2_from_u,
+        spec.distribution.u_from_tan2,
+    )
     nch = vec_type._length_
     smooth = mirror is not None
 
     @wp.kernel(enable_backward=False, module="unique")
-    def gauss_legendre_kernel(
-        texel: wp.array(dtype=wp.vec3), rule_u: wp.array(dtype=wp.vec2d), rule_p: wp.array(dtype=wp.vec2d),
-        out: wp.array2d(dtype=wp.float64),
-    ):
+    def gauss_legendre_kernel(texel: wp.array(dtype=wp.vec3), rule_u: Rule, rule_p: Rule, out: Rows64):
         i = wp.tid()
         a = texel[i][1]
         prm = texel[i][2]
@@ -219,14 +224,11 @@ def make_qmc(spec, vndf: bool):
     smooth = mirror is not None
 
     @wp.kernel(enable_backward=False, module="unique")
-    def qmc_kernel(
-        texel: wp.array(dtype=wp.vec3), pts: wp.array2d(dtype=float), wts: wp.array(dtype=wp.float64),
-        out: wp.array2d(dtype=wp.float64),
-    ):
+    def qmc_kernel(texel: wp.array(dtype=wp.vec3), pts: Points2, wts: Values64, out: Rows64):
         i = wp.tid()
+        v = view_dir(texel[i][0])
         a = texel[i][1]
         prm = texel[i][2]
-        v = view_dir(texel[i][0])
         acc = acc_type()
         n = pts.shape[0]
         if wp.static(smooth):
@@ -250,7 +252,7 @@ def make_qmc(spec, vndf: bool):
 
 ESTIMATORS = {
     "gauss_legendre": "deterministic product Gauss-Legendre over panels in theta_h (or CDF(theta_h)) and phi, "
-                      "split exactly at the horizon (default; converges exponentially)",
+    "split exactly at the horizon (default; converges exponentially)",
     "sobol_vndf": "scrambled Sobol' points, GGX visible-normal sampling (Dupuy & Benyoub 2023)",
     "sobol_ndf": "scrambled Sobol' points, NDF importance sampling of D(h)(n.h)",
     "hammersley_ndf": "Hammersley points, NDF importance sampling (Filament cmgen's estimator)",
@@ -301,7 +303,7 @@ class GaussLegendre:
         return gl_order(self.budget)
 
     def samples(self, inputs: dict) -> np.ndarray:
-        return np.full(len(inputs["nov"]), 3 * self.order ** 2)
+        return np.full(len(inputs["nov"]), 3 * self.order**2)
 
     def prepare(self, integrand, device: str) -> None:
         load(gl_kernel(integrand), device)

@@ -6,6 +6,7 @@
   u_k = r / (1 + r), r = 16^k, do not depend on alpha, only their number K (``n_tail_cuts``) does.
 - A facet m sees a direction x on the azimuth arc |phi - phi_x| <= ``arc_half_width`` = acos(-cot theta_m cot theta_x).
 """
+
 from __future__ import annotations
 
 import math

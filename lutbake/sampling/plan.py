@@ -14,6 +14,7 @@ The three parts it composes stay apart, as in ``warp.fem.integrate(integrand, do
 - the **grid** (``Grid``): the axes and the per-texel inputs (lutbake.axes gives the values).
 The error estimate re-evaluates one set of probe texels (``probe_indices``) with ``refined()``.
 """
+
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -108,9 +109,18 @@ def probe_indices(grid: Grid) -> np.ndarray:
     return np.unique(np.concatenate(parts))
 
 
-def per_texel_plan(integrand, estimator, grid: Grid, *, channels: dict[str, str], reconstruction: str,
-                   terms: dict[str, str], extra: dict[str, str] | None = None, relative_error: bool = False,
-                   error_estimate: bool = True) -> TexelPlan:
+def per_texel_plan(
+    integrand,
+    estimator,
+    grid: Grid,
+    *,
+    channels: dict[str, str],
+    reconstruction: str,
+    terms: dict[str, str],
+    extra: dict[str, str] | None = None,
+    relative_error: bool = False,
+    error_estimate: bool = True,
+) -> TexelPlan:
     """The texel plan of ``grid``'s texels integrated by ``estimator``: texel i = estimator.evaluate(integrand,
     grid inputs of i) (reduced over ``grid.nodes``), the first ``integrand.nch`` channels kept.
     ``relative_error``: the error estimate is max |a - b| / |b| over probe texels with |b| > 1e-6."""
@@ -133,8 +143,18 @@ def per_texel_plan(integrand, estimator, grid: Grid, *, channels: dict[str, str]
 
     samples = estimator.samples(grid.inputs)  # evaluations per input row
     k = 1 if grid.nodes is None else len(grid.nodes)
-    return TexelPlan(axes=grid.axes, channels=channels, reconstruction=reconstruction, n_texels=grid.n_texels,
-                     n_channels=integrand.nch, run_tile=lambda s, e, d: run(slice(s, e), estimator, d),
-                     prepare=lambda d: estimator.prepare(integrand, d), samples=int(round(np.mean(samples) * k)),
-                     estimator=estimator.name, terms=terms, cost=float(np.sum(samples)), extra=dict(extra or {}),
-                     error_estimate=estimate if error_estimate else None)
+    return TexelPlan(
+        axes=grid.axes,
+        channels=channels,
+        reconstruction=reconstruction,
+        n_texels=grid.n_texels,
+        n_channels=integrand.nch,
+        run_tile=lambda s, e, d: run(slice(s, e), estimator, d),
+        prepare=lambda d: estimator.prepare(integrand, d),
+        samples=int(round(np.mean(samples) * k)),
+        estimator=estimator.name,
+        terms=terms,
+        cost=float(np.sum(samples)),
+        extra=dict(extra or {}),
+        error_estimate=estimate if error_estimate else None,
+    )

@@ -28,6 +28,7 @@ Cost per texel: P n_u (4 n_μ n_φ + n_φ) evaluations (P u panels), against 48 
 direct nested rule (n = 8: 196 608). Orders per texel are chosen by ``orders_for`` (1.5 x at grazing
 view), and the error estimate re-integrates probe texels with every order + 8.
 """
+
 from __future__ import annotations
 
 import functools
@@ -59,8 +60,17 @@ def swapped_kernel(T):
     row n of xs, ws (``rules``) is the n-point rule on [0, 1], ns[n] = n."""
 
     @wp.func
-    def arc_integral(cm: wp.float64, sm: wp.float64, cx: wp.float64, sx: wp.float64, f0: wp.float64,
-                     xp: wp.array2d(dtype=wp.float64), wpp: wp.array2d(dtype=wp.float64), rp: int, n: int):
+    def arc_integral(
+        cm: wp.float64,
+        sm: wp.float64,
+        cx: wp.float64,
+        sx: wp.float64,
+        f0: wp.float64,
+        xp: wp.array2d(dtype=wp.float64),
+        wpp: wp.array2d(dtype=wp.float64),
+        rp: int,
+        n: int,
+    ):
         """∫ (m.x)+ T(m.x) dφ over the arc where m.x > 0 (2 ∫_0^w, the arc being symmetric)."""
         w = arc_half_width(cm, sm, cx, sx)
         acc = wp.float64(0.0)
@@ -80,10 +90,16 @@ def swapped_kernel(T):
         return (hi - lo) * wp.float64(6.0) * s * (wp.float64(1.0) - s)
 
     @wp.kernel(enable_backward=False, module="unique")
-    def albedo_kernel(nov: wp.array(dtype=wp.float64), alpha: wp.array(dtype=wp.float64),
-                      f0: wp.array(dtype=wp.float64), rule: wp.array2d(dtype=int),
-                      xs: wp.array2d(dtype=wp.float64), ws: wp.array2d(dtype=wp.float64),
-                      ns: wp.array(dtype=int), out: wp.array2d(dtype=wp.float64)):
+    def albedo_kernel(
+        nov: wp.array(dtype=wp.float64),
+        alpha: wp.array(dtype=wp.float64),
+        f0: wp.array(dtype=wp.float64),
+        rule: wp.array2d(dtype=int),
+        xs: wp.array2d(dtype=wp.float64),
+        ws: wp.array2d(dtype=wp.float64),
+        ns: wp.array(dtype=int),
+        out: wp.array2d(dtype=wp.float64),
+    ):
         i = wp.tid()
         one = wp.float64(1.0)
         zero = wp.float64(0.0)
@@ -133,8 +149,12 @@ def swapped_kernel(T):
                         V = arc_integral(cm, sm, cv, sv, ff, xs, ws, rp, npp)
                         if V > zero:
                             # H(theta_m): mu = n.l on four panels cut at sin(theta_m), 2 alpha and 16 alpha (sorted)
-                            cuts = sort4(zero, wp.min(sm, one), wp.min(wp.float64(2.0) * a, one),
-                                         wp.min(wp.float64(16.0) * a, one))
+                            cuts = sort4(
+                                zero,
+                                wp.min(sm, one),
+                                wp.min(wp.float64(2.0) * a, one),
+                                wp.min(wp.float64(16.0) * a, one),
+                            )
                             H = zero
                             for pm in range(4):
                                 ends = interval(pm, cuts, one)
@@ -169,8 +189,11 @@ def rules(device: str):
         x, w = points.gauss_legendre(n)
         xs[n, :n], ws[n, :n] = x, w
     ns = np.arange(MAX_ORDER + 1, dtype=np.int32)
-    return (wp.array(xs, dtype=wp.float64, device=device), wp.array(ws, dtype=wp.float64, device=device),
-            wp.array(ns, dtype=int, device=device))
+    return (
+        wp.array(xs, dtype=wp.float64, device=device),
+        wp.array(ws, dtype=wp.float64, device=device),
+        wp.array(ns, dtype=int, device=device),
+    )
 
 
 def orders_for(nov: np.ndarray, alpha: np.ndarray, base: int) -> np.ndarray:
@@ -182,8 +205,9 @@ def orders_for(nov: np.ndarray, alpha: np.ndarray, base: int) -> np.ndarray:
     return np.minimum(o, MAX_ORDER)
 
 
-def integrate_swapped(integrand, nov, alpha, f0=0.0, order: int = 12, orders: np.ndarray | None = None,
-                   device: str = "cpu") -> np.ndarray:
+def integrate_swapped(
+    integrand, nov, alpha, f0=0.0, order: int = 12, orders: np.ndarray | None = None, device: str = "cpu"
+) -> np.ndarray:
     """E(nov_i) for GGX alpha_i and f0 (rho = 1) of the microfacet diffuse ``integrand`` (its ``transmission``
     T and factor c(f0): lutbake.integrands.diffuse), float64 (N,). ``orders``: (N, 3) per texel (u, μ, φ);
     omitted: ``orders_for(nov, alpha, order)``."""
@@ -195,10 +219,19 @@ def integrate_swapped(integrand, nov, alpha, f0=0.0, order: int = 12, orders: np
         orders = orders_for(nov, alpha, order)
     orders = np.ascontiguousarray(np.minimum(orders, MAX_ORDER), dtype=np.int32)
     out = wp.zeros((n, 1), dtype=wp.float64, device=device)
-    wp.launch(swapped_kernel(integrand.transmission), dim=n,
-              inputs=[wp.array(nov, dtype=wp.float64, device=device), wp.array(alpha, dtype=wp.float64, device=device),
-                      wp.array(f0a, dtype=wp.float64, device=device), wp.array(orders, dtype=int, device=device),
-                      *rules(device), out], device=device)
+    wp.launch(
+        swapped_kernel(integrand.transmission),
+        dim=n,
+        inputs=[
+            wp.array(nov, dtype=wp.float64, device=device),
+            wp.array(alpha, dtype=wp.float64, device=device),
+            wp.array(f0a, dtype=wp.float64, device=device),
+            wp.array(orders, dtype=int, device=device),
+            *rules(device),
+            out,
+        ],
+        device=device,
+    )
     c = integrand.f0_scale
     return out.numpy()[:, 0] * np.array([c(x) for x in f0a]) if n else np.zeros(0)
 
@@ -211,8 +244,11 @@ def u_panels(nov: np.ndarray, alpha: np.ndarray) -> np.ndarray:
     u_v = c * c / (alpha * alpha * (1 - c * c) + c * c)
     r2 = TAIL_RATIO ** (2.0 * np.arange(1, MAX_TAIL_CUTS + 1))
     cuts = r2 / (1 + r2)
-    on_cut = np.zeros(len(c), bool) if len(c) == 0 else np.any(np.isclose(u_v[:, None], cuts[None, :], rtol=0, atol=0)
-                                                                 | (u_v[:, None] >= 1.0), axis=1)
+    on_cut = (
+        np.zeros(len(c), bool)
+        if len(c) == 0
+        else np.any(np.isclose(u_v[:, None], cuts[None, :], rtol=0, atol=0) | (u_v[:, None] >= 1.0), axis=1)
+    )
     return k + 1 + (~on_cut)
 
 

@@ -11,6 +11,7 @@ apart (after pbrt-v4's ``TrowbridgeReitzDistribution``, src/pbrt/util/scattering
 Edge policy (lutbake.edge): alpha >= ALPHA_MIN here; the alpha -> 0 mirror limit is taken by the integrands that
 have it (lutbake.integrands.specular), not by a quadrature.
 """
+
 from __future__ import annotations
 
 import functools
@@ -26,7 +27,7 @@ MASKINGS = {
     "smith_separable": "Smith G2 = G1(v) G1(l), separable (Heitz 2014, Eq. 98)",
     "v_cavity": "Cook-Torrance V-cavity min(1, 2 NoH NoV / VoH, 2 NoH NoL / VoH) (lecture 003)",
     "smith_joint_approx": "UE4's Vis_SmithJointApprox as G2 = 2 NoL NoV / (NoL (NoV (1-a) + a) + NoV (NoL (1-a) + a)), "
-                          "a = alpha (an approximation of height-correlated Smith GGX; NDF-independent)",
+    "a = alpha (an approximation of height-correlated Smith GGX; NDF-independent)",
 }
 
 
@@ -65,18 +66,22 @@ def _G2(d: Distribution, masking_name: str):
     """The composed masking-shadowing ``G2(NoV, NoL, NoH, VoH, alpha)`` of ``d`` and a masking form."""
     Lam = d.Lambda
     if masking_name == "smith_height_correlated":
+
         @wp.func
         def G2(NoV: float, NoL: float, NoH: float, VoH: float, alpha: float):
             return masking.G2_smith_height_correlated(Lam(NoV, alpha), Lam(NoL, alpha))
     elif masking_name == "smith_separable":
+
         @wp.func
         def G2(NoV: float, NoL: float, NoH: float, VoH: float, alpha: float):
             return masking.G2_smith_separable(Lam(NoV, alpha), Lam(NoL, alpha))
     elif masking_name == "v_cavity":
+
         @wp.func
         def G2(NoV: float, NoL: float, NoH: float, VoH: float, alpha: float):
             return masking.G2_v_cavity(NoH, NoV, NoL, VoH, VoH)
     elif masking_name == "smith_joint_approx":
+
         @wp.func
         def G2(NoV: float, NoL: float, NoH: float, VoH: float, alpha: float):
             return masking.G2_smith_joint_approx(NoV, NoL, alpha)
@@ -128,15 +133,34 @@ def _pdf_vndf(d: Distribution):
     return pdf_vndf
 
 
-GGX = Distribution("ggx", "GGX / Trowbridge-Reitz (Walter et al. 2007)", ndf.D_ggx, masking.Lambda_ggx,
-                   ndf.tan2_from_u_ggx, ndf.u_from_tan2_ggx, ndf.sample_vndf_ggx)
-BECKMANN = Distribution("beckmann", "Beckmann, normalised with 1/pi (Walter et al. 2007, Eq. 25)", ndf.D_beckmann,
-                        masking.Lambda_beckmann, ndf.tan2_from_u_beckmann, ndf.u_from_tan2_beckmann)
+GGX = Distribution(
+    "ggx",
+    "GGX / Trowbridge-Reitz (Walter et al. 2007)",
+    ndf.D_ggx,
+    masking.Lambda_ggx,
+    ndf.tan2_from_u_ggx,
+    ndf.u_from_tan2_ggx,
+    ndf.sample_vndf_ggx,
+)
+BECKMANN = Distribution(
+    "beckmann",
+    "Beckmann, normalised with 1/pi (Walter et al. 2007, Eq. 25)",
+    ndf.D_beckmann,
+    masking.Lambda_beckmann,
+    ndf.tan2_from_u_beckmann,
+    ndf.u_from_tan2_beckmann,
+)
 # Blinn-Phong has no closed-form Smith Lambda. Walter et al. 2007 (Sec. 5.2) suggest Beckmann's at the same
 # alpha, but that is only close for small alpha: at alpha = 1 (s = 0, D = 1/pi) it gave E(F = 1) = 1.77 at
 # grazing view. So Blinn-Phong pairs with the V-cavity G only (Lambda = None; kinds.dfg checks it).
-BLINN_PHONG = Distribution("blinn_phong", "normalized Blinn-Phong (s + 2)/(2 pi) (n.h)^s, s = 2/alpha^2 - 2 "
-                           "(masking = v_cavity only: no closed-form Smith Lambda)", ndf.D_blinn_phong, None,
-                           ndf.tan2_from_u_blinn_phong, ndf.u_from_tan2_blinn_phong)
+BLINN_PHONG = Distribution(
+    "blinn_phong",
+    "normalized Blinn-Phong (s + 2)/(2 pi) (n.h)^s, s = 2/alpha^2 - 2 "
+    "(masking = v_cavity only: no closed-form Smith Lambda)",
+    ndf.D_blinn_phong,
+    None,
+    ndf.tan2_from_u_blinn_phong,
+    ndf.u_from_tan2_blinn_phong,
+)
 NDFS = {d.name: d for d in (GGX, BECKMANN, BLINN_PHONG)}
 SMITH_NDFS = tuple(n for n, d in NDFS.items() if d.Lambda is not None)
