@@ -5,7 +5,8 @@
    its start-up included), alternating, ``--rounds`` times: wall times, their ratio (target <= 1.15 on a
    2-core machine), tiles, and bytes moved per tile (task arguments to the workers, float64 results back,
    error-estimate inputs), and the CPU seconds of all processes (client + workers: a measure of the
-   overhead that other load on the machine does not distort). Every file of the Dask bake is compared with the thread bake (pixels and every
+   overhead that other load on the machine does not distort). Every file of the Dask bake is compared
+   with the thread bake (pixels and every
    lutbake:* attribute).
 2. **Scaling on paper** for the largest table of the batch (the 1024^2 glTF DFG, ``lut_ggx``), from what
    the Dask bake measured: W = the CPU seconds of its n tile launches on the workers (thread CPU time, so
@@ -39,7 +40,7 @@ from lutbake import batch, cluster  # noqa: E402
 from lutbake.config import load_configs, preset_path  # noqa: E402
 from lutbake.executor import default_workers  # noqa: E402
 from lutbake.io.exr import read_exr  # noqa: E402
-from lutbake.tables import lookup_kind  # noqa: E402
+from lutbake.kinds import lookup_kind  # noqa: E402
 
 OUT = ROOT / "outputs" / "bench"
 PRESETS = ("filament", "filament-corrected", "gltf", "gltf-charlie", "gltf-sheen-e", "blender-eevee", "unreal")
@@ -100,21 +101,21 @@ def cpu_seconds() -> float:
 
 def thread_run(out: Path) -> tuple[float, float, list]:
     t0, c0 = time.perf_counter(), cpu_seconds()
-    jobs = batch.plan(specs(), out, force=True)
-    assert batch.run(jobs, default_workers(), progress=False) is None
+    jobs = batch.schedule(specs(), out, force=True)
+    assert batch.run(jobs, default_workers()) is None
     return time.perf_counter() - t0, cpu_seconds() - c0, jobs
 
 
 def dask_run(out: Path, scheduler: str) -> tuple[float, float, float, list, TimedRunner, float]:
     """Wall, client CPU and workers' CPU seconds (start-up included) of the batch on ``scheduler``."""
     t0, c0 = time.perf_counter(), cpu_seconds()
-    jobs = batch.plan(specs(), out, force=True)
+    jobs = batch.schedule(specs(), out, force=True)
     real = cluster.DaskRunner
     cluster.DaskRunner = TimedRunner  # session() builds its runner from the module attribute
     try:
         with cluster.session(scheduler) as runner:
             started = time.perf_counter() - t0
-            assert batch.run(jobs, len(jobs), progress=False) is None
+            assert batch.run(jobs, len(jobs)) is None
             cpu_workers = sum(runner.client.run(cpu_seconds).values())
     finally:
         cluster.DaskRunner = real
@@ -176,7 +177,8 @@ def main(argv=None):
             f"round {r}: thread {t_thread:.1f} s, {args.scheduler} {t_dask:.1f} s (start {started:.1f} s): "
             f"ratio {t_dask / t_thread:.3f}; CPU {cpu_thread:.1f} s vs {cpu_dask:.1f} s (client + workers): "
             f"ratio {cpu_dask / cpu_thread:.3f}; {st.tiles} tiles, {st.bytes_to_workers / st.tiles:.0f} B to and "
-            f"{st.bytes_from_workers / st.tiles:.0f} B from the workers per tile (+ {st.bytes_estimate_inputs / st.tiles:.0f}"
+            f"{st.bytes_from_workers / st.tiles:.0f} B from the workers per tile "
+            f"(+ {st.bytes_estimate_inputs / st.tiles:.0f}"
             f" B of error-estimate inputs); identical files: {same}"
         )
     # the projection, from the last Dask round

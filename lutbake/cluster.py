@@ -20,8 +20,8 @@ table cancels its futures and writes nothing).
   Warp, numpy and scipy. Every tile carries a token of that identity, so a worker that joins later with
   another one fails its tile with the same message instead of baking different bits.
 - **Devices**: ``--device cpu`` runs CLUSTER_TILE_TEXELS-texel tiles on any worker (any cut gives the same
-  bits; larger than the thread executor's 512 so that Dask's per-task cost stays small); ``--device cuda`` runs device-sized
-  tiles (lutbake.devices) on the workers that have a CUDA device, and refuses a cluster with none. A
+  bits; larger than the thread executor's 512 so that Dask's per-task cost stays small); ``--device cuda``
+  runs device-sized tiles (lutbake.devices) on the workers that have a CUDA device, and refuses a cluster with none. A
   table's tiles all run on one kind of device: its bits never depend on which worker took which tile.
 - **Local clusters** (``local:N``): a distributed.LocalCluster of N single-threaded worker processes on
   this machine; they ignore SIGINT (Ctrl-C in a terminal reaches the whole process group: the client
@@ -31,7 +31,7 @@ Python API::
 
     from lutbake import batch, cluster
     with cluster.session("local:2"):            # or "tcp://HOST:8786"
-        batch.run(batch.plan(specs, "outputs"))  # lutbake.bake(...) works the same inside the block
+        batch.run(batch.schedule(specs, "outputs"))  # lutbake.bake(...) works the same inside the block
 """
 
 from __future__ import annotations
@@ -144,7 +144,7 @@ def identity() -> dict[str, str]:
     import warp
 
     from . import __version__
-    from .batch import sources_digest
+    from .provenance import sources_digest
 
     return {
         "lutbake": __version__,
@@ -181,7 +181,7 @@ def _check_token(expect: str) -> None:
 
 def worker_plan(spec, device: str):
     """The plan of ``spec`` in this worker process, built and its kernels loaded for ``device`` once."""
-    from .tables import lookup_kind
+    from .kinds import lookup_kind
 
     key = (spec.kind, spec.toml(), device)
     with _WORKER_LOCK:
@@ -309,13 +309,14 @@ class DaskRunner:
         spec,
         plan,
         device: str,
-        progress: bool | None = None,
+        progress=None,
         label: str = "",
         cancel: threading.Event | None = None,
     ) -> np.ndarray:
-        """lutbake.executor.execute() on the cluster: float64 data of shape plan.shape."""
+        """lutbake.executor.execute() on the cluster: float64 data of shape plan.shape (``progress``: an
+        executor.Progress factory, updated in the calling thread as tiles arrive)."""
         from .devices import plan_tile_texels
-        from .executor import Cancelled, progress_bar, tiles
+        from .executor import Cancelled, tiles
 
         if device != self.device:
             raise ValueError(f"this runner bakes on {self.device!r}, not {device!r}")
@@ -335,30 +336,32 @@ class DaskRunner:
         finished: queue.Queue = queue.Queue()
         for f in futures:
             f.add_done_callback(finished.put)
+        update = progress(label, plan.n_texels, plan.cost) if progress is not None else None
         try:
-            with progress_bar(plan, progress, label) as bar:
-                while pending:
-                    if cancel is not None and cancel.is_set():
-                        raise Cancelled(label)
-                    try:
-                        f = finished.get(timeout=POLL_S)
-                    except queue.Empty:
-                        continue
-                    if f in pending:
-                        pending.discard(f)
-                        s, e = futures[f]
-                        data, seconds = f.result()  # a task's exception (a kernel error, KilledWorker) raises here
-                        out[s:e] = data
-                        f.release()
-                        with self.stats.lock:
-                            self.stats.tiles += 1
-                            self.stats.bytes_to_workers += sent
-                            self.stats.bytes_from_workers += data.nbytes
-                            self.stats.worker_seconds += seconds
-                            self.stats.tile_seconds.append((spec.name, e - s, seconds))
-                        bar.update(e - s)
-                        if self.on_tile is not None:
-                            self.on_tile(spec.name, s, e)
+            while pending:
+                if cancel is not None and cancel.is_set():
+                    raise Cancelled(label)
+                try:
+                    f = finished.get(timeout=POLL_S)
+                except queue.Empty:
+                    continue
+                if f not in pending:
+                    continue
+                pending.discard(f)
+                s, e = futures[f]
+                data, seconds = f.result()  # a task's exception (a kernel error, KilledWorker) raises here
+                out[s:e] = data
+                f.release()
+                with self.stats.lock:
+                    self.stats.tiles += 1
+                    self.stats.bytes_to_workers += sent
+                    self.stats.bytes_from_workers += data.nbytes
+                    self.stats.worker_seconds += seconds
+                    self.stats.tile_seconds.append((spec.name, e - s, seconds))
+                if update is not None:
+                    update(e - s)
+                if self.on_tile is not None:
+                    self.on_tile(spec.name, s, e)
         finally:
             if pending:  # cancelled or failed: no tile of this table runs any more
                 self.client.cancel(list(pending))

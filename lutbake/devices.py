@@ -31,7 +31,7 @@ def tile_texels(
 ) -> int:
     """Texels per tile (launch) of a table of ``n_texels`` on ``device``.
 
-    ``evals_per_texel``: integrand evaluations per texel (Plan.cost / Plan.n_texels);
+    ``evals_per_texel``: integrand evaluations per texel (TexelPlan.cost / n_texels);
     ``free_bytes``: the CUDA device's free memory (default: asked of Warp). Always >= 1; a CPU tile is
     CPU_TILE_TEXELS; a CUDA tile is the whole table or a multiple of CPU_TILE_TEXELS."""
     if n_texels <= 0:
@@ -49,7 +49,7 @@ def tile_texels(
 
 
 def plan_tile_texels(plan, device: str = "cpu", free_bytes: int | None = None) -> int:
-    """tile_texels() of a lutbake.tables.base.Plan."""
+    """tile_texels() of a lutbake.sampling.plan.TexelPlan."""
     return tile_texels(plan.n_texels, plan.cost / max(1, plan.n_texels), plan.n_channels, device, free_bytes)
 
 

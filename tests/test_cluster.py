@@ -86,7 +86,7 @@ def deadline(seconds=BAKE_DEADLINE_S):
 
 def thread_bake(specs, out) -> dict:
     """{name: (pixels, lutbake:* header)} of the files a local (thread executor) batch writes."""
-    jobs = batch.plan(specs, out, force=True)
+    jobs = batch.schedule(specs, out, force=True)
     assert batch.run(jobs, workers=2) is None
     return {j.name: read_exr(j.path) for j in jobs}
 
@@ -166,7 +166,7 @@ def test_a_killed_worker_costs_only_its_tiles(client, tmp_path):
             os.kill(pids[victim], signal.SIGKILL)
 
     r.on_tile = kill_one
-    jobs = batch.plan(specs, tmp_path / "out")
+    jobs = batch.schedule(specs, tmp_path / "out")
     with deadline(), cluster.activate(r):
         assert batch.run(jobs, workers=len(jobs)) is None
     assert killed and killed["tiles"] >= 1 and killed["remaining"] > 1  # the kill happened mid-bake, with tiles on it

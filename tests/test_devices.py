@@ -13,7 +13,7 @@ from lutbake.api import bake_table
 from lutbake.axes import Axis
 from lutbake.config import validate_table
 from lutbake.devices import CPU_TILE_TEXELS, CUDA_MEMORY_FRACTION, CUDA_TILE_MAX_EVALS, tile_texels
-from lutbake.tables.base import Plan
+from lutbake.sampling.plan import TexelPlan
 
 GIB = 1 << 30
 # A CUDA bake evaluates the same float32 integrand with the GPU's float32 functions and FMA contraction and
@@ -53,12 +53,12 @@ def test_a_cuda_tile_is_never_below_one_cpu_tile():
     assert tile_texels(1 << 20, 1e12, 2, "cuda", free_bytes=GIB) == CPU_TILE_TEXELS
 
 
-def fake_plan(n_texels: int, evals: int, calls: list) -> Plan:
+def fake_plan(n_texels: int, evals: int, calls: list) -> TexelPlan:
     def run_tile(start, stop, device):
         calls.append((start, stop, device))
         return np.arange(start, stop, dtype=np.float64)[:, None]
 
-    return Plan(
+    return TexelPlan(
         axes=[Axis("NoV", "x", n_texels)],
         channels={"c": ""},
         reconstruction="",
@@ -78,12 +78,12 @@ def test_the_executor_launches_device_sized_tiles_on_cuda(monkeypatch):
     n = 5000
     for device, expect in [("cpu", executor.tiles(n, CPU_TILE_TEXELS)), ("cuda", [(0, n)])]:
         calls = []
-        out = executor.execute(fake_plan(n, 432, calls), workers=2, device=device, progress=False)
+        out = executor.execute(fake_plan(n, 432, calls), workers=2, device=device)
         assert sorted(calls) == [(s, e, device) for s, e in expect]
         np.testing.assert_array_equal(out.ravel(), np.arange(n))
     big = CUDA_TILE_MAX_EVALS // 1000 + 1  # texels over one launch's evaluation budget at 1000 evaluations each
     calls = []
-    executor.execute(fake_plan(big, 1000, calls), device="cuda", progress=False)
+    executor.execute(fake_plan(big, 1000, calls), device="cuda")
     assert len(calls) == 2 and calls[0][1] % CPU_TILE_TEXELS == 0 and calls[-1][1] == big
 
 
@@ -103,8 +103,7 @@ def test_cuda_bake_equals_the_cpu_bake_within_float32_evaluation(name):
     cpu = bake_table(spec, workers=2, device="cpu")[0].data.astype(np.float64)
     gpu = bake_table(spec, device="cuda")[0].data.astype(np.float64)
     diff = np.abs(gpu - cpu)
-    print(
-        f"{name}: max |cuda - cpu| = {diff.max():.3e}, max relative = {np.max(diff / np.maximum(np.abs(cpu), 1e-30)):.3e}"
-    )
+    rel = np.max(diff / np.maximum(np.abs(cpu), 1e-30))
+    print(f"{name}: max |cuda - cpu| = {diff.max():.3e}, max relative = {rel:.3e}")
     assert np.all(np.isfinite(gpu))
     np.testing.assert_allclose(gpu, cpu, rtol=CUDA_VS_CPU_RTOL, atol=CUDA_VS_CPU_ATOL)
