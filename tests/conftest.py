@@ -9,8 +9,10 @@
   where an integrand is not analytic (a converged reference in a few thousand nodes, not a brute-force grid).
 - ``charlie_reference(alpha, nov, visibility, clamp=False)``: ∫ D_charlie V (n.l) dω_l by that rule in
   numpy, independent of lutbake's @wp.funcs (the sheen and Filament cloth tests compare with it).
+- ``terminal_sigint``: SIGINT raises KeyboardInterrupt during the test, also under ``make test &``.
 """
 
+import signal
 from pathlib import Path
 
 import numpy as np
@@ -165,3 +167,11 @@ def graded_rule():
 def charlie_reference():
     """``charlie_reference(alpha, nov, "ashikhmin" | "charlie", clamp=False)`` -> float (see integrate_charlie)."""
     return integrate_charlie
+
+
+@pytest.fixture
+def terminal_sigint():
+    """SIGINT raises KeyboardInterrupt, as in a terminal (a shell's background job inherits SIG_IGN for it)."""
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)

@@ -193,14 +193,6 @@ def test_report_has_every_field(three):
     assert [t["status"] for t in doc["tables"]] == ["skipped", "skipped", "skipped", "baked"]
 
 
-@pytest.fixture
-def terminal_sigint():
-    """SIGINT raises KeyboardInterrupt, as in a terminal (a shell's background job inherits SIG_IGN for it)."""
-    old = signal.signal(signal.SIGINT, signal.default_int_handler)
-    yield
-    signal.signal(signal.SIGINT, old)
-
-
 @pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(
     monkeypatch, tmp_path, signum, code, terminal_sigint

@@ -29,6 +29,7 @@ from lutbake.config import load_configs, validate_table  # noqa: E402
 from lutbake.io.exr import read_exr  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
+pytestmark = pytest.mark.usefixtures("terminal_sigint")  # the interrupt tests and deadline() need SIGINT
 BAKE_DEADLINE_S = 90  # a cluster test that has not finished by then is interrupted (and fails)
 TILE = 512  # small cluster tiles in these tests, so that small tables are cut into several
 

@@ -167,7 +167,7 @@ LAYERS = [
     {"integrands"},
     {"kinds"},
     {"config"},
-    {"executor", "provenance"},
+    {"executor", "provenance", "devices", "cluster", "cluster_probe"},  # cluster: the executor's Dask counterpart
     {"pipeline"},
     {"batch"},
     {"api"},
