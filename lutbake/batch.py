@@ -2,8 +2,9 @@
 
 - **Content hash.** Every output records ``lutbake:content_hash`` = sha256 of the table's canonical
   TOML (``TableSpec.toml()``), the lutbake version and the source text of the modules that define
-  the kernels and terms (``HASH_SOURCES``). A table whose output exists with the same hash is
-  *skipped*; anything else (no file, unreadable file, other hash) is baked again.
+  the kernels and terms (``HASH_SOURCES``). A table whose output exists with the same hash, and whose
+  stored bytes match the sha256 recorded with it (lutbake.io.integrity), is *skipped*; anything else
+  (no file, unreadable, truncated or garbled file, half-written data + sidecar, other hash) is baked again.
 - **Plan first.** ``plan()`` takes already-validated specs (``config.load_configs`` validates every
   config before anything runs) and decides, per table, its output path, its hash and whether it is
   up to date. Nothing is baked while planning.
@@ -21,11 +22,9 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import json
-import os
 import signal
 import threading
 import time
-import uuid
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
@@ -33,6 +32,9 @@ from typing import Callable
 
 from . import __version__
 from .io.formats import output_path, write_table
+from .io.atomic import atomic_write_bytes, remove_stale_temps
+from .io.integrity import verified_attributes
+from .io.oserror import os_error_text
 from .config import TableSpec
 
 PACKAGE = Path(__file__).parent
@@ -76,33 +78,10 @@ def content_hash(spec: TableSpec, digest: bytes | None = None) -> str:
 
 
 def read_header(path) -> dict[str, str] | None:
-    """The ``lutbake:*`` attributes of an existing output (prefix removed): an EXR's first part header,
-    or for the other formats their ``.json`` sidecar; None if missing or unreadable (not up to date)."""
-    path = Path(path)
-    if not path.is_file():
-        return None
-    if path.suffix != ".exr":
-        try:
-            doc = json.loads(path.with_suffix(".json").read_text(encoding="utf-8"))
-            meta = doc["lutbake"] if doc.get("file") == path.name else None
-            return {k[len("lutbake:"):] if k.startswith("lutbake:") else k: str(v) for k, v in meta.items()}
-        except Exception:  # no sidecar (ktx2, h) or a foreign one: rebake
-            return None
-    try:
-        import OpenImageIO as oiio
-
-        inp = oiio.ImageInput.open(str(path))
-        if inp is None:
-            oiio.geterror()
-            return None
-        try:
-            spec = inp.spec()
-            return {p.name[len("lutbake:"):]: str(p.value) for p in spec.extra_attribs
-                    if p.name.startswith("lutbake:")}
-        finally:
-            inp.close()
-    except Exception:  # a corrupt or foreign file is simply not up to date
-        return None
+    """The ``lutbake:*`` attributes of an existing output (prefix removed), only if the output passes its
+    integrity check (lutbake.io.integrity: the recorded sha256 of the stored bytes; for the non-EXR formats
+    the ``<file>.json`` sidecar written last); None if missing, corrupt or half-written (not up to date)."""
+    return verified_attributes(path)
 
 
 @dataclass
@@ -160,10 +139,12 @@ def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.E
     from .errors import LutbakeError
     from .executor import Cancelled
     t0 = time.perf_counter()
+    needed = 0
     try:
         if cancel.is_set():
             raise Cancelled(job.name)
         table, seconds, samples = bake_table(job.spec, workers, device, progress, cancel=cancel)
+        needed = table.data.nbytes
         if table.attributes.get(HASH_ATTRIBUTE) != job.content_hash:  # sources changed under a running batch
             raise RuntimeError("the lutbake sources changed while the batch ran; run it again")
         if cancel.is_set():
@@ -177,6 +158,10 @@ def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.E
         job.message = f"{job.spec.source}: table '{job.name}': out of memory{': ' + str(e) if str(e) else ''}; nothing written"
     except LutbakeError as e:
         job.status, job.message = "failed", str(e)
+    except OSError as e:  # the output could not be written: say why (a full disk, a read-only mount ...)
+        job.status = "failed"
+        job.message = (f"{job.spec.source}: table '{job.name}': cannot write {job.path}: "
+                       f"{os_error_text(e, job.path.parent, needed)}; the next run bakes it again")
     except Exception as e:  # a kernel error, an I/O error, anything: this table fails, the others go on
         job.status = "failed"
         job.message = f"{job.spec.source}: table '{job.name}': {type(e).__name__}: {e}; nothing written"
@@ -202,6 +187,8 @@ def run(jobs: list[Job], workers: int | None = None, device: str = "cpu", progre
     from .executor import default_workers
 
     workers = workers or default_workers()
+    for d in sorted({j.path.parent for j in jobs}):
+        remove_stale_temps(d)  # left by writers that were killed before their rename
     pending = [j for j in jobs if j.status == "pending"]
     if not pending:
         return None
@@ -265,14 +252,7 @@ def write_report(path, jobs: list[Job], status: int, signum: int | None = None) 
         "counts": {s: sum(j.status == s for j in jobs) for s in STATUSES},
         "tables": [j.report() for j in jobs],
     }
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp")
-    try:
-        tmp.write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    atomic_write_bytes(path, (json.dumps(doc, indent=2) + "\n").encode("utf-8"))
     return path
 
 

@@ -73,9 +73,10 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
       lutbake bake configs/dfg.toml --set dfg.estimator=sobol_vndf --set dfg.samples=4096
       lutbake bake --preset unreal --format dds        # -> outputs/preintegrated_gf.dds (R16G16_FLOAT)
     """
-    from . import batch
+    from . import batch, preflight
     from .config import load_configs, preset_path
     from .errors import ConfigError
+    from .textsafe import escape_controls
 
     _quiet_warp()
     try:
@@ -85,18 +86,20 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
         if fmt:
             overrides = tuple(overrides) + (f'format="{fmt}"',)
         specs = load_configs(paths, overrides)
-        if out_dir.exists() and not out_dir.is_dir():
-            raise ConfigError("--out-dir", "out-dir", str(out_dir), message="exists and is not a directory")
-        if report is not None and report.is_dir():
-            raise ConfigError("--report", "report", str(report), message="is a directory")
+        preflight.check_out_dir(out_dir)
         if device == "cuda":
             import warp as wp
 
             if not wp.is_cuda_available():
                 raise ConfigError("--device", "device", "cuda", "cpu", "no CUDA device is available")
         jobs = batch.plan(specs, out_dir, force=force)
+        preflight.check_outputs(jobs)
+        preflight.check_report(report, jobs, paths)
     except ConfigError as e:
         click.echo(f"error: {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    except RecursionError:  # a value nested too deeply for some check that slipped past load_configs
+        click.echo("error: a config or --set value is nested too deeply", err=True)
         sys.exit(EXIT_CONFIG)
     except KeyboardInterrupt:
         click.echo("interrupted (SIGINT) while planning: nothing was baked or written", err=True)
@@ -104,13 +107,13 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
 
     def on_done(job):
         if job.status == "baked":
-            click.echo(f"{job.path}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel")
+            click.echo(f"{escape_controls(str(job.path))}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel")
         elif job.status == "failed":
-            click.echo(f"FAILED {job.name}: {job.message}", err=True)
+            click.echo(f"FAILED {job.name}: {escape_controls(job.message)}", err=True)
 
     for job in jobs:
         if job.status == "skipped":
-            click.echo(f"skipped {job.path} (up to date)")
+            click.echo(f"skipped {escape_controls(str(job.path))} (up to date)")
     signum = None
     try:
         with batch.signal_handlers():
@@ -122,7 +125,14 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
                 job.status, job.message = "interrupted", "interrupted; nothing written"
     status = batch.exit_status(jobs, signum)
     if report is not None:
-        batch.write_report(report, jobs, status, signum)
+        try:
+            batch.write_report(report, jobs, status, signum)
+        except OSError as e:
+            from .io.oserror import os_error_text
+
+            click.echo(f"error: cannot write the report {escape_controls(str(report))}: "
+                       f"{escape_controls(os_error_text(e, report.parent))}", err=True)
+            status = status or batch.EXIT_FAILED
     failed = [j.name for j in jobs if j.status == "failed"]
     unfinished = [j.name for j in jobs if j.status in ("interrupted", "pending")]
     if failed:

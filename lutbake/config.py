@@ -15,10 +15,12 @@ from types import MappingProxyType
 from typing import Any, Mapping
 
 from .errors import ConfigError
+from .preflight import config_file_problem
 from .tables import KINDS, lookup_kind
 from .tables.base import Key
+from .value_bounds import unit_range
 
-NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,128}$")
+NAME_RE = re.compile(r"[A-Za-z0-9_-]{1,128}")  # use fullmatch: "$" would accept a final newline
 MAX_TEXELS = 1 << 26  # 64 Mi texels; float64 accumulation of 4 channels = 2 GiB
 BYTES_PER_TEXEL = 32  # float64 x 4 channels while baking
 MAX_LIST = 1024  # entries of a float_list key
@@ -84,7 +86,7 @@ def _check_value(key: Key, value, file, table) -> Any:
     if key.type in ("str", "name"):
         if not isinstance(value, str):
             fail("must be a string", ", ".join(key.choices) if key.choices else None)
-        if key.type == "name" and not NAME_RE.match(value):
+        if key.type == "name" and not NAME_RE.fullmatch(value):
             fail("must be 1-128 letters, digits, '-' or '_' (it names the output file)")
         if key.choices is not None and value not in key.choices:
             fail("is not a known value", ", ".join(key.choices))
@@ -136,6 +138,17 @@ def _check_value(key: Key, value, file, table) -> Any:
     raise AssertionError(key.type)
 
 
+def texel_count(options: Mapping[str, Any]) -> tuple[int, str]:
+    """(texels of the table, the size key that names it): ``size`` times every ``*_size`` key (or, where a
+    ``*_values`` list replaces it, the list's length). Every size key falls under the one MAX_TEXELS cap."""
+    factors = {"size": math.prod(options["size"])} if isinstance(options.get("size"), list) else {}
+    for k, v in options.items():
+        if k.endswith("_size") and isinstance(v, int):
+            listed = options.get(k[: -len("_size")] + "_values")
+            factors[k] = len(listed) if isinstance(listed, list) else v
+    return math.prod(factors.values()), max(factors, key=factors.get, default="size")
+
+
 def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
     """Validate one ``[[table]]`` mapping against its kind's keys."""
     label = f"#{index + 1}" + (f" ({raw['name']!r})" if isinstance(raw.get("name"), str) else "")
@@ -163,12 +176,17 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
             options[k.name] = list(k.default) if isinstance(k.default, list) else k.default
     options["kind"] = kind.name
     spec = TableSpec(options["name"], kind.name, MappingProxyType(options), str(file), index)
-    texels = math.prod(options.get("size", [1]))
+    texels, size_key = texel_count(options)
     if texels > MAX_TEXELS:
-        raise ConfigError(file, "size", options["size"],
+        raise ConfigError(file, size_key, options[size_key],
                           f"at most {MAX_TEXELS} texels = {human_bytes(MAX_TEXELS * BYTES_PER_TEXEL)}",
                           f"{texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} of memory while "
                           "baking", label)
+    if options.get("format") == "png16":
+        reason = unit_range(spec)
+        if reason:
+            raise ConfigError(file, "format", "png16", "exr, npy, dds, ktx2, h",
+                              f"png16 stores values in [0, 1] only, and this table's {reason}", label)
     if kind.check is not None:
         msg = kind.check(spec)
         if msg:
@@ -191,6 +209,8 @@ def parse_overrides(items: tuple[str, ...] | list[str]) -> list[tuple[str | None
             value = tomllib.loads(f"v = {rhs.strip()}")["v"]
         except tomllib.TOMLDecodeError:
             value = rhs.strip()  # a bare word: a string
+        except RecursionError:
+            raise ConfigError("--set", key.strip(), message="VALUE is nested too deeply") from None
         out.append((table or None, key, value))
     return out
 
@@ -198,10 +218,13 @@ def parse_overrides(items: tuple[str, ...] | list[str]) -> list[tuple[str | None
 def load_config(path, overrides=()) -> list[TableSpec]:
     """Read and validate one TOML config; ``overrides`` from parse_overrides() are applied first."""
     path = Path(path)
-    if not path.is_file():
-        raise ConfigError(path, None, message="no such config file")
+    problem = config_file_problem(path)
+    if problem:
+        raise ConfigError(path, None, message=problem)
     try:
         doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except RecursionError:
+        raise ConfigError(path, None, message="invalid TOML: arrays, tables or dotted keys nested too deeply") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError, ValueError) as e:
         raise ConfigError(path, None, message=f"invalid TOML: {e}") from None
     except OSError as e:

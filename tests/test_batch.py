@@ -298,7 +298,7 @@ def test_every_format_is_skipped_when_up_to_date(tmp_path, fmt, ext):
     out = tmp_path / "out"
     first = bake(cfg, "--out-dir", out)
     assert first.exit_code == 0, first.output
-    assert (out / f"t{ext}").is_file() and (out / "t.json").is_file()
+    assert (out / f"t{ext}").is_file() and (out / f"t{ext}.json").is_file()
     again = bake(cfg, "--out-dir", out)
     assert again.exit_code == 0 and f"skipped {out / ('t' + ext)} (up to date)" in again.output
     changed = bake(cfg, "--out-dir", out, "--set", "samples=64")

@@ -19,6 +19,9 @@ File layout (the contract engines and ``lutbake inspect`` rely on):
   error, never written.
 - Writes are atomic: the file is written to a temporary sibling, fsynced, then renamed onto the
   target, so an interrupted or failed write never leaves a half-written file or clobbers the old one.
+- ``lutbake:data_hash`` (every part): the sha256 of the file's bytes with these 64 hex digits set to ``0``
+  (lutbake.io.integrity); a rerun skips the table only if it matches, so a truncated or garbled file is
+  baked again.
 """
 from __future__ import annotations
 
@@ -29,6 +32,7 @@ import numpy as np
 
 from ..table import Table
 from .atomic import atomic_write
+from .integrity import HASH_KEY, PLACEHOLDER, seal_exr
 
 PREFIX = "lutbake:"
 CHANNEL_LETTERS = ("R", "G", "B", "A")
@@ -36,7 +40,7 @@ DTYPES = {"float32": ("float", np.float32), "half": ("half", np.float16)}
 COMPRESSION = "zip"
 # attributes lutbake writes itself; Table.attributes may not shadow them
 RESERVED = frozenset(
-    {"kind", "table", "axes", "channels", "channel_names", "reconstruction", "slice_index", "slice_value"}
+    {"kind", "table", "axes", "channels", "channel_names", "reconstruction", "slice_index", "slice_value", "data_hash"}
 )
 PER_PART = frozenset({"slice_index", "slice_value"})
 
@@ -185,7 +189,7 @@ def write_exr(table: Table, path, dtype: str = "float32") -> Path:
     path = Path(path)
     pixels = _check_table(table, dtype)
     fmt = DTYPES[dtype][0]
-    attrs = _header(table)
+    attrs = {**_header(table), HASH_KEY: PLACEHOLDER.decode()}  # sealed with the file's hash before the rename
     if pixels.ndim == 3:
         parts = [(None, attrs, pixels)]
     else:
@@ -200,7 +204,11 @@ def write_exr(table: Table, path, dtype: str = "float32") -> Path:
             for k in range(pixels.shape[0])
         ]
 
-    return atomic_write(path, lambda tmp: _write_oiio(tmp, parts, fmt))
+    def write(tmp):
+        _write_oiio(tmp, parts, fmt)
+        seal_exr(tmp)
+
+    return atomic_write(path, write)
 
 
 # --------------------------------------------------------------------------------------- reading
