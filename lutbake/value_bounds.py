@@ -17,13 +17,17 @@ tests/test_value_bounds.py against bakes of every kind, layout and model:
 """
 from __future__ import annotations
 
-# dfg layouts whose channels are weighted single-scattering albedos (each weight in [0, 1])
+# dfg layouts whose channels are weighted single-scattering albedos (each weight in [0, 1]), and the others
 UNIT_LAYOUTS = frozenset({"scale_bias", "multiscatter", "scale_bias_f82"})
-# specular models whose directional albedo is at most 1 (energy conserving)
+ABOVE_ONE_LAYOUTS = frozenset({"multiscatter_cloth", "charlie", "sheen_albedo", "charlie_clamped",
+                               "sheen_albedo_clamped"})
+# specular models whose directional albedo is at most 1 (energy conserving), and the others
 UNIT_SPECULAR_MODELS = frozenset({"microfacet", "cook_torrance", "ashikhmin_shirley"})
-# diffuse models whose tabulated albedo ratio is at most 1
+ABOVE_ONE_SPECULAR_MODELS = frozenset({"blinn_phong"})
+# diffuse models whose tabulated albedo ratio is at most 1, and the others
 UNIT_DIFFUSE_MODELS = frozenset({"lambert", "oren_nayar_improved", "oren_nayar_fresnel", "fitted", "fitted_slides",
                                  "microfacet"})
+ABOVE_ONE_DIFFUSE_MODELS = frozenset({"oren_nayar"})
 SPECULAR_KINDS = frozenset({"dfg", "albedo", "albedo_avg", "specular_3d", "specular_aniso"})
 DIFFUSE_KINDS = frozenset({"diffuse", "diffuse_3d"})
 UNBOUNDED_KINDS = {"btf": "btf tabulates BRDF values f, which peak above 1"}
