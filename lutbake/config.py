@@ -15,7 +15,7 @@ from types import MappingProxyType
 from typing import Any, Mapping
 
 from .errors import ConfigError
-from .preflight import config_file_problem
+from .preflight import config_file_problem, nesting_problem
 from .tables import KINDS, lookup_kind
 from .tables.base import Key
 from .value_bounds import unit_range
@@ -205,6 +205,9 @@ def parse_overrides(items: tuple[str, ...] | list[str]) -> list[tuple[str | None
             raise ConfigError("--set", item, message="must look like KEY=VALUE or TABLE.KEY=VALUE")
         lhs, rhs = item.split("=", 1)
         table, _, key = lhs.strip().rpartition(".")
+        problem = nesting_problem(rhs)
+        if problem:
+            raise ConfigError("--set", key.strip(), message=f"VALUE: {problem}")
         try:
             value = tomllib.loads(f"v = {rhs.strip()}")["v"]
         except tomllib.TOMLDecodeError:
@@ -222,7 +225,11 @@ def load_config(path, overrides=()) -> list[TableSpec]:
     if problem:
         raise ConfigError(path, None, message=problem)
     try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+        text = path.read_text(encoding="utf-8")
+        problem = nesting_problem(text)
+        if problem:
+            raise ConfigError(path, None, message=f"invalid config: {problem}")
+        doc = tomllib.loads(text)
     except RecursionError:
         raise ConfigError(path, None, message="invalid TOML: arrays, tables or dotted keys nested too deeply") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError, ValueError) as e:

@@ -5,6 +5,7 @@ written. A config path that is not a regular file says what it is."""
 from __future__ import annotations
 
 import os
+import re
 import stat
 from pathlib import Path
 
@@ -105,3 +106,30 @@ def check_report(report, jobs, configs=()) -> None:
     problem = directory_problem(report.parent)
     if problem:
         raise ConfigError("--report", "report", str(report), message=f"cannot be written: {report.parent}: {problem}")
+
+
+MAX_NESTING = 32  # arrays / inline tables inside each other; lutbake's deepest value is a list of numbers
+MAX_KEY_PARTS = 32  # parts of one dotted key; tomllib takes quadratic time on long ones (20 000 parts: ~45 s)
+_STRINGS = re.compile(r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'|"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'')
+_COMMENT = re.compile(r"#[^\n]*")
+
+
+def nesting_problem(text: str) -> str | None:
+    """Why ``text`` (TOML) is too deeply nested to be a config, found in one linear pass before parsing it
+    (a RecursionError or minutes of parsing otherwise), or None."""
+    bare = _COMMENT.sub("", _STRINGS.sub('""', text))
+    depth = deepest = 0
+    for ch in bare:
+        if ch in "[{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif ch in "]}":
+            depth = max(depth - 1, 0)
+    if deepest > MAX_NESTING:
+        return f"arrays or inline tables nested {deepest} deep (at most {MAX_NESTING})"
+    for line in bare.splitlines():
+        key = line.split("=", 1)[0]
+        parts = key.count(".") + 1
+        if parts > MAX_KEY_PARTS:
+            return f"a dotted key of {parts} parts (at most {MAX_KEY_PARTS})"
+    return None
