@@ -58,8 +58,9 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.<ext> (EXR unless `format` / --format says otherwise).
 
     All configs are validated before any kernel runs; a bad config exits with status 2 and writes
-    nothing. A table whose output exists with the same content hash (its config, the lutbake version
-    and the kernels' source) is skipped ("skipped PATH (up to date)"); --force rebakes it. Tables bake
+    nothing; so does an out-dir or --report that cannot be written. A table whose output exists with
+    the same content hash (its config, the lutbake version and the kernels' source), and whose bytes
+    match the sha256 recorded with it, is skipped ("skipped PATH (up to date)"); --force rebakes it. Tables bake
     in parallel; each prints one line: path, shape, seconds, samples per texel. A table that fails
     does not stop the others; the exit status is then 1. Outputs are replaced atomically: Ctrl-C
     (exit 130) or SIGTERM (exit 143) keeps finished tables, writes no unfinished one, and lists the

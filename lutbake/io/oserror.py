@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import errno
-import os
 import shutil
 
 LOW_SPACE_BYTES = 1 << 20  # a failed write with less free space than this (plus the data) is a full disk
