@@ -144,6 +144,23 @@ def test_an_intact_output_is_verified_and_skipped(pristine, tmp_path, fmt):
     assert attrs["content_hash"] == batch.content_hash(a)
 
 
+@pytest.mark.parametrize("chunk", [1, 7, 97, 128, 129, 1000, 4096])
+def test_exr_hash_does_not_depend_on_the_chunk_size(pristine, tmp_path, monkeypatch, chunk):
+    """The EXR is hashed in chunks (a 1 GiB table is never read at once): any chunking gives one answer."""
+    from lutbake.io import integrity
+
+    _, _, dir_a, _ = pristine["exr"]
+    good = dir_a / "t.exr"
+    raw = good.read_bytes()
+    flipped = tmp_path / "t.exr"
+    i = raw.index(b"lutbake:data_hash") + 30  # inside the recorded digits
+    flipped.write_bytes(raw[:i] + bytes([raw[i] ^ 1]) + raw[i + 1:])
+    monkeypatch.setattr(integrity, "CHUNK", chunk)
+    assert integrity.exr_intact(good) and not integrity.exr_intact(flipped)
+    assert integrity._scan_exr(good)[0] == integrity.sha256_bytes(
+        raw.replace(raw[raw.index(b"lutbake:data_hash") + 29:][:64], integrity.PLACEHOLDER))
+
+
 # ------------------------------------------------------------------------------ fault injection
 
 KILLER = textwrap.dedent("""

@@ -36,8 +36,18 @@ _EXR_HASH_ATTR = re.compile(re.escape(b"lutbake:" + HASH_KEY.encode() + b"\0stri
                             + b"([0-9a-f]{64})")
 
 
+CHUNK = 8 << 20  # files are hashed in chunks: a 1 GiB table is never read into memory at once
+MAX_SIDECAR_BYTES = 64 << 20  # a sidecar is a few KiB; anything far larger is not one (and is not read)
+_CARRY = 128  # > the length of one lutbake:data_hash attribute (name, type, size, 64 digits)
+
+
 def sha256_bytes(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
+
+
+def sha256_file(path) -> str:
+    with open(path, "rb") as f:
+        return hashlib.file_digest(f, "sha256").hexdigest()
 
 
 def sidecar_path(path) -> Path:
@@ -48,35 +58,50 @@ def sidecar_path(path) -> Path:
 
 # ---------------------------------------------------------------------------------------------- EXR
 
+def _scan_exr(path) -> tuple[str, list[tuple[int, bytes]]]:
+    """(sha256 of the file with every lutbake:data_hash value set to the placeholder, [(offset, value)])."""
+    h, found, buf, base = hashlib.sha256(), [], b"", 0
+    with open(path, "rb") as f:
+        while True:
+            chunk = f.read(CHUNK)
+            buf += chunk
+            cut = len(buf) if not chunk else max(len(buf) - _CARRY, 0)  # a match starting before cut is whole
+            matches = []
+            for m in _EXR_HASH_ATTR.finditer(buf):
+                if m.start() >= cut:
+                    break
+                if m.end() > cut:  # straddles the cut: hash it with the next chunk
+                    cut = m.start()
+                    break
+                matches.append(m)
+            part = bytearray(buf[:cut])
+            for m in matches:
+                found.append((base + m.start(1), m.group(1)))
+                part[m.start(1):m.end(1)] = PLACEHOLDER
+            h.update(part)
+            buf, base = buf[cut:], base + cut
+            if not chunk:
+                return h.hexdigest(), found
+
+
 def seal_exr(path) -> str:
     """Replace the placeholder digits of every ``lutbake:data_hash`` in the EXR at ``path`` (a temporary file,
     before its rename) by the sha256 of the file with the placeholders; returns the digest."""
-    path = Path(path)
-    data = path.read_bytes()
-    spans = [m.span(1) for m in _EXR_HASH_ATTR.finditer(data) if m.group(1) == PLACEHOLDER]
-    if not spans:
+    digest, found = _scan_exr(path)
+    if not found or any(value != PLACEHOLDER for _, value in found):
         raise OSError(f"{path}: the writer left no lutbake:{HASH_KEY} placeholder to seal")
-    digest = sha256_bytes(data)
     with open(path, "r+b") as f:
-        for start, _ in spans:
-            f.seek(start)
+        for offset, _ in found:
+            f.seek(offset)
             f.write(digest.encode())
     return digest
 
 
-def exr_intact(data: bytes) -> bool:
-    """True if the EXR bytes hold ``lutbake:data_hash`` (every copy equal) matching the bytes themselves."""
-    found = list(_EXR_HASH_ATTR.finditer(data))
-    digests = {m.group(1) for m in found}
-    if len(digests) != 1:
-        return False
-    digest = digests.pop()
-    if digest == PLACEHOLDER:
-        return False
-    zeroed = bytearray(data)
-    for m in found:
-        zeroed[m.start(1):m.end(1)] = PLACEHOLDER
-    return sha256_bytes(bytes(zeroed)) == digest.decode()
+def exr_intact(path) -> bool:
+    """True if the EXR holds ``lutbake:data_hash`` (every copy equal) matching its own bytes."""
+    digest, found = _scan_exr(path)
+    values = {value for _, value in found}
+    return len(values) == 1 and values.pop().decode() == digest != PLACEHOLDER.decode()
 
 
 def _exr_attributes(path: Path) -> dict[str, str] | None:
@@ -104,7 +129,7 @@ def sidecar_document(path, fmt: str, attributes: dict[str, str], extra: dict | N
     path = Path(path)
     doc = {"file": path.name, "format": fmt, "sidecar_version": SIDECAR_VERSION,
            "row_order": "file row 0 = table row 0 (y index 0); column 0 = x index 0", **(extra or {}),
-           "data_sha256": sha256_bytes(path.read_bytes()), "lutbake": dict(attributes)}
+           "data_sha256": sha256_file(path), "lutbake": dict(attributes)}
     doc["sidecar_sha256"] = sha256_bytes(_canonical(doc))
     return doc
 
@@ -119,13 +144,16 @@ def read_sidecar(path) -> dict | None:
     """The sidecar document of data file ``path`` if it is intact and names ``path``'s current bytes."""
     path = Path(path)
     try:
-        doc = json.loads(sidecar_path(path).read_bytes().decode("utf-8"))
+        side = sidecar_path(path)
+        if side.stat().st_size > MAX_SIDECAR_BYTES:
+            return None
+        doc = json.loads(side.read_bytes().decode("utf-8"))
         if not isinstance(doc, dict) or doc.get("file") != path.name or not isinstance(doc.get("lutbake"), dict):
             return None
         claimed = doc.pop("sidecar_sha256", None)
         if claimed != sha256_bytes(_canonical(doc)):
             return None
-        if doc.get("data_sha256") != sha256_bytes(path.read_bytes()):
+        if doc.get("data_sha256") != sha256_file(path):
             return None
         return doc
     except (OSError, ValueError, RecursionError):  # missing, unreadable, not JSON, not UTF-8
@@ -153,7 +181,7 @@ def verified_attributes(path) -> dict[str, str] | None:
         if not path.is_file():
             return None
         if path.suffix == ".exr":
-            return _exr_attributes(path) if exr_intact(path.read_bytes()) else None
+            return _exr_attributes(path) if exr_intact(path) else None
         doc = read_sidecar(path)
         if doc is None:
             return None
