@@ -138,15 +138,16 @@ def _check_value(key: Key, value, file, table) -> Any:
     raise AssertionError(key.type)
 
 
-def texel_count(options: Mapping[str, Any]) -> tuple[int, str]:
-    """(texels of the table, the size key that names it): ``size`` times every ``*_size`` key (or, where a
-    ``*_values`` list replaces it, the list's length). Every size key falls under the one MAX_TEXELS cap."""
+def texel_count(options: Mapping[str, Any]) -> tuple[int, str, dict[str, int]]:
+    """(texels of the table, the size key with the largest factor, every key's factor): ``size`` times every
+    ``*_size`` key (or, where a ``*_values`` list replaces it, the list's length). Every size key falls under
+    the one MAX_TEXELS cap."""
     factors = {"size": math.prod(options["size"])} if isinstance(options.get("size"), list) else {}
     for k, v in options.items():
         if k.endswith("_size") and isinstance(v, int):
             listed = options.get(k[: -len("_size")] + "_values")
             factors[k] = len(listed) if isinstance(listed, list) else v
-    return math.prod(factors.values()), max(factors, key=factors.get, default="size")
+    return math.prod(factors.values()), max(factors, key=factors.get, default="size"), factors
 
 
 def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
@@ -176,11 +177,11 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
             options[k.name] = list(k.default) if isinstance(k.default, list) else k.default
     options["kind"] = kind.name
     spec = TableSpec(options["name"], kind.name, MappingProxyType(options), str(file), index)
-    texels, size_key = texel_count(options)
+    texels, size_key, factors = texel_count(options)
     if texels > MAX_TEXELS:
         raise ConfigError(file, size_key, options[size_key],
                           f"at most {MAX_TEXELS} texels = {human_bytes(MAX_TEXELS * BYTES_PER_TEXEL)}",
-                          f"{texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} of memory while "
+                          f"{' x '.join(f'{k} {v}' for k, v in factors.items())} = {texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} of memory while "
                           "baking", label)
     if options.get("format") == "png16":
         reason = unit_range(spec)

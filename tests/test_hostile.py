@@ -361,7 +361,8 @@ def test_escape_sequences_are_printed_escaped(payload, where):
     if where == "key":
         assert_rejected(with_key(payload, 1), payload)
     elif where == "set_key":
-        assert_rejected(toml_tables(BASE), payload, overrides=[f"{payload}=1"])
+        # --set strips the key as str.strip does (some control characters count as white space)
+        assert_rejected(toml_tables(BASE), payload.strip(), overrides=[f"{payload}=1"])
     else:
         assert_rejected(with_key(where, "x" + payload), where)
 
