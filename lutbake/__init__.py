@@ -1,14 +1,22 @@
 """lutbake: bake pre-integrated BRDF tables with Warp kernels on the CPU.
 
-    import lutbake
-    results = lutbake.bake(["configs/dfg.toml"], out_dir="outputs")
+import lutbake
+results = lutbake.bake(["configs/dfg.toml"], out_dir="outputs")
 """
+
 __version__ = "0.1.0"
 
 # imported on first use (PEP 562), so the command line starts without numpy/Warp and a Ctrl-C during those
 # imports is handled by lutbake._entry, not printed as a traceback
-_EXPORTS = {"bake": "api", "bake_table": "api", "BakeResult": "api", "TableSpec": "config", "load_config": "config",
-            "load_configs": "config", "Table": "table"}
+_EXPORTS = {
+    "bake": "api",
+    "bake_table": "api",
+    "BakeResult": "api",
+    "TableSpec": "config",
+    "load_config": "config",
+    "load_configs": "config",
+    "Table": "table",
+}
 
 
 def __getattr__(name: str):

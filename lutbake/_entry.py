@@ -1,6 +1,7 @@
 """The ``lutbake`` command's entry point: Ctrl-C at any moment, even while the start-up imports (click, numpy,
 Warp, OpenImageIO) run, ends the command quietly with status 130 instead of a KeyboardInterrupt traceback
 (issue 11). Imports nothing heavy itself; ``lutbake/__init__`` is lazy for the same reason."""
+
 from __future__ import annotations
 
 import sys

@@ -1,6 +1,7 @@
 """Errors users see. A ConfigError always names the file, the key, the bad value and what is allowed.
 Keys and values are shown repr-escaped and bounded (lutbake.textsafe): no terminal escape sequence and no
 RecursionError reaches the user."""
+
 from __future__ import annotations
 
 from .textsafe import escape_controls, safe_repr
@@ -11,8 +12,15 @@ class LutbakeError(Exception):
 
 
 class ConfigError(LutbakeError):
-    def __init__(self, file, key: str | None, value=None, allowed: str | None = None, message: str | None = None,
-                 table: str | None = None):
+    def __init__(
+        self,
+        file,
+        key: str | None,
+        value=None,
+        allowed: str | None = None,
+        message: str | None = None,
+        table: str | None = None,
+    ):
         self.file, self.key, self.value, self.allowed, self.table = str(file), key, value, allowed, table
         where = self.file
         if table is not None:

@@ -2,6 +2,7 @@
 after the bake (an out-dir below a file, on a read-only mount or behind a dangling symlink; a --report that
 cannot be written or would overwrite an output, its sidecar or a config) is a ConfigError, exit 2, nothing
 written. A config path that is not a regular file says what it is."""
+
 from __future__ import annotations
 
 import os
@@ -12,8 +13,13 @@ from pathlib import Path
 from .errors import ConfigError
 
 MAX_CONFIG_BYTES = 1 << 20  # a config is a few KiB; a larger file is not one (and is not read into memory)
-_FILE_TYPES = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a FIFO (named pipe)"),
-               (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"), (stat.S_ISSOCK, "a socket"))
+_FILE_TYPES = (
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
 
 
 def _what_is(mode: int) -> str:
@@ -48,8 +54,11 @@ def directory_problem(path) -> str | None:
     while not probe.exists():
         if os.path.islink(probe):
             target = os.readlink(probe)
-            return (f"is a dangling symlink (to {target!r})" if probe == path
-                    else f"{probe} is a dangling symlink (to {target!r})")
+            return (
+                f"is a dangling symlink (to {target!r})"
+                if probe == path
+                else f"{probe} is a dangling symlink (to {target!r})"
+            )
         if probe.parent == probe:
             break
         probe = probe.parent
@@ -80,8 +89,13 @@ def check_outputs(jobs) -> None:
     """Every output path must be a regular file or absent (a directory or device there fails the rename)."""
     for job in jobs:
         if os.path.lexists(job.path) and not job.path.is_symlink() and not job.path.is_file():
-            raise ConfigError(job.spec.source, "name", job.name, table=job.name,
-                              message=f"its output {job.path} exists and is {_what_is(os.lstat(job.path).st_mode)}")
+            raise ConfigError(
+                job.spec.source,
+                "name",
+                job.name,
+                table=job.name,
+                message=f"its output {job.path} exists and is {_what_is(os.lstat(job.path).st_mode)}",
+            )
 
 
 def check_report(report, jobs, configs=()) -> None:
@@ -92,14 +106,24 @@ def check_report(report, jobs, configs=()) -> None:
         return
     report = Path(report)
     if os.path.lexists(report) and not report.is_file():
-        what = "is a directory" if report.is_dir() else (
-            "is a dangling symlink" if not report.exists() else f"exists and is {_what_is(os.stat(report).st_mode)}")
+        what = (
+            "is a directory"
+            if report.is_dir()
+            else (
+                "is a dangling symlink" if not report.exists() else f"exists and is {_what_is(os.stat(report).st_mode)}"
+            )
+        )
         raise ConfigError("--report", "report", str(report), message=what)
     for job in jobs:
         for p, what in ((job.path, "the output"), (sidecar_path(job.path), "the sidecar")):
             if _same(report, p):
-                raise ConfigError("--report", "report", str(report), table=job.name,
-                                  message=f"is {what} of table '{job.name}'; the report would overwrite it")
+                raise ConfigError(
+                    "--report",
+                    "report",
+                    str(report),
+                    table=job.name,
+                    message=f"is {what} of table '{job.name}'; the report would overwrite it",
+                )
     for c in configs:
         if _same(report, Path(c)):
             raise ConfigError("--report", "report", str(report), message=f"is the config {c}; it would be overwritten")

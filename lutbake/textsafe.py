@@ -1,6 +1,7 @@
 """Untrusted text (config keys and values, file names, messages of other libraries) made safe to print:
 control characters (C0 but tab and newline, DEL, C1) and the bidirectional overrides are shown as escapes,
 so a key holding ``"\\x1b]0;PWNED\\x07\\x1b[2J"`` cannot retitle or clear the terminal (issue 11)."""
+
 from __future__ import annotations
 
 import re

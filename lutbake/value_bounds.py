@@ -15,18 +15,21 @@ tests/test_value_bounds.py against bakes of every kind, layout and model:
   Oren-Nayar of lecture 003 (its A = 0.57 term: up to ~1.04), and btf, which tabulates BRDF values
   f (peaks above 1; the fitted_slides reading even dips below 0).
 """
+
 from __future__ import annotations
 
 # dfg layouts whose channels are weighted single-scattering albedos (each weight in [0, 1]), and the others
 UNIT_LAYOUTS = frozenset({"scale_bias", "multiscatter", "scale_bias_f82"})
-ABOVE_ONE_LAYOUTS = frozenset({"multiscatter_cloth", "charlie", "sheen_albedo", "charlie_clamped",
-                               "sheen_albedo_clamped"})
+ABOVE_ONE_LAYOUTS = frozenset(
+    {"multiscatter_cloth", "charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped"}
+)
 # specular models whose directional albedo is at most 1 (energy conserving), and the others
 UNIT_SPECULAR_MODELS = frozenset({"microfacet", "cook_torrance", "ashikhmin_shirley"})
 ABOVE_ONE_SPECULAR_MODELS = frozenset({"blinn_phong"})
 # diffuse models whose tabulated albedo ratio is at most 1, and the others
-UNIT_DIFFUSE_MODELS = frozenset({"lambert", "oren_nayar_improved", "oren_nayar_fresnel", "fitted", "fitted_slides",
-                                 "microfacet"})
+UNIT_DIFFUSE_MODELS = frozenset(
+    {"lambert", "oren_nayar_improved", "oren_nayar_fresnel", "fitted", "fitted_slides", "microfacet"}
+)
 ABOVE_ONE_DIFFUSE_MODELS = frozenset({"oren_nayar"})
 SPECULAR_KINDS = frozenset({"dfg", "albedo", "albedo_avg", "specular_3d", "specular_aniso"})
 DIFFUSE_KINDS = frozenset({"diffuse", "diffuse_3d"})

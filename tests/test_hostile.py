@@ -4,6 +4,7 @@ conflicting options, hostile --set overrides and garbage documents.
 
 Each must raise a ConfigError naming the file and the key, and through the CLI exit with status 2,
 print no traceback and write nothing."""
+
 import functools
 import json
 import math
@@ -26,13 +27,15 @@ from lutbake.tables.dfg import KEYS, MAX_SAMPLES
 
 # In CI (CI set) the examples are derandomized: the same inputs every run, so a landing never hinges on a
 # random draw; locally hypothesis explores new inputs each run.
-SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow],
-                    derandomize=bool(os.environ.get("CI")))
+SETTINGS = settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=bool(os.environ.get("CI"))
+)
 BASE = {"name": "ok", "kind": "dfg", "size": [8, 4], "samples": 48}
 UNSAFE = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f]")  # no terminal control character reaches the user
 
 
 # ----------------------------------------------------------------------------------- TOML writing
+
 
 def tv(v) -> str:
     """A TOML value for any JSON-like Python value (nan/inf too; strings escaped)."""
@@ -60,6 +63,7 @@ def toml_tables(*tables) -> str:
 
 
 # ------------------------------------------------------------------------------------- the check
+
 
 def assert_rejected(text: str | bytes, key: str | None, fragment: str | None = None, overrides=(), extra=None):
     """``text`` as a config file: ConfigError naming the file and the key; CLI exit 2, nothing written."""
@@ -98,50 +102,72 @@ def with_key(key, value, **more):
 
 # ---------------------------------------------------------------------------------- value sources
 
-scalars = st.one_of(st.booleans(), st.integers(-(2**70), 2**70), st.floats(allow_nan=True, allow_infinity=True),
-                    st.text(max_size=12))
-values = st.recursive(scalars, lambda inner: st.one_of(st.lists(inner, max_size=4),
-                                                       st.dictionaries(st.text(max_size=5), inner, max_size=3)),
-                      max_leaves=6)
+scalars = st.one_of(
+    st.booleans(), st.integers(-(2**70), 2**70), st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=12)
+)
+values = st.recursive(
+    scalars,
+    lambda inner: st.one_of(st.lists(inner, max_size=4), st.dictionaries(st.text(max_size=5), inner, max_size=3)),
+    max_leaves=6,
+)
 
 
 def bad_for(key):
     """Values of ``key`` that are always invalid."""
     k = KEYS[key]
-    not_str = st.one_of(st.booleans(), st.integers(), st.floats(), st.lists(scalars, max_size=3),
-                        st.dictionaries(st.text(max_size=4), scalars, max_size=2))
+    not_str = st.one_of(
+        st.booleans(),
+        st.integers(),
+        st.floats(),
+        st.lists(scalars, max_size=3),
+        st.dictionaries(st.text(max_size=4), scalars, max_size=2),
+    )
     if k.type in ("str", "name"):
         if k.type == "name":
             return st.one_of(not_str, st.text(max_size=140).filter(lambda s: not NAME_RE.fullmatch(s)))
         return st.one_of(not_str, st.text(max_size=20).filter(lambda s: s not in k.choices and s != "split_sum"))
     if k.type == "int":
         hi = int(k.maximum) if k.maximum is not None else 2**64
-        return st.one_of(st.floats(), st.text(max_size=8), st.booleans(), st.lists(st.integers(1, 9), max_size=2),
-                         st.integers(max_value=int(k.minimum) - 1), st.integers(min_value=hi + 1, max_value=hi * 4))
+        return st.one_of(
+            st.floats(),
+            st.text(max_size=8),
+            st.booleans(),
+            st.lists(st.integers(1, 9), max_size=2),
+            st.integers(max_value=int(k.minimum) - 1),
+            st.integers(min_value=hi + 1, max_value=hi * 4),
+        )
     if k.type == "int_pair":
         return st.one_of(
-            st.integers(), st.text(max_size=6), st.floats(),
+            st.integers(),
+            st.text(max_size=6),
+            st.floats(),
             st.lists(st.integers(1, 64), max_size=5).filter(lambda v: len(v) != 2),
             st.tuples(st.integers(max_value=0), st.integers(1, 64)).map(list),
             st.tuples(st.integers(1, 64), st.integers(max_value=0)).map(list),
             st.tuples(st.floats(), st.integers(1, 9)).map(list),
-            st.tuples(st.integers(1, 9), st.one_of(st.text(max_size=3), st.booleans())).map(list))
+            st.tuples(st.integers(1, 9), st.one_of(st.text(max_size=3), st.booleans())).map(list),
+        )
     if k.type == "float_range":
         unit = st.floats(0.0, 1.0)
         return st.one_of(
-            st.integers(), st.text(max_size=6), st.booleans(),
+            st.integers(),
+            st.text(max_size=6),
+            st.booleans(),
             st.lists(unit, max_size=4).filter(lambda v: len(v) != 2),
-            st.tuples(st.floats(allow_nan=True, allow_infinity=True).filter(lambda x: not math.isfinite(x)),
-                      unit).map(list),
+            st.tuples(st.floats(allow_nan=True, allow_infinity=True).filter(lambda x: not math.isfinite(x)), unit).map(
+                list
+            ),
             st.tuples(unit, st.sampled_from([math.nan, math.inf, -math.inf])).map(list),
             st.tuples(unit, unit).filter(lambda v: v[0] > v[1]).map(list),
             st.tuples(st.floats(max_value=-1e-9, allow_nan=False, allow_infinity=False), unit).map(list),
             st.tuples(unit, st.floats(min_value=1.0000001, allow_nan=False, allow_infinity=False)).map(list),
-            st.tuples(unit, st.text(max_size=3)).map(list))
+            st.tuples(unit, st.text(max_size=3)).map(list),
+        )
     raise AssertionError(key)
 
 
 # -------------------------------------------------------------------------------------------- tests
+
 
 @SETTINGS
 @given(key=st.text(min_size=1, max_size=24).filter(lambda k: k not in KEYS), value=values)
@@ -160,24 +186,53 @@ def test_wrong_types_and_values_for_every_key(data, key):
 
 
 @SETTINGS
-@given(value=st.one_of(st.text(max_size=8).filter(lambda s: s not in ("dfg", "split_sum")), st.integers(),
-                       st.lists(st.text(max_size=3), max_size=2)))
+@given(
+    value=st.one_of(
+        st.text(max_size=8).filter(lambda s: s not in ("dfg", "split_sum")),
+        st.integers(),
+        st.lists(st.text(max_size=3), max_size=2),
+    )
+)
 def test_bad_kind(value):
     assert_rejected(with_key("kind", value), "kind")
 
 
 @SETTINGS
-@given(name=st.one_of(st.text(max_size=140), st.sampled_from(["../../x", "..", "../x", "/etc/passwd", "a/b", "a\\b",
-                                                               "C:\\x", "x.exr", "", " ", "x" * 129, "ｄｆｇ", "名前",
-                                                               "dfg\x00", "dfg\n", "é", "🙂", "-" * 129]))
-       .filter(lambda s: not NAME_RE.fullmatch(s)))
+@given(
+    name=st.one_of(
+        st.text(max_size=140),
+        st.sampled_from(
+            [
+                "../../x",
+                "..",
+                "../x",
+                "/etc/passwd",
+                "a/b",
+                "a\\b",
+                "C:\\x",
+                "x.exr",
+                "",
+                " ",
+                "x" * 129,
+                "ｄｆｇ",
+                "名前",
+                "dfg\x00",
+                "dfg\n",
+                "é",
+                "🙂",
+                "-" * 129,
+            ]
+        ),
+    ).filter(lambda s: not NAME_RE.fullmatch(s))
+)
 def test_unicode_and_path_traversal_names(name):
     assert_rejected(with_key("name", name), "name", "letters")
 
 
 @SETTINGS
-@given(size=st.tuples(st.integers(1, 10**30), st.integers(1, 10**30)).filter(lambda s: s[0] * s[1] > MAX_TEXELS)
-       .map(list))
+@given(
+    size=st.tuples(st.integers(1, 10**30), st.integers(1, 10**30)).filter(lambda s: s[0] * s[1] > MAX_TEXELS).map(list)
+)
 @example(size=[100000, 100000])
 @example(size=[2**26, 2])
 @example(size=[10**200, 10**200])
@@ -199,10 +254,15 @@ def test_zero_negative_and_huge_samples(samples):
 
 
 @SETTINGS
-@given(key=st.sampled_from(["nov_range", "roughness_range"]),
-       rng=st.tuples(st.sampled_from([0.0, 0.5, math.nan, math.inf, -math.inf]),
-                     st.sampled_from([1.0, math.nan, math.inf, -math.inf])).filter(
-                         lambda r: not all(map(math.isfinite, r))).map(list))
+@given(
+    key=st.sampled_from(["nov_range", "roughness_range"]),
+    rng=st.tuples(
+        st.sampled_from([0.0, 0.5, math.nan, math.inf, -math.inf]),
+        st.sampled_from([1.0, math.nan, math.inf, -math.inf]),
+    )
+    .filter(lambda r: not all(map(math.isfinite, r)))
+    .map(list),
+)
 def test_nan_and_inf_in_ranges(key, rng):
     assert_rejected(with_key(key, rng), key, "finite")
 
@@ -223,22 +283,48 @@ def test_duplicate_table_names(name, across):
         assert_rejected(toml_tables(t, {**t, "layout": "multiscatter"}), "name", "duplicate")
 
 
-@pytest.mark.parametrize("opts, key, fragment", [
-    ({"estimator": "sobol_vndf", "ndf": "beckmann"}, "estimator", "visible-normal"),
-])
+@pytest.mark.parametrize(
+    "opts, key, fragment",
+    [
+        ({"estimator": "sobol_vndf", "ndf": "beckmann"}, "estimator", "visible-normal"),
+    ],
+)
 def test_conflicting_options(opts, key, fragment):
     assert_rejected(toml_tables({**BASE, **opts}), key, fragment)
     assert_rejected(toml_tables({**BASE, "ndf": "beckmann"}), key, fragment, overrides=["estimator=sobol_vndf"])
 
 
 @SETTINGS
-@given(override=st.sampled_from([
-    "size=[0,0]", "size=[100000,100000]", "name=../../x", "nov_range=[nan, 1.0]", "roughness_range=[0.0, inf]",
-    "samples=inf", "samples=-3", "samples=0", "seed=-1", "nosuch=1", "ghost.samples=3", "=1", "ok.=1",
-    "ndf=phong", "dtype=float16", "kind=nope", "size=\"big\"", "layout=[1,2]", "estimator=sobol_vndf",
-]) | st.builds("{}={}".format, st.text(max_size=8).filter(
-    lambda k: "=" not in k and "." not in k and k.strip() == k and k not in KEYS),
-                st.text(max_size=8)))
+@given(
+    override=st.sampled_from(
+        [
+            "size=[0,0]",
+            "size=[100000,100000]",
+            "name=../../x",
+            "nov_range=[nan, 1.0]",
+            "roughness_range=[0.0, inf]",
+            "samples=inf",
+            "samples=-3",
+            "samples=0",
+            "seed=-1",
+            "nosuch=1",
+            "ghost.samples=3",
+            "=1",
+            "ok.=1",
+            "ndf=phong",
+            "dtype=float16",
+            "kind=nope",
+            'size="big"',
+            "layout=[1,2]",
+            "estimator=sobol_vndf",
+        ]
+    )
+    | st.builds(
+        "{}={}".format,
+        st.text(max_size=8).filter(lambda k: "=" not in k and "." not in k and k.strip() == k and k not in KEYS),
+        st.text(max_size=8),
+    )
+)
 def test_hostile_set_overrides(override):
     base = toml_tables({**BASE, "ndf": "beckmann"})
     key = override.split("=", 1)[0].rpartition(".")[2] if "=" in override else override
@@ -296,8 +382,10 @@ CONTROL = st.characters(categories=["Cc", "Cf", "Zl", "Zp"], exclude_characters=
 
 
 @SETTINGS
-@given(depth=st.integers(1_000, 100_000),
-       how=st.sampled_from(["array", "inline_table", "dotted", "dotted_in_table", "set", "set_closed"]))
+@given(
+    depth=st.integers(1_000, 100_000),
+    how=st.sampled_from(["array", "inline_table", "dotted", "dotted_in_table", "set", "set_closed"]),
+)
 @example(depth=100_000, how="array")
 @example(depth=50_000, how="inline_table")
 @example(depth=20_000, how="dotted")
@@ -309,16 +397,20 @@ def test_deep_nesting_is_a_config_error(depth, how):
         value = "[" * depth + ("]" * depth if how == "set_closed" else "")
         assert_rejected(toml_tables(BASE), None, overrides=["size=" + value])
         return
-    text = {"array": "x = " + "[" * depth + "]" * depth + "\n",
-            "inline_table": "x = " + "{a = " * depth + "1" + "}" * depth + "\n",
-            "dotted": ".".join(["k"] * depth) + " = 1\n",
-            "dotted_in_table": toml_tables(BASE) + ".".join(["k"] * depth) + " = 1\n"}[how]
+    text = {
+        "array": "x = " + "[" * depth + "]" * depth + "\n",
+        "inline_table": "x = " + "{a = " * depth + "1" + "}" * depth + "\n",
+        "dotted": ".".join(["k"] * depth) + " = 1\n",
+        "dotted_in_table": toml_tables(BASE) + ".".join(["k"] * depth) + " = 1\n",
+    }[how]
     assert_rejected(text, None)
 
 
 @SETTINGS
-@given(name=st.from_regex(r"[A-Za-z0-9_-]{1,16}", fullmatch=True),
-       tail=st.sampled_from(["\n", "\r\n", "\r", " ", "\t", "\u2028", "\x1b[2J", "\u202e"]))
+@given(
+    name=st.from_regex(r"[A-Za-z0-9_-]{1,16}", fullmatch=True),
+    tail=st.sampled_from(["\n", "\r\n", "\r", " ", "\t", "\u2028", "\x1b[2J", "\u202e"]),
+)
 @example(name="t", tail="\n")
 def test_a_valid_name_with_a_trailing_character_is_refused(name, tail):
     assert_rejected(with_key("name", name + tail), "name", "letters")
@@ -335,9 +427,16 @@ def test_every_size_key_is_under_the_one_texel_cap(data, kind):
     k = KINDS[kind].keys[key]
     raw = {"name": "t", "kind": kind}
     if k.type == "int_pair":
-        raw[key] = [MAX_TEXELS + 1, 1] if data is None else data.draw(
-            st.tuples(st.integers(1, 10**12), st.integers(1, 10**12)).filter(lambda s: s[0] * s[1] > MAX_TEXELS)
-            .map(list), label="value")
+        raw[key] = (
+            [MAX_TEXELS + 1, 1]
+            if data is None
+            else data.draw(
+                st.tuples(st.integers(1, 10**12), st.integers(1, 10**12))
+                .filter(lambda s: s[0] * s[1] > MAX_TEXELS)
+                .map(list),
+                label="value",
+            )
+        )
     elif k.maximum is None:
         raw[key] = 10**12 if data is None else data.draw(st.integers(MAX_TEXELS + 1, 2**62), label="value")
     else:  # a capped slice count: over the cap together with a big size
@@ -371,8 +470,11 @@ FORMAT_EXT = {"exr": ".exr", "npy": ".npy", "png16": ".png", "dds": ".dds", "ktx
 
 
 @SETTINGS
-@given(fmt=st.sampled_from(sorted(FORMAT_EXT)), sidecar=st.booleans(),
-       name=st.from_regex(r"[A-Za-z0-9_-]{1,12}", fullmatch=True))
+@given(
+    fmt=st.sampled_from(sorted(FORMAT_EXT)),
+    sidecar=st.booleans(),
+    name=st.from_regex(r"[A-Za-z0-9_-]{1,12}", fullmatch=True),
+)
 def test_a_report_over_an_output_or_its_sidecar_is_refused(fmt, sidecar, name):
     with tempfile.TemporaryDirectory() as d:
         d = Path(d)
@@ -386,33 +488,54 @@ def test_a_report_over_an_output_or_its_sidecar_is_refused(fmt, sidecar, name):
 
 def _catalogue():
     """Issue 11's hostile inputs, one per line: (id, config text or a path maker, extra CLI args, exit)."""
-    deep = {"array-100000": "x = " + "[" * 100_000 + "]" * 100_000 + "\n",
-            "inline-50000": "x = " + "{a = " * 50_000 + "1" + "}" * 50_000 + "\n",
-            "dotted-20000": ".".join(["k"] * 20_000) + " = 1\n"}
+    deep = {
+        "array-100000": "x = " + "[" * 100_000 + "]" * 100_000 + "\n",
+        "inline-50000": "x = " + "{a = " * 50_000 + "1" + "}" * 50_000 + "\n",
+        "dotted-20000": ".".join(["k"] * 20_000) + " = 1\n",
+    }
     cases = [(k, v, [], 2) for k, v in deep.items()]
-    cases += [("set-60000", toml_tables(BASE), ["--set", "size=" + "[" * 60_000], 2),
-              ("name-newline", with_key("name", "t\n"), [], 2),
-              ("albedo_avg-roughness_size-1e12", toml_tables({"name": "t", "kind": "albedo_avg",
-                                                              "roughness_size": 10**12}), [], 2),
-              ("albedo_avg-roughness_size-1e8", toml_tables({"name": "t", "kind": "albedo_avg",
-                                                             "roughness_size": 10**8}), [], 2),
-              ("png16-charlie", toml_tables({**BASE, "layout": "charlie", "format": "png16"}), [], 2),
-              ("png16-blinn_phong", toml_tables({**BASE, "model": "blinn_phong"}), ["--format", "png16"], 2),
-              ("escape-key", with_key("\u001b]0;PWNED\u0007\u001b[2J", 1), [], 2),
-              ("escape-value", with_key("ndf", "\u001b]0;PWNED\u0007\u001b[2J"), [], 2),
-              ("escape-set", toml_tables(BASE), ["--set", "\u001b[2J=1"], 2)]
+    cases += [
+        ("set-60000", toml_tables(BASE), ["--set", "size=" + "[" * 60_000], 2),
+        ("name-newline", with_key("name", "t\n"), [], 2),
+        (
+            "albedo_avg-roughness_size-1e12",
+            toml_tables({"name": "t", "kind": "albedo_avg", "roughness_size": 10**12}),
+            [],
+            2,
+        ),
+        (
+            "albedo_avg-roughness_size-1e8",
+            toml_tables({"name": "t", "kind": "albedo_avg", "roughness_size": 10**8}),
+            [],
+            2,
+        ),
+        ("png16-charlie", toml_tables({**BASE, "layout": "charlie", "format": "png16"}), [], 2),
+        ("png16-blinn_phong", toml_tables({**BASE, "model": "blinn_phong"}), ["--format", "png16"], 2),
+        ("escape-key", with_key("\u001b]0;PWNED\u0007\u001b[2J", 1), [], 2),
+        ("escape-value", with_key("ndf", "\u001b]0;PWNED\u0007\u001b[2J"), [], 2),
+        ("escape-set", toml_tables(BASE), ["--set", "\u001b[2J=1"], 2),
+    ]
     for fmt, ext in FORMAT_EXT.items():
-        cases.append((f"report-is-output-{fmt}", toml_tables({**BASE, "format": fmt}),
-                      ["--report", "{out}/ok" + ext], 2))
-        cases.append((f"report-is-sidecar-{fmt}", toml_tables({**BASE, "format": fmt}),
-                      ["--report", "{out}/ok" + ext + ".json"], 2))
-    cases += [("report-is-config", toml_tables(BASE), ["--report", "{cfg}"], 2),
-              ("report-under-file", toml_tables(BASE), ["--report", "{cfg}/r.json"], 2),
-              ("out-dir-under-file", toml_tables(BASE), ["--out-dir", "{cfg}/o"], 2),
-              ("out-dir-dangling-symlink", toml_tables(BASE), ["--out-dir", "{dangling}"], 2),
-              ("config-is-directory", "{dir}", [], 2),
-              ("config-is-fifo", "{fifo}", [], 2),
-              ("config-is-dev-zero", "/dev/zero", [], 2)]
+        cases.append(
+            (f"report-is-output-{fmt}", toml_tables({**BASE, "format": fmt}), ["--report", "{out}/ok" + ext], 2)
+        )
+        cases.append(
+            (
+                f"report-is-sidecar-{fmt}",
+                toml_tables({**BASE, "format": fmt}),
+                ["--report", "{out}/ok" + ext + ".json"],
+                2,
+            )
+        )
+    cases += [
+        ("report-is-config", toml_tables(BASE), ["--report", "{cfg}"], 2),
+        ("report-under-file", toml_tables(BASE), ["--report", "{cfg}/r.json"], 2),
+        ("out-dir-under-file", toml_tables(BASE), ["--out-dir", "{cfg}/o"], 2),
+        ("out-dir-dangling-symlink", toml_tables(BASE), ["--out-dir", "{dangling}"], 2),
+        ("config-is-directory", "{dir}", [], 2),
+        ("config-is-fifo", "{fifo}", [], 2),
+        ("config-is-dev-zero", "/dev/zero", [], 2),
+    ]
     return cases
 
 

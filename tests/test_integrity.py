@@ -9,6 +9,7 @@
   config's exact bytes, and a skip happens only where the output on disk is that config's.
 - a full disk between the data and the sidecar; stale temp files of dead writers; one sidecar per file.
 """
+
 from __future__ import annotations
 
 import errno
@@ -34,8 +35,16 @@ from lutbake.io.formats import EXTENSIONS  # noqa: E402
 from lutbake.io.integrity import sidecar_path, verified_attributes  # noqa: E402
 
 FORMATS = ("exr", "npy", "png16", "dds", "ktx2", "h")
-DATA_MODES = ("zero_bytes", "truncated_half", "short_by_100", "flip_first", "flip_middle", "flip_last",
-              "junk_appended", "foreign_data")
+DATA_MODES = (
+    "zero_bytes",
+    "truncated_half",
+    "short_by_100",
+    "flip_first",
+    "flip_middle",
+    "flip_last",
+    "junk_appended",
+    "foreign_data",
+)
 SIDECAR_MODES = ("sidecar_zero_bytes", "sidecar_garbled_value", "sidecar_removed")
 CASES = [(f, m) for f in FORMATS for m in DATA_MODES] + [(f, m) for f in FORMATS if f != "exr" for m in SIDECAR_MODES]
 
@@ -94,7 +103,7 @@ def corrupt(out: Path, fmt: str, mode: str, foreign: Path) -> None:
         data.write_bytes(raw[:-100])
     elif mode.startswith("flip_"):
         i = {"flip_first": 0, "flip_middle": len(raw) // 2, "flip_last": len(raw) - 1}[mode]
-        data.write_bytes(raw[:i] + bytes([raw[i] ^ 0x5A]) + raw[i + 1:])
+        data.write_bytes(raw[:i] + bytes([raw[i] ^ 0x5A]) + raw[i + 1 :])
     elif mode == "junk_appended":
         data.write_bytes(raw + b"\x00junk" * 4)
     elif mode == "foreign_data":  # another config's output in its place, this config's sidecar left
@@ -122,8 +131,9 @@ def sweep_case(pristine, fmt: str, mode: str, work: Path) -> tuple[bool, bool]:
         return True, False
     batch.run([job], workers=1, progress=False)
     name = f"t{EXTENSIONS[fmt]}"
-    restored = (job.status == "baked" and same_output(out / name, dir_a / name)
-                and batch.plan([a], out)[0].status == "skipped")
+    restored = (
+        job.status == "baked" and same_output(out / name, dir_a / name) and batch.plan([a], out)[0].status == "skipped"
+    )
     return False, restored
 
 
@@ -154,11 +164,12 @@ def test_exr_hash_does_not_depend_on_the_chunk_size(pristine, tmp_path, monkeypa
     raw = good.read_bytes()
     flipped = tmp_path / "t.exr"
     i = raw.index(b"lutbake:data_hash") + 30  # inside the recorded digits
-    flipped.write_bytes(raw[:i] + bytes([raw[i] ^ 1]) + raw[i + 1:])
+    flipped.write_bytes(raw[:i] + bytes([raw[i] ^ 1]) + raw[i + 1 :])
     monkeypatch.setattr(integrity, "CHUNK", chunk)
     assert integrity.exr_intact(good) and not integrity.exr_intact(flipped)
     assert integrity._scan_exr(good)[0] == integrity.sha256_bytes(
-        raw.replace(raw[raw.index(b"lutbake:data_hash") + 29:][:64], integrity.PLACEHOLDER))
+        raw.replace(raw[raw.index(b"lutbake:data_hash") + 29 :][:64], integrity.PLACEHOLDER)
+    )
 
 
 # ------------------------------------------------------------------------------ fault injection
@@ -192,8 +203,13 @@ def write_killed(table, out: Path, fmt: str, kill_at: int, tmp: Path) -> subproc
     tf = tmp / f"table_{fmt}.pkl"
     tf.write_bytes(pickle.dumps(table))
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    return subprocess.run([sys.executable, "-c", KILLER, str(tf), str(out), fmt, str(kill_at)], env=env,
-                          capture_output=True, text=True, timeout=120)
+    return subprocess.run(
+        [sys.executable, "-c", KILLER, str(tf), str(out), fmt, str(kill_at)],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
 
 
 @pytest.mark.parametrize("fmt", ["npy", "exr", "ktx2"])
@@ -250,6 +266,7 @@ def test_a_full_disk_between_data_and_sidecar_makes_the_next_run_rebake(pristine
 
 # ------------------------------------------------------------------------------- stale temp files
 
+
 def test_stale_temp_files_of_dead_writers_are_removed(pristine, tmp_path):
     a, _, dir_a, _ = pristine["exr"]
     out = tmp_path / "o"
@@ -285,6 +302,7 @@ def test_killed_writer_temp_file_is_removed_by_the_next_run(pristine, tmp_path):
 
 
 # --------------------------------------------------------------------- one sidecar per output file
+
 
 def test_npy_and_h_of_one_table_keep_two_sidecars_and_both_skip(tmp_path):
     from click.testing import CliRunner
@@ -334,6 +352,7 @@ def test_a_legacy_shared_sidecar_is_replaced(pristine, tmp_path):
 
 
 # ------------------------------------------------------------------------------- counts, by hand
+
 
 def main_counts() -> None:
     """``python tests/test_integrity.py``: the corruption sweep's counts."""

@@ -3,6 +3,7 @@
 Everything a batch will touch on disk is checked before any kernel runs (exit 2, nothing written); a
 config nested 100 000 deep is a ConfigError; a write error says what happened (a full disk by name); a
 Ctrl-C during the start-up imports exits 130 quietly; untrusted text is printed escaped."""
+
 from __future__ import annotations
 
 import json
@@ -35,6 +36,7 @@ def cfg(tmp_path):
 @pytest.fixture
 def no_kernel(monkeypatch):
     """Fails the test if any table is baked (a plan-time error must come before any kernel)."""
+
     def boom(*a, **k):
         raise AssertionError("a kernel ran before the error")
 
@@ -69,6 +71,7 @@ def mount(tmp_path):
 
 # ------------------------------------------------------------------ item 6: late failures -> exit 2
 
+
 def test_out_dir_below_a_file_is_refused_before_any_kernel(cfg, tmp_path, no_kernel):
     (tmp_path / "f").write_text("")
     refused(bake(cfg, "--out-dir", tmp_path / "f" / "sub" / "o"), "is a file, not a directory")
@@ -99,12 +102,16 @@ def test_png16_of_a_table_above_one_is_refused_at_plan_time(tmp_path, no_kernel)
     p.write_text(DFG)
     refused(bake(p, "--out-dir", tmp_path / "o", "--format", "png16", "--set", "layout=sheen_albedo"), "png16")
     refused(bake("--preset", "gltf-charlie", "--out-dir", tmp_path / "o", "--format", "png16"), "png16")
-    refused(bake(p, "--out-dir", tmp_path / "o", "--format", "png16", "--set", "kind=btf",
-                 "--set", "samples=4"), "png16", "btf")
+    refused(
+        bake(p, "--out-dir", tmp_path / "o", "--format", "png16", "--set", "kind=btf", "--set", "samples=4"),
+        "png16",
+        "btf",
+    )
     assert not (tmp_path / "o").exists()
 
 
 # --------------------------------------------------------- items 4 and 8: --report checked up front
+
 
 def test_report_under_a_file_is_refused_before_any_kernel(cfg, tmp_path, no_kernel):
     (tmp_path / "f").write_text("")
@@ -117,13 +124,13 @@ def test_report_on_a_read_only_mount_is_refused(cfg, tmp_path, mount, no_kernel)
     refused(bake(cfg, "--out-dir", tmp_path / "o", "--report", ro / "r.json"), "read-only file system")
 
 
-@pytest.mark.parametrize("fmt, victim", [("exr", "t.exr"), ("npy", "t.npy"), ("npy", "t.npy.json"),
-                                         ("h", "t.h.json")])
+@pytest.mark.parametrize("fmt, victim", [("exr", "t.exr"), ("npy", "t.npy"), ("npy", "t.npy.json"), ("h", "t.h.json")])
 def test_report_that_is_an_output_or_its_sidecar_is_refused(cfg, tmp_path, no_kernel, fmt, victim):
     out = tmp_path / "o"
     refused(bake(cfg, "--out-dir", out, "--format", fmt, "--report", out / victim), "of table 't'")
-    refused(bake(cfg, "--out-dir", out, "--format", fmt, "--report", tmp_path / "x" / ".." / "o" / victim),
-            "of table 't'")
+    refused(
+        bake(cfg, "--out-dir", out, "--format", fmt, "--report", tmp_path / "x" / ".." / "o" / victim), "of table 't'"
+    )
 
 
 def test_report_that_is_the_config_is_refused(cfg, tmp_path, no_kernel):
@@ -151,6 +158,7 @@ def test_report_on_a_full_disk_is_an_error_not_a_traceback(cfg, tmp_path, mount)
 
 
 # --------------------------------------------------------------------- item 7: ENOSPC names the cause
+
 
 def test_a_full_disk_names_the_cause(cfg, tmp_path, mount):
     out = mount(tmp_path / "small", "size=16k")
@@ -220,13 +228,18 @@ def test_a_directory_fifo_or_device_as_config_says_what_it_is(tmp_path):
 
 # ------------------------------------------------------------------- item 4: deep nesting, Ctrl-C
 
-@pytest.mark.parametrize("text", [
-    "x = " + "[" * 100_000 + "]" * 100_000 + "\n",
-    "x = " + "{a = " * 50_000 + "1" + "}" * 50_000 + "\n",
-    "[[table]]\n" + ".".join(["k"] * 20_000) + " = 1\n",
-    ".".join(["k"] * 20_000) + " = 1\n",
-    DFG + "size = " + "[" * 3000 + "]" * 3000 + "\n",
-], ids=["array-100000", "inline-table-50000", "dotted-key-20000-in-table", "dotted-key-20000", "size-3000"])
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "x = " + "[" * 100_000 + "]" * 100_000 + "\n",
+        "x = " + "{a = " * 50_000 + "1" + "}" * 50_000 + "\n",
+        "[[table]]\n" + ".".join(["k"] * 20_000) + " = 1\n",
+        ".".join(["k"] * 20_000) + " = 1\n",
+        DFG + "size = " + "[" * 3000 + "]" * 3000 + "\n",
+    ],
+    ids=["array-100000", "inline-table-50000", "dotted-key-20000-in-table", "dotted-key-20000", "size-3000"],
+)
 def test_deeply_nested_toml_is_a_config_error(tmp_path, text, no_kernel):
     p = tmp_path / "deep.toml"
     p.write_text(text)
@@ -251,9 +264,15 @@ def test_ctrl_c_during_start_up_imports_exits_130_quietly(cfg, tmp_path, module)
         "        return None\n"
         "sys.meta_path.insert(0, Hook())\n"
         "sys.argv = ['lutbake'] + sys.argv[1:]\n"
-        "runpy.run_module('lutbake', run_name='__main__')\n")
-    p = subprocess.run([sys.executable, "-c", hook, "bake", str(cfg), "--out-dir", str(tmp_path / "o")],
-                       capture_output=True, text=True, timeout=120, env={**os.environ, "PYTHONPATH": str(ROOT)})
+        "runpy.run_module('lutbake', run_name='__main__')\n"
+    )
+    p = subprocess.run(
+        [sys.executable, "-c", hook, "bake", str(cfg), "--out-dir", str(tmp_path / "o")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
     assert p.returncode == 130, (p.returncode, p.stderr)
     assert "Traceback" not in p.stderr and "KeyboardInterrupt" not in p.stderr, p.stderr
     assert "interrupted" in p.stderr
@@ -262,11 +281,15 @@ def test_ctrl_c_during_start_up_imports_exits_130_quietly(cfg, tmp_path, module)
 
 def test_entry_point_keeps_exit_codes_and_usage_errors():
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    run = lambda *a: subprocess.run([sys.executable, "-m", "lutbake", *a], capture_output=True, text=True,  # noqa: E731
-                                    timeout=120, env=env)
+    run = lambda *a: subprocess.run(
+        [sys.executable, "-m", "lutbake", *a],
+        capture_output=True,
+        text=True,  # noqa: E731
+        timeout=120,
+        env=env,
+    )
     assert run("--version").returncode == 0
     r = run("bake", "--workers", "0")
     assert r.returncode == 2 and "Usage:" in r.stderr and "Traceback" not in r.stderr
     r = run("nosuchcommand")
     assert r.returncode == 2 and "No such command" in r.stderr
-

@@ -2,6 +2,7 @@
 item 6) are checked against bakes: every declaration "within [0, 1]" holds on a small table of that
 kind/layout/model, every "may exceed 1" is shown to exceed 1 by more than PNG_SLACK, and every layout and
 model a kind offers is declared one way or the other."""
+
 import pytest
 
 from lutbake import value_bounds as vb
@@ -12,19 +13,32 @@ from lutbake.tables import KINDS, aniso, diffuse
 from lutbake.tables.dfg import LAYOUTS
 from lutbake.terms.sets import MODELS
 
-SMALL = {"dfg": {"size": [16, 16]}, "albedo": {"size": [16, 16]}, "albedo_avg": {"roughness_size": 16},
-         "specular_3d": {"size": [8, 8], "f0_size": 3}, "specular_aniso": {"size": [8, 8], "anisotropy_size": 3},
-         "diffuse": {"size": [16, 16]}, "diffuse_3d": {"size": [8, 8], "f0_size": 3},
-         "btf": {"size": [8, 8], "phi_size": 4, "sigma_size": 3}}
-UNIT = ([("dfg", {"layout": lay}) for lay in sorted(vb.UNIT_LAYOUTS)]
-        + [(k, {"model": m}) for k in ("dfg", "albedo", "albedo_avg", "specular_3d")
-           for m in sorted(vb.UNIT_SPECULAR_MODELS)]
-        + [("specular_aniso", {"model": m}) for m in sorted(aniso.MODELS)]
-        + [(k, {"model": m}) for k in ("diffuse", "diffuse_3d") for m in sorted(vb.UNIT_DIFFUSE_MODELS)])
-ABOVE = ([("dfg", {"layout": lay}) for lay in sorted(vb.ABOVE_ONE_LAYOUTS)]
-         + [(k, {"model": m}) for k in ("dfg", "albedo") for m in sorted(vb.ABOVE_ONE_SPECULAR_MODELS)]
-         + [(k, {"model": m}) for k in ("diffuse", "diffuse_3d") for m in sorted(vb.ABOVE_ONE_DIFFUSE_MODELS)]
-         + [("btf", {"model": "microfacet"})])
+SMALL = {
+    "dfg": {"size": [16, 16]},
+    "albedo": {"size": [16, 16]},
+    "albedo_avg": {"roughness_size": 16},
+    "specular_3d": {"size": [8, 8], "f0_size": 3},
+    "specular_aniso": {"size": [8, 8], "anisotropy_size": 3},
+    "diffuse": {"size": [16, 16]},
+    "diffuse_3d": {"size": [8, 8], "f0_size": 3},
+    "btf": {"size": [8, 8], "phi_size": 4, "sigma_size": 3},
+}
+UNIT = (
+    [("dfg", {"layout": lay}) for lay in sorted(vb.UNIT_LAYOUTS)]
+    + [
+        (k, {"model": m})
+        for k in ("dfg", "albedo", "albedo_avg", "specular_3d")
+        for m in sorted(vb.UNIT_SPECULAR_MODELS)
+    ]
+    + [("specular_aniso", {"model": m}) for m in sorted(aniso.MODELS)]
+    + [(k, {"model": m}) for k in ("diffuse", "diffuse_3d") for m in sorted(vb.UNIT_DIFFUSE_MODELS)]
+)
+ABOVE = (
+    [("dfg", {"layout": lay}) for lay in sorted(vb.ABOVE_ONE_LAYOUTS)]
+    + [(k, {"model": m}) for k in ("dfg", "albedo") for m in sorted(vb.ABOVE_ONE_SPECULAR_MODELS)]
+    + [(k, {"model": m}) for k in ("diffuse", "diffuse_3d") for m in sorted(vb.ABOVE_ONE_DIFFUSE_MODELS)]
+    + [("btf", {"model": "microfacet"})]
+)
 
 
 def spec(kind, opts):

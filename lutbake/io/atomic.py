@@ -1,6 +1,7 @@
 """Atomic file writes shared by every writer: write a temporary sibling, fsync, rename onto the target.
 An interrupted or failed write never leaves a half-written file and never clobbers the old one; the temporary
 file of a writer killed outright (SIGKILL) is removed by a later run (remove_stale_temps)."""
+
 from __future__ import annotations
 
 import os

@@ -17,6 +17,7 @@ the check refuses (then the next run bakes the table again):
 ``verified_attributes(path)`` returns an output's ``lutbake:*`` attributes only if every check passes;
 anything else (missing, truncated, garbled, foreign, half-written unit) returns None: not up to date.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -32,8 +33,9 @@ PLACEHOLDER = b"0" * 64
 SIDECAR_SUFFIX = ".json"
 SIDECAR_VERSION = 2  # 1: the old shared <stem>.json (no data hash), never trusted for a skip
 # an EXR string attribute: name \0 type \0 int32 size, then the value (OpenEXR file layout, "Header Attributes")
-_EXR_HASH_ATTR = re.compile(re.escape(b"lutbake:" + HASH_KEY.encode() + b"\0string\0" + struct.pack("<i", 64))
-                            + b"([0-9a-f]{64})")
+_EXR_HASH_ATTR = re.compile(
+    re.escape(b"lutbake:" + HASH_KEY.encode() + b"\0string\0" + struct.pack("<i", 64)) + b"([0-9a-f]{64})"
+)
 
 
 CHUNK = 8 << 20  # files are hashed in chunks: a 1 GiB table is never read into memory at once
@@ -58,6 +60,7 @@ def sidecar_path(path) -> Path:
 
 # ---------------------------------------------------------------------------------------------- EXR
 
+
 def _scan_exr(path) -> tuple[str, list[tuple[int, bytes]]]:
     """(sha256 of the file with every lutbake:data_hash value set to the placeholder, [(offset, value)])."""
     h, found, buf, base = hashlib.sha256(), [], b"", 0
@@ -77,7 +80,7 @@ def _scan_exr(path) -> tuple[str, list[tuple[int, bytes]]]:
             part = bytearray(buf[:cut])
             for m in matches:
                 found.append((base + m.start(1), m.group(1)))
-                part[m.start(1):m.end(1)] = PLACEHOLDER
+                part[m.start(1) : m.end(1)] = PLACEHOLDER
             h.update(part)
             buf, base = buf[cut:], base + cut
             if not chunk:
@@ -112,13 +115,15 @@ def _exr_attributes(path: Path) -> dict[str, str] | None:
         oiio.geterror()
         return None
     try:
-        return {p.name[len("lutbake:"):]: str(p.value) for p in inp.spec().extra_attribs
-                if p.name.startswith("lutbake:")}
+        return {
+            p.name[len("lutbake:") :]: str(p.value) for p in inp.spec().extra_attribs if p.name.startswith("lutbake:")
+        }
     finally:
         inp.close()
 
 
 # ------------------------------------------------------------------------------------------ sidecars
+
 
 def _canonical(doc: dict) -> bytes:
     return json.dumps(doc, sort_keys=True, ensure_ascii=False, separators=(",", ":")).encode("utf-8")
@@ -127,9 +132,15 @@ def _canonical(doc: dict) -> bytes:
 def sidecar_document(path, fmt: str, attributes: dict[str, str], extra: dict | None = None) -> dict:
     """The sidecar of the data file ``path`` as it is on disk now (call it after the data's rename)."""
     path = Path(path)
-    doc = {"file": path.name, "format": fmt, "sidecar_version": SIDECAR_VERSION,
-           "row_order": "file row 0 = table row 0 (y index 0); column 0 = x index 0", **(extra or {}),
-           "data_sha256": sha256_file(path), "lutbake": dict(attributes)}
+    doc = {
+        "file": path.name,
+        "format": fmt,
+        "sidecar_version": SIDECAR_VERSION,
+        "row_order": "file row 0 = table row 0 (y index 0); column 0 = x index 0",
+        **(extra or {}),
+        "data_sha256": sha256_file(path),
+        "lutbake": dict(attributes),
+    }
     doc["sidecar_sha256"] = sha256_bytes(_canonical(doc))
     return doc
 
@@ -173,6 +184,7 @@ def legacy_sidecar(path) -> Path | None:
 
 # ------------------------------------------------------------------------------------------ checking
 
+
 def verified_attributes(path) -> dict[str, str] | None:
     """The ``lutbake:*`` attributes (prefix removed) of the output at ``path`` if the file and its metadata
     pass every integrity check; None otherwise (missing, corrupt, half-written, foreign: bake it again)."""
@@ -185,6 +197,6 @@ def verified_attributes(path) -> dict[str, str] | None:
         doc = read_sidecar(path)
         if doc is None:
             return None
-        return {k[len("lutbake:"):] if k.startswith("lutbake:") else k: str(v) for k, v in doc["lutbake"].items()}
+        return {k[len("lutbake:") :] if k.startswith("lutbake:") else k: str(v) for k, v in doc["lutbake"].items()}
     except Exception:  # noqa: BLE001 - any failure to verify means "not up to date", never a crash
         return None

@@ -1,15 +1,22 @@
 """A write error said in words that name its cause. OpenImageIO reports a full disk as "File output failed"
 (no errno); Python's own writers carry the errno (ENOSPC, EROFS, EDQUOT ...) but print it as
 "[Errno 28] ...". os_error_text() names the cause either way (issue 11)."""
+
 from __future__ import annotations
 
 import errno
 import shutil
 
 LOW_SPACE_BYTES = 1 << 20  # a failed write with less free space than this (plus the data) is a full disk
-CAUSES = {errno.ENOSPC: "no space left on device", errno.EDQUOT: "disk quota exceeded",
-          errno.EROFS: "read-only file system", errno.EACCES: "permission denied", errno.EPERM: "permission denied",
-          errno.EFBIG: "file too large", errno.EIO: "input/output error"}
+CAUSES = {
+    errno.ENOSPC: "no space left on device",
+    errno.EDQUOT: "disk quota exceeded",
+    errno.EROFS: "read-only file system",
+    errno.EACCES: "permission denied",
+    errno.EPERM: "permission denied",
+    errno.EFBIG: "file too large",
+    errno.EIO: "input/output error",
+}
 
 
 def os_error_text(e: OSError, directory=None, needed: int = 0) -> str:
