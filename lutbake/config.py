@@ -10,19 +10,19 @@ from __future__ import annotations
 import math
 import re
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any, Mapping
+from typing import Any
 
 from .errors import ConfigError
+from .kinds import KINDS, Key, lookup_kind
 from .preflight import config_file_problem, nesting_problem
-from .tables import KINDS, lookup_kind
-from .tables.base import Key
 from .value_bounds import unit_range
 
 NAME_RE = re.compile(r"[A-Za-z0-9_-]{1,128}")  # use fullmatch: "$" would accept a final newline
-MAX_TEXELS = 1 << 26  # 64 Mi texels; float64 accumulation of 4 channels = 2 GiB
+MAX_TEXELS = 1 << 26  # 64 Mi texels of any kind (Kind.texels); float64 accumulation of 4 channels = 2 GiB
 BYTES_PER_TEXEL = 32  # float64 x 4 channels while baking
 MAX_LIST = 1024  # entries of a float_list key
 
@@ -151,18 +151,6 @@ def _check_value(key: Key, value, file, table) -> Any:
     raise AssertionError(key.type)
 
 
-def texel_count(options: Mapping[str, Any]) -> tuple[int, str, dict[str, int]]:
-    """(texels of the table, the size key with the largest factor, every key's factor): ``size`` times every
-    ``*_size`` key (or, where a ``*_values`` list replaces it, the list's length). Every size key falls under
-    the one MAX_TEXELS cap."""
-    factors = {"size": math.prod(options["size"])} if isinstance(options.get("size"), list) else {}
-    for k, v in options.items():
-        if k.endswith("_size") and isinstance(v, int):
-            listed = options.get(k[: -len("_size")] + "_values")
-            factors[k] = len(listed) if isinstance(listed, list) else v
-    return math.prod(factors.values()), max(factors, key=factors.get, default="size"), factors
-
-
 def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
     """Validate one ``[[table]]`` mapping against its kind's keys."""
     label = f"#{index + 1}" + (f" ({raw['name']!r})" if isinstance(raw.get("name"), str) else "")
@@ -191,15 +179,17 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
             options[k.name] = list(k.default) if isinstance(k.default, list) else k.default
     options["kind"] = kind.name
     spec = TableSpec(options["name"], kind.name, MappingProxyType(options), str(file), index)
-    texels, size_key, factors = texel_count(options)
+    texels = kind.texels(options)
     if texels > MAX_TEXELS:
+        size_keys = [k for k in options if k == "size" or k.endswith("_size")]  # the key to name: size, else ...
+        size_key = "size" if "size" in options else (size_keys[0] if size_keys else "size")
         raise ConfigError(
             file,
             size_key,
-            options[size_key],
+            options.get(size_key),
             f"at most {MAX_TEXELS} texels = {human_bytes(MAX_TEXELS * BYTES_PER_TEXEL)}",
-            f"{' x '.join(f'{k} {v}' for k, v in factors.items())} = {texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} of memory while "
-            "baking",
+            f"{kind.texels_doc} = {texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} "
+            "of memory while baking",
             label,
         )
     if options.get("format") == "png16":

@@ -72,8 +72,8 @@ def same_output(p: Path, q: Path) -> bool:
 
 
 def bake_into(spec, out: Path) -> batch.Job:
-    (job,) = batch.plan([spec], out, force=True)
-    batch.run([job], workers=1, progress=False)
+    (job,) = batch.schedule([spec], out, force=True)
+    batch.run([job], workers=1, progress=None)
     assert job.status == "baked", job.message
     return job
 
@@ -126,13 +126,15 @@ def sweep_case(pristine, fmt: str, mode: str, work: Path) -> tuple[bool, bool]:
     out = work / f"{fmt}_{mode}"
     shutil.copytree(dir_a, out)
     corrupt(out, fmt, mode, dir_b)
-    (job,) = batch.plan([a], out)
+    (job,) = batch.schedule([a], out)
     if job.status == "skipped":
         return True, False
-    batch.run([job], workers=1, progress=False)
+    batch.run([job], workers=1, progress=None)
     name = f"t{EXTENSIONS[fmt]}"
     restored = (
-        job.status == "baked" and same_output(out / name, dir_a / name) and batch.plan([a], out)[0].status == "skipped"
+        job.status == "baked"
+        and same_output(out / name, dir_a / name)
+        and batch.schedule([a], out)[0].status == "skipped"
     )
     return False, restored
 
@@ -148,7 +150,7 @@ def test_a_corrupted_output_is_rebaked_not_skipped(pristine, tmp_path, fmt, mode
 def test_an_intact_output_is_verified_and_skipped(pristine, tmp_path, fmt):
     a, _, dir_a, _ = pristine[fmt]
     shutil.copytree(dir_a, tmp_path / "o")
-    (job,) = batch.plan([a], tmp_path / "o")
+    (job,) = batch.schedule([a], tmp_path / "o")
     assert job.status == "skipped"
     attrs = verified_attributes(tmp_path / "o" / f"t{EXTENSIONS[fmt]}")
     assert attrs["content_hash"] == batch.content_hash(a)
@@ -229,19 +231,19 @@ def test_a_writer_killed_at_every_step_leaves_nothing_a_rerun_trusts(pristine, t
             shutil.copytree(dir_a, out)
             p = write_killed(table_b, out, fmt, kill_at, tmp_path)
             assert p.returncode == -signal.SIGKILL, (kill_at, p.stdout, p.stderr)
-            (job,) = batch.plan([rerun], out)
+            (job,) = batch.schedule([rerun], out)
             if job.status == "skipped":  # a skip is right only if the output on disk is this config's
                 assert same_output(out / name, theirs / name), f"{fmt}: killed after '{steps[kill_at - 1]}'"
-            batch.run([job], workers=1, progress=False)
+            batch.run([job], workers=1, progress=None)
             assert same_output(out / name, theirs / name), (kill_at, steps[kill_at - 1])
-            assert batch.plan([rerun], out)[0].status == "skipped"
+            assert batch.schedule([rerun], out)[0].status == "skipped"
             assert not [f for f in out.iterdir() if atomic.TEMP_RE.fullmatch(f.name)], "stale temp files left"
         if fmt != "exr" and steps[kill_at - 1].startswith("renamed t."):
             # the decisive instant: B's data renamed, A's sidecar still there: A's rerun must not skip
             out = tmp_path / f"decisive{kill_at}"
             shutil.copytree(dir_a, out)
             write_killed(table_b, out, fmt, kill_at, tmp_path)
-            assert batch.plan([a], out)[0].status == "pending"
+            assert batch.schedule([a], out)[0].status == "pending"
 
 
 def test_a_full_disk_between_data_and_sidecar_makes_the_next_run_rebake(pristine, tmp_path, monkeypatch):
@@ -255,12 +257,12 @@ def test_a_full_disk_between_data_and_sidecar_makes_the_next_run_rebake(pristine
 
     with monkeypatch.context() as m:
         m.setattr(formats, "write_sidecar", full_disk)
-        (job,) = batch.plan([b], out)
-        batch.run([job], workers=1, progress=False)
+        (job,) = batch.schedule([b], out)
+        batch.run([job], workers=1, progress=None)
     assert job.status == "failed" and "no space left on device" in job.message, job.message
-    (again,) = batch.plan([a], out)
+    (again,) = batch.schedule([a], out)
     assert again.status == "pending", "A's sidecar over B's data was trusted"
-    batch.run([again], workers=1, progress=False)
+    batch.run([again], workers=1, progress=None)
     assert same_output(out / "t.npy", dir_a / "t.npy")
 
 
@@ -280,9 +282,9 @@ def test_stale_temp_files_of_dead_writers_are_removed(pristine, tmp_path):
     mine = [out / "notes.tmp", out / f".t.exr.{dead_pid}.tmp.exr", out / "keep.exr"]  # not lutbake's pattern
     for f in stale + [live] + mine:
         f.write_bytes(b"partial")
-    jobs = batch.plan([a], out)
+    jobs = batch.schedule([a], out)
     assert jobs[0].status == "skipped"
-    batch.run(jobs, workers=1, progress=False)
+    batch.run(jobs, workers=1, progress=None)
     assert not any(f.exists() for f in stale)
     assert live.exists() and all(f.exists() for f in mine)
 
@@ -296,8 +298,8 @@ def test_killed_writer_temp_file_is_removed_by_the_next_run(pristine, tmp_path):
     assert p.returncode == -signal.SIGKILL
     left = [f for f in out.iterdir() if atomic.TEMP_RE.fullmatch(f.name)]
     assert len(left) == 1
-    jobs = batch.plan([a], out)
-    batch.run(jobs, workers=1, progress=False)
+    jobs = batch.schedule([a], out)
+    batch.run(jobs, workers=1, progress=None)
     assert jobs[0].status == "skipped" and not left[0].exists()
 
 
@@ -346,8 +348,8 @@ def test_a_legacy_shared_sidecar_is_replaced(pristine, tmp_path):
     shutil.copytree(dir_a, out)
     legacy = out / "t.json"  # the pre-issue-11 <stem>.json of this file
     legacy.write_text(json.dumps({"file": "t.npy", "format": "npy", "lutbake": {"content_hash": "x"}}))
-    (job,) = batch.plan([a], out, force=True)
-    batch.run([job], workers=1, progress=False)
+    (job,) = batch.schedule([a], out, force=True)
+    batch.run([job], workers=1, progress=None)
     assert not legacy.exists() and sidecar_path(out / "t.npy").is_file()
 
 

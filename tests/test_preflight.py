@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from lutbake import api
+from lutbake import batch
 from lutbake.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -40,7 +40,7 @@ def no_kernel(monkeypatch):
     def boom(*a, **k):
         raise AssertionError("a kernel ran before the error")
 
-    monkeypatch.setattr(api, "bake_table", boom)
+    monkeypatch.setattr(batch, "bake_table", boom)
 
 
 def refused(r, *fragments):
@@ -281,13 +281,12 @@ def test_ctrl_c_during_start_up_imports_exits_130_quietly(cfg, tmp_path, module)
 
 def test_entry_point_keeps_exit_codes_and_usage_errors():
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    run = lambda *a: subprocess.run(
-        [sys.executable, "-m", "lutbake", *a],
-        capture_output=True,
-        text=True,  # noqa: E731
-        timeout=120,
-        env=env,
-    )
+
+    def run(*a):
+        return subprocess.run(
+            [sys.executable, "-m", "lutbake", *a], capture_output=True, text=True, timeout=120, env=env
+        )
+
     assert run("--version").returncode == 0
     r = run("bake", "--workers", "0")
     assert r.returncode == 2 and "Usage:" in r.stderr and "Traceback" not in r.stderr

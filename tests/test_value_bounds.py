@@ -8,10 +8,12 @@ import pytest
 from lutbake import value_bounds as vb
 from lutbake.api import bake_table
 from lutbake.config import validate_table
+from lutbake.integrands.anisotropic import ANISO_MODELS
+from lutbake.integrands.diffuse import DIFFUSE_MODELS
+from lutbake.integrands.specular import SPECULAR_MODELS as MODELS
 from lutbake.io.formats import PNG_SLACK
-from lutbake.tables import KINDS, aniso, diffuse
-from lutbake.tables.dfg import LAYOUTS
-from lutbake.terms.sets import MODELS
+from lutbake.kinds import KINDS
+from lutbake.kinds.dfg import LAYOUTS
 
 SMALL = {
     "dfg": {"size": [16, 16]},
@@ -30,7 +32,7 @@ UNIT = (
         for k in ("dfg", "albedo", "albedo_avg", "specular_3d")
         for m in sorted(vb.UNIT_SPECULAR_MODELS)
     ]
-    + [("specular_aniso", {"model": m}) for m in sorted(aniso.MODELS)]
+    + [("specular_aniso", {"model": m}) for m in sorted(ANISO_MODELS)]
     + [(k, {"model": m}) for k in ("diffuse", "diffuse_3d") for m in sorted(vb.UNIT_DIFFUSE_MODELS)]
 )
 ABOVE = (
@@ -49,8 +51,8 @@ def test_every_kind_layout_and_model_is_declared():
     assert set(KINDS) == vb.SPECULAR_KINDS | vb.DIFFUSE_KINDS | set(vb.UNBOUNDED_KINDS)
     assert vb.UNIT_LAYOUTS | vb.ABOVE_ONE_LAYOUTS == set(LAYOUTS) and not vb.UNIT_LAYOUTS & vb.ABOVE_ONE_LAYOUTS
     assert vb.UNIT_SPECULAR_MODELS | vb.ABOVE_ONE_SPECULAR_MODELS == set(MODELS)
-    assert set(aniso.MODELS) <= vb.UNIT_SPECULAR_MODELS
-    assert vb.UNIT_DIFFUSE_MODELS | vb.ABOVE_ONE_DIFFUSE_MODELS == set(diffuse.MODELS)
+    assert set(ANISO_MODELS) <= vb.UNIT_SPECULAR_MODELS
+    assert vb.UNIT_DIFFUSE_MODELS | vb.ABOVE_ONE_DIFFUSE_MODELS == set(DIFFUSE_MODELS)
 
 
 @pytest.mark.parametrize("kind, opts", UNIT, ids=[f"{k}-{'-'.join(o.values())}" for k, o in UNIT])
