@@ -78,10 +78,8 @@ def bake_into(spec, out: Path) -> batch.Job:
     return job
 
 
-@pytest.fixture(scope="module")
-def pristine(tmp_path_factory):
+def bake_pristine(tmp: Path) -> dict:
     """fmt -> (spec A, spec B, dir of A's output, dir of B's output): A and B differ in samples."""
-    tmp = tmp_path_factory.mktemp("pristine")
     made = {}
     for fmt in FORMATS:
         a, b = spec_for(tmp, 48, fmt), spec_for(tmp, 64, fmt)
@@ -89,6 +87,11 @@ def pristine(tmp_path_factory):
         bake_into(b, tmp / fmt / "b")
         made[fmt] = (a, b, tmp / fmt / "a", tmp / fmt / "b")
     return made
+
+
+@pytest.fixture(scope="module")
+def pristine(tmp_path_factory):
+    return bake_pristine(tmp_path_factory.mktemp("pristine"))
 
 
 def corrupt(out: Path, fmt: str, mode: str, foreign: Path) -> None:
@@ -362,12 +365,7 @@ def main_counts() -> None:
 
     with tempfile.TemporaryDirectory() as d:
         d = Path(d)
-        made = {}
-        for fmt in FORMATS:
-            a, b = spec_for(d, 48, fmt), spec_for(d, 64, fmt)
-            bake_into(a, d / fmt / "a")
-            bake_into(b, d / fmt / "b")
-            made[fmt] = (a, b, d / fmt / "a", d / fmt / "b")
+        made = bake_pristine(d)
         rebaked = skipped = 0
         for fmt, mode in CASES:
             s, ok = sweep_case(made, fmt, mode, d / "work")
