@@ -544,9 +544,9 @@ def _catalogue():
         ("report-under-file", toml_tables(BASE), ["--report", "{cfg}/r.json"], 2),
         ("out-dir-under-file", toml_tables(BASE), ["--out-dir", "{cfg}/o"], 2),
         ("out-dir-dangling-symlink", toml_tables(BASE), ["--out-dir", "{dangling}"], 2),
-        ("config-is-directory", "{dir}", [], 2),
-        ("config-is-fifo", "{fifo}", [], 2),
-        ("config-is-dev-zero", "/dev/zero", [], 2),
+        ("config-is-directory", "{dir}", [], 2, "is a directory, not a config file"),
+        ("config-is-fifo", "{fifo}", [], 2, "is a FIFO (named pipe), not a config file"),
+        ("config-is-dev-zero", "/dev/zero", [], 2, "is a character device, not a config file"),
     ]
     return cases
 
@@ -556,7 +556,7 @@ CATALOGUE = _catalogue()
 
 def run_catalogue_case(case) -> tuple[bool, str]:
     """(handled cleanly, why not): the expected exit, no traceback, no control character, nothing written."""
-    cid, text, args, want = case
+    cid, text, args, want, *fragment = case  # fragment: the words the message must say, where given
     with tempfile.TemporaryDirectory() as d:
         d = Path(d)
         cfg = d / "c.toml"
@@ -584,6 +584,8 @@ def run_catalogue_case(case) -> tuple[bool, str]:
             problems.append("control characters printed")
         if sorted(p.name for p in d.iterdir()) != before:
             problems.append("wrote files")
+        if fragment and fragment[0] not in r.output:
+            problems.append(f"does not say {fragment[0]!r}")
         return not problems, f"{cid}: {', '.join(problems)}: {r.output[:300]!r}"
 
 
