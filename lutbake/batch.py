@@ -232,6 +232,7 @@ def write_report(path, jobs: list[Job], status: int, signum: int | None = None) 
         "counts": {s: sum(j.status == s for j in jobs) for s in STATUSES},
         "tables": [j.report() for j in jobs],
     }
+    remove_stale_temps(path.parent)  # a report writer killed before its rename left one
     atomic_write_bytes(path, (json.dumps(doc, indent=2) + "\n").encode("utf-8"))
     return path
 

@@ -86,16 +86,21 @@ def check_out_dir(out_dir) -> None:
 
 
 def check_outputs(jobs) -> None:
-    """Every output path must be a regular file or absent (a directory or device there fails the rename)."""
+    """Every output path and sidecar path must be a regular file or absent (a directory or device there fails
+    the rename after the bake)."""
+    from .io.integrity import sidecar_path
+
     for job in jobs:
-        if os.path.lexists(job.path) and not job.path.is_symlink() and not job.path.is_file():
-            raise ConfigError(
-                job.spec.source,
-                "name",
-                job.name,
-                table=job.name,
-                message=f"its output {job.path} exists and is {_what_is(os.lstat(job.path).st_mode)}",
-            )
+        paths = (job.path,) if job.path.suffix == ".exr" else (job.path, sidecar_path(job.path))
+        for p in paths:
+            if os.path.lexists(p) and not p.is_symlink() and not p.is_file():
+                raise ConfigError(
+                    job.spec.source,
+                    "name",
+                    job.name,
+                    table=job.name,
+                    message=f"its output {p} exists and is {_what_is(os.lstat(p).st_mode)}",
+                )
 
 
 def check_report(report, jobs, configs=()) -> None:

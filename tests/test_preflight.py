@@ -93,6 +93,8 @@ def test_out_dir_on_a_read_only_mount_is_refused(cfg, tmp_path, mount, no_kernel
 def test_an_output_path_that_is_a_directory_is_refused(cfg, tmp_path, no_kernel):
     (tmp_path / "o" / "t.exr").mkdir(parents=True)
     refused(bake(cfg, "--out-dir", tmp_path / "o"), "is a directory")
+    (tmp_path / "o" / "t.npy.json").mkdir()  # the sidecar's path: its rename would fail after the bake
+    refused(bake(cfg, "--out-dir", tmp_path / "o", "--format", "npy"), "t.npy.json exists and is a directory")
 
 
 def test_png16_of_a_table_above_one_is_refused_at_plan_time(tmp_path, no_kernel):
