@@ -18,8 +18,10 @@ from ..edge import COS_EPS
 @wp.func
 def cos_transmitted(eta: float, VoH: float):
     """cos theta_t = sqrt(1 - (1 - (v.h)^2) / eta^2) of the ray refracted through the facet h (Snell's law,
-    Walter et al. 2007, Eq. 40); -1 flags total internal reflection (eta < 1 and v.h below cos theta_c)."""
-    s = 1.0 - (1.0 - VoH * VoH) / (eta * eta)
+    Walter et al. 2007, Eq. 40); -1 flags total internal reflection (eta < 1 and v.h below cos theta_c).
+    Evaluated as sqrt((eta^2 - 1 + (v.h)^2) / eta^2) (the g of F_dielectric over eta): the printed form cancels in
+    float32 at small v.h (1 - 1e-8 rounds to 1), which took eta = 1 for total internal reflection at grazing v.h."""
+    s = (eta * eta - 1.0 + VoH * VoH) / (eta * eta)
     if s <= 0.0:
         return -1.0
     return wp.sqrt(s)
