@@ -41,8 +41,22 @@ def G2_np(masking, lam_i, lam_o):
     return 1.0 / ((1.0 + lam_i) * (1.0 + lam_o))
 
 
-def bsdf(v, o, alpha, eta, ndf="ggx", masking="smith_separable"):
-    """(f_r, f_t) at direction arrays o (..., 3); each is 0 on the other side."""
+def schlick_weight(x):
+    return np.clip(1.0 - x, 0.0, 1.0) ** 5
+
+
+def eevee_s(eta, c):
+    """Blender EEVEE's Schlick weight s of a facet with v.h = c (eevee_lut_comp.glsl): (1 - v.h)^5 for eta >= 1
+    (ggx_btdf_gt_one); (1 - |t.h|)^5 with t the refracted direction for eta < 1 (ggx_bsdf_split_sum; 1 under TIR)."""
+    if eta >= 1.0:
+        return schlick_weight(c)
+    ct2 = 1.0 - (1.0 - c * c) / (eta * eta)
+    return schlick_weight(np.sqrt(np.maximum(ct2, 0.0)))
+
+
+def bsdf(v, o, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exact"):
+    """(f_r, f_t) at direction arrays o (..., 3); each is 0 on the other side. ``fresnel = "eevee"`` returns the
+    Fresnel-free lobes weighted as EEVEE's tables: ((1 - s) f_r/F, s f_r/F, (1 - s) f_t/(1 - F)) (eevee_s)."""
     D, Lam = NDF[ndf]
     nov = v[2]
     noo = o[..., 2]
@@ -63,6 +77,11 @@ def bsdf(v, o, alpha, eta, ndf="ggx", masking="smith_separable"):
         ft = (np.abs(vh * oh) * eta * eta * (1.0 - fresnel_np(eta, vh)) * D(ht[..., 2], alpha) * g2
               / (nov * np.abs(noo) * (vh + eta * oh) ** 2))
         ft = np.where((noo < 0) & (vh > 0) & (oh < 0), ft, 0.0)
+        if fresnel == "eevee":
+            fr0 = np.where((noo > 0) & (vhr > 0), D(hr[..., 2], alpha) * g2 / (4.0 * nov * noo), 0.0)
+            sr, st = eevee_s(eta, vhr), eevee_s(eta, vh)
+            ft0 = ft / (1.0 - fresnel_np(eta, vh))
+            return tuple(np.nan_to_num(x) for x in ((1 - sr) * fr0, sr * fr0, (1 - st) * ft0))
     return np.nan_to_num(fr), np.nan_to_num(ft)
 
 
@@ -120,8 +139,9 @@ def _phi_rule(cos_v, sin_v, cuts, theta):
     return (lo + (hi - lo) * (x + 1) / 2).reshape(n, -1), ((hi - lo) * w / 2).reshape(n, -1)
 
 
-def energies(nov, alpha, eta, ndf="ggx", masking="smith_separable"):
-    """(E_R, E_T) of the texel by the graded product rule (module docstring). eta = 1 makes f_t a delta: excluded."""
+def energies(nov, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exact"):
+    """(E_R, E_T) of the texel by the graded product rule (module docstring); fresnel = "eevee": EEVEE's (scale, bias,
+    transmission_factor). eta = 1 makes f_t a delta: excluded."""
     nov = float(nov)
     sin_v = np.sqrt(max(1.0 - nov * nov, 0.0))
     v = np.array([sin_v, 0.0, nov])
@@ -145,8 +165,8 @@ def energies(nov, alpha, eta, ndf="ggx", masking="smith_separable"):
             ph, wp_ = _phi_rule(nov, sin_v, cuts, t)
             st = np.sin(t)[:, None]
             o = np.stack([st * np.cos(ph), st * np.sin(ph), np.broadcast_to(np.cos(t)[:, None], ph.shape)], axis=-1)
-            fr, ft = bsdf(v, o, alpha, eta, ndf, masking)
-            f = fr if lo == 0.0 else ft
-            total += np.sum(w * np.sin(t) * np.abs(np.cos(t)) * np.sum(wp_ * f, axis=1))
-        out.append(2.0 * total)
+            fs = bsdf(v, o, alpha, eta, ndf, masking, fresnel)
+            fs = fs[:-1] if lo == 0.0 else fs[-1:]
+            total = total + np.array([np.sum(w * np.sin(t) * np.abs(np.cos(t)) * np.sum(wp_ * f, axis=1)) for f in fs])
+        out += list(2.0 * total)
     return tuple(out)
