@@ -206,3 +206,25 @@ def test_bad_configs_name_the_key():
         spec(kind="dielectric", layout="openpbr", masking="smith_height_correlated")
     with pytest.raises(Exception, match="masking"):
         spec(kind="dielectric", masking="v_cavity")
+
+
+def test_openpbr_header_writes_its_arrays_as_unorm16(tmp_path):
+    import re
+
+    from lutbake.io.formats import write_table
+    from lutbake.table import Table
+
+    rng = np.random.default_rng(5)
+    channels = kd.CHANNELS["openpbr"]
+    data = rng.uniform(0, 1, (32, 32, 32, 3)).astype(np.float32)
+    path = write_table(Table("opbr", "dielectric", data, [], channels, ""), tmp_path, "openpbr_h")
+    text = path.read_text()
+    for name, c, want in [("IdealDielectricEnergyComplement", 0, data[..., 0]),
+                          ("OpaqueDielectricEnergyComplement", 1, data[..., 1]),
+                          ("IdealMetalEnergyComplement", 2, data[16, ..., 2])]:
+        body = re.search(rf"OpenPBR_{name}_Array\[(\d+)\] = {{[^\n]*\n(.*?)}};", text, re.S)
+        codes = np.array([int(x) for x in re.findall(r"\d+", body.group(2))])
+        assert int(body.group(1)) == want.size == codes.size
+        np.testing.assert_array_equal(codes, np.rint(want.ravel().astype(np.float64) * 65535))
+    with pytest.raises(Exception, match="format"):
+        spec(kind="dielectric", format="openpbr_h")

@@ -322,6 +322,8 @@ def check_spec(spec) -> tuple[str, str] | None:
         return ("ior_mapping", "'symmetric' needs ior_range[1] > 1 (the largest eta) and an even ior_size")
     if o["layout"] in ("eevee_btdf", "eevee_bsdf", "openpbr") and (o["ndf"], o["masking"]) != ("ggx", "smith_separable"):
         return ("layout", f"layout {o['layout']!r} fixes ndf = 'ggx' and masking = 'smith_separable' (the engine's)")
+    if o.get("format") == "openpbr_h" and o["layout"] != "openpbr":
+        return ("format", f"'openpbr_h' writes OpenPBR's arrays: it needs layout = 'openpbr', not {o['layout']!r}")
     size = o.get("size", [1, 1])
     n = size[0] * size[1] * o["ior_size"]
     if n > 1 << 24:
