@@ -214,10 +214,10 @@ def integrate(key: tuple, nov, alpha, eta, samples: int, seed: int, device: str 
 
 
 def post_process(layout: str, e: np.ndarray) -> np.ndarray:
-    """The integrals (n, 3) -> the layout's channels: complements for openpbr, the first channel for eevee_btdf."""
+    """The integrals (n, 3) -> the layout's channels: complements for openpbr, the transmission factor (channel 2) for eevee_btdf."""
     if layout == "openpbr":
         return np.stack([1.0 - (e[:, 0] + e[:, 1]), 1.0 - e[:, 0], 1.0 - e[:, 2]], axis=1)
-    return e[:, :1] if layout == "eevee_btdf" else e
+    return e[:, 2:] if layout == "eevee_btdf" else e
 
 
 def _plan(o: dict, axes, channels, reconstruction, n_texels, run, key, extra, samples, evals_per_texel) -> Plan:
