@@ -1,4 +1,5 @@
 """The ``lutbake`` command line: a thin layer over lutbake.api."""
+
 from __future__ import annotations
 
 import sys
@@ -18,6 +19,17 @@ def _quiet_warp():
     import warp as wp
 
     wp.config.log_level = logging.WARNING
+
+
+def out_dir_option(default: str, what: str):
+    """The shared ``--out-dir`` option of the commands that write files."""
+    return click.option(
+        "--out-dir",
+        type=click.Path(path_type=Path),
+        default=Path(default),
+        show_default=True,
+        help=f"Directory the {what} are written to.",
+    )
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
@@ -40,20 +52,34 @@ def main():
 @main.command()
 @click.argument("configs", nargs=-1, type=click.Path(path_type=Path))
 @click.option("--preset", "presets", multiple=True, metavar="NAME", help="Bake a preset config (lutbake list).")
-@click.option("--out-dir", type=click.Path(path_type=Path), default=Path("outputs"), show_default=True,
-              help="Directory the EXRs are written to.")
-@click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",
-              help="Override a key in every table (KEY=VALUE) or one table (NAME.KEY=VALUE); VALUE is TOML.")
-@click.option("--workers", type=click.IntRange(min=1), default=None,
-              help="Worker threads (default: every core).")
-@click.option("--device", type=click.Choice(["cpu", "cuda"]), default="cpu", show_default=True,
-              help="Warp device the kernels run on.")
+@out_dir_option("outputs", "tables")
+@click.option(
+    "--set",
+    "overrides",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Override a key in every table (KEY=VALUE) or one table (NAME.KEY=VALUE); VALUE is TOML.",
+)
+@click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
+@click.option(
+    "--device", type=click.Choice(["cpu", "cuda"]), default="cpu", help="Warp device of the kernels: cpu, cuda."
+)
 @click.option("--progress/--no-progress", default=None, help="Progress bar (default: on a terminal, for long bakes).")
 @click.option("--force", is_flag=True, help="Rebake every table, even those whose output is up to date.")
-@click.option("--report", type=click.Path(path_type=Path, dir_okay=False), default=None, metavar="FILE.json",
-              help="Write a JSON summary: per table status, path, content hash, seconds, samples, error estimate.")
-@click.option("--format", "fmt", type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h"]), default=None,
-              help="Output format of every table (same as --set format=...; default: each table's `format`, exr).")
+@click.option(
+    "--report",
+    type=click.Path(path_type=Path, dir_okay=False),
+    default=None,
+    metavar="FILE.json",
+    help="Write a JSON summary: per table status, path, content hash, seconds, samples, error estimate.",
+)
+@click.option(
+    "--format",
+    "fmt",
+    type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h"]),
+    default=None,
+    help="Output format of every table (same as --set format=...; default: each table's `format`, exr).",
+)
 def bake(configs, presets, out_dir, overrides, workers, device, progress, force, report, fmt):
     """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.<ext> (EXR unless `format` / --format says otherwise).
 
@@ -94,7 +120,7 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
 
             if not wp.is_cuda_available():
                 raise ConfigError("--device", "device", "cuda", "cpu", "no CUDA device is available")
-        jobs = batch.plan(specs, out_dir, force=force)
+        jobs = batch.schedule(specs, out_dir, force=force)
     except ConfigError as e:
         click.echo(f"error: {e}", err=True)
         sys.exit(EXIT_CONFIG)
@@ -111,10 +137,12 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     for job in jobs:
         if job.status == "skipped":
             click.echo(f"skipped {job.path} (up to date)")
+    pending = sum(j.status == "pending" for j in jobs)
+    bars = progress if progress is not None else (sys.stderr.isatty() and pending == 1)
     signum = None
     try:
         with batch.signal_handlers():
-            signum = batch.run(jobs, workers, device, progress, on_done=on_done)
+            signum = batch.run(jobs, workers, device, progress_bars if bars else None, on_done=on_done)
     except (KeyboardInterrupt, batch.Interrupted) as e:  # a second Ctrl-C while tables wind down
         signum = getattr(e, "signum", 2)
         for job in jobs:
@@ -128,10 +156,32 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     if failed:
         click.echo(f"{len(failed)} of {len(jobs)} tables failed: {', '.join(failed)}", err=True)
     if signum is not None:
-        click.echo(f"interrupted ({batch.signal_name(signum)}): {len(unfinished)} of {len(jobs)} tables did not "
-                   f"finish: {', '.join(unfinished) or '-'}; run the same command again to bake only those",
-                   err=True)
+        click.echo(
+            f"interrupted ({batch.signal_name(signum)}): {len(unfinished)} of {len(jobs)} tables did not "
+            f"finish: {', '.join(unfinished) or '-'}; run the same command again to bake only those",
+            err=True,
+        )
     sys.exit(status)
+
+
+PROGRESS_MIN_EVALS = 1.5e7  # about a second of work on two busy cores: show a bar above it
+
+
+def progress_bars(label: str, n_texels: int, cost: float):
+    """lutbake.executor.Progress drawn as a click progress bar on stderr (tables above PROGRESS_MIN_EVALS)."""
+    if cost <= PROGRESS_MIN_EVALS:
+        return None
+    bar = click.progressbar(length=n_texels, label=label, file=sys.stderr, show_eta=True)
+    bar.__enter__()
+    left = [n_texels]
+
+    def update(n: int) -> None:
+        bar.update(n)
+        left[0] -= n
+        if left[0] <= 0:
+            bar.__exit__(None, None, None)
+
+    return update
 
 
 @main.command("list")
@@ -139,13 +189,19 @@ def list_():
     """List table kinds, selectable terms, estimators and presets."""
     from .axes import TEXELS
     from .config import presets
+    from .integrands.anisotropic import ANISO_MODELS
+    from .integrands.diffuse import DIFFUSE_MODELS
+    from .integrands.fresnel import FRESNELS
+    from .integrands.specular import SPECULAR_MODELS
     from .io.formats import FORMATS
-    from .tables import KINDS
-    from .tables.dfg import LAYOUTS
-    from .tables.diffuse import MODELS as DIFFUSE_MODELS
-    from .tables.specular import ESTIMATORS
-    from .tables import aniso
-    from .terms.sets import MASKINGS, MODELS, NDFS
+    from .kinds import KINDS
+    from .kinds.dfg import LAYOUTS
+    from .kinds.diffuse import DIFFUSE_ESTIMATORS
+    from .kinds.specular_aniso import VIEW_AZIMUTHS
+    from .sampling.anisotropic import ANISO_ESTIMATORS
+    from .sampling.hemisphere import ESTIMATORS
+    from .terms.distributions import MASKINGS, NDFS
+    from .terms.metals import METALS
 
     def section(title, items):
         click.echo(click.style(title, bold=True))
@@ -153,23 +209,25 @@ def list_():
             click.echo(f"  {k:<26} {v}")
         click.echo()
 
-    section("Table kinds (kind = ...)", {k.name + (f" ({', '.join(k.aliases)})" if k.aliases else ""): k.description
-                                         for k in KINDS.values()})
+    section(
+        "Table kinds (kind = ...)",
+        {k.name + (f" ({', '.join(k.aliases)})" if k.aliases else ""): k.description for k in KINDS.values()},
+    )
     section("NDFs (ndf = ...)", {k: v.description for k, v in NDFS.items()})
     section("Masking-shadowing (masking = ...)", MASKINGS)
-    section("Models (dfg, albedo, albedo_avg, specular_3d: model = ...)", MODELS)
-    section("Anisotropic models (specular_aniso: model = ...)", aniso.MODELS)
-    section("View azimuth (specular_aniso: view_azimuth = ...)", aniso.VIEW_AZIMUTHS)
-    from .tables.fresnel import FRESNELS
-    from .terms.metals import METALS
+    section("Models (dfg, albedo, albedo_avg, specular_3d: model = ...)", SPECULAR_MODELS)
+    section("Anisotropic models (specular_aniso: model = ...)", ANISO_MODELS)
+    section("View azimuth (specular_aniso: view_azimuth = ...)", VIEW_AZIMUTHS)
 
     section("Fresnel (specular_3d: fresnel = ...; dfg factors Schlick out)", FRESNELS)
-    section("Metals (specular_3d: metal = ...)", {k: f"n+ik R,G,B = {m.n} + i{m.k}; {m.source}"
-                                                  for k, m in METALS.items()})
+    section(
+        "Metals (specular_3d: metal = ...)", {k: f"n+ik R,G,B = {m.n} + i{m.k}; {m.source}" for k, m in METALS.items()}
+    )
     section("DFG layouts (layout = ...)", LAYOUTS)
-    section("Estimators (estimator = ...)", ESTIMATORS)
+    section("Estimators (dfg, albedo, albedo_avg, specular_3d: estimator = ...)", ESTIMATORS)
     section("Diffuse models (kind = diffuse, model = ...)", DIFFUSE_MODELS)
-    section("Estimators (specular_aniso: estimator = ...)", aniso.ESTIMATORS)
+    section("Estimators (diffuse, diffuse_3d: estimator = ...)", DIFFUSE_ESTIMATORS)
+    section("Estimators (specular_aniso: estimator = ...)", ANISO_ESTIMATORS)
     section("Texel conventions (texel = ...)", TEXELS)
     section("Output formats (format = ... / --format)", FORMATS)
     section("Presets (--preset NAME)", {k: _first_comment(p) for k, p in presets().items()})
@@ -202,12 +260,21 @@ def inspect(file):
 
 
 @main.command()
-@click.option("--out-dir", type=click.Path(path_type=Path), default=Path("outputs/figures"), show_default=True,
-              help="Directory the PNGs are written to.")
-@click.option("--sigma-to-alpha", type=click.Choice(["sigma", "sigma_squared"]), default="sigma", show_default=True,
-              help="GGX alpha from sigma for the integrated microfacet model.")
-@click.option("--order", type=click.IntRange(min=2, max=64), default=12, show_default=True,
-              help="Gauss-Legendre order of the microfacet integral over m.")
+@out_dir_option("outputs/figures", "PNGs")
+@click.option(
+    "--sigma-to-alpha",
+    type=click.Choice(["sigma", "sigma_squared"]),
+    default="sigma",
+    show_default=True,
+    help="GGX alpha from sigma for the integrated microfacet model.",
+)
+@click.option(
+    "--order",
+    type=click.IntRange(min=2, max=64),
+    default=12,
+    show_default=True,
+    help="Gauss-Legendre order of the microfacet integral over m.",
+)
 @click.option("--no-png", is_flag=True, help="Only print the error table.")
 def plot(out_dir, sigma_to_alpha, order, no_png):
     """Reproduce the seed's Figures 11-15 (settings of Figures 6-10): Oren-Nayar, Oren-Nayar with Fresnel,
@@ -223,13 +290,19 @@ def plot(out_dir, sigma_to_alpha, order, no_png):
     if not no_png:
         for p in plot_all(out_dir, sigma_to_alpha, order):
             click.echo(str(p))
-    click.echo(f"fitted (Eq. 8) vs integrated (Eq. 4), alpha from sigma: {sigma_to_alpha}; errors in units of the "
-               "integrated curve's maximum")
-    click.echo(f"{'figure':<7}{'abscissa':<9}{'fixed cos':>10}{'cos phi':>9}{'sigma':>7}{'max err':>9}{'rms err':>9}"
-               f"{'at deg':>8}")
+    click.echo(
+        f"fitted (Eq. 8) vs integrated (Eq. 4), alpha from sigma: {sigma_to_alpha}; errors in units of the "
+        "integrated curve's maximum"
+    )
+    click.echo(
+        f"{'figure':<7}{'abscissa':<9}{'fixed cos':>10}{'cos phi':>9}{'sigma':>7}{'max err':>9}{'rms err':>9}"
+        f"{'at deg':>8}"
+    )
     for r in error_table(sigma_to_alpha=sigma_to_alpha, order=order):
-        click.echo(f"{r['figure']:<7}{r['vary']:<9}{r['fixed_cos']:>10.3f}{r['cos_phi']:>9.3f}{r['sigma']:>7.2f}"
-                   f"{r['max_err']:>9.3f}{r['rms_err']:>9.3f}{r['argmax_deg']:>8.0f}")
+        click.echo(
+            f"{r['figure']:<7}{r['vary']:<9}{r['fixed_cos']:>10.3f}{r['cos_phi']:>9.3f}{r['sigma']:>7.2f}"
+            f"{r['max_err']:>9.3f}{r['rms_err']:>9.3f}{r['argmax_deg']:>8.0f}"
+        )
 
 
 @main.command()
@@ -251,8 +324,13 @@ def validate():
 
 @main.command()
 @click.argument("file", type=click.Path(path_type=Path))
-@click.option("-o", "--out", type=click.Path(path_type=Path), default=None,
-              help="PNG to write (default: FILE's stem + .preview.png beside it).")
+@click.option(
+    "-o",
+    "--out",
+    type=click.Path(path_type=Path),
+    default=None,
+    help="PNG to write (default: FILE's stem + .preview.png beside it).",
+)
 def preview(file, out):
     """Render a PNG of a baked table: each channel colour-mapped with labelled axes, and (dfg) a row of
     spheres lit with the split-sum through the table. Reads EXR, or .npy with its .json sidecar.

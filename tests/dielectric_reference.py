@@ -4,21 +4,23 @@ whole sphere, in its own spherical coordinates about n, with the BSDF written di
 quadrature and its closed-form F):
 
     E_R = ∫_{n.o > 0} f_r(v, o) n.o dω_o,   f_r = F(v.h_r) D(h_r) G2(v, o) / (4 n.v n.o),  h_r = (v + o) / |v + o|
-    E_T = ∫_{n.o < 0} f_t(v, o) |n.o| dω_o, f_t = |v.h||o.h| eta^2 (1 - F(v.h)) D(h) G2(v, o) / (n.v |n.o| (v.h + eta o.h)^2),
+    E_T = ∫_{n.o < 0} f_t(v, o) |n.o| dω_o,
+          f_t = |v.h||o.h| eta^2 (1 - F(v.h)) D(h) G2(v, o) / (n.v |n.o| (v.h + eta o.h)^2),
           h = -(v + eta o) / |v + eta o| (flipped to n.h > 0), valid where v.h > 0 > o.h
     dω_o = sin(theta) dtheta dphi, phi in [0, pi] twice (v lies in the xz-plane).
 
 Composite Gauss-Legendre (GL_NODES per panel) with panels graded geometrically (PANEL_RATIO) from every anchor:
 the lobe peaks (mirror and refracted directions, at phi = pi), and the curves where the integrand is not smooth:
 the cone v.o = -min(eta, 1/eta) that bounds transmission, the circle n.o = -n.v / eta where the transmission
-half vector reaches the horizon (GGX's D(pi/2) = alpha^2 / pi: the integrand jumps to 0 there), the cone v.o = 2 cos^2(theta_c) - 1 where reflection's
+half vector reaches the horizon (GGX's D(pi/2) = alpha^2 / pi: the integrand jumps to 0 there),
+the cone v.o = 2 cos^2(theta_c) - 1 where reflection's
 Fresnel has its total-internal-reflection kink (eta < 1), and the horizon. Each is a closed-form breakpoint in phi at
 every theta (cos(phi) = (k - n.v cos(theta)) / (sin(theta_v) sin(theta))) and enters [0, pi] at closed-form theta.
 """
+
 from __future__ import annotations
 
 import numpy as np
-
 from test_reference_dfg import NDF
 
 GL_NODES = 12
@@ -74,8 +76,15 @@ def bsdf(v, o, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exact"
         ht = np.where(ht[..., 2:3] < 0, -ht, ht)
         vh = ht @ v
         oh = np.sum(ht * o, axis=-1)
-        ft = (np.abs(vh * oh) * eta * eta * (1.0 - fresnel_np(eta, vh)) * D(ht[..., 2], alpha) * g2
-              / (nov * np.abs(noo) * (vh + eta * oh) ** 2))
+        ft = (
+            np.abs(vh * oh)
+            * eta
+            * eta
+            * (1.0 - fresnel_np(eta, vh))
+            * D(ht[..., 2], alpha)
+            * g2
+            / (nov * np.abs(noo) * (vh + eta * oh) ** 2)
+        )
         ft = np.where((noo < 0) & (vh > 0) & (oh < 0), ft, 0.0)
         if fresnel == "eevee":
             fr0 = np.where((noo > 0) & (vhr > 0), D(hr[..., 2], alpha) * g2 / (4.0 * nov * noo), 0.0)
@@ -161,7 +170,7 @@ def energies(nov, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exa
         th, wt = _gl(_graded(lo, hi, anchors))
         total = 0.0
         for c in range(0, len(th), 64):
-            t, w = th[c:c + 64], wt[c:c + 64]
+            t, w = th[c : c + 64], wt[c : c + 64]
             ph, wp_ = _phi_rule(nov, sin_v, cuts, t)
             st = np.sin(t)[:, None]
             o = np.stack([st * np.cos(ph), st * np.sin(ph), np.broadcast_to(np.cos(t)[:, None], ph.shape)], axis=-1)

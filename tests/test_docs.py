@@ -1,7 +1,8 @@
 """Every registered kind, key and allowed value is documented in docs/config.md; README has the two commands."""
+
 from pathlib import Path
 
-from lutbake.tables import KINDS
+from lutbake.kinds import KINDS
 
 ROOT = Path(__file__).resolve().parents[1]
 

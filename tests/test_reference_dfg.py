@@ -8,15 +8,17 @@ not over the half vector as the package's estimators do, with its own numpy D an
     dω_l = sin(theta_l) dtheta_l dphi_l, theta_l in [0, pi/2], phi_l in [0, 2 pi] (twice [0, pi] by symmetry).
 
 Composite Gauss-Legendre in both angles, with panels graded geometrically towards the mirror direction
-(theta_l = theta_v, phi_l = pi for v at phi = 0, where D peaks: width ~2 alpha in theta_l, ~2 alpha (n.v) in phi_l) and towards the horizon theta_l = pi/2
+(theta_l = theta_v, phi_l = pi for v at phi = 0, where D peaks: width ~2 alpha in theta_l, ~2 alpha (n.v) in
+phi_l) and towards the horizon theta_l = pi/2
 (where G2 varies on the scale min(n.v, alpha)); the rule is converged to ~1e-8 at these texels
 (doubling the nodes per panel changes it by less than that).
 """
+
 import numpy as np
 import pytest
 from scipy.special import erf
 
-from lutbake.tables.specular import integrate, kernel_for
+from lutbake.integrands.specular import hemisphere_integral
 
 REFERENCE_ATOL = 1.0e-4  # |table - reference| per channel
 QMC_SAMPLES = 1 << 16
@@ -37,21 +39,22 @@ def texels():
 
 # --- numpy terms ------------------------------------------------------------------------------------
 
+
 def D_ggx(cos_h, alpha):
     c2 = cos_h * cos_h
     tan2 = np.maximum(1.0 - c2, 0.0) / c2
-    return 1.0 / (np.pi * alpha ** 2 * c2 * c2 * (1.0 + tan2 / alpha ** 2) ** 2)
+    return 1.0 / (np.pi * alpha**2 * c2 * c2 * (1.0 + tan2 / alpha**2) ** 2)
 
 
 def D_beckmann(cos_h, alpha):
     c2 = cos_h * cos_h
     tan2 = np.maximum(1.0 - c2, 0.0) / c2
-    return np.exp(-tan2 / alpha ** 2) / (np.pi * alpha ** 2 * c2 * c2)
+    return np.exp(-tan2 / alpha**2) / (np.pi * alpha**2 * c2 * c2)
 
 
 def Lambda_ggx(c, alpha):
     tan2 = np.maximum(1.0 - c * c, 0.0) / (c * c)
-    return 0.5 * (np.sqrt(1.0 + alpha ** 2 * tan2) - 1.0)
+    return 0.5 * (np.sqrt(1.0 + alpha**2 * tan2) - 1.0)
 
 
 def Lambda_beckmann(c, alpha):
@@ -77,6 +80,7 @@ def G2(masking, lv, ll, noh=None, nov=None, nol=None, voh=None):
 
 
 # --- the reference integrator ---------------------------------------------------------------------------
+
 
 def graded_edges(lo, hi, anchors):
     """lo, hi, and for each (anchor, first) the anchor and anchor +- first * PANEL_RATIO^j inside [lo, hi]."""
@@ -122,8 +126,10 @@ def reference_dfg(nov, alpha, ndf, masking, n=GL_NODES):
 def references():
     """Reference (scale, bias) per texel for both term sets, computed once."""
     nov, alpha = texels()
-    return {key: np.array([reference_dfg(n, a, *key) for n, a in zip(nov, alpha)])
-            for key in [("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"), ("beckmann", "v_cavity")]}
+    return {
+        key: np.array([reference_dfg(n, a, *key) for n, a in zip(nov, alpha)])
+        for key in [("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"), ("beckmann", "v_cavity")]
+    }
 
 
 def test_reference_integrator_is_converged():
@@ -133,13 +139,14 @@ def test_reference_integrator_is_converged():
             # V-cavity's min() has kinks inside the domain that the panels do not follow: algebraic convergence,
             # measured 5e-6 (16 nodes) and 3e-6 (32 nodes) from 64 nodes per panel
             atol = REFERENCE_ATOL / (10 if key[1] == "v_cavity" else 100)
-            np.testing.assert_allclose(reference_dfg(n, a, *key), reference_dfg(n, a, *key, n=2 * GL_NODES),
-                                       rtol=0.0, atol=atol)
+            np.testing.assert_allclose(
+                reference_dfg(n, a, *key), reference_dfg(n, a, *key, n=2 * GL_NODES), rtol=0.0, atol=atol
+            )
 
 
 def table(ndf, masking, estimator, samples, form="microfacet"):
     nov, alpha = texels()
-    return integrate(kernel_for(ndf, masking, "scale_bias", estimator, form), nov, alpha, estimator, samples, SEED, 2)
+    return hemisphere_integral(ndf, masking, "scale_bias", nov, alpha, estimator, samples, SEED, form=form)
 
 
 def report(got, want):
@@ -166,13 +173,13 @@ def test_dfg_beckmann_separable_gauss_legendre_matches_reference(references):
     np.testing.assert_allclose(got, references[("beckmann", "smith_separable")], rtol=0.0, atol=REFERENCE_ATOL)
 
 
-def test_dfg_cook_torrance_gauss_legendre_matches_reference(references):
+def test_dfg_cook_torrance_gauss_legendre_matches_reference(references, spec):
     """The lecture's Cook-Torrance (Beckmann D with 1/pi, V-cavity G, Schlick F): the table kernel of
-    model = "cook_torrance" (lutbake.terms.sets.model_terms) against the reference with the V-cavity G written here."""
-    from lutbake.config import validate_table
-    from lutbake.tables.dfg import terms_of
+    model = "cook_torrance" (lutbake.integrands.specular.model_terms) against the reference with the V-cavity G
+    written here."""
+    from lutbake.kinds.dfg import terms_of
 
-    form, ndf, masking = terms_of(validate_table({"name": "t", "kind": "dfg", "model": "cook_torrance"}, "<test>", 0).options)
+    form, ndf, masking = terms_of(spec(kind="dfg", model="cook_torrance").options)
     # the same kinks slow the table's Gauss-Legendre too: measured max error 8.4e-4 at 432 samples (the default),
     # 8.4e-5 at 1152, 4.2e-5 at 4608; scrambled Sobol' NDF sampling with 2^20 points agrees with the reference to 3.5e-7
     got = table(ndf, masking, "gauss_legendre", 4608, form)

@@ -1,5 +1,5 @@
 """Integrands of the rough dielectric BSDF (Walter, Marschner, Li & Torrance 2007, "Microfacet models for refraction
-through rough surfaces", Eqs. 20-21) in the half-vector measure, for the energy tables of lutbake.tables.dielectric.
+through rough surfaces", Eqs. 20-21) in the half-vector measure, for the energy tables of lutbake.kinds.dielectric.
 
 For a view v (n.v = mu > 0, on the incident side, relative index eta = eta_o / eta_i), both lobes are written over
 the same microfacet normal h (v.h > 0, n.h > 0):
@@ -20,6 +20,7 @@ A *Fresnel mode* picks the channels (each a weight of the two lobes at the same 
                  s = 1 under total internal reflection, where EEVEE's refract() returns 0)
 with w_R = D G2(v, l) (v.h) / mu [n.l > 0] and w_T = D G2(v, t) (v.h) / mu [n.t < 0].
 """
+
 from __future__ import annotations
 
 import functools
@@ -28,9 +29,10 @@ import warp as wp
 
 from ..edge import COS_EPS
 from ..terms import fresnel
-from ..terms.dielectric import refract
+from ..terms.dielectric import cos_transmitted, refract
+from ..terms.distributions import NDFS
 from ..terms.frame import reflect
-from ..terms.sets import G2_for, NDFS
+from .specular import SpecularIntegrand
 
 FRESNEL_MODES = {
     "exact": "(E_R, E_T, E_R + E_T) with the exact dielectric Fresnel (Walter et al. 2007, Eq. 22; TIR included)",
@@ -48,7 +50,7 @@ def integrand_for(ndf_name: str, masking_name: str, mode: str):
     if masking_name not in MASKINGS:
         raise KeyError(f"masking {masking_name!r} is not defined for transmission; valid: {', '.join(MASKINGS)}")
     D = NDFS[ndf_name].D
-    G2 = G2_for(ndf_name, masking_name)
+    G2 = NDFS[ndf_name].G2(masking_name)
 
     @wp.func
     def integrand(v: wp.vec3, h: wp.vec3, alpha: float, eta: float):
@@ -58,12 +60,12 @@ def integrand_for(ndf_name: str, masking_name: str, mode: str):
             return wp.vec3()
         w = D(h, alpha) * VoH / NoV
         NoL = reflect(v, h)[2]
-        w_r = float(0.0)
+        w_r = w * 0.0  # dynamic (a literal is a constant to Warp)
         if NoL > COS_EPS:
             w_r = w * G2(NoV, NoL, h[2], VoH, alpha)
         t = refract(v, h, eta)
         NoT = -t[2]
-        w_t = float(0.0)
+        w_t = w * 0.0
         if NoT > COS_EPS:
             w_t = w * G2(NoV, NoT, h[2], VoH, alpha)
         if wp.static(mode == "eevee"):
@@ -78,3 +80,45 @@ def integrand_for(ndf_name: str, masking_name: str, mode: str):
         return wp.vec3(F * w_r, (1.0 - F) * w_t, F * w_r + (1.0 - F) * w_t)
 
     return integrand
+
+
+@functools.lru_cache(maxsize=None)
+def mirror_for(mode: str):
+    """The exact alpha -> 0 limit (lutbake.edge): D -> delta about n, so h = n, v.h = mu, G2 -> 1, and each lobe
+    keeps its Fresnel weight at mu: E_R = F(mu, eta), E_T = 1 - F(mu, eta) (0 under total internal reflection)."""
+
+    @wp.func
+    def mirror(v: wp.vec3, eta: float):
+        mu = v[2]
+        if mu <= COS_EPS:
+            return wp.vec3()
+        ct = cos_transmitted(eta, mu)
+        w_t = wp.where(ct > COS_EPS, 1.0, 0.0)
+        if wp.static(mode == "eevee"):
+            x = mu
+            if eta < 1.0:
+                x = wp.max(ct, 0.0)  # the refracted cosine; 0 under TIR: s = 1
+            s = fresnel.Fc_schlick(x)
+            return wp.vec3(1.0 - s, s, (1.0 - s) * w_t)
+        F = fresnel.F_dielectric(eta, mu)
+        if wp.static(mode == "exact_metal"):
+            return wp.vec3(F, (1.0 - F) * w_t, 1.0)
+        return wp.vec3(F, (1.0 - F) * w_t, F + (1.0 - F) * w_t)
+
+    return mirror
+
+
+@functools.lru_cache(maxsize=None)
+def dielectric_integrand(ndf_name: str, masking_name: str, mode: str, nch: int = 3) -> SpecularIntegrand:
+    """The integrand record (lutbake.integrands.specular.SpecularIntegrand: g, vec, distribution, mirror) of a
+    (terms, Fresnel mode) key; the kernels' per-texel ``param`` is the relative IOR eta."""
+    return SpecularIntegrand(
+        ("dielectric", ndf_name, masking_name, mode),
+        integrand_for(ndf_name, masking_name, mode),
+        wp.vec3,
+        wp.vec3d,
+        3,
+        nch,
+        NDFS[ndf_name],
+        mirror_for(mode),
+    )

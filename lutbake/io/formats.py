@@ -10,6 +10,7 @@
 | ``h`` | <name>.h | half-float bits (uint16_t) or float | the conventions in a comment block |
 Row 0 of every file is table row 0 (no flip); column 0 is x index 0. Every write is atomic.
 """
+
 from __future__ import annotations
 
 import json
@@ -18,10 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..table import Table
+from ..table import Table, metadata
+from ..table import pixels as checked_pixels
 from . import dds, ktx2
 from .atomic import atomic_write, atomic_write_bytes
-from .exr import _check_table, _header, write_exr
+from .exr import write_exr
 
 FORMATS = {
     "exr": "OpenEXR via OpenImageIO, float32 or half, lutbake:* header attributes (default)",
@@ -33,23 +35,31 @@ FORMATS = {
     "openpbr_h": "OpenPBR's energy-table header: UNORM16 uint16_t arrays under its names (layout openpbr only)",
 }
 PNG_SLACK = 1.0e-3  # values this close outside [0, 1] are integration noise (e.g. E = 1 + 3e-5): clipped
-EXTENSIONS = {"exr": ".exr", "npy": ".npy", "png16": ".png", "dds": ".dds", "ktx2": ".ktx2", "h": ".h", "openpbr_h": ".h"}
-
-
-def metadata(table: Table) -> dict[str, str]:
-    """The lutbake attributes every format carries (as the EXR header's lutbake:* strings)."""
-    return _header(table)
+EXTENSIONS = {
+    "exr": ".exr",
+    "npy": ".npy",
+    "png16": ".png",
+    "dds": ".dds",
+    "ktx2": ".ktx2",
+    "h": ".h",
+    "openpbr_h": ".h",
+}
 
 
 def _sidecar(table: Table, path: Path, fmt: str, extra: dict | None = None) -> None:
     meta = {k: v for k, v in metadata(table).items()}
-    doc = {"file": path.name, "format": fmt, "row_order": "file row 0 = table row 0 (y index 0); column 0 = x index 0",
-           **(extra or {}), "lutbake": meta}
+    doc = {
+        "file": path.name,
+        "format": fmt,
+        "row_order": "file row 0 = table row 0 (y index 0); column 0 = x index 0",
+        **(extra or {}),
+        "lutbake": meta,
+    }
     atomic_write_bytes(path.with_suffix(".json"), (json.dumps(doc, indent=1, ensure_ascii=False) + "\n").encode())
 
 
 def write_npy(table: Table, path, dtype: str = "float32") -> Path:
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write(path, lambda tmp: np.save(tmp, pixels, allow_pickle=False))
     _sidecar(table, path, "npy", {"dtype": str(pixels.dtype), "shape": list(pixels.shape)})
@@ -62,17 +72,22 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
     outside [0, 1] are clipped; anything further out is an error (the format cannot hold it)."""
     import OpenImageIO as oiio
 
-    pixels = _check_table(table, "float32")
+    pixels = checked_pixels(table, "float32")
     path = Path(path)
     if pixels.ndim != 3:
         raise ValueError(f"table {table.name!r}: png16 holds 2D tables only; use dds, ktx2, exr or npy for 3D")
     lo, hi = float(pixels.min()), float(pixels.max())
     if lo < -PNG_SLACK or hi > 1.0 + PNG_SLACK:
         names = list(table.channels)
-        bad = [names[c] for c in range(pixels.shape[-1])
-               if pixels[..., c].min() < -PNG_SLACK or pixels[..., c].max() > 1.0 + PNG_SLACK]
-        raise ValueError(f"table {table.name!r}: png16 stores [0, 1] only; channel(s) {bad} span [{lo:.6g}, {hi:.6g}] "
-                         "(use exr, dds, ktx2, npy or h)")
+        bad = [
+            names[c]
+            for c in range(pixels.shape[-1])
+            if pixels[..., c].min() < -PNG_SLACK or pixels[..., c].max() > 1.0 + PNG_SLACK
+        ]
+        raise ValueError(
+            f"table {table.name!r}: png16 stores [0, 1] only; channel(s) {bad} span [{lo:.6g}, {hi:.6g}] "
+            "(use exr, dds, ktx2, npy or h)"
+        )
     if pixels.shape[-1] == 2:
         pixels = np.concatenate([pixels, np.zeros(pixels.shape[:-1] + (1,), np.float32)], axis=-1)
     codes = np.round(np.clip(pixels.astype(np.float64), 0.0, 1.0) * 65535.0).astype(np.uint16)
@@ -81,8 +96,10 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
     def write(tmp):
         spec = oiio.ImageSpec(w, h, nch, "uint16")
         spec.attribute("oiio:ColorSpace", "linear")  # OIIO then writes gAMA = 1.0, never an sRGB chunk
-        spec.attribute("ImageDescription", f"lutbake {table.kind} table {table.name}: linear values, "
-                                           "code / 65535; conventions in the .json sidecar")
+        spec.attribute(
+            "ImageDescription",
+            f"lutbake {table.kind} table {table.name}: linear values, code / 65535; conventions in the .json sidecar",
+        )
         out = oiio.ImageOutput.create(str(tmp))
         if out is None or not out.open(str(tmp), spec):
             raise OSError(f"cannot write {path}: {oiio.geterror()}")
@@ -92,13 +109,20 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
             raise OSError(f"cannot write {path}: {out.geterror()}")
 
     atomic_write(path, write)
-    _sidecar(table, path, "png16", {"encoding": "uint16 code / 65535, linear (no transfer function)",
-                                    "channels_in_file": "RGB (B = 0)" if len(table.channels) == 2 else "as table"})
+    _sidecar(
+        table,
+        path,
+        "png16",
+        {
+            "encoding": "uint16 code / 65535, linear (no transfer function)",
+            "channels_in_file": "RGB (B = 0)" if len(table.channels) == 2 else "as table",
+        },
+    )
     return path
 
 
 def write_dds(table: Table, path, dtype: str = "float32") -> Path:
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write_bytes(path, dds.encode(pixels))
     fmt = dds.DXGI_NAMES[dds.DXGI[(dtype, 4 if pixels.shape[-1] == 3 else pixels.shape[-1])]]
@@ -109,7 +133,7 @@ def write_dds(table: Table, path, dtype: str = "float32") -> Path:
 def write_ktx2(table: Table, path, dtype: str = "float32", array: bool = False) -> Path:
     from .. import __version__
 
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write_bytes(path, ktx2.encode(pixels, metadata(table), array=array, writer=f"lutbake {__version__}"))
     _sidecar(table, path, "ktx2", {"array": array})
@@ -127,27 +151,39 @@ def header_text(table: Table, dtype: str = "float32") -> str:
     element ((z * HEIGHT + y) * WIDTH + x) * CHANNELS + c."""
     from .. import __version__
 
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     ident = _c_ident(table.name)
     macro = ident.upper()
     dims = pixels.shape
-    lines = [f"/* {table.name}.h -- generated by lutbake {__version__}; do not edit.", " *",
-             f" * kind: {table.kind}",
-             f" * array: {ident}[" + " * ".join(str(n) for n in dims) + "], flat: element "
-             + ("((z * H + y) * W + x) * C + c" if pixels.ndim == 4 else "(y * W + x) * C + c")
-             + " (rows y, columns x, channels c)",
-             " * row 0 = table row 0 (y index 0); column 0 = x index 0. Upload row 0 first (OpenGL: t = 0 at row 0).",
-             " * values: " + ("IEEE 754 binary16 bit patterns (uint16_t); upload as GL_HALF_FLOAT / DXGI *_FLOAT"
-                              if dtype == "half" else "float32"),
-             " *", " * axes:"]
+    lines = [
+        f"/* {table.name}.h -- generated by lutbake {__version__}; do not edit.",
+        " *",
+        f" * kind: {table.kind}",
+        f" * array: {ident}["
+        + " * ".join(str(n) for n in dims)
+        + "], flat: element "
+        + ("((z * H + y) * W + x) * C + c" if pixels.ndim == 4 else "(y * W + x) * C + c")
+        + " (rows y, columns x, channels c)",
+        " * row 0 = table row 0 (y index 0); column 0 = x index 0. Upload row 0 first (OpenGL: t = 0 at row 0).",
+        " * values: "
+        + (
+            "IEEE 754 binary16 bit patterns (uint16_t); upload as GL_HALF_FLOAT / DXGI *_FLOAT"
+            if dtype == "half"
+            else "float32"
+        ),
+        " *",
+        " * axes:",
+    ]
     for ax in table.axes:
         d = ax.describe()
-        lines += [f" *   {d['name']}: {d['dim']} ({d['image']}), count {d['count']}, texel {d['texel']} "
-                  f"({d['texel_formula']}), order {d['order']}",
-                  f" *     mapping {d['mapping']}: {d['mapping_formula']}"
-                  + (f", clamped to {d['clamp']}" if d.get("clamp") else ""),
-                  f" *     index 0 = {d['values'][0]:.9g}, index {d['count'] - 1} = {d['values'][-1]:.9g}",
-                  f" *     sample at {d['uv_formula']}"]
+        lines += [
+            f" *   {d['name']}: {d['dim']} ({d['image']}), count {d['count']}, texel {d['texel']} "
+            f"({d['texel_formula']}), order {d['order']}",
+            f" *     mapping {d['mapping']}: {d['mapping_formula']}"
+            + (f", clamped to {d['clamp']}" if d.get("clamp") else ""),
+            f" *     index 0 = {d['values'][0]:.9g}, index {d['count'] - 1} = {d['values'][-1]:.9g}",
+            f" *     sample at {d['uv_formula']}",
+        ]
     lines += [" * channels:"] + [f" *   {c} = {n}: {m}" for c, (n, m) in zip("RGBA", table.channels.items())]
     lines += [" * reconstruction:", f" *   {table.reconstruction}", " *", " * provenance:"]
     for k in ("terms", "estimator", "samples", "seed", "version", "warp_version"):
@@ -169,7 +205,7 @@ def header_text(table: Table, dtype: str = "float32") -> str:
         items = [f"{float(x):.9g}f" for x in flat]
         items = [s if ("." in s or "e" in s) else s[:-1] + ".0f" for s in items]
     per_line = 12
-    rows = [", ".join(items[i:i + per_line]) for i in range(0, len(items), per_line)]
+    rows = [", ".join(items[i : i + per_line]) for i in range(0, len(items), per_line)]
     size = " * ".join(f"{macro}_{n}" for n in names)
     body += f"\nstatic const {ctype} {ident}[{size}] = {{\n    "
     body += ",\n    ".join(rows) + "\n};\n"
@@ -189,8 +225,15 @@ def write_openpbr(table: Table, path, dtype: str = "float32") -> Path:
     return write_openpbr_header(table, path, dtype)
 
 
-WRITERS = {"exr": write_exr, "npy": write_npy, "png16": write_png16, "dds": write_dds, "ktx2": write_ktx2,
-           "h": write_header, "openpbr_h": write_openpbr}
+WRITERS = {
+    "exr": write_exr,
+    "npy": write_npy,
+    "png16": write_png16,
+    "dds": write_dds,
+    "ktx2": write_ktx2,
+    "h": write_header,
+    "openpbr_h": write_openpbr,
+}
 
 
 def output_path(out_dir, name: str, fmt: str) -> Path:

@@ -2,12 +2,14 @@
 
 The integrand (lutbake.integrands.dielectric) is a function of h = (theta_h, phi) that is analytic except on a few
 curves where a lobe's support ends or the Fresnel term has a square-root kink. As the ``dfg`` estimator splits at
-the reflection horizon (lutbake.sampling.estimators, docs/estimators.md), this one integrates every smooth piece over
-its exact domain. With v = (sin theta_v, 0, cos theta_v), c = v.h = cos(theta_v) cos(theta_h) + sin(theta_v) sin(theta_h)
+the reflection horizon (lutbake.sampling.hemisphere, docs/estimators.md), this one integrates every smooth piece over
+its exact domain. With v = (sin theta_v, 0, cos theta_v),
+c = v.h = cos(theta_v) cos(theta_h) + sin(theta_v) sin(theta_h)
 cos(phi) grows with cos(phi), and each curve is a breakpoint in phi at every theta_h, in closed form:
     phi_l  n.l = 0 (reflection horizon):   cos(phi) = c* = -cos(theta_v) cos(2 theta_h) / (sin(theta_v) sin(2 theta_h))
     phi_0  v.h = 0 (end of the visible normals): cos(phi) = -cot(theta_v) cot(theta_h)
-    phi_c  v.h = cos(theta_c) = sqrt(1 - eta^2), eta < 1 (TIR; F's sqrt kink): cos(phi) = (cos theta_c - mu cos theta_h) / (sin theta_v sin theta_h)
+    phi_c  v.h = cos(theta_c) = sqrt(1 - eta^2), eta < 1 (TIR; F's sqrt kink):
+           cos(phi) = (cos theta_c - mu cos theta_h) / (sin theta_v sin theta_h)
     phi_t  n.t = 0, eta < 1 (refraction horizon): t on the horizon at azimuth psi has h = (v + eta t) / |v + eta t|, so
            cos(theta_h) = mu / sqrt(1 + eta^2 + 2 eta sin(theta_v) cos(psi)) gives psi, and phi_t = atan2(eta sin psi,
            sin theta_v + eta cos psi) (a valid refraction pair needs v.t < -eta)
@@ -25,24 +27,46 @@ Every outer panel is smoothstep-mapped (removes the square-root ends). Inner pan
 phi-breakpoints: a panel ending at a horizon (phi_l or phi_t) uses the sinh map of the dfg estimator towards it
 (G2 has a pole at n.o = -alpha / (1 + 2 Lambda(v)) just past the cut), with x -> x^2 at its lower end when that end is a
 kink; the other panels are smoothstep-mapped.
-Per texel: n.v, alpha and the relative IOR eta (the kernel's ``param``); GL nodes/weights on [0, 1] for the outer and
-inner variables (lutbake.tables.specular.point_arrays). float64 accumulation, float32 terms.
+Per texel: (n.v, alpha, eta) (eta = the kernel's ``param``); GL (node, weight) rules on [0, 1] for the outer and
+inner variables. float64 accumulation, float32 terms. alpha = 0 takes the integrand's closed-form mirror limit.
+``DielectricGaussLegendre`` is this quadrature as an estimator of the lutbake.sampling.plan protocol; the QMC
+estimators of lutbake.sampling.hemisphere serve as the second estimator unchanged (the integrand lives in the same
+half-vector measure).
 """
+
 from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
 
 import warp as wp
 
-from ..terms.frame import view_dir
-from .estimators import PANEL_RATIO, PI64, asinh64, horizon_scale, next_geometric
+from .arrays import Rows64, Rule
+from .hemisphere import (
+    PANEL_RATIO,
+    PI64,
+    GaussLegendre,
+    asinh64,
+    facet_weight_for,
+    next_geometric,
+    outer_variable_for,
+    store_row,
+    texel_view,
+)
 
+ZERO64 = wp.constant(wp.float64(0.0))
+ONE64 = wp.constant(wp.float64(1.0))
+TWO64 = wp.constant(wp.float64(2.0))
+HALF64 = wp.constant(wp.float64(0.5))
 MAX_PANELS = 96  # outer panels per texel (a guard; grazing texels at the smallest alpha use ~30)
 vec4d = wp.types.vector(length=4, dtype=wp.float64)
 vec7d = wp.types.vector(length=7, dtype=wp.float64)
 
 
 @wp.func
-def next_theta_dielectric(t_lo: wp.float64, theta_a: wp.float64, theta_b: wp.float64, theta_peak: wp.float64,
-                          kinks: vec7d):
+def next_theta_dielectric(
+    t_lo: wp.float64, theta_a: wp.float64, theta_b: wp.float64, theta_peak: wp.float64, kinks: vec7d
+):
     """Upper edge of the outer panel starting at t_lo: the smallest candidate above t_lo among the NDF-peak points
     theta_peak R^j, the horizon grading (theta_a R^j below pi/4; pi/2 - (pi/2 - t_lo)/R up to theta_b) and the kinks."""
     quarter = PI64 * wp.float64(0.25)
@@ -100,8 +124,9 @@ def phi_refraction_horizon(cos_v: wp.float64, sin_v: wp.float64, cos_h: wp.float
 
 
 @wp.func
-def dnot_dphi(cos_v: wp.float64, sin_v: wp.float64, cos_h: wp.float64, sin_h: wp.float64, phi: wp.float64,
-              eta: wp.float64):
+def dnot_dphi(
+    cos_v: wp.float64, sin_v: wp.float64, cos_h: wp.float64, sin_h: wp.float64, phi: wp.float64, eta: wp.float64
+):
     """|d(n.t)/dphi| at phi: n.t = (c/eta - cos theta_t) cos theta_h - mu/eta with c = v.h (module docstring)."""
     c = cos_v * cos_h + sin_v * sin_h * wp.cos(phi)
     ct = wp.sqrt(wp.max(wp.float64(1.0) - (wp.float64(1.0) - c * c) / (eta * eta), wp.float64(1.0e-300)))
@@ -109,108 +134,83 @@ def dnot_dphi(cos_v: wp.float64, sin_v: wp.float64, cos_h: wp.float64, sin_h: wp
     return wp.abs(dc * cos_h * (wp.float64(1.0) / eta - c / (eta * eta * ct)))
 
 
-def make_gauss_legendre_dielectric(integrand, pdf, tan2_from_u, u_from_tan2, vec_type, acc_type):
-    """The kernel (module docstring). Same inputs as lutbake.sampling.estimators.make_gauss_legendre (param = eta)."""
-    nch = vec_type._length_
+def make_gauss_legendre_dielectric(spec):
+    """The kernel (module docstring) for an integrand record (lutbake.integrands.dielectric.dielectric_integrand).
+    Inputs as lutbake.sampling.hemisphere.make_gauss_legendre: texel (n.v, alpha, eta), rule_u, rule_p, out."""
+    acc_type, mirror = spec.acc, spec.mirror
+    d = spec.distribution
+    outer_range, outer_node = outer_variable_for(d.tan2_from_u, d.u_from_tan2)
+    facet_weight = facet_weight_for(spec.g, d.pdf_ndf)
+    nch = spec.vec._length_
 
     @wp.kernel(enable_backward=False, module="unique")
-    def gauss_legendre_dielectric_kernel(
-        nov: wp.array(dtype=float),
-        alpha: wp.array(dtype=float),
-        param: wp.array(dtype=float),
-        xu: wp.array(dtype=wp.float64),
-        wu: wp.array(dtype=wp.float64),
-        xp: wp.array(dtype=wp.float64),
-        wq: wp.array(dtype=wp.float64),
-        out: wp.array2d(dtype=wp.float64),
-    ):
+    def gauss_legendre_dielectric_kernel(texel: wp.array(dtype=wp.vec3), rule_u: Rule, rule_p: Rule, out: Rows64):
         i = wp.tid()
-        a = alpha[i]
-        eta_f = param[i]
-        a64 = wp.float64(a)
+        v, a, eta_f, a64, cos_v, sin_v, eps_l, theta_a, theta_b, theta_peak = texel_view(texel[i])
         eta = wp.float64(eta_f)
-        v = view_dir(nov[i])
-        cos_v = wp.float64(v[2])
-        sin_v = wp.float64(v[0])
-        zero = wp.float64(0.0)
-        one = wp.float64(1.0)
-        two = wp.float64(2.0)
-        half = PI64 * wp.float64(0.5)
-        inside = eta < one
-        eps_l = horizon_scale(cos_v, a64)
+        half = PI64 * HALF64
+        inside = eta < ONE64
         theta_v = wp.atan2(sin_v, cos_v)
-        theta_a = wp.float64(0.5) * wp.atan2(cos_v, sin_v)  # c* = -1
-        theta_b = half - theta_a  # c* = +1
-        theta_peak = wp.atan(a64)
-        cos_c = zero  # cos of the critical angle (eta < 1)
-        kinks = vec7d(two * theta_a, -one, -one, -one, -one, -one, -one)
+        cos_c = ZERO64  # cos of the critical angle (eta < 1)
+        kinks = vec7d(TWO64 * theta_a, -ONE64, -ONE64, -ONE64, -ONE64, -ONE64, -ONE64)
         if inside:
-            cos_c = wp.sqrt(one - eta * eta)
+            cos_c = wp.sqrt(ONE64 - eta * eta)
             theta_c = wp.asin(eta)
             kinks[1] = wp.abs(theta_c - theta_v)
             kinks[2] = theta_v + theta_c
-            kinks[3] = acos_clamped(cos_v / wp.sqrt(one + eta * eta + two * eta * sin_v))
-            kinks[4] = acos_clamped(cos_v / wp.sqrt(wp.max(one + eta * eta - two * eta * sin_v, wp.float64(1.0e-300))))
+            kinks[3] = acos_clamped(cos_v / wp.sqrt(ONE64 + eta * eta + TWO64 * eta * sin_v))
+            kinks[4] = acos_clamped(
+                cos_v / wp.sqrt(wp.max(ONE64 + eta * eta - TWO64 * eta * sin_v, wp.float64(1.0e-300)))
+            )
             if cos_v < cos_c:  # phi_t meets phi_c: the horizon t with v.t = -eta
                 kinks[5] = wp.acos(cos_v / cos_c)
-            if cos_v < two * cos_c:  # phi_c meets phi_l: F's kink reaches the reflection horizon
-                kinks[6] = wp.acos(cos_v / (two * cos_c))
+            if cos_v < TWO64 * cos_c:  # phi_c meets phi_l: F's kink reaches the reflection horizon
+                kinks[6] = wp.acos(cos_v / (TWO64 * cos_c))
         acc = acc_type()
-        t_lo = zero
-        n_panels = int(0)
+        t_lo = ZERO64
+        if a <= 0.0:  # alpha -> 0: the closed-form mirror limit below (lutbake.edge), no quadrature
+            t_lo = half
+        n_panels = wp.int32(0)  # a dynamic variable (a literal 0 is a constant to Warp)
         while t_lo < half and n_panels < MAX_PANELS:
             t_hi = next_theta_dielectric(t_lo, theta_a, theta_b, theta_peak, kinks)
             n_panels += 1
             in_u = t_hi <= theta_peak
-            x_lo = t_lo
-            x_hi = t_hi
-            if in_u:
-                x_lo = u_from_tan2(wp.tan(t_lo) * wp.tan(t_lo), a64)
-                x_hi = u_from_tan2(wp.tan(t_hi) * wp.tan(t_hi), a64)
-            dx = x_hi - x_lo
-            for k in range(xu.shape[0]):
-                s = xu[k]
-                x = x_lo + dx * s * s * (wp.float64(3.0) - two * s)  # smoothstep
-                wk = wu[k] * dx * wp.float64(6.0) * s * (one - s)
-                cos_h = wp.cos(x)
-                sin_h = wp.sin(x)
-                if in_u:
-                    tan2 = tan2_from_u(x, a64)
-                    cos_h = one / wp.sqrt(one + tan2)
-                    sin_h = wp.sqrt(tan2) * cos_h
-                else:
-                    wk = wk * two * PI64 * sin_h  # du = 2 pi D cos sin dtheta, and g / p = g / (D cos)
+            x_lo, dx = outer_range(t_lo, t_hi, in_u, a64)
+            for k in range(rule_u.shape[0]):
+                s = rule_u[k][0]
+                x = x_lo + dx * s * s * (wp.float64(3.0) - TWO64 * s)  # smoothstep
+                cos_h, sin_h, wk = outer_node(x, rule_u[k][1] * dx * wp.float64(6.0) * s * (ONE64 - s), in_u, a64)
                 # phi-breakpoints at this theta_h (module docstring)
                 den = sin_v * sin_h
                 phi_l = PI64
                 phi_0 = PI64
                 phi_c = PI64
-                phi_t = -one
+                phi_t = -ONE64
                 if den > wp.float64(1.0e-300):
-                    c_star = -cos_v * (cos_h * cos_h - sin_h * sin_h) / (two * den * cos_h)
+                    c_star = -cos_v * (cos_h * cos_h - sin_h * sin_h) / (TWO64 * den * cos_h)
                     phi_l = acos_clamped(c_star)
                     phi_0 = acos_clamped(-cos_v * cos_h / den)
                     if inside:
                         phi_c = acos_clamped((cos_c - cos_v * cos_h) / den)
                 else:  # normal view: v.h = cos(theta_h), n.l > 0 iff theta_h < pi/4, for every phi
-                    if cos_h * cos_h - sin_h * sin_h <= zero:
-                        phi_l = zero
+                    if cos_h * cos_h - sin_h * sin_h <= ZERO64:
+                        phi_l = ZERO64
                     if inside and cos_h <= cos_c:
-                        phi_c = zero
+                        phi_c = ZERO64
                 if inside:
                     phi_t = phi_refraction_horizon(cos_v, sin_v, cos_h, eta)
                     if phi_t > phi_c:
-                        phi_t = -one
+                        phi_t = -ONE64
                 phi_tr = phi_0
                 if inside:
                     phi_tr = phi_c
-                    if phi_t >= zero:
+                    if phi_t >= ZERO64:
                         phi_tr = phi_t
                 phi_end = wp.max(phi_l, phi_tr)
-                if phi_end <= zero:
+                if phi_end <= ZERO64:
                     continue
                 brk = sort4(vec4d(phi_l, phi_0, phi_c, phi_t))
-                p_lo = zero
+                p_lo = ZERO64
                 for m in range(5):
                     p_hi = phi_end
                     if m < 4:
@@ -219,43 +219,53 @@ def make_gauss_legendre_dielectric(integrand, pdf, tan2_from_u, u_from_tan2, vec
                         continue
                     dp = p_hi - p_lo
                     horizon_end = (p_hi == phi_l and phi_l < PI64) or (p_hi == phi_t)
-                    kink_lo = p_lo > zero
+                    kink_lo = p_lo > ZERO64
                     eps = PI64
                     if horizon_end:
-                        slope = two * cos_h * sin_v * sin_h * wp.max(wp.sin(p_hi), wp.float64(1.0e-12))
+                        slope = TWO64 * cos_h * sin_v * sin_h * wp.max(wp.sin(p_hi), wp.float64(1.0e-12))
                         if p_hi == phi_t:
                             slope = wp.max(dnot_dphi(cos_v, sin_v, cos_h, sin_h, p_hi, eta), wp.float64(1.0e-12))
                         eps = wp.max(eps_l / slope, wp.float64(1.0e-12))
                     big_a = asinh64(dp / eps)
-                    for j in range(xp.shape[0]):
-                        y = xp[j]
-                        wy = wq[j]
+                    for j in range(rule_p.shape[0]):
+                        y = rule_p[j][0]
+                        wy = rule_p[j][1]
                         phi = p_lo
                         w = wk
                         if horizon_end:
                             if kink_lo:
-                                wy = wy * two * y
+                                wy = wy * TWO64 * y
                                 y = y * y
                             # sinh map (Johnston & Elliott 2005) towards p_hi: phi = p_hi - eps sinh(A (1 - y))
-                            arg = big_a * (one - y)
+                            arg = big_a * (ONE64 - y)
                             phi = p_hi - eps * wp.sinh(arg)
                             w = wk * wy * eps * wp.cosh(arg) * big_a
                         else:
-                            phi = p_lo + dp * y * y * (wp.float64(3.0) - two * y)
-                            w = wk * wy * dp * wp.float64(6.0) * y * (one - y)
+                            phi = p_lo + dp * y * y * (wp.float64(3.0) - TWO64 * y)
+                            w = wk * wy * dp * wp.float64(6.0) * y * (ONE64 - y)
                         h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
-                        g = integrand(v, h, a, eta_f)
-                        if in_u:
-                            p = pdf(v, h, a)
-                            if p > 0.0:
-                                for c in range(wp.static(nch)):
-                                    acc[c] = acc[c] + w * wp.float64(g[c] / p)
-                        else:
-                            for c in range(wp.static(nch)):
-                                acc[c] = acc[c] + w * wp.float64(g[c])
+                        gw = facet_weight(v, h, a, eta_f, in_u)
+                        for c in range(wp.static(nch)):
+                            acc[c] = acc[c] + w * wp.float64(gw[c])
                     p_lo = p_hi
             t_lo = t_hi
         for c in range(wp.static(nch)):
             out[i, c] = acc[c] / PI64
+        if a <= 0.0:  # the mirror limit (lutbake.edge)
+            store_row(out, i, mirror(v, eta_f))
 
     return gauss_legendre_dielectric_kernel
+
+
+@functools.lru_cache(maxsize=None)
+def gl_dielectric_kernel(spec):
+    return make_gauss_legendre_dielectric(spec)
+
+
+@dataclass(frozen=True)
+class DielectricGaussLegendre(GaussLegendre):
+    """The ``gauss_legendre`` estimator of the dielectric kinds (lutbake.sampling.hemisphere.GaussLegendre with this
+    module's kernel): order n = gl_order(budget) per panel in both variables; the panel count varies per texel."""
+
+    def _kernel(self, integrand):
+        return gl_dielectric_kernel(integrand)

@@ -10,6 +10,7 @@ Walter et al. 2007, Eq. 22, valid for any relative eta > 0 (it returns 1 under t
 Edge policy (lutbake.edge): every term returns 0 (or the zero vector) for back-facing or grazing inputs
 (cosines <= COS_EPS) and under total internal reflection; nothing divides by an unchecked cosine.
 """
+
 import warp as wp
 
 from ..edge import COS_EPS
@@ -66,8 +67,9 @@ def f_dielectric_reflection(D: float, G2: float, F: float, NoI: float, NoO: floa
 
 
 @wp.func
-def f_dielectric_transmission(D: float, G2: float, F: float, NoI: float, NoO: float, IoH: float, OoH: float,
-                              eta: float):
+def f_dielectric_transmission(
+    D: float, G2: float, F: float, NoI: float, NoO: float, IoH: float, OoH: float, eta: float
+):
     """BTDF part of the rough dielectric BSDF (Walter et al. 2007, Eq. 21), eta_i = 1, eta_o = eta:
     f_t = |i.h||o.h| eta_o^2 (1 - F(i.h)) D(h) G2 / (|n.i||n.o| (eta_i i.h + eta_o o.h)^2), h = h_t.
     Arguments are absolute cosines except IoH, OoH (signed: a transmission pair has i.h > 0 > o.h).

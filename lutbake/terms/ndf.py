@@ -5,6 +5,7 @@ Every D is normalised so that the projected microfacet area is one, ∫ D(m) (n.
 are the inverse and forward CDFs of the polar angle under the density D(m)(n.m) (float64: they feed
 quadrature breakpoints where 1 - u underflows float32 for small alpha).
 """
+
 import warp as wp
 
 from ..edge import COS_EPS
@@ -66,21 +67,30 @@ def u_from_tan2_beckmann(tan2: wp.float64, alpha: wp.float64):
 
 
 @wp.func
-def sample_vndf_ggx(v: wp.vec3, alpha: float, u1: float, u2: float):
-    """Visible-normal sample of isotropic GGX by spherical caps (Dupuy & Benyoub 2023, Listing 3;
-    equivalent to Heitz 2018). Density: pdf(h) = G1(v) max(0, v.h) D(h) / (n.v)."""
-    vh = wp.normalize(wp.vec3(alpha * v[0], alpha * v[1], v[2]))
+def sample_vndf_ggx_aniso(v: wp.vec3, alpha_x: float, alpha_y: float, u1: float, u2: float):
+    """Visible-normal sample of anisotropic GGX (Heitz 2018, JCGT 7(4); spherical caps, Dupuy & Benyoub 2023):
+    stretch v by (ax, ay, 1), sample the visible hemisphere, unstretch. pdf = G1(v) max(0, v.h) D(h) / (n.v)."""
+    vh = wp.normalize(wp.vec3(alpha_x * v[0], alpha_y * v[1], v[2]))
     phi = 2.0 * wp.pi * u1
     z = (1.0 - u2) * (1.0 + vh[2]) - vh[2]
     s = wp.sqrt(wp.clamp(1.0 - z * z, 0.0, 1.0))
     nh = wp.vec3(s * wp.cos(phi), s * wp.sin(phi), z) + vh
-    return wp.normalize(wp.vec3(alpha * nh[0], alpha * nh[1], wp.max(nh[2], 0.0)))
+    return wp.normalize(wp.vec3(alpha_x * nh[0], alpha_y * nh[1], wp.max(nh[2], 0.0)))
+
+
+@wp.func
+def sample_vndf_ggx(v: wp.vec3, alpha: float, u1: float, u2: float):
+    """Visible-normal sample of isotropic GGX by spherical caps (Dupuy & Benyoub 2023, Listing 3;
+    equivalent to Heitz 2018): the anisotropic sampler at alpha_x = alpha_y = alpha.
+    Density: pdf(h) = G1(v) max(0, v.h) D(h) / (n.v)."""
+    return sample_vndf_ggx_aniso(v, alpha, alpha, u1, u2)
 
 
 # --- normalized Blinn-Phong ---------------------------------------------------------------------------
 # Shininess s <-> alpha: alpha = sqrt(2 / (s + 2)), s = 2 / alpha^2 - 2 (Walter et al. 2007, Sec. 5.2; the
 # lecture's "roughness = sqrt(2 / (2 + shininess))"): with it Blinn-Phong and Beckmann of the same alpha nearly
 # coincide, and (s + 2) / (2 pi) = 1 / (pi alpha^2).
+
 
 @wp.func
 def log1p64(x: wp.float64):
@@ -141,6 +151,7 @@ def u_from_tan2_blinn_phong(tan2: wp.float64, alpha: wp.float64):
 
 # --- anisotropic GGX (Heitz 2014, JCGT 3(2), Eq. 85; tangent = +x, bitangent = +y) -----------------------
 
+
 @wp.func
 def D_ggx_aniso(h: wp.vec3, alpha_x: float, alpha_y: float):
     """Anisotropic GGX: D = 1 / (pi ax ay ((h.x/ax)^2 + (h.y/ay)^2 + (h.z)^2)^2); 0 for n.h <= 0.
@@ -153,19 +164,8 @@ def D_ggx_aniso(h: wp.vec3, alpha_x: float, alpha_y: float):
     return INV_PI / (alpha_x * alpha_y * d * d)
 
 
-@wp.func
-def sample_vndf_ggx_aniso(v: wp.vec3, alpha_x: float, alpha_y: float, u1: float, u2: float):
-    """Visible-normal sample of anisotropic GGX (Heitz 2018, JCGT 7(4); spherical caps, Dupuy & Benyoub 2023):
-    stretch v by (ax, ay, 1), sample the visible hemisphere, unstretch. pdf = G1(v) max(0, v.h) D(h) / (n.v)."""
-    vh = wp.normalize(wp.vec3(alpha_x * v[0], alpha_y * v[1], v[2]))
-    phi = 2.0 * wp.pi * u1
-    z = (1.0 - u2) * (1.0 + vh[2]) - vh[2]
-    s = wp.sqrt(wp.clamp(1.0 - z * z, 0.0, 1.0))
-    nh = wp.vec3(s * wp.cos(phi), s * wp.sin(phi), z) + vh
-    return wp.normalize(wp.vec3(alpha_x * nh[0], alpha_y * nh[1], wp.max(nh[2], 0.0)))
-
-
 # --- Ashikhmin-Shirley 2000 ("An anisotropic Phong BRDF model", JGT 5(2)) -------------------------------
+
 
 @wp.func
 def D_ashikhmin_shirley(h: wp.vec3, nu: float, nv: float):

@@ -11,6 +11,7 @@ variables), with panels graded geometrically towards every point where the integ
 (the NDF peak) or loses smoothness (a cut where v.m = 0), and the term values come from the Warp
 ``@wp.func``s themselves (:mod:`.probe`).
 """
+
 from __future__ import annotations
 
 import functools
@@ -19,9 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..edge import ALPHA_MIN, NOV_MIN
+from ..integrands.specular import hemisphere_integral
 from ..sampling import points
-from ..tables import specular
-from ..terms.sets import NDFS, SMITH_NDFS
+from ..terms.distributions import NDFS, SMITH_NDFS
 from .probe import BRDF_PAIRS, evaluate_brdfs, evaluate_terms
 
 # Tolerances (absolute unless said otherwise). The terms run in float32: ~1e-7 is the floor.
@@ -53,7 +54,11 @@ KC_FURNACE_TOL_SMOOTHEST = 5.0e-3  # every row
 
 # Grids.
 PROJECTED_AREA_ALPHAS = (1.0e-3, 1.0e-2, 0.1, 0.5, 1.0)
-ANISOTROPIES = (0.5, 1.0, -1.0)  # with PROJECTED_AREA_ALPHAS, through the Burley mapping (tables.aniso.alpha_xy)
+ANISOTROPIES = (
+    0.5,
+    1.0,
+    -1.0,
+)  # with PROJECTED_AREA_ALPHAS, through the Burley mapping (integrands.anisotropic.alpha_xy)
 ANISO_FURNACE_NOVS = (0.1, 0.5, 1.0)
 ANISO_FURNACE_PHIS = (0.0, np.pi / 4, np.pi / 2)
 ANISO_FURNACE_ALPHAS = (1.0e-2, 0.3)
@@ -64,8 +69,12 @@ FURNACE_ALPHAS = (1.0e-3, 1.0e-2, 0.1, 0.5, 1.0)
 ALBEDO_COUNT = 24  # texel-centre grid in n.v and perceptual roughness, plus the clamped edges
 MIRROR_NOVS = tuple(np.linspace(0.05, 1.0, 20))  # below ~0.05, Lambda(alpha = 1e-4) is not yet negligible
 ALBEDO_MASKINGS = ("smith_height_correlated", "smith_separable")
-DFG_MIRROR_PAIRS = (("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"), ("beckmann", "v_cavity"),
-                    ("blinn_phong", "v_cavity"))
+DFG_MIRROR_PAIRS = (
+    ("ggx", "smith_height_correlated"),
+    ("beckmann", "smith_separable"),
+    ("beckmann", "v_cavity"),
+    ("blinn_phong", "v_cavity"),
+)
 RECIPROCITY_SAMPLES = 4096
 ESTIMATOR_TEXELS = ((0.1, 0.04), (0.3, 1.0), (0.5, 0.25), (0.9, 0.64), (1.0, 0.01))  # (n.v, alpha)
 ESTIMATOR_QMC_SAMPLES = 1 << 16
@@ -96,6 +105,7 @@ def _result(name: str, measured: float, tolerance: float, detail: str) -> CheckR
 
 # --- quadrature helpers --------------------------------------------------------------------------
 
+
 def _graded_edges(lo: float, hi: float, anchors: list[tuple[float, float]]) -> np.ndarray:
     """Panel edges on [lo, hi]: the ends, every anchor a, and a +- first * PANEL_RATIO^j inside [lo, hi]
     for each (a, first) in ``anchors``."""
@@ -125,32 +135,33 @@ def _h(theta: np.ndarray, phi: np.ndarray | float = 0.0) -> np.ndarray:
 
 # --- NDF normalisation -----------------------------------------------------------------------------
 
+
 def ndf_projected_area_is_one(ndf_name: str) -> CheckResult:
     """∫ D(m)(n.m) dω_m = 2 pi ∫_0^{pi/2} D(theta) cos(theta) sin(theta) dtheta = 1 (Walter et al. 2007, Eq. 4),
     composite GL in theta, panels graded geometrically from the pole at the NDF's scale atan(alpha)."""
+    err, detail = _projected_area(f"D_{ndf_name}", lambda alpha: (0.0, np.arctan(alpha) / 16.0))
+    return _result(f"ndf_projected_area_is_one[{ndf_name}]", err, PROJECTED_AREA_TOL, detail)
+
+
+def _projected_area(term: str, grade_at) -> tuple[float, str]:
+    """max over PROJECTED_AREA_ALPHAS of |2 pi ∫ D cos sin dtheta - 1| for the term ``term``, by composite GL with
+    panels graded towards grade_at(alpha) = (point, scale); and the check's detail line."""
     errors = []
     for alpha in PROJECTED_AREA_ALPHAS:
-        theta, w = _composite_gl(_graded_edges(0.0, np.pi / 2, [(0.0, np.arctan(alpha) / 16.0)]))
-        D = evaluate_terms(h=_h(theta), alpha=alpha)[f"D_{ndf_name}"].astype(np.float64)
+        theta, w = _composite_gl(_graded_edges(0.0, np.pi / 2, [grade_at(alpha)]))
+        D = evaluate_terms(h=_h(theta), alpha=alpha)[term].astype(np.float64)
         errors.append(abs(2.0 * np.pi * np.sum(w * D * np.cos(theta) * np.sin(theta)) - 1.0))
     k = int(np.argmax(errors))
-    return _result(f"ndf_projected_area_is_one[{ndf_name}]", errors[k], PROJECTED_AREA_TOL,
-                   f"max |∫D(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS}; worst at alpha={PROJECTED_AREA_ALPHAS[k]}")
+    where = f"worst at alpha={PROJECTED_AREA_ALPHAS[k]}"
+    return errors[k], f"max |∫{term}(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS}; {where}"
 
 
 def charlie_projected_area_is_one() -> CheckResult:
     """The Charlie sheen NDF (Estevez & Kulla 2017), D = (2 + 1/alpha) sin(theta)^(1/alpha) / (2 pi), is
     normalised in projected area: 2 pi ∫ D cos sin dtheta = 1. Its mass sits within ~sqrt(alpha) of the
     horizon, so the panels are graded towards theta = pi/2."""
-    errors = []
-    for alpha in PROJECTED_AREA_ALPHAS:
-        theta, w = _composite_gl(_graded_edges(0.0, np.pi / 2, [(np.pi / 2, np.sqrt(alpha) / 16.0)]))
-        D = evaluate_terms(h=_h(theta), alpha=alpha)["D_charlie"].astype(np.float64)
-        errors.append(abs(2.0 * np.pi * np.sum(w * D * np.cos(theta) * np.sin(theta)) - 1.0))
-    k = int(np.argmax(errors))
-    return _result("ndf_projected_area_is_one[charlie]", errors[k], CHARLIE_AREA_TOL,
-                   f"max |∫D_charlie(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS}; worst at "
-                   f"alpha={PROJECTED_AREA_ALPHAS[k]}")
+    err, detail = _projected_area("D_charlie", lambda alpha: (np.pi / 2, np.sqrt(alpha) / 16.0))
+    return _result("ndf_projected_area_is_one[charlie]", err, CHARLIE_AREA_TOL, detail)
 
 
 def weak_white_furnace(ndf_name: str) -> CheckResult:
@@ -185,14 +196,14 @@ def weak_white_furnace(ndf_name: str) -> CheckResult:
             errors.append(abs(integral - nov))
             where.append((nov, alpha))
     k = int(np.argmax(errors))
-    return _result(f"weak_white_furnace[{ndf_name}]", errors[k], WEAK_FURNACE_TOL,
-                   f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over n.v in {FURNACE_NOVS} x alpha in {FURNACE_ALPHAS}; "
-                   f"worst at (n.v, alpha)={where[k]}")
+    grid = f"n.v in {FURNACE_NOVS} x alpha in {FURNACE_ALPHAS}"
+    detail = f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over {grid}; worst at (n.v, alpha)={where[k]}"
+    return _result(f"weak_white_furnace[{ndf_name}]", errors[k], WEAK_FURNACE_TOL, detail)
 
 
 def _aniso_pairs(alphas=PROJECTED_AREA_ALPHAS) -> list[tuple[float, float, float, float]]:
     """(alpha, a, alpha_x, alpha_y) through the Burley mapping of the specular_aniso kind."""
-    from ..tables.aniso import alpha_xy
+    from ..integrands.anisotropic import alpha_xy
 
     out = []
     for alpha in alphas:
@@ -232,9 +243,13 @@ def ndf_projected_area_is_one_aniso() -> CheckResult:
     alpha in PROJECTED_AREA_ALPHAS x anisotropy in ANISOTROPIES (Burley mapping); composite GL in theta graded
     from the pole at atan(min(alpha_x, alpha_y)) and in phi graded towards both axes."""
     err, where = _aniso_measure("D_ggx_aniso", lambda t: np.cos(t) * np.sin(t))
-    return _result("ndf_projected_area_is_one[ggx_aniso]", err, ANISO_AREA_TOL,
-                   f"max |∫D(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS} x anisotropy in {ANISOTROPIES}; "
-                   f"worst at (alpha, a)={where}")
+    return _result(
+        "ndf_projected_area_is_one[ggx_aniso]",
+        err,
+        ANISO_AREA_TOL,
+        f"max |∫D(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS} x anisotropy in {ANISOTROPIES}; "
+        f"worst at (alpha, a)={where}",
+    )
 
 
 def ashikhmin_shirley_density_is_one() -> CheckResult:
@@ -242,9 +257,13 @@ def ashikhmin_shirley_density_is_one() -> CheckResult:
     1 over the hemisphere (a solid-angle density: ∫ p_h dω = 1, not the projected area), for nu, nv of the
     same (alpha_x, alpha_y) pairs (nu = max(2/alpha_x^2 - 2, 0))."""
     err, where = _aniso_measure("D_ashikhmin_shirley", lambda t: np.sin(t), horizon=True)
-    return _result("ashikhmin_shirley_density_is_one", err, AS_DENSITY_TOL,
-                   f"max |∫p_h dω - 1| over alpha in {PROJECTED_AREA_ALPHAS} x anisotropy in {ANISOTROPIES}; "
-                   f"worst at (alpha, a)={where}")
+    return _result(
+        "ashikhmin_shirley_density_is_one",
+        err,
+        AS_DENSITY_TOL,
+        f"max |∫p_h dω - 1| over alpha in {PROJECTED_AREA_ALPHAS} x anisotropy in {ANISOTROPIES}; "
+        f"worst at (alpha, a)={where}",
+    )
 
 
 def weak_white_furnace_aniso() -> CheckResult:
@@ -276,9 +295,13 @@ def weak_white_furnace_aniso() -> CheckResult:
                 errors.append(abs(integral - nov))
                 where.append((nov, round(phi_v, 4), alpha, a))
     k = int(np.argmax(errors))
-    return _result("weak_white_furnace[ggx_aniso]", errors[k], ANISO_FURNACE_TOL,
-                   f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over n.v in {ANISO_FURNACE_NOVS} x phi_v in {{0, pi/4, pi/2}} "
-                   f"x alpha in {ANISO_FURNACE_ALPHAS} x anisotropy in {ANISOTROPIES}; worst at (n.v, phi_v, alpha, a)={where[k]}")
+    return _result(
+        "weak_white_furnace[ggx_aniso]",
+        errors[k],
+        ANISO_FURNACE_TOL,
+        f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over n.v in {ANISO_FURNACE_NOVS} x phi_v in {{0, pi/4, pi/2}} "
+        f"x alpha in {ANISO_FURNACE_ALPHAS} x anisotropy in {ANISOTROPIES}; worst at (n.v, phi_v, alpha, a)={where[k]}",
+    )
 
 
 def kulla_conty_residual(E: np.ndarray, E_avg: np.ndarray, mu: np.ndarray) -> np.ndarray:
@@ -298,8 +321,8 @@ def kulla_conty_white_furnace() -> CheckResult:
     KC_N_MU x KC_N_ROUGH) and ``albedo_avg`` tables and measures max |E + E_ms - 1| per roughness row
     (kulla_conty_residual). Measured: the worst row with r >= 0.1 (tolerance KC_FURNACE_TOL); the smoothest rows
     must stay within KC_FURNACE_TOL_SMOOTHEST (module constants)."""
-    from ..api import bake_table
     from ..config import validate_table
+    from ..pipeline import bake_table
 
     e = bake_table(validate_table({"name": "e", "kind": "albedo", "size": [KC_N_MU, KC_N_ROUGH]}, "<check>", 0))[0]
     avg = bake_table(validate_table({"name": "a", "kind": "albedo_avg", "roughness_size": KC_N_ROUGH}, "<check>", 0))[0]
@@ -311,19 +334,20 @@ def kulla_conty_white_furnace() -> CheckResult:
         measured = float("inf")
     loss = float(np.max(1.0 - e.data[..., 0]))
     rows = ", ".join(f"r={r:.3f}: {w:.1e}" for r, w in zip(rough, worst))
-    return _result("kulla_conty_white_furnace", measured, KC_FURNACE_TOL,
-                   f"max |E + E_ms - 1| per roughness row ({rows}); all rows <= {KC_FURNACE_TOL_SMOOTHEST:.0e}: "
-                   f"{bool(np.max(worst) <= KC_FURNACE_TOL_SMOOTHEST)}; uncompensated max loss 1 - E = {loss:.3f}")
+    return _result(
+        "kulla_conty_white_furnace",
+        measured,
+        KC_FURNACE_TOL,
+        f"max |E + E_ms - 1| per roughness row ({rows}); all rows <= {KC_FURNACE_TOL_SMOOTHEST:.0e}: "
+        f"{bool(np.max(worst) <= KC_FURNACE_TOL_SMOOTHEST)}; uncompensated max loss 1 - E = {loss:.3f}",
+    )
 
 
 # --- tables ------------------------------------------------------------------------------------------
 
-def _integrate(ndf_name: str, masking_name: str, channels: str, nov, alpha, estimator: str = "gauss_legendre",
-               samples: int | None = None) -> np.ndarray:
-    kernel = specular.kernel_for(ndf_name, masking_name, channels, estimator)
-    samples = specular.DEFAULT_SAMPLES[estimator] if samples is None else samples
-    return specular.integrate(kernel, np.asarray(nov, np.float32), np.asarray(alpha, np.float32), estimator,
-                              samples, SEED, 2)
+
+# (ndf, masking, channels, nov, alpha, estimator="gauss_legendre", samples=None) -> (N, C), at the checks' seed
+_integrate = functools.partial(hemisphere_integral, seed=SEED)
 
 
 def albedo_le_one_and_mirror_limit(ndf_name: str, masking_name: str) -> CheckResult:
@@ -339,9 +363,13 @@ def albedo_le_one_and_mirror_limit(ndf_name: str, masking_name: str) -> CheckRes
     i, j = np.unravel_index(np.argmax(E), E.shape)
     mirror = _integrate(ndf_name, masking_name, "albedo", MIRROR_NOVS, np.full(len(MIRROR_NOVS), ALPHA_MIN))[:, 0]
     mirror_err = float(np.max(np.abs(mirror - 1.0)))
-    return _result(f"albedo_le_one_and_mirror_limit[{ndf_name},{masking_name}]", max(excess, mirror_err), ALBEDO_TOL,
-                   f"max(E - 1) = {excess:.3e} at (n.v, alpha)=({N[i, j]:.4g}, {A[i, j]:.4g}) on a "
-                   f"{len(novs)}x{len(alphas)} grid; max |E(alpha={ALPHA_MIN}) - 1| = {mirror_err:.3e} for n.v in [0.05, 1]")
+    return _result(
+        f"albedo_le_one_and_mirror_limit[{ndf_name},{masking_name}]",
+        max(excess, mirror_err),
+        ALBEDO_TOL,
+        f"max(E - 1) = {excess:.3e} at (n.v, alpha)=({N[i, j]:.4g}, {A[i, j]:.4g}) on a "
+        f"{len(novs)}x{len(alphas)} grid; max |E(alpha={ALPHA_MIN}) - 1| = {mirror_err:.3e} for n.v in [0.05, 1]",
+    )
 
 
 def dfg_mirror_limit(ndf_name: str, masking_name: str) -> CheckResult:
@@ -352,9 +380,9 @@ def dfg_mirror_limit(ndf_name: str, masking_name: str) -> CheckResult:
     fc = (1.0 - nov.astype(np.float32).astype(np.float64)) ** 5
     err = np.maximum(np.abs(sb[:, 0] - (1.0 - fc)), np.abs(sb[:, 1] - fc))
     k = int(np.argmax(err))
-    return _result(f"dfg_mirror_limit[{ndf_name},{masking_name}]", err[k], DFG_MIRROR_TOL,
-                   f"max over n.v in [0.05, 1] of |scale - (1-(1-n.v)^5)|, |bias - (1-n.v)^5| at alpha={ALPHA_MIN}; "
-                   f"worst at n.v={nov[k]:.4g}")
+    what = f"|scale - (1-(1-n.v)^5)|, |bias - (1-n.v)^5| at alpha={ALPHA_MIN}"
+    detail = f"max over n.v in [0.05, 1] of {what}; worst at n.v={nov[k]:.4g}"
+    return _result(f"dfg_mirror_limit[{ndf_name},{masking_name}]", err[k], DFG_MIRROR_TOL, detail)
 
 
 def estimators_agree() -> CheckResult:
@@ -365,12 +393,17 @@ def estimators_agree() -> CheckResult:
     qmc = _integrate("ggx", "smith_height_correlated", "scale_bias", nov, alpha, "sobol_vndf", ESTIMATOR_QMC_SAMPLES)
     err = np.abs(gl - qmc)
     k = int(np.argmax(err.max(axis=1)))
-    return _result("estimators_agree", err.max(), ESTIMATOR_AGREEMENT_TOL,
-                   f"max |gauss_legendre - sobol_vndf(2^16)| over (n.v, alpha) in {ESTIMATOR_TEXELS}, "
-                   f"channels scale, bias; worst at {ESTIMATOR_TEXELS[k]}")
+    return _result(
+        "estimators_agree",
+        err.max(),
+        ESTIMATOR_AGREEMENT_TOL,
+        f"max |gauss_legendre - sobol_vndf(2^16)| over (n.v, alpha) in {ESTIMATOR_TEXELS}, "
+        f"channels scale, bias; worst at {ESTIMATOR_TEXELS[k]}",
+    )
 
 
 # --- BRDF and Fresnel identities ---------------------------------------------------------------------
+
 
 @functools.lru_cache(maxsize=1)
 def _reciprocity_brdfs() -> tuple[dict, dict]:
@@ -390,7 +423,7 @@ def _reciprocity_brdfs() -> tuple[dict, dict]:
 
 
 def reciprocity(ndf_name: str, masking_name: str) -> CheckResult:
-    """Helmholtz reciprocity f(l, v) = f(v, l) of the assembled specular BRDF (probe.brdf_for) at
+    """Helmholtz reciprocity f(l, v) = f(v, l) of the assembled specular BRDF (probe.specular_brdf_for) at
     random direction pairs (n.l, n.v biased towards grazing), alpha = r^2, r in [0.1, 1], f0 in [0, 1]."""
     fwd, bwd = _reciprocity_brdfs()
     a = fwd[(ndf_name, masking_name)].astype(np.float64)
@@ -398,8 +431,12 @@ def reciprocity(ndf_name: str, masking_name: str) -> CheckResult:
     scale = np.maximum(np.maximum(np.abs(a), np.abs(b)), np.finfo(np.float64).tiny)
     rel = np.where((a == 0.0) & (b == 0.0), 0.0, np.abs(a - b) / scale)
     nonzero = int(np.count_nonzero(a))
-    return _result(f"reciprocity[{ndf_name},{masking_name}]", rel.max(), RECIPROCITY_RTOL,
-                   f"max relative |f(l,v) - f(v,l)| over {RECIPROCITY_SAMPLES} random pairs ({nonzero} nonzero)")
+    return _result(
+        f"reciprocity[{ndf_name},{masking_name}]",
+        rel.max(),
+        RECIPROCITY_RTOL,
+        f"max relative |f(l,v) - f(v,l)| over {RECIPROCITY_SAMPLES} random pairs ({nonzero} nonzero)",
+    )
 
 
 def fresnel_eq2_is_exact_dielectric() -> CheckResult:
@@ -412,9 +449,13 @@ def fresnel_eq2_is_exact_dielectric() -> CheckResult:
     exact = evaluate_terms(eta=(1.0 + s) / (1.0 - s), cos_theta=c)["F_dielectric"].astype(np.float64)
     err = np.abs(eq2 - exact)
     i, j = np.unravel_index(np.argmax(err), err.shape)
-    return _result("fresnel_eq2_is_exact_dielectric", err.max(), FRESNEL_EQ2_TOL,
-                   f"max |F_dielectric_f0(f0, c) - F_dielectric(eta(f0), c)| on 96 f0 x 101 c; "
-                   f"worst at (f0, c)=({f0[i, 0]:.3g}, {c[0, j]:.3g})")
+    return _result(
+        "fresnel_eq2_is_exact_dielectric",
+        err.max(),
+        FRESNEL_EQ2_TOL,
+        f"max |F_dielectric_f0(f0, c) - F_dielectric(eta(f0), c)| on 96 f0 x 101 c; "
+        f"worst at (f0, c)=({f0[i, 0]:.3g}, {c[0, j]:.3g})",
+    )
 
 
 def schlick_endpoints() -> CheckResult:
@@ -424,8 +465,12 @@ def schlick_endpoints() -> CheckResult:
     at_grazing = evaluate_terms(f0=f0, cos_theta=0.0)["F_schlick"].astype(np.float64)
     err_n = np.max(np.abs(at_normal - f0.astype(np.float32)))
     err_g = np.max(np.abs(at_grazing - 1.0))
-    return _result("schlick_endpoints", max(err_n, err_g), SCHLICK_ENDPOINT_TOL,
-                   f"max |F(f0,1) - f0| = {err_n:.3e}, max |F(f0,0) - 1| = {err_g:.3e} over 101 f0 in [0, 1]")
+    return _result(
+        "schlick_endpoints",
+        max(err_n, err_g),
+        SCHLICK_ENDPOINT_TOL,
+        f"max |F(f0,1) - f0| = {err_n:.3e}, max |F(f0,0) - 1| = {err_g:.3e} over 101 f0 in [0, 1]",
+    )
 
 
 # --- microfacet diffuse (Gotanda 2014, Eq. 4) ---------------------------------------------------------
@@ -452,7 +497,7 @@ def _random_pairs(n: int, seed: int, min_cos: float = 0.0):
 def diffuse_sigma0_is_lambert_eq6() -> CheckResult:
     """At sigma = 0 (alpha = ALPHA_MIN) the microfacet diffuse BRDF (Eq. 4, facets with Eq. 6) is Lambert x Eq. 6:
     F_diff(n.l, n.v, f0) / pi, for every pair with n.l, n.v >= 0.1 (the limit needs alpha << n.x)."""
-    from ..tables.diffuse import eval_brdf
+    from ..integrands.diffuse import eval_brdf
 
     l, v = _random_pairs(DIFFUSE_PAIRS, SEED, 0.1)
     worst = 0.0
@@ -461,27 +506,35 @@ def diffuse_sigma0_is_lambert_eq6() -> CheckResult:
         w = lambda c: 1 - (1 - c) ** 5  # noqa: E731
         ref = 1.05 * (1 - f0) * w(l[:, 2]) * w(v[:, 2]) / np.pi
         worst = max(worst, float(np.max(np.abs(f - ref) / ref)))
-    return _result("diffuse_sigma0_is_lambert_eq6", worst, DIFFUSE_SIGMA0_RTOL,
-                   f"max relative over {DIFFUSE_PAIRS} random pairs x f0 in (0, 0.04, 0.5), GL order {DIFFUSE_ORDER}")
+    return _result(
+        "diffuse_sigma0_is_lambert_eq6",
+        worst,
+        DIFFUSE_SIGMA0_RTOL,
+        f"max relative over {DIFFUSE_PAIRS} random pairs x f0 in (0, 0.04, 0.5), GL order {DIFFUSE_ORDER}",
+    )
 
 
 def diffuse_reciprocity() -> CheckResult:
     """f(l, v) = f(v, l) for the microfacet diffuse BRDF, random pairs (grazing included), sigma 0.05 .. 1."""
-    from ..tables.diffuse import eval_brdf
+    from ..integrands.diffuse import eval_brdf
 
     l, v = _random_pairs(DIFFUSE_PAIRS, SEED + 1)
     sigma = np.random.default_rng(SEED + 2).uniform(0.05, 1.0, DIFFUSE_PAIRS)
     a = eval_brdf("microfacet", l, v, sigma, 0.04, "eq6", "sigma", DIFFUSE_ORDER)
     b = eval_brdf("microfacet", v, l, sigma, 0.04, "eq6", "sigma", DIFFUSE_ORDER)
     rel = np.abs(a - b) / np.maximum(np.maximum(a, b), 1e-30)
-    return _result("diffuse_reciprocity", float(rel.max()), DIFFUSE_RECIPROCITY_RTOL,
-                   f"max relative over {DIFFUSE_PAIRS} random pairs, sigma in [0.05, 1]")
+    return _result(
+        "diffuse_reciprocity",
+        float(rel.max()),
+        DIFFUSE_RECIPROCITY_RTOL,
+        f"max relative over {DIFFUSE_PAIRS} random pairs, sigma in [0.05, 1]",
+    )
 
 
 def diffuse_albedo_le_one() -> CheckResult:
     """The directional albedo E(v) = ∫ f (n.l) dω_l of the microfacet diffuse model is <= 1 for every NoV, sigma, f0
     and per-facet Fresnel form (rho = 1): measured max(0, max E - 1)."""
-    from ..tables import diffuse_albedo
+    from ..integrands.diffuse import albedo_swapped
 
     nov = np.array([NOV_MIN, 0.01, 0.05, 0.2, 0.5, 0.8, 1.0])
     alpha = np.array([ALPHA_MIN, 0.01, 0.1, 0.3, 0.6, 1.0])
@@ -489,15 +542,20 @@ def diffuse_albedo_le_one() -> CheckResult:
     worst, top = 0.0, 0.0
     for form in ("eq6", "schlick", "dielectric_f0"):
         for f0 in (0.0, 0.04, 0.5):
-            e = diffuse_albedo.albedo(N, A, f0, form, order=DIFFUSE_ORDER)
+            e = albedo_swapped(N, A, f0, form, order=DIFFUSE_ORDER)
             top = max(top, float(e.max()))
             worst = max(worst, float(np.max(e - 1.0)))
-    return _result("diffuse_albedo_le_one", max(worst, 0.0), DIFFUSE_ALBEDO_TOL,
-                   f"max E = {top:.7f} over {len(N)} (NoV, alpha) x f0 in (0, 0.04, 0.5) x facet forms eq6, schlick, "
-                   "dielectric_f0")
+    return _result(
+        "diffuse_albedo_le_one",
+        max(worst, 0.0),
+        DIFFUSE_ALBEDO_TOL,
+        f"max E = {top:.7f} over {len(N)} (NoV, alpha) x f0 in (0, 0.04, 0.5) x facet forms eq6, schlick, "
+        "dielectric_f0",
+    )
 
 
 # --- registry ------------------------------------------------------------------------------------------
+
 
 def _registry() -> dict:
     checks = {}

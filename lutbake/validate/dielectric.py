@@ -1,7 +1,8 @@
 """Named checks of the rough dielectric BSDF and its energy tables (lutbake validate; docs/transmission.md).
 
 - ``dielectric_smooth_limit``: alpha -> 0 (ALPHA_MIN): E_R -> F(mu, eta), E_T -> 1 - F(mu, eta) (a smooth interface
-  conserves energy), for eta > 1 and eta < 1 including total internal reflection (E_R = 1, E_T = 0 for mu < cos theta_c).
+  conserves energy), for eta > 1 and eta < 1 including total internal reflection (E_R = 1, E_T = 0 for
+  mu < cos theta_c).
   View cosines within SMOOTH_KINK_GAP of cos theta_c are left out: F has a square-root kink there that any alpha > 0
   smooths over a width ~alpha, so the limit is reached only as sqrt(alpha).
 - ``dielectric_index_matched``: eta = 1: F = 0 and every facet refracts v into -v, so E_R = 0 and
@@ -13,6 +14,7 @@
 - ``dielectric_energy_le_one``: E_R + E_T <= 1 over a (mu, alpha, eta) grid; reports where the loss is largest.
 - ``dielectric_estimators_agree``: panelled Gauss-Legendre vs scrambled-Sobol' VNDF sampling.
 """
+
 from __future__ import annotations
 
 import functools
@@ -23,8 +25,8 @@ import warp as wp
 from ..edge import ALPHA_MIN
 from ..terms import dielectric as td
 from ..terms import fresnel
+from ..terms.distributions import NDFS
 from ..terms.frame import reflect
-from ..terms.sets import G2_for, NDFS
 from .checks import _result
 
 SMOOTH_LIMIT_TOL = 2.0e-5  # |E_R - F|, |E_T - (1 - F)| at alpha = ALPHA_MIN, |mu - cos theta_c| >= SMOOTH_KINK_GAP
@@ -39,11 +41,11 @@ ENERGY_TOL = 1.0e-6  # E_R + E_T <= 1 + tol
 ESTIMATOR_TOL = 5.0e-5  # |GL - sobol_vndf (2^16)|
 ETAS = (0.5, 0.67, 0.9, 1.1, 1.5, 2.5)
 SEED = 20261127
-GL_SAMPLES = 3 * 12 ** 2
+GL_SAMPLES = 3 * 12**2
 
 
 def _integrate(nov, alpha, eta, masking="smith_separable", estimator="gauss_legendre", samples=GL_SAMPLES):
-    from ..tables.dielectric import integrate
+    from ..kinds.dielectric import integrate
 
     f = (np.asarray(x, np.float32) for x in np.broadcast_arrays(nov, alpha, eta))
     return integrate(("ggx", masking, "exact", estimator), *f, samples, SEED)
@@ -73,9 +75,13 @@ def smooth_limit() -> tuple[float, str]:
 
 def dielectric_smooth_limit():
     worst, where = smooth_limit()
-    return _result("dielectric_smooth_limit", worst, SMOOTH_LIMIT_TOL,
-                   f"max |E_R - F|, |E_T - (1 - F)| at alpha = {ALPHA_MIN:g}, eta in {ETAS}, {len(SMOOTH_NOVS)} mu "
-                   f"(TIR branch included; |mu - cos theta_c| >= {SMOOTH_KINK_GAP}); worst at {where}")
+    return _result(
+        "dielectric_smooth_limit",
+        worst,
+        SMOOTH_LIMIT_TOL,
+        f"max |E_R - F|, |E_T - (1 - F)| at alpha = {ALPHA_MIN:g}, eta in {ETAS}, {len(SMOOTH_NOVS)} mu "
+        f"(TIR branch included; |mu - cos theta_c| >= {SMOOTH_KINK_GAP}); worst at {where}",
+    )
 
 
 def lambda_ggx_np(mu, alpha):
@@ -98,19 +104,28 @@ def dielectric_index_matched():
         exp = index_matched_expected(mu, alpha, m)
         worst = max(worst, float(np.max(np.abs(e[:, 0]))), float(np.max(np.abs(e[:, 1] - exp))))
         loss = max(loss, float(np.max(1 - exp)))
-    return _result("dielectric_index_matched", worst, INDEX_MATCHED_TOL,
-                   f"max |E_R|, |E_T - G2(mu, mu)/G1(mu)| at eta = 1, both maskings, 60 (mu, alpha); single scattering "
-                   f"keeps E_T < 1 there: the largest 1 - E_T is {loss:.3f} (alpha = 1)")
+    return _result(
+        "dielectric_index_matched",
+        worst,
+        INDEX_MATCHED_TOL,
+        f"max |E_R|, |E_T - G2(mu, mu)/G1(mu)| at eta = 1, both maskings, 60 (mu, alpha); single scattering "
+        f"keeps E_T < 1 there: the largest 1 - E_T is {loss:.3f} (alpha = 1)",
+    )
 
 
 @functools.lru_cache(maxsize=None)
 def _bsdf_kernel(masking: str):
     D = NDFS["ggx"].D
-    G2 = G2_for("ggx", masking)
+    G2 = NDFS["ggx"].G2(masking)
 
     @wp.kernel(enable_backward=False, module="unique")
-    def eval_bsdf(i: wp.array(dtype=wp.vec3), o: wp.array(dtype=wp.vec3), alpha: wp.array(dtype=float),
-                  eta: wp.array(dtype=float), out: wp.array2d(dtype=float)):
+    def eval_bsdf(
+        i: wp.array(dtype=wp.vec3),
+        o: wp.array(dtype=wp.vec3),
+        alpha: wp.array(dtype=float),
+        eta: wp.array(dtype=float),
+        out: wp.array2d(dtype=float),
+    ):
         k = wp.tid()
         a = alpha[k]
         e = eta[k]
@@ -121,14 +136,16 @@ def _bsdf_kernel(masking: str):
         if vo[2] > 0.0:  # reflection: h_r = normalize(i + o)
             h = wp.normalize(vi + vo)
             IoH = wp.dot(vi, h)
-            out[k, 0] = td.f_dielectric_reflection(D(h, a), G2(NoI, NoO, h[2], IoH, a), fresnel.F_dielectric(e, IoH),
-                                                   NoI, NoO)
+            out[k, 0] = td.f_dielectric_reflection(
+                D(h, a), G2(NoI, NoO, h[2], IoH, a), fresnel.F_dielectric(e, IoH), NoI, NoO
+            )
         else:
             h = td.half_vector_transmission(vi, vo, e)
             IoH = wp.dot(vi, h)
             OoH = wp.dot(vo, h)
-            out[k, 0] = td.f_dielectric_transmission(D(h, a), G2(NoI, NoO, h[2], IoH, a),
-                                                     fresnel.F_dielectric(e, wp.abs(IoH)), NoI, NoO, IoH, OoH, e)
+            out[k, 0] = td.f_dielectric_transmission(
+                D(h, a), G2(NoI, NoO, h[2], IoH, a), fresnel.F_dielectric(e, wp.abs(IoH)), NoI, NoO, IoH, OoH, e
+            )
         # the reflected / refracted direction terms, for the tests
         out[k, 1] = reflect(vi, wp.vec3(0.0, 0.0, 1.0))[2]
         out[k, 2] = td.refract(vi, wp.vec3(0.0, 0.0, 1.0), e)[2]
@@ -142,9 +159,18 @@ def evaluate_bsdf(i, o, alpha, eta, masking="smith_separable") -> np.ndarray:
     n = len(i)
     a, e = (np.ascontiguousarray(np.broadcast_to(np.asarray(x, np.float32), (n,))) for x in (alpha, eta))
     out = wp.zeros((n, 3), dtype=float, device="cpu")
-    wp.launch(_bsdf_kernel(masking), dim=n, device="cpu",
-              inputs=[wp.array(i, dtype=wp.vec3), wp.array(o, dtype=wp.vec3), wp.array(a, dtype=float),
-                      wp.array(e, dtype=float), out])
+    wp.launch(
+        _bsdf_kernel(masking),
+        dim=n,
+        device="cpu",
+        inputs=[
+            wp.array(i, dtype=wp.vec3),
+            wp.array(o, dtype=wp.vec3),
+            wp.array(a, dtype=float),
+            wp.array(e, dtype=float),
+            out,
+        ],
+    )
     return out.numpy()[:, 0].astype(np.float64)
 
 
@@ -189,7 +215,7 @@ def reciprocity_errors(masking="smith_separable") -> tuple[float, float, float]:
     # i -> o crosses from index 1 into eta; the reverse path o -> i starts in eta: relative index 1/eta, seen from
     # o's side (the frame flipped, z -> -z, so that o is above)
     flip = np.array([1.0, 1.0, -1.0])
-    ft_io = evaluate_bsdf(i, o_dn, alpha, eta, masking) / eta ** 2
+    ft_io = evaluate_bsdf(i, o_dn, alpha, eta, masking) / eta**2
     ft_oi = evaluate_bsdf(o_dn * flip, i * flip, alpha, 1.0 / eta, masking)
     rel = []
     for a, b, o in ((fr_io, fr_oi, o_up), (ft_io, ft_oi, o_dn)):
@@ -204,11 +230,15 @@ def dielectric_reciprocity():
     for m in ("smith_separable", "smith_height_correlated"):
         r, t, a = reciprocity_errors(m)
         worst, every = max(worst, r, t), max(every, a)
-    return _result("dielectric_reciprocity", worst, RECIPROCITY_RTOL,
-                   f"max relative |f_r(i,o) - f_r(o,i)| and |f_t(i->o)/eta_o^2 - f_t(o->i)/eta_i^2| over "
-                   f"{RECIPROCITY_PAIRS} random pairs per lobe and masking, alpha in [0.05, 1], eta in {ETAS}, facet "
-                   f"cosines >= {RECIPROCITY_MIN_COS} and >= {RECIPROCITY_KINK_GAP} from cos theta_c (float32 "
-                   f"conditioning; over every pair: {every:.1e})")
+    return _result(
+        "dielectric_reciprocity",
+        worst,
+        RECIPROCITY_RTOL,
+        f"max relative |f_r(i,o) - f_r(o,i)| and |f_t(i->o)/eta_o^2 - f_t(o->i)/eta_i^2| over "
+        f"{RECIPROCITY_PAIRS} random pairs per lobe and masking, alpha in [0.05, 1], eta in {ETAS}, facet "
+        f"cosines >= {RECIPROCITY_MIN_COS} and >= {RECIPROCITY_KINK_GAP} from cos theta_c (float32 "
+        f"conditioning; over every pair: {every:.1e})",
+    )
 
 
 def energy_grid():
@@ -223,9 +253,13 @@ def dielectric_energy_le_one():
     e = _integrate(M, A, E)
     s = e[:, 0] + e[:, 1]
     k = int(np.argmax(1 - s))
-    return _result("dielectric_energy_le_one", max(float(s.max()) - 1.0, 0.0), ENERGY_TOL,
-                   f"max E_R + E_T - 1 over {len(M)} (mu, alpha, eta); largest loss 1 - (E_R + E_T) = {1 - s[k]:.4f} at "
-                   f"mu = {M[k]}, alpha = {A[k]}, eta = {E[k]} (high roughness, grazing)")
+    return _result(
+        "dielectric_energy_le_one",
+        max(float(s.max()) - 1.0, 0.0),
+        ENERGY_TOL,
+        f"max E_R + E_T - 1 over {len(M)} (mu, alpha, eta); largest loss 1 - (E_R + E_T) = {1 - s[k]:.4f} at "
+        f"mu = {M[k]}, alpha = {A[k]}, eta = {E[k]} (high roughness, grazing)",
+    )
 
 
 def dielectric_estimators_agree():
@@ -234,8 +268,12 @@ def dielectric_estimators_agree():
     eta = np.array([1.5, 0.67, 1.33, 0.75, 0.9], np.float32)
     a = _integrate(mu, alpha, eta)
     b = _integrate(mu, alpha, eta, estimator="sobol_vndf", samples=1 << 16)
-    return _result("dielectric_estimators_agree", float(np.max(np.abs(a - b))), ESTIMATOR_TOL,
-                   "max |gauss_legendre - sobol_vndf (2^16)| over 5 texels x (E_R, E_T, E_R + E_T)")
+    return _result(
+        "dielectric_estimators_agree",
+        float(np.max(np.abs(a - b))),
+        ESTIMATOR_TOL,
+        "max |gauss_legendre - sobol_vndf (2^16)| over 5 texels x (E_R, E_T, E_R + E_T)",
+    )
 
 
 CHECKS = {

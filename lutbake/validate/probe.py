@@ -9,10 +9,10 @@ Host API (inputs broadcast against each other; ``h``, ``l``, ``v`` carry a trail
 
     evaluate_terms(h=..., alpha=..., nov=..., nol=..., voh=..., loh=..., f0=..., eta=..., cos_theta=...)
         -> {term name: array}, names in ``TERM_NAMES``:
-        D_<ndf>            D(h, alpha)                                  for every NDF in sets.NDFS
+        D_<ndf>            D(h, alpha)                                  for every NDF in distributions.NDFS
         Lambda_<ndf>       Lambda(nov, alpha)
         G1_smith_<ndf>     G1_smith(Lambda(nov, alpha))
-        G2[<ndf>,<masking>]  sets.G2_for(ndf, masking)(nov, nol, h.z, voh, alpha)  (the composed G2 tables use)
+        G2[<ndf>,<masking>]  NDFS[ndf].G2(masking)(nov, nol, h.z, voh, alpha)  (the composed G2 tables use)
         G2_v_cavity        G2_v_cavity(h.z, nov, nol, voh, loh)          (with its own l.h)
         D_ggx_aniso        D_ggx_aniso(h, alpha, alpha_y)               (alpha = alpha_x along the tangent +x)
         Lambda_ggx_aniso   Lambda_ggx_aniso(v, alpha, alpha_y)
@@ -26,6 +26,7 @@ Host API (inputs broadcast against each other; ``h``, ``l``, ``v`` carry a trail
         left to a reciprocity check is the order of G2's and the denominator's arguments
         (Gotanda 2014 course notes, Eq. 1), 0 where n.l or n.v <= COS_EPS.
 """
+
 from __future__ import annotations
 
 import functools
@@ -35,7 +36,7 @@ import warp as wp
 
 from ..edge import COS_EPS
 from ..terms import fresnel, masking, ndf
-from ..terms.sets import MASKINGS, NDFS, G2_for, pair_allowed
+from ..terms.distributions import MASKINGS, NDFS
 
 wp.set_module_options({"enable_backward": False})
 
@@ -43,6 +44,7 @@ wp.set_module_options({"enable_backward": False})
 @wp.struct
 class TermInputs:
     """One input record: every term reads the fields it needs (see the module docstring)."""
+
     h: wp.vec3
     v: wp.vec3
     alpha: float
@@ -57,6 +59,7 @@ class TermInputs:
 
 
 # --- one probe per term: a wp.func TermInputs -> float, paired with its output name ---------------
+
 
 def _ndf_probes(ndf_name: str) -> list:
     nd = NDFS[ndf_name]
@@ -81,7 +84,7 @@ def _ndf_probes(ndf_name: str) -> list:
 
 
 def _g2_probe(ndf_name: str, masking_name: str) -> tuple:
-    G2 = G2_for(ndf_name, masking_name)
+    G2 = NDFS[ndf_name].G2(masking_name)
 
     @wp.func
     def probe_G2(x: TermInputs):
@@ -140,61 +143,62 @@ def _probe_V_charlie(x: TermInputs):
     return masking.V_charlie(x.nov, x.nol, x.alpha)
 
 
-BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS if pair_allowed(n, m))
+BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS if NDFS[n].masking_allowed(m))
 
 _PROBES = (
     [p for n in NDFS for p in _ndf_probes(n)]
     + [_g2_probe(n, m) for n, m in BRDF_PAIRS]
-    + [("D_ggx_aniso", _probe_D_ggx_aniso), ("Lambda_ggx_aniso", _probe_Lambda_ggx_aniso),
-       ("D_ashikhmin_shirley", _probe_D_ashikhmin_shirley), ("D_charlie", _probe_D_charlie),
-       ("V_charlie", _probe_V_charlie)]
-    + [("G2_v_cavity", _probe_G2_v_cavity), ("F_schlick", _probe_F_schlick), ("Fc_schlick", _probe_Fc_schlick),
-       ("F_dielectric", _probe_F_dielectric), ("F_dielectric_f0", _probe_F_dielectric_f0)]
+    + [
+        ("D_ggx_aniso", _probe_D_ggx_aniso),
+        ("Lambda_ggx_aniso", _probe_Lambda_ggx_aniso),
+        ("D_ashikhmin_shirley", _probe_D_ashikhmin_shirley),
+        ("D_charlie", _probe_D_charlie),
+        ("V_charlie", _probe_V_charlie),
+    ]
+    + [
+        ("G2_v_cavity", _probe_G2_v_cavity),
+        ("F_schlick", _probe_F_schlick),
+        ("Fc_schlick", _probe_Fc_schlick),
+        ("F_dielectric", _probe_F_dielectric),
+        ("F_dielectric_f0", _probe_F_dielectric_f0),
+    ]
 )
 TERM_NAMES: tuple[str, ...] = tuple(name for name, _ in _PROBES)
 _PROBE_FUNCS = [f for _, f in _PROBES]
 
 
+SCALARS = ("alpha", "alpha_y", "nov", "nol", "voh", "loh", "f0", "eta", "cos_theta")  # _terms_kernel's s columns
+
+
 @wp.kernel
-def _terms_kernel(
-    h: wp.array(dtype=wp.vec3),
-    v: wp.array(dtype=wp.vec3),
-    alpha: wp.array(dtype=float),
-    alpha_y: wp.array(dtype=float),
-    nov: wp.array(dtype=float),
-    nol: wp.array(dtype=float),
-    voh: wp.array(dtype=float),
-    loh: wp.array(dtype=float),
-    f0: wp.array(dtype=float),
-    eta: wp.array(dtype=float),
-    cos_theta: wp.array(dtype=float),
-    out: wp.array2d(dtype=float),
-):
+def _terms_kernel(hv: wp.array2d(dtype=wp.vec3), s: wp.array2d(dtype=float), out: wp.array2d(dtype=float)):
+    """hv[i] = (h, v); s[i] = SCALARS in order."""
     i = wp.tid()
     x = TermInputs()
-    x.h = h[i]
-    x.v = v[i]
-    x.alpha = alpha[i]
-    x.alpha_y = alpha_y[i]
-    x.nov = nov[i]
-    x.nol = nol[i]
-    x.voh = voh[i]
-    x.loh = loh[i]
-    x.f0 = f0[i]
-    x.eta = eta[i]
-    x.cos_theta = cos_theta[i]
+    x.h = hv[i, 0]
+    x.v = hv[i, 1]
+    x.alpha = s[i, 0]
+    x.alpha_y = s[i, 1]
+    x.nov = s[i, 2]
+    x.nol = s[i, 3]
+    x.voh = s[i, 4]
+    x.loh = s[i, 5]
+    x.f0 = s[i, 6]
+    x.eta = s[i, 7]
+    x.cos_theta = s[i, 8]
     for k in range(wp.static(len(_PROBE_FUNCS))):
         out[i, k] = wp.static(_PROBE_FUNCS[k])(x)
 
 
 # --- full specular BRDFs ------------------------------------------------------------------------
 
+
 @functools.lru_cache(maxsize=None)
-def brdf_for(ndf_name: str, masking_name: str):
+def specular_brdf_for(ndf_name: str, masking_name: str):
     """``f(l, v, alpha, f0)``: the Cook-Torrance specular BRDF of one (NDF, masking) pair with Schlick F,
     assembled from the terms exactly as tables assemble it (module docstring)."""
     D = NDFS[ndf_name].D
-    G2 = G2_for(ndf_name, masking_name)
+    G2 = NDFS[ndf_name].G2(masking_name)
 
     @wp.func
     def brdf(l: wp.vec3, v: wp.vec3, alpha: float, f0: float):
@@ -213,23 +217,19 @@ def brdf_for(ndf_name: str, masking_name: str):
     return brdf
 
 
-_BRDF_FUNCS = [brdf_for(n, m) for n, m in BRDF_PAIRS]
+_BRDF_FUNCS = [specular_brdf_for(n, m) for n, m in BRDF_PAIRS]
 
 
 @wp.kernel
-def _brdf_kernel(
-    l: wp.array(dtype=wp.vec3),
-    v: wp.array(dtype=wp.vec3),
-    alpha: wp.array(dtype=float),
-    f0: wp.array(dtype=float),
-    out: wp.array2d(dtype=float),
-):
+def _brdf_kernel(lv: wp.array2d(dtype=wp.vec3), alpha_f0: wp.array(dtype=wp.vec2), out: wp.array2d(dtype=float)):
+    """lv[i] = (l, v); alpha_f0[i] = (alpha, f0)."""
     i = wp.tid()
     for k in range(wp.static(len(_BRDF_FUNCS))):
-        out[i, k] = wp.static(_BRDF_FUNCS[k])(l[i], v[i], alpha[i], f0[i])
+        out[i, k] = wp.static(_BRDF_FUNCS[k])(lv[i, 0], lv[i, 1], alpha_f0[i][0], alpha_f0[i][1])
 
 
 # --- host side ------------------------------------------------------------------------------------
+
 
 def _vec_and_scalars(vecs: dict, scalars: dict) -> tuple[tuple, dict]:
     """Broadcast (..., 3) vectors and (...) scalars to one shape; return it and flat float32 arrays."""
@@ -244,8 +244,21 @@ def _vec_and_scalars(vecs: dict, scalars: dict) -> tuple[tuple, dict]:
     return shape, flat
 
 
-def evaluate_terms(*, h=(0.0, 0.0, 1.0), v=(0.0, 0.0, 1.0), alpha=0.5, alpha_y=None, nov=1.0, nol=1.0, voh=1.0,
-                   loh=1.0, f0=0.04, eta=1.5, cos_theta=1.0, device: str = "cpu") -> dict[str, np.ndarray]:
+def evaluate_terms(
+    *,
+    h=(0.0, 0.0, 1.0),
+    v=(0.0, 0.0, 1.0),
+    alpha=0.5,
+    alpha_y=None,
+    nov=1.0,
+    nol=1.0,
+    voh=1.0,
+    loh=1.0,
+    f0=0.04,
+    eta=1.5,
+    cos_theta=1.0,
+    device: str = "cpu",
+) -> dict[str, np.ndarray]:
     """Every term of ``TERM_NAMES`` at the broadcast inputs (module docstring) -> {name: float32 array}.
     ``h`` is in the shading frame (n = +z) and is used as given (not normalised); n.h for G2 is h.z.
     The anisotropic terms read ``alpha`` as alpha_x (tangent, +x), ``alpha_y`` (default: alpha) and the
@@ -253,14 +266,23 @@ def evaluate_terms(*, h=(0.0, 0.0, 1.0), v=(0.0, 0.0, 1.0), alpha=0.5, alpha_y=N
     alpha_y = alpha if alpha_y is None else alpha_y
     shape, x = _vec_and_scalars(
         {"h": h, "v": v},
-        {"alpha": alpha, "alpha_y": alpha_y, "nov": nov, "nol": nol, "voh": voh, "loh": loh, "f0": f0, "eta": eta,
-         "cos_theta": cos_theta},
+        {
+            "alpha": alpha,
+            "alpha_y": alpha_y,
+            "nov": nov,
+            "nol": nol,
+            "voh": voh,
+            "loh": loh,
+            "f0": f0,
+            "eta": eta,
+            "cos_theta": cos_theta,
+        },
     )
     n = int(np.prod(shape, dtype=np.int64))
     out = wp.zeros((n, len(TERM_NAMES)), dtype=float, device=device)
-    inputs = [wp.array(x[k], dtype=wp.vec3, device=device) for k in ("h", "v")]
-    inputs += [wp.array(x[k], dtype=float, device=device)
-               for k in ("alpha", "alpha_y", "nov", "nol", "voh", "loh", "f0", "eta", "cos_theta")]
+    hv = np.ascontiguousarray(np.stack([x["h"], x["v"]], axis=1), dtype=np.float32)
+    sc = np.ascontiguousarray(np.stack([x[k] for k in SCALARS], axis=1), dtype=np.float32)
+    inputs = [wp.array(hv, dtype=wp.vec3, device=device), wp.array(sc, dtype=float, device=device)]
     if n:
         wp.launch(_terms_kernel, dim=n, inputs=inputs + [out], device=device)
     res = out.numpy()
@@ -273,8 +295,9 @@ def evaluate_brdfs(l, v, alpha, f0=0.04, device: str = "cpu") -> dict[tuple[str,
     shape, x = _vec_and_scalars({"l": l, "v": v}, {"alpha": alpha, "f0": f0})
     n = int(np.prod(shape, dtype=np.int64))
     out = wp.zeros((n, len(BRDF_PAIRS)), dtype=float, device=device)
-    inputs = [wp.array(x["l"], dtype=wp.vec3, device=device), wp.array(x["v"], dtype=wp.vec3, device=device),
-              wp.array(x["alpha"], dtype=float, device=device), wp.array(x["f0"], dtype=float, device=device)]
+    lv = np.ascontiguousarray(np.stack([x["l"], x["v"]], axis=1), dtype=np.float32)
+    af = np.ascontiguousarray(np.stack([x["alpha"], x["f0"]], axis=1), dtype=np.float32)
+    inputs = [wp.array(lv, dtype=wp.vec3, device=device), wp.array(af, dtype=wp.vec2, device=device)]
     if n:
         wp.launch(_brdf_kernel, dim=n, inputs=inputs + [out], device=device)
     res = out.numpy()

@@ -10,14 +10,18 @@ part's lutbake:slice_value). For Schlick it collapses to the dfg table: E = f0 s
 (tests/test_specular3d.py). With ``metal = "<name>"`` the table is 2D, NoV x roughness, and R, G, B hold
 E with F = F_conductor(n_c + i k_c, v.h) for the metal's three wavelengths (lutbake.terms.metals).
 """
+
 from __future__ import annotations
 
 import numpy as np
 
 from ..axes import Axis
+from ..integrands.specular import specular_integrand
+from ..sampling.hemisphere import estimator_for
+from ..sampling.plan import TexelPlan, per_texel_plan
 from ..terms.metals import METALS
-from . import dfg, specular
-from .base import Key, Kind, Plan
+from . import dfg
+from .base import Key, declare
 
 FRESNEL_CHOICES = {
     "schlick": "f0 + (1 - f0)(1 - v.h)^5 (Schlick 1994)",
@@ -27,16 +31,26 @@ FRESNEL_CHOICES = {
 }
 KEYS = {
     **{k: v for k, v in dfg.KEYS.items() if k != "layout"},
-    "fresnel": Key("fresnel", "str", "dielectric_f0", "the Fresnel term integrated (ignored with metal)", FRESNEL_CHOICES),
+    "fresnel": Key(
+        "fresnel", "str", "dielectric_f0", "the Fresnel term integrated (ignored with metal)", FRESNEL_CHOICES
+    ),
     "f0_size": Key("f0_size", "int", 16, "f0 slice count (z); ignored with metal", minimum=1, maximum=1024),
-    "f0_range": Key("f0_range", "float_range", [0.0, 1.0], "f0 at t = 0 and t = 1 (same texel convention)",
-                    minimum=0.0, maximum=1.0),
-    "metal": Key("metal", "str", None, "a conductor by name: a 2D NoV x roughness RGB table with exact complex "
-                 "Fresnel instead of the f0 slices", {k: m.source for k, m in METALS.items()}),
+    "f0_range": Key(
+        "f0_range", "float_range", [0.0, 1.0], "f0 at t = 0 and t = 1 (same texel convention)", minimum=0.0, maximum=1.0
+    ),
+    "metal": Key(
+        "metal",
+        "str",
+        None,
+        "a conductor by name: a 2D NoV x roughness RGB table with exact complex Fresnel instead of the f0 slices",
+        {k: m.source for k, m in METALS.items()},
+    ),
 }
-RECONSTRUCTION_3D = ("load part k as layer k of a 3D texture; E = texture(lut3d, vec3(NoV, roughness, f0)).r "
-                     "(texel centres on all three axes: trilinear filtering interpolates f0 between slices); "
-                     "specular = prefiltered * E")
+RECONSTRUCTION_3D = (
+    "load part k as layer k of a 3D texture; E = texture(lut3d, vec3(NoV, roughness, f0)).r "
+    "(texel centres on all three axes: trilinear filtering interpolates f0 between slices); "
+    "specular = prefiltered * E"
+)
 RECONSTRUCTION_METAL = "E = texture(lut, vec2(NoV, roughness)).rgb; specular = prefiltered * E (per channel)"
 
 
@@ -47,48 +61,48 @@ def axes_for(o: dict) -> list[Axis]:
     return [Axis("f0", "z", o["f0_size"], *o["f0_range"], texel=o["texel"])] + axes
 
 
-def plan(spec) -> Plan:
+def plan(spec) -> TexelPlan:
     o = spec.options
     axes = axes_for(o)
-    est = o["estimator"]
-    samples = o["samples"] or specular.DEFAULT_SAMPLES[est]
     metal = o["metal"]
     channels_name = f"metal:{metal}" if metal else f"F:{o['fresnel']}"
     form, nd, mk = dfg.terms_of(o)
-    key = (nd, mk, channels_name, est, form)
-    rough, nov_axis = axes[-2:]
+    nch = 3 if metal else 1
+    integrand = specular_integrand(nd, mk, channels_name, form, nch)
     nz = 1 if metal else axes[0].count
     # texel t = (iz * ny + iy) * nx + ix: z (f0) slowest, then roughness, then NoV
-    nov, alpha = (np.tile(x, nz) for x in dfg.texel_grid([rough, nov_axis]))
-    f0 = None if metal else np.repeat(axes[0].values(), rough.count * nov_axis.count)
-    nch = 3 if metal else 1
+    f0 = None if metal else np.repeat(axes[0].values(), axes[-2].count * axes[-1].count)
     if metal:
         m = METALS[metal]
-        channels = {f"e_{c}": f"E with F_conductor({n} + {k}i) at {w:g} nm" for c, n, k, w in
-                    zip("rgb", m.n, m.k, m.wavelengths_nm)}
+        channels = {
+            f"e_{c}": f"E with F_conductor({n} + {k}i) at {w:g} nm"
+            for c, n, k, w in zip("rgb", m.n, m.k, m.wavelengths_nm)
+        }
         terms = {**dfg.terms_record(o, "conductor"), "metal": metal}
         extra = {"metal_source": m.source}
     else:
         channels = {"e": f"E = ∫ f (n.l) dω_l with F = {o['fresnel']}(f0 of the slice, v.h)"}
         terms = dfg.terms_record(o, o["fresnel"])
         extra = {}
-    return specular.hemisphere_plan(
-        key=key, nov=nov, alpha=alpha, param=f0, samples=o["samples"], seed=o["seed"], nch=nch,
-        kernel_channels=nch if metal else 2, axes=axes, channels=channels,
-        reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D, terms=terms, extra=extra)
+    return per_texel_plan(
+        integrand,
+        estimator_for(o["estimator"], o["samples"], o["seed"]),
+        dfg.grid_for(axes, integrand, f0, nz),
+        channels=channels,
+        reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D,
+        terms=terms,
+        extra={**extra, **dfg.specular_extra(integrand)},
+    )
 
 
-def check_spec(spec) -> tuple[str, str] | None:
-    msg = dfg.check_spec(spec)
-    if msg:
-        return msg
-    o = spec.options
-    n = o["size"][0] * o["size"][1] * (1 if o["metal"] else o["f0_size"])
-    if n > 1 << 26:
-        return ("size", f"size x f0_size = {n} texels: at most {1 << 26}")
-    return None
+def texel_count(o: dict) -> int:
+    """size x f0_size"""
+    return o["size"][0] * o["size"][1] * (1 if o["metal"] else o["f0_size"])
 
 
-SPECULAR_3D = Kind("specular_3d", "specular AmbientBRDF for any Fresnel: NoV x roughness x f0 slices (R = E), "
-                   "or NoV x roughness RGB for a named metal", KEYS, plan, aliases=("ambient_brdf_3d",),
-                   check=check_spec)
+DESCRIPTION = (
+    "specular AmbientBRDF for any Fresnel: NoV x roughness x f0 slices (R = E), or NoV x roughness RGB for "
+    "a named metal"
+)
+RULES = {"aliases": ("ambient_brdf_3d",), "check": dfg.check_spec, "texels": texel_count}
+SPECULAR_3D = declare("specular_3d", DESCRIPTION, KEYS, plan, dfg.SPECULAR_ESTIMATION, **RULES)
