@@ -8,7 +8,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 OUT    ?= outputs
 CONFIGS := $(wildcard configs/*.toml)
-PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-eevee unreal
+PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-eevee unreal blender-eevee-btdf blender-eevee-bsdf openpbr turquin
 SOURCES := $(shell find lutbake -name '*.py' -o -name '*.toml' 2>/dev/null)
 WORKERS ?=
 FORCE   ?=
@@ -64,3 +64,4 @@ clean:
 # every kind against converged references, C and numpy baselines: outputs/bench/report.json + accuracy_vs_time.png
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench.py
+	$(BIN)/python benchmarks/bench_dielectric.py

@@ -76,7 +76,7 @@ def main():
 @click.option(
     "--format",
     "fmt",
-    type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h"]),
+    type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h", "openpbr_h"]),
     default=None,
     help="Output format of every table (same as --set format=...; default: each table's `format`, exr).",
 )

@@ -31,6 +31,10 @@ UNIT_DIFFUSE_MODELS = frozenset(
     {"lambert", "oren_nayar_improved", "oren_nayar_fresnel", "fitted", "fitted_slides", "microfacet"}
 )
 ABOVE_ONE_DIFFUSE_MODELS = frozenset({"oren_nayar"})
+# rough dielectrics: E_R, E_T, E_R + E_T <= 1 (single-scattering energy conservation), the OpenPBR complements
+# 1 - E and EEVEE's Fresnel-factored scale / bias / transmission factors, every layout (measured on the full EEVEE
+# and OpenPBR grids: min >= 0, max <= 1.000000)
+DIELECTRIC_KINDS = frozenset({"dielectric", "dielectric_avg"})
 SPECULAR_KINDS = frozenset({"dfg", "albedo", "albedo_avg", "specular_3d", "specular_aniso"})
 DIFFUSE_KINDS = frozenset({"diffuse", "diffuse_3d"})
 UNBOUNDED_KINDS = {"btf": "btf tabulates BRDF values f, which peak above 1"}
@@ -47,6 +51,6 @@ def unit_range(spec) -> str | None:
         return f"model {o['model']!r} is not energy conserving: its albedo exceeds 1"
     if spec.kind in DIFFUSE_KINDS and o.get("model", "microfacet") not in UNIT_DIFFUSE_MODELS:
         return f"model {o['model']!r} exceeds 1 (its albedo is not bounded by 1)"
-    if spec.kind not in SPECULAR_KINDS | DIFFUSE_KINDS:
+    if spec.kind not in SPECULAR_KINDS | DIFFUSE_KINDS | DIELECTRIC_KINDS:
         return f"kind {spec.kind!r} declares no value range"
     return None

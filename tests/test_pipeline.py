@@ -77,6 +77,21 @@ AGREEMENT = [
         "sobol_ndf",
         AGREEMENT_TOL_ANISO,
     ),
+    # the dielectric kinds: panelled GL split at every kink vs GGX visible-normal Sobol' (16384 points), eta both sides
+    (
+        "dielectric",
+        {"size": [4, 3], "ior_size": 2, "ior_range": [0.7, 1.5], "roughness_range": [0.3, 1.0]},
+        "gauss_legendre",
+        "sobol_vndf",
+        AGREEMENT_TOL_QMC,
+    ),
+    (
+        "dielectric_avg",
+        {"roughness_size": 3, "ior_size": 2, "ior_range": [0.7, 1.5], "roughness_range": [0.3, 1.0], "mu_order": 6},
+        "gauss_legendre",
+        "sobol_vndf",
+        AGREEMENT_TOL_QMC,
+    ),
 ]
 
 

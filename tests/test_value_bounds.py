@@ -24,6 +24,7 @@ SMALL = {
     "diffuse": {"size": [16, 16]},
     "diffuse_3d": {"size": [8, 8], "f0_size": 3},
     "btf": {"size": [8, 8], "phi_size": 4, "sigma_size": 3},
+    "dielectric": {"size": [8, 8], "ior_size": 4},
 }
 UNIT = (
     [("dfg", {"layout": lay}) for lay in sorted(vb.UNIT_LAYOUTS)]
@@ -34,6 +35,7 @@ UNIT = (
     ]
     + [("specular_aniso", {"model": m}) for m in sorted(ANISO_MODELS)]
     + [(k, {"model": m}) for k in ("diffuse", "diffuse_3d") for m in sorted(vb.UNIT_DIFFUSE_MODELS)]
+    + [("dielectric", {"layout": "energy"})]
 )
 ABOVE = (
     [("dfg", {"layout": lay}) for lay in sorted(vb.ABOVE_ONE_LAYOUTS)]
@@ -48,7 +50,7 @@ def spec(kind, opts):
 
 
 def test_every_kind_layout_and_model_is_declared():
-    assert set(KINDS) == vb.SPECULAR_KINDS | vb.DIFFUSE_KINDS | set(vb.UNBOUNDED_KINDS)
+    assert set(KINDS) == vb.SPECULAR_KINDS | vb.DIFFUSE_KINDS | vb.DIELECTRIC_KINDS | set(vb.UNBOUNDED_KINDS)
     assert vb.UNIT_LAYOUTS | vb.ABOVE_ONE_LAYOUTS == set(LAYOUTS) and not vb.UNIT_LAYOUTS & vb.ABOVE_ONE_LAYOUTS
     assert vb.UNIT_SPECULAR_MODELS | vb.ABOVE_ONE_SPECULAR_MODELS == set(MODELS)
     assert set(ANISO_MODELS) <= vb.UNIT_SPECULAR_MODELS

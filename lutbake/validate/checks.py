@@ -581,6 +581,9 @@ def _registry() -> dict:
     checks["diffuse_sigma0_is_lambert_eq6"] = diffuse_sigma0_is_lambert_eq6
     checks["diffuse_reciprocity"] = diffuse_reciprocity
     checks["diffuse_albedo_le_one"] = diffuse_albedo_le_one
+    from . import dielectric  # the rough dielectric BSDF's checks (imports _result from here)
+
+    checks.update(dielectric.CHECKS)
     return checks
 
 
