@@ -46,6 +46,8 @@ def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu",
     if plan.error_estimate is not None:
         err, how = plan.error_estimate(data.reshape(plan.n_texels, plan.n_channels), device)
         extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)
+    if plan.attributes_after is not None:
+        extra.update(plan.attributes_after(data))
     attributes = {
         "terms": json.dumps(plan.terms),
         "estimator": plan.estimator,

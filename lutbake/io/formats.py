@@ -184,6 +184,11 @@ def write_header(table: Table, path, dtype: str = "float32") -> Path:
 
 WRITERS = {"exr": write_exr, "npy": write_npy, "png16": write_png16, "dds": write_dds, "ktx2": write_ktx2,
            "h": write_header}
+# the LTC engine layouts (kind ltc only): lutbake.ltc.export
+from ..ltc import export as _ltc_export  # noqa: E402
+
+WRITERS.update(_ltc_export.WRITERS)
+EXTENSIONS.update(_ltc_export.EXTENSIONS)
 
 
 def output_path(out_dir, name: str, fmt: str) -> Path:

@@ -9,8 +9,10 @@ from .diffuse import DIFFUSE
 from .aniso import SPECULAR_ANISO
 from .diffuse3d import DIFFUSE_3D
 from .btf import BTF
+from ..ltc.kind import LTC
 
-KINDS: dict[str, Kind] = {k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D, SPECULAR_ANISO, DIFFUSE, DIFFUSE_3D, BTF)}
+KINDS: dict[str, Kind] = {k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D, SPECULAR_ANISO, DIFFUSE, DIFFUSE_3D, BTF,
+                                              LTC)}
 ALIASES: dict[str, str] = {alias: k.name for k in KINDS.values() for alias in k.aliases}
 
 

@@ -46,6 +46,8 @@ class Plan:
     extra: dict[str, str] = field(default_factory=dict)
     # (flat float64 data (n_texels, n_channels), device) -> (estimated max abs error, how it was estimated)
     error_estimate: Callable[[np.ndarray, str], tuple[float, str]] | None = None
+    # (data of plan.shape) -> extra lutbake:* attributes known only after the bake (e.g. ltc fit-error statistics)
+    attributes_after: Callable[[np.ndarray], dict[str, str]] | None = None
 
     @property
     def shape(self) -> tuple[int, ...]:
