@@ -195,7 +195,8 @@ def plan(spec) -> Plan:
         "metric": "Heitz et al. 2016 L3 distance, MIS over lobe and LTC samples (ltc_code computeError)",
         "fit_samples": f"{o['fit_samples']} x {o['fit_samples']} per technique",
         "optimiser": f"Nelder-Mead (ltc_code nelder_mead.h), tol {fit.NELDER_MEAD_TOL}, <= {fit.NELDER_MEAD_ITERS} "
-                     f"iterations per restart, simplex sizes {list(fit.SIMPLEX_STEP)} in (log m11, log m22, m13/m11)",
+                     f"iterations per restart, simplex sizes {list(fit.COARSE_STEPS)} (coarse pass), "
+                     f"{list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11)",
         "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses; each texel starts from the "
                    "best of the analytic guesses and the surrounding coarse fits (no chaining)",
         "alpha_min": ALPHA_MIN, "theta_max": THETA_MAX,
