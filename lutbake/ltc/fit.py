@@ -43,6 +43,9 @@ NELDER_MEAD_ITERS = 100
 # 80 % more evaluations and changed the median error by 1e-9 relative on GGX 64^2)
 COARSE_STEPS = (0.5, 0.1, 0.02)
 FINE_STEPS = (0.1,)
+# absolute stop: simplex values within (1e-6)^3 ∫ f^3 (relative L3 errors within 1e-6): reached only by lobes an
+# LTC fits exactly (Lambert), whose E ~ 1e-22 would otherwise run every iteration on rounding noise
+ATOL_RELATIVE = 1.0e-6
 COARSE_NODES = 8  # coarse-pass texels per axis (including both ends)
 DEFAULT_GRID = 32  # ltc_code Nsample: the metric's grid is N x N per sampling technique
 M_MIN = 1.0e-7  # ltc_code FitLTC::update: m11, m22 >= 1e-7
@@ -232,16 +235,20 @@ class Problem:
         return self.error(texel, self.matrices(texel, q))
 
     def relative(self, texel: np.ndarray, err: np.ndarray) -> np.ndarray:
-        """The scale-free fit error e = (E / ∫ f^3)^(1/3) recorded per texel."""
-        f3 = self.f3[texel]
+        """The scale-free fit error e = (E / ∫ f^3)^(1/3) recorded per texel. ∫ f^3 is the lobe sampler's estimate,
+        floored at Hölder's bound ∫ f^3 >= (∫ f)^3 / (2 pi)^2 = magnitude^3 / (4 pi^2): where a sampler misses a
+        lobe (charlie at alpha -> 0 and grazing view puts it all within 1e-2 rad of the horizon) the estimate
+        falls below that provable bound and the floor keeps e finite and meaningful (0 for a zero lobe)."""
+        f3 = np.maximum(self.f3[texel], self.magnitude[texel] ** 3 / (4.0 * np.pi ** 2))
         return np.cbrt(np.where(f3 > 0.0, err / np.where(f3 > 0.0, f3, 1.0), 0.0))
 
 
 def nelder_mead(fun, texel: np.ndarray, start: np.ndarray, step: float, tol: float = NELDER_MEAD_TOL,
-                iters: int = NELDER_MEAD_ITERS) -> tuple[np.ndarray, np.ndarray]:
+                iters: int = NELDER_MEAD_ITERS, atol: np.ndarray | float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """ltc_code's downhill simplex (nelder_mead.h) run on every texel at once: ``fun(texel_subset, q)`` -> values.
-    Each texel follows exactly the scalar algorithm (its own simplex, its own stopping test); the vector form only
-    batches the objective calls. Returns (best q (n, 3), best value (n,))."""
+    Each texel follows exactly the scalar algorithm (its own simplex, its own stopping test
+    2 |f_lo - f_hi| < tol (|f_lo| + |f_hi|) + atol); the vector form only batches the objective calls.
+    Returns (best q (n, 3), best value (n,))."""
     n, dim = start.shape
     s = np.repeat(start[:, None, :], dim + 1, axis=1)
     for i in range(dim):
@@ -254,7 +261,7 @@ def nelder_mead(fun, texel: np.ndarray, start: np.ndarray, step: float, tol: flo
         lo, nh, hi = order[:, 0], order[:, -2], order[:, -1]
         flo, fhi, fnh = f[rows, lo], f[rows, hi], f[rows, nh]
         a, b = np.abs(flo), np.abs(fhi)
-        active &= ~(2.0 * np.abs(a - b) < (a + b) * tol)
+        active &= ~(2.0 * np.abs(a - b) < (a + b) * tol + atol)
         idx = np.flatnonzero(active)
         if len(idx) == 0:
             break
@@ -311,8 +318,9 @@ def best_of(problem: Problem, texel: np.ndarray, cands: np.ndarray) -> np.ndarra
 def refine(problem: Problem, texel: np.ndarray, start: np.ndarray, steps) -> tuple[np.ndarray, np.ndarray]:
     """Nelder-Mead from ``start``, restarted from its result at each simplex size of ``steps``."""
     q, f = start, None
+    atol = ATOL_RELATIVE ** 3 * problem.f3[texel]
     for step in steps:
-        q, f = nelder_mead(problem.objective, texel, q, step)
+        q, f = nelder_mead(problem.objective, texel, q, step, atol=atol)
     return q, f
 
 
