@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import gzip
+import os
 import json
 import re
 import sys
@@ -51,8 +52,9 @@ def published():
 def bake(lobe: str, workers: int):
     spec = load_configs([ROOT / "lutbake" / "presets" / "ltc-ggx.toml"],
                         [f'lobe="{lobe}"', f'name="ltc_{lobe}"', 'format="exr"', 'dtype="float32"'])[0]
+    cpu0 = time.process_time()
     table, seconds, _ = bake_table(spec, workers=workers, progress=False)
-    return table, seconds
+    return table, seconds, time.process_time() - cpu0
 
 
 def area(lobe: str, t1, t2, axes) -> dict:
@@ -69,15 +71,15 @@ def main(argv=None):
     wp.config.quiet = True
     OUT.mkdir(parents=True, exist_ok=True)
     workers = default_workers()
-    report = {"machine": {"workers": workers}, "lobes": {}}
+    report = {"machine": {"workers": workers, "load_average_at_start": list(os.getloadavg())}, "lobes": {}}
     tables = {}
     for lobe in args.lobes.split(","):
-        table, seconds = bake(lobe, workers)
+        table, seconds, cpu = bake(lobe, workers)
         tables[lobe] = table
-        report["lobes"][lobe] = {"seconds": round(seconds, 2), "size": "64x64",
+        report["lobes"][lobe] = {"seconds": round(seconds, 2), "cpu_seconds": round(cpu, 2), "size": "64x64",
                                  **{k: float(v) for k, v in table.attributes.items()
                                     if k.startswith("fit_error_")}}
-        print(f"{lobe}: {seconds:.1f} s, fit error median {table.attributes['fit_error_median']}, "
+        print(f"{lobe}: {seconds:.1f} s wall, {cpu:.1f} s CPU, fit error median {table.attributes['fit_error_median']}, "
               f"max {table.attributes['fit_error_max']}", flush=True)
 
     axes = axes_for({"lobe": "ggx", "size": [N, N]})
@@ -135,6 +137,7 @@ def main(argv=None):
         report["area_lights"][lobe] = area(lobe, table.data[0].astype(np.float64), table.data[1].astype(np.float64), ax)
         print(f"area lights {lobe}:", json.dumps(report["area_lights"][lobe]), flush=True)
     print("area lights published ggx:", json.dumps(report["area_lights"]["published_ggx"]), flush=True)
+    report["machine"]["load_average_at_end"] = list(os.getloadavg())
     (OUT / "ltc.json").write_text(json.dumps(report, indent=1))
     print(f"wrote {OUT / 'ltc.json'}")
 

@@ -24,7 +24,8 @@ MAGNITUDE_ATOL = 1e-6  # the issue's bound: magnitude channel = albedo table
 SPHERE_ATOL = 1e-7  # integrated sphere table vs Snyder's closed form
 PUBLISHED_SPHERE_ATOL = 2e-5  # vs ltc_code's float32 closed form printed with 6 digits
 NO_WORSE_FRACTION = 0.95  # the issue: no worse than the published table at >= 95 % of texels
-AREA_REL_MEDIAN = 0.05  # GGX area lights: median relative error of magnitude x polygon integral
+AREA_REL_MEDIAN = 0.05  # GGX area lights: median relative error of magnitude x polygon integral (measured 0.022; ltc_code 0.020)
+AREA_VS_PUBLISHED = 1.1  # ... and no more than 10 % above the published table's on the same texels and lights
 LAMBERT_ATOL = 1e-6
 
 
@@ -153,16 +154,26 @@ def test_clip_horizon_keeps_the_upper_part():
 
 
 def test_area_lights_ggx_against_brute_force(ggx, coarse):
+    """magnitude x polygon integral vs the brute-force integral of f (n.l) over 12 quad / triangle lights (several
+    crossing the horizon) at 9 texels: lutbake's fit is as good as ltc_code's published one (whose errors here,
+    like ours, come from what one clamped cosine cannot represent: bench_ltc.py reports the full distribution)."""
     texels = [(t, a) for t in (0, 24, 48) for a in (16, 40, 63)]
     idx = np.array([t * N + a for t, a in texels])
     m, _ = fit.fit_texels(ggx, idx, N, coarse)
-    t1 = np.zeros((N, N, 4))
+    t1p, _ = published()
+    ours, pub = np.zeros((N, N, 4)), np.zeros((N, N, 4))
     t2 = np.zeros((N, N, 4))
     for k, (t, a) in enumerate(texels):
-        t1[t, a] = fit.pack_inverse(m[k:k + 1])[0]
-        t2[t, a, 0] = ggx.magnitude[t * N + a]
+        ours[t, a] = fit.pack_inverse(m[k:k + 1])[0]
+        pub[t, a] = t1p[t, a]
+        t2[t, a, 0] = ggx.magnitude[t * N + a]  # the same magnitude for both: the comparison is of the fits
     axes = axes_for({"lobe": "ggx", "size": [N, N]})
-    rows = ltc_area.compare("ggx", t1, t2, axes[1].values(), axes[2].alpha(), texels, s=256)
-    rel = np.array([r["rel_error"] for r in rows if r["rel_error"] is not None])
-    assert len(rel) > len(rows) // 2
-    assert np.median(rel) < AREA_REL_MEDIAN, f"median relative error {np.median(rel):.3f}"
+    medians = {}
+    for name, t1 in (("lutbake", ours), ("ltc_code", pub)):
+        rows = ltc_area.compare("ggx", t1, t2, axes[1].values(), axes[2].alpha(), texels, s=256)
+        rel = np.array([r["rel_error"] for r in rows if r["rel_error"] is not None])
+        assert len(rel) > len(rows) // 2
+        medians[name] = np.median(rel)
+    print("area-light median relative error", medians)
+    assert medians["lutbake"] < AREA_REL_MEDIAN, medians
+    assert medians["lutbake"] <= AREA_VS_PUBLISHED * medians["ltc_code"], medians

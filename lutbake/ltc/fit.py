@@ -66,7 +66,7 @@ def ltc_eval(m_inv: wp.mat33d, det_inv: wp.float64, l: wp.vec3d):
 def kernels(lobe_name: str):
     """(texel_terms, lobe_samples, heitz_error) Warp kernels for a lobe, compiled once per Warp cache."""
     lb = lobe(lobe_name)
-    f_cos, sample, pdf = lb.f_cos, lb.sample, lb.pdf
+    f_cos, sample, pdf, f_pdf = lb.f_cos, lb.sample, lb.pdf, lb.f_pdf
 
     @wp.kernel(enable_backward=False)
     def texel_terms(v: wp.array(dtype=wp.vec3), alpha: wp.array(dtype=float), grid: wp.array(dtype=wp.vec2),
@@ -124,8 +124,9 @@ def kernels(lobe_name: str):
             ld = wp.normalize(mi * cos_dirs[s])
             l = wp.vec3(float(ld[0]), float(ld[1]), float(ld[2]))
             d = ltc_eval(m_inv, det_inv, ld)
-            e = wp.abs(wp.float64(f_cos(vi, l, a)) - mag * d)
-            q = d + wp.float64(pdf(vi, l, a))
+            fp = f_pdf(vi, l, a)
+            e = wp.abs(wp.float64(fp[0]) - mag * d)
+            q = d + wp.float64(fp[1])
             if q > wp.float64(0.0):
                 acc += e * e * e / q
             # lobe sample (precomputed by lobe_samples)

@@ -78,6 +78,15 @@ def ggx_f_cos(v: wp.vec3, l: wp.vec3, alpha: float):
 
 
 @wp.func
+def ggx_f_pdf(v: wp.vec3, l: wp.vec3, alpha: float):
+    """(ggx_f_cos, ggx_pdf) sharing h and D (where f != 0, n.h > 0 and D_ggx_abs = D_ggx)."""
+    h = half_vector(v, l)
+    d = D_ggx_abs(h, alpha)
+    f = smith_f_cos(d, masking.Lambda_ggx(v[2], alpha), masking.Lambda_ggx(l[2], alpha), v[2], l[2])
+    return wp.vec2(f, pdf_reflected_ndf(d, h, v))
+
+
+@wp.func
 def ggx_sample(v: wp.vec3, alpha: float, u1: float, u2: float):
     """ltc_code BrdfGGX::sample: phi = 2 pi u1, slope radius r = alpha sqrt(u2 / (1 - u2)), l = reflect(v, h)."""
     phi = 2.0 * wp.pi * u1
@@ -98,6 +107,15 @@ def beckmann_f_cos(v: wp.vec3, l: wp.vec3, alpha: float):
     h = half_vector(v, l)
     return smith_f_cos(ndf.D_beckmann(h, alpha), masking.Lambda_beckmann(v[2], alpha),
                        masking.Lambda_beckmann(l[2], alpha), v[2], l[2])
+
+
+@wp.func
+def beckmann_f_pdf(v: wp.vec3, l: wp.vec3, alpha: float):
+    """(beckmann_f_cos, beckmann_pdf) sharing h and D."""
+    h = half_vector(v, l)
+    d = D_beckmann_abs(h, alpha)
+    f = smith_f_cos(d, masking.Lambda_beckmann(v[2], alpha), masking.Lambda_beckmann(l[2], alpha), v[2], l[2])
+    return wp.vec2(f, pdf_reflected_ndf(d, h, v))
 
 
 @wp.func
@@ -145,6 +163,16 @@ def cosine_pdf(v: wp.vec3, l: wp.vec3, alpha: float):
     return wp.max(l[2], 0.0) * INV_PI
 
 
+@wp.func
+def charlie_f_pdf(v: wp.vec3, l: wp.vec3, alpha: float):
+    return wp.vec2(charlie_f_cos(v, l, alpha), cosine_pdf(v, l, alpha))
+
+
+@wp.func
+def lambert_f_pdf(v: wp.vec3, l: wp.vec3, alpha: float):
+    return wp.vec2(lambert_f_cos(v, l, alpha), cosine_pdf(v, l, alpha))
+
+
 @dataclass(frozen=True)
 class Lobe:
     name: str
@@ -152,19 +180,20 @@ class Lobe:
     f_cos: object
     sample: object
     pdf: object
+    f_pdf: object  # (f_cos, pdf) at once, sharing the terms both need
     magnitude: str  # how the magnitude / Fresnel channels are integrated (lutbake.ltc.kind)
     roughness: str  # "perceptual": the x axis is r, alpha = r^2; "alpha": the x axis is alpha; "none"
 
 
 LOBES = {
     "ggx": Lobe("ggx", "GGX, height-correlated Smith (ltc_code's BrdfGGX; the reference case)", ggx_f_cos,
-                ggx_sample, ggx_pdf, "dfg:ggx", "perceptual"),
+                ggx_sample, ggx_pdf, ggx_f_pdf, "dfg:ggx", "perceptual"),
     "beckmann": Lobe("beckmann", "Beckmann, height-correlated Smith with the exact Lambda", beckmann_f_cos,
-                     beckmann_sample, beckmann_pdf, "dfg:beckmann", "perceptual"),
+                     beckmann_sample, beckmann_pdf, beckmann_f_pdf, "dfg:beckmann", "perceptual"),
     "charlie": Lobe("charlie", "KHR_materials_sheen: D_charlie V_ashikhmin, alpha = sheenRoughness (gltf-charlie)",
-                    charlie_f_cos, cosine_sample, cosine_pdf, "dfg:charlie", "alpha"),
+                    charlie_f_cos, cosine_sample, cosine_pdf, charlie_f_pdf, "dfg:charlie", "alpha"),
     "lambert": Lobe("lambert", "Lambert (n.l)/pi: its LTC is the identity (a check)", lambert_f_cos, cosine_sample,
-                    cosine_pdf, "lambert", "none"),
+                    cosine_pdf, lambert_f_pdf, "lambert", "none"),
 }
 
 
