@@ -60,7 +60,7 @@ def smith_f_cos(D_h: float, Lambda_v: float, Lambda_l: float, NoV: float, NoL: f
 @wp.func
 def D_ggx_abs(h: wp.vec3, alpha: float):
     """D_ggx evaluated at the upper-hemisphere mirror of h (ltc_code's D uses (n.h)^4 and slopes, even in n.h):
-    only the sampling density uses it, for h with n.h < 0 (l far below the horizon)."""
+    only the sampling density needs it, for h with n.h < 0 (l far below the horizon)."""
     return ndf.D_ggx(wp.vec3(h[0], h[1], wp.abs(h[2])), alpha)
 
 
@@ -71,66 +71,49 @@ def D_beckmann_abs(h: wp.vec3, alpha: float):
 
 
 @wp.func
-def ggx_f_cos(v: wp.vec3, l: wp.vec3, alpha: float):
-    """GGX, height-correlated Smith: f (n.l) = D_ggx(h) G2 / (4 n.v) (ltc_code BrdfGGX::eval)."""
-    h = half_vector(v, l)
-    return smith_f_cos(ndf.D_ggx(h, alpha), masking.Lambda_ggx(v[2], alpha), masking.Lambda_ggx(l[2], alpha), v[2], l[2])
+def slope_radius_ggx(alpha: float, u: float):
+    """ltc_code BrdfGGX::sample: slope radius alpha sqrt(u / (1 - u)) (the GGX NDF's inverse CDF in tan theta_h)."""
+    return alpha * wp.sqrt(u / (1.0 - u))
 
 
 @wp.func
-def ggx_f_pdf(v: wp.vec3, l: wp.vec3, alpha: float):
-    """(ggx_f_cos, ggx_pdf) sharing h and D (where f != 0, n.h > 0 and D_ggx_abs = D_ggx)."""
-    h = half_vector(v, l)
-    d = D_ggx_abs(h, alpha)
-    f = smith_f_cos(d, masking.Lambda_ggx(v[2], alpha), masking.Lambda_ggx(l[2], alpha), v[2], l[2])
-    return wp.vec2(f, pdf_reflected_ndf(d, h, v))
+def slope_radius_beckmann(alpha: float, u: float):
+    """ltc_code BrdfBeckmann::sample: slope radius alpha sqrt(-log u)."""
+    return alpha * wp.sqrt(-wp.log(u))
 
 
-@wp.func
-def ggx_sample(v: wp.vec3, alpha: float, u1: float, u2: float):
-    """ltc_code BrdfGGX::sample: phi = 2 pi u1, slope radius r = alpha sqrt(u2 / (1 - u2)), l = reflect(v, h)."""
-    phi = 2.0 * wp.pi * u1
-    r = alpha * wp.sqrt(u2 / (1.0 - u2))
-    h = wp.normalize(wp.vec3(r * wp.cos(phi), r * wp.sin(phi), 1.0))
-    return reflect(v, h)
+def microfacet_lobe(D_abs, Lambda, slope_radius):
+    """(f_cos, sample, pdf, f_pdf) of a microfacet lobe with height-correlated Smith masking:
+    f (n.l) = D(h) G2 / (4 n.v) (ltc_code Brdf*::eval), l = reflect(v, h) with h of slope radius
+    slope_radius(alpha, u2) at azimuth 2 pi u1, density D (n.h) / (4 |v.h|)."""
+
+    @wp.func
+    def f_pdf(v: wp.vec3, l: wp.vec3, alpha: float):
+        h = half_vector(v, l)
+        d = D_abs(h, alpha)  # = D(h) wherever f != 0 (n.l, n.v > 0 imply n.h > 0)
+        f = smith_f_cos(d, Lambda(v[2], alpha), Lambda(l[2], alpha), v[2], l[2])
+        return wp.vec2(f, pdf_reflected_ndf(d, h, v))
+
+    @wp.func
+    def f_cos(v: wp.vec3, l: wp.vec3, alpha: float):
+        return f_pdf(v, l, alpha)[0]
+
+    @wp.func
+    def pdf(v: wp.vec3, l: wp.vec3, alpha: float):
+        return f_pdf(v, l, alpha)[1]
+
+    @wp.func
+    def sample(v: wp.vec3, alpha: float, u1: float, u2: float):
+        phi = 2.0 * wp.pi * u1
+        r = slope_radius(alpha, u2)
+        h = wp.normalize(wp.vec3(r * wp.cos(phi), r * wp.sin(phi), 1.0))
+        return reflect(v, h)
+
+    return f_cos, sample, pdf, f_pdf
 
 
-@wp.func
-def ggx_pdf(v: wp.vec3, l: wp.vec3, alpha: float):
-    h = half_vector(v, l)
-    return pdf_reflected_ndf(D_ggx_abs(h, alpha), h, v)
-
-
-@wp.func
-def beckmann_f_cos(v: wp.vec3, l: wp.vec3, alpha: float):
-    """Beckmann, height-correlated Smith with the exact Lambda (Heitz 2014, Eq. 69)."""
-    h = half_vector(v, l)
-    return smith_f_cos(ndf.D_beckmann(h, alpha), masking.Lambda_beckmann(v[2], alpha),
-                       masking.Lambda_beckmann(l[2], alpha), v[2], l[2])
-
-
-@wp.func
-def beckmann_f_pdf(v: wp.vec3, l: wp.vec3, alpha: float):
-    """(beckmann_f_cos, beckmann_pdf) sharing h and D."""
-    h = half_vector(v, l)
-    d = D_beckmann_abs(h, alpha)
-    f = smith_f_cos(d, masking.Lambda_beckmann(v[2], alpha), masking.Lambda_beckmann(l[2], alpha), v[2], l[2])
-    return wp.vec2(f, pdf_reflected_ndf(d, h, v))
-
-
-@wp.func
-def beckmann_sample(v: wp.vec3, alpha: float, u1: float, u2: float):
-    """ltc_code BrdfBeckmann::sample: phi = 2 pi u1, slope radius r = alpha sqrt(-log u2)."""
-    phi = 2.0 * wp.pi * u1
-    r = alpha * wp.sqrt(-wp.log(u2))
-    h = wp.normalize(wp.vec3(r * wp.cos(phi), r * wp.sin(phi), 1.0))
-    return reflect(v, h)
-
-
-@wp.func
-def beckmann_pdf(v: wp.vec3, l: wp.vec3, alpha: float):
-    h = half_vector(v, l)
-    return pdf_reflected_ndf(D_beckmann_abs(h, alpha), h, v)
+GGX_FUNCS = microfacet_lobe(D_ggx_abs, masking.Lambda_ggx, slope_radius_ggx)
+BECKMANN_FUNCS = microfacet_lobe(D_beckmann_abs, masking.Lambda_beckmann, slope_radius_beckmann)
 
 
 @wp.func
@@ -186,10 +169,10 @@ class Lobe:
 
 
 LOBES = {
-    "ggx": Lobe("ggx", "GGX, height-correlated Smith (ltc_code's BrdfGGX; the reference case)", ggx_f_cos,
-                ggx_sample, ggx_pdf, ggx_f_pdf, "dfg:ggx", "perceptual"),
-    "beckmann": Lobe("beckmann", "Beckmann, height-correlated Smith with the exact Lambda", beckmann_f_cos,
-                     beckmann_sample, beckmann_pdf, beckmann_f_pdf, "dfg:beckmann", "perceptual"),
+    "ggx": Lobe("ggx", "GGX, height-correlated Smith (ltc_code's BrdfGGX; the reference case)", *GGX_FUNCS,
+                "dfg:ggx", "perceptual"),
+    "beckmann": Lobe("beckmann", "Beckmann, height-correlated Smith with the exact Lambda", *BECKMANN_FUNCS,
+                     "dfg:beckmann", "perceptual"),
     "charlie": Lobe("charlie", "KHR_materials_sheen: D_charlie V_ashikhmin, alpha = sheenRoughness (gltf-charlie)",
                     charlie_f_cos, cosine_sample, cosine_pdf, charlie_f_pdf, "dfg:charlie", "alpha"),
     "lambert": Lobe("lambert", "Lambert (n.l)/pi: its LTC is the identity (a check)", lambert_f_cos, cosine_sample,
