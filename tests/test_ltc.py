@@ -177,3 +177,26 @@ def test_area_lights_ggx_against_brute_force(ggx, coarse):
     print("area-light median relative error", medians)
     assert medians["lutbake"] < AREA_REL_MEDIAN, medians
     assert medians["lutbake"] <= AREA_VS_PUBLISHED * medians["ltc_code"], medians
+
+
+# Unity-Technologies/Graphics, Packages/com.unity.render-pipelines.high-definition/Runtime/Material/LTCAreaLight/
+# Generated/LtcData.BRDF_GGX.cs @ 77535410d2c8ed6c459db07f854b8c572ed08f9a (Unity Companion License): FP16 bits of
+# row thetaIndex = 1 (cos theta = 0.9997481) at roughnessIndex 20, 40 and row 2 at 20, 40 (HDRP's own fit).
+HDRP_GGX_ROWS = {(1, 20): (17652, 42421, 17652, 12061), (1, 40): (15758, 42013, 15759, 10013),
+                 (2, 20): (17652, 43446, 17654, 13086), (2, 40): (15757, 43048, 15759, 11041)}
+HDRP_RTOL = 2e-3  # HDRP's fit vs ltc_code's at smooth texels, FP16: measured 9.5e-4 (a wrong order, sign or scale: > 1)
+
+
+def test_hdrp_packing_matches_hdrp_shipped_ggx_texels():
+    from lutbake.ltc.export import hdrp_pack
+
+    t1, _ = published()
+    for (t, a), bits in HDRP_GGX_ROWS.items():
+        hdrp = np.array(bits, np.uint16).view(np.float16).astype(np.float64)
+        ours = hdrp_pack(t1[t, a])
+        np.testing.assert_allclose(ours, hdrp, rtol=HDRP_RTOL, err_msg=f"texel (t={t}, a={a})")
+    # both packings describe the same M^-1 up to scale
+    x = hdrp_pack(t1[5, 30])
+    inv_h = np.array([[x[0], 0, x[3]], [0, x[2], 0], [x[1], 0, 1.0]])
+    inv_l = polygon.inverse_matrix(t1[5, 30])
+    np.testing.assert_allclose(inv_h / inv_h[1, 1], inv_l, rtol=1e-12)

@@ -45,6 +45,8 @@ FORMATS = {
     "js": "three.js ES module: LTC_MAT_1 / LTC_MAT_2 Float32Arrays as RectAreaLightTexturesLib's, .z of "
           "LTC_MAT_2 = 0",
     "c": "Blender EEVEE C arrays ltc_mat_<lobe>[N][N][4], ltc_mag_<lobe>[N][N][2], ltc_disk_integral[N][N][1]",
+    "cs": "Unity HDRP C# table s_LtcMatrixData_BRDF_<LOBE> (ushort FP16 bits, one RGBA16F slice of _LtcData): "
+          "(M^-1_00, M^-1_20, M^-1_11, M^-1_02) / M^-1_22",
 }
 KEYS = {
     "name": Key("name", "name", None, "output stem: <out-dir>/<name>.<ext>", required=True),
