@@ -96,10 +96,18 @@ def test_pack_unpack_round_trip_and_published_layout():
     np.testing.assert_array_equal(t1[0, :, 0], 1.0)
 
 
-def test_ltc_bake_magnitude_equals_albedo_table(tmp_path):
-    size = 8
-    spec = load_configs([Path("lutbake/presets/ltc-ggx.toml")], [f"size=[{size},{size}]", 'format="exr"'])
-    ltc = api.bake(spec, out_dir=tmp_path, workers=2)[0].table
+SMALL = 8
+
+
+@pytest.fixture(scope="module")
+def small_ltc(tmp_path_factory):
+    spec = load_configs([Path("lutbake/presets/ltc-ggx.toml")], [f"size=[{SMALL},{SMALL}]", 'format="exr"'])
+    return api.bake(spec, out_dir=tmp_path_factory.mktemp("ltc"), workers=2)[0].table
+
+
+def test_ltc_bake_magnitude_equals_albedo_table(small_ltc, tmp_path):
+    size = SMALL
+    ltc = small_ltc
     cfg = tmp_path / "albedo.toml"
     cfg.write_text('[[table]]\nname = "e"\nkind = "albedo"\n'
                    f'size = [{size}, {size}]\ntexel = "endpoint"\naxis_order = "roughness_x"\n'
@@ -200,3 +208,36 @@ def test_hdrp_packing_matches_hdrp_shipped_ggx_texels():
     inv_h = np.array([[x[0], 0, x[3]], [0, x[2], 0], [x[1], 0, 1.0]])
     inv_l = polygon.inverse_matrix(t1[5, 30])
     np.testing.assert_allclose(inv_h / inv_h[1, 1], inv_l, rtol=1e-12)
+
+
+def test_engine_layouts_hold_the_table(small_ltc, tmp_path):
+    from lutbake.io.formats import write_table
+    from lutbake.ltc.export import FP16_MAX, hdrp_fp16, hdrp_pack
+    from test_formats import read_dds_spec
+
+    t1 = small_ltc.data[0].astype(np.float32)
+    t2 = small_ltc.data[1].astype(np.float32)
+    p = write_table(small_ltc, tmp_path, "ltc_dds", "half")
+    d1 = read_dds_spec(p.read_bytes())[0]
+    d2 = read_dds_spec((tmp_path / "ltc_ggx_2.dds").read_bytes())[0]
+    np.testing.assert_array_equal(d1, t1.astype(np.float16))
+    np.testing.assert_array_equal(d2[..., [0, 1, 3]], t2[..., [0, 1, 3]].astype(np.float16))
+    np.testing.assert_array_equal(d2[..., 2], 0)  # ltc_code's unused channel
+    num = re.compile(r"-?[0-9.]+(?:e[-+]?[0-9]+)?")
+    js = write_table(small_ltc, tmp_path, "js").read_text()
+    m1 = js.split("LTC_MAT_1 = new Float32Array([")[1].split("])")[0]
+    np.testing.assert_array_equal(np.array(num.findall(m1), np.float32).reshape(SMALL, SMALL, 4), t1)
+    c = write_table(small_ltc, tmp_path, "c").read_text()
+    mag = c.split("ltc_mag_ggx[8][8][2] = {")[1].split("};")[0]
+    np.testing.assert_array_equal(np.array([float(x) for x in num.findall(mag)], np.float32).reshape(8, 8, 2),
+                                  t2[..., :2])
+    spec = load_configs([Path("lutbake/presets/ltc-hdrp.toml")], [f"size=[{SMALL},{SMALL}]"])[0]
+    hdrp = api.bake([spec], out_dir=tmp_path, workers=2, write=False)[0].table
+    t1 = hdrp.data[0].astype(np.float32)
+    cs = write_table(hdrp, tmp_path, "cs").read_text()
+    body = cs.split("new ushort[8 * 8 * 4]")[1]
+    bits = np.array([int(x) for x in re.findall(r"^\s+([0-9, ]+),$", body, re.M) for x in x.split(",")], np.uint16)
+    np.testing.assert_array_equal(bits.reshape(8, 8, 4), hdrp_fp16(t1).view(np.uint16))
+    finite = np.abs(hdrp_pack(t1)) <= FP16_MAX
+    assert finite.mean() > 0.9  # only smooth grazing texels saturate (HDRP's shipped table saturates there too)
+    np.testing.assert_allclose(hdrp_fp16(t1)[finite].astype(np.float64), hdrp_pack(t1)[finite], rtol=1e-3)

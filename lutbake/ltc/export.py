@@ -21,6 +21,7 @@ import numpy as np
 
 from ..table import Table
 
+FP16_MAX = 65504.0
 EXTENSIONS = {"ltc_dds": "_1.dds", "js": ".js", "c": ".cc", "cs": ".cs"}
 
 
@@ -125,6 +126,12 @@ def hdrp_pack(ltc_1: np.ndarray) -> np.ndarray:
     return np.stack([x / w, y / w, 1.0 / w, z / w], axis=-1)
 
 
+def hdrp_fp16(ltc_1: np.ndarray) -> np.ndarray:
+    """hdrp_pack as FP16, saturated to +-65504: at smooth, grazing texels M^-1_11 / M^-1_22 exceeds FP16, and HDRP's
+    shipped table holds 65504 there (bits 31743, e.g. its last row at alpha = 0.001), i.e. it saturates too."""
+    return np.clip(hdrp_pack(ltc_1), -FP16_MAX, FP16_MAX).astype(np.float16)
+
+
 def cs_text(table: Table) -> str:
     from .. import __version__
     import json
@@ -132,7 +139,7 @@ def cs_text(table: Table) -> str:
     t1, _ = engine_textures(table)
     n_y, n_x = t1.shape[:2]
     lobe = json.loads(table.attributes.get("terms", "{}")).get("lobe", "ggx").upper()
-    bits = hdrp_pack(t1).astype(np.float16).view(np.uint16)
+    bits = hdrp_fp16(t1).view(np.uint16)
     rows = []
     for t in range(n_y):
         rows.append(f"            // row {t}: cos(theta) = 1 - ({t} / {n_y - 1})^2")
@@ -143,7 +150,8 @@ def cs_text(table: Table) -> str:
             "        // 3x3 coefficients of M^-1 (Heitz et al. 2016 LTC), FP16 bits, as HDRP's Generated/LtcData.BRDF_*.cs:\n"
             "        // element (<roughnessIndex> + N * <thetaIndex>) * 4, roughness = (index / (N - 1))^2 (perceptual axis),\n"
             "        // cosTheta = 1 - (thetaIndex / (N - 1))^2; texel = (M^-1_00, M^-1_20, M^-1_11, M^-1_02) / M^-1_22, read by\n"
-            "        // SampleLtcMatrix as invM._m00_m02_m11_m20 with invM._m22 = 1 (the transpose of M^-1).\n"
+            "        // SampleLtcMatrix as invM._m00_m02_m11_m20 with invM._m22 = 1 (the transpose of M^-1); saturated to\n"
+            "        // +-65504 where the ratio exceeds FP16 (smooth, grazing texels), as HDRP's own table.\n"
             f"        internal static ushort[] s_LtcMatrixData_BRDF_{lobe} = new ushort[{n_x} * {n_y} * 4]\n        {{\n"
             + "\n".join(rows) + "\n        };\n    }\n}\n")
 

@@ -57,6 +57,9 @@ KEYS = {
                        "sampling technique (ltc_code Nsample = 32)", minimum=4, maximum=256),
     "samples": Key("samples", "int", None, "Gauss-Legendre budget of the magnitude / fresnel integrals per texel; "
                    "omitted: 432 (ggx, beckmann), 3072 (charlie)", minimum=12, maximum=1 << 20),
+    "alpha_min": Key("alpha_min", "float", ALPHA_MIN, "smallest NDF alpha fitted (lutbake's edge policy: 1e-4; Unity "
+                     "HDRP's own fit: 1e-3)",
+                     minimum=ALPHA_MIN, maximum=0.1),
     "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}),
     "format": Key("format", "str", "exr", "output file format", FORMATS),
 }
@@ -87,10 +90,11 @@ def axes_for(o: dict) -> list[Axis]:
             Axis(rname, "x", n_rough, 0.0, 1.0, texel="endpoint")]
 
 
-def texel_params(axes: list[Axis]) -> tuple[np.ndarray, np.ndarray]:
-    """Per texel of one slice, row-major (y = view slowest): (NoV, alpha) as float32."""
+def texel_params(axes: list[Axis], alpha_min: float = ALPHA_MIN) -> tuple[np.ndarray, np.ndarray]:
+    """Per texel of one slice, row-major (y = view slowest): (NoV, alpha) as float32, alpha >= alpha_min."""
     _, view, rough = axes
-    return np.repeat(view.values(), rough.count), np.tile(rough.alpha(), view.count)
+    alpha = np.maximum(rough.alpha(), np.float32(alpha_min))
+    return np.repeat(view.values(), rough.count), np.tile(alpha, view.count)
 
 
 def magnitude_fresnel(lobe_name: str, nov: np.ndarray, alpha: np.ndarray, samples: int | None,
@@ -122,7 +126,7 @@ class LtcBake:
     def __init__(self, o: dict, axes: list[Axis]):
         self.o = o
         self.axes = axes
-        self.nov, self.alpha = texel_params(axes)
+        self.nov, self.alpha = texel_params(axes, o["alpha_min"])
         self.n_view, self.n_rough = axes[1].count, axes[2].count
         self._lock = threading.Lock()
         self._fits: dict[tuple[int, int], tuple[threading.Lock, list]] = {}
@@ -201,7 +205,7 @@ def plan(spec) -> Plan:
                      f"{list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11)",
         "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses; each texel starts from the "
                    "best of the analytic guesses and the surrounding coarse fits (no chaining)",
-        "alpha_min": ALPHA_MIN, "theta_max": THETA_MAX,
+        "alpha_min": o["alpha_min"], "theta_max": THETA_MAX,
         "magnitude": f"Gauss-Legendre, {m_samples} samples (lutbake albedo / dfg kernels)"}),
         "ltc_texture_slices": "slice_0 = ltc_1 (inverse matrix), slice_1 = ltc_2 (magnitude, fresnel, fit_error, "
                               "sphere)"}
