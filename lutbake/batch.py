@@ -37,7 +37,7 @@ from .config import TableSpec
 
 PACKAGE = Path(__file__).parent
 # the modules whose source defines what a table holds (kernels, terms, estimators, axes, edge policy)
-HASH_SOURCES = ("terms/*.py", "sampling/*.py", "tables/*.py", "axes.py", "edge.py")
+HASH_SOURCES = ("terms/*.py", "sampling/*.py", "tables/*.py", "ltc/*.py", "axes.py", "edge.py")
 HASH_ATTRIBUTE = "content_hash"
 STATUSES = ("baked", "skipped", "failed", "interrupted")
 EXIT_OK, EXIT_FAILED, EXIT_SIGINT, EXIT_SIGTERM = 0, 1, 130, 143
