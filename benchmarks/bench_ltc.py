@@ -9,6 +9,7 @@
 5. Area lights (lutbake.validate.ltc_area): relative error of magnitude x polygon integral against the brute
    force, per lobe and roughness, for lutbake's tables and the published GGX table.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -45,13 +46,17 @@ def published():
     text = gzip.decompress((ROOT / "tests" / "data" / "ltc_code_ltc.js.gz").read_bytes()).decode()
     a, b = text.split("var g_ltc_2")
     num = re.compile(r"-?[0-9.]+(?:e[-+]?[0-9]+)?")
-    return (np.array([float(x) for x in num.findall(a.split("[", 1)[1])]).reshape(N, N, 4),
-            np.array([float(x) for x in num.findall(b.split("[", 1)[1])]).reshape(N, N, 4))
+    return (
+        np.array([float(x) for x in num.findall(a.split("[", 1)[1])]).reshape(N, N, 4),
+        np.array([float(x) for x in num.findall(b.split("[", 1)[1])]).reshape(N, N, 4),
+    )
 
 
 def bake(lobe: str, workers: int):
-    spec = load_configs([ROOT / "lutbake" / "presets" / "ltc-ggx.toml"],
-                        [f'lobe="{lobe}"', f'name="ltc_{lobe}"', 'format="exr"', 'dtype="float32"'])[0]
+    spec = load_configs(
+        [ROOT / "lutbake" / "presets" / "ltc-ggx.toml"],
+        [f'lobe="{lobe}"', f'name="ltc_{lobe}"', 'format="exr"', 'dtype="float32"'],
+    )[0]
     cpu0 = time.process_time()
     table, seconds, _ = bake_table(spec, workers=workers, progress=False)
     return table, seconds, time.process_time() - cpu0
@@ -76,11 +81,17 @@ def main(argv=None):
     for lobe in args.lobes.split(","):
         table, seconds, cpu = bake(lobe, workers)
         tables[lobe] = table
-        report["lobes"][lobe] = {"seconds": round(seconds, 2), "cpu_seconds": round(cpu, 2), "size": "64x64",
-                                 **{k: float(v) for k, v in table.attributes.items()
-                                    if k.startswith("fit_error_")}}
-        print(f"{lobe}: {seconds:.1f} s wall, {cpu:.1f} s CPU, fit error median {table.attributes['fit_error_median']}, "
-              f"max {table.attributes['fit_error_max']}", flush=True)
+        report["lobes"][lobe] = {
+            "seconds": round(seconds, 2),
+            "cpu_seconds": round(cpu, 2),
+            "size": "64x64",
+            **{k: float(v) for k, v in table.attributes.items() if k.startswith("fit_error_")},
+        }
+        print(
+            f"{lobe}: {seconds:.1f} s wall, {cpu:.1f} s CPU, fit error median {table.attributes['fit_error_median']}, "
+            f"max {table.attributes['fit_error_max']}",
+            flush=True,
+        )
 
     axes = axes_for({"lobe": "ggx", "size": [N, N]})
     nov, alpha = texel_params(axes)
@@ -97,7 +108,8 @@ def main(argv=None):
         "fraction_no_worse": float(np.mean(e_ours <= e_pub)),
         "relative_error_median": {"lutbake": float(np.median(r_ours)), "ltc_code": float(np.median(r_pub))},
         "relative_error_max": {"lutbake": float(r_ours.max()), "ltc_code": float(r_pub.max())},
-        "note": "lutbake's table is stored as float32; the fit itself is float64"}
+        "note": "lutbake's table is stored as float32; the fit itself is float64",
+    }
     print("GGX vs published:", json.dumps(report["ggx_vs_published"]), flush=True)
 
     # objective backends: Warp kernel vs numpy port, per (texel, candidate) evaluation
@@ -112,26 +124,37 @@ def main(argv=None):
     for k in sub:
         ltc_port.compute_error(m[k], mag[k], prob.v[k].astype(np.float64), float(alpha[k]))
     numpy_us = (time.perf_counter() - t0) / len(sub) * 1e6
-    report["objective_us_per_eval"] = {"warp_kernel_1_thread": round(warp_us, 1), "numpy_port": round(numpy_us, 1),
-                                       "ratio": round(numpy_us / warp_us, 1)}
+    report["objective_us_per_eval"] = {
+        "warp_kernel_1_thread": round(warp_us, 1),
+        "numpy_port": round(numpy_us, 1),
+        "ratio": round(numpy_us / warp_us, 1),
+    }
     print("objective us/eval:", report["objective_us_per_eval"], flush=True)
 
     # the straight port of fitTab on a subset, extrapolated
     rng = np.random.default_rng(0)
-    pick = [(int(t), int(a)) for t, a in zip(rng.integers(1, N, args.port_texels), rng.integers(0, N, args.port_texels))]
+    pick = [
+        (int(t), int(a)) for t, a in zip(rng.integers(1, N, args.port_texels), rng.integers(0, N, args.port_texels))
+    ]
     t0 = time.perf_counter()
     ltc_port.fit_tab(N, pick)
     per_texel = (time.perf_counter() - t0) / len(pick)
     est = per_texel * N * N
     report["baseline_straight_port"] = {
-        "texels_run": len(pick), "seconds_per_texel": round(per_texel, 3), "extrapolated_64x64_s": round(est, 1),
+        "texels_run": len(pick),
+        "seconds_per_texel": round(per_texel, 3),
+        "extrapolated_64x64_s": round(est, 1),
         "ratio_to_lutbake_ggx": round(est / report["lobes"]["ggx"]["seconds"], 1),
-        "note": "single thread; run on a random subset of texels (chained within the subset) and extrapolated"}
+        "note": "single thread; run on a random subset of texels (chained within the subset) and extrapolated",
+    }
     print("straight port:", report["baseline_straight_port"], flush=True)
 
     # area lights
-    report["area_lights"] = {"lights": [name for name, _ in ltc_area.light_set()],
-                             "texels": AREA_TEXELS, "published_ggx": area("ggx", t1p, t2p, axes)}
+    report["area_lights"] = {
+        "lights": [name for name, _ in ltc_area.light_set()],
+        "texels": AREA_TEXELS,
+        "published_ggx": area("ggx", t1p, t2p, axes),
+    }
     for lobe, table in tables.items():
         ax = axes_for({"lobe": lobe, "size": [N, N]})
         report["area_lights"][lobe] = area(lobe, table.data[0].astype(np.float64), table.data[1].astype(np.float64), ax)

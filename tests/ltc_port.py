@@ -4,6 +4,7 @@ computeError, NelderMead, fitTab's chained loop), float64, the sample loops vect
 Used by the tests as an independent implementation of Heitz's error metric and by `make bench` as the
 single-threaded baseline of the fit (benchmarks/bench_ltc.py). Nothing here imports lutbake.ltc.fit.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -59,7 +60,7 @@ def ltc_eval(m, magnitude, l):
     lo /= np.linalg.norm(lo, axis=1, keepdims=True)
     l_ = lo @ m.T
     ln = np.linalg.norm(l_, axis=1)
-    jac = abs(np.linalg.det(m)) / ln ** 3
+    jac = abs(np.linalg.det(m)) / ln**3
     d = np.maximum(0.0, lo[:, 2]) / PI
     return magnitude * d / jac
 

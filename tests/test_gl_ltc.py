@@ -2,6 +2,7 @@
 docs/shaders/lutbake_ltc.glsl integrates a quad light with them at random shading points (random normal, view,
 roughness, f0 and light), and the result equals lutbake.ltc.polygon.shade evaluated on the CPU from the same
 texels (same uv, same edge-integral fit, float64). Skipped where no GL context exists (see test_gl_consumer)."""
+
 from pathlib import Path
 
 import numpy as np
@@ -79,7 +80,9 @@ def test_gl_integrates_a_quad_light_with_the_ltc_tables(ctx, tmp_path):  # noqa:
             flat out vec2 rf;
             void main() {{ n = in_n; v = in_v; p0 = in_p0; p1 = in_p1; p2 = in_p2; p3 = in_p3; rf = in_rf;
                 gl_Position = vec4((in_i + 0.5) / {N_POINTS}.0 * 2.0 - 1.0, 0.0, 0.0, 1.0); gl_PointSize = 1.0; }}""",
-        fragment_shader=f"#version 330\n#define LUTBAKE_LTC_SIZE {SIZE}.0\n" + SNIPPET.read_text() + """
+        fragment_shader=f"#version 330\n#define LUTBAKE_LTC_SIZE {SIZE}.0\n"
+        + SNIPPET.read_text()
+        + """
             uniform sampler2D ltc_1; uniform sampler2D ltc_2;
             flat in vec3 n; flat in vec3 v; flat in vec3 p0; flat in vec3 p1; flat in vec3 p2; flat in vec3 p3;
             flat in vec2 rf; out vec4 color;
@@ -87,13 +90,15 @@ def test_gl_integrates_a_quad_light_with_the_ltc_tables(ctx, tmp_path):  # noqa:
                 vec3 p[4] = vec3[4](p0, p1, p2, p3);
                 vec3 s = lutbake_ltc_specular(ltc_1, ltc_2, n, v, rf.x, vec3(rf.y), p, vec3(1.0), true);
                 color = vec4(s, 1.0);
-            }""")
+            }""",
+    )
     prog["ltc_1"].value = 0
     prog["ltc_2"].value = 1
     data = np.concatenate([attrs, np.arange(N_POINTS, dtype=np.float32)[:, None]], axis=1)
     vbo = ctx.buffer(np.ascontiguousarray(data).tobytes())
-    vao = ctx.vertex_array(prog, [(vbo, "3f 3f 3f 3f 3f 3f 2f 1f", "in_n", "in_v", "in_p0", "in_p1", "in_p2", "in_p3",
-                                   "in_rf", "in_i")])
+    vao = ctx.vertex_array(
+        prog, [(vbo, "3f 3f 3f 3f 3f 3f 2f 1f", "in_n", "in_v", "in_p0", "in_p1", "in_p2", "in_p3", "in_rf", "in_i")]
+    )
     fbo.use()
     texs[0].use(0)
     texs[1].use(1)
@@ -104,9 +109,15 @@ def test_gl_integrates_a_quad_light_with_the_ltc_tables(ctx, tmp_path):  # noqa:
         o.release()
 
     t1c, t2c = t1.astype(np.float64), t2.astype(np.float64)
-    want = np.array([polygon.shade(t1c, t2c, a[-2], nov, quad, f0=a[-1], edge=polygon.edge_fitted)
-                     for a, (rough, nov, f0, r, quad) in zip(attrs.astype(np.float64), cases)])
+    want = np.array(
+        [
+            polygon.shade(t1c, t2c, a[-2], nov, quad, f0=a[-1], edge=polygon.edge_fitted)
+            for a, (rough, nov, f0, r, quad) in zip(attrs.astype(np.float64), cases)
+        ]
+    )
     lit = want > 1e-3
     assert lit.sum() > N_POINTS // 3, "too few lit cases to test anything"
-    print(f"max |GL - CPU| {np.abs(got - want).max():.2e}, max rel (lit) {np.max(np.abs(got - want)[lit] / want[lit]):.2e}")
+    print(
+        f"max |GL - CPU| {np.abs(got - want).max():.2e}, max rel (lit) {np.max(np.abs(got - want)[lit] / want[lit]):.2e}"
+    )
     np.testing.assert_allclose(got, want, rtol=GL_RTOL, atol=GL_ATOL)

@@ -1,6 +1,7 @@
 """Kind ltc (Heitz et al. 2016 LTC fits): the metric against a straight port of ltc_code, the published GGX
 table, the magnitude = albedo identity, the sphere table's closed form, independence of tiling, the Lambert
 identity, polygon integrals and the area-light ground truth."""
+
 from __future__ import annotations
 
 import gzip
@@ -24,7 +25,9 @@ MAGNITUDE_ATOL = 1e-6  # the issue's bound: magnitude channel = albedo table
 SPHERE_ATOL = 1e-7  # integrated sphere table vs Snyder's closed form
 PUBLISHED_SPHERE_ATOL = 2e-5  # vs ltc_code's float32 closed form printed with 6 digits
 NO_WORSE_FRACTION = 0.95  # the issue: no worse than the published table at >= 95 % of texels
-AREA_REL_MEDIAN = 0.05  # GGX area lights: median relative error of magnitude x polygon integral (measured 0.022; ltc_code 0.020)
+AREA_REL_MEDIAN = (
+    0.05  # GGX area lights: median relative error of magnitude x polygon integral (measured 0.022; ltc_code 0.020)
+)
 AREA_VS_PUBLISHED = 1.1  # ... and no more than 10 % above the published table's on the same texels and lights
 LAMBERT_ATOL = 1e-6
 
@@ -55,7 +58,9 @@ def coarse(ggx):
 def test_heitz_metric_equals_a_straight_port_of_computeError(ggx):
     rng = np.random.default_rng(3)
     texels = rng.choice(N * N, 12, replace=False)
-    q = np.stack([np.log(rng.uniform(0.05, 1.0, 12)), np.log(rng.uniform(0.05, 1.0, 12)), rng.uniform(-.3, .3, 12)], 1)
+    q = np.stack(
+        [np.log(rng.uniform(0.05, 1.0, 12)), np.log(rng.uniform(0.05, 1.0, 12)), rng.uniform(-0.3, 0.3, 12)], 1
+    )
     m = ggx.matrices(texels, q)
     ours = ggx.error(texels, m)
     for k, t in enumerate(texels):
@@ -87,7 +92,7 @@ def test_pack_unpack_round_trip_and_published_layout():
     rng = np.random.default_rng(0)
     m = np.zeros((5, 3, 3))
     m[:, 0, 0], m[:, 1, 1], m[:, 2, 2] = rng.uniform(0.1, 1, 5), rng.uniform(0.1, 1, 5), 1.0
-    m[:, 0, 2], m[:, 2, 0] = rng.uniform(-.5, .5, 5), rng.uniform(-.5, .5, 5)
+    m[:, 0, 2], m[:, 2, 0] = rng.uniform(-0.5, 0.5, 5), rng.uniform(-0.5, 0.5, 5)
     inv = np.linalg.inv(m)
     np.testing.assert_allclose(fit.unpack_inverse(fit.pack_inverse(m)), inv / inv[:, 1:2, 1:2], rtol=1e-12)
     # the published first row (t = 0, normal incidence) is diagonal: (m22 / m11 = 1, 0, 0, m22)
@@ -109,9 +114,11 @@ def test_ltc_bake_magnitude_equals_albedo_table(small_ltc, tmp_path):
     size = SMALL
     ltc = small_ltc
     cfg = tmp_path / "albedo.toml"
-    cfg.write_text('[[table]]\nname = "e"\nkind = "albedo"\n'
-                   f'size = [{size}, {size}]\ntexel = "endpoint"\naxis_order = "roughness_x"\n'
-                   f'nov_mapping = "one_minus_t2"\nnov_clamp = [{float(np.cos(np.float32(1.57)))!r}, 1.0]\n')
+    cfg.write_text(
+        '[[table]]\nname = "e"\nkind = "albedo"\n'
+        f'size = [{size}, {size}]\ntexel = "endpoint"\naxis_order = "roughness_x"\n'
+        f'nov_mapping = "one_minus_t2"\nnov_clamp = [{float(np.cos(np.float32(1.57)))!r}, 1.0]\n'
+    )
     alb = api.bake([cfg], out_dir=tmp_path, workers=1, write=False)[0].table
     assert [a.name for a in alb.axes] == ["NoV", "perceptual_roughness"]
     np.testing.assert_array_equal(alb.axes[0].values(), ltc.axes[1].values())
@@ -123,8 +130,11 @@ def test_ltc_bake_magnitude_equals_albedo_table(small_ltc, tmp_path):
 def test_sphere_table_integration_matches_snyder_closed_form():
     rng = np.random.default_rng(7)
     for omega, sigma in zip(rng.uniform(0, np.pi, 300), rng.uniform(1e-3, np.pi / 2, 300)):
-        np.testing.assert_allclose(sphere.cap_projected_solid_angle(omega, sigma), sphere.snyder_cap(omega, sigma),
-                                   atol=SPHERE_ATOL * np.pi * np.sin(sigma) ** 2)
+        np.testing.assert_allclose(
+            sphere.cap_projected_solid_angle(omega, sigma),
+            sphere.snyder_cap(omega, sigma),
+            atol=SPHERE_ATOL * np.pi * np.sin(sigma) ** 2,
+        )
 
 
 def test_sphere_table_matches_published_channel():
@@ -150,8 +160,7 @@ def test_form_factor_of_polygons_against_cosine_sampling():
     for _, poly in ltc_area.light_set():
         mc = np.mean(ltc_area.hits(l, poly))
         np.testing.assert_allclose(abs(polygon.form_factor(poly)), mc, atol=4e-3)
-        np.testing.assert_allclose(polygon.form_factor(poly, polygon.edge_fitted), polygon.form_factor(poly),
-                                   atol=1e-3)
+        np.testing.assert_allclose(polygon.form_factor(poly, polygon.edge_fitted), polygon.form_factor(poly), atol=1e-3)
 
 
 def test_clip_horizon_keeps_the_upper_part():
@@ -172,7 +181,7 @@ def test_area_lights_ggx_against_brute_force(ggx, coarse):
     ours, pub = np.zeros((N, N, 4)), np.zeros((N, N, 4))
     t2 = np.zeros((N, N, 4))
     for k, (t, a) in enumerate(texels):
-        ours[t, a] = fit.pack_inverse(m[k:k + 1])[0]
+        ours[t, a] = fit.pack_inverse(m[k : k + 1])[0]
         pub[t, a] = t1p[t, a]
         t2[t, a, 0] = ggx.magnitude[t * N + a]  # the same magnitude for both: the comparison is of the fits
     axes = axes_for({"lobe": "ggx", "size": [N, N]})
@@ -190,8 +199,12 @@ def test_area_lights_ggx_against_brute_force(ggx, coarse):
 # Unity-Technologies/Graphics, Packages/com.unity.render-pipelines.high-definition/Runtime/Material/LTCAreaLight/
 # Generated/LtcData.BRDF_GGX.cs @ 77535410d2c8ed6c459db07f854b8c572ed08f9a (Unity Companion License): FP16 bits of
 # row thetaIndex = 1 (cos theta = 0.9997481) at roughnessIndex 20, 40 and row 2 at 20, 40 (HDRP's own fit).
-HDRP_GGX_ROWS = {(1, 20): (17652, 42421, 17652, 12061), (1, 40): (15758, 42013, 15759, 10013),
-                 (2, 20): (17652, 43446, 17654, 13086), (2, 40): (15757, 43048, 15759, 11041)}
+HDRP_GGX_ROWS = {
+    (1, 20): (17652, 42421, 17652, 12061),
+    (1, 40): (15758, 42013, 15759, 10013),
+    (2, 20): (17652, 43446, 17654, 13086),
+    (2, 40): (15757, 43048, 15759, 11041),
+}
 HDRP_RTOL = 2e-3  # HDRP's fit vs ltc_code's at smooth texels, FP16: measured 9.5e-4 (a wrong order, sign or scale: > 1)
 
 
@@ -229,8 +242,9 @@ def test_engine_layouts_hold_the_table(small_ltc, tmp_path):
     np.testing.assert_array_equal(np.array(num.findall(m1), np.float32).reshape(SMALL, SMALL, 4), t1)
     c = write_table(small_ltc, tmp_path, "c").read_text()
     mag = c.split("ltc_mag_ggx[8][8][2] = {")[1].split("};")[0]
-    np.testing.assert_array_equal(np.array([float(x) for x in num.findall(mag)], np.float32).reshape(8, 8, 2),
-                                  t2[..., :2])
+    np.testing.assert_array_equal(
+        np.array([float(x) for x in num.findall(mag)], np.float32).reshape(8, 8, 2), t2[..., :2]
+    )
     spec = load_configs([Path("lutbake/presets/ltc-hdrp.toml")], [f"size=[{SMALL},{SMALL}]"])[0]
     hdrp = api.bake([spec], out_dir=tmp_path, workers=2, write=False)[0].table
     t1 = hdrp.data[0].astype(np.float32)

@@ -27,6 +27,7 @@ the coarse pass itself starting from analytic guesses only. No texel depends on 
 a texel's result is a function of its own inputs and the coarse pass alone, so the table is bit-identical
 for any tiling or worker count (ltc_code instead chains each texel off the previously fitted neighbour).
 """
+
 from __future__ import annotations
 
 import functools
@@ -69,8 +70,13 @@ def kernels(lobe_name: str):
     f_cos, sample, pdf, f_pdf = lb.f_cos, lb.sample, lb.pdf, lb.f_pdf
 
     @wp.kernel(enable_backward=False)
-    def texel_terms(v: wp.array(dtype=wp.vec3), alpha: wp.array(dtype=float), grid: wp.array(dtype=wp.vec2),
-                    avg_dir: wp.array(dtype=wp.vec3d), f3: wp.array(dtype=wp.float64)):
+    def texel_terms(
+        v: wp.array(dtype=wp.vec3),
+        alpha: wp.array(dtype=float),
+        grid: wp.array(dtype=wp.vec2),
+        avg_dir: wp.array(dtype=wp.vec3d),
+        f3: wp.array(dtype=wp.float64),
+    ):
         """Per texel: the lobe's average direction Σ (f / p) l (ltc_code computeAvgTerms) and ∫ f^3 dω ≈ Σ f^3 / p."""
         i = wp.tid()
         vi = v[i]
@@ -90,9 +96,14 @@ def kernels(lobe_name: str):
         f3[i] = m3 / wp.float64(grid.shape[0])
 
     @wp.kernel(enable_backward=False)
-    def lobe_samples(v: wp.array(dtype=wp.vec3), alpha: wp.array(dtype=float), grid: wp.array(dtype=wp.vec2),
-                     dirs: wp.array2d(dtype=wp.vec3d), f: wp.array2d(dtype=wp.float64),
-                     p: wp.array2d(dtype=wp.float64)):
+    def lobe_samples(
+        v: wp.array(dtype=wp.vec3),
+        alpha: wp.array(dtype=float),
+        grid: wp.array(dtype=wp.vec2),
+        dirs: wp.array2d(dtype=wp.vec3d),
+        f: wp.array2d(dtype=wp.float64),
+        p: wp.array2d(dtype=wp.float64),
+    ):
         """The lobe-sampled half of the metric does not depend on M: its directions, f (n.l) and density, once."""
         i, s = wp.tid()
         vi = v[i]
@@ -104,11 +115,18 @@ def kernels(lobe_name: str):
         p[i, s] = wp.float64(pdf(vi, l, a))
 
     @wp.kernel(enable_backward=False)
-    def heitz_error(texel: wp.array(dtype=int), m: wp.array(dtype=wp.mat33d), v: wp.array(dtype=wp.vec3),
-                    alpha: wp.array(dtype=float), magnitude: wp.array(dtype=wp.float64),
-                    cos_dirs: wp.array(dtype=wp.vec3d), lobe_dirs: wp.array2d(dtype=wp.vec3d),
-                    lobe_f: wp.array2d(dtype=wp.float64), lobe_p: wp.array2d(dtype=wp.float64),
-                    err: wp.array(dtype=wp.float64)):
+    def heitz_error(
+        texel: wp.array(dtype=int),
+        m: wp.array(dtype=wp.mat33d),
+        v: wp.array(dtype=wp.vec3),
+        alpha: wp.array(dtype=float),
+        magnitude: wp.array(dtype=wp.float64),
+        cos_dirs: wp.array(dtype=wp.vec3d),
+        lobe_dirs: wp.array2d(dtype=wp.vec3d),
+        lobe_f: wp.array2d(dtype=wp.float64),
+        lobe_p: wp.array2d(dtype=wp.float64),
+        err: wp.array(dtype=wp.float64),
+    ):
         """ltc_code computeError: 1/N^2 Σ over LTC samples and lobe samples of |f - mag D|^3 / (p_ltc + p_brdf)."""
         i = wp.tid()
         t = texel[i]
@@ -157,8 +175,15 @@ def cosine_dirs(grid: np.ndarray) -> np.ndarray:
 class Problem:
     """The per-texel data of a fit (views, alphas, magnitudes, frames) and its objective on Warp's CPU device."""
 
-    def __init__(self, lobe_name: str, nov: np.ndarray, alpha: np.ndarray, magnitude: np.ndarray,
-                 n_grid: int = DEFAULT_GRID, device: str = "cpu"):
+    def __init__(
+        self,
+        lobe_name: str,
+        nov: np.ndarray,
+        alpha: np.ndarray,
+        magnitude: np.ndarray,
+        n_grid: int = DEFAULT_GRID,
+        device: str = "cpu",
+    ):
         self.lobe = lobe_name
         self.device = device
         self.nov = np.asarray(nov, np.float32)
@@ -184,8 +209,12 @@ class Problem:
         self._ldir = wp.zeros((self.n, s), dtype=wp.vec3d, device=d)
         self._lf = wp.zeros((self.n, s), dtype=wp.float64, device=d)
         self._lp = wp.zeros((self.n, s), dtype=wp.float64, device=d)
-        wp.launch(lobe_samples, dim=(self.n, s), inputs=[self._v, self._alpha, self._grid, self._ldir, self._lf,
-                                                         self._lp], device=d)
+        wp.launch(
+            lobe_samples,
+            dim=(self.n, s),
+            inputs=[self._v, self._alpha, self._grid, self._ldir, self._lf, self._lp],
+            device=d,
+        )
         self.frame_z = self._frames(avg.numpy())
         self.evaluations = 0
 
@@ -225,10 +254,23 @@ class Problem:
             return np.zeros(0)
         d = self.device
         out = wp.zeros(k, dtype=wp.float64, device=d)
-        wp.launch(self._heitz, dim=k, inputs=[wp.array(np.asarray(texel, np.int32), dtype=int, device=d),
-                                              wp.array(np.ascontiguousarray(m, np.float64), dtype=wp.mat33d, device=d),
-                                              self._v, self._alpha, self._mag, self._cos, self._ldir, self._lf,
-                                              self._lp, out], device=d)
+        wp.launch(
+            self._heitz,
+            dim=k,
+            inputs=[
+                wp.array(np.asarray(texel, np.int32), dtype=int, device=d),
+                wp.array(np.ascontiguousarray(m, np.float64), dtype=wp.mat33d, device=d),
+                self._v,
+                self._alpha,
+                self._mag,
+                self._cos,
+                self._ldir,
+                self._lf,
+                self._lp,
+                out,
+            ],
+            device=d,
+        )
         self.evaluations += k
         return out.numpy()
 
@@ -240,12 +282,19 @@ class Problem:
         floored at Hölder's bound ∫ f^3 >= (∫ f)^3 / (2 pi)^2 = magnitude^3 / (4 pi^2): where a sampler misses a
         lobe (charlie at alpha -> 0 and grazing view puts it all within 1e-2 rad of the horizon) the estimate
         falls below that provable bound and the floor keeps e finite and meaningful (0 for a zero lobe)."""
-        f3 = np.maximum(self.f3[texel], self.magnitude[texel] ** 3 / (4.0 * np.pi ** 2))
+        f3 = np.maximum(self.f3[texel], self.magnitude[texel] ** 3 / (4.0 * np.pi**2))
         return np.cbrt(np.where(f3 > 0.0, err / np.where(f3 > 0.0, f3, 1.0), 0.0))
 
 
-def nelder_mead(fun, texel: np.ndarray, start: np.ndarray, step: float, tol: float = NELDER_MEAD_TOL,
-                iters: int = NELDER_MEAD_ITERS, atol: np.ndarray | float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+def nelder_mead(
+    fun,
+    texel: np.ndarray,
+    start: np.ndarray,
+    step: float,
+    tol: float = NELDER_MEAD_TOL,
+    iters: int = NELDER_MEAD_ITERS,
+    atol: np.ndarray | float = 0.0,
+) -> tuple[np.ndarray, np.ndarray]:
     """ltc_code's downhill simplex (nelder_mead.h) run on every texel at once: ``fun(texel_subset, q)`` -> values.
     Each texel follows exactly the scalar algorithm (its own simplex, its own stopping test
     2 |f_lo - f_hi| < tol (|f_lo| + |f_hi|) + atol); the vector form only batches the objective calls.
@@ -319,7 +368,7 @@ def best_of(problem: Problem, texel: np.ndarray, cands: np.ndarray) -> np.ndarra
 def refine(problem: Problem, texel: np.ndarray, start: np.ndarray, steps) -> tuple[np.ndarray, np.ndarray]:
     """Nelder-Mead from ``start``, restarted from its result at each simplex size of ``steps``."""
     q, f = start, None
-    atol = ATOL_RELATIVE ** 3 * problem.f3[texel]
+    atol = ATOL_RELATIVE**3 * problem.f3[texel]
     for step in steps:
         q, f = nelder_mead(problem.objective, texel, q, step, atol=atol)
     return q, f
@@ -383,5 +432,3 @@ def unpack_inverse(t: np.ndarray) -> np.ndarray:
 def heitz_error_of_packed(problem: Problem, texel: np.ndarray, packed: np.ndarray) -> np.ndarray:
     """Heitz's metric of a stored table (its packed inverse matrices), e.g. the published ltc_code table."""
     return problem.error(texel, np.linalg.inv(unpack_inverse(packed)))
-
-

@@ -21,6 +21,7 @@ in the metadata: alpha >= 1e-4 (lutbake.edge; ltc_code 1e-5), magnitude and fres
 The sphere channel's own axes: x = z * 0.5 + 0.5 (z = cos of the form-factor direction's elevation), y =
 len = |form factor|, both endpoint (ltc_code genSphereTab).
 """
+
 from __future__ import annotations
 
 import json
@@ -42,35 +43,52 @@ FORMATS = {
     "exr": "OpenEXR, two parts (slice_0 = ltc_1, slice_1 = ltc_2), lutbake:* attributes (default)",
     "npy": "NumPy (2, N, N, 4) + .json sidecar",
     "ltc_dds": "ltc_code's two files <name>_1.dds, <name>_2.dds: RGBA16F (dtype half, as ltc_code) or RGBA32F",
-    "js": "three.js ES module: LTC_MAT_1 / LTC_MAT_2 Float32Arrays as RectAreaLightTexturesLib's, .z of "
-          "LTC_MAT_2 = 0",
+    "js": "three.js ES module: LTC_MAT_1 / LTC_MAT_2 Float32Arrays as RectAreaLightTexturesLib's, .z of LTC_MAT_2 = 0",
     "c": "Blender EEVEE C arrays ltc_mat_<lobe>[N][N][4], ltc_mag_<lobe>[N][N][2], ltc_disk_integral[N][N][1]",
     "cs": "Unity HDRP C# table s_LtcMatrixData_BRDF_<LOBE> (ushort FP16 bits, one RGBA16F slice of _LtcData): "
-          "(M^-1_00, M^-1_20, M^-1_11, M^-1_02) / M^-1_22",
+    "(M^-1_00, M^-1_20, M^-1_11, M^-1_02) / M^-1_22",
 }
 KEYS = {
     "name": Key("name", "name", None, "output stem: <out-dir>/<name>.<ext>", required=True),
     "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
     "lobe": Key("lobe", "str", "ggx", "the lobe fitted", {k: v.description for k, v in LOBES.items()}),
     "size": Key("size", "int_pair", [64, 64], "[view, roughness] texel counts (ltc_code: 64 x 64)", minimum=2),
-    "fit_samples": Key("fit_samples", "int", fit.DEFAULT_GRID, "N: the error metric's N x N stratified grid per "
-                       "sampling technique (ltc_code Nsample = 32)", minimum=4, maximum=256),
-    "samples": Key("samples", "int", None, "Gauss-Legendre budget of the magnitude / fresnel integrals per texel; "
-                   "omitted: 432 (ggx, beckmann), 3072 (charlie)", minimum=12, maximum=1 << 20),
-    "alpha_min": Key("alpha_min", "float", ALPHA_MIN, "smallest NDF alpha fitted (lutbake's edge policy: 1e-4; Unity "
-                     "HDRP's own fit: 1e-3)",
-                     minimum=ALPHA_MIN, maximum=0.1),
+    "fit_samples": Key(
+        "fit_samples",
+        "int",
+        fit.DEFAULT_GRID,
+        "N: the error metric's N x N stratified grid per sampling technique (ltc_code Nsample = 32)",
+        minimum=4,
+        maximum=256,
+    ),
+    "samples": Key(
+        "samples",
+        "int",
+        None,
+        "Gauss-Legendre budget of the magnitude / fresnel integrals per texel; "
+        "omitted: 432 (ggx, beckmann), 3072 (charlie)",
+        minimum=12,
+        maximum=1 << 20,
+    ),
+    "alpha_min": Key(
+        "alpha_min",
+        "float",
+        ALPHA_MIN,
+        "smallest NDF alpha fitted (lutbake's edge policy: 1e-4; Unity HDRP's own fit: 1e-3)",
+        minimum=ALPHA_MIN,
+        maximum=0.1,
+    ),
     "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}),
     "format": Key("format", "str", "exr", "output file format", FORMATS),
 }
 CHANNELS = {
     "x": "slice 0 (ltc_1): M^-1_00 / M^-1_11; slice 1 (ltc_2): magnitude = ∫ f (n.l) dω_l with F = 1",
     "y": "slice 0: M^-1_20 / M^-1_11 (glm invM[0][2]); slice 1: fresnel = ∫ f (1 - v.h)^5 (n.l) dω_l "
-         "(= magnitude for lobes without Fresnel)",
+    "(= magnitude for lobes without Fresnel)",
     "z": "slice 0: M^-1_02 / M^-1_11 (glm invM[2][0]); slice 1: fit_error = (E / ∫ f^3 dω)^(1/3), E = Heitz's L3 "
-         "metric of the fit (0 in engine layouts)",
+    "metric of the fit (0 in engine layouts)",
     "w": "slice 0: M^-1_22 / M^-1_11; slice 1: sphere = horizon-clipped / unclipped form factor of a spherical cap, "
-         "at x = z * 0.5 + 0.5, y = len (own axes, endpoint texels)",
+    "at x = z * 0.5 + 0.5, y = len (own axes, endpoint texels)",
 }
 RECONSTRUCTION = (
     "uv = vec2(roughness, sqrt(1 - NoV)) * (N - 1)/N + 0.5/N; t1 = texture(ltc_1, uv); t2 = texture(ltc_2, uv); "
@@ -78,16 +96,19 @@ RECONSTRUCTION = (
     "T1 = normalize(V - N NoV): polygon integral I = 1/(2 pi) Σ edges acos(v_i.v_j) normalize(v_i x v_j).z of the "
     "clipped, normalised vertices Minv p_i; specular = light * I * (f0 * t2.x + (1 - f0) * t2.y); "
     "sphere/disk: I = len * texture(ltc_2, vec2(z * 0.5 + 0.5, len) * (N - 1)/N + 0.5/N).w for the vector "
-    "form factor F (len = |F|, z = F.z / len)")
+    "form factor F (len = |F|, z = F.z / len)"
+)
 
 
 def axes_for(o: dict) -> list[Axis]:
     n_view, n_rough = o["size"]
     lb = LOBES[o["lobe"]]
     rname = "alpha" if lb.roughness == "alpha" else "perceptual_roughness"
-    return [Axis("texture", "z", 2, 1.0, 2.0, texel="endpoint", mapping="listed", listed=(1.0, 2.0)),
-            Axis("NoV", "y", n_view, 0.0, 1.0, texel="endpoint", mapping="one_minus_t2", clamp=(NOV_LO, 1.0)),
-            Axis(rname, "x", n_rough, 0.0, 1.0, texel="endpoint")]
+    return [
+        Axis("texture", "z", 2, 1.0, 2.0, texel="endpoint", mapping="listed", listed=(1.0, 2.0)),
+        Axis("NoV", "y", n_view, 0.0, 1.0, texel="endpoint", mapping="one_minus_t2", clamp=(NOV_LO, 1.0)),
+        Axis(rname, "x", n_rough, 0.0, 1.0, texel="endpoint"),
+    ]
 
 
 def texel_params(axes: list[Axis], alpha_min: float = ALPHA_MIN) -> tuple[np.ndarray, np.ndarray]:
@@ -97,8 +118,9 @@ def texel_params(axes: list[Axis], alpha_min: float = ALPHA_MIN) -> tuple[np.nda
     return np.repeat(view.values(), rough.count), np.tile(alpha, view.count)
 
 
-def magnitude_fresnel(lobe_name: str, nov: np.ndarray, alpha: np.ndarray, samples: int | None,
-                      device: str = "cpu") -> tuple[np.ndarray, np.ndarray]:
+def magnitude_fresnel(
+    lobe_name: str, nov: np.ndarray, alpha: np.ndarray, samples: int | None, device: str = "cpu"
+) -> tuple[np.ndarray, np.ndarray]:
     """(magnitude, fresnel) per texel from lutbake's integrators. GGX / Beckmann: magnitude is the ``albedo``
     kind's kernel (so it equals that table bit for bit), fresnel the ``dfg`` multiscatter kernel's Fc channel;
     charlie: the ``dfg`` charlie layout's B channel (the gltf-charlie table), fresnel = magnitude; lambert: 1."""
@@ -176,13 +198,22 @@ class LtcBake:
 def fit_error_stats(data: np.ndarray) -> dict[str, str]:
     """The lutbake:fit_error_* attributes: statistics of slice 1's z channel (relative L3 error per texel)."""
     e = np.asarray(data)[1, ..., 2].ravel()
-    return {"fit_error_max": f"{e.max():.4g}", "fit_error_median": f"{np.median(e):.4g}",
-            "fit_error_p95": f"{np.quantile(e, 0.95):.4g}",
-            "fit_error": json.dumps({"metric": "(E / ∫ f^3 dω)^(1/3), E = ∫ |f (n.l) - magnitude D_ltc|^3 dω by MIS "
-                                     "over the lobe's and the LTC's N x N stratified samples (Heitz et al. 2016, "
-                                     "ltc_code computeError)", "max": float(e.max()),
-                                     "median": float(np.median(e)), "p95": float(np.quantile(e, 0.95)),
-                                     "mean": float(e.mean())})}
+    return {
+        "fit_error_max": f"{e.max():.4g}",
+        "fit_error_median": f"{np.median(e):.4g}",
+        "fit_error_p95": f"{np.quantile(e, 0.95):.4g}",
+        "fit_error": json.dumps(
+            {
+                "metric": "(E / ∫ f^3 dω)^(1/3), E = ∫ |f (n.l) - magnitude D_ltc|^3 dω by MIS "
+                "over the lobe's and the LTC's N x N stratified samples (Heitz et al. 2016, "
+                "ltc_code computeError)",
+                "max": float(e.max()),
+                "median": float(np.median(e)),
+                "p95": float(np.quantile(e, 0.95)),
+                "mean": float(e.mean()),
+            }
+        ),
+    }
 
 
 def plan(spec) -> Plan:
@@ -192,27 +223,48 @@ def plan(spec) -> Plan:
     n = axes[1].count * axes[2].count
     lb = LOBES[o["lobe"]]
     m_samples = 0 if lb.magnitude == "lambert" else (o["samples"] or MAGNITUDE_SAMPLES[o["lobe"]])
-    terms = {"lobe": o["lobe"], "description": lb.description,
-             "fresnel": "schlick (1 - v.h)^5 channel" if lb.magnitude.startswith("dfg:") and lb.name != "charlie"
-             else "none (fresnel channel = magnitude)",
-             "layout": "ltc_code (selfshadow/ltc_code fit/fitLTC.cpp packTab)"}
-    extra = {"ltc_fit": json.dumps({
-        "parametrisation": "M = [X Y Z] [[m11, 0, m13], [0, m22, 0], [0, 0, 1]], Z = lobe's average direction",
-        "metric": "Heitz et al. 2016 L3 distance, MIS over lobe and LTC samples (ltc_code computeError)",
-        "fit_samples": f"{o['fit_samples']} x {o['fit_samples']} per technique",
-        "optimiser": f"Nelder-Mead (ltc_code nelder_mead.h), tol {fit.NELDER_MEAD_TOL}, <= {fit.NELDER_MEAD_ITERS} "
-                     f"iterations per restart, simplex sizes {list(fit.COARSE_STEPS)} (coarse pass), "
-                     f"{list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11)",
-        "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses; each texel starts from the "
-                   "best of the analytic guesses and the surrounding coarse fits (no chaining)",
-        "alpha_min": o["alpha_min"], "theta_max": THETA_MAX,
-        "magnitude": f"Gauss-Legendre, {m_samples} samples (lutbake albedo / dfg kernels)"}),
+    terms = {
+        "lobe": o["lobe"],
+        "description": lb.description,
+        "fresnel": "schlick (1 - v.h)^5 channel"
+        if lb.magnitude.startswith("dfg:") and lb.name != "charlie"
+        else "none (fresnel channel = magnitude)",
+        "layout": "ltc_code (selfshadow/ltc_code fit/fitLTC.cpp packTab)",
+    }
+    extra = {
+        "ltc_fit": json.dumps(
+            {
+                "parametrisation": "M = [X Y Z] [[m11, 0, m13], [0, m22, 0], [0, 0, 1]], Z = lobe's average direction",
+                "metric": "Heitz et al. 2016 L3 distance, MIS over lobe and LTC samples (ltc_code computeError)",
+                "fit_samples": f"{o['fit_samples']} x {o['fit_samples']} per technique",
+                "optimiser": f"Nelder-Mead (ltc_code nelder_mead.h), tol {fit.NELDER_MEAD_TOL}, <= {fit.NELDER_MEAD_ITERS} "
+                f"iterations per restart, simplex sizes {list(fit.COARSE_STEPS)} (coarse pass), "
+                f"{list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11)",
+                "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses; each texel starts from the "
+                "best of the analytic guesses and the surrounding coarse fits (no chaining)",
+                "alpha_min": o["alpha_min"],
+                "theta_max": THETA_MAX,
+                "magnitude": f"Gauss-Legendre, {m_samples} samples (lutbake albedo / dfg kernels)",
+            }
+        ),
         "ltc_texture_slices": "slice_0 = ltc_1 (inverse matrix), slice_1 = ltc_2 (magnitude, fresnel, fit_error, "
-                              "sphere)"}
-    return Plan(axes=axes, channels=CHANNELS, reconstruction=RECONSTRUCTION, n_texels=2 * n, n_channels=4,
-                run_tile=state.run_tile, prepare=state.prepare, samples=2 * o["fit_samples"] ** 2,
-                estimator="ltc_fit", terms=terms, cost=float(n) * 300 * 2 * o["fit_samples"] ** 2, extra=extra,
-                attributes_after=fit_error_stats)
+        "sphere)",
+    }
+    return Plan(
+        axes=axes,
+        channels=CHANNELS,
+        reconstruction=RECONSTRUCTION,
+        n_texels=2 * n,
+        n_channels=4,
+        run_tile=state.run_tile,
+        prepare=state.prepare,
+        samples=2 * o["fit_samples"] ** 2,
+        estimator="ltc_fit",
+        terms=terms,
+        cost=float(n) * 300 * 2 * o["fit_samples"] ** 2,
+        extra=extra,
+        attributes_after=fit_error_stats,
+    )
 
 
 def check_spec(spec):
@@ -222,6 +274,12 @@ def check_spec(spec):
     return None
 
 
-LTC = Kind("ltc", "Linearly Transformed Cosine fit (Heitz et al. 2016): ltc_code's two RGBA textures "
-                  "(inverse matrix; magnitude, fresnel, fit error, sphere integral)", KEYS, plan,
-           aliases=("ltc_fit",), check=check_spec)
+LTC = Kind(
+    "ltc",
+    "Linearly Transformed Cosine fit (Heitz et al. 2016): ltc_code's two RGBA textures "
+    "(inverse matrix; magnitude, fresnel, fit error, sphere integral)",
+    KEYS,
+    plan,
+    aliases=("ltc_fit",),
+    check=check_spec,
+)

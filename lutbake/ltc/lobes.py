@@ -14,6 +14,7 @@ ltc_code's agree sample for sample on GGX.
 | charlie | D_charlie V_ashikhmin (n.l) (the gltf-charlie preset's lobe, alpha = sheenRoughness) | cosine |
 | lambert | (n.l) / pi (the identity LTC: a check) | cosine |
 """
+
 from __future__ import annotations
 
 import functools
@@ -169,14 +170,40 @@ class Lobe:
 
 
 LOBES = {
-    "ggx": Lobe("ggx", "GGX, height-correlated Smith (ltc_code's BrdfGGX; the reference case)", *GGX_FUNCS,
-                "dfg:ggx", "perceptual"),
-    "beckmann": Lobe("beckmann", "Beckmann, height-correlated Smith with the exact Lambda", *BECKMANN_FUNCS,
-                     "dfg:beckmann", "perceptual"),
-    "charlie": Lobe("charlie", "KHR_materials_sheen: D_charlie V_ashikhmin, alpha = sheenRoughness (gltf-charlie)",
-                    charlie_f_cos, cosine_sample, cosine_pdf, charlie_f_pdf, "dfg:charlie", "alpha"),
-    "lambert": Lobe("lambert", "Lambert (n.l)/pi: its LTC is the identity (a check)", lambert_f_cos, cosine_sample,
-                    cosine_pdf, lambert_f_pdf, "lambert", "none"),
+    "ggx": Lobe(
+        "ggx",
+        "GGX, height-correlated Smith (ltc_code's BrdfGGX; the reference case)",
+        *GGX_FUNCS,
+        "dfg:ggx",
+        "perceptual",
+    ),
+    "beckmann": Lobe(
+        "beckmann",
+        "Beckmann, height-correlated Smith with the exact Lambda",
+        *BECKMANN_FUNCS,
+        "dfg:beckmann",
+        "perceptual",
+    ),
+    "charlie": Lobe(
+        "charlie",
+        "KHR_materials_sheen: D_charlie V_ashikhmin, alpha = sheenRoughness (gltf-charlie)",
+        charlie_f_cos,
+        cosine_sample,
+        cosine_pdf,
+        charlie_f_pdf,
+        "dfg:charlie",
+        "alpha",
+    ),
+    "lambert": Lobe(
+        "lambert",
+        "Lambert (n.l)/pi: its LTC is the identity (a check)",
+        lambert_f_cos,
+        cosine_sample,
+        cosine_pdf,
+        lambert_f_pdf,
+        "lambert",
+        "none",
+    ),
 }
 
 

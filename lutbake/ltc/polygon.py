@@ -9,6 +9,7 @@ so the fitted lobe's integral over the polygon is magnitude * I (F = 1), and wit
 (f0 * magnitude + (1 - f0) * fresnel) * I. ``edge_fitted`` is the rational fit of theta / sin theta that
 ltc_code's shaders use (IntegrateEdgeVec; Hill & Heitz 2017), for comparing with a GPU.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -78,7 +79,7 @@ def bilinear(tex: np.ndarray, u: float, v: float) -> np.ndarray:
     x0, y0 = int(np.floor(x)), int(np.floor(y))
     x1, y1 = min(x0 + 1, w - 1), min(y0 + 1, h - 1)
     fx, fy = x - x0, y - y0
-    return ((1 - fy) * ((1 - fx) * tex[y0, x0] + fx * tex[y0, x1]) + fy * ((1 - fx) * tex[y1, x0] + fx * tex[y1, x1]))
+    return (1 - fy) * ((1 - fx) * tex[y0, x0] + fx * tex[y0, x1]) + fy * ((1 - fx) * tex[y1, x0] + fx * tex[y1, x1])
 
 
 def lookup_uv(n: int, roughness: float, nov: float) -> tuple[float, float]:
@@ -87,8 +88,16 @@ def lookup_uv(n: int, roughness: float, nov: float) -> tuple[float, float]:
     return roughness * s + 0.5 / n, np.sqrt(max(1.0 - nov, 0.0)) * s + 0.5 / n
 
 
-def shade(ltc_1: np.ndarray, ltc_2: np.ndarray, roughness: float, nov: float, poly: np.ndarray,
-          f0: float = 1.0, edge=edge_exact, two_sided: bool = True) -> float:
+def shade(
+    ltc_1: np.ndarray,
+    ltc_2: np.ndarray,
+    roughness: float,
+    nov: float,
+    poly: np.ndarray,
+    f0: float = 1.0,
+    edge=edge_exact,
+    two_sided: bool = True,
+) -> float:
     """(f0 * magnitude + (1 - f0) * fresnel) * I for a polygon in the shading frame, texels fetched bilinearly
     as a GPU does (f0 = 1: the lobe itself, F = 1)."""
     u, v = lookup_uv(ltc_1.shape[1], roughness, nov)

@@ -18,6 +18,7 @@ clamped cosine is exact,
 leaving I = ∫_0^sigma J(b) sin b db, done with Gauss-Legendre panels split where the horizon enters and leaves
 the cap's rings (b = |pi/2 - omega|). ``snyder_cap`` is Snyder's closed form (ltc_code's ihemi) for the tests.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -71,7 +72,9 @@ def snyder_cap(omega: float, sigma: float) -> float:
         return 0.0
     g = np.arcsin(np.clip(np.cos(sigma) / np.sin(omega), -1.0, 1.0))
     G = -2.0 * np.sin(omega) * np.cos(sigma) * np.cos(g) + np.pi / 2 - g + np.sin(g) * np.cos(g)
-    H = np.cos(omega) * (np.cos(g) * np.sqrt(max(s2 - np.cos(g) ** 2, 0.0)) + s2 * np.arcsin(np.clip(np.cos(g) / np.sin(sigma), -1, 1)))
+    H = np.cos(omega) * (
+        np.cos(g) * np.sqrt(max(s2 - np.cos(g) ** 2, 0.0)) + s2 * np.arcsin(np.clip(np.cos(g) / np.sin(sigma), -1, 1))
+    )
     if omega < np.pi / 2:
         return np.pi * np.cos(omega) * s2 + G - H
     return G + H

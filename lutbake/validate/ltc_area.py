@@ -12,6 +12,7 @@ The light set (``light_set``): quads and triangles of several sizes, distances a
 mirror direction, the side and the viewer, several crossing the horizon (clipped by the LTC side; the brute
 force simply finds no sample below the horizon).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -62,11 +63,14 @@ def light_polygon(shape, elev, azim, dist, size, tilt, roll) -> np.ndarray:
 
 
 def light_set() -> list[tuple[str, np.ndarray]]:
-    return [(f"{s} el{e} az{a} d{d:g} s{sz:g} tilt{t}", light_polygon(s, e, a, d, sz, t, r))
-            for s, e, a, d, sz, t, r in LIGHTS]
+    return [
+        (f"{s} el{e} az{a} d{d:g} s{sz:g} tilt{t}", light_polygon(s, e, a, d, sz, t, r))
+        for s, e, a, d, sz, t, r in LIGHTS
+    ]
 
 
 # ---- numpy lobes (Walter et al. 2007; Heitz 2014; Estevez & Kulla 2017; Ashikhmin & Premoze 2007) ----
+
 
 def _lambda_ggx(c, alpha):
     c = np.clip(c, 1e-12, 1.0)
@@ -144,8 +148,15 @@ def ltc_value(t1: np.ndarray, t2: np.ndarray, nov: float, poly: np.ndarray) -> f
     return float(t2[0]) * abs(polygon.form_factor(poly @ minv.T))
 
 
-def compare(lobe: str, ltc_1: np.ndarray, ltc_2: np.ndarray, nov_values: np.ndarray, alpha_values: np.ndarray,
-            texels: list[tuple[int, int]], s: int = 512) -> list[dict]:
+def compare(
+    lobe: str,
+    ltc_1: np.ndarray,
+    ltc_2: np.ndarray,
+    nov_values: np.ndarray,
+    alpha_values: np.ndarray,
+    texels: list[tuple[int, int]],
+    s: int = 512,
+) -> list[dict]:
     """Per (view row t, roughness column a) texel and light: the LTC value, the brute force, their errors."""
     lights = light_set()
     polys = [p for _, p in lights]
@@ -156,9 +167,19 @@ def compare(lobe: str, ltc_1: np.ndarray, ltc_2: np.ndarray, nov_values: np.ndar
         mag = float(ltc_2[t, a, 0])
         for (name, p), g in zip(lights, gt):
             val = ltc_value(ltc_1[t, a], ltc_2[t, a], nov, p)
-            rows.append({"t": t, "a": a, "nov": nov, "alpha": alpha, "light": name, "ltc": val, "reference": g,
-                         "abs_error": abs(val - g) / max(mag, 1e-12),
-                         "rel_error": abs(val - g) / g if g > GT_FLOOR * mag else None})
+            rows.append(
+                {
+                    "t": t,
+                    "a": a,
+                    "nov": nov,
+                    "alpha": alpha,
+                    "light": name,
+                    "ltc": val,
+                    "reference": g,
+                    "abs_error": abs(val - g) / max(mag, 1e-12),
+                    "rel_error": abs(val - g) / g if g > GT_FLOOR * mag else None,
+                }
+            )
     return rows
 
 
@@ -169,8 +190,12 @@ def summarise(rows: list[dict], key: str = "a") -> dict:
         sel = [r for r in rows if r[key] == k]
         rel = np.array([r["rel_error"] for r in sel if r["rel_error"] is not None])
         ab = np.array([r["abs_error"] for r in sel])
-        out[k] = {"cases": len(sel), "rel_cases": int(len(rel)),
-                  "rel_median": float(np.median(rel)) if len(rel) else None,
-                  "rel_p90": float(np.quantile(rel, 0.9)) if len(rel) else None,
-                  "rel_max": float(rel.max()) if len(rel) else None, "abs_max": float(ab.max())}
+        out[k] = {
+            "cases": len(sel),
+            "rel_cases": int(len(rel)),
+            "rel_median": float(np.median(rel)) if len(rel) else None,
+            "rel_p90": float(np.quantile(rel, 0.9)) if len(rel) else None,
+            "rel_max": float(rel.max()) if len(rel) else None,
+            "abs_max": float(ab.max()),
+        }
     return out
