@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import argparse
 import gzip
-import os
 import json
+import os
 import re
 import sys
 import time
@@ -27,14 +27,14 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
+import ltc_port  # noqa: E402
 import warp as wp  # noqa: E402
 
-import ltc_port  # noqa: E402
 from lutbake.api import bake_table  # noqa: E402
 from lutbake.config import load_configs  # noqa: E402
 from lutbake.executor import default_workers  # noqa: E402
+from lutbake.kinds.ltc import axes_for, texel_params  # noqa: E402
 from lutbake.ltc import fit  # noqa: E402
-from lutbake.ltc.kind import axes_for, texel_params  # noqa: E402
 from lutbake.validate import ltc_area  # noqa: E402
 
 OUT = ROOT / "outputs" / "bench"

@@ -6,15 +6,13 @@ texels (same uv, same edge-integral fit, float64). Skipped where no GL context e
 from pathlib import Path
 
 import numpy as np
-import pytest
+from test_formats import read_dds_spec
+from test_gl_consumer import ctx  # noqa: F401 - the shared GL context fixture
 
 from lutbake.api import bake_table
 from lutbake.config import load_configs
 from lutbake.io.formats import write_table
 from lutbake.ltc import polygon
-
-from test_formats import read_dds_spec
-from test_gl_consumer import ctx  # noqa: F401 - the shared GL context fixture
 
 SNIPPET = Path(__file__).resolve().parents[1] / "docs" / "shaders" / "lutbake_ltc.glsl"
 N_POINTS = 256
@@ -117,7 +115,6 @@ def test_gl_integrates_a_quad_light_with_the_ltc_tables(ctx, tmp_path):  # noqa:
     )
     lit = want > 1e-3
     assert lit.sum() > N_POINTS // 3, "too few lit cases to test anything"
-    print(
-        f"max |GL - CPU| {np.abs(got - want).max():.2e}, max rel (lit) {np.max(np.abs(got - want)[lit] / want[lit]):.2e}"
-    )
+    rel = np.max(np.abs(got - want)[lit] / want[lit])
+    print(f"max |GL - CPU| {np.abs(got - want).max():.2e}, max rel (lit) {rel:.2e}")
     np.testing.assert_allclose(got, want, rtol=GL_RTOL, atol=GL_ATOL)

@@ -8,14 +8,14 @@ import gzip
 import re
 from pathlib import Path
 
+import ltc_port
 import numpy as np
 import pytest
 
-import ltc_port
 from lutbake import api
 from lutbake.config import load_configs
+from lutbake.kinds.ltc import axes_for, magnitude_fresnel, texel_params
 from lutbake.ltc import fit, polygon, sphere
-from lutbake.ltc.kind import axes_for, magnitude_fresnel, texel_params
 from lutbake.validate import ltc_area
 
 DATA = Path(__file__).parent / "data"
@@ -209,7 +209,7 @@ HDRP_RTOL = 2e-3  # HDRP's fit vs ltc_code's at smooth texels, FP16: measured 9.
 
 
 def test_hdrp_packing_matches_hdrp_shipped_ggx_texels():
-    from lutbake.ltc.export import hdrp_pack
+    from lutbake.io.ltc import hdrp_pack
 
     t1, _ = published()
     for (t, a), bits in HDRP_GGX_ROWS.items():
@@ -224,9 +224,10 @@ def test_hdrp_packing_matches_hdrp_shipped_ggx_texels():
 
 
 def test_engine_layouts_hold_the_table(small_ltc, tmp_path):
-    from lutbake.io.formats import write_table
-    from lutbake.ltc.export import FP16_MAX, hdrp_fp16, hdrp_pack
     from test_formats import read_dds_spec
+
+    from lutbake.io.formats import write_table
+    from lutbake.io.ltc import FP16_MAX, hdrp_fp16, hdrp_pack
 
     t1 = small_ltc.data[0].astype(np.float32)
     t2 = small_ltc.data[1].astype(np.float32)

@@ -10,7 +10,7 @@ ltc_code's agree sample for sample on GGX.
 | lobe | f (n.l) | sampler |
 | --- | --- | --- |
 | ggx | D_ggx G2 / (4 n.v), height-correlated Smith (ltc_code's BrdfGGX) | NDF (tan^2 = alpha^2 u/(1 - u)) |
-| beckmann | D_beckmann G2 / (4 n.v), height-correlated Smith, exact Lambda (ltc_code: Walter's rational fit) | NDF (tan^2 = -alpha^2 log u) |
+| beckmann | D_beckmann G2 / (4 n.v), height-correlated Smith, exact Lambda (ltc_code: Walter's fit) | NDF, log |
 | charlie | D_charlie V_ashikhmin (n.l) (the gltf-charlie preset's lobe, alpha = sheenRoughness) | cosine |
 | lambert | (n.l) / pi (the identity LTC: a check) | cosine |
 """
@@ -165,7 +165,7 @@ class Lobe:
     sample: object
     pdf: object
     f_pdf: object  # (f_cos, pdf) at once, sharing the terms both need
-    magnitude: str  # how the magnitude / Fresnel channels are integrated (lutbake.ltc.kind)
+    magnitude: str  # how the magnitude / Fresnel channels are integrated (lutbake.kinds.ltc)
     roughness: str  # "perceptual": the x axis is r, alpha = r^2; "alpha": the x axis is alpha; "none"
 
 

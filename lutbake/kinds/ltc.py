@@ -31,10 +31,12 @@ import numpy as np
 
 from ..axes import Axis
 from ..edge import ALPHA_MIN
-from ..tables import specular
-from ..tables.base import Key, Kind, Plan
-from . import fit, sphere
-from .lobes import LOBES
+from ..integrands.specular import specular_integrand
+from ..ltc import fit, sphere
+from ..ltc.lobes import LOBES
+from ..sampling.hemisphere import estimator_for
+from ..sampling.plan import TexelPlan
+from .base import Estimation, Key, declare
 
 THETA_MAX = 1.57  # ltc_code fitTab: theta = min(1.57, acos(1 - x^2))
 NOV_LO = float(np.cos(np.float32(THETA_MAX)))
@@ -48,9 +50,13 @@ FORMATS = {
     "cs": "Unity HDRP C# table s_LtcMatrixData_BRDF_<LOBE> (ushort FP16 bits, one RGBA16F slice of _LtcData): "
     "(M^-1_00, M^-1_20, M^-1_11, M^-1_02) / M^-1_22",
 }
+ESTIMATORS = {
+    "gauss_legendre": "the fit (Heitz's L3 metric, Nelder-Mead per texel: lutbake.ltc.fit) with magnitude and fresnel "
+    "by Gauss-Legendre (default)",
+    "sobol_ndf": "the same fit with magnitude and fresnel by scrambled Sobol' points, NDF importance sampling (a "
+    "second, independent estimator of the integrals the fit depends on; ggx and beckmann)",
+}
 KEYS = {
-    "name": Key("name", "name", None, "output stem: <out-dir>/<name>.<ext>", required=True),
-    "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
     "lobe": Key("lobe", "str", "ggx", "the lobe fitted", {k: v.description for k, v in LOBES.items()}),
     "size": Key("size", "int_pair", [64, 64], "[view, roughness] texel counts (ltc_code: 64 x 64)", minimum=2),
     "fit_samples": Key(
@@ -61,15 +67,6 @@ KEYS = {
         minimum=4,
         maximum=256,
     ),
-    "samples": Key(
-        "samples",
-        "int",
-        None,
-        "Gauss-Legendre budget of the magnitude / fresnel integrals per texel; "
-        "omitted: 432 (ggx, beckmann), 3072 (charlie)",
-        minimum=12,
-        maximum=1 << 20,
-    ),
     "alpha_min": Key(
         "alpha_min",
         "float",
@@ -78,7 +75,6 @@ KEYS = {
         minimum=ALPHA_MIN,
         maximum=0.1,
     ),
-    "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}),
     "format": Key("format", "str", "exr", "output file format", FORMATS),
 }
 CHANNELS = {
@@ -112,32 +108,57 @@ def axes_for(o: dict) -> list[Axis]:
 
 
 def texel_params(axes: list[Axis], alpha_min: float = ALPHA_MIN) -> tuple[np.ndarray, np.ndarray]:
-    """Per texel of one slice, row-major (y = view slowest): (NoV, alpha) as float32, alpha >= alpha_min."""
+    """Per texel of one slice, row-major (y = view slowest): (NoV, alpha) as float32, alpha >= alpha_min (the
+    alpha fitted: an LTC of a Dirac lobe is not defined)."""
     _, view, rough = axes
     alpha = np.maximum(rough.alpha(), np.float32(alpha_min))
     return np.repeat(view.values(), rough.count), np.tile(alpha, view.count)
 
 
+def magnitude_alpha(axes: list[Axis], alpha_min: float = ALPHA_MIN) -> np.ndarray:
+    """The alpha at which magnitude and fresnel are integrated: the axis alpha itself under lutbake's edge policy
+    (alpha -> 0: the exact mirror limit, as the ``albedo`` table), or alpha_min where a larger one is set."""
+    _, view, rough = axes
+    a = rough.alpha()
+    if alpha_min > ALPHA_MIN:
+        a = np.maximum(a, np.float32(alpha_min))
+    return np.tile(a, view.count)
+
+
 def magnitude_fresnel(
-    lobe_name: str, nov: np.ndarray, alpha: np.ndarray, samples: int | None, device: str = "cpu"
+    lobe_name: str,
+    nov: np.ndarray,
+    alpha: np.ndarray,
+    samples: int | None,
+    device: str = "cpu",
+    estimator: str = "gauss_legendre",
+    seed: int = 0,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(magnitude, fresnel) per texel from lutbake's integrators. GGX / Beckmann: magnitude is the ``albedo``
-    kind's kernel (so it equals that table bit for bit), fresnel the ``dfg`` multiscatter kernel's Fc channel;
-    charlie: the ``dfg`` charlie layout's B channel (the gltf-charlie table), fresnel = magnitude; lambert: 1."""
+    """(magnitude, fresnel) per texel from lutbake's integrators (``estimator``, default Gauss-Legendre).
+    GGX / Beckmann: magnitude is the ``albedo`` kind's integrand (so it equals that table at the same texels),
+    fresnel the ``dfg`` multiscatter integrand's Fc channel; charlie: the ``dfg`` charlie layout's B channel (the
+    gltf-charlie table), fresnel = magnitude; lambert: 1. ``alpha`` goes through the integrands' edge policy
+    (mirror limit at alpha -> 0)."""
     lb = LOBES[lobe_name]
     if lb.magnitude == "lambert":
         one = np.ones(len(nov))
         return one, one.copy()
-    samples = samples or MAGNITUDE_SAMPLES[lobe_name]
+    if estimator == "gauss_legendre":
+        samples = samples or MAGNITUDE_SAMPLES[lobe_name]
+    est = estimator_for(estimator, samples, seed)
+    nov = np.asarray(nov, np.float32)
+    zero = np.zeros(len(nov), np.float32)
+
+    def integrate(integrand):
+        inputs = {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": zero}
+        return est.evaluate(integrand, inputs, device)
+
     _, which = lb.magnitude.split(":")
     if which == "charlie":
-        k = specular.kernel_for("ggx", "smith_height_correlated", "charlie", "gauss_legendre")
-        m = specular.integrate(k, nov, alpha, "gauss_legendre", samples, 0, 3, device)[:, 2]
+        m = integrate(specular_integrand("ggx", "smith_height_correlated", "charlie"))[:, 2]
         return m, m.copy()
-    ka = specular.kernel_for(which, "smith_height_correlated", "albedo", "gauss_legendre")
-    kf = specular.kernel_for(which, "smith_height_correlated", "multiscatter", "gauss_legendre")
-    mag = specular.integrate(ka, nov, alpha, "gauss_legendre", samples, 0, 2, device)[:, 0]
-    fres = specular.integrate(kf, nov, alpha, "gauss_legendre", samples, 0, 2, device)[:, 0]
+    mag = integrate(specular_integrand(which, "smith_height_correlated", "albedo", "microfacet", 1))[:, 0]
+    fres = integrate(specular_integrand(which, "smith_height_correlated", "multiscatter"))[:, 0]
     return mag, fres
 
 
@@ -159,7 +180,11 @@ class LtcBake:
     def prepare(self, device: str) -> None:
         with self._lock:
             if self.problem is None:
-                mag, fres = magnitude_fresnel(self.o["lobe"], self.nov, self.alpha, self.o["samples"], device)
+                o = self.o
+                alpha = magnitude_alpha(self.axes, o["alpha_min"])
+                mag, fres = magnitude_fresnel(
+                    o["lobe"], self.nov, alpha, o["samples"], device, o["estimator"], o["seed"]
+                )
                 self.fresnel = fres
                 p = fit.Problem(self.o["lobe"], self.nov, self.alpha, mag, self.o["fit_samples"], device)
                 self.coarse = fit.coarse_pass(p, self.n_view, self.n_rough)
@@ -216,13 +241,15 @@ def fit_error_stats(data: np.ndarray) -> dict[str, str]:
     }
 
 
-def plan(spec) -> Plan:
+def plan(spec) -> TexelPlan:
     o = spec.options
     axes = axes_for(o)
     state = LtcBake(o, axes)
     n = axes[1].count * axes[2].count
     lb = LOBES[o["lobe"]]
-    m_samples = 0 if lb.magnitude == "lambert" else (o["samples"] or MAGNITUDE_SAMPLES[o["lobe"]])
+    m_samples = 0 if lb.magnitude == "lambert" else o["samples"]
+    if o["estimator"] == "gauss_legendre" and not m_samples:
+        m_samples = MAGNITUDE_SAMPLES[o["lobe"]]
     terms = {
         "lobe": o["lobe"],
         "description": lb.description,
@@ -237,20 +264,20 @@ def plan(spec) -> Plan:
                 "parametrisation": "M = [X Y Z] [[m11, 0, m13], [0, m22, 0], [0, 0, 1]], Z = lobe's average direction",
                 "metric": "Heitz et al. 2016 L3 distance, MIS over lobe and LTC samples (ltc_code computeError)",
                 "fit_samples": f"{o['fit_samples']} x {o['fit_samples']} per technique",
-                "optimiser": f"Nelder-Mead (ltc_code nelder_mead.h), tol {fit.NELDER_MEAD_TOL}, <= {fit.NELDER_MEAD_ITERS} "
-                f"iterations per restart, simplex sizes {list(fit.COARSE_STEPS)} (coarse pass), "
-                f"{list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11)",
-                "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses; each texel starts from the "
-                "best of the analytic guesses and the surrounding coarse fits (no chaining)",
+                "optimiser": f"Nelder-Mead (ltc_code nelder_mead.h), tol {fit.NELDER_MEAD_TOL}, "
+                f"<= {fit.NELDER_MEAD_ITERS} iterations per restart, simplex sizes {list(fit.COARSE_STEPS)} "
+                f"(coarse pass), {list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11)",
+                "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses; each texel starts "
+                "from the best of the analytic guesses and the surrounding coarse fits (no chaining)",
                 "alpha_min": o["alpha_min"],
                 "theta_max": THETA_MAX,
-                "magnitude": f"Gauss-Legendre, {m_samples} samples (lutbake albedo / dfg kernels)",
+                "magnitude": f"{o['estimator']}, {m_samples or 'default'} samples (lutbake albedo / dfg integrands)",
             }
         ),
         "ltc_texture_slices": "slice_0 = ltc_1 (inverse matrix), slice_1 = ltc_2 (magnitude, fresnel, fit_error, "
         "sphere)",
     }
-    return Plan(
+    return TexelPlan(
         axes=axes,
         channels=CHANNELS,
         reconstruction=RECONSTRUCTION,
@@ -259,7 +286,7 @@ def plan(spec) -> Plan:
         run_tile=state.run_tile,
         prepare=state.prepare,
         samples=2 * o["fit_samples"] ** 2,
-        estimator="ltc_fit",
+        estimator=f"ltc_fit (magnitude: {o['estimator']})",
         terms=terms,
         cost=float(n) * 300 * 2 * o["fit_samples"] ** 2,
         extra=extra,
@@ -269,17 +296,37 @@ def plan(spec) -> Plan:
 
 def check_spec(spec):
     o = spec.options
+    if o["estimator"] != "gauss_legendre" and LOBES[o["lobe"]].magnitude not in ("dfg:ggx", "dfg:beckmann"):
+        return (
+            "estimator",
+            f"estimator {o['estimator']!r} samples the GGX / Beckmann NDF: lobe {o['lobe']!r} needs 'gauss_legendre'",
+        )
     if o["format"] == "ltc_dds" and o["dtype"] not in ("half", "float32"):
         return ("dtype", "ltc_dds writes RGBA16F (half) or RGBA32F (float32)")
     return None
 
 
-LTC = Kind(
+def texel_count(o: dict) -> int:
+    """2 x size (two texture slices)"""
+    return 2 * o["size"][0] * o["size"][1]
+
+
+ESTIMATION = Estimation(
+    ESTIMATORS,
+    "gauss_legendre",
+    "Gauss-Legendre budget of the magnitude / fresnel integrals per texel; "
+    "omitted: 432 (ggx, beckmann), 3072 (charlie)",
+    samples_min=12,
+    samples_max=1 << 20,
+)
+LTC = declare(
     "ltc",
     "Linearly Transformed Cosine fit (Heitz et al. 2016): ltc_code's two RGBA textures "
     "(inverse matrix; magnitude, fresnel, fit error, sphere integral)",
     KEYS,
     plan,
+    ESTIMATION,
     aliases=("ltc_fit",),
     check=check_spec,
+    texels=texel_count,
 )
