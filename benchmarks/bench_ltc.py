@@ -58,7 +58,7 @@ def bake(lobe: str, workers: int):
         [f'lobe="{lobe}"', f'name="ltc_{lobe}"', 'format="exr"', 'dtype="float32"'],
     )[0]
     cpu0 = time.process_time()
-    table, seconds, _ = bake_table(spec, workers=workers, progress=False)
+    table, seconds, _ = bake_table(spec, workers=workers)
     return table, seconds, time.process_time() - cpu0
 
 
