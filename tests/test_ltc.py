@@ -256,3 +256,22 @@ def test_engine_layouts_hold_the_table(small_ltc, tmp_path):
     finite = np.abs(hdrp_pack(t1)) <= FP16_MAX
     assert finite.mean() > 0.9  # only smooth grazing texels saturate (HDRP's shipped table saturates there too)
     np.testing.assert_allclose(hdrp_fp16(t1)[finite].astype(np.float64), hdrp_pack(t1)[finite], rtol=1e-3)
+
+
+def test_ltc_presets_load_with_their_engine_layouts():
+    from lutbake.config import preset_path
+    from lutbake.io.formats import output_path
+
+    want = {
+        "ltc-ggx": ("ltc_dds", "ltc_ggx_1.dds"),
+        "ltc-threejs": ("js", "ltc_threejs.js"),
+        "ltc-eevee": ("c", "ltc_eevee.cc"),
+        "ltc-hdrp": ("cs", "LtcData_BRDF_GGX.cs"),
+    }
+    for preset, (fmt, file) in want.items():
+        (spec,) = load_configs([preset_path(preset)])
+        assert spec.kind == "ltc" and spec.options["lobe"] == "ggx" and spec.options["size"] == [64, 64]
+        assert spec.options["format"] == fmt
+        assert output_path("out", spec.name, fmt).name == file
+    (hdrp,) = load_configs([preset_path("ltc-hdrp")])
+    assert hdrp.options["alpha_min"] == 1e-3
