@@ -65,35 +65,9 @@ def ltc_eval(m_inv: wp.mat33d, det_inv: wp.float64, l: wp.vec3d):
 
 @functools.lru_cache(maxsize=None)
 def kernels(lobe_name: str):
-    """(texel_terms, lobe_samples, heitz_error) Warp kernels for a lobe, compiled once per Warp cache."""
+    """(lobe_samples, heitz_error) Warp kernels for a lobe, compiled once per Warp cache."""
     lb = lobe(lobe_name)
     f_cos, sample, pdf, f_pdf = lb.f_cos, lb.sample, lb.pdf, lb.f_pdf
-
-    @wp.kernel(enable_backward=False)
-    def texel_terms(
-        v: wp.array(dtype=wp.vec3),
-        alpha: wp.array(dtype=float),
-        grid: wp.array(dtype=wp.vec2),
-        avg_dir: wp.array(dtype=wp.vec3d),
-        f3: wp.array(dtype=wp.float64),
-    ):
-        """Per texel: the lobe's average direction Σ (f / p) l (ltc_code computeAvgTerms) and ∫ f^3 dω ≈ Σ f^3 / p."""
-        i = wp.tid()
-        vi = v[i]
-        a = alpha[i]
-        acc = wp.vec3d()
-        m3 = wp.float64(0.0)
-        for s in range(grid.shape[0]):
-            u = grid[s]
-            l = sample(vi, a, u[0], u[1])
-            p = pdf(vi, l, a)
-            if p > 0.0:
-                f = wp.float64(f_cos(vi, l, a))
-                w = f / wp.float64(p)
-                acc += w * wp.vec3d(wp.float64(l[0]), wp.float64(l[1]), wp.float64(l[2]))
-                m3 += f * f * w
-        avg_dir[i] = acc
-        f3[i] = m3 / wp.float64(grid.shape[0])
 
     @wp.kernel(enable_backward=False)
     def lobe_samples(
@@ -155,7 +129,7 @@ def kernels(lobe_name: str):
                 acc += e2 * e2 * e2 / q2
         err[i] = acc / wp.float64(cos_dirs.shape[0])
 
-    return texel_terms, lobe_samples, heitz_error
+    return lobe_samples, heitz_error
 
 
 def stratified_grid(n: int) -> np.ndarray:
@@ -194,17 +168,13 @@ class Problem:
         self.v = np.stack([np.sqrt(np.maximum(1.0 - nv * nv, 0.0)), np.zeros_like(nv), nv], axis=1).astype(np.float32)
         self.isotropic = self.nov >= np.float32(1.0)
         grid = stratified_grid(n_grid)
-        self._texel_terms, lobe_samples, self._heitz = kernels(lobe_name)
+        lobe_samples, self._heitz = kernels(lobe_name)
         d = device
         self._grid = wp.array(grid, dtype=wp.vec2, device=d)
         self._cos = wp.array(cosine_dirs(grid), dtype=wp.vec3d, device=d)
         self._v = wp.array(self.v, dtype=wp.vec3, device=d)
         self._alpha = wp.array(self.alpha, dtype=float, device=d)
         self._mag = wp.array(self.magnitude, dtype=wp.float64, device=d)
-        avg = wp.zeros(self.n, dtype=wp.vec3d, device=d)
-        f3 = wp.zeros(self.n, dtype=wp.float64, device=d)
-        wp.launch(self._texel_terms, dim=self.n, inputs=[self._v, self._alpha, self._grid, avg, f3], device=d)
-        self.f3 = f3.numpy()
         s = len(grid)
         self._ldir = wp.zeros((self.n, s), dtype=wp.vec3d, device=d)
         self._lf = wp.zeros((self.n, s), dtype=wp.float64, device=d)
@@ -215,7 +185,11 @@ class Problem:
             inputs=[self._v, self._alpha, self._grid, self._ldir, self._lf, self._lp],
             device=d,
         )
-        self.frame_z = self._frames(avg.numpy())
+        # from the lobe's samples: its average direction Σ (f / p) l (ltc_code computeAvgTerms) and ∫ f^3 ≈ Σ f^3 / p
+        f, p = self._lf.numpy(), self._lp.numpy()
+        w = np.where(p > 0.0, f / np.where(p > 0.0, p, 1.0), 0.0)
+        self.f3 = np.sum(f * f * w, axis=1) / s
+        self.frame_z = self._frames(np.einsum("ts,tsk->tk", w, self._ldir.numpy()))
         self.evaluations = 0
 
     def _frames(self, avg: np.ndarray) -> np.ndarray:
