@@ -37,7 +37,10 @@ ABOVE_ONE_DIFFUSE_MODELS = frozenset({"oren_nayar"})
 DIELECTRIC_KINDS = frozenset({"dielectric", "dielectric_avg"})
 SPECULAR_KINDS = frozenset({"dfg", "albedo", "albedo_avg", "specular_3d", "specular_aniso"})
 DIFFUSE_KINDS = frozenset({"diffuse", "diffuse_3d"})
-UNBOUNDED_KINDS = {"btf": "btf tabulates BRDF values f, which peak above 1"}
+UNBOUNDED_KINDS = {
+    "btf": "btf tabulates BRDF values f, which peak above 1",
+    "ltc": "ltc holds the entries of inverse LTC matrices, far above 1 at low roughness",
+}
 
 
 def unit_range(spec) -> str | None:

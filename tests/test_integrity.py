@@ -32,7 +32,7 @@ from lutbake import api, batch  # noqa: E402
 from lutbake.config import load_configs  # noqa: E402
 from lutbake.io import atomic, formats  # noqa: E402
 from lutbake.io.formats import EXTENSIONS  # noqa: E402
-from lutbake.io.integrity import sidecar_path, verified_attributes  # noqa: E402
+from lutbake.io.integrity import sha256_file, sidecar_path, verified_attributes  # noqa: E402
 
 FORMATS = ("exr", "npy", "png16", "dds", "ktx2", "h")
 DATA_MODES = (
@@ -175,6 +175,21 @@ def test_exr_hash_does_not_depend_on_the_chunk_size(pristine, tmp_path, monkeypa
     assert integrity._scan_exr(good)[0] == integrity.sha256_bytes(
         raw.replace(raw[raw.index(b"lutbake:data_hash") + 29 :][:64], integrity.PLACEHOLDER)
     )
+
+
+def test_every_file_of_a_multi_file_output_is_verified(tmp_path):
+    """ltc_dds writes <name>_1.dds and <name>_2.dds under one sidecar: a change to either is caught."""
+    from lutbake.io.integrity import read_sidecar, write_sidecar
+
+    first, second = tmp_path / "t_1.dds", tmp_path / "t_2.dds"
+    second.write_bytes(b"second texture")
+    first.write_bytes(b"first texture")
+    write_sidecar(first, "ltc_dds", {"content_hash": "h"}, {"files": [first.name, second.name]})
+    assert read_sidecar(first)["files_sha256"] == {second.name: sha256_file(second)}
+    second.write_bytes(b"second textur!")
+    assert read_sidecar(first) is None
+    second.unlink()
+    assert read_sidecar(first) is None
 
 
 # ------------------------------------------------------------------------------ fault injection

@@ -232,6 +232,11 @@ WRITERS = {
     "h": write_header,
     "openpbr_h": write_openpbr,
 }
+# the LTC engine layouts (kind ltc only): lutbake.io.ltc
+from . import ltc as _ltc_export  # noqa: E402
+
+WRITERS.update(_ltc_export.WRITERS)
+EXTENSIONS.update(_ltc_export.EXTENSIONS)
 
 
 def output_path(out_dir, name: str, fmt: str) -> Path:

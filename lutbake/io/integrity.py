@@ -132,6 +132,7 @@ def _canonical(doc: dict) -> bytes:
 def sidecar_document(path, fmt: str, attributes: dict[str, str], extra: dict | None = None) -> dict:
     """The sidecar of the data file ``path`` as it is on disk now (call it after the data's rename)."""
     path = Path(path)
+    others = [n for n in (extra or {}).get("files", []) if n != path.name]  # e.g. ltc_dds's <name>_2.dds
     doc = {
         "file": path.name,
         "format": fmt,
@@ -141,6 +142,8 @@ def sidecar_document(path, fmt: str, attributes: dict[str, str], extra: dict | N
         "data_sha256": sha256_file(path),
         "lutbake": dict(attributes),
     }
+    if others:
+        doc["files_sha256"] = {n: sha256_file(path.with_name(n)) for n in others}
     doc["sidecar_sha256"] = sha256_bytes(_canonical(doc))
     return doc
 
@@ -166,6 +169,9 @@ def read_sidecar(path) -> dict | None:
             return None
         if doc.get("data_sha256") != sha256_file(path):
             return None
+        for name, digest in doc.get("files_sha256", {}).items():  # the other files of a multi-file output
+            if Path(name).name != name or sha256_file(path.with_name(name)) != digest:
+                return None
         return doc
     except (OSError, ValueError, RecursionError):  # missing, unreadable, not JSON, not UTF-8
         return None

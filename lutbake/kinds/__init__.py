@@ -14,6 +14,7 @@ from .dfg import DFG
 from .dielectric import DIELECTRIC, DIELECTRIC_AVG
 from .diffuse import DIFFUSE
 from .diffuse_3d import DIFFUSE_3D
+from .ltc import LTC
 from .specular_3d import SPECULAR_3D
 from .specular_aniso import SPECULAR_ANISO
 
@@ -30,6 +31,7 @@ KINDS: dict[str, Kind] = {
         BTF,
         DIELECTRIC,
         DIELECTRIC_AVG,
+        LTC,
     )
 }
 ALIASES: dict[str, str] = {alias: k.name for k in KINDS.values() for alias in k.aliases}
