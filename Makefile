@@ -8,13 +8,14 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 OUT    ?= outputs
 CONFIGS := $(wildcard configs/*.toml)
-PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-eevee unreal
+PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-eevee unreal blender-eevee-btdf blender-eevee-bsdf \
+           openpbr turquin ltc-ggx ltc-threejs ltc-eevee ltc-hdrp
 SOURCES := $(shell find lutbake -name '*.py' -o -name '*.toml' 2>/dev/null)
 WORKERS ?=
 FORCE   ?=
 LUTS_STAMP := $(OUT)/.luts.stamp
 
-.PHONY: lint luts test validate bench clean venv help force-luts figures bench-diffuse bench-cluster
+.PHONY: lint luts test validate bench clean venv help force-luts figures bench-diffuse bench-ltc bench-cluster
 
 help:
 	@echo "make luts | test | validate | clean"
@@ -66,7 +67,13 @@ clean:
 # outputs/bench/cluster.json (docs/cluster.md)
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench.py
+	$(BIN)/python benchmarks/bench_dielectric.py
+	$(BIN)/python benchmarks/bench_ltc.py
 	$(BIN)/python benchmarks/bench_cluster.py
+
+# LTC fits (kind ltc): fit time per lobe at 64^2, the straight-port baseline, area-light errors: outputs/bench/ltc.json
+bench-ltc: $(STAMP)
+	$(BIN)/python benchmarks/bench_ltc.py
 
 bench-cluster: $(STAMP)
 	$(BIN)/python benchmarks/bench_cluster.py

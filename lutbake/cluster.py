@@ -53,6 +53,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .config import BYTES_PER_TEXEL, MAX_TEXELS
 from .errors import ConfigError, LutbakeError
 
 SCHEDULER_FORMS = (
@@ -64,6 +65,7 @@ MAX_LOCAL_WORKERS = 256
 CONNECT_TIMEOUT_S = 30  # to reach the scheduler, and for its first worker to join
 POLL_S = 0.2  # how often a waiting table looks at its cancel event
 CLUSTER_TILE_TEXELS = 4096  # CPU tiles of a cluster bake: 8 executor tiles, so Dask's per-task cost stays small
+MAX_TABLE_BYTES = MAX_TEXELS * BYTES_PER_TEXEL  # float64 data of the largest table a config allows
 PLAN_CACHE_SIZE = 64  # plans kept per worker process (a plan holds its texel grid; a batch has tens of tables)
 IDENTITY_KEYS = ("lutbake", "kernel_sources", "warp", "numpy", "scipy")
 
@@ -320,7 +322,10 @@ class DaskRunner:
 
         if device != self.device:
             raise ValueError(f"this runner bakes on {self.device!r}, not {device!r}")
-        parts = tiles(plan.n_texels, max(CLUSTER_TILE_TEXELS, plan_tile_texels(plan, device, self.cuda_free_bytes)))
+        cuda = device.startswith("cuda")
+        parts = tiles(
+            plan.n_texels, plan_tile_texels(plan, device, self.cuda_free_bytes) if cuda else CLUSTER_TILE_TEXELS
+        )
         prefix = f"lutbake-{spec.name}-{uuid.uuid4().hex[:8]}-{device}"
         with self.stats.lock:
             self.tables += 1
@@ -371,8 +376,12 @@ class DaskRunner:
 
     def estimate_error(self, spec, data: np.ndarray, device: str) -> tuple[float, str]:
         key = f"lutbake-{spec.name}-{uuid.uuid4().hex[:8]}-{device}-error-estimate"
-        [shipped] = self.client.scatter([data], workers=self.targets)  # the table travels as data, not in the graph
-        fut = self._submit(estimate_error_task, spec, shipped, device, self.token, key=key, priority=1)
+        import dask
+
+        # the table travels inside the task (not scattered to one worker, whose death would lose it): the task
+        # can then run again elsewhere like a tile; a 1024^2 table is 16 MiB, above Dask's warning threshold
+        with dask.config.set({"distributed.admin.large-graph-warning-threshold": MAX_TABLE_BYTES}):
+            fut = self._submit(estimate_error_task, spec, data, device, self.token, key=key, priority=1)
         with self.stats.lock:
             self.stats.bytes_estimate_inputs += data.nbytes
         return fut.result()

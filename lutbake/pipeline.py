@@ -35,6 +35,8 @@ def bake_table(
     if estimate is not None:
         err, how = estimate
         extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)
+    if plan.attributes_after is not None:
+        extra.update(plan.attributes_after(data))
     table = Table(
         spec.name,
         spec.kind,
