@@ -10,7 +10,7 @@ stored value can resolve, so the quadrature error never moves a stored code by m
 | storage | tolerance (absolute) | relative_tolerance |
 | --- | --- | --- |
 | ``format = "png16"`` (16-bit UNORM) | 1 / (4 * 65535) = 3.8e-6 | 0 |
-| ``dtype = "half"`` (any float format) | 2^-26 = 1.5e-8 (a quarter of half's subnormal step) | 2^-13 = 1.2e-4 (a quarter of half's smallest relative step, 2^-11) |
+| ``dtype = "half"`` | 2^-26 = 1.5e-8 (1/4 of the subnormal step) | 2^-13 = 1.2e-4 (1/4 of the relative step 2^-11) |
 | ``dtype = "float32"`` | 1e-6 | 1e-6 |
 
 float32 is not held to its own quantum (6e-8 relative): the BRDF terms are evaluated in float32, so ~1e-7 is the

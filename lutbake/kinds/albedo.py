@@ -20,9 +20,9 @@ import numpy as np
 from ..axes import Axis
 from ..integrands.fresnel import mu_nodes
 from ..integrands.specular import specular_integrand
-from ..tolerance import tolerance_of
 from ..sampling.hemisphere import estimator_for
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..tolerance import tolerance_of
 from . import dfg
 from .base import Key, declare
 

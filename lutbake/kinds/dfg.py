@@ -26,10 +26,10 @@ import numpy as np
 from ..axes import MAPPINGS, ORDERS, ROUGHNESS_PARAMS, TEXELS, Axis
 from ..edge import alpha_policy
 from ..integrands.specular import N_CHANNELS, SHEEN_LAYOUTS, SPECULAR_MODELS, model_terms, specular_integrand
-from ..tolerance import tolerance_of
 from ..sampling.hemisphere import ESTIMATORS, estimator_for
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from ..terms.distributions import MASKINGS, NDFS
+from ..tolerance import tolerance_of
 from .base import Estimation, Key, declare
 
 LAYOUTS = {

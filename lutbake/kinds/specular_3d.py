@@ -17,10 +17,10 @@ import numpy as np
 
 from ..axes import Axis
 from ..integrands.specular import specular_integrand
-from ..tolerance import tolerance_of
 from ..sampling.hemisphere import estimator_for
 from ..sampling.plan import TexelPlan, per_texel_plan
 from ..terms.metals import METALS
+from ..tolerance import tolerance_of
 from . import dfg
 from .base import Key, declare
 
