@@ -241,7 +241,7 @@ def make_gauss_legendre(spec):
         if wp.static(smooth):
             if a <= 0.0:  # alpha -> 0: the closed-form mirror limit below (lutbake.edge), no quadrature
                 t_start = theta_b
-        n_panels = 0
+        n_panels = wp.int32(0)  # a dynamic variable (Warp: a bare literal is a constant)
         t_lo = t_start
         while t_lo < theta_b:
             t_lo = next_theta(t_lo, theta_a, theta_peak)
@@ -268,12 +268,12 @@ def make_gauss_legendre(spec):
             t_hi = next_theta(t_lo, theta_a, theta_peak)
             q = panel_sum(v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, levels[0][0], levels[0][1])
             d = acc_type()  # |Q_(k) - Q_(k-1)|: the error of Q_(k-1), an estimate (and with exponential
-            lev = 1  # convergence a bound) of Q_(k)'s
+            lev = wp.int32(1)  # convergence a bound) of Q_(k)'s
             while lev < n_levels:
                 fine = panel_sum(
                     v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, levels[lev][0], levels[lev][1]
                 )
-                ok = 1
+                ok = wp.int32(1)
                 for c in range(wp.static(nch)):
                     d[c] = wp.abs(fine[c] - q[c])
                     q[c] = fine[c]
