@@ -89,7 +89,7 @@ def common_keys(e: Estimation) -> dict[str, Key]:
             "relative_tolerance",
             "float",
             None,
-            "relative error target per value (see tolerance); unset: from the dtype (float32 1e-6, half 1.2e-4)",
+            "relative error target per value (see tolerance); unset: from the dtype (float32 0, half 1.2e-4)",
             minimum=0.0,
             maximum=1.0,
         ),

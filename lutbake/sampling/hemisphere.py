@@ -200,10 +200,13 @@ def make_gauss_legendre(spec):
             big_a = asinh64(phimax / eps)
             for j in range(n):
                 # sinh map (Johnston & Elliott 2005): phi = phimax - eps sinh(big_a (1 - x))
-                arg = big_a * (one - rules[off + j][0])
-                phi = phimax - eps * wp.sinh(arg)
-                w = wk * rules[off + j][1] * eps * wp.cosh(arg) * big_a
-                h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
+                # one exp for sinh and cosh; cos and sin of phi in float32 (h is a float32 vector anyway)
+                ex = wp.exp(big_a * (one - rules[off + j][0]))
+                phi = phimax - eps * wp.float64(0.5) * (ex - one / ex)
+                w = wk * rules[off + j][1] * eps * wp.float64(0.5) * (ex + one / ex) * big_a
+                phi32 = float(phi)
+                sin_h32 = float(sin_h)
+                h = wp.vec3(sin_h32 * wp.cos(phi32), sin_h32 * wp.sin(phi32), float(cos_h))
                 g = integrand(v, h, a, prm)
                 if in_u:
                     p = pdf(v, h, a)
