@@ -200,13 +200,11 @@ def make_gauss_legendre(spec):
             big_a = asinh64(phimax / eps)
             for j in range(n):
                 # sinh map (Johnston & Elliott 2005): phi = phimax - eps sinh(big_a (1 - x))
-                # one exp for sinh and cosh; cos and sin of phi in float32 (h is a float32 vector anyway)
+                # sinh and cosh from one exp (Warp has no sincos; cos and sin of phi stay float64)
                 ex = wp.exp(big_a * (one - rules[off + j][0]))
                 phi = phimax - eps * wp.float64(0.5) * (ex - one / ex)
                 w = wk * rules[off + j][1] * eps * wp.float64(0.5) * (ex + one / ex) * big_a
-                phi32 = float(phi)
-                sin_h32 = float(sin_h)
-                h = wp.vec3(sin_h32 * wp.cos(phi32), sin_h32 * wp.sin(phi32), float(cos_h))
+                h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
                 g = integrand(v, h, a, prm)
                 if in_u:
                     p = pdf(v, h, a)
