@@ -20,7 +20,16 @@ from .io.integrity import verified_attributes
 
 PACKAGE = Path(__file__).parent
 # the modules whose source defines what a table holds (kernels, terms, estimators, kinds, axes, edge policy)
-HASH_SOURCES = ("terms/*.py", "integrands/*.py", "sampling/*.py", "kinds/*.py", "ltc/*.py", "axes.py", "edge.py")
+HASH_SOURCES = (
+    "terms/*.py",
+    "integrands/*.py",
+    "sampling/*.py",
+    "kinds/*.py",
+    "ltc/*.py",
+    "axes.py",
+    "edge.py",
+    "tolerance.py",
+)
 HASH_ATTRIBUTE = "content_hash"
 
 

@@ -165,6 +165,15 @@ def bad_for(key):
             st.tuples(unit, st.floats(min_value=1.0000001, allow_nan=False, allow_infinity=False)).map(list),
             st.tuples(unit, st.text(max_size=3)).map(list),
         )
+    if k.type == "float":
+        return st.one_of(
+            st.text(max_size=6),
+            st.booleans(),
+            st.lists(st.floats(0.0, 1.0), max_size=3),
+            st.floats(allow_nan=True, allow_infinity=True).filter(lambda x: not math.isfinite(x)),
+            st.floats(max_value=k.minimum, exclude_max=True, allow_nan=False, allow_infinity=False),
+            st.floats(min_value=k.maximum, exclude_min=True, allow_nan=False, allow_infinity=False),
+        )
     raise AssertionError(key)
 
 

@@ -22,6 +22,7 @@ from ..integrands.fresnel import mu_nodes
 from ..integrands.specular import specular_integrand
 from ..sampling.hemisphere import estimator_for
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..tolerance import tolerance_of
 from . import dfg
 from .base import Key, declare
 
@@ -61,7 +62,7 @@ def plan_albedo(spec) -> TexelPlan:
     integrand = integrand_of(o)
     return per_texel_plan(
         integrand,
-        estimator_for(o["estimator"], o["samples"], o["seed"]),
+        estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
         dfg.grid_for(axes, integrand),
         channels=ALBEDO_CHANNELS,
         reconstruction=ALBEDO_RECONSTRUCTION,
@@ -91,7 +92,7 @@ def plan_albedo_avg(spec) -> TexelPlan:
     )
     return per_texel_plan(
         integrand,
-        estimator_for(o["estimator"], o["samples"], o["seed"]),
+        estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
         grid,
         channels=AVG_CHANNELS,
         reconstruction=AVG_RECONSTRUCTION,

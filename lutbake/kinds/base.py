@@ -57,7 +57,7 @@ class Estimation:
 
 
 def common_keys(e: Estimation) -> dict[str, Key]:
-    """The keys every kind has: name, kind, format, dtype, seed, samples, estimator."""
+    """The keys every kind has: name, kind, format, dtype, seed, samples, estimator, tolerance, relative_tolerance."""
     return {
         "name": Key(
             "name",
@@ -76,6 +76,23 @@ def common_keys(e: Estimation) -> dict[str, Key]:
             "seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0, maximum=MAX_SEED
         ),
         "format": Key("format", "str", "exr", "output file format: <out-dir>/<name>.<ext>", FORMATS),
+        "tolerance": Key(
+            "tolerance",
+            "float",
+            None,
+            "absolute error target per value, e <= max(tolerance, relative_tolerance |v|) (adaptive estimators); "
+            "unset: a quarter of the storage quantum (png16: 3.8e-6; lutbake.tolerance)",
+            minimum=0.0,
+            maximum=1.0,
+        ),
+        "relative_tolerance": Key(
+            "relative_tolerance",
+            "float",
+            None,
+            "relative error target per value (see tolerance); unset: from the dtype (float32 0, half 1.2e-4)",
+            minimum=0.0,
+            maximum=1.0,
+        ),
     }
 
 

@@ -29,6 +29,7 @@ from ..integrands.specular import N_CHANNELS, SHEEN_LAYOUTS, SPECULAR_MODELS, mo
 from ..sampling.hemisphere import ESTIMATORS, estimator_for
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from ..terms.distributions import MASKINGS, NDFS
+from ..tolerance import tolerance_of
 from .base import Estimation, Key, declare
 
 LAYOUTS = {
@@ -300,7 +301,7 @@ def plan(spec) -> TexelPlan:
         }
     return per_texel_plan(
         integrand,
-        estimator_for(o["estimator"], o["samples"], o["seed"]),
+        estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
         grid_for(axes, integrand),
         channels=CHANNELS[o["layout"]],
         reconstruction=reconstruction(o["layout"], axes),

@@ -20,6 +20,7 @@ from ..integrands.specular import specular_integrand
 from ..sampling.hemisphere import estimator_for
 from ..sampling.plan import TexelPlan, per_texel_plan
 from ..terms.metals import METALS
+from ..tolerance import tolerance_of
 from . import dfg
 from .base import Key, declare
 
@@ -86,7 +87,7 @@ def plan(spec) -> TexelPlan:
         extra = {}
     return per_texel_plan(
         integrand,
-        estimator_for(o["estimator"], o["samples"], o["seed"]),
+        estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
         dfg.grid_for(axes, integrand, f0, nz),
         channels=channels,
         reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D,

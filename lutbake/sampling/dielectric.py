@@ -39,13 +39,16 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 
+import numpy as np
 import warp as wp
 
+from . import points
 from .arrays import Rows64, Rule
 from .hemisphere import (
     PANEL_RATIO,
     PI64,
     GaussLegendre,
+    _launch,
     asinh64,
     facet_weight_for,
     next_geometric,
@@ -269,3 +272,7 @@ class DielectricGaussLegendre(GaussLegendre):
 
     def _kernel(self, integrand):
         return gl_dielectric_kernel(integrand)
+
+    def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
+        rule = wp.array(np.stack(points.gauss_legendre(self.order), axis=1), dtype=wp.vec2d, device=device)
+        return _launch(self._kernel(integrand), inputs, [rule, rule], integrand.kernel_channels, device)

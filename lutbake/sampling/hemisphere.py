@@ -56,6 +56,10 @@ from .arrays import Points2, Rows64, Rule, Values64
 PI64 = wp.constant(wp.float64(math.pi))
 
 
+# the BRDF terms run in float32: a texel value carries their rounding, ~1e-7 relative (measured: orders 48 and 64
+# differ by 3e-8 on the 128^2 dfg), which no difference of two orders sees; the error estimate adds it
+TERMS_ROUNDING = wp.constant(wp.float64(1.0e-7))
+QUADRATURE_SHARE = wp.constant(wp.float64(0.9))  # of the tolerance; the rest is left to TERMS_ROUNDING
 PANEL_RATIO = 4.0  # panels grow geometrically in theta_h (and in pi/2 - theta_h) by this factor
 
 
@@ -172,69 +176,149 @@ def facet_weight_for(integrand, pdf):
 
 
 def make_gauss_legendre(spec):
-    """Product Gauss-Legendre over panels in theta_h (module docstring). Per panel [t_lo, t_hi]:
+    """Product Gauss-Legendre over panels in theta_h (module docstring), adaptive per panel. Per panel [t_lo, t_hi]:
     - the outer variable is u = CDF(theta_h) on the NDF-peak panel [0, atan(alpha)] (the weight is
       g / p, D cancels), and theta_h itself beyond it (the weight is 2 pi sin(theta_h) g, because
       du = 2 pi D cos sin dtheta); a panel in region B has its outer variable smoothstep-mapped;
     - the inner variable phi runs over [0, pi] in region A and [0, acos c*] in region B, through a
       sinh map that resolves G2's pole at n.l = -horizon_scale next to the cut.
-    Kernel inputs: per-texel (n.v, alpha, param); GL (node, weight) pairs on [0, 1] for the outer (rule_u) and
-    inner (rule_p) variables. ``spec``: an integrand record (g, vec, acc, distribution, mirror)."""
+    Adaptivity: the panel is integrated by the n_0 x n_0 product rule, then n_1 x n_1, ... (``levels``: the orders,
+    their rules concatenated in ``rules``) until two successive orders agree within the panel's share of the
+    texel's tolerance, e_panel = max_c |Q_(k) - Q_(k-1)| <= 0.9 max(tol_abs, tol_rel |I_c|) pi / n_panels (I_c: the
+    texel's value at order n_0, a first pass, only where tol_rel > 0). The panel keeps Q_(k), the finer one, and
+    e_panel, the error of the coarser one: a bound, with exponential convergence, of Q_(k)'s error. A texel's
+    error estimate (``err``) is the sum of its panels' e / pi, plus TERMS_ROUNDING |I| (float32 terms;
+    the panels share QUADRATURE_SHARE of the tolerance). One level: the fixed-order rule, err = 0.
+    Kernel inputs: per-texel (n.v, alpha, param); ``levels`` (offset, order) into ``rules``, GL (node, weight)
+    pairs on [0, 1]; ``tol`` (tol_abs, tol_rel). ``spec``: an integrand record (g, vec, acc, distribution,
+    mirror)."""
     vec_type, acc_type, mirror = spec.vec, spec.acc, spec.mirror
     outer_range, outer_node = outer_variable_for(spec.distribution.tan2_from_u, spec.distribution.u_from_tan2)
     facet_weight = facet_weight_for(spec.g, spec.distribution.pdf_ndf)
     nch = vec_type._length_
     smooth = mirror is not None
 
+    @wp.func
+    def panel_sum(
+        v: wp.vec3,
+        a: float,
+        prm: float,
+        t_lo: wp.float64,
+        t_hi: wp.float64,
+        theta_a: wp.float64,
+        theta_peak: wp.float64,
+        eps_l: wp.float64,
+        rules: Rule,
+        off: int,
+        n: int,
+    ):
+        """The n x n product rule (rules[off : off + n]) over the panel [t_lo, t_hi]: the sum of w g / p."""
+        one = wp.float64(1.0)
+        two = wp.float64(2.0)
+        a64 = wp.float64(a)
+        cos_v = wp.float64(v[2])
+        sin_v = wp.float64(v[0])
+        acc = acc_type()
+        in_b = t_lo >= theta_a
+        in_u = t_hi <= theta_peak
+        x_lo, dx = outer_range(t_lo, t_hi, in_u, a64)
+        for k in range(n):
+            s = rules[off + k][0]
+            x = x_lo + dx * s
+            wk = rules[off + k][1] * dx
+            if in_b:  # smoothstep: removes the sqrt-like ends of acos(c*) at c* = +-1
+                x = x_lo + dx * s * s * (wp.float64(3.0) - two * s)
+                wk = rules[off + k][1] * dx * wp.float64(6.0) * s * (one - s)
+            cos_h, sin_h, wk = outer_node(x, wk, in_u, a64)
+            phimax = PI64
+            eps = PI64  # sinh-map scale; >= phimax makes the map nearly linear
+            if in_b:
+                # c* = -cos(theta_v) cos(2 theta_h) / (sin(theta_v) sin(2 theta_h))
+                c_star = -cos_v * (cos_h * cos_h - sin_h * sin_h) / (sin_v * two * sin_h * cos_h)
+                phimax = wp.acos(wp.clamp(c_star, -one, one))
+                # n.l = 2 (n.h) sin(theta_v) sin(theta_h) (cos(phi) - c*): G2's pole at n.l = -eps_l
+                # lies eps_l / slope beyond phimax
+                slope = two * cos_h * sin_v * sin_h * wp.max(wp.sin(phimax), wp.float64(1.0e-12))
+                eps = wp.max(eps_l / slope, wp.float64(1.0e-12))
+            big_a = asinh64(phimax / eps)
+            for j in range(n):
+                # sinh map (Johnston & Elliott 2005): phi = phimax - eps sinh(big_a (1 - x))
+                # sinh and cosh from one exp (Warp has no sincos; cos and sin of phi stay float64)
+                ex = wp.exp(big_a * (one - rules[off + j][0]))
+                phi = phimax - eps * wp.float64(0.5) * (ex - one / ex)
+                w = wk * rules[off + j][1] * eps * wp.float64(0.5) * (ex + one / ex) * big_a
+                h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
+                gw = facet_weight(v, h, a, prm, in_u)
+                for c in range(wp.static(nch)):
+                    acc[c] = acc[c] + w * wp.float64(gw[c])
+        return acc
+
     @wp.kernel(enable_backward=False, module="unique")
-    def gauss_legendre_kernel(texel: wp.array(dtype=wp.vec3), rule_u: Rule, rule_p: Rule, out: Rows64):
+    def gauss_legendre_kernel(
+        texel: wp.array(dtype=wp.vec3),
+        rules: Rule,
+        levels: wp.array(dtype=wp.vec2i),
+        tol: wp.vec2d,
+        out: Rows64,
+        err: Rows64,
+    ):
         i = wp.tid()
         # theta_b: c* = +1, nothing beyond reflects above the horizon
         v, a, prm, a64, cos_v, sin_v, eps_l, theta_a, theta_b, theta_peak = texel_view(texel[i])
         zero = wp.float64(0.0)
-        one = wp.float64(1.0)
-        two = wp.float64(2.0)
-        acc = acc_type()
-        t_lo = zero
+        n_levels = levels.shape[0]
+        t_start = zero
         if wp.static(smooth):
             if a <= 0.0:  # alpha -> 0: the closed-form mirror limit below (lutbake.edge), no quadrature
-                t_lo = theta_b
+                t_start = theta_b
+        n_panels = wp.int32(0)  # a dynamic variable (Warp: a bare literal is a constant)
+        t_lo = t_start
+        while t_lo < theta_b:
+            t_lo = next_theta(t_lo, theta_a, theta_peak)
+            n_panels += 1
+        # the per-panel target: a share of max(tol_abs, tol_rel |I_c|), in units of the sum (I = sum / pi)
+        mag = acc_type()  # |I_c| at the coarsest order (relative tolerance only)
+        if tol[1] > zero and n_levels > 1:
+            t_lo = t_start
+            while t_lo < theta_b:
+                t_hi = next_theta(t_lo, theta_a, theta_peak)
+                q0 = panel_sum(v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, levels[0][0], levels[0][1])
+                for c in range(wp.static(nch)):
+                    mag[c] = mag[c] + q0[c]
+                t_lo = t_hi
+        target = acc_type()
+        for c in range(wp.static(nch)):
+            target[c] = (
+                QUADRATURE_SHARE * wp.max(tol[0] * PI64, tol[1] * wp.abs(mag[c])) / wp.float64(wp.max(n_panels, 1))
+            )
+        acc = acc_type()
+        e_acc = acc_type()
+        t_lo = t_start
         while t_lo < theta_b:
             t_hi = next_theta(t_lo, theta_a, theta_peak)
-            in_b = t_lo >= theta_a
-            in_u = t_hi <= theta_peak
-            x_lo, dx = outer_range(t_lo, t_hi, in_u, a64)
-            for k in range(rule_u.shape[0]):
-                s = rule_u[k][0]
-                x = x_lo + dx * s
-                wk = rule_u[k][1] * dx
-                if in_b:  # smoothstep: removes the sqrt-like ends of acos(c*) at c* = +-1
-                    x = x_lo + dx * s * s * (wp.float64(3.0) - two * s)
-                    wk = rule_u[k][1] * dx * wp.float64(6.0) * s * (one - s)
-                cos_h, sin_h, wk = outer_node(x, wk, in_u, a64)
-                phimax = PI64
-                eps = PI64  # sinh-map scale; >= phimax makes the map nearly linear
-                if in_b:
-                    # c* = -cos(theta_v) cos(2 theta_h) / (sin(theta_v) sin(2 theta_h))
-                    c_star = -cos_v * (cos_h * cos_h - sin_h * sin_h) / (sin_v * two * sin_h * cos_h)
-                    phimax = wp.acos(wp.clamp(c_star, -one, one))
-                    # n.l = 2 (n.h) sin(theta_v) sin(theta_h) (cos(phi) - c*): G2's pole at n.l = -eps_l
-                    # lies eps_l / slope beyond phimax
-                    slope = two * cos_h * sin_v * sin_h * wp.max(wp.sin(phimax), wp.float64(1.0e-12))
-                    eps = wp.max(eps_l / slope, wp.float64(1.0e-12))
-                big_a = asinh64(phimax / eps)
-                for j in range(rule_p.shape[0]):
-                    # sinh map (Johnston & Elliott 2005): phi = phimax - eps sinh(big_a (1 - x))
-                    arg = big_a * (one - rule_p[j][0])
-                    phi = phimax - eps * wp.sinh(arg)
-                    w = wk * rule_p[j][1] * eps * wp.cosh(arg) * big_a
-                    h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
-                    gw = facet_weight(v, h, a, prm, in_u)
-                    for c in range(wp.static(nch)):
-                        acc[c] = acc[c] + w * wp.float64(gw[c])
+            q = panel_sum(v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, levels[0][0], levels[0][1])
+            d = acc_type()  # |Q_(k) - Q_(k-1)|: the error of Q_(k-1), an estimate (and with exponential
+            lev = wp.int32(1)  # convergence a bound) of Q_(k)'s
+            while lev < n_levels:
+                fine = panel_sum(
+                    v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, levels[lev][0], levels[lev][1]
+                )
+                ok = wp.int32(1)
+                for c in range(wp.static(nch)):
+                    d[c] = wp.abs(fine[c] - q[c])
+                    q[c] = fine[c]
+                    if d[c] > target[c]:
+                        ok = 0
+                lev += 1
+                if ok == 1:
+                    lev = n_levels
+            for c in range(wp.static(nch)):
+                acc[c] = acc[c] + q[c]
+                e_acc[c] = e_acc[c] + d[c]
             t_lo = t_hi
         for c in range(wp.static(nch)):
             out[i, c] = acc[c] / PI64
+            err[i, c] = e_acc[c] / PI64 + TERMS_ROUNDING * wp.abs(acc[c] / PI64)
         if wp.static(smooth):
             if a <= 0.0:  # the mirror limit (lutbake.edge)
                 store_row(out, i, mirror(v, prm))
@@ -310,14 +394,51 @@ def load(kernel, device: str = "cpu") -> None:
     wp.load_module(kernel.module, device=device)
 
 
+def _texels(inputs: dict, device: str):
+    n = len(inputs["nov"])
+    texel = np.stack([np.asarray(inputs[k], dtype=np.float32) for k in ("nov", "alpha", "param")], axis=1)
+    return n, wp.array(np.ascontiguousarray(texel), dtype=wp.vec3, device=device)
+
+
 def _launch(kernel, inputs: dict, point_arrays: list, kernel_channels: int, device: str) -> np.ndarray:
     """One launch over texels (nov[i], alpha[i], param[i]) -> float64 array (len, kernel_channels)."""
-    n = len(inputs["nov"])
+    n, texel = _texels(inputs, device)
     out = wp.zeros((n, kernel_channels), dtype=wp.float64, device=device)
-    texel = np.stack([np.asarray(inputs[k], dtype=np.float32) for k in ("nov", "alpha", "param")], axis=1)
-    arrays = [wp.array(np.ascontiguousarray(texel), dtype=wp.vec3, device=device)]
-    wp.launch(kernel, dim=n, inputs=arrays + point_arrays + [out], device=device)
+    wp.launch(kernel, dim=n, inputs=[texel] + point_arrays + [out], device=device)
     return out.numpy()
+
+
+# the successive product-rule orders of a panel: a ratio of ~1.5 (each level costs ~2.25x the last). Starting lower
+# (4, 6, ...) let coincidental agreements of two coarse rules pass (measured: error 1.9e-6 at an estimate 8e-7 on
+# the 128^2 dfg); from 6 every estimate bounds the error against order 64 (tests/test_tolerance.py)
+ADAPTIVE_ORDERS = (6, 9, 12, 16, 24, 32, 48, 64)
+
+
+@functools.lru_cache(maxsize=None)
+def gl_levels(orders: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """The GL rules of ``orders`` on [0, 1], concatenated ((node, weight) rows), and (offset, order) per order."""
+    rules = [np.stack(points.gauss_legendre(n), axis=1) for n in orders]
+    offsets = np.cumsum([0] + [len(r) for r in rules[:-1]])
+    return np.concatenate(rules), np.stack([offsets, orders], axis=1).astype(np.int32)
+
+
+def gl_launch(integrand, inputs: dict, orders: tuple[int, ...], tol: tuple[float, float], device: str):
+    """The gauss_legendre kernel over texels ``inputs`` at ``orders`` (one: fixed order) and tolerance
+    (absolute, relative): (values, error estimates), float64 (n, kernel_channels) each."""
+    n, texel = _texels(inputs, device)
+    rules, levels = gl_levels(tuple(orders))
+    out = wp.zeros((n, integrand.kernel_channels), dtype=wp.float64, device=device)
+    err = wp.zeros((n, integrand.kernel_channels), dtype=wp.float64, device=device)
+    args = [
+        texel,
+        wp.array(rules, dtype=wp.vec2d, device=device),
+        wp.array(levels, dtype=wp.vec2i, device=device),
+        wp.vec2d(*tol),
+        out,
+        err,
+    ]
+    wp.launch(gl_kernel(integrand), dim=n, inputs=args, device=device)
+    return out.numpy(), err.numpy()
 
 
 @dataclass(frozen=True)
@@ -342,12 +463,38 @@ class GaussLegendre:
         load(self._kernel(integrand), device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
-        rule = wp.array(np.stack(points.gauss_legendre(self.order), axis=1), dtype=wp.vec2d, device=device)
-        return _launch(self._kernel(integrand), inputs, [rule, rule], integrand.kernel_channels, device)
+        return gl_launch(integrand, inputs, (self.order,), (0.0, 0.0), device)[0]
 
     def refined(self):
         n = self.order
         return replace(self, budget=3 * (n + 4) ** 2), f"order {n} - order {n + 4}"
+
+
+@dataclass(frozen=True)
+class AdaptiveGaussLegendre:
+    """``gauss_legendre`` to a tolerance: each panel at orders ADAPTIVE_ORDERS in turn until two agree within its
+    share of max(absolute, relative |I|) (make_gauss_legendre). ``evaluate_with_error`` also returns each texel's
+    error estimate (the sum over panels of |Q_(k) - Q_(k-1)|), recorded as the table's lutbake:error_estimate."""
+
+    absolute: float
+    relative: float
+    orders: tuple[int, ...] = ADAPTIVE_ORDERS
+    name: str = "gauss_legendre"
+
+    def samples(self, inputs: dict) -> np.ndarray:  # nominal: 3 panels at the middle order (the work adapts)
+        return np.full(len(inputs["nov"]), 3 * self.orders[len(self.orders) // 2] ** 2)
+
+    def prepare(self, integrand, device: str) -> None:
+        load(gl_kernel(integrand), device)
+
+    def evaluate_with_error(self, integrand, inputs: dict, device: str) -> tuple[np.ndarray, np.ndarray]:
+        return gl_launch(integrand, inputs, self.orders, (self.absolute, self.relative), device)
+
+    def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
+        return self.evaluate_with_error(integrand, inputs, device)[0]
+
+    def refined(self):
+        return replace(self, absolute=self.absolute / 100, relative=self.relative / 100), "tolerance / 100"
 
 
 @dataclass(frozen=True)
@@ -384,9 +531,12 @@ class QuasiMonteCarlo:
         return replace(self, seed=self.seed + 1), "seed - (seed + 1) (two scramblings)"
 
 
-def estimator_for(name: str, samples: int | None = None, seed: int = 0):
-    """The hemisphere estimator ``name`` (ESTIMATORS) at ``samples`` per texel (None: its default)."""
+def estimator_for(name: str, samples: int | None = None, seed: int = 0, tolerance=None):
+    """The hemisphere estimator ``name`` (ESTIMATORS) at ``samples`` per texel (None: its default). gauss_legendre
+    without ``samples`` but with a ``tolerance`` (lutbake.tolerance.Tolerance) adapts its order to it."""
     budget = samples or DEFAULT_SAMPLES[name]
+    if name == "gauss_legendre" and samples is None and tolerance is not None:
+        return AdaptiveGaussLegendre(tolerance.absolute, tolerance.relative)
     if name == "gauss_legendre":
         return GaussLegendre(budget)
     if name in ESTIMATORS:

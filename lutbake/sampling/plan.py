@@ -130,6 +130,37 @@ def per_texel_plan(
     def run(idx, est, device):
         return grid.reduce(est.evaluate(integrand, grid.rows(idx), device))[:, : integrand.nch]
 
+    adaptive = hasattr(estimator, "evaluate_with_error")
+    tolerance_record = (
+        {"tolerance": f"max({estimator.absolute:.3g}, {estimator.relative:.3g} |v|) per value"} if adaptive else {}
+    )
+    texel_error = np.zeros((grid.n_texels, integrand.nch)) if adaptive else None
+
+    def run_adaptive(s: int, e: int, device: str) -> np.ndarray:
+        """Values of texels [s, e), their error estimates kept in texel_error (a tile writes only its rows);
+        sub-texels' errors add up with |weights| (grid.reduce is linear, the GL weights positive)."""
+        values, err = estimator.evaluate_with_error(integrand, grid.rows(slice(s, e)), device)
+        texel_error[s:e] = grid.reduce(err)[:, : integrand.nch]
+        return grid.reduce(values)[:, : integrand.nch]
+
+    def adaptive_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
+        """The max over texels of the kernel's own per-texel estimate; the method names the worst ratio to the
+        tolerance (<= 1: every texel met it)."""
+        values = data.reshape(grid.n_texels, -1)
+        target = np.maximum(estimator.absolute, estimator.relative * np.abs(values))
+        ratio = float(np.max(texel_error / target))
+        err = float(np.max(texel_error))
+        if relative_error:
+            ok = np.abs(values) > 1e-6
+            err = float(np.max(texel_error[ok] / np.abs(values[ok]))) if ok.any() else 0.0
+        how = (
+            "per texel: sum over panels of |Q(order k) - Q(order k-1)| at the order that met the tolerance "
+            f"(every texel); max error / tolerance = {ratio:.3g}"
+        )
+        if relative_error:
+            how = "relative (|f| > 1e-6), " + how + f"; max abs {float(np.max(texel_error)):.3e}"
+        return err, how
+
     def estimate(data: np.ndarray, device: str) -> tuple[float, str]:
         idx = probe_indices(grid)
         refined, how = estimator.refined()
@@ -151,12 +182,12 @@ def per_texel_plan(
         reconstruction=reconstruction,
         n_texels=grid.n_texels,
         n_channels=integrand.nch,
-        run_tile=lambda s, e, d: run(slice(s, e), estimator, d),
+        run_tile=run_adaptive if adaptive else (lambda s, e, d: run(slice(s, e), estimator, d)),
         prepare=lambda d: estimator.prepare(integrand, d),
         samples=int(round(np.mean(samples) * k)),
         estimator=estimator.name,
         terms=terms,
         cost=float(np.sum(samples)),
-        extra=dict(extra or {}),
-        error_estimate=estimate if error_estimate else None,
+        extra={**(extra or {}), **tolerance_record},
+        error_estimate=(adaptive_estimate if adaptive else estimate) if error_estimate else None,
     )
