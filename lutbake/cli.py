@@ -274,5 +274,9 @@ def preview(file, out):
     click.echo(str(path))
 
 
+from .cli_engines import audit  # noqa: E402  (commands for shipping tables to engines)
+
+main.add_command(audit)
+
 if __name__ == "__main__":
     main()

@@ -1,0 +1,82 @@
+"""CLI commands for shipping tables to engines: ``audit``, ``size``, ``fit`` (registered by lutbake.cli)."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+EXIT_CONFIG = 2
+
+
+def _quiet():
+    from .cli import _quiet_warp
+
+    _quiet_warp()
+
+
+def _shape(text: str | None):
+    if text is None:
+        return None
+    try:
+        parts = tuple(int(p) for p in text.lower().split("x"))
+    except ValueError:
+        parts = ()
+    if len(parts) != 3 or min(parts) < 1:
+        raise click.BadParameter(f"{text!r}: expected ROWSxCOLUMNSxCHANNELS, e.g. 16x16x2", param_hint="--shape")
+    return parts
+
+
+@click.command()
+@click.argument("file", type=click.Path(path_type=Path))
+@click.option("--preset", default=None, metavar="NAME", help="Conventions of a preset (lutbake list); default 'default'.")
+@click.option("--config", type=click.Path(path_type=Path), default=None, help="Conventions of a config's first table.")
+@click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",
+              help="Override a convention key (texel, row_order, roughness, layout, ...); the size is the file's.")
+@click.option("--tolerance", type=float, default=1e-3, show_default=True,
+              help="Exit 0 when the chosen error metric is within this, 1 otherwise.")
+@click.option("--metric", type=click.Choice(["max", "p99", "mean"]), default="max", show_default=True,
+              help="Which |file - converged| statistic is held against --tolerance.")
+@click.option("--max-side", type=click.IntRange(min=2), default=128, show_default=True,
+              help="Re-integrate at most this many rows and columns (strided subset, last row/column included).")
+@click.option("--shape", default=None, metavar="RxCxC", help="Layout of a text array (C header / JS / WGSL / Rust) "
+              "whose file does not declare it, e.g. 16x16x2.")
+@click.option("--error-map", type=click.Path(path_type=Path), default=None, metavar="PNG",
+              help="Write |file - converged| per channel with labelled axes.")
+@click.option("--json", "as_json", is_flag=True, help="Print the report as JSON (for CI).")
+@click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
+def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, error_map, as_json, workers):
+    """Compare the LUT FILE with a converged re-bake under declared conventions and diagnose mistakes.
+
+    Reports max/mean/percentile |file - converged| per channel and where the maximum sits, tests each usual
+    hand-over mistake against the data (flipped/swapped axes, half- and one-texel offsets, alpha vs
+    perceptual roughness, sRGB decoding, swapped channels, the other split-sum layout) and names the one that
+    explains the data, the storage quantisation and the Monte-Carlo noise (estimated sample count).
+    Exit 0 when within --tolerance, 1 otherwise, 2 on a bad option, file or config.
+
+    \b
+    Examples:
+      lutbake audit dfg.dds --preset filament
+      lutbake audit lut_ggx.png --preset gltf --error-map lut_ggx.err.png --json
+      lutbake audit brdf.h --set texel=endpoint --set axis_order=roughness_x --shape 64x64x3
+    """
+    from .audit import audit as run_audit
+    from .audit import report_json
+    from .errors import ConfigError
+
+    _quiet()
+    if preset and config:
+        click.echo("error: give --preset or --config, not both", err=True)
+        sys.exit(EXIT_CONFIG)
+    try:
+        report = run_audit(file, {"preset": preset, "config": config, "overrides": overrides}, tolerance=tolerance,
+                           metric=metric, max_side=max_side, error_map=error_map, shape=_shape(shape),
+                           workers=workers)
+    except ConfigError as e:
+        click.echo(f"error: {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    except (OSError, ValueError) as e:
+        click.echo(f"error: {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    click.echo(report_json(report) if as_json else report.text())
+    sys.exit(0 if report.passed else 1)
