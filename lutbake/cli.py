@@ -274,9 +274,10 @@ def preview(file, out):
     click.echo(str(path))
 
 
-from .cli_engines import audit  # noqa: E402  (commands for shipping tables to engines)
+from .cli_engines import audit, size  # noqa: E402  (commands for shipping tables to engines)
 
 main.add_command(audit)
+main.add_command(size)
 
 if __name__ == "__main__":
     main()

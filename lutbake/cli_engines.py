@@ -80,3 +80,48 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
         sys.exit(EXIT_CONFIG)
     click.echo(report_json(report) if as_json else report.text())
     sys.exit(0 if report.passed else 1)
+
+
+@click.command()
+@click.option("--preset", default=None, metavar="NAME", help="Conventions of a preset (lutbake list); default 'default'.")
+@click.option("--config", type=click.Path(path_type=Path), default=None, help="Conventions of a config's first table.")
+@click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE", help="Override a convention key.")
+@click.option("--max-error", type=float, required=True, help="Target max |bilinear(table) - integral| between texels.")
+@click.option("--sizes", default="8,16,32,64,128,256,512", show_default=True,
+              help="Square sizes N to try, in increasing order (stops once every format meets the target).")
+@click.option("--nov-min", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True,
+              help="Measure only where NoV >= this (the grazing corner never converges on a linear NoV axis).")
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+@click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
+def size(preset, config, overrides, max_error, sizes, nov_min, as_json, workers):
+    """Smallest N x N resolution per storage format (UNORM8/10/16, F16, F32) whose max error after bilinear
+    filtering, measured between texels against the integral, is within --max-error.
+
+    \b
+    Examples:
+      lutbake size --preset default --max-error 1e-3
+      lutbake size --preset unity-hdrp --max-error 1e-4 --nov-min 0.05 --json
+    """
+    import json
+
+    from .errors import ConfigError
+    from .size import smallest_sizes
+
+    _quiet()
+    try:
+        ns = tuple(int(s) for s in sizes.split(","))
+        if not ns or min(ns) < 2:
+            raise ValueError
+    except ValueError:
+        click.echo(f"error: --sizes {sizes!r}: a comma-separated list of integers >= 2", err=True)
+        sys.exit(EXIT_CONFIG)
+    if max_error <= 0:
+        click.echo("error: --max-error must be > 0", err=True)
+        sys.exit(EXIT_CONFIG)
+    try:
+        result = smallest_sizes({"preset": preset, "config": config, "overrides": overrides}, max_error, ns,
+                                workers=workers, nov_min=nov_min)
+    except (ConfigError, OSError, ValueError) as e:
+        click.echo(f"error: {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    click.echo(json.dumps(result.as_dict(), indent=1) if as_json else result.text())
