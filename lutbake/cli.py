@@ -274,10 +274,10 @@ def preview(file, out):
     click.echo(str(path))
 
 
-from .cli_engines import audit, size  # noqa: E402  (commands for shipping tables to engines)
+from .cli_engines import audit, fit, size  # noqa: E402  (commands for shipping tables to engines)
 
-main.add_command(audit)
-main.add_command(size)
+for _command in (audit, size, fit):
+    main.add_command(_command)
 
 if __name__ == "__main__":
     main()

@@ -125,3 +125,37 @@ def size(preset, config, overrides, max_error, sizes, nov_min, as_json, workers)
         click.echo(f"error: {e}", err=True)
         sys.exit(EXIT_CONFIG)
     click.echo(json.dumps(result.as_dict(), indent=1) if as_json else result.text())
+
+
+@click.command()
+@click.argument("family", type=click.Choice(["karis-mobile", "gotanda-eq8"]))
+@click.option("--lang", type=click.Choice(["glsl", "hlsl"]), default="glsl", show_default=True)
+@click.option("-o", "--out", type=click.Path(path_type=Path, dir_okay=False), default=None,
+              help="Write the shader function here (default: print it after the error table).")
+@click.option("--json", "as_json", is_flag=True, help="Print constants and errors as JSON.")
+def fit(family, lang, out, as_json):
+    """Refit a published closed form to lutbake's integral and emit it as GLSL/HLSL with its measured error
+    (published constants vs refit, side by side).
+
+    \b
+    Examples:
+      lutbake fit karis-mobile --lang hlsl -o env_brdf_approx.hlsl
+      lutbake fit gotanda-eq8 --json
+    """
+    import json
+
+    from .fit import fit as run_fit
+    from .io.atomic import atomic_write_bytes
+
+    _quiet()
+    result = run_fit(family)
+    if as_json:
+        click.echo(json.dumps({"family": family, "published": list(result.published), "refit": list(result.refit),
+                               "errors": result.errors}, indent=1))
+    else:
+        click.echo(result.text())
+    if out is not None:
+        atomic_write_bytes(out, result.code[lang].encode())
+        click.echo(str(out))
+    elif not as_json:
+        click.echo(result.code[lang])

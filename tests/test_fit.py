@@ -1,0 +1,51 @@
+"""lutbake fit: the published closed forms re-implemented in numpy match lutbake's terms, and the refits help."""
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from lutbake.cli import main
+from lutbake.fit import GOTANDA_PUBLISHED, KARIS_PUBLISHED, fit_gotanda, fit_karis, gotanda_eq8, karis_mobile
+from lutbake.tables import diffuse
+
+EQ8_RTOL = 1e-5  # float32 Warp term vs float64 numpy
+
+
+def test_karis_published_constants_reproduce_envbrdfapprox_by_hand():
+    # Karis 2014 at roughness 0.5, NoV 0.5, written out: r = 0.5 c0 + c1
+    r = 0.5 * np.array([-1, -0.0275, -0.572, 0.022]) + np.array([1, 0.0425, 1.04, -0.04])
+    a004 = min(r[0] ** 2, 2 ** (-9.28 * 0.5)) * r[0] + r[1]
+    expected = np.array([-1.04 * a004 + r[2], 1.04 * a004 + r[3]])
+    np.testing.assert_allclose(karis_mobile(KARIS_PUBLISHED, np.array(0.5), np.array(0.5)), expected, rtol=1e-12)
+
+
+def test_gotanda_eq8_numpy_equals_lutbake_fitted_term():
+    rng = np.random.default_rng(3)
+    nl, nv, sig = rng.uniform(0.05, 1, 64), rng.uniform(0.05, 1, 64), rng.uniform(0, 1, 64)
+    phi = rng.uniform(0, np.pi, 64)
+    sl, sv = np.sqrt(1 - nl ** 2), np.sqrt(1 - nv ** 2)
+    l = np.stack([sl * np.cos(phi), sl * np.sin(phi), nl], -1)
+    v = np.stack([sv, 0 * sv, nv], -1)
+    ref = diffuse.eval_brdf("fitted", l, v, sig)
+    got = gotanda_eq8(GOTANDA_PUBLISHED, nl, nv, sl * sv * np.cos(phi) + nl * nv, sig)
+    np.testing.assert_allclose(got, ref, rtol=EQ8_RTOL, atol=1e-7)
+
+
+def test_karis_refit_lowers_the_rms_and_emits_both_languages():
+    r = fit_karis(n=16)
+    assert r.errors["refit"]["rms over A, B"] < r.errors["published"]["rms over A, B"]
+    assert "EnvBRDFApprox_lutbake" in r.code["glsl"] and "float2" in r.code["hlsl"]
+
+
+@pytest.mark.parametrize("lang", ["glsl", "hlsl"])
+def test_gotanda_refit_lowers_the_floored_max_relative_error(lang):
+    r = fit_gotanda(6, 4, 5, max_nfev=40)
+    key = "max relative, floored at 0.02/pi"
+    assert r.errors["refit"][key] < r.errors["published"][key]
+    assert "Fd_gotanda_refit" in r.code[lang]
+
+
+def test_cli_fit_writes_the_shader(tmp_path):
+    out = tmp_path / "approx.hlsl"
+    res = CliRunner().invoke(main, ["fit", "karis-mobile", "--lang", "hlsl", "-o", str(out)])
+    assert res.exit_code == 0, res.output
+    assert "published" in res.output and "float2 EnvBRDFApprox_lutbake" in out.read_text()
