@@ -7,6 +7,7 @@ from pathlib import Path
 import click
 
 from . import __version__
+from .io.formats import WRITERS
 
 EXIT_CONFIG = 2
 
@@ -52,7 +53,7 @@ def main():
 @click.option("--force", is_flag=True, help="Rebake every table, even those whose output is up to date.")
 @click.option("--report", type=click.Path(path_type=Path, dir_okay=False), default=None, metavar="FILE.json",
               help="Write a JSON summary: per table status, path, content hash, seconds, samples, error estimate.")
-@click.option("--format", "fmt", type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h"]), default=None,
+@click.option("--format", "fmt", type=click.Choice(list(WRITERS)), default=None,
               help="Output format of every table (same as --set format=...; default: each table's `format`, exr).")
 def bake(configs, presets, out_dir, overrides, workers, device, progress, force, report, fmt):
     """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.<ext> (EXR unless `format` / --format says otherwise).
