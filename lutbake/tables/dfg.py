@@ -24,7 +24,7 @@ import numpy as np
 from ..axes import MAPPINGS, ORDERS, ROUGHNESS_PARAMS, TEXELS, Axis
 from ..io.formats import FORMATS
 from ..terms.sets import MASKINGS, MODELS, NDFS, model_terms, pair_allowed
-from . import specular
+from . import engine_layouts, specular
 from .base import Key, Kind, Plan
 
 MAX_SAMPLES = 1 << 24  # per texel; beyond this a point set alone needs > 128 MiB and a table takes days
@@ -89,12 +89,15 @@ RECONSTRUCTION["sheen_albedo"] = (
     "f = f_sheen + (f_diffuse + f_specular) * sheenAlbedoScaling; .g is E with Ashikhmin visibility")
 RECONSTRUCTION["charlie_clamped"] = RECONSTRUCTION["charlie"]
 RECONSTRUCTION["sheen_albedo_clamped"] = RECONSTRUCTION["sheen_albedo"]
-N_CHANNELS = specular.N_CHANNELS
+N_CHANNELS = {**specular.N_CHANNELS, **{k: 3 for k in engine_layouts.LAYOUTS}}
+LAYOUTS.update(engine_layouts.LAYOUTS)
+CHANNELS.update(engine_layouts.CHANNELS)
+RECONSTRUCTION.update(engine_layouts.RECONSTRUCTION)
 AXIS_ORDERS = {
     "nov_x": "columns (x) = NoV, rows (y) = roughness: sample at vec2(NoV, roughness) (Filament, glTF, UE4)",
     "roughness_x": "columns (x) = roughness, rows (y) = NoV: sample at vec2(roughness, NoV-coordinate) (Blender EEVEE)",
 }
-NOV_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "one_minus_t2")}
+NOV_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "one_minus_t2", "square")}
 ROUGHNESS_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "texel_offset")}
 
 COMMON_KEYS = {
@@ -227,10 +230,17 @@ def plan(spec) -> Plan:
         terms = {"model": "sheen", "ndf": "charlie (alpha = the roughness axis' alpha)", "masking": vis,
                  "fresnel": "none (F = 1)", "layout": o["layout"],
                  "gauss_legendre_panels": "the GGX CDF in theta_h (panelling only; the integrand is the sheen lobe)"}
-    return specular.hemisphere_plan(
-        key=(nd, mk, o["layout"], o["estimator"], form), nov=nov, alpha=alpha, param=None,
-        samples=o["samples"], seed=o["seed"], nch=nch, kernel_channels=3 if o["layout"] in SHEEN_LAYOUTS else nch,
+    base = engine_layouts.BASE_LAYOUT.get(o["layout"], o["layout"])
+    if base != o["layout"]:
+        nch = N_CHANNELS[base]
+        terms["diffuse"] = "disney (Burley 2012, HDRP DisneyDiffuseNoPI / 1.03571), minus 0.5"
+    plan = specular.hemisphere_plan(
+        key=(nd, mk, base, o["estimator"], form), nov=nov, alpha=alpha, param=None,
+        samples=o["samples"], seed=o["seed"], nch=nch, kernel_channels=3 if base in SHEEN_LAYOUTS else nch,
         axes=axes, channels=CHANNELS[o["layout"]], reconstruction=reconstruction(o["layout"], axes), terms=terms)
+    if base != o["layout"]:
+        plan = engine_layouts.with_diffuse_channel(plan, nov, engine_layouts.perceptual_roughness_grid(axes))
+    return plan
 
 
 DFG = Kind("dfg", "split-sum specular DFG: NoV x roughness, scale/bias or multiscatter (Σ Fc·V, Σ V) channels",
