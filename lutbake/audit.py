@@ -165,7 +165,7 @@ def hypotheses(conv: Conventions) -> list[Hypothesis]:
             if s < 0:
                 toward = toward.replace("t = 1", "t = 0").replace("rougher", "smoother").replace("larger", "smaller")
             hs.append(Hypothesis(f"{axis.lower()}_offset_{s:+g}",
-                                 f"the {axis} axis offset by {what} {toward}: texel i holds t = (i + 0.5 {s:+g})/N",
+                                 f"the {axis} axis offset by {what} {toward}: every texel holds t {s:+g}/N",
                                  positions(conv, **{key: s})))
     if declared_power == 2.0:
         hs.append(Hypothesis("roughness_is_alpha", "the roughness axis holds alpha (alpha = t), not perceptual "

@@ -136,3 +136,17 @@ def test_cli_json_exit_codes_and_error_map(clean, tmp_path):
     assert "PASS" in res.output
     res = CliRunner().invoke(main, ["audit", str(q), "--preset", "no-such-engine"])
     assert res.exit_code == 2 and "no-such-engine" in res.output
+
+
+def test_threejs_shipped_js_array_fits_the_threejs_preset():
+    r = run(DATA / "threejs_dfg_lut.js", preset="threejs", shape=(16, 16, 2))
+    assert r.extra["chosen"] == "nominal" and r.quantisation["kind"] == "half"
+    nominal = next(h for h in r.hypotheses if h["name"] == "nominal")
+    assert nominal["rms"] < 0.1 * min(h["rms"] for h in r.hypotheses if h["name"] != "nominal")
+
+
+def test_threejs_shipped_table_is_height_correlated_not_separable():
+    hc = run(DATA / "threejs_dfg_lut.js", preset="threejs", shape=(16, 16, 2))
+    sep = audit(DATA / "threejs_dfg_lut.js", {"preset": "threejs", "overrides": ["masking=smith_separable"]},
+                max_side=MAX_SIDE, shape=(16, 16, 2))
+    assert hc.hypotheses[0]["rms"] < 0.1 * sep.hypotheses[0]["rms"]
