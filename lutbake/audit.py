@@ -73,10 +73,15 @@ def other_layout(pred: np.ndarray, layout: str) -> np.ndarray:
 
 @dataclass
 class Positions:
-    """Per-texel (NoV, alpha) of a file-sized grid: rows x columns."""
+    """Per-texel (NoV, alpha, perceptual roughness) of a file-sized grid: rows x columns."""
 
     nov: np.ndarray
     alpha: np.ndarray
+    rough: np.ndarray  # perceptual roughness before the alpha floor (the Disney diffuse channel's parameter)
+
+    def map(self, fn) -> "Positions":
+        """The same index operation (flip, transpose, subset) applied to every field."""
+        return Positions(fn(self.nov), fn(self.alpha), fn(self.rough))
 
 
 @dataclass
@@ -138,11 +143,14 @@ def positions(conv: Conventions, shift_rough: float = 0.0, shift_nov: float = 0.
     power = alpha_power if alpha_power is not None else (2.0 if rname == "perceptual_roughness" else 1.0)
     nov_1d = np.maximum(vals["NoV"], NOV_MIN)
     alpha_1d = np.maximum(vals[rname] ** power, ALPHA_MIN)
+    rough_1d = np.sqrt(np.clip(vals[rname] ** power, 0.0, None))
     if x_axis.name == "NoV":
         nov, alpha = np.meshgrid(nov_1d, alpha_1d)
+        rough = np.meshgrid(nov_1d, rough_1d)[1]
     else:
         alpha, nov = np.meshgrid(alpha_1d, nov_1d)
-    return Positions(nov, alpha)
+        rough = np.meshgrid(rough_1d, nov_1d)[0]
+    return Positions(nov, alpha, rough)
 
 
 def hypotheses(conv: Conventions) -> list[Hypothesis]:
@@ -152,12 +160,12 @@ def hypotheses(conv: Conventions) -> list[Hypothesis]:
     hs = [Hypothesis("nominal", f"the declared conventions ({conv.source})", nominal)]
     row_axis = conv.axes[0].name
     hs.append(Hypothesis("rows_flipped", f"rows in reverse order (the {row_axis} axis flipped: row 0 at the "
-                         "other end)", Positions(nominal.nov[::-1], nominal.alpha[::-1])))
+                         "other end)", nominal.map(lambda a: a[::-1])))
     hs.append(Hypothesis("columns_flipped", f"columns in reverse order (the {conv.axes[1].name} axis flipped)",
-                         Positions(nominal.nov[:, ::-1], nominal.alpha[:, ::-1])))
+                         nominal.map(lambda a: a[:, ::-1])))
     if nominal.nov.shape[0] == nominal.nov.shape[1]:
         hs.append(Hypothesis("axes_swapped", "rows and columns swapped (NoV and roughness exchanged)",
-                             Positions(nominal.nov.T, nominal.alpha.T)))
+                             nominal.map(lambda a: a.T)))
     for axis, key in (("roughness", "shift_rough"), ("NoV", "shift_nov")):
         for s in (-1.0, -0.5, 0.5, 1.0):
             what = "one texel" if abs(s) == 1 else "half a texel"
@@ -197,9 +205,13 @@ class Integrator:
         self.specular = specular
         o = conv.options
         self.form, self.ndf, self.masking = terms_of(o)
+        from .tables import engine_layouts
+
+        self.engine_layouts = engine_layouts
         self.layout = o["layout"]
-        self.nch = specular.N_CHANNELS[self.layout]
-        self.kernel_channels = 3 if self.layout in specular.SHEEN_LAYOUTS else self.nch
+        self.base = engine_layouts.BASE_LAYOUT.get(self.layout, self.layout)  # the specular kernel's layout
+        self.nch = specular.N_CHANNELS[self.base]
+        self.kernel_channels = 3 if self.base in specular.SHEEN_LAYOUTS else self.nch
         self.workers = workers
         self._cache: dict[bytes, np.ndarray] = {}
 
@@ -218,18 +230,25 @@ class Integrator:
                     estimator=estimator, terms={}, cost=float(n * samples))
         return execute(plan, workers=self.workers, progress=False).reshape(n, nch)
 
-    def converged(self, nov: np.ndarray, alpha: np.ndarray) -> np.ndarray:
-        key = nov.astype(np.float32).tobytes() + alpha.astype(np.float32).tobytes()
+    def converged(self, nov: np.ndarray, alpha: np.ndarray, rough: np.ndarray | None = None) -> np.ndarray:
+        """Every channel of the layout at (NoV, alpha); ``rough`` (perceptual) feeds an engine diffuse channel
+        (default sqrt(alpha))."""
+        rough = np.sqrt(alpha) if rough is None else rough
+        key = b"".join(a.astype(np.float32).tobytes() for a in (nov, alpha, rough))
         if key not in self._cache:
-            self._cache[key] = self._run(self.layout, "gauss_legendre", REFERENCE_SAMPLES, self.nch,
-                                         self.kernel_channels, nov.astype(np.float32), alpha.astype(np.float32))
+            out = self._run(self.base, "gauss_legendre", REFERENCE_SAMPLES, self.nch, self.kernel_channels,
+                            nov.astype(np.float32), alpha.astype(np.float32))
+            if self.base != self.layout:
+                b = self.engine_layouts.disney_fgd(nov, rough) - self.engine_layouts.HDRP_DIFFUSE_OFFSET
+                out = np.concatenate([out, b[:, None]], axis=1)
+            self._cache[key] = out
         return self._cache[key]
 
     def hammersley(self, nov, alpha, samples: int) -> np.ndarray | None:
         """The engines' usual estimator (R, G of the split-sum layout), or None for the sheen layouts."""
-        if self.layout in self.specular.SHEEN_LAYOUTS or self.form != "microfacet":
+        if self.base in self.specular.SHEEN_LAYOUTS or self.form != "microfacet":
             return None
-        base = "multiscatter" if self.layout.startswith("multiscatter") else "scale_bias"
+        base = "multiscatter" if self.base.startswith("multiscatter") else "scale_bias"
         return self._run(base, "hammersley_ndf", samples, 2, 2, nov.astype(np.float32), alpha.astype(np.float32))
 
 
@@ -371,8 +390,9 @@ def audit(path, conv_args: dict | None = None, tolerance: float = 1e-3, metric: 
     hs = hypotheses(conv)
     preds = {}
     for h in hs:
-        sub = Positions(h.positions.nov[np.ix_(iy, ix)], h.positions.alpha[np.ix_(iy, ix)])
-        pred = integ.converged(sub.nov.ravel(), sub.alpha.ravel()).reshape(len(iy), len(ix), -1)[..., :nch]
+        sub = h.positions.map(lambda a: a[np.ix_(iy, ix)])
+        pred = integ.converged(sub.nov.ravel(), sub.alpha.ravel(), sub.rough.ravel()).reshape(
+            len(iy), len(ix), -1)[..., :nch]
         if h.transform is not None:
             pred = h.transform(pred)
         d = (data - pred)[..., compared]

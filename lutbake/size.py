@@ -53,17 +53,19 @@ def axis_at(axis: Axis, x: np.ndarray) -> np.ndarray:
     return axis._map(np.clip(t, 0.0, 1.0))
 
 
-def half_grid(conv: Conventions) -> tuple[np.ndarray, np.ndarray]:
-    """(NoV, alpha) on the (2H - 1) x (2W - 1) grid of half-integer texel indices."""
+def half_grid(conv: Conventions) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(NoV, alpha, perceptual roughness) on the (2H - 1) x (2W - 1) grid of half-integer texel indices."""
     y_axis, x_axis = conv.axes
     vals = {a.name: axis_at(a, np.arange(2 * a.count - 1) / 2.0) for a in (y_axis, x_axis)}
     rname = next(n for n in vals if n != "NoV")
-    alpha_1d = np.maximum(vals[rname] ** (2.0 if rname == "perceptual_roughness" else 1.0), ALPHA_MIN)
+    a = np.clip(vals[rname] ** (2.0 if rname == "perceptual_roughness" else 1.0), 0.0, None)
+    alpha_1d, rough_1d = np.maximum(a, ALPHA_MIN), np.sqrt(a)
     nov_1d = np.maximum(vals["NoV"], NOV_MIN)
     if x_axis.name == "NoV":
-        return tuple(np.meshgrid(nov_1d, alpha_1d))
+        nov, alpha = np.meshgrid(nov_1d, alpha_1d)
+        return nov, alpha, np.meshgrid(nov_1d, rough_1d)[1]
     alpha, nov = np.meshgrid(alpha_1d, nov_1d)
-    return nov, alpha
+    return nov, alpha, np.meshgrid(rough_1d, nov_1d)[0]
 
 
 def bilinear_half(table: np.ndarray) -> np.ndarray:
@@ -109,8 +111,8 @@ def measure(conv_args: dict, n: int, channels=None, workers=None, nov_min: float
     with NoV >= ``nov_min``."""
     conv = conventions(**conv_args, shape=(n, n))
     integ = Integrator(conv, workers)
-    nov, alpha = half_grid(conv)
-    ref = integ.converged(nov.ravel(), alpha.ravel()).reshape(nov.shape + (-1,))
+    nov, alpha, rough = half_grid(conv)
+    ref = integ.converged(nov.ravel(), alpha.ravel(), rough.ravel()).reshape(nov.shape + (-1,))
     if channels is not None:
         ref = ref[..., channels]
     table = ref[::2, ::2]

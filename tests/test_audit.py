@@ -150,3 +150,19 @@ def test_threejs_shipped_table_is_height_correlated_not_separable():
     sep = audit(DATA / "threejs_dfg_lut.js", {"preset": "threejs", "overrides": ["masking=smith_separable"]},
                 max_side=MAX_SIDE, shape=(16, 16, 2))
     assert hc.hypotheses[0]["rms"] < 0.1 * sep.hypotheses[0]["rms"]
+
+
+def test_unity_hdrp_table_audits_clean_and_its_sqrt_axis_flip_is_found(tmp_path):
+    """A lutbake unity-hdrp table (Disney channel B, x = sqrt(NoV), endpoints) re-audited under its preset."""
+    import lutbake
+    from lutbake.config import load_config, preset_path
+
+    spec = load_config(preset_path("unity-hdrp"), [(None, "size", [16, 16])])[0]
+    table, _, _ = lutbake.bake_table(spec)
+    p = tmp_path / "hdrp.npy"
+    np.save(p, table.data)
+    r = run(p, preset="unity-hdrp", tolerance=CLEAN_TOL)
+    assert r.passed and r.extra["chosen"] == "nominal", r.text()
+    q = tmp_path / "hdrp_flipped.npy"
+    np.save(q, table.data[:, ::-1])
+    assert run(q, preset="unity-hdrp").extra["chosen"] == "columns_flipped"
