@@ -1,8 +1,9 @@
 """lutbake: bake pre-integrated BRDF tables with Warp kernels on the CPU.
 
-    import lutbake
-    results = lutbake.bake(["configs/dfg.toml"], out_dir="outputs")
+import lutbake
+results = lutbake.bake(["configs/dfg.toml"], out_dir="outputs")
 """
+
 __version__ = "0.1.0"
 
 from .api import BakeResult, bake, bake_table  # noqa: E402

@@ -23,6 +23,7 @@ Then, with the best conventions:
   sampler, UE4) at N = 64 ... 16384 samples, quantised the same way; the N whose residual matches the file's
   (log-log interpolation) is the estimated sample count.
 """
+
 from __future__ import annotations
 
 import json
@@ -131,8 +132,9 @@ def _axis_values(axis: Axis, shift: float) -> np.ndarray:
     return axis._map(t)
 
 
-def positions(conv: Conventions, shift_rough: float = 0.0, shift_nov: float = 0.0,
-              alpha_power: float | None = None) -> Positions:
+def positions(
+    conv: Conventions, shift_rough: float = 0.0, shift_nov: float = 0.0, alpha_power: float | None = None
+) -> Positions:
     """(NoV, alpha) at every file texel; ``alpha_power``: alpha = roughness-axis value ** power (declared:
     2 for perceptual roughness, 1 for alpha)."""
     y_axis, x_axis = conv.axes
@@ -159,39 +161,88 @@ def hypotheses(conv: Conventions) -> list[Hypothesis]:
     declared_power = 2.0 if rname == "perceptual_roughness" else 1.0
     hs = [Hypothesis("nominal", f"the declared conventions ({conv.source})", nominal)]
     row_axis = conv.axes[0].name
-    hs.append(Hypothesis("rows_flipped", f"rows in reverse order (the {row_axis} axis flipped: row 0 at the "
-                         "other end)", nominal.map(lambda a: a[::-1])))
-    hs.append(Hypothesis("columns_flipped", f"columns in reverse order (the {conv.axes[1].name} axis flipped)",
-                         nominal.map(lambda a: a[:, ::-1])))
+    hs.append(
+        Hypothesis(
+            "rows_flipped",
+            f"rows in reverse order (the {row_axis} axis flipped: row 0 at the other end)",
+            nominal.map(lambda a: a[::-1]),
+        )
+    )
+    hs.append(
+        Hypothesis(
+            "columns_flipped",
+            f"columns in reverse order (the {conv.axes[1].name} axis flipped)",
+            nominal.map(lambda a: a[:, ::-1]),
+        )
+    )
     if nominal.nov.shape[0] == nominal.nov.shape[1]:
-        hs.append(Hypothesis("axes_swapped", "rows and columns swapped (NoV and roughness exchanged)",
-                             nominal.map(lambda a: a.T)))
+        hs.append(
+            Hypothesis(
+                "axes_swapped", "rows and columns swapped (NoV and roughness exchanged)", nominal.map(lambda a: a.T)
+            )
+        )
     for axis, key in (("roughness", "shift_rough"), ("NoV", "shift_nov")):
         for s in (-1.0, -0.5, 0.5, 1.0):
             what = "one texel" if abs(s) == 1 else "half a texel"
             toward = "toward t = 1 (rougher)" if axis == "roughness" else "toward t = 1 (larger NoV)"
             if s < 0:
                 toward = toward.replace("t = 1", "t = 0").replace("rougher", "smoother").replace("larger", "smaller")
-            hs.append(Hypothesis(f"{axis.lower()}_offset_{s:+g}",
-                                 f"the {axis} axis offset by {what} {toward}: every texel holds t {s:+g}/N",
-                                 positions(conv, **{key: s})))
+            hs.append(
+                Hypothesis(
+                    f"{axis.lower()}_offset_{s:+g}",
+                    f"the {axis} axis offset by {what} {toward}: every texel holds t {s:+g}/N",
+                    positions(conv, **{key: s}),
+                )
+            )
     if declared_power == 2.0:
-        hs.append(Hypothesis("roughness_is_alpha", "the roughness axis holds alpha (alpha = t), not perceptual "
-                             "roughness (alpha = t^2)", positions(conv, alpha_power=1.0)))
-        hs.append(Hypothesis("roughness_squared_twice", "alpha = t^4: perceptual roughness squared twice",
-                             positions(conv, alpha_power=4.0)))
+        hs.append(
+            Hypothesis(
+                "roughness_is_alpha",
+                "the roughness axis holds alpha (alpha = t), not perceptual roughness (alpha = t^2)",
+                positions(conv, alpha_power=1.0),
+            )
+        )
+        hs.append(
+            Hypothesis(
+                "roughness_squared_twice",
+                "alpha = t^4: perceptual roughness squared twice",
+                positions(conv, alpha_power=4.0),
+            )
+        )
     else:
-        hs.append(Hypothesis("roughness_is_perceptual", "the roughness axis holds perceptual roughness "
-                             "(alpha = t^2), not alpha", positions(conv, alpha_power=2.0)))
-    hs.append(Hypothesis("srgb_decoded", "values sRGB-decoded (file = sRGB EOTF(truth): a linear LUT read or "
-                         "converted as sRGB)", nominal, srgb_eotf))
+        hs.append(
+            Hypothesis(
+                "roughness_is_perceptual",
+                "the roughness axis holds perceptual roughness (alpha = t^2), not alpha",
+                positions(conv, alpha_power=2.0),
+            )
+        )
+    hs.append(
+        Hypothesis(
+            "srgb_decoded",
+            "values sRGB-decoded (file = sRGB EOTF(truth): a linear LUT read or converted as sRGB)",
+            nominal,
+            srgb_eotf,
+        )
+    )
     hs.append(Hypothesis("srgb_encoded", "values sRGB-encoded (file = sRGB OETF(truth))", nominal, srgb_oetf))
-    hs.append(Hypothesis("channels_swapped", "R and G swapped", nominal,
-                         lambda p: np.concatenate([p[..., 1:2], p[..., 0:1], p[..., 2:]], axis=-1)))
+    hs.append(
+        Hypothesis(
+            "channels_swapped",
+            "R and G swapped",
+            nominal,
+            lambda p: np.concatenate([p[..., 1:2], p[..., 0:1], p[..., 2:]], axis=-1),
+        )
+    )
     other = "scale_bias" if conv.layout.startswith("multiscatter") else "multiscatter"
-    hs.append(Hypothesis("layout_" + other, f"the file is in the {other} layout, declared {conv.layout} "
-                         "(multiscatter (R, G) = (bias, scale + bias))", nominal,
-                         lambda p: other_layout(p, conv.layout)))
+    hs.append(
+        Hypothesis(
+            "layout_" + other,
+            f"the file is in the {other} layout, declared {conv.layout} (multiscatter (R, G) = (bias, scale + bias))",
+            nominal,
+            lambda p: other_layout(p, conv.layout),
+        )
+    )
     return hs
 
 
@@ -225,9 +276,19 @@ class Integrator:
         def run_tile(s, e, device):
             return self.specular.integrate(k, nov[s:e], alpha[s:e], estimator, samples, 0, kch, device)[:, :nch]
 
-        plan = Plan(axes=[Axis("i", "x", n)], channels={}, reconstruction="", n_texels=n, n_channels=nch,
-                    run_tile=run_tile, prepare=lambda d: self.specular.load(k, d), samples=samples,
-                    estimator=estimator, terms={}, cost=float(n * samples))
+        plan = Plan(
+            axes=[Axis("i", "x", n)],
+            channels={},
+            reconstruction="",
+            n_texels=n,
+            n_channels=nch,
+            run_tile=run_tile,
+            prepare=lambda d: self.specular.load(k, d),
+            samples=samples,
+            estimator=estimator,
+            terms={},
+            cost=float(n * samples),
+        )
         return execute(plan, workers=self.workers, progress=False).reshape(n, nch)
 
     def converged(self, nov: np.ndarray, alpha: np.ndarray, rough: np.ndarray | None = None) -> np.ndarray:
@@ -236,8 +297,15 @@ class Integrator:
         rough = np.sqrt(alpha) if rough is None else rough
         key = b"".join(a.astype(np.float32).tobytes() for a in (nov, alpha, rough))
         if key not in self._cache:
-            out = self._run(self.base, "gauss_legendre", REFERENCE_SAMPLES, self.nch, self.kernel_channels,
-                            nov.astype(np.float32), alpha.astype(np.float32))
+            out = self._run(
+                self.base,
+                "gauss_legendre",
+                REFERENCE_SAMPLES,
+                self.nch,
+                self.kernel_channels,
+                nov.astype(np.float32),
+                alpha.astype(np.float32),
+            )
             if self.base != self.layout:
                 b = self.engine_layouts.disney_fgd(nov, rough) - self.engine_layouts.HDRP_DIFFUSE_OFFSET
                 out = np.concatenate([out, b[:, None]], axis=1)
@@ -263,8 +331,11 @@ def detect_quantisation(values: np.ndarray, storage: str) -> dict:
     for bits in UNORM_BITS:
         m = float((1 << bits) - 1)
         if v.size and v.min() >= 0 and v.max() <= 1 and np.max(np.abs(v * m - np.round(v * m))) <= QUANT_TOL:
-            return {"kind": f"unorm{bits}", "step": 1.0 / m,
-                    "description": f"{bits}-bit UNORM codes (step 1/{int(m)} = {1.0 / m:.3g})"}
+            return {
+                "kind": f"unorm{bits}",
+                "step": 1.0 / m,
+                "description": f"{bits}-bit UNORM codes (step 1/{int(m)} = {1.0 / m:.3g})",
+            }
     if v.size and np.array_equal(v.astype(np.float16).astype(np.float64), v):
         return {"kind": "half", "step": None, "description": "IEEE half floats (relative step 2^-11 = 4.9e-4)"}
     return {"kind": "float", "step": None, "description": f"floats (file storage {storage})"}
@@ -308,14 +379,19 @@ class AuditReport:
         return {k: getattr(self, k) for k in self.__dataclass_fields__}
 
     def text(self) -> str:
-        lines = [f"audit {self.file}", f"  conventions: {self.conventions}",
-                 f"  evaluated: {self.evaluated['rows']} x {self.evaluated['columns']} of "
-                 f"{self.evaluated['file_rows']} x {self.evaluated['file_columns']} texels "
-                 f"(stride {self.evaluated['stride']})",
-                 "  |file - converged re-bake| per channel:"]
+        lines = [
+            f"audit {self.file}",
+            f"  conventions: {self.conventions}",
+            f"  evaluated: {self.evaluated['rows']} x {self.evaluated['columns']} of "
+            f"{self.evaluated['file_rows']} x {self.evaluated['file_columns']} texels "
+            f"(stride {self.evaluated['stride']})",
+            "  |file - converged re-bake| per channel:",
+        ]
         for c, s in self.errors.items():
-            lines.append(f"    {c}: max {s['max']:.3g} at {s['where']}, mean {s['mean']:.3g}, "
-                         + ", ".join(f"p{p} {s[f'p{p}']:.3g}" for p in PERCENTILES))
+            lines.append(
+                f"    {c}: max {s['max']:.3g} at {s['where']}, mean {s['mean']:.3g}, "
+                + ", ".join(f"p{p} {s[f'p{p}']:.3g}" for p in PERCENTILES)
+            )
         lines.append("  hypotheses (RMS over " + "/".join(self.channels) + ", best first):")
         for h in sorted(self.hypotheses, key=lambda h: h["rms"])[:6]:
             lines.append(f"    {h['rms']:.3g}  {h['name']}: {h['description']}")
@@ -325,8 +401,10 @@ class AuditReport:
         if self.error_map:
             lines.append(f"  error map: {self.error_map}")
         verdict = "PASS" if self.passed else "FAIL"
-        lines.append(f"  {verdict}: {self.metric} error {self.value:.3g} {'<=' if self.passed else '>'} "
-                     f"tolerance {self.tolerance:g}")
+        lines.append(
+            f"  {verdict}: {self.metric} error {self.value:.3g} {'<=' if self.passed else '>'} "
+            f"tolerance {self.tolerance:g}"
+        )
         return "\n".join(lines)
 
 
@@ -341,16 +419,23 @@ def _noise_estimate(integ: Integrator, pos_sub: Positions, data: np.ndarray, ref
     rms_quant = float(np.sqrt(np.mean((quantise(ref2, quant) - ref2) ** 2)))
     out = {"rms_residual": rms_obs, "rms_quantisation_alone": rms_quant, "texels": int(len(pick))}
     if rms_obs <= max(NOISE_FLOOR_RATIO * rms_quant, 1e-6):
-        out.update(detected=False, samples=None,
-                   description=f"no sampling noise above the storage rounding (residual RMS {rms_obs:.3g}, rounding "
-                               f"alone {rms_quant:.3g})")
+        out.update(
+            detected=False,
+            samples=None,
+            description=f"no sampling noise above the storage rounding (residual RMS {rms_obs:.3g}, rounding "
+            f"alone {rms_quant:.3g})",
+        )
         return out
     curve = []
     for n in NOISE_SAMPLES:
         est = integ.hammersley(nov, alpha, n)
         if est is None:
-            out.update(detected=True, samples=None, description=f"residual RMS {rms_obs:.3g} above the rounding "
-                       f"({rms_quant:.3g}); no sample-count calibration for layout {integ.layout}")
+            out.update(
+                detected=True,
+                samples=None,
+                description=f"residual RMS {rms_obs:.3g} above the rounding "
+                f"({rms_quant:.3g}); no sample-count calibration for layout {integ.layout}",
+            )
             return out
         curve.append((n, float(np.sqrt(np.mean((quantise(est, quant) - ref2) ** 2)))))
     out["calibration"] = [{"samples": n, "rms": e} for n, e in curve]
@@ -363,15 +448,26 @@ def _noise_estimate(integ: Integrator, pos_sub: Positions, data: np.ndarray, ref
     else:
         n_est = float(np.exp(np.interp(np.log(rms_obs), es[order], ns[order])))
         bound = f"~{n_est:.0f}"
-    out.update(detected=True, samples=n_est, samples_bound=bound,
-               description=f"Monte-Carlo noise: residual RMS {rms_obs:.3g} vs {rms_quant:.3g} from rounding alone; "
-                           f"matches a Hammersley NDF-sampled estimate with {bound} samples per texel")
+    out.update(
+        detected=True,
+        samples=n_est,
+        samples_bound=bound,
+        description=f"Monte-Carlo noise: residual RMS {rms_obs:.3g} vs {rms_quant:.3g} from rounding alone; "
+        f"matches a Hammersley NDF-sampled estimate with {bound} samples per texel",
+    )
     return out
 
 
-def audit(path, conv_args: dict | None = None, tolerance: float = 1e-3, metric: str = "max",
-          max_side: int = MAX_SIDE, error_map: Path | None = None, shape=None, workers: int | None = None
-          ) -> AuditReport:
+def audit(
+    path,
+    conv_args: dict | None = None,
+    tolerance: float = 1e-3,
+    metric: str = "max",
+    max_side: int = MAX_SIDE,
+    error_map: Path | None = None,
+    shape=None,
+    workers: int | None = None,
+) -> AuditReport:
     """Audit the LUT at ``path`` against conventions(**conv_args) (see the module docstring)."""
     if metric not in METRICS:
         raise ValueError(f"metric {metric!r}: allowed {', '.join(METRICS)}")
@@ -391,24 +487,29 @@ def audit(path, conv_args: dict | None = None, tolerance: float = 1e-3, metric: 
     preds = {}
     for h in hs:
         sub = h.positions.map(lambda a: a[np.ix_(iy, ix)])
-        pred = integ.converged(sub.nov.ravel(), sub.alpha.ravel(), sub.rough.ravel()).reshape(
-            len(iy), len(ix), -1)[..., :nch]
+        pred = integ.converged(sub.nov.ravel(), sub.alpha.ravel(), sub.rough.ravel()).reshape(len(iy), len(ix), -1)[
+            ..., :nch
+        ]
         if h.transform is not None:
             pred = h.transform(pred)
         d = (data - pred)[..., compared]
-        h.rms, h.max = float(np.sqrt(np.mean(d ** 2))), float(np.max(np.abs(d)))
+        h.rms, h.max = float(np.sqrt(np.mean(d**2))), float(np.max(np.abs(d)))
         preds[h.name] = (pred, sub)
     nominal = hs[0]
     best = min(hs, key=lambda h: h.rms)
     diagnosis = []
     if best is not nominal and best.rms < MISMATCH_RATIO * nominal.rms:
-        diagnosis.append(f"convention mismatch: {best.name}: {best.description} (RMS {nominal.rms:.3g} -> "
-                         f"{best.rms:.3g}, max {nominal.max:.3g} -> {best.max:.3g})")
+        diagnosis.append(
+            f"convention mismatch: {best.name}: {best.description} (RMS {nominal.rms:.3g} -> "
+            f"{best.rms:.3g}, max {nominal.max:.3g} -> {best.max:.3g})"
+        )
         chosen = best
     else:
         alt = min((h for h in hs if h is not nominal), key=lambda h: h.rms)
-        diagnosis.append(f"the declared conventions fit: no alternative explains the data better by {1 / MISMATCH_RATIO:g}x "
-                         f"(nominal RMS {nominal.rms:.3g}; best alternative {alt.name}, {alt.rms:.3g})")
+        diagnosis.append(
+            f"the declared conventions fit: no alternative explains the data better by {1 / MISMATCH_RATIO:g}x "
+            f"(nominal RMS {nominal.rms:.3g}; best alternative {alt.name}, {alt.rms:.3g})"
+        )
         chosen = nominal
     quant = detect_quantisation(lut.data[..., [c for c in compared if c < fch]], lut.storage)
     ref_nominal, sub_nominal = preds["nominal"]
@@ -426,27 +527,44 @@ def audit(path, conv_args: dict | None = None, tolerance: float = 1e-3, metric: 
     for c in compared:
         s = _stats(err[..., c])
         k = np.unravel_index(np.argmax(np.abs(err[..., c])), err[..., c].shape)
-        s["where"] = (f"row {int(iy[k[0]])} ({conv.axes[0].name} {y_vals[k[0]]:.4g}), column {int(ix[k[1]])} "
-                      f"({conv.axes[1].name} {x_vals[k[1]]:.4g})")
+        s["where"] = (
+            f"row {int(iy[k[0]])} ({conv.axes[0].name} {y_vals[k[0]]:.4g}), column {int(ix[k[1]])} "
+            f"({conv.axes[1].name} {x_vals[k[1]]:.4g})"
+        )
         errors["RGBA"[c] + " = " + names[c]] = s
     allerr = np.abs(err[..., compared])
     value = {"max": float(allerr.max()), "p99": float(np.percentile(allerr, 99)), "mean": float(allerr.mean())}[metric]
     report = AuditReport(
-        file=str(path), conventions=f"{conv.source} (layout {conv.layout}, {conv.axes[0].name} rows "
-                                    f"{conv.axes[0].texel}/{conv.axes[0].mapping}/{conv.axes[0].order}, "
-                                    f"{conv.axes[1].name} columns {conv.axes[1].texel}/{conv.axes[1].mapping}/"
-                                    f"{conv.axes[1].order})",
+        file=str(path),
+        conventions=f"{conv.source} (layout {conv.layout}, {conv.axes[0].name} rows "
+        f"{conv.axes[0].texel}/{conv.axes[0].mapping}/{conv.axes[0].order}, "
+        f"{conv.axes[1].name} columns {conv.axes[1].texel}/{conv.axes[1].mapping}/"
+        f"{conv.axes[1].order})",
         channels=["RGBA"[c] for c in compared],
-        evaluated={"rows": len(iy), "columns": len(ix), "file_rows": rows, "file_columns": cols,
-                   "stride": int(max(1, math.ceil(max(rows, cols) / max_side)))},
+        evaluated={
+            "rows": len(iy),
+            "columns": len(ix),
+            "file_rows": rows,
+            "file_columns": cols,
+            "stride": int(max(1, math.ceil(max(rows, cols) / max_side))),
+        },
         errors=errors,
         hypotheses=[{"name": h.name, "description": h.description, "rms": h.rms, "max": h.max} for h in hs],
-        diagnosis=diagnosis, quantisation=quant, noise=noise, metric=metric, tolerance=tolerance, value=value,
+        diagnosis=diagnosis,
+        quantisation=quant,
+        noise=noise,
+        metric=metric,
+        tolerance=tolerance,
+        value=value,
         passed=bool(value <= tolerance),
-        extra={"best": best.name, "chosen": chosen.name, "storage": lut.storage})
+        extra={"best": best.name, "chosen": chosen.name, "storage": lut.storage},
+    )
     if error_map is not None:
-        report.error_map = str(write_error_map(error_map, err[..., compared], [names[c] for c in compared],
-                                               conv.axes, iy, ix, Path(path).name))
+        report.error_map = str(
+            write_error_map(
+                error_map, err[..., compared], [names[c] for c in compared], conv.axes, iy, ix, Path(path).name
+            )
+        )
     return report
 
 
@@ -465,8 +583,10 @@ def write_error_map(out: Path, err: np.ndarray, names: list[str], axes: list[Axi
         ax = axs[0, c]
         im = ax.imshow(np.abs(err[..., c]), origin="lower", cmap="magma", interpolation="nearest", aspect="auto")
         ax.set_title(f"|file - converged|  {'RGBA'[c]} = {names[c]}", fontsize=9)
-        for axis, idx, setter, ticker in ((axes[1], ix, ax.set_xlabel, ax.set_xticks),
-                                          (axes[0], iy, ax.set_ylabel, ax.set_yticks)):
+        for axis, idx, setter, ticker in (
+            (axes[1], ix, ax.set_xlabel, ax.set_xticks),
+            (axes[0], iy, ax.set_ylabel, ax.set_yticks),
+        ):
             vals = axis.values()
             pos = np.unique(np.linspace(0, len(idx) - 1, 5).round().astype(int))
             ticker(pos, [f"{vals[idx[p]]:.3g}" for p in pos], fontsize=7)

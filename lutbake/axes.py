@@ -17,6 +17,7 @@ bilinear sampler reconstructs the table at a parameter value; ``uv_formula`` say
 A roughness axis also carries the NDF alpha at every index: alpha = r^2 for ``perceptual_roughness``,
 alpha = value for ``alpha``.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -25,17 +26,21 @@ import numpy as np
 
 from .edge import ALPHA_MIN, NOV_MIN
 
-IMAGE_DIMS = {"x": "columns", "y": "rows", "z": "slices",
-              "y_block": "row blocks: image row = (y_block index) * (count of the y axis) + (y index)"}
+IMAGE_DIMS = {
+    "x": "columns",
+    "y": "rows",
+    "z": "slices",
+    "y_block": "row blocks: image row = (y_block index) * (count of the y axis) + (y index)",
+}
 TEXELS = {"center": "t = (i + 0.5) / N", "endpoint": "t = i / (N - 1)"}
 MAPPINGS = {
     "linear": "value = lo + (hi - lo) * t",
     "one_minus_t2": "value = lo + (hi - lo) * (1 - t^2), i.e. t = sqrt(1 - value) on [0, 1] (Blender EEVEE NoV)",
     "square": "value = lo + (hi - lo) * t^2, i.e. t = sqrt(value) on [0, 1] (Unity HDRP PreIntegratedFGD: x = sqrt(NoV))",
     "texel_offset": "value = lo + (hi - lo) * min(t + 1/N, 1): one texel past the texel centre "
-                    "(Filament cmgen's roughness rows, r = clamp((H - y + 0.5)/H, 0, 1) in image row y)",
+    "(Filament cmgen's roughness rows, r = clamp((H - y + 0.5)/H, 0, 1) in image row y)",
     "listed": "value = values[i], listed in the config (not evenly spaced in general: map a parameter to a "
-              "fractional index by searching the values)",
+    "fractional index by searching the values)",
 }
 ORDERS = {
     "lo_first": "index 0 (first row / column) holds t near 0",
@@ -124,8 +129,9 @@ class Axis:
         if self.mapping == "listed":
             return f"(fractional index of x among the listed values + 0.5) / {n}"
         s = "x" if (self.lo, self.hi) == (0.0, 1.0) else f"(x - {self.lo:g}) / {self.hi - self.lo:g}"
-        t = {"linear": s, "one_minus_t2": f"sqrt(1 - {s})", "square": f"sqrt({s})",
-             "texel_offset": f"{s} - 1/{n}"}[self.mapping]
+        t = {"linear": s, "one_minus_t2": f"sqrt(1 - {s})", "square": f"sqrt({s})", "texel_offset": f"{s} - 1/{n}"}[
+            self.mapping
+        ]
         u = t if self.texel == "center" else f"({t}) * {n - 1}/{n} + 0.5/{n}"
         return f"1 - ({u})" if self.order == "hi_first" else u
 

@@ -1,4 +1,5 @@
 """CLI commands for shipping tables to engines: ``audit``, ``size``, ``fit`` (registered by lutbake.cli)."""
+
 from __future__ import annotations
 
 import sys
@@ -29,20 +30,51 @@ def _shape(text: str | None):
 
 @click.command()
 @click.argument("file", type=click.Path(path_type=Path))
-@click.option("--preset", default=None, metavar="NAME", help="Conventions of a preset (lutbake list); default 'default'.")
+@click.option(
+    "--preset", default=None, metavar="NAME", help="Conventions of a preset (lutbake list); default 'default'."
+)
 @click.option("--config", type=click.Path(path_type=Path), default=None, help="Conventions of a config's first table.")
-@click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",
-              help="Override a convention key (texel, row_order, roughness, layout, ...); the size is the file's.")
-@click.option("--tolerance", type=float, default=1e-3, show_default=True,
-              help="Exit 0 when the chosen error metric is within this, 1 otherwise.")
-@click.option("--metric", type=click.Choice(["max", "p99", "mean"]), default="max", show_default=True,
-              help="Which |file - converged| statistic is held against --tolerance.")
-@click.option("--max-side", type=click.IntRange(min=2), default=128, show_default=True,
-              help="Re-integrate at most this many rows and columns (strided subset, last row/column included).")
-@click.option("--shape", default=None, metavar="RxCxC", help="Layout of a text array (C header / JS / WGSL / Rust) "
-              "whose file does not declare it, e.g. 16x16x2.")
-@click.option("--error-map", type=click.Path(path_type=Path), default=None, metavar="PNG",
-              help="Write |file - converged| per channel with labelled axes.")
+@click.option(
+    "--set",
+    "overrides",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Override a convention key (texel, row_order, roughness, layout, ...); the size is the file's.",
+)
+@click.option(
+    "--tolerance",
+    type=float,
+    default=1e-3,
+    show_default=True,
+    help="Exit 0 when the chosen error metric is within this, 1 otherwise.",
+)
+@click.option(
+    "--metric",
+    type=click.Choice(["max", "p99", "mean"]),
+    default="max",
+    show_default=True,
+    help="Which |file - converged| statistic is held against --tolerance.",
+)
+@click.option(
+    "--max-side",
+    type=click.IntRange(min=2),
+    default=128,
+    show_default=True,
+    help="Re-integrate at most this many rows and columns (strided subset, last row/column included).",
+)
+@click.option(
+    "--shape",
+    default=None,
+    metavar="RxCxC",
+    help="Layout of a text array (C header / JS / WGSL / Rust) whose file does not declare it, e.g. 16x16x2.",
+)
+@click.option(
+    "--error-map",
+    type=click.Path(path_type=Path),
+    default=None,
+    metavar="PNG",
+    help="Write |file - converged| per channel with labelled axes.",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON (for CI).")
 @click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
 def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, error_map, as_json, workers):
@@ -69,9 +101,16 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
         click.echo("error: give --preset or --config, not both", err=True)
         sys.exit(EXIT_CONFIG)
     try:
-        report = run_audit(file, {"preset": preset, "config": config, "overrides": overrides}, tolerance=tolerance,
-                           metric=metric, max_side=max_side, error_map=error_map, shape=_shape(shape),
-                           workers=workers)
+        report = run_audit(
+            file,
+            {"preset": preset, "config": config, "overrides": overrides},
+            tolerance=tolerance,
+            metric=metric,
+            max_side=max_side,
+            error_map=error_map,
+            shape=_shape(shape),
+            workers=workers,
+        )
     except ConfigError as e:
         click.echo(f"error: {e}", err=True)
         sys.exit(EXIT_CONFIG)
@@ -83,14 +122,25 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
 
 
 @click.command()
-@click.option("--preset", default=None, metavar="NAME", help="Conventions of a preset (lutbake list); default 'default'.")
+@click.option(
+    "--preset", default=None, metavar="NAME", help="Conventions of a preset (lutbake list); default 'default'."
+)
 @click.option("--config", type=click.Path(path_type=Path), default=None, help="Conventions of a config's first table.")
 @click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE", help="Override a convention key.")
 @click.option("--max-error", type=float, required=True, help="Target max |bilinear(table) - integral| between texels.")
-@click.option("--sizes", default="8,16,32,64,128,256,512", show_default=True,
-              help="Square sizes N to try, in increasing order (stops once every format meets the target).")
-@click.option("--nov-min", type=click.FloatRange(0.0, 1.0), default=0.0, show_default=True,
-              help="Measure only where NoV >= this (the grazing corner never converges on a linear NoV axis).")
+@click.option(
+    "--sizes",
+    default="8,16,32,64,128,256,512",
+    show_default=True,
+    help="Square sizes N to try, in increasing order (stops once every format meets the target).",
+)
+@click.option(
+    "--nov-min",
+    type=click.FloatRange(0.0, 1.0),
+    default=0.0,
+    show_default=True,
+    help="Measure only where NoV >= this (the grazing corner never converges on a linear NoV axis).",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
 def size(preset, config, overrides, max_error, sizes, nov_min, as_json, workers):
@@ -119,8 +169,13 @@ def size(preset, config, overrides, max_error, sizes, nov_min, as_json, workers)
         click.echo("error: --max-error must be > 0", err=True)
         sys.exit(EXIT_CONFIG)
     try:
-        result = smallest_sizes({"preset": preset, "config": config, "overrides": overrides}, max_error, ns,
-                                workers=workers, nov_min=nov_min)
+        result = smallest_sizes(
+            {"preset": preset, "config": config, "overrides": overrides},
+            max_error,
+            ns,
+            workers=workers,
+            nov_min=nov_min,
+        )
     except (ConfigError, OSError, ValueError) as e:
         click.echo(f"error: {e}", err=True)
         sys.exit(EXIT_CONFIG)
@@ -130,8 +185,13 @@ def size(preset, config, overrides, max_error, sizes, nov_min, as_json, workers)
 @click.command()
 @click.argument("family", type=click.Choice(["karis-mobile", "gotanda-eq8"]))
 @click.option("--lang", type=click.Choice(["glsl", "hlsl"]), default="glsl", show_default=True)
-@click.option("-o", "--out", type=click.Path(path_type=Path, dir_okay=False), default=None,
-              help="Write the shader function here (default: print it after the error table).")
+@click.option(
+    "-o",
+    "--out",
+    type=click.Path(path_type=Path, dir_okay=False),
+    default=None,
+    help="Write the shader function here (default: print it after the error table).",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print constants and errors as JSON.")
 def fit(family, lang, out, as_json):
     """Refit a published closed form to lutbake's integral and emit it as GLSL/HLSL with its measured error
@@ -150,8 +210,17 @@ def fit(family, lang, out, as_json):
     _quiet()
     result = run_fit(family)
     if as_json:
-        click.echo(json.dumps({"family": family, "published": list(result.published), "refit": list(result.refit),
-                               "errors": result.errors}, indent=1))
+        click.echo(
+            json.dumps(
+                {
+                    "family": family,
+                    "published": list(result.published),
+                    "refit": list(result.refit),
+                    "errors": result.errors,
+                },
+                indent=1,
+            )
+        )
     else:
         click.echo(result.text())
     if out is not None:

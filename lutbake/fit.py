@@ -15,6 +15,7 @@ Families:
 Both fits are least squares (scipy.optimize.least_squares, trust-region reflective; gotanda-eq8 with a soft-L1
 loss) from the published constants; errors are measured on the fitting grid and on a second, offset grid (held out).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -26,13 +27,72 @@ FAMILIES = {
     "gotanda-eq8": "Gotanda 2014 Eq. 8 fitted diffuse refit to the integrated Eq. 4 (microfacet diffuse)",
 }
 KARIS_PUBLISHED = np.array([-1.0, -0.0275, -0.572, 0.022, 1.0, 0.0425, 1.04, -0.04, -9.28, 1.04])
-GOTANDA_PUBLISHED = np.array([0.542026, 0.303573, 1.36053, 5.0, 4.0, -0.733996, 1.50912, -1.16402, 39.0,
-                              0.09, 1.31072, 0.995584, 0.3726732, 0.188566, 0.388410, 1.4, 0.5])
+GOTANDA_PUBLISHED = np.array(
+    [
+        0.542026,
+        0.303573,
+        1.36053,
+        5.0,
+        4.0,
+        -0.733996,
+        1.50912,
+        -1.16402,
+        39.0,
+        0.09,
+        1.31072,
+        0.995584,
+        0.3726732,
+        0.188566,
+        0.388410,
+        1.4,
+        0.5,
+    ]
+)
 # every denominator and exponent of Eq. 8 stays positive inside these bounds (k, e0 - e1, q, v0, v1, v2, v4, v5)
-GOTANDA_BOUNDS = (np.array([-np.inf, -np.inf, 0.05, 4.5, 0.0, -np.inf, -np.inf, -np.inf, 0.0, 1e-3, 0.05, 0.0,
-                            -np.inf, 0.01, 0.0, -np.inf, -np.inf]),
-                  np.array([np.inf, np.inf, np.inf, 8.0, 4.4, np.inf, np.inf, np.inf, np.inf, np.inf, np.inf, np.inf,
-                            0.99, np.inf, np.inf, np.inf, np.inf]))
+GOTANDA_BOUNDS = (
+    np.array(
+        [
+            -np.inf,
+            -np.inf,
+            0.05,
+            4.5,
+            0.0,
+            -np.inf,
+            -np.inf,
+            -np.inf,
+            0.0,
+            1e-3,
+            0.05,
+            0.0,
+            -np.inf,
+            0.01,
+            0.0,
+            -np.inf,
+            -np.inf,
+        ]
+    ),
+    np.array(
+        [
+            np.inf,
+            np.inf,
+            np.inf,
+            8.0,
+            4.4,
+            np.inf,
+            np.inf,
+            np.inf,
+            np.inf,
+            np.inf,
+            np.inf,
+            np.inf,
+            0.99,
+            np.inf,
+            np.inf,
+            np.inf,
+            np.inf,
+        ]
+    ),
+)
 GOTANDA_NFEV = 300  # least-squares evaluations (each with a finite-difference Jacobian): ~1 min here
 GOTANDA_F_SCALE = 0.03  # soft_l1: relative errors beyond ~3 % count linearly (the tail does not rule the body)
 KARIS_F0 = (0.04, 1.0)  # karis-mobile fits E = f0 A + B at these f0 (dielectric, white metal)
@@ -55,10 +115,13 @@ def gotanda_eq8(p: np.ndarray, nol, nov, lov, sigma) -> np.ndarray:
     s, s2 = sigma, sigma * sigma
     omv, oml = np.clip(1 - nov, 0, 1), np.clip(1 - nol, 0, 1)
     kk = s2 + k
-    fr = ((1 - (a1 * s2 + a2 * s) / kk) * (1 - omv ** (e0 - e1 * s2) / kk)
-          * ((c3 * s2 * s + c2 * s2 + c1 * s) * omv ** (1 + 1 / (q * s2 * s2 + 1)) + 1))
-    lmv = (np.maximum(1 - 2 * s, 0) * (1 - oml ** 5) + np.minimum(2 * s, 1)) * ((1 - lm * s) * nol + lm * s * nol ** 2)
-    vd = s2 / ((s2 + v0) * (v1 + v2 * nov)) * (1 - oml ** ((1 - v3 * nov ** 2) / (v4 + v5 * nov)))
+    fr = (
+        (1 - (a1 * s2 + a2 * s) / kk)
+        * (1 - omv ** (e0 - e1 * s2) / kk)
+        * ((c3 * s2 * s + c2 * s2 + c1 * s) * omv ** (1 + 1 / (q * s2 * s2 + 1)) + 1)
+    )
+    lmv = (np.maximum(1 - 2 * s, 0) * (1 - oml**5) + np.minimum(2 * s, 1)) * ((1 - lm * s) * nol + lm * s * nol**2)
+    vd = s2 / ((s2 + v0) * (v1 + v2 * nov)) * (1 - oml ** ((1 - v3 * nov**2) / (v4 + v5 * nov)))
     d = lov - nol * nov
     bpv = np.where(d < 0, bp * nov * nol * d, d)
     return 1.05 / np.pi * (fr * lmv + vd * bpv) / nol
@@ -95,11 +158,15 @@ def _karis_target(n: int, offset: float = 0.5):
 def _karis_errors(p, nov, r, ref) -> dict:
     err = np.abs(karis_mobile(p, nov, r) - ref)
     d = karis_mobile(p, nov, r) - ref
-    return {"max |A - scale|": float(err[..., 0].max()), "mean |A - scale|": float(err[..., 0].mean()),
-            "max |B - bias|": float(err[..., 1].max()), "mean |B - bias|": float(err[..., 1].mean()),
-            "rms over A, B": float(np.sqrt(np.mean(err ** 2))),
-            "max |E - E_exact| (f0 = 0.04)": float(np.abs(0.04 * d[..., 0] + d[..., 1]).max()),
-            "max |E - E_exact| (f0 = 1)": float(np.abs(d[..., 0] + d[..., 1]).max())}
+    return {
+        "max |A - scale|": float(err[..., 0].max()),
+        "mean |A - scale|": float(err[..., 0].mean()),
+        "max |B - bias|": float(err[..., 1].max()),
+        "mean |B - bias|": float(err[..., 1].mean()),
+        "rms over A, B": float(np.sqrt(np.mean(err**2))),
+        "max |E - E_exact| (f0 = 0.04)": float(np.abs(0.04 * d[..., 0] + d[..., 1]).max()),
+        "max |E - E_exact| (f0 = 1)": float(np.abs(d[..., 0] + d[..., 1]).max()),
+    }
 
 
 def _karis_residual(p, nov, r, ref) -> np.ndarray:
@@ -112,8 +179,9 @@ def fit_karis(n: int = 64) -> FitResult:
     from scipy.optimize import least_squares
 
     nov, r, ref = _karis_target(n)
-    res = least_squares(lambda p: _karis_residual(p, nov, r, ref), KARIS_PUBLISHED, method="trf", x_scale="jac",
-                        max_nfev=4000)
+    res = least_squares(
+        lambda p: _karis_residual(p, nov, r, ref), KARIS_PUBLISHED, method="trf", x_scale="jac", max_nfev=4000
+    )
     hn, hr, href = _karis_target(n, 0.0 + 0.25)  # held out: a quarter-texel offset grid
     errors = {}
     for name, p in (("published", KARIS_PUBLISHED), ("refit", res.x)):
@@ -150,10 +218,14 @@ def _gotanda_errors(p, grid, ref) -> dict:
     rel = np.abs(fit - ref) / np.maximum(ref, REL_FLOOR / np.pi)
     raw = np.abs(fit - ref) / np.maximum(ref, 1e-12)
     ok = ~((L < GRAZING) & (V < GRAZING))
-    return {"median relative": float(np.median(raw)), "p95 relative": float(np.percentile(raw, 95)),
-            "max relative (not both grazing)": float(raw[ok].max()),
-            f"max relative, floored at {REL_FLOOR}/pi": float(rel.max()),
-            "max relative (all)": float(raw.max()), "max abs (1/sr)": float(np.abs(fit - ref).max())}
+    return {
+        "median relative": float(np.median(raw)),
+        "p95 relative": float(np.percentile(raw, 95)),
+        "max relative (not both grazing)": float(raw[ok].max()),
+        f"max relative, floored at {REL_FLOOR}/pi": float(rel.max()),
+        "max relative (all)": float(raw.max()),
+        "max abs (1/sr)": float(np.abs(fit - ref).max()),
+    }
 
 
 def fit_gotanda(n_cos: int = 10, n_phi: int = 6, n_sigma: int = 8, max_nfev: int = GOTANDA_NFEV) -> FitResult:
@@ -163,9 +235,16 @@ def fit_gotanda(n_cos: int = 10, n_phi: int = 6, n_sigma: int = 8, max_nfev: int
     ref = _gotanda_target(grid)
     L, V, lov, S = grid[:4]
     w = 1 / np.maximum(ref, REL_FLOOR / np.pi)
-    res = least_squares(lambda p: (gotanda_eq8(p, L, V, lov, S) - ref) * w, GOTANDA_PUBLISHED, method="trf",
-                        bounds=GOTANDA_BOUNDS, x_scale="jac", loss="soft_l1", f_scale=GOTANDA_F_SCALE,
-                        max_nfev=max_nfev)
+    res = least_squares(
+        lambda p: (gotanda_eq8(p, L, V, lov, S) - ref) * w,
+        GOTANDA_PUBLISHED,
+        method="trf",
+        bounds=GOTANDA_BOUNDS,
+        x_scale="jac",
+        loss="soft_l1",
+        f_scale=GOTANDA_F_SCALE,
+        max_nfev=max_nfev,
+    )
     held = _gotanda_grid(n_cos + 1, n_phi + 1, n_sigma + 1, offset=0.37)
     href = _gotanda_target(held)
     errors = {}
@@ -189,16 +268,24 @@ def _header(family: str, errors: dict, comment: str) -> str:
 
 def karis_code(p: np.ndarray, errors: dict) -> dict:
     c0, c1 = ", ".join(_f(x) for x in p[0:4]), ", ".join(_f(x) for x in p[4:8])
-    body = ("{t}4 r = roughness * {t}4({c0}) + {t}4({c1});\n"
-            "    float a004 = min(r.x * r.x, exp2({k} * NoV)) * r.x + r.y;\n"
-            "    return {t}2({ms}, {s}) * a004 + r.zw;\n")
+    body = (
+        "{t}4 r = roughness * {t}4({c0}) + {t}4({c1});\n"
+        "    float a004 = min(r.x * r.x, exp2({k} * NoV)) * r.x + r.y;\n"
+        "    return {t}2({ms}, {s}) * a004 + r.zw;\n"
+    )
     out = {}
     for lang, t in (("glsl", "vec"), ("hlsl", "float")):
         head = _header("karis-mobile", errors, "//")
         sig = f"{t}2 EnvBRDFApprox_lutbake(float NoV, float roughness)"
         code = body.format(t=t, c0=c0, c1=c1, k=_f(p[8]), ms=_f(-p[9]), s=_f(p[9]))
-        out[lang] = (head + "// E = f0 * AB.x + AB.y; roughness = perceptual roughness (alpha = roughness^2)\n"
-                     + sig + " {\n    " + code + "}\n")
+        out[lang] = (
+            head
+            + "// E = f0 * AB.x + AB.y; roughness = perceptual roughness (alpha = roughness^2)\n"
+            + sig
+            + " {\n    "
+            + code
+            + "}\n"
+        )
     return out
 
 
@@ -219,9 +306,11 @@ def gotanda_code(p: np.ndarray, errors: dict) -> dict:
     out = {}
     for lang in ("glsl", "hlsl"):
         head = _header("gotanda-eq8", errors, "//")
-        out[lang] = (head + "// Gotanda 2014 Eq. 8 with refit constants; diffuse radiance = rho * E0 * this; "
-                     "BRDF = this / NoL\nfloat Fd_gotanda_refit(float NoL, float NoV, float LoV, float sigma, "
-                     "float f0) {\n" + body + "}\n")
+        out[lang] = (
+            head + "// Gotanda 2014 Eq. 8 with refit constants; diffuse radiance = rho * E0 * this; "
+            "BRDF = this / NoL\nfloat Fd_gotanda_refit(float NoL, float NoV, float LoV, float sigma, "
+            "float f0) {\n" + body + "}\n"
+        )
     return out
 
 

@@ -6,6 +6,7 @@ the bottom). Bottom row (``dfg`` tables): spheres of increasing roughness lit by
 environment with the split-sum, E = table(NoV, r) reconstructed per the file's layout, so a wrong axis,
 flip or channel order shows up as an implausible sphere.
 """
+
 from __future__ import annotations
 
 import json
@@ -26,9 +27,18 @@ def axis_from_meta(d: dict) -> Axis:
     lo, hi = d.get("range", [0.0, 1.0])
     clamp = d.get("clamp")
     listed = tuple(d["values"]) if d.get("mapping") == "listed" else ()
-    return Axis(d["name"], d["dim"], int(d["count"]), float(lo), float(hi), texel=d.get("texel", "center"),
-                mapping=d.get("mapping", "linear"), order=d.get("order", "lo_first"),
-                clamp=tuple(clamp) if clamp else None, listed=listed)
+    return Axis(
+        d["name"],
+        d["dim"],
+        int(d["count"]),
+        float(lo),
+        float(hi),
+        texel=d.get("texel", "center"),
+        mapping=d.get("mapping", "linear"),
+        order=d.get("order", "lo_first"),
+        clamp=tuple(clamp) if clamp else None,
+        listed=listed,
+    )
 
 
 def read_table(path: Path) -> tuple[np.ndarray, dict]:
@@ -48,7 +58,7 @@ def sample(data: np.ndarray, axes: list[Axis], nov: np.ndarray, rough: np.ndarra
     y_axis, x_axis = axes
     by = {a.name: a for a in axes}
     rname = next(n for n in by if n != "NoV")
-    u = {"NoV": by["NoV"].uv(nov), rname: by[rname].uv(rough if rname != "alpha" else rough ** 2)}
+    u = {"NoV": by["NoV"].uv(nov), rname: by[rname].uv(rough if rname != "alpha" else rough**2)}
     h, w = data.shape[:2]
     x = np.clip(u[x_axis.name] * w - 0.5, 0, w - 1)
     y = np.clip(u[y_axis.name] * h - 0.5, 0, h - 1)
@@ -56,8 +66,7 @@ def sample(data: np.ndarray, axes: list[Axis], nov: np.ndarray, rough: np.ndarra
     y0 = np.clip(np.floor(y).astype(int), 0, max(h - 2, 0))
     x1, y1 = np.minimum(x0 + 1, w - 1), np.minimum(y0 + 1, h - 1)
     fx, fy = (x - x0)[..., None], (y - y0)[..., None]
-    return ((1 - fy) * ((1 - fx) * data[y0, x0] + fx * data[y0, x1])
-            + fy * ((1 - fx) * data[y1, x0] + fx * data[y1, x1]))
+    return (1 - fy) * ((1 - fx) * data[y0, x0] + fx * data[y0, x1]) + fy * ((1 - fx) * data[y1, x0] + fx * data[y1, x1])
 
 
 def specular_E(t: np.ndarray, layout: str, f0: np.ndarray) -> np.ndarray:
@@ -71,16 +80,16 @@ def sphere(data, axes, layout, roughness, size=128):
     """An orthographic sphere, view along -z, lit by prefiltered sky/ground radiance times E."""
     s = (np.arange(size) + 0.5) / size * 2 - 1
     X, Y = np.meshgrid(s, -s)
-    inside = X ** 2 + Y ** 2 < 1
-    Z = np.sqrt(np.clip(1 - X ** 2 - Y ** 2, 0, 1))
+    inside = X**2 + Y**2 < 1
+    Z = np.sqrt(np.clip(1 - X**2 - Y**2, 0, 1))
     nov = np.clip(Z, 1e-4, 1.0)
     refl = np.stack([2 * nov * X, 2 * nov * Y, 2 * nov * Z - 1], -1)  # R = 2 (n.v) n - v, v = +z
     up = np.clip(0.5 + 0.5 * refl[..., 1], 0, 1)[..., None]
-    radiance = GROUND + (SKY - GROUND) * (up ** 0.5)
+    radiance = GROUND + (SKY - GROUND) * (up**0.5)
     avg = 0.5 * (SKY + GROUND)
-    blur = roughness ** 2  # the prefiltered sky tends to its average as roughness grows
+    blur = roughness**2  # the prefiltered sky tends to its average as roughness grows
     # a sun prefiltered by a lobe of solid angle ~ 2 pi w: exp((cos - 1) / w) / (2 pi w)
-    w = max(2.0 * roughness ** 4, 2e-4)
+    w = max(2.0 * roughness**4, 2e-4)
     sun = SUN_POWER * np.exp((refl @ SUN_DIR - 1) / w) / (2 * np.pi * w)
     prefiltered = (1 - blur) * radiance + blur * avg + np.minimum(sun, 50.0)[..., None]
     E = specular_E(sample(data, axes, nov, np.full_like(nov, roughness)), layout, SPHERE_F0)

@@ -15,6 +15,7 @@ Not measured: the clamp-to-edge band outside the outermost texel centres (NoV < 
 centre texels), which no resolution removes (it shrinks as 1/N), and the GPU's own fixed-point filter weights
 (8 fractional bits on many GPUs: at most 1/512 of a texel-to-texel step).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -26,8 +27,11 @@ from .axes import Axis
 from .edge import ALPHA_MIN, NOV_MIN
 
 STORAGE = {
-    "unorm8": "8-bit UNORM (R8G8)", "unorm10": "10-bit UNORM (A2R10G10B10)", "unorm16": "16-bit UNORM (R16G16)",
-    "f16": "half float (R16G16_FLOAT)", "f32": "float (R32G32_FLOAT)",
+    "unorm8": "8-bit UNORM (R8G8)",
+    "unorm10": "10-bit UNORM (A2R10G10B10)",
+    "unorm16": "16-bit UNORM (R16G16)",
+    "f16": "half float (R16G16_FLOAT)",
+    "f32": "float (R32G32_FLOAT)",
 }
 SIZES = (8, 16, 32, 64, 128, 256, 512)
 
@@ -88,22 +92,30 @@ class SizeResult:
 
     def text(self) -> str:
         fmts = list(STORAGE)
-        lines = [f"max |bilinear(table) - integral| between texels, {self.conventions}",
-                 "N      " + "".join(f"{f:>10}" for f in fmts)]
+        lines = [
+            f"max |bilinear(table) - integral| between texels, {self.conventions}",
+            "N      " + "".join(f"{f:>10}" for f in fmts),
+        ]
         for n in self.sizes:
             if n in self.errors:
                 lines.append(f"{n:<7}" + "".join(f"{self.errors[n][f]:>10.2e}" for f in fmts))
         lines.append(f"smallest N with max error <= {self.target:g}:")
         for f in fmts:
             n = self.smallest[f]
-            lines.append(f"  {f:8} {STORAGE[f]:28} " + (f"{n}^2 (error {self.errors[n][f]:.2e})" if n else
-                                                         f"none up to {max(self.errors)}^2"))
+            lines.append(
+                f"  {f:8} {STORAGE[f]:28} "
+                + (f"{n}^2 (error {self.errors[n][f]:.2e})" if n else f"none up to {max(self.errors)}^2")
+            )
         return "\n".join(lines)
 
     def as_dict(self) -> dict:
-        return {"target": self.target, "conventions": self.conventions, "storage": STORAGE,
-                "errors": {str(n): e for n, e in self.errors.items()},
-                "smallest": self.smallest}
+        return {
+            "target": self.target,
+            "conventions": self.conventions,
+            "storage": STORAGE,
+            "errors": {str(n): e for n, e in self.errors.items()},
+            "smallest": self.smallest,
+        }
 
 
 def measure(conv_args: dict, n: int, channels=None, workers=None, nov_min: float = 0.0) -> dict:
@@ -120,8 +132,9 @@ def measure(conv_args: dict, n: int, channels=None, workers=None, nov_min: float
     return {f: float(np.max(np.abs(bilinear_half(store(table, f)) - ref)[inside])) for f in STORAGE}
 
 
-def smallest_sizes(conv_args: dict, target: float, sizes=SIZES, channels=None, workers=None,
-                   nov_min: float = 0.0) -> SizeResult:
+def smallest_sizes(
+    conv_args: dict, target: float, sizes=SIZES, channels=None, workers=None, nov_min: float = 0.0
+) -> SizeResult:
     """Measure each size in increasing order until every format meets ``target`` (or the sizes run out)."""
     errors, smallest = {}, {f: None for f in STORAGE}
     for n in sorted(sizes):

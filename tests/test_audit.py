@@ -4,6 +4,7 @@ Shipped tables (tests/data, provenance in the .json beside each): Filament cmgen
 offset, 1024 Hammersley samples, half floats) and the glTF Sample Viewer's lut_ggx (8-bit, 1024 samples).
 Broken copies of a lutbake table are built here: sRGB-decoded, rows flipped, half-texel shifted.
 """
+
 import json
 from pathlib import Path
 
@@ -28,8 +29,15 @@ def dfg_at(r_rows: np.ndarray, nov_cols: np.ndarray) -> np.ndarray:
     """scale/bias at perceptual roughness r (rows) x NoV (columns): lutbake's kernel at points built here."""
     nov, r = np.meshgrid(nov_cols, r_rows)
     k = specular.kernel_for("ggx", "smith_height_correlated", "scale_bias", "gauss_legendre")
-    out = specular.integrate(k, nov.ravel().astype(np.float32), np.maximum(r.ravel() ** 2, 1e-4).astype(np.float32),
-                             "gauss_legendre", 432, 0, 2)
+    out = specular.integrate(
+        k,
+        nov.ravel().astype(np.float32),
+        np.maximum(r.ravel() ** 2, 1e-4).astype(np.float32),
+        "gauss_legendre",
+        432,
+        0,
+        2,
+    )
     return out.reshape(len(r_rows), len(nov_cols), 2)
 
 
@@ -84,11 +92,14 @@ def test_clean_lutbake_table_passes_and_shows_no_defect(clean, tmp_path):
     assert not r.noise["detected"]
 
 
-@pytest.mark.parametrize("name, make, expected", [
-    ("srgb", lambda t: srgb_decode(t), "srgb_decoded"),
-    ("flipped", lambda t: t[::-1], "rows_flipped"),
-    ("swapped", lambda t: t[..., ::-1], "channels_swapped"),
-])
+@pytest.mark.parametrize(
+    "name, make, expected",
+    [
+        ("srgb", lambda t: srgb_decode(t), "srgb_decoded"),
+        ("flipped", lambda t: t[::-1], "rows_flipped"),
+        ("swapped", lambda t: t[..., ::-1], "channels_swapped"),
+    ],
+)
 def test_broken_copy_is_diagnosed(clean, tmp_path, name, make, expected):
     p = tmp_path / f"{name}.npy"
     np.save(p, make(clean).astype(np.float32))
@@ -147,8 +158,12 @@ def test_threejs_shipped_js_array_fits_the_threejs_preset():
 
 def test_threejs_shipped_table_is_height_correlated_not_separable():
     hc = run(DATA / "threejs_dfg_lut.js", preset="threejs", shape=(16, 16, 2))
-    sep = audit(DATA / "threejs_dfg_lut.js", {"preset": "threejs", "overrides": ["masking=smith_separable"]},
-                max_side=MAX_SIDE, shape=(16, 16, 2))
+    sep = audit(
+        DATA / "threejs_dfg_lut.js",
+        {"preset": "threejs", "overrides": ["masking=smith_separable"]},
+        max_side=MAX_SIDE,
+        shape=(16, 16, 2),
+    )
     assert hc.hypotheses[0]["rms"] < 0.1 * sep.hypotheses[0]["rms"]
 
 

@@ -1,6 +1,7 @@
 """JS / WGSL / Rust array outputs and zstd KTX2, each read back by an independent reader:
 node (JS), rustc (Rust), a parser written here (WGSL), and a KTX2 parser written here with the zstandard
 package (KTX2). Node and rustc tests skip with the reason where the tool is missing."""
+
 import json
 import re
 import shutil
@@ -23,8 +24,15 @@ def table():
     rng = np.random.default_rng(7)
     data = rng.random((H, W, 2)).astype(np.float32)
     axes = [Axis("perceptual_roughness", "y", H), Axis("NoV", "x", W)]
-    return Table("lut-x", "dfg", data, axes, {"scale": "multiplies f0", "bias": "added"}, "E = f0 * t.r + t.g",
-                 {"config": "[[table]]\nname = \"lut-x\"\n"})
+    return Table(
+        "lut-x",
+        "dfg",
+        data,
+        axes,
+        {"scale": "multiplies f0", "bias": "added"},
+        "E = f0 * t.r + t.g",
+        {"config": '[[table]]\nname = "lut-x"\n'},
+    )
 
 
 def half(x):
@@ -38,9 +46,11 @@ def test_js_module_read_by_node(table, tmp_path, dtype):
     text = path.read_text()
     assert text.startswith("/*") and "texel center" in text and "lutbake:shape = [5, 7, 2]" in text
     mjs = tmp_path / "read.mjs"
-    mjs.write_text(f"import * as m from '{path.as_posix()}';\n"
-                   "const a = m.LUT_X; console.log(JSON.stringify({type: a.constructor.name, "
-                   "h: m.LUT_X_HEIGHT, w: m.LUT_X_WIDTH, c: m.LUT_X_CHANNELS, v: Array.from(a)}));\n")
+    mjs.write_text(
+        f"import * as m from '{path.as_posix()}';\n"
+        "const a = m.LUT_X; console.log(JSON.stringify({type: a.constructor.name, "
+        "h: m.LUT_X_HEIGHT, w: m.LUT_X_WIDTH, c: m.LUT_X_CHANNELS, v: Array.from(a)}));\n"
+    )
     out = json.loads(subprocess.run(["node", str(mjs)], capture_output=True, text=True, check=True).stdout)
     assert (out["h"], out["w"], out["c"]) == (H, W, 2)
     if dtype == "half":
@@ -66,9 +76,11 @@ def test_wgsl_array_parsed_independently(table, tmp_path):
 def test_rust_const_read_by_rustc(table, tmp_path):
     path = write_table(table, tmp_path, "rs", "half")
     main = tmp_path / "main.rs"
-    main.write_text(f'include!("{path.as_posix()}");\n'
-                    'fn main() { println!("{} {} {}", LUT_X_HEIGHT, LUT_X_WIDTH, LUT_X_CHANNELS); '
-                    'for b in LUT_X.iter() { println!("{}", b); } }\n')
+    main.write_text(
+        f'include!("{path.as_posix()}");\n'
+        'fn main() { println!("{} {} {}", LUT_X_HEIGHT, LUT_X_WIDTH, LUT_X_CHANNELS); '
+        'for b in LUT_X.iter() { println!("{}", b); } }\n'
+    )
     exe = tmp_path / "main"
     subprocess.run(["rustc", "-O", "-o", str(exe), str(main)], check=True, capture_output=True)
     lines = subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout.split()
@@ -84,7 +96,7 @@ def test_ktx2_zstd_parsed_independently(table, tmp_path):
     assert (vk, type_size, w, h, scheme) == (83, 1, W, H, 2)  # R16G16_SFLOAT, typeSize 1 when supercompressed, zstd
     off, size, raw = struct.unpack_from("<QQQ", blob, 80)
     assert raw == H * W * 2 * 2 and off + size == len(blob)
-    level = zstandard.ZstdDecompressor().decompress(blob[off:off + size], max_output_size=raw)
+    level = zstandard.ZstdDecompressor().decompress(blob[off : off + size], max_output_size=raw)
     np.testing.assert_array_equal(np.frombuffer(level, "<f2").reshape(H, W, 2).astype(np.float32), half(table.data))
     kvd_off, kvd_len = struct.unpack_from("<II", blob, 56)
-    assert b"lutbake:metadata" in blob[kvd_off:kvd_off + kvd_len]
+    assert b"lutbake:metadata" in blob[kvd_off : kvd_off + kvd_len]

@@ -1,5 +1,6 @@
 """HDRP's Disney (Burley) and Fabric Lambert diffuse terms against numpy, and the Disney FGD channel of the
 unity-hdrp layout against scipy's adaptive quadrature (an independent method)."""
+
 import numpy as np
 import pytest
 import warp as wp
@@ -19,8 +20,14 @@ def disney_numpy(nov, nol, lov, r):
 
 
 @wp.kernel
-def eval_terms(nov: wp.array(dtype=float), nol: wp.array(dtype=float), lov: wp.array(dtype=float),
-               r: wp.array(dtype=float), out: wp.array(dtype=float), fab: wp.array(dtype=float)):
+def eval_terms(
+    nov: wp.array(dtype=float),
+    nol: wp.array(dtype=float),
+    lov: wp.array(dtype=float),
+    r: wp.array(dtype=float),
+    out: wp.array(dtype=float),
+    fab: wp.array(dtype=float),
+):
     i = wp.tid()
     out[i] = Fd_disney_hdrp(nov[i], nol[i], lov[i], r[i])
     fab[i] = Fd_fabric_lambert_hdrp(r[i] * r[i])
@@ -31,12 +38,12 @@ def test_disney_and_fabric_terms_match_numpy():
     n = 256
     nov, nol, r = rng.uniform(0.01, 1, n), rng.uniform(0.01, 1, n), rng.uniform(0, 1, n)
     phi = rng.uniform(0, np.pi, n)
-    lov = np.sqrt(1 - nov ** 2) * np.sqrt(1 - nol ** 2) * np.cos(phi) + nov * nol
+    lov = np.sqrt(1 - nov**2) * np.sqrt(1 - nol**2) * np.cos(phi) + nov * nol
     arrs = [wp.array(a.astype(np.float32), dtype=float) for a in (nov, nol, lov, r)]
     out, fab = wp.zeros(n, dtype=float), wp.zeros(n, dtype=float)
     wp.launch(eval_terms, dim=n, inputs=arrs + [out, fab])
     np.testing.assert_allclose(out.numpy(), disney_numpy(nov, nol, lov, r), rtol=TERM_RTOL)
-    np.testing.assert_allclose(fab.numpy(), 1.0 - 0.5 * r ** 2, rtol=TERM_RTOL)
+    np.testing.assert_allclose(fab.numpy(), 1.0 - 0.5 * r**2, rtol=TERM_RTOL)
 
 
 def test_disney_back_facing_is_zero():
@@ -49,7 +56,7 @@ def test_disney_back_facing_is_zero():
 @pytest.mark.parametrize("nov, r", [(1e-4, 0.0), (0.05, 0.3), (0.5, 0.5), (0.9, 1.0), (0.2, 0.9)])
 def test_disney_fgd_equals_scipy_quadrature(nov, r):
     nov32, r32 = float(np.float32(nov)), float(np.float32(r))
-    sv = np.sqrt(1 - nov32 ** 2)
+    sv = np.sqrt(1 - nov32**2)
 
     def f(phi, mu):
         lov = sv * np.sqrt(1 - mu * mu) * np.cos(phi) + nov32 * mu

@@ -1,4 +1,5 @@
 """lutbake fit: the published closed forms re-implemented in numpy match lutbake's terms, and the refits help."""
+
 import numpy as np
 import pytest
 from click.testing import CliRunner
@@ -22,7 +23,7 @@ def test_gotanda_eq8_numpy_equals_lutbake_fitted_term():
     rng = np.random.default_rng(3)
     nl, nv, sig = rng.uniform(0.05, 1, 64), rng.uniform(0.05, 1, 64), rng.uniform(0, 1, 64)
     phi = rng.uniform(0, np.pi, 64)
-    sl, sv = np.sqrt(1 - nl ** 2), np.sqrt(1 - nv ** 2)
+    sl, sv = np.sqrt(1 - nl**2), np.sqrt(1 - nv**2)
     l = np.stack([sl * np.cos(phi), sl * np.sin(phi), nl], -1)
     v = np.stack([sv, 0 * sv, nv], -1)
     ref = diffuse.eval_brdf("fitted", l, v, sig)
@@ -62,8 +63,9 @@ def test_emitted_glsl_compiles_and_matches_numpy():
     r = fit_karis(n=16)
     pts = np.array([[0.1, 0.2], [0.5, 0.5], [0.9, 0.95], [0.02, 0.7]], np.float32)
     got = _render(ctx, r.code["glsl"], "vec4(EnvBRDFApprox_lutbake(q.x, q.y), 0.0, 1.0)", pts)[:, :2]
-    np.testing.assert_allclose(got, karis_mobile(r.refit, pts[:, 0].astype(np.float64), pts[:, 1].astype(np.float64)),
-                               atol=1e-5)
+    np.testing.assert_allclose(
+        got, karis_mobile(r.refit, pts[:, 0].astype(np.float64), pts[:, 1].astype(np.float64)), atol=1e-5
+    )
     glsl_gotanda = fit_gotanda(6, 4, 5, max_nfev=5).code["glsl"]
     _render(ctx, glsl_gotanda, "vec4(Fd_gotanda_refit(q.x, q.y, 0.1, 0.5, 0.04))", pts)  # compiles and runs
     ctx.release()
@@ -76,9 +78,10 @@ def _render(ctx, functions: str, expr: str, pts: np.ndarray) -> np.ndarray:
     n = len(pts)
     prog = ctx.program(
         vertex_shader="#version 330\nin vec2 p; in float i; out vec2 q;\nuniform float n;\n"
-                      "void main() { q = p; gl_Position = vec4((2.0 * i + 1.0) / n - 1.0, 0.0, 0.0, 1.0); "
-                      "gl_PointSize = 1.0; }",
-        fragment_shader="#version 330\nin vec2 q; out vec4 color;\n" + functions + f"void main() {{ color = {expr}; }}")
+        "void main() { q = p; gl_Position = vec4((2.0 * i + 1.0) / n - 1.0, 0.0, 0.0, 1.0); "
+        "gl_PointSize = 1.0; }",
+        fragment_shader="#version 330\nin vec2 q; out vec4 color;\n" + functions + f"void main() {{ color = {expr}; }}",
+    )
     prog["n"].value = float(n)
     data = np.concatenate([pts, np.arange(n, dtype=np.float32)[:, None]], 1).astype(np.float32)
     vao = ctx.vertex_array(prog, [(ctx.buffer(data.tobytes()), "2f 1f", "p", "i")])

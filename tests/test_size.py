@@ -1,4 +1,5 @@
 """lutbake size: bilinear reconstruction between texels, storage rounding, and the resolution search."""
+
 import json
 
 import numpy as np

@@ -1,4 +1,5 @@
 """Every named check of lutbake.validate passes: analytic reductions and invariants of the terms and tables."""
+
 import pytest
 
 from lutbake.validate import CHECKS, CheckResult, run_all

@@ -10,6 +10,7 @@ Every text format starts with the conventions comment block of the C header (lut
 including a ``lutbake:shape = [rows, columns, channels]`` line; row 0 of the array is table row 0. A ``.json``
 sidecar is written beside each file (so every format is skipped when up to date).
 """
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -32,7 +33,7 @@ def _items(pixels: np.ndarray, dtype: str, kind: str) -> list[str]:
 
 
 def _rows(items: list[str], indent: str = "    ") -> str:
-    return ",\n".join(indent + ", ".join(items[i:i + PER_LINE]) for i in range(0, len(items), PER_LINE))
+    return ",\n".join(indent + ", ".join(items[i : i + PER_LINE]) for i in range(0, len(items), PER_LINE))
 
 
 def _comment(lines: list[str], style: str) -> str:
@@ -57,22 +58,28 @@ def source_text(table: Table, fmt: str, dtype: str = "float32") -> str:
         values = "IEEE 754 binary16 bit patterns (Uint16Array): HalfFloatType" if half else "Float32Array"
         text = _comment([head] + convention_lines(table, pixels, dtype, ident, values), "block")
         arr = "Uint16Array" if half else "Float32Array"
-        text += "".join(f"export const {ident}_{k} = {v};\n" for k, v in
-                        zip((["DEPTH"] if len(dims) == 4 else []) + ["HEIGHT", "WIDTH", "CHANNELS"], dims))
+        text += "".join(
+            f"export const {ident}_{k} = {v};\n"
+            for k, v in zip((["DEPTH"] if len(dims) == 4 else []) + ["HEIGHT", "WIDTH", "CHANNELS"], dims)
+        )
         items = _items(pixels, dtype, "bits" if half else "float")
         return text + f"export const {ident} = new {arr}( [\n{_rows(items, chr(9))}\n] );\nexport default {ident};\n"
     if fmt == "wgsl":
-        values = ("f32 holding the half-rounded values (what an Rg16Float texture returns)" if half else "f32")
+        values = "f32 holding the half-rounded values (what an Rg16Float texture returns)" if half else "f32"
         text = _comment([head] + convention_lines(table, pixels, dtype, ident, values), "line")
-        text += "".join(f"const {ident}_{k}: u32 = {v}u;\n" for k, v in
-                        zip((["DEPTH"] if len(dims) == 4 else []) + ["HEIGHT", "WIDTH", "CHANNELS"], dims))
+        text += "".join(
+            f"const {ident}_{k}: u32 = {v}u;\n"
+            for k, v in zip((["DEPTH"] if len(dims) == 4 else []) + ["HEIGHT", "WIDTH", "CHANNELS"], dims)
+        )
         vals = pixels.astype(np.float16).astype(np.float32) if half else pixels
         return text + f"const {ident}: array<f32, {n}> = array<f32, {n}>(\n{_rows(_items(vals, dtype, 'float'))}\n);\n"
     if fmt == "rs":
         values = "IEEE 754 binary16 bit patterns (u16; half::f16::from_bits)" if half else "f32"
         text = _comment([head] + convention_lines(table, pixels, dtype, ident, values), "line")
-        text += "".join(f"pub const {ident}_{k}: usize = {v};\n" for k, v in
-                        zip((["DEPTH"] if len(dims) == 4 else []) + ["HEIGHT", "WIDTH", "CHANNELS"], dims))
+        text += "".join(
+            f"pub const {ident}_{k}: usize = {v};\n"
+            for k, v in zip((["DEPTH"] if len(dims) == 4 else []) + ["HEIGHT", "WIDTH", "CHANNELS"], dims)
+        )
         ty = "u16" if half else "f32"
         items = _items(pixels, dtype, "bits" if half else "float")
         if not half:
@@ -99,8 +106,9 @@ def write_ktx2_zstd(table: Table, path, dtype: str = "float32") -> Path:
 
     pixels = _check_table(table, dtype)
     path = Path(path)
-    atomic_write_bytes(path, ktx2.encode(pixels, metadata(table), writer=f"lutbake {__version__}",
-                                         supercompression="zstd"))
+    atomic_write_bytes(
+        path, ktx2.encode(pixels, metadata(table), writer=f"lutbake {__version__}", supercompression="zstd")
+    )
     _sidecar(table, path, "ktx2zst", {"supercompression": "zstd (scheme 2)", "zstd_level": ktx2.ZSTD_LEVEL})
     return path
 

@@ -20,6 +20,7 @@ File layout (the contract engines and ``lutbake inspect`` rely on):
 - Writes are atomic: the file is written to a temporary sibling, fsynced, then renamed onto the
   target, so an interrupted or failed write never leaves a half-written file or clobbers the old one.
 """
+
 from __future__ import annotations
 
 import json
@@ -64,16 +65,13 @@ def _check_table(table: Table, dtype: str) -> np.ndarray:
         raise ValueError(f"table {table.name!r}: dtype must be one of {sorted(DTYPES)}, got {dtype!r}")
     data = np.asarray(table.data)
     if data.ndim not in (3, 4):
-        raise ValueError(
-            f"table {table.name!r}: data must be (y, x, C) or (z, y, x, C), got shape {data.shape}"
-        )
+        raise ValueError(f"table {table.name!r}: data must be (y, x, C) or (z, y, x, C), got shape {data.shape}")
     nch = data.shape[-1]
     if not 1 <= nch <= 4:
         raise ValueError(f"table {table.name!r}: an EXR holds 1 to 4 channels, the data has {nch}")
     if len(table.channels) != nch:
         raise ValueError(
-            f"table {table.name!r}: {len(table.channels)} channel names {list(table.channels)} "
-            f"for {nch} data channels"
+            f"table {table.name!r}: {len(table.channels)} channel names {list(table.channels)} for {nch} data channels"
         )
     if data.dtype.kind not in "fiu":
         raise ValueError(f"table {table.name!r}: data must be numeric, got dtype {data.dtype}")
@@ -85,8 +83,10 @@ def _check_table(table: Table, dtype: str) -> np.ndarray:
     if blocks:  # a 4th axis flattened into the rows: row = block index * (y count) + y index
         y_axes = [a for a in table.axes if a.dim == "y"]
         if not y_axes or sizes["y"] % blocks[0].count:
-            raise ValueError(f"table {table.name!r}: a y_block axis needs a y axis and {sizes['y']} rows divisible "
-                             f"by its count {blocks[0].count}")
+            raise ValueError(
+                f"table {table.name!r}: a y_block axis needs a y axis and {sizes['y']} rows divisible "
+                f"by its count {blocks[0].count}"
+            )
         sizes["y_block"] = blocks[0].count
         sizes["y"] //= blocks[0].count
     for axis in table.axes:
@@ -101,9 +101,7 @@ def _check_table(table: Table, dtype: str) -> np.ndarray:
         raise ValueError(f"table {table.name!r}: a 3D table needs an axis with dim 'z'")
     clash = RESERVED.intersection(table.attributes)
     if clash:
-        raise ValueError(
-            f"table {table.name!r}: attributes {sorted(clash)} are reserved (lutbake writes them itself)"
-        )
+        raise ValueError(f"table {table.name!r}: attributes {sorted(clash)} are reserved (lutbake writes them itself)")
 
     with np.errstate(over="ignore", invalid="ignore"):
         out = np.ascontiguousarray(data, dtype=DTYPES[dtype][1])
@@ -223,7 +221,7 @@ def _open(path: Path):
 
 def _lutbake_attrs(spec) -> dict[str, str]:
     return {
-        p.name[len(PREFIX):]: p.value if isinstance(p.value, str) else _attr_text(p.value)
+        p.name[len(PREFIX) :]: p.value if isinstance(p.value, str) else _attr_text(p.value)
         for p in spec.extra_attribs
         if p.name.startswith(PREFIX)
     }
@@ -242,8 +240,7 @@ def _read_parts(path) -> tuple[list[np.ndarray], list[dict[str, str]], list[dict
             a = _lutbake_attrs(spec)
             if "kind" not in a:
                 raise ValueError(
-                    f"{path}: not a lutbake EXR (part {k} has no lutbake:kind attribute; "
-                    "was it written by lutbake?)"
+                    f"{path}: not a lutbake EXR (part {k} has no lutbake:kind attribute; was it written by lutbake?)"
                 )
             names = list(spec.channelnames)
             want = [c for c in CHANNEL_LETTERS if c in names]
@@ -320,9 +317,7 @@ def describe_exr(path) -> str:
     lines = [f"{path}"]
     h, w, nch = pixels[0].shape
     layout = f"{len(pixels)} parts (one per z slice) of {w} x {h}" if data.ndim == 4 else f"{w} x {h}"
-    lines.append(
-        f"  kind: {attrs['kind']}" + (f"   table: {attrs['table']}" if "table" in attrs else "")
-    )
+    lines.append(f"  kind: {attrs['kind']}" + (f"   table: {attrs['table']}" if "table" in attrs else ""))
     lines.append(
         f"  image: {layout}, {nch} channel(s) {','.join(facts[0]['channels'])}, "
         f"{facts[0]['format']}, {facts[0]['compression']} compression"
@@ -333,10 +328,14 @@ def describe_exr(path) -> str:
     for ax in axes:
         values = ax.get("values") or []
         rng = ax.get("range", ["?", "?"])
-        lines.append(f"  {ax.get('name')}: {ax.get('dim')} ({ax.get('image')}), count {ax.get('count')}, "
-                     f"range [{_fmt(rng[0])}, {_fmt(rng[1])}]")
-        lines.append(f"    texel {ax.get('texel')} ({ax.get('texel_formula')}), "
-                     f"mapping {ax.get('mapping')} ({ax.get('mapping_formula')})")
+        lines.append(
+            f"  {ax.get('name')}: {ax.get('dim')} ({ax.get('image')}), count {ax.get('count')}, "
+            f"range [{_fmt(rng[0])}, {_fmt(rng[1])}]"
+        )
+        lines.append(
+            f"    texel {ax.get('texel')} ({ax.get('texel_formula')}), "
+            f"mapping {ax.get('mapping')} ({ax.get('mapping_formula')})"
+        )
         if values:
             lines.append(f"    index 0 = {_fmt(values[0])}, index {len(values) - 1} = {_fmt(values[-1])}")
         if ax.get("uv_formula"):
@@ -345,9 +344,7 @@ def describe_exr(path) -> str:
         if alpha:
             lines.append(f"    alpha {_fmt(min(alpha))} .. {_fmt(max(alpha))} ({ax.get('alpha_formula')})")
     if data.ndim == 4:
-        slices = ", ".join(
-            f"{f['name']}={a.get('slice_value', '?')}" for f, a in zip(facts, part_attrs)
-        )
+        slices = ", ".join(f"{f['name']}={a.get('slice_value', '?')}" for f, a in zip(facts, part_attrs))
         lines.append(f"  parts: {slices}")
 
     lines.append("channels:")

@@ -10,6 +10,7 @@
 | ``h`` | <name>.h | half-float bits (uint16_t) or float | the conventions in a comment block |
 Row 0 of every file is table row 0 (no flip); column 0 is x index 0. Every write is atomic.
 """
+
 from __future__ import annotations
 
 import json
@@ -42,8 +43,13 @@ def metadata(table: Table) -> dict[str, str]:
 
 def _sidecar(table: Table, path: Path, fmt: str, extra: dict | None = None) -> None:
     meta = {k: v for k, v in metadata(table).items()}
-    doc = {"file": path.name, "format": fmt, "row_order": "file row 0 = table row 0 (y index 0); column 0 = x index 0",
-           **(extra or {}), "lutbake": meta}
+    doc = {
+        "file": path.name,
+        "format": fmt,
+        "row_order": "file row 0 = table row 0 (y index 0); column 0 = x index 0",
+        **(extra or {}),
+        "lutbake": meta,
+    }
     atomic_write_bytes(path.with_suffix(".json"), (json.dumps(doc, indent=1, ensure_ascii=False) + "\n").encode())
 
 
@@ -68,10 +74,15 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
     lo, hi = float(pixels.min()), float(pixels.max())
     if lo < -PNG_SLACK or hi > 1.0 + PNG_SLACK:
         names = list(table.channels)
-        bad = [names[c] for c in range(pixels.shape[-1])
-               if pixels[..., c].min() < -PNG_SLACK or pixels[..., c].max() > 1.0 + PNG_SLACK]
-        raise ValueError(f"table {table.name!r}: png16 stores [0, 1] only; channel(s) {bad} span [{lo:.6g}, {hi:.6g}] "
-                         "(use exr, dds, ktx2, npy or h)")
+        bad = [
+            names[c]
+            for c in range(pixels.shape[-1])
+            if pixels[..., c].min() < -PNG_SLACK or pixels[..., c].max() > 1.0 + PNG_SLACK
+        ]
+        raise ValueError(
+            f"table {table.name!r}: png16 stores [0, 1] only; channel(s) {bad} span [{lo:.6g}, {hi:.6g}] "
+            "(use exr, dds, ktx2, npy or h)"
+        )
     if pixels.shape[-1] == 2:
         pixels = np.concatenate([pixels, np.zeros(pixels.shape[:-1] + (1,), np.float32)], axis=-1)
     codes = np.round(np.clip(pixels.astype(np.float64), 0.0, 1.0) * 65535.0).astype(np.uint16)
@@ -80,8 +91,10 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
     def write(tmp):
         spec = oiio.ImageSpec(w, h, nch, "uint16")
         spec.attribute("oiio:ColorSpace", "linear")  # OIIO then writes gAMA = 1.0, never an sRGB chunk
-        spec.attribute("ImageDescription", f"lutbake {table.kind} table {table.name}: linear values, "
-                                           "code / 65535; conventions in the .json sidecar")
+        spec.attribute(
+            "ImageDescription",
+            f"lutbake {table.kind} table {table.name}: linear values, code / 65535; conventions in the .json sidecar",
+        )
         out = oiio.ImageOutput.create(str(tmp))
         if out is None or not out.open(str(tmp), spec):
             raise OSError(f"cannot write {path}: {oiio.geterror()}")
@@ -91,8 +104,15 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
             raise OSError(f"cannot write {path}: {out.geterror()}")
 
     atomic_write(path, write)
-    _sidecar(table, path, "png16", {"encoding": "uint16 code / 65535, linear (no transfer function)",
-                                    "channels_in_file": "RGB (B = 0)" if len(table.channels) == 2 else "as table"})
+    _sidecar(
+        table,
+        path,
+        "png16",
+        {
+            "encoding": "uint16 code / 65535, linear (no transfer function)",
+            "channels_in_file": "RGB (B = 0)" if len(table.channels) == 2 else "as table",
+        },
+    )
     return path
 
 
@@ -120,29 +140,43 @@ def _c_ident(name: str) -> str:
     return s if not s[0].isdigit() else "_" + s
 
 
-def convention_lines(table: Table, pixels: np.ndarray, dtype: str, ident: str,
-                     values: str | None = None) -> list[str]:
+def convention_lines(table: Table, pixels: np.ndarray, dtype: str, ident: str, values: str | None = None) -> list[str]:
     """The conventions comment block every source-code output carries (C header, JS/TS, WGSL, Rust), one
     line per item, without comment markers: array layout, axes (texel, mapping, order, uv), channels,
     reconstruction, provenance and the config."""
     dims = pixels.shape
-    lines = ["", f"kind: {table.kind}",
-             f"array: {ident}[" + " * ".join(str(n) for n in dims) + "], flat: element "
-             + ("((z * H + y) * W + x) * C + c" if pixels.ndim == 4 else "(y * W + x) * C + c")
-             + " (rows y, columns x, channels c)",
-             f"lutbake:shape = [{', '.join(str(n) for n in dims)}]",
-             "row 0 = table row 0 (y index 0); column 0 = x index 0. Upload row 0 first (OpenGL: t = 0 at row 0).",
-             "values: " + (values or ("IEEE 754 binary16 bit patterns (uint16_t); upload as GL_HALF_FLOAT / "
-                                      "DXGI *_FLOAT" if dtype == "half" else "float32")),
-             "", "axes:"]
+    lines = [
+        "",
+        f"kind: {table.kind}",
+        f"array: {ident}["
+        + " * ".join(str(n) for n in dims)
+        + "], flat: element "
+        + ("((z * H + y) * W + x) * C + c" if pixels.ndim == 4 else "(y * W + x) * C + c")
+        + " (rows y, columns x, channels c)",
+        f"lutbake:shape = [{', '.join(str(n) for n in dims)}]",
+        "row 0 = table row 0 (y index 0); column 0 = x index 0. Upload row 0 first (OpenGL: t = 0 at row 0).",
+        "values: "
+        + (
+            values
+            or (
+                "IEEE 754 binary16 bit patterns (uint16_t); upload as GL_HALF_FLOAT / DXGI *_FLOAT"
+                if dtype == "half"
+                else "float32"
+            )
+        ),
+        "",
+        "axes:",
+    ]
     for ax in table.axes:
         d = ax.describe()
-        lines += [f"  {d['name']}: {d['dim']} ({d['image']}), count {d['count']}, texel {d['texel']} "
-                  f"({d['texel_formula']}), order {d['order']}",
-                  f"    mapping {d['mapping']}: {d['mapping_formula']}"
-                  + (f", clamped to {d['clamp']}" if d.get("clamp") else ""),
-                  f"    index 0 = {d['values'][0]:.9g}, index {d['count'] - 1} = {d['values'][-1]:.9g}",
-                  f"    sample at {d['uv_formula']}"]
+        lines += [
+            f"  {d['name']}: {d['dim']} ({d['image']}), count {d['count']}, texel {d['texel']} "
+            f"({d['texel_formula']}), order {d['order']}",
+            f"    mapping {d['mapping']}: {d['mapping_formula']}"
+            + (f", clamped to {d['clamp']}" if d.get("clamp") else ""),
+            f"    index 0 = {d['values'][0]:.9g}, index {d['count'] - 1} = {d['values'][-1]:.9g}",
+            f"    sample at {d['uv_formula']}",
+        ]
     lines += ["channels:"] + [f"  {c} = {n}: {m}" for c, (n, m) in zip("RGBA", table.channels.items())]
     lines += ["reconstruction:", f"  {table.reconstruction}", "", "provenance:"]
     for k in ("terms", "estimator", "samples", "seed", "version", "warp_version"):
@@ -179,7 +213,7 @@ def header_text(table: Table, dtype: str = "float32") -> str:
         items = [f"{float(x):.9g}f" for x in flat]
         items = [s if ("." in s or "e" in s) else s[:-1] + ".0f" for s in items]
     per_line = 12
-    rows = [", ".join(items[i:i + per_line]) for i in range(0, len(items), per_line)]
+    rows = [", ".join(items[i : i + per_line]) for i in range(0, len(items), per_line)]
     size = " * ".join(f"{macro}_{n}" for n in names)
     body += f"\nstatic const {ctype} {ident}[{size}] = {{\n    "
     body += ",\n    ".join(rows) + "\n};\n"
@@ -193,8 +227,14 @@ def write_header(table: Table, path, dtype: str = "float32") -> Path:
     return path
 
 
-WRITERS = {"exr": write_exr, "npy": write_npy, "png16": write_png16, "dds": write_dds, "ktx2": write_ktx2,
-           "h": write_header}
+WRITERS = {
+    "exr": write_exr,
+    "npy": write_npy,
+    "png16": write_png16,
+    "dds": write_dds,
+    "ktx2": write_ktx2,
+    "h": write_header,
+}
 
 
 def _register_code_arrays() -> None:

@@ -11,6 +11,7 @@ Bevy's proposed DFG LUT is a zstd KTX2):
 - Key/value data: ``KTXorientation`` = ``rd`` (``rdi`` for 3D): x to the right, y down, i.e. the first
   stored row is table row 0; ``KTXwriter``; and ``lutbake:metadata`` (JSON of the lutbake attributes).
 """
+
 from __future__ import annotations
 
 import json
@@ -23,11 +24,21 @@ from .dds import gpu_channels
 
 IDENTIFIER = bytes([0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A])
 VK_FORMAT = {
-    ("half", 1): 76, ("half", 2): 83, ("half", 4): 97,  # VK_FORMAT_R16_SFLOAT, R16G16_SFLOAT, R16G16B16A16_SFLOAT
-    ("float32", 1): 100, ("float32", 2): 103, ("float32", 4): 109,  # R32_SFLOAT, R32G32_SFLOAT, R32G32B32A32_SFLOAT
+    ("half", 1): 76,
+    ("half", 2): 83,
+    ("half", 4): 97,  # VK_FORMAT_R16_SFLOAT, R16G16_SFLOAT, R16G16B16A16_SFLOAT
+    ("float32", 1): 100,
+    ("float32", 2): 103,
+    ("float32", 4): 109,  # R32_SFLOAT, R32G32_SFLOAT, R32G32B32A32_SFLOAT
 }
-VK_FORMAT_NAMES = {76: "VK_FORMAT_R16_SFLOAT", 83: "VK_FORMAT_R16G16_SFLOAT", 97: "VK_FORMAT_R16G16B16A16_SFLOAT",
-                   100: "VK_FORMAT_R32_SFLOAT", 103: "VK_FORMAT_R32G32_SFLOAT", 109: "VK_FORMAT_R32G32B32A32_SFLOAT"}
+VK_FORMAT_NAMES = {
+    76: "VK_FORMAT_R16_SFLOAT",
+    83: "VK_FORMAT_R16G16_SFLOAT",
+    97: "VK_FORMAT_R16G16B16A16_SFLOAT",
+    100: "VK_FORMAT_R32_SFLOAT",
+    103: "VK_FORMAT_R32G32_SFLOAT",
+    109: "VK_FORMAT_R32G32B32A32_SFLOAT",
+}
 KHR_DF_MODEL_RGBSDA = 1
 KHR_DF_PRIMARIES_BT709 = 1
 KHR_DF_TRANSFER_LINEAR = 1
@@ -68,8 +79,13 @@ def _kvd(pairs: dict[str, str]) -> bytes:
     return out
 
 
-def encode(pixels: np.ndarray, metadata: dict[str, str] | None = None, array: bool = False,
-           writer: str = "lutbake", supercompression: str = "none") -> bytes:
+def encode(
+    pixels: np.ndarray,
+    metadata: dict[str, str] | None = None,
+    array: bool = False,
+    writer: str = "lutbake",
+    supercompression: str = "none",
+) -> bytes:
     """KTX2 bytes for a (y, x, C) or (z, y, x, C) float16/float32 array; ``supercompression`` "none" or "zstd"."""
     dtype = "half" if pixels.dtype == np.float16 else "float32"
     data = np.ascontiguousarray(gpu_channels(pixels))
@@ -100,8 +116,9 @@ def encode(pixels: np.ndarray, metadata: dict[str, str] | None = None, array: bo
         vk_type_size = 1  # typeSize must be 1 when supercompressed (§3.6)
     else:
         level, vk_type_size = raw, type_size
-    head = IDENTIFIER + struct.pack("<9I", VK_FORMAT[(dtype, nch)], vk_type_size, width, height, depth, layers, 1, 1,
-                                    scheme)
+    head = IDENTIFIER + struct.pack(
+        "<9I", VK_FORMAT[(dtype, nch)], vk_type_size, width, height, depth, layers, 1, 1, scheme
+    )
     head += struct.pack("<IIIIQQ", dfd_off, len(dfd), kvd_off, len(kvd), 0, 0)
     head += struct.pack("<QQQ", level_off, len(level), len(raw))
     assert len(head) == header_len
@@ -115,13 +132,14 @@ def decode(blob: bytes) -> tuple[np.ndarray, dict[str, str]]:
         raise ValueError("not a KTX 2.0 file (bad identifier)")
     vk, _, width, height, depth, layers, faces, levels, scheme = struct.unpack_from("<9I", blob, 12)
     if vk not in FROM_VK_FORMAT:
-        raise ValueError(f"KTX2 vkFormat {vk} is not a float format lutbake reads "
-                         f"({', '.join(VK_FORMAT_NAMES.values())})")
+        raise ValueError(
+            f"KTX2 vkFormat {vk} is not a float format lutbake reads ({', '.join(VK_FORMAT_NAMES.values())})"
+        )
     if scheme not in SUPERCOMPRESSION.values():
         raise ValueError(f"KTX2 supercompressionScheme {scheme}: only none (0) and Zstandard (2) are read")
     dfd_off, dfd_len, kvd_off, kvd_len, _, _ = struct.unpack_from("<IIIIQQ", blob, 48)
     level_off, level_len, raw_len = struct.unpack_from("<QQQ", blob, 80)
-    level = blob[level_off:level_off + level_len]
+    level = blob[level_off : level_off + level_len]
     if scheme:
         import zstandard
 
@@ -129,7 +147,7 @@ def decode(blob: bytes) -> tuple[np.ndarray, dict[str, str]]:
     pairs, pos = {}, kvd_off
     while pos < kvd_off + kvd_len:
         (n,) = struct.unpack_from("<I", blob, pos)
-        key, _, value = blob[pos + 4:pos + 4 + n].partition(b"\0")
+        key, _, value = blob[pos + 4 : pos + 4 + n].partition(b"\0")
         pairs[key.decode("utf-8")] = value.rstrip(b"\0").decode("utf-8")
         pos += 4 + n + (-n % 4)
     dtype, nch = FROM_VK_FORMAT[vk]

@@ -14,6 +14,7 @@ A text array's layout must be declared: ``#define *_HEIGHT/_WIDTH/_CHANNELS`` (l
 Row 0 of the result is the first row stored in the file (no flip). A JSON sidecar beside the file
 (lutbake's, or /work/shared/refs style) is returned in ``sidecar``.
 """
+
 from __future__ import annotations
 
 import json
@@ -75,8 +76,10 @@ def _text_shape(text: str, shape) -> tuple[int, ...]:
     dims = {k: int(v) for k, v in re.findall(r"#define\s+\w+?_(HEIGHT|WIDTH|CHANNELS)\s+(\d+)", text)}
     if len(dims) == 3:
         return dims["HEIGHT"], dims["WIDTH"], dims["CHANNELS"]
-    raise ValueError("the array's layout is not declared in the file: give shape=(rows, columns, channels) "
-                     "(CLI: --shape ROWSxCOLUMNSxCHANNELS)")
+    raise ValueError(
+        "the array's layout is not declared in the file: give shape=(rows, columns, channels) "
+        "(CLI: --shape ROWSxCOLUMNSxCHANNELS)"
+    )
 
 
 def parse_text_array(text: str, shape=None) -> tuple[np.ndarray, str]:

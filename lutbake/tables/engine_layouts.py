@@ -11,6 +11,7 @@ in mu = n.l in (0, 1) and phi in (0, pi) (the integrand is even in phi), with th
 The integrand is a polynomial in mu and cos(phi) times sqrt(1 - mu^2) (through l.v): DIFFUSE_ORDER nodes per
 dimension reach 1e-9 (tested against scipy's adaptive quadrature).
 """
+
 from __future__ import annotations
 
 import functools
@@ -31,11 +32,12 @@ CHANNELS = {
         "fc": "∫ f/F (1 - v.h)^5 (n.l) dω_l: the f90 weight (HDRP preFGD.x)",
         "e_ss": "∫ f/F (n.l) dω_l: E with F = 1, HDRP's 'reflectivity' (preFGD.y)",
         "disney_fgd_minus_half": "(1/pi) ∫ Fd_disney(n.v, n.l, l.v, r) (n.l) dω_l - 0.5, Burley diffuse without 1/pi "
-                                 "normalised by 1.03571 as HDRP's DisneyDiffuseNoPI (preFGD.z; diffuseFGD = z + 0.5)"},
+        "normalised by 1.03571 as HDRP's DisneyDiffuseNoPI (preFGD.z; diffuseFGD = z + 0.5)",
+    },
 }
 RECONSTRUCTION = {
     "multiscatter_disney": "uv = Remap01ToHalfTexelCoord(vec2(sqrt(NoV), perceptualRoughness), 64); t = texture(lut, "
-                           "uv).rgb; specularFGD = mix(t.r, t.g, f0); diffuseFGD = t.b + 0.5; reflectivity = t.g",
+    "uv).rgb; specularFGD = mix(t.r, t.g, f0); diffuseFGD = t.b + 0.5; reflectivity = t.g",
 }
 BASE_LAYOUT = {"multiscatter_disney": "multiscatter"}
 
@@ -43,8 +45,13 @@ BASE_LAYOUT = {"multiscatter_disney": "multiscatter"}
 @functools.lru_cache(maxsize=None)
 def diffuse_kernel():
     @wp.kernel(enable_backward=False)
-    def disney_fgd(nov: wp.array(dtype=float), r: wp.array(dtype=float), x: wp.array(dtype=wp.float64),
-                   w: wp.array(dtype=wp.float64), out: wp.array(dtype=wp.float64)):
+    def disney_fgd(
+        nov: wp.array(dtype=float),
+        r: wp.array(dtype=float),
+        x: wp.array(dtype=wp.float64),
+        w: wp.array(dtype=wp.float64),
+        out: wp.array(dtype=wp.float64),
+    ):
         i = wp.tid()
         NoV = nov[i]
         v = wp.vec3(wp.sqrt(wp.max(1.0 - NoV * NoV, 0.0)), 0.0, NoV)
@@ -68,10 +75,18 @@ def disney_fgd(nov: np.ndarray, perceptual_roughness: np.ndarray, device: str = 
     """(1/pi) ∫ Fd_disney_hdrp (n.l) dω_l at every (NoV, r), float64 (no -0.5 offset)."""
     x, w = np.polynomial.legendre.leggauss(DIFFUSE_ORDER)
     out = wp.zeros(len(nov), dtype=wp.float64, device=device)
-    wp.launch(diffuse_kernel(), dim=len(nov), device=device,
-              inputs=[wp.array(np.ascontiguousarray(nov, np.float32), dtype=float, device=device),
-                      wp.array(np.ascontiguousarray(perceptual_roughness, np.float32), dtype=float, device=device),
-                      wp.array(x, dtype=wp.float64, device=device), wp.array(w, dtype=wp.float64, device=device), out])
+    wp.launch(
+        diffuse_kernel(),
+        dim=len(nov),
+        device=device,
+        inputs=[
+            wp.array(np.ascontiguousarray(nov, np.float32), dtype=float, device=device),
+            wp.array(np.ascontiguousarray(perceptual_roughness, np.float32), dtype=float, device=device),
+            wp.array(x, dtype=wp.float64, device=device),
+            wp.array(w, dtype=wp.float64, device=device),
+            out,
+        ],
+    )
     return out.numpy()
 
 

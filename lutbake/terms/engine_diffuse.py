@@ -10,6 +10,7 @@
 - ``Fd_fabric_lambert_hdrp``: HDRP's "FabricLambertNoPI" (BSDF.hlsl, "empirical"): lerp(1, 0.5, alpha) with
   alpha = r^2 as its PreIntegratedFGD_CharlieFabricLambert passes it; the BRDF is that / pi, constant over l.
 """
+
 from __future__ import annotations
 
 import warp as wp
