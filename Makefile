@@ -1,7 +1,7 @@
 # lutbake — the two commands of the README, and a few more.
 #   make luts      create the venv if missing, install, bake every config in configs/ and every engine
 #                  preset (PRESETS) into outputs/
-#   make test      create the venv if missing, install, run the test suite
+#   make test      create the venv if missing, install, run ruff (check + format --check), then the test suite
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
@@ -14,7 +14,7 @@ WORKERS ?=
 FORCE   ?=
 LUTS_STAMP := $(OUT)/.luts.stamp
 
-.PHONY: luts test validate bench clean venv help force-luts figures bench-diffuse
+.PHONY: lint luts test validate bench clean venv help force-luts figures bench-diffuse
 
 help:
 	@echo "make luts | test | validate | clean"
@@ -42,7 +42,11 @@ force-luts:
 figures: $(STAMP)
 	$(BIN)/lutbake plot --out-dir $(OUT)/figures
 
-test: $(STAMP)
+lint: $(STAMP)
+	$(BIN)/ruff check lutbake tests benchmarks
+	$(BIN)/ruff format --check lutbake tests benchmarks
+
+test: $(STAMP) lint
 	@$(BIN)/python -c "import moderngl; moderngl.create_standalone_context(backend='egl').release()" 2>/dev/null \
 		|| echo "note: no EGL OpenGL here; the GL consumer test will skip (Debian: apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri)"
 	$(BIN)/python -m pytest -q

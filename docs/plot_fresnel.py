@@ -14,7 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from lutbake.tables.fresnel import evaluate  # noqa: E402
+from lutbake.integrands.fresnel import evaluate  # noqa: E402
 from lutbake.terms.metals import fit_lazanyi_a  # noqa: E402
 
 AL = (1.3, 7.48)

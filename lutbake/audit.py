@@ -2,7 +2,7 @@
 diagnose the usual hand-over mistakes by testing each one against the data.
 
 The conventions are a ``dfg`` table spec (a preset or config, plus ``--set`` keys; the size is the file's).
-Every file texel (row y, column x) then has a declared (NoV, alpha) (lutbake.tables.dfg.axes_for); the
+Every file texel (row y, column x) then has a declared (NoV, alpha) (lutbake.kinds.dfg.axes_for); the
 reference is lutbake's Gauss-Legendre integral at those points (error ~4e-7), on a strided subset of at most
 ``max_side`` x ``max_side`` texels (the last row and column always included).
 
@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from .axes import Axis
-from .edge import ALPHA_MIN, NOV_MIN
+from .edge import NOV_MIN
 from .io.readers import LutFile, read_lut
 
 MAX_SIDE = 128  # default subset: at most this many rows and columns are re-integrated
@@ -80,7 +80,7 @@ class Positions:
     alpha: np.ndarray
     rough: np.ndarray  # perceptual roughness before the alpha floor (the Disney diffuse channel's parameter)
 
-    def map(self, fn) -> "Positions":
+    def map(self, fn) -> Positions:
         """The same index operation (flip, transpose, subset) applied to every field."""
         return Positions(fn(self.nov), fn(self.alpha), fn(self.rough))
 
@@ -112,7 +112,7 @@ def conventions(config=None, preset=None, overrides=(), shape=None) -> Conventio
     """The declared conventions: a config file or preset, ``--set`` overrides, size from ``shape`` (rows, cols)."""
     from .config import load_config, parse_overrides, preset_path
     from .errors import ConfigError
-    from .tables.dfg import axes_for
+    from .kinds.dfg import axes_for
 
     path = Path(config) if config else preset_path(preset or "default")
     ovr = parse_overrides(overrides)
@@ -144,7 +144,7 @@ def positions(
     rname = next(n for n in vals if n != "NoV")
     power = alpha_power if alpha_power is not None else (2.0 if rname == "perceptual_roughness" else 1.0)
     nov_1d = np.maximum(vals["NoV"], NOV_MIN)
-    alpha_1d = np.maximum(vals[rname] ** power, ALPHA_MIN)
+    alpha_1d = np.clip(vals[rname] ** power, 0.0, None)  # the integrand applies the alpha -> 0 policy (lutbake.edge)
     rough_1d = np.sqrt(np.clip(vals[rname] ** power, 0.0, None))
     if x_axis.name == "NoV":
         nov, alpha = np.meshgrid(nov_1d, alpha_1d)
@@ -250,46 +250,45 @@ class Integrator:
     """Converged (and, for the noise estimate, Hammersley) integrals at arbitrary (NoV, alpha), cached."""
 
     def __init__(self, conv: Conventions, workers: int | None = None):
-        from .tables import specular
-        from .tables.dfg import terms_of
+        from .integrands import engine_diffuse, specular
+        from .kinds.dfg import terms_of
 
         self.specular = specular
+        self.engine_diffuse = engine_diffuse
         o = conv.options
         self.form, self.ndf, self.masking = terms_of(o)
-        from .tables import engine_layouts
-
-        self.engine_layouts = engine_layouts
         self.layout = o["layout"]
-        self.base = engine_layouts.BASE_LAYOUT.get(self.layout, self.layout)  # the specular kernel's layout
+        self.base = engine_diffuse.BASE_LAYOUT.get(self.layout, self.layout)  # the specular integrand's layout
         self.nch = specular.N_CHANNELS[self.base]
-        self.kernel_channels = 3 if self.base in specular.SHEEN_LAYOUTS else self.nch
         self.workers = workers
         self._cache: dict[bytes, np.ndarray] = {}
 
-    def _run(self, layout, estimator, samples, nch, kch, nov, alpha) -> np.ndarray:
+    def _run(self, layout, estimator, samples, nch, nov, alpha) -> np.ndarray:
+        """The (terms, layout) integrand at texels (nov[i], alpha[i]) by ``estimator``, tiles on every worker."""
         from .executor import execute
-        from .tables.base import Plan
+        from .sampling.hemisphere import estimator_for
+        from .sampling.plan import Grid, per_texel_plan
 
-        k = self.specular.kernel_for(self.ndf, self.masking, layout, estimator, self.form)
+        integrand = self.specular.specular_integrand(self.ndf, self.masking, layout, self.form, nch)
         n = len(nov)
-
-        def run_tile(s, e, device):
-            return self.specular.integrate(k, nov[s:e], alpha[s:e], estimator, samples, 0, kch, device)[:, :nch]
-
-        plan = Plan(
-            axes=[Axis("i", "x", n)],
+        grid = Grid(
+            [Axis("i", "x", n)],
+            {
+                "nov": np.asarray(nov, np.float32),
+                "alpha": integrand.alpha_input(alpha),
+                "param": np.zeros(n, np.float32),
+            },
+        )
+        plan = per_texel_plan(
+            integrand,
+            estimator_for(estimator, samples, 0),
+            grid,
             channels={},
             reconstruction="",
-            n_texels=n,
-            n_channels=nch,
-            run_tile=run_tile,
-            prepare=lambda d: self.specular.load(k, d),
-            samples=samples,
-            estimator=estimator,
             terms={},
-            cost=float(n * samples),
+            error_estimate=False,
         )
-        return execute(plan, workers=self.workers, progress=False).reshape(n, nch)
+        return execute(plan, workers=self.workers).reshape(n, nch)
 
     def converged(self, nov: np.ndarray, alpha: np.ndarray, rough: np.ndarray | None = None) -> np.ndarray:
         """Every channel of the layout at (NoV, alpha); ``rough`` (perceptual) feeds an engine diffuse channel
@@ -297,17 +296,9 @@ class Integrator:
         rough = np.sqrt(alpha) if rough is None else rough
         key = b"".join(a.astype(np.float32).tobytes() for a in (nov, alpha, rough))
         if key not in self._cache:
-            out = self._run(
-                self.base,
-                "gauss_legendre",
-                REFERENCE_SAMPLES,
-                self.nch,
-                self.kernel_channels,
-                nov.astype(np.float32),
-                alpha.astype(np.float32),
-            )
+            out = self._run(self.base, "gauss_legendre", REFERENCE_SAMPLES, self.nch, nov, alpha)
             if self.base != self.layout:
-                b = self.engine_layouts.disney_fgd(nov, rough) - self.engine_layouts.HDRP_DIFFUSE_OFFSET
+                b = self.engine_diffuse.disney_fgd(nov, rough) - self.engine_diffuse.HDRP_DIFFUSE_OFFSET
                 out = np.concatenate([out, b[:, None]], axis=1)
             self._cache[key] = out
         return self._cache[key]
@@ -317,7 +308,7 @@ class Integrator:
         if self.base in self.specular.SHEEN_LAYOUTS or self.form != "microfacet":
             return None
         base = "multiscatter" if self.base.startswith("multiscatter") else "scale_bias"
-        return self._run(base, "hammersley_ndf", samples, 2, 2, nov.astype(np.float32), alpha.astype(np.float32))
+        return self._run(base, "hammersley_ndf", samples, 2, nov, alpha)
 
 
 def subset(n: int, max_side: int) -> np.ndarray:
@@ -475,7 +466,7 @@ def audit(
     rows, cols, fch = lut.data.shape
     conv = conventions(**(conv_args or {}), shape=(rows, cols))
     integ = Integrator(conv, workers)
-    from .tables.dfg import CHANNELS
+    from .kinds.dfg import CHANNELS
 
     names = list(CHANNELS[conv.layout])
     nch = min(fch, len(names))

@@ -22,6 +22,17 @@ def _quiet_warp():
     wp.config.log_level = logging.WARNING
 
 
+def out_dir_option(default: str, what: str):
+    """The shared ``--out-dir`` option of the commands that write files."""
+    return click.option(
+        "--out-dir",
+        type=click.Path(path_type=Path),
+        default=Path(default),
+        show_default=True,
+        help=f"Directory the {what} are written to.",
+    )
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
 @click.version_option(__version__, prog_name="lutbake")
 def main():
@@ -42,13 +53,7 @@ def main():
 @main.command()
 @click.argument("configs", nargs=-1, type=click.Path(path_type=Path))
 @click.option("--preset", "presets", multiple=True, metavar="NAME", help="Bake a preset config (lutbake list).")
-@click.option(
-    "--out-dir",
-    type=click.Path(path_type=Path),
-    default=Path("outputs"),
-    show_default=True,
-    help="Directory the EXRs are written to.",
-)
+@out_dir_option("outputs", "tables")
 @click.option(
     "--set",
     "overrides",
@@ -58,11 +63,7 @@ def main():
 )
 @click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
 @click.option(
-    "--device",
-    type=click.Choice(["cpu", "cuda"]),
-    default="cpu",
-    show_default=True,
-    help="Warp device the kernels run on.",
+    "--device", type=click.Choice(["cpu", "cuda"]), default="cpu", help="Warp device of the kernels: cpu, cuda."
 )
 @click.option("--progress/--no-progress", default=None, help="Progress bar (default: on a terminal, for long bakes).")
 @click.option("--force", is_flag=True, help="Rebake every table, even those whose output is up to date.")
@@ -120,7 +121,7 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
 
             if not wp.is_cuda_available():
                 raise ConfigError("--device", "device", "cuda", "cpu", "no CUDA device is available")
-        jobs = batch.plan(specs, out_dir, force=force)
+        jobs = batch.schedule(specs, out_dir, force=force)
     except ConfigError as e:
         click.echo(f"error: {e}", err=True)
         sys.exit(EXIT_CONFIG)
@@ -137,10 +138,12 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     for job in jobs:
         if job.status == "skipped":
             click.echo(f"skipped {job.path} (up to date)")
+    pending = sum(j.status == "pending" for j in jobs)
+    bars = progress if progress is not None else (sys.stderr.isatty() and pending == 1)
     signum = None
     try:
         with batch.signal_handlers():
-            signum = batch.run(jobs, workers, device, progress, on_done=on_done)
+            signum = batch.run(jobs, workers, device, progress_bars if bars else None, on_done=on_done)
     except (KeyboardInterrupt, batch.Interrupted) as e:  # a second Ctrl-C while tables wind down
         signum = getattr(e, "signum", 2)
         for job in jobs:
@@ -162,18 +165,44 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     sys.exit(status)
 
 
+PROGRESS_MIN_EVALS = 1.5e7  # about a second of work on two busy cores: show a bar above it
+
+
+def progress_bars(label: str, n_texels: int, cost: float):
+    """lutbake.executor.Progress drawn as a click progress bar on stderr (tables above PROGRESS_MIN_EVALS)."""
+    if cost <= PROGRESS_MIN_EVALS:
+        return None
+    bar = click.progressbar(length=n_texels, label=label, file=sys.stderr, show_eta=True)
+    bar.__enter__()
+    left = [n_texels]
+
+    def update(n: int) -> None:
+        bar.update(n)
+        left[0] -= n
+        if left[0] <= 0:
+            bar.__exit__(None, None, None)
+
+    return update
+
+
 @main.command("list")
 def list_():
     """List table kinds, selectable terms, estimators and presets."""
     from .axes import TEXELS
     from .config import presets
+    from .integrands.anisotropic import ANISO_MODELS
+    from .integrands.diffuse import DIFFUSE_MODELS
+    from .integrands.fresnel import FRESNELS
+    from .integrands.specular import SPECULAR_MODELS
     from .io.formats import FORMATS
-    from .tables import KINDS
-    from .tables.dfg import LAYOUTS
-    from .tables.diffuse import MODELS as DIFFUSE_MODELS
-    from .tables.specular import ESTIMATORS
-    from .tables import aniso
-    from .terms.sets import MASKINGS, MODELS, NDFS
+    from .kinds import KINDS
+    from .kinds.dfg import LAYOUTS
+    from .kinds.diffuse import DIFFUSE_ESTIMATORS
+    from .kinds.specular_aniso import VIEW_AZIMUTHS
+    from .sampling.anisotropic import ANISO_ESTIMATORS
+    from .sampling.hemisphere import ESTIMATORS
+    from .terms.distributions import MASKINGS, NDFS
+    from .terms.metals import METALS
 
     def section(title, items):
         click.echo(click.style(title, bold=True))
@@ -187,20 +216,19 @@ def list_():
     )
     section("NDFs (ndf = ...)", {k: v.description for k, v in NDFS.items()})
     section("Masking-shadowing (masking = ...)", MASKINGS)
-    section("Models (dfg, albedo, albedo_avg, specular_3d: model = ...)", MODELS)
-    section("Anisotropic models (specular_aniso: model = ...)", aniso.MODELS)
-    section("View azimuth (specular_aniso: view_azimuth = ...)", aniso.VIEW_AZIMUTHS)
-    from .tables.fresnel import FRESNELS
-    from .terms.metals import METALS
+    section("Models (dfg, albedo, albedo_avg, specular_3d: model = ...)", SPECULAR_MODELS)
+    section("Anisotropic models (specular_aniso: model = ...)", ANISO_MODELS)
+    section("View azimuth (specular_aniso: view_azimuth = ...)", VIEW_AZIMUTHS)
 
     section("Fresnel (specular_3d: fresnel = ...; dfg factors Schlick out)", FRESNELS)
     section(
         "Metals (specular_3d: metal = ...)", {k: f"n+ik R,G,B = {m.n} + i{m.k}; {m.source}" for k, m in METALS.items()}
     )
     section("DFG layouts (layout = ...)", LAYOUTS)
-    section("Estimators (estimator = ...)", ESTIMATORS)
+    section("Estimators (dfg, albedo, albedo_avg, specular_3d: estimator = ...)", ESTIMATORS)
     section("Diffuse models (kind = diffuse, model = ...)", DIFFUSE_MODELS)
-    section("Estimators (specular_aniso: estimator = ...)", aniso.ESTIMATORS)
+    section("Estimators (diffuse, diffuse_3d: estimator = ...)", DIFFUSE_ESTIMATORS)
+    section("Estimators (specular_aniso: estimator = ...)", ANISO_ESTIMATORS)
     section("Texel conventions (texel = ...)", TEXELS)
     section("Output formats (format = ... / --format)", FORMATS)
     section("Presets (--preset NAME)", {k: _first_comment(p) for k, p in presets().items()})
@@ -233,13 +261,7 @@ def inspect(file):
 
 
 @main.command()
-@click.option(
-    "--out-dir",
-    type=click.Path(path_type=Path),
-    default=Path("outputs/figures"),
-    show_default=True,
-    help="Directory the PNGs are written to.",
-)
+@out_dir_option("outputs/figures", "PNGs")
 @click.option(
     "--sigma-to-alpha",
     type=click.Choice(["sigma", "sigma_squared"]),

@@ -10,17 +10,17 @@ from __future__ import annotations
 import math
 import re
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any, Mapping
+from typing import Any
 
 from .errors import ConfigError
-from .tables import KINDS, lookup_kind
-from .tables.base import Key
+from .kinds import KINDS, Key, lookup_kind
 
 NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,128}$")
-MAX_TEXELS = 1 << 26  # 64 Mi texels; float64 accumulation of 4 channels = 2 GiB
+MAX_TEXELS = 1 << 26  # 64 Mi texels of any kind (Kind.texels); float64 accumulation of 4 channels = 2 GiB
 BYTES_PER_TEXEL = 32  # float64 x 4 channels while baking
 MAX_LIST = 1024  # entries of a float_list key
 
@@ -177,14 +177,15 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
             options[k.name] = list(k.default) if isinstance(k.default, list) else k.default
     options["kind"] = kind.name
     spec = TableSpec(options["name"], kind.name, MappingProxyType(options), str(file), index)
-    texels = math.prod(options.get("size", [1]))
+    texels = kind.texels(options)
     if texels > MAX_TEXELS:
         raise ConfigError(
             file,
             "size",
-            options["size"],
+            options.get("size"),
             f"at most {MAX_TEXELS} texels = {human_bytes(MAX_TEXELS * BYTES_PER_TEXEL)}",
-            f"{texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} of memory while baking",
+            f"{kind.texels_doc} = {texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} "
+            "of memory while baking",
             label,
         )
     if kind.check is not None:

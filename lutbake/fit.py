@@ -151,7 +151,7 @@ def _karis_target(n: int, offset: float = 0.5):
     nov, r = np.meshgrid(t, t)
     axes = [Axis("perceptual_roughness", "y", n), Axis("NoV", "x", n)]
     conv = Conventions({"layout": "scale_bias", "ndf": "ggx", "masking": "smith_height_correlated"}, axes, "fit")
-    ref = Integrator(conv).converged(nov.ravel(), np.maximum(r.ravel() ** 2, 1e-4)).reshape(n, n, 2)
+    ref = Integrator(conv).converged(nov.ravel(), r.ravel() ** 2).reshape(n, n, 2)
     return nov, r, ref
 
 
@@ -203,7 +203,7 @@ def _gotanda_grid(n_cos: int = 12, n_phi: int = 7, n_sigma: int = 9, offset: flo
 
 
 def _gotanda_target(grid, order: int = 16):
-    from .tables import diffuse
+    from .integrands import diffuse
 
     L, V, lov, S, sl, sv, P = grid
     sp = np.sqrt(np.maximum(1 - P * P, 0))

@@ -24,7 +24,7 @@ import numpy as np
 
 from .audit import Conventions, Integrator, conventions
 from .axes import Axis
-from .edge import ALPHA_MIN, NOV_MIN
+from .edge import NOV_MIN
 
 STORAGE = {
     "unorm8": "8-bit UNORM (R8G8)",
@@ -63,7 +63,7 @@ def half_grid(conv: Conventions) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     vals = {a.name: axis_at(a, np.arange(2 * a.count - 1) / 2.0) for a in (y_axis, x_axis)}
     rname = next(n for n in vals if n != "NoV")
     a = np.clip(vals[rname] ** (2.0 if rname == "perceptual_roughness" else 1.0), 0.0, None)
-    alpha_1d, rough_1d = np.maximum(a, ALPHA_MIN), np.sqrt(a)
+    alpha_1d, rough_1d = a, np.sqrt(a)  # the integrand applies the alpha -> 0 policy (lutbake.edge)
     nov_1d = np.maximum(vals["NoV"], NOV_MIN)
     if x_axis.name == "NoV":
         nov, alpha = np.meshgrid(nov_1d, alpha_1d)

@@ -6,7 +6,7 @@ import pytest
 import warp as wp
 from scipy import integrate
 
-from lutbake.tables.engine_layouts import HDRP_DIFFUSE_OFFSET, disney_fgd
+from lutbake.integrands.engine_diffuse import HDRP_DIFFUSE_OFFSET, disney_fgd
 from lutbake.terms.engine_diffuse import Fd_disney_hdrp, Fd_fabric_lambert_hdrp
 
 TERM_RTOL = 1e-6  # float32 Warp term vs float64 numpy
@@ -68,7 +68,8 @@ def test_disney_fgd_equals_scipy_quadrature(nov, r):
 
 
 def test_disney_fgd_smooth_limit_is_the_product_of_two_schlick_averages():
-    # r = 0: fd90 = 0.5 and l.v drops out, so the FGD factorises: (1 - 0.5 (1 - NoV)^5) * 2 ∫ (1 - 0.5 (1 - mu)^5) mu dmu
+    # r = 0: fd90 = 0.5 and l.v drops out, so the FGD factorises:
+    # (1 - 0.5 (1 - NoV)^5) * 2 ∫ (1 - 0.5 (1 - mu)^5) mu dmu
     nov = 0.3
     inner = 2 * integrate.quad(lambda mu: (1 - 0.5 * (1 - mu) ** 5) * mu, 0, 1)[0]
     ref = (1 - 0.5 * (1 - nov) ** 5) * inner / 1.03571

@@ -86,7 +86,7 @@ def read_ktx2_spec(blob):
     assert w0 == 0 and (w1 & 0xFFFF) == 2
     block = w1 >> 16
     nsamples = (block - 24) // 16
-    model, prim, transfer, dflags = w2 & 0xFF, (w2 >> 8) & 0xFF, (w2 >> 16) & 0xFF, w2 >> 24
+    model, prim, transfer, _dflags = w2 & 0xFF, (w2 >> 8) & 0xFF, (w2 >> 16) & 0xFF, w2 >> 24
     assert (model, prim, transfer) == (1, 1, 1)  # RGBSDA, BT709, LINEAR (never sRGB = 2)
     channels = []
     for s in range(nsamples):

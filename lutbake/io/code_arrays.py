@@ -1,11 +1,12 @@
 """Tables as source code for engines that embed them, and KTX2 with zstd supercompression.
 
-| format | file | element type | read by |
-| --- | --- | --- | --- |
-| ``js`` | <name>.js: ES module, ``export const <NAME>`` | ``Uint16Array`` of IEEE half bits (dtype half, as three.js' DFGLUTData.js) or ``Float32Array`` | any bundler; three.js ``new DataTexture(NAME, W, H, RGFormat, HalfFloatType)`` |
-| ``wgsl`` | <name>.wgsl: ``const <NAME>: array<f32, N>`` | f32 (dtype half: the half-rounded values, so the shader sees exactly the texture's values) | WGSL (no ``enable f16`` needed) |
-| ``rs`` | <name>.rs: ``pub const <NAME>: [u16; N]`` / ``[f32; N]`` + ``<NAME>_WIDTH`` ... | half bits (``half::f16::from_bits``) or f32 | Rust (wgpu ``Rg16Float``: upload the bits as bytes, little-endian) |
-| ``ktx2zst`` | <name>.ktx2: KTX2, supercompressionScheme 2 (Zstandard) | as ``ktx2`` | Bevy / KTX-Software / libktx |
+- ``js``: <name>.js, an ES module ``export const <NAME>``: a ``Uint16Array`` of IEEE half bits (dtype half, as
+  three.js' DFGLUTData.js) or a ``Float32Array``; three.js ``new DataTexture(NAME, W, H, RGFormat, HalfFloatType)``.
+- ``wgsl``: <name>.wgsl, ``const <NAME>: array<f32, N>`` (dtype half: the half-rounded values, so the shader sees
+  exactly the texture's values; no ``enable f16`` needed).
+- ``rs``: <name>.rs, ``pub const <NAME>: [u16; N]`` of half bits (``half::f16::from_bits``; wgpu ``Rg16Float``:
+  upload the bits little-endian) or ``[f32; N]``, with ``<NAME>_HEIGHT`` / ``_WIDTH`` / ``_CHANNELS``.
+- ``ktx2zst``: <name>.ktx2, KTX2 with supercompressionScheme 2 (Zstandard), as ``ktx2`` otherwise (Bevy, libktx).
 Every text format starts with the conventions comment block of the C header (lutbake.io.formats.convention_lines),
 including a ``lutbake:shape = [rows, columns, channels]`` line; row 0 of the array is table row 0. A ``.json``
 sidecar is written beside each file (so every format is skipped when up to date).
@@ -17,7 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..table import Table
+from ..table import Table, metadata
+from ..table import pixels as checked_pixels
 from . import ktx2
 from .atomic import atomic_write_bytes
 
@@ -45,10 +47,9 @@ def _comment(lines: list[str], style: str) -> str:
 def source_text(table: Table, fmt: str, dtype: str = "float32") -> str:
     """The JS / WGSL / Rust source of ``table`` (module docstring)."""
     from .. import __version__
-    from .exr import _check_table
     from .formats import _c_ident, convention_lines
 
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     ident = _c_ident(table.name).upper()
     dims = list(pixels.shape)
     n = int(np.prod(dims))
@@ -101,10 +102,9 @@ def _writer(fmt: str):
 
 def write_ktx2_zstd(table: Table, path, dtype: str = "float32") -> Path:
     from .. import __version__
-    from .exr import _check_table
-    from .formats import _sidecar, metadata
+    from .formats import _sidecar
 
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write_bytes(
         path, ktx2.encode(pixels, metadata(table), writer=f"lutbake {__version__}", supercompression="zstd")
@@ -114,7 +114,7 @@ def write_ktx2_zstd(table: Table, path, dtype: str = "float32") -> Path:
 
 
 FORMATS = {
-    "js": "JavaScript/TypeScript ES module: Uint16Array of half bits (dtype half) or Float32Array + conventions comment",
+    "js": "JavaScript/TypeScript ES module: Uint16Array of half bits (half) or Float32Array + conventions comment",
     "wgsl": "WGSL const array<f32, N> (half-rounded values for dtype half) + conventions comment",
     "rs": "Rust pub const [u16; N] of half bits (dtype half) or [f32; N] + conventions comment",
     "ktx2zst": "KTX 2.0 with Zstandard supercompression (scheme 2), as ktx2 otherwise (Bevy)",

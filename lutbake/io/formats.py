@@ -19,10 +19,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ..table import Table
+from ..table import Table, metadata
+from ..table import pixels as checked_pixels
 from . import dds, ktx2
 from .atomic import atomic_write, atomic_write_bytes
-from .exr import _check_table, _header, write_exr
+from .exr import write_exr
 
 FORMATS = {
     "exr": "OpenEXR via OpenImageIO, float32 or half, lutbake:* header attributes (default)",
@@ -34,11 +35,6 @@ FORMATS = {
 }
 PNG_SLACK = 1.0e-3  # values this close outside [0, 1] are integration noise (e.g. E = 1 + 3e-5): clipped
 EXTENSIONS = {"exr": ".exr", "npy": ".npy", "png16": ".png", "dds": ".dds", "ktx2": ".ktx2", "h": ".h"}
-
-
-def metadata(table: Table) -> dict[str, str]:
-    """The lutbake attributes every format carries (as the EXR header's lutbake:* strings)."""
-    return _header(table)
 
 
 def _sidecar(table: Table, path: Path, fmt: str, extra: dict | None = None) -> None:
@@ -54,7 +50,7 @@ def _sidecar(table: Table, path: Path, fmt: str, extra: dict | None = None) -> N
 
 
 def write_npy(table: Table, path, dtype: str = "float32") -> Path:
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write(path, lambda tmp: np.save(tmp, pixels, allow_pickle=False))
     _sidecar(table, path, "npy", {"dtype": str(pixels.dtype), "shape": list(pixels.shape)})
@@ -67,7 +63,7 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
     outside [0, 1] are clipped; anything further out is an error (the format cannot hold it)."""
     import OpenImageIO as oiio
 
-    pixels = _check_table(table, "float32")
+    pixels = checked_pixels(table, "float32")
     path = Path(path)
     if pixels.ndim != 3:
         raise ValueError(f"table {table.name!r}: png16 holds 2D tables only; use dds, ktx2, exr or npy for 3D")
@@ -117,7 +113,7 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
 
 
 def write_dds(table: Table, path, dtype: str = "float32") -> Path:
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write_bytes(path, dds.encode(pixels))
     fmt = dds.DXGI_NAMES[dds.DXGI[(dtype, 4 if pixels.shape[-1] == 3 else pixels.shape[-1])]]
@@ -128,7 +124,7 @@ def write_dds(table: Table, path, dtype: str = "float32") -> Path:
 def write_ktx2(table: Table, path, dtype: str = "float32", array: bool = False) -> Path:
     from .. import __version__
 
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write_bytes(path, ktx2.encode(pixels, metadata(table), array=array, writer=f"lutbake {__version__}"))
     _sidecar(table, path, "ktx2", {"array": array})
@@ -193,7 +189,7 @@ def header_text(table: Table, dtype: str = "float32") -> str:
     element ((z * HEIGHT + y) * WIDTH + x) * CHANNELS + c."""
     from .. import __version__
 
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     ident = _c_ident(table.name)
     macro = ident.upper()
     dims = pixels.shape

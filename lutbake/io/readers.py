@@ -1,14 +1,14 @@
 """Read any LUT file lutbake can audit into a float64 (rows, columns, channels) array.
 
 ``read_lut(path, shape=None, encoding=None) -> LutFile``. Formats, by extension:
-| extension | what is read | quantisation known from the file |
-| --- | --- | --- |
-| ``.exr`` | OpenImageIO, float; ``lutbake:*`` attributes when present | half / float32 pixel type |
-| ``.png`` | OpenImageIO, the raw UNORM codes (8 or 16 bit), value = code / (2^bits - 1), **no transfer function** | bits |
-| ``.dds`` | DX10 header, R16G16_FLOAT ... RGBA32F (lutbake.io.dds) | half / float32 |
-| ``.ktx2`` | lutbake.io.ktx2.decode (uncompressed or zstd supercompressed) | half / float32 |
-| ``.npy`` | an integer array is UNORM codes (value = code / dtype max), a float array is values | dtype |
-| ``.h`` ``.hpp`` ``.inc`` ``.js`` ``.ts`` ``.mjs`` ``.wgsl`` ``.rs`` | the numbers of the first brace/bracket array: hex ``0x....`` as IEEE half bits, decimals as floats | half bits / float |
+- ``.exr``: OpenImageIO, float; the ``lutbake:*`` attributes when present.
+- ``.png``: OpenImageIO, the raw UNORM codes (8 or 16 bit), value = code / (2^bits - 1), **no transfer function**.
+- ``.dds``: DX10 header, R16G16_FLOAT ... RGBA32F (lutbake.io.dds); ``.ktx2``: lutbake.io.ktx2.decode (plain or zstd).
+- ``.npy``, ``.npz``: an integer array is UNORM codes (value = code / dtype max), a float array values (npz: the
+  array named ``table``, else its only one).
+- ``.h .hpp .inc .js .ts .mjs .wgsl .rs``: the numbers of the first brace/bracket array: hex ``0x....`` literals
+  are IEEE half bits, decimal literals floats.
+``storage`` records how the file stores a value (unorm8/16, half, float32), which the audit's quantisation check uses.
 A text array's layout must be declared: ``#define *_HEIGHT/_WIDTH/_CHANNELS`` (lutbake's C header), the
 ``lutbake:shape`` line of lutbake's JS/WGSL/Rust comment block, or ``shape=(rows, columns, channels)``.
 Row 0 of the result is the first row stored in the file (no flip). A JSON sidecar beside the file
@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 TEXT_EXTENSIONS = (".h", ".hpp", ".inc", ".js", ".mjs", ".ts", ".wgsl", ".rs")
-READABLE = (".exr", ".png", ".dds", ".ktx2", ".npy") + TEXT_EXTENSIONS
+READABLE = (".exr", ".png", ".dds", ".ktx2", ".npy", ".npz") + TEXT_EXTENSIONS
 
 
 @dataclass
@@ -136,8 +136,11 @@ def read_lut(path, shape=None) -> LutFile:
         data, storage = arr.astype(np.float64), _float_storage(arr)
         if "lutbake:metadata" in kv:
             attrs = json.loads(kv["lutbake:metadata"])
-    elif ext == ".npy":
+    elif ext in (".npy", ".npz"):
         arr = np.load(path, allow_pickle=False)
+        if ext == ".npz":  # one array: named "table" (tests/data), else the only one
+            names = list(arr.files)
+            arr = arr["table" if "table" in names else names[0]]
         if np.issubdtype(arr.dtype, np.unsignedinteger):
             data, storage = _unorm(arr)
         else:

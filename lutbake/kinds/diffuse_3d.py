@@ -13,14 +13,13 @@ table cannot be rescaled and f0 becomes a z axis. Stored like specular_3d: a mul
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
-import warp as wp
 
 from ..axes import Axis
-from . import diffuse, diffuse_albedo
-from .base import Key, Kind, Plan
+from ..integrands.diffuse import FACET_FRESNEL, diffuse_integrand, f0_factor
+from ..sampling.plan import TexelPlan, per_texel_plan
+from . import diffuse
+from .base import Key, declare
 
 KEYS = {
     **{k: v for k, v in diffuse.KEYS.items() if k != "f0"},
@@ -29,7 +28,7 @@ KEYS = {
         "str",
         "dielectric_f0",
         "Fresnel transmission on each facet (microfacet model); the default is the form where f0 does not factor out",
-        diffuse.FACET_FRESNEL,
+        FACET_FRESNEL,
     ),
     "f0_size": Key("f0_size", "int", 16, "f0 slice count (z)", minimum=1, maximum=1024),
     "f0_range": Key(
@@ -43,11 +42,11 @@ RECONSTRUCTION = (
 )
 
 
-def plan(spec) -> Plan:
+def plan(spec) -> TexelPlan:
     o = spec.options
     n_nov, n_sigma = o["size"]
     f0_axis = Axis("f0", "z", o["f0_size"], *o["f0_range"], texel=o["texel"])
-    sig_axis = Axis("sigma", "y", n_sigma, *o["sigma_range"], texel=o["texel"])
+    sig_axis = Axis("sigma", "y", n_sigma, *o["sigma_range"], texel=o["texel"], alpha_map=o["sigma_to_alpha"])
     nov_axis = Axis("NoV", "x", n_nov, *o["nov_range"], texel=o["texel"])
     nz = f0_axis.count
     # texel t = (iz * ny + iy) * nx + ix: f0 slowest, then sigma, then NoV
@@ -55,12 +54,14 @@ def plan(spec) -> Plan:
     sigma = np.tile(np.repeat(sig_axis.values(), n_nov), nz)
     f0 = np.repeat(f0_axis.values(), n_sigma * n_nov).astype(np.float64)
     model, ff = o["model"], o["facet_fresnel"]
-    order = diffuse.order_for(o)
     terms = {"model": model, "f0": "z axis"}
     if model == "microfacet":
         terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff, sigma_to_alpha=o["sigma_to_alpha"])
-    fields = dict(
-        axes=[f0_axis, sig_axis, nov_axis],
+    axes = [f0_axis, sig_axis, nov_axis]
+    return per_texel_plan(
+        diffuse_integrand(model, ff),
+        diffuse.estimator_of(o),
+        diffuse.diffuse_grid(axes, nov, sigma, f0, o["sigma_to_alpha"]),
         channels={
             "E": "∫ f_r (n.l) dω_l for rho = 1 at the slice's f0: directional diffuse reflectance under "
             "uniform white light"
@@ -70,66 +71,20 @@ def plan(spec) -> Plan:
         extra={
             "rho": "1",
             "f0_factor": "none: f0 is the z axis (per-slice lutbake:slice_value)",
-            "factoring_form": diffuse.f0_factor(model, ff),
-            "sigma_alpha": json.dumps(
-                [float(a) for a in diffuse.alpha_from_sigma(sig_axis.values(), o["sigma_to_alpha"])]
-            ),
+            "factoring_form": f0_factor(model, ff),
+            **diffuse.sigma_record(sig_axis),
         },
     )
-    if model == "microfacet":
-        alpha = diffuse.alpha_from_sigma(sigma, o["sigma_to_alpha"])
-        return diffuse_albedo.microfacet_albedo_plan(
-            nov=nov, alpha=alpha, f0=f0, facet_fresnel=ff, order=order, **fields
-        )
-    key = (model, ff)
-
-    def run(idx, n, device):
-        idx = np.arange(len(nov))[idx]
-        out = np.empty((len(idx), 1))
-        for value in np.unique(f0[idx]):  # closed forms take one f0 per launch
-            sel = f0[idx] == value
-            out[sel, 0] = diffuse.albedo(
-                model, nov[idx][sel], sigma[idx][sel], float(value), ff, o["sigma_to_alpha"], n, device=device
-            )
-        return out
-
-    def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
-        idx = np.unique(
-            np.concatenate(
-                [np.arange(0, len(nov), max(1, len(nov) // 256)), np.flatnonzero(nov <= nov.min())[:: max(1, nz)]]
-            )
-        )
-        err = float(np.max(np.abs(data[idx] - run(idx, order + 8, device))))
-        return err, f"max |order {order} - order {order + 8}| over {len(idx)} probe texels"
-
-    evals = 4 * order * order
-    return Plan(
-        n_texels=len(nov),
-        n_channels=1,
-        run_tile=lambda s, e, d: run(slice(s, e), order, d),
-        prepare=lambda d: wp.load_module(diffuse.albedo_kernel_for(*key).module, device=d),
-        samples=evals,
-        estimator="gauss_legendre",
-        cost=float(len(nov)) * evals,
-        error_estimate=error_estimate,
-        **fields,
-    )
 
 
-def check_spec(spec) -> str | None:
-    o = spec.options
-    n = o["size"][0] * o["size"][1] * o["f0_size"]
-    if n > 1 << 26:
-        return f"size x f0_size = {n} texels: at most {1 << 26}"
-    return None
+def texel_count(o: dict) -> int:
+    """size x f0_size"""
+    return o["size"][0] * o["size"][1] * o["f0_size"]
 
 
-DIFFUSE_3D = Kind(
-    "diffuse_3d",
-    "diffuse AmbientBRDF with an f0 axis: NoV x sigma x f0 slices (R = E), for per-facet "
-    "Fresnel forms where f0 does not factor out (exact dielectric, Eq. 2)",
-    KEYS,
-    plan,
-    aliases=("ambient_brdf_diffuse_3d",),
-    check=check_spec,
+DESCRIPTION = (
+    "diffuse AmbientBRDF with an f0 axis: NoV x sigma x f0 slices (R = E), for per-facet Fresnel forms where "
+    "f0 does not factor out (exact dielectric, Eq. 2)"
 )
+RULES = {"aliases": ("ambient_brdf_diffuse_3d",), "check": diffuse.check_spec, "texels": texel_count}
+DIFFUSE_3D = declare("diffuse_3d", DESCRIPTION, KEYS, plan, diffuse.DIFFUSE_ESTIMATION, **RULES)

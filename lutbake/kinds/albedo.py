@@ -7,9 +7,10 @@ The multiple-scattering lobe that restores the energy single scattering loses,
     f_ms(l, v) = (1 - E(n.v)) (1 - E(n.l)) / (pi (1 - E_avg)),
 integrates with the cosine to exactly 1 - E(n.v), so E + E_ms = 1 for every view (the white furnace:
 tests/test_albedo.py). With Fresnel, f_ms is scaled by
-    F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)),  F_avg = 2 ∫ F(mu) mu dmu  (lutbake.tables.fresnel.f_avg).
-E is the `dfg` integral with channels (1, 0) (lutbake.tables.specular.channels_albedo); E_avg runs the same
-kernel at Gauss-Legendre nodes in mu (MU_PANELS, mu_order nodes each) and sums 2 w E mu per roughness.
+    F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)),  F_avg = 2 ∫ F(mu) mu dmu  (lutbake.integrands.fresnel.f_avg).
+E is the `dfg` integral with channels (1, 0) (lutbake.integrands.specular.channels_albedo); E_avg evaluates the
+same integrand at Gauss-Legendre nodes in mu (two panels, mu_order nodes each: the grid's ``nodes``) and sums
+2 w E mu per roughness.
 """
 
 from __future__ import annotations
@@ -17,9 +18,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import Axis
-from . import dfg, specular
-from .base import Key, Kind, Plan
-from .fresnel import mu_nodes
+from ..integrands.fresnel import mu_nodes
+from ..integrands.specular import specular_integrand
+from ..sampling.hemisphere import estimator_for
+from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from . import dfg
+from .base import Key, declare
 
 ALBEDO_KEYS = {k: v for k, v in dfg.KEYS.items() if k != "layout"}
 ALBEDO_CHANNELS = {"e": "E = ∫ f/F (n.l) dω_l: single-scattering directional albedo with F = 1"}
@@ -31,7 +35,6 @@ ALBEDO_RECONSTRUCTION = (
 )
 
 AVG_KEYS = {
-    **dfg.COMMON_KEYS,
     "roughness_size": Key("roughness_size", "int", 128, "roughness texel count (the table is one row)", minimum=1),
     "mu_order": Key(
         "mu_order",
@@ -47,23 +50,23 @@ AVG_CHANNELS = {"e_avg": "E_avg = 2 ∫ E(mu) mu dmu: hemispherical albedo with 
 AVG_RECONSTRUCTION = "E_avg = texture(albedo_avg, vec2(roughness, 0.5)).r (one row; x = roughness)"
 
 
-def plan_albedo(spec) -> Plan:
+def integrand_of(o: dict):
+    form, nd, mk = dfg.terms_of(o)
+    return specular_integrand(nd, mk, "albedo", form, 1)
+
+
+def plan_albedo(spec) -> TexelPlan:
     o = spec.options
     axes = dfg.axes_for(o)
-    nov, alpha = dfg.texel_grid(axes)
-    form, nd, mk = dfg.terms_of(o)
-    return specular.hemisphere_plan(
-        key=(nd, mk, "albedo", o["estimator"], form),
-        nov=nov,
-        alpha=alpha,
-        param=None,
-        samples=o["samples"],
-        seed=o["seed"],
-        nch=1,
-        axes=axes,
+    integrand = integrand_of(o)
+    return per_texel_plan(
+        integrand,
+        estimator_for(o["estimator"], o["samples"], o["seed"]),
+        dfg.grid_for(axes, integrand),
         channels=ALBEDO_CHANNELS,
         reconstruction=ALBEDO_RECONSTRUCTION,
         terms=dfg.terms_record(o, "none (F = 1)"),
+        extra=dfg.specular_extra(integrand),
     )
 
 
@@ -72,54 +75,49 @@ def avg_roughness_axis(o: dict) -> Axis:
     return Axis(rname, "x", o["roughness_size"], *o["roughness_range"], texel=o["texel"])
 
 
-def plan_albedo_avg(spec) -> Plan:
+def plan_albedo_avg(spec) -> TexelPlan:
+    """E_avg(r) = sum_k (2 w_k mu_k) E(mu_k, r): a texel is the weighted sum over the mu nodes (Grid.nodes)."""
     o = spec.options
     rough = avg_roughness_axis(o)
-    est = o["estimator"]
-    samples = o["samples"] or specular.DEFAULT_SAMPLES[est]
-    form, nd, mk = dfg.terms_of(o)
-    key = (nd, mk, "albedo", est, form)
+    integrand = integrand_of(o)
     mu, w = mu_nodes(o["mu_order"])
-    alphas = rough.alpha()
-
-    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
-        k = specular.kernel_for(*key)
-        n = stop - start
-        nov = np.tile(mu, n)
-        alpha = np.repeat(alphas[start:stop], len(mu))
-        E = specular.integrate(k, nov, alpha, est, samples, o["seed"], 2, device)[:, 0].reshape(n, len(mu))
-        return (2.0 * E @ (w * mu))[:, None]
-
-    eff = specular.effective_samples(est, samples)
-    return Plan(
-        axes=[rough],
+    n = rough.count
+    alpha = np.repeat(rough.alpha(), len(mu))
+    grid = Grid(
+        [rough],
+        {"nov": np.tile(mu, n), "alpha": integrand.alpha_input(alpha), "param": np.zeros(n * len(mu), np.float32)},
+        nodes=w * mu,
+        scale=2.0,
+    )
+    return per_texel_plan(
+        integrand,
+        estimator_for(o["estimator"], o["samples"], o["seed"]),
+        grid,
         channels=AVG_CHANNELS,
         reconstruction=AVG_RECONSTRUCTION,
-        n_texels=rough.count,
-        n_channels=1,
-        run_tile=run_tile,
-        prepare=lambda d: specular.load(specular.kernel_for(*key), d),
-        samples=eff * len(mu),
-        estimator=est,
         terms=dfg.terms_record(o, "none (F = 1)"),
-        cost=float(rough.count) * len(mu) * eff,
-        extra={"mu_nodes": str(len(mu))},
+        extra={"mu_nodes": str(len(mu)), **dfg.specular_extra(integrand)},
+        error_estimate=False,
     )
 
 
-ALBEDO = Kind(
+ALBEDO_DESCRIPTION = "Kulla-Conty directional albedo E(NoV, roughness) with F = 1 (R = E)"
+ALBEDO = declare(
     "albedo",
-    "Kulla-Conty directional albedo E(NoV, roughness) with F = 1 (R = E)",
+    ALBEDO_DESCRIPTION,
     ALBEDO_KEYS,
     plan_albedo,
+    dfg.SPECULAR_ESTIMATION,
     aliases=("e_ss",),
     check=dfg.check_spec,
 )
-ALBEDO_AVG = Kind(
-    "albedo_avg",
-    "Kulla-Conty average albedo E_avg(roughness) = 2 ∫ E mu dmu: one row",
-    AVG_KEYS,
-    plan_albedo_avg,
-    aliases=("e_avg",),
-    check=dfg.check_spec,
-)
+
+
+def avg_texels(o: dict) -> int:
+    """roughness_size"""
+    return o["roughness_size"]
+
+
+AVG_DESCRIPTION = "Kulla-Conty average albedo E_avg(roughness) = 2 ∫ E mu dmu: one row"
+AVG_RULES = {"aliases": ("e_avg",), "check": dfg.check_spec, "texels": avg_texels}
+ALBEDO_AVG = declare("albedo_avg", AVG_DESCRIPTION, AVG_KEYS, plan_albedo_avg, dfg.SPECULAR_ESTIMATION, **AVG_RULES)

@@ -16,9 +16,12 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import Axis
+from ..integrands.specular import specular_integrand
+from ..sampling.hemisphere import estimator_for
+from ..sampling.plan import TexelPlan, per_texel_plan
 from ..terms.metals import METALS
-from . import dfg, specular
-from .base import Key, Kind, Plan
+from . import dfg
+from .base import Key, declare
 
 FRESNEL_CHOICES = {
     "schlick": "f0 + (1 - f0)(1 - v.h)^5 (Schlick 1994)",
@@ -58,21 +61,17 @@ def axes_for(o: dict) -> list[Axis]:
     return [Axis("f0", "z", o["f0_size"], *o["f0_range"], texel=o["texel"])] + axes
 
 
-def plan(spec) -> Plan:
+def plan(spec) -> TexelPlan:
     o = spec.options
     axes = axes_for(o)
-    est = o["estimator"]
-    samples = o["samples"] or specular.DEFAULT_SAMPLES[est]
     metal = o["metal"]
     channels_name = f"metal:{metal}" if metal else f"F:{o['fresnel']}"
     form, nd, mk = dfg.terms_of(o)
-    key = (nd, mk, channels_name, est, form)
-    rough, nov_axis = axes[-2:]
+    nch = 3 if metal else 1
+    integrand = specular_integrand(nd, mk, channels_name, form, nch)
     nz = 1 if metal else axes[0].count
     # texel t = (iz * ny + iy) * nx + ix: z (f0) slowest, then roughness, then NoV
-    nov, alpha = (np.tile(x, nz) for x in dfg.texel_grid([rough, nov_axis]))
-    f0 = None if metal else np.repeat(axes[0].values(), rough.count * nov_axis.count)
-    nch = 3 if metal else 1
+    f0 = None if metal else np.repeat(axes[0].values(), axes[-2].count * axes[-1].count)
     if metal:
         m = METALS[metal]
         channels = {
@@ -85,40 +84,25 @@ def plan(spec) -> Plan:
         channels = {"e": f"E = ∫ f (n.l) dω_l with F = {o['fresnel']}(f0 of the slice, v.h)"}
         terms = dfg.terms_record(o, o["fresnel"])
         extra = {}
-    return specular.hemisphere_plan(
-        key=key,
-        nov=nov,
-        alpha=alpha,
-        param=f0,
-        samples=o["samples"],
-        seed=o["seed"],
-        nch=nch,
-        kernel_channels=nch if metal else 2,
-        axes=axes,
+    return per_texel_plan(
+        integrand,
+        estimator_for(o["estimator"], o["samples"], o["seed"]),
+        dfg.grid_for(axes, integrand, f0, nz),
         channels=channels,
         reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D,
         terms=terms,
-        extra=extra,
+        extra={**extra, **dfg.specular_extra(integrand)},
     )
 
 
-def check_spec(spec) -> tuple[str, str] | None:
-    msg = dfg.check_spec(spec)
-    if msg:
-        return msg
-    o = spec.options
-    n = o["size"][0] * o["size"][1] * (1 if o["metal"] else o["f0_size"])
-    if n > 1 << 26:
-        return ("size", f"size x f0_size = {n} texels: at most {1 << 26}")
-    return None
+def texel_count(o: dict) -> int:
+    """size x f0_size"""
+    return o["size"][0] * o["size"][1] * (1 if o["metal"] else o["f0_size"])
 
 
-SPECULAR_3D = Kind(
-    "specular_3d",
-    "specular AmbientBRDF for any Fresnel: NoV x roughness x f0 slices (R = E), "
-    "or NoV x roughness RGB for a named metal",
-    KEYS,
-    plan,
-    aliases=("ambient_brdf_3d",),
-    check=check_spec,
+DESCRIPTION = (
+    "specular AmbientBRDF for any Fresnel: NoV x roughness x f0 slices (R = E), or NoV x roughness RGB for "
+    "a named metal"
 )
+RULES = {"aliases": ("ambient_brdf_3d",), "check": dfg.check_spec, "texels": texel_count}
+SPECULAR_3D = declare("specular_3d", DESCRIPTION, KEYS, plan, dfg.SPECULAR_ESTIMATION, **RULES)

@@ -20,7 +20,7 @@ Quadrature (every rule Gauss-Legendre, every panel smoothstep-mapped, float64 th
   90 degrees), so that the wide-angle tail (tiny D mass, but V and H vary there on their own, α-free, scale)
   gets as many nodes as the peak; the panel holding u_v is cut there (beyond it the facet no longer sees v
   for every φ_m). The cut points u_k = r / (1 + r), r = 16^k, do not depend on α, only their number K does
-  (lutbake.tables.diffuse.fd_microfacet_for uses the same panels for the BRDF itself);
+  (lutbake.sampling.panels; lutbake.sampling.facets uses the same panels for the BRDF itself);
 - H: μ = n.l on four panels cut at sin θ_m (beyond it m.l > 0 for every φ_l), 2α and 16α (the shoulder of
   G2 ~ 2μ/α at grazing light and its slow approach to 1); in φ only the visible arc |φ| <= acos(-cot θ_m cot θ_l) (its
   ends are zeros of (m.x)+ T(m.x), no kink inside); the arc is symmetric, so 2 ∫_0^w.
@@ -32,72 +32,32 @@ view), and the error estimate re-integrates probe texels with every order + 8.
 from __future__ import annotations
 
 import functools
-import math
+from dataclasses import dataclass
 
 import numpy as np
 import warp as wp
 
-from ..sampling import points
-from ..terms import fresnel
-
-PI64 = wp.constant(wp.float64(math.pi))
-TAIL_RATIO = 4.0  # u panels end where tan(theta_m) = alpha * 4^k, k = 1 .. K (geometric in theta_m)
-TAIL_RATIO64 = wp.constant(wp.float64(TAIL_RATIO))
-TAIL_TAN = 4.0  # ... until tan(theta_m) >= 4 (76 degrees); the last panel runs to theta_m = 90 degrees
-MAX_TAIL_CUTS = 16
-TAIL_TAN64 = wp.constant(wp.float64(TAIL_TAN))
-
-
-@wp.func
-def n_tail_cuts(alpha: wp.float64):
-    k = int(wp.ceil(wp.log(TAIL_TAN64 / alpha) / wp.log(TAIL_RATIO64)))
-    return wp.clamp(k, 1, MAX_TAIL_CUTS)
-
-
-@wp.func
-def T_pow5(c: wp.float64, f0: wp.float64):
-    """1 - (1 - c)^5: the transmission shape of Eq. 6 and of 1 - F_Schlick (its f0 factor is in c(f0))."""
-    m = wp.float64(1.0) - c
-    m2 = m * m
-    return wp.float64(1.0) - m2 * m2 * m
-
-
-@wp.func
-def T_dielectric_f0(c: wp.float64, f0: wp.float64):
-    """1 - F(f0, c) with F the exact dielectric Fresnel of Eq. 2 (evaluated in float32, as the terms)."""
-    return wp.float64(1.0) - wp.float64(fresnel.F_dielectric_f0(float(f0), float(c)))
-
-
-# facet form -> (transmission T(c, f0), the f0 factor c(f0) as a Python function)
-FACET_SPLIT = {
-    "eq6": (T_pow5, lambda f0: 1.05 * (1.0 - f0)),
-    "schlick": (T_pow5, lambda f0: (1.0 - f0) ** 2),
-    "dielectric_f0": (T_dielectric_f0, lambda f0: 1.0),
-}
-
-
-@wp.func
-def lambda_ggx64(c: wp.float64, alpha: wp.float64):
-    c2 = c * c
-    return wp.float64(0.5) * (wp.sqrt(c2 + alpha * alpha * (wp.float64(1.0) - c2)) / c - wp.float64(1.0))
-
-
-@wp.func
-def half_arc(cos_m: wp.float64, sin_m: wp.float64, cos_x: wp.float64, sin_x: wp.float64):
-    den = sin_m * sin_x
-    num = -cos_m * cos_x
-    if den <= wp.abs(num):
-        if num <= wp.float64(0.0):
-            return PI64
-        return wp.float64(0.0)
-    return wp.acos(wp.clamp(num / den, wp.float64(-1.0), wp.float64(1.0)))
+from ..terms.masking import Lambda_ggx64
+from . import points
+from .panels import (
+    MAX_TAIL_CUTS,
+    PI64,
+    TAIL_RATIO,
+    TAIL_RATIO64,
+    arc_half_width,
+    facet_cos_sin,
+    interval,
+    n_tail_cuts,
+    n_tail_cuts_np,
+    sort4,
+)
 
 
 @functools.lru_cache(maxsize=None)
-def albedo_kernel_for(facet_fresnel: str):
-    """Kernel: E(nov[i]) / c(f0) for alpha[i], f0[i]. rule[i] = (n_u, n_μ, n_φ), the texel's GL orders for u,
-    μ = n.l and the arcs: row n of xs, ws (``rules``) is the n-point rule on [0, 1], ns[n] = n."""
-    T = FACET_SPLIT[facet_fresnel][0]
+def swapped_kernel(T):
+    """Kernel: E(nov[i]) / c(f0) for alpha[i], f0[i] and the facet transmission ``T(c, f0)`` (float64;
+    lutbake.terms.diffuse.T_*). rule[i] = (n_u, n_μ, n_φ), the texel's GL orders for u, μ = n.l and the arcs:
+    row n of xs, ws (``rules``) is the n-point rule on [0, 1], ns[n] = n."""
 
     @wp.func
     def arc_integral(
@@ -112,7 +72,7 @@ def albedo_kernel_for(facet_fresnel: str):
         n: int,
     ):
         """∫ (m.x)+ T(m.x) dφ over the arc where m.x > 0 (2 ∫_0^w, the arc being symmetric)."""
-        w = half_arc(cm, sm, cx, sx)
+        w = arc_half_width(cm, sm, cx, sx)
         acc = wp.float64(0.0)
         if w > wp.float64(0.0):
             for j in range(n):
@@ -153,7 +113,7 @@ def albedo_kernel_for(facet_fresnel: str):
         nm = ns[rm]
         npp = ns[rp]
         sv = wp.sqrt(wp.max(one - cv * cv, zero))
-        lam_v = lambda_ggx64(cv, a)
+        lam_v = Lambda_ggx64(cv, a)
         den_v = a * a * (one - cv * cv) + cv * cv
         u_v = cv * cv / den_v
         om_v = a * a * (one - cv * cv) / den_v  # 1 - u_v without cancellation
@@ -172,10 +132,8 @@ def albedo_kernel_for(facet_fresnel: str):
             for h in range(2):
                 lo = prev
                 om_lo = om_prev
-                hi = cut
                 om_hi = om_cut
                 if split and h == 0:
-                    hi = u_v
                     om_hi = om_v
                 if split and h == 1:
                     lo = u_v
@@ -184,50 +142,31 @@ def albedo_kernel_for(facet_fresnel: str):
                 if (h == 0 or split) and du > zero:
                     for q in range(nu):
                         s = xs[ru, q]
-                        u = lo + du * s * s * (wp.float64(3.0) - wp.float64(2.0) * s)
                         wu = ws[ru, q] * du * wp.float64(6.0) * s * (one - s)
-                        omu = om_hi + du * (one - s) * (one - s) * (one + wp.float64(2.0) * s)  # 1 - u
-                        tan2 = a * a * u / omu
-                        cm = one / wp.sqrt(one + tan2)
-                        sm = wp.sqrt(tan2) * cm
+                        csm = facet_cos_sin(lo, du, om_hi, s, a)
+                        cm = csm[0]
+                        sm = csm[1]
                         V = arc_integral(cm, sm, cv, sv, ff, xs, ws, rp, npp)
                         if V > zero:
                             # H(theta_m): mu = n.l on four panels cut at sin(theta_m), 2 alpha and 16 alpha (sorted)
-                            c1 = wp.min(sm, one)
-                            c2 = wp.min(wp.float64(2.0) * a, one)
-                            c3 = wp.min(wp.float64(16.0) * a, one)
-                            if c1 > c2:
-                                t0 = c1
-                                c1 = c2
-                                c2 = t0
-                            if c2 > c3:
-                                t0 = c2
-                                c2 = c3
-                                c3 = t0
-                            if c1 > c2:
-                                t0 = c1
-                                c1 = c2
-                                c2 = t0
+                            cuts = sort4(
+                                zero,
+                                wp.min(sm, one),
+                                wp.min(wp.float64(2.0) * a, one),
+                                wp.min(wp.float64(16.0) * a, one),
+                            )
                             H = zero
                             for pm in range(4):
-                                mlo = zero
-                                mhi = c1
-                                if pm == 1:
-                                    mlo = c1
-                                    mhi = c2
-                                if pm == 2:
-                                    mlo = c2
-                                    mhi = c3
-                                if pm == 3:
-                                    mlo = c3
-                                    mhi = one
+                                ends = interval(pm, cuts, one)
+                                mlo = ends[0]
+                                mhi = ends[1]
                                 if mhi > mlo:
                                     for q in range(nm):
                                         t = xs[rm, q]
                                         mu = smooth(mlo, mhi, t)
                                         wmu = ws[rm, q] * smooth_w(mlo, mhi, t)
                                         sl = wp.sqrt(wp.max(one - mu * mu, zero))
-                                        g2 = one / (one + lam_v + lambda_ggx64(mu, a))
+                                        g2 = one / (one + lam_v + Lambda_ggx64(mu, a))
                                         H = H + wmu * g2 * arc_integral(cm, sm, mu, sl, ff, xs, ws, rp, npp)
                             acc = acc + wu * V * H / cm
             prev = cut
@@ -266,16 +205,11 @@ def orders_for(nov: np.ndarray, alpha: np.ndarray, base: int) -> np.ndarray:
     return np.minimum(o, MAX_ORDER)
 
 
-def albedo(
-    nov,
-    alpha,
-    f0=0.0,
-    facet_fresnel: str = "eq6",
-    order: int = 12,
-    orders: np.ndarray | None = None,
-    device: str = "cpu",
+def integrate_swapped(
+    integrand, nov, alpha, f0=0.0, order: int = 12, orders: np.ndarray | None = None, device: str = "cpu"
 ) -> np.ndarray:
-    """E(nov_i) for GGX alpha_i and f0 (rho = 1), float64 (N,). ``orders``: (N, 3) per texel (u, μ, φ);
+    """E(nov_i) for GGX alpha_i and f0 (rho = 1) of the microfacet diffuse ``integrand`` (its ``transmission``
+    T and factor c(f0): lutbake.integrands.diffuse), float64 (N,). ``orders``: (N, 3) per texel (u, μ, φ);
     omitted: ``orders_for(nov, alpha, order)``."""
     nov = np.ascontiguousarray(nov, dtype=np.float64).reshape(-1)
     n = len(nov)
@@ -286,7 +220,7 @@ def albedo(
     orders = np.ascontiguousarray(np.minimum(orders, MAX_ORDER), dtype=np.int32)
     out = wp.zeros((n, 1), dtype=wp.float64, device=device)
     wp.launch(
-        albedo_kernel_for(facet_fresnel),
+        swapped_kernel(integrand.transmission),
         dim=n,
         inputs=[
             wp.array(nov, dtype=wp.float64, device=device),
@@ -298,14 +232,14 @@ def albedo(
         ],
         device=device,
     )
-    c = FACET_SPLIT[facet_fresnel][1]
+    c = integrand.f0_scale
     return out.numpy()[:, 0] * np.array([c(x) for x in f0a]) if n else np.zeros(0)
 
 
 def u_panels(nov: np.ndarray, alpha: np.ndarray) -> np.ndarray:
     """u panels per texel: K + 1 geometric ones (n_tail_cuts), one more where u_v falls inside one."""
     alpha = np.asarray(alpha, np.float64)
-    k = np.clip(np.ceil(np.log(TAIL_TAN / alpha) / np.log(TAIL_RATIO)), 1, MAX_TAIL_CUTS).astype(int)
+    k = n_tail_cuts_np(alpha)
     c = np.asarray(nov, np.float64)
     u_v = c * c / (alpha * alpha * (1 - c * c) + c * c)
     r2 = TAIL_RATIO ** (2.0 * np.arange(1, MAX_TAIL_CUTS + 1))
@@ -327,52 +261,29 @@ def evaluations(orders: np.ndarray, nov: np.ndarray, alpha: np.ndarray) -> np.nd
 ESTIMATE_EXTRA_ORDER = 8  # the error estimate re-integrates probe texels with every order + 8
 
 
-def probe_indices(nov: np.ndarray, alpha: np.ndarray, budget: int = 256) -> np.ndarray:
-    """Strided texels plus the hardest ones (smallest alpha at the most grazing views)."""
-    n = len(nov)
-    strided = np.arange(0, n, max(1, n // budget))
-    hard = np.lexsort((alpha, nov))[: min(n, 64)]  # most grazing first, then smallest alpha
-    small = np.lexsort((nov, alpha))[: min(n, 64)]
-    return np.unique(np.concatenate([strided, hard, small]))
+@dataclass(frozen=True)
+class SwappedGaussLegendre:
+    """The microfacet diffuse albedo by the swapped integral (module docstring) at base order ``order`` (per-texel
+    orders: ``orders_for``; ``extra`` is added to every order). Inputs: nov, alpha, f0."""
 
+    order: int = 12
+    extra: int = 0
+    name: str = "gauss_legendre_swapped"
 
-def microfacet_albedo_plan(
-    *, nov: np.ndarray, alpha: np.ndarray, f0: np.ndarray, facet_fresnel: str, order: int, **plan_fields
-):
-    """Plan of a table whose texel i is E(nov[i], alpha[i], f0[i]) of the microfacet model (one channel),
-    with per-texel orders (orders_for) and an error estimate from re-integrating probe texels at orders + 8."""
-    from .base import Plan
+    def _orders(self, inputs: dict) -> np.ndarray:
+        return orders_for(inputs["nov"], inputs["alpha"], self.order) + self.extra
 
-    orders = orders_for(nov, alpha, order)
-    nov = nov.astype(np.float64)
-    alpha = alpha.astype(np.float64)
-    f0 = f0.astype(np.float64)
-    evals = evaluations(orders, nov, alpha)
+    def samples(self, inputs: dict) -> np.ndarray:
+        nov, alpha = (np.asarray(inputs[k], np.float64) for k in ("nov", "alpha"))
+        return evaluations(self._orders(inputs), nov, alpha)
 
-    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
-        return albedo(
-            nov[start:stop], alpha[start:stop], f0[start:stop], facet_fresnel, orders=orders[start:stop], device=device
-        )[:, None]
+    def prepare(self, integrand, device: str) -> None:
+        wp.load_module(swapped_kernel(integrand.transmission).module, device=device)
 
-    def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
-        idx = probe_indices(nov, alpha)
-        other = albedo(
-            nov[idx], alpha[idx], f0[idx], facet_fresnel, orders=orders[idx] + ESTIMATE_EXTRA_ORDER, device=device
-        )
-        err = float(np.max(np.abs(data.reshape(len(nov), -1)[idx, 0] - other)))
-        return err, (
-            f"max |orders (n_u, n_mu, n_phi) - orders + {ESTIMATE_EXTRA_ORDER}| over {len(idx)} probe texels "
-            "(strided + most grazing NoV + smallest alpha)"
-        )
+    def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
+        nov, alpha, f0 = (np.asarray(inputs[k], np.float64) for k in ("nov", "alpha", "f0"))
+        return integrate_swapped(integrand, nov, alpha, f0, orders=self._orders(inputs), device=device)[:, None]
 
-    return Plan(
-        n_texels=len(nov),
-        n_channels=1,
-        run_tile=run_tile,
-        prepare=lambda d: wp.load_module(albedo_kernel_for(facet_fresnel).module, device=d),
-        samples=int(round(evals.mean())),
-        estimator="gauss_legendre_swapped",
-        cost=float(evals.sum()),
-        error_estimate=error_estimate,
-        **plan_fields,
-    )
+    def refined(self):
+        e = self.extra + ESTIMATE_EXTRA_ORDER
+        return SwappedGaussLegendre(self.order, e), f"orders (n_u, n_mu, n_phi) - orders + {e}"

@@ -13,7 +13,8 @@ Axes, by default: x (columns) = NoV, y (rows) = roughness; image row 0 is the fi
 (smoothest). The engine conventions are explicit keys: ``axis_order`` (which quantity is x),
 ``row_order`` (image row 0 = t near 0 or near 1), ``nov_mapping`` / ``roughness_mapping`` (how t maps to
 the value) and ``nov_clamp`` (lutbake.axes).
-The integral and its estimators are derived in lutbake.sampling.estimators.
+Integrand: lutbake.integrands.specular (SpecularIntegrand); estimators: lutbake.sampling.hemisphere, where the
+integral is derived.
 """
 
 from __future__ import annotations
@@ -23,13 +24,14 @@ import re
 import numpy as np
 
 from ..axes import MAPPINGS, ORDERS, ROUGHNESS_PARAMS, TEXELS, Axis
-from ..io.formats import FORMATS
-from ..terms.sets import MASKINGS, MODELS, NDFS, model_terms, pair_allowed
-from . import engine_layouts, specular
-from .base import Key, Kind, Plan
-
-MAX_SAMPLES = 1 << 24  # per texel; beyond this a point set alone needs > 128 MiB and a table takes days
-MAX_SEED = (1 << 64) - 1
+from ..edge import alpha_policy
+from ..integrands import engine_diffuse
+from ..integrands.specular import N_CHANNELS as SPECULAR_CHANNELS
+from ..integrands.specular import SHEEN_LAYOUTS, SPECULAR_MODELS, model_terms, specular_integrand
+from ..sampling.hemisphere import ESTIMATORS, estimator_for
+from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..terms.distributions import MASKINGS, NDFS
+from .base import Estimation, Key, declare
 
 LAYOUTS = {
     "scale_bias": "R = scale, G = bias: E = f0 * R + G (Karis 2013)",
@@ -38,12 +40,12 @@ LAYOUTS = {
     "multiscatter_cloth": "multiscatter + B = ∫ D_charlie V_ashikhmin (n.l): cloth DV (Filament --ibl-dfg-cloth)",
     "charlie": "sheen lobe alone: R = G = 0, B = ∫ D_charlie V_ashikhmin (n.l): the glTF Sample Viewer's lut_charlie "
     "(KHR_materials_sheen IBL; gauss_legendre only)",
-    "sheen_albedo": "sheen lobe alone: R = E = ∫ D_charlie V_charlie (n.l) (KHR_materials_sheen albedo scaling, Charlie "
-    "visibility), G = the same with V_ashikhmin (gauss_legendre only)",
+    "sheen_albedo": "sheen lobe alone: R = E = ∫ D_charlie V_charlie (n.l) (KHR_materials_sheen albedo scaling, "
+    "Charlie visibility), G = the same with V_ashikhmin (gauss_legendre only)",
     "charlie_clamped": "charlie with V_ashikhmin clamped to [0, 1]: the glTF Sample Viewer's LUT() integrand exactly",
-    "sheen_albedo_clamped": "sheen_albedo with each V clamped to [0, 1], as the glTF Sample Viewer's V_Sheen / V_Ashikhmin",
+    "sheen_albedo_clamped": "sheen_albedo with each V clamped to [0, 1], as the glTF Sample Viewer's V_Sheen / "
+    "V_Ashikhmin",
 }
-SHEEN_LAYOUTS = specular.SHEEN_LAYOUTS
 CHANNELS = {
     "scale_bias": {
         "scale": "∫ f/F (1 - (1 - v.h)^5) (n.l) dω_l: multiplies f0",
@@ -83,8 +85,9 @@ CHANNELS["sheen_albedo_clamped"] = {
 RECONSTRUCTION = {
     "scale_bias": "uv = vec2(NoV, roughness) (texel centres per lutbake:axes); t = texture(lut, uv).rg; "
     "specular = prefiltered * (f0 * t.r + t.g)",
-    "multiscatter": "uv = vec2(NoV, roughness); t = texture(lut, uv).rg; E = mix(t.r, t.g, f0) = (1 - f0) t.r + f0 t.g; "
-    "specular = prefiltered * E; energy compensation = 1 + f0 (1 / t.g - 1)",
+    "multiscatter": "uv = vec2(NoV, roughness); t = texture(lut, uv).rg; "
+    "E = mix(t.r, t.g, f0) = (1 - f0) t.r + f0 t.g; specular = prefiltered * E; "
+    "energy compensation = 1 + f0 (1 / t.g - 1)",
 }
 RECONSTRUCTION["scale_bias_f82"] = (
     RECONSTRUCTION["scale_bias"] + "; F82 tint (Blender EEVEE): b = mix(f0, 1, (6/7)^5) * 7/(6/7)^6 * (1 - f82_tint), "
@@ -104,10 +107,10 @@ RECONSTRUCTION["sheen_albedo"] = (
 )
 RECONSTRUCTION["charlie_clamped"] = RECONSTRUCTION["charlie"]
 RECONSTRUCTION["sheen_albedo_clamped"] = RECONSTRUCTION["sheen_albedo"]
-N_CHANNELS = {**specular.N_CHANNELS, **{k: 3 for k in engine_layouts.LAYOUTS}}
-LAYOUTS.update(engine_layouts.LAYOUTS)
-CHANNELS.update(engine_layouts.CHANNELS)
-RECONSTRUCTION.update(engine_layouts.RECONSTRUCTION)
+N_CHANNELS = {**SPECULAR_CHANNELS, **{k: 3 for k in engine_diffuse.LAYOUTS}}
+LAYOUTS.update(engine_diffuse.LAYOUTS)
+CHANNELS.update(engine_diffuse.CHANNELS)
+RECONSTRUCTION.update(engine_diffuse.RECONSTRUCTION)
 AXIS_ORDERS = {
     "nov_x": "columns (x) = NoV, rows (y) = roughness: sample at vec2(NoV, roughness) (Filament, glTF, UE4)",
     "roughness_x": "columns (x) = roughness, rows (y) = NoV: sample at vec2(roughness, NoV-coordinate) (Blender EEVEE)",
@@ -115,31 +118,7 @@ AXIS_ORDERS = {
 NOV_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "one_minus_t2", "square")}
 ROUGHNESS_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "texel_offset")}
 
-COMMON_KEYS = {
-    "name": Key(
-        "name",
-        "name",
-        None,
-        "output stem: <out-dir>/<name>.<ext> (ext per format); letters, digits, - and _ only",
-        required=True,
-    ),
-    "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
-    "samples": Key(
-        "samples",
-        "int",
-        None,
-        "integrand evaluations per texel; omitted: the estimator's default quality",
-        minimum=1,
-        maximum=MAX_SAMPLES,
-    ),
-    "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}),
-    "estimator": Key("estimator", "str", "gauss_legendre", "how the integral is estimated", specular.ESTIMATORS),
-    "seed": Key("seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0, maximum=MAX_SEED),
-    "format": Key("format", "str", "exr", "output file format: <out-dir>/<name>.<ext>", FORMATS),
-}
-
 KEYS = {
-    **COMMON_KEYS,
     "size": Key("size", "int_pair", [128, 128], "[NoV, roughness] texel counts", minimum=1),
     "roughness": Key("roughness", "str", "perceptual", "what the roughness axis holds", ROUGHNESS_PARAMS),
     "ndf": Key("ndf", "str", "ggx", "normal distribution function", {k: v.description for k, v in NDFS.items()}),
@@ -149,7 +128,7 @@ KEYS = {
         "str",
         "microfacet",
         "the BRDF's term set (lecture 003); other than microfacet, it fixes ndf and masking (leave them unset)",
-        MODELS,
+        SPECULAR_MODELS,
     ),
     "layout": Key("layout", "str", "scale_bias", "channel layout", LAYOUTS),
     "texel": Key("texel", "str", "center", "texel convention of both axes", TEXELS),
@@ -183,9 +162,9 @@ def check_spec(spec) -> tuple[str, str] | None:
             f"(got ndf = {o['ndf']!r}, masking = {o['masking']!r})",
         )
     form, nd, mk = terms_of(o)
-    if form == "microfacet" and not pair_allowed(nd, mk):
+    if form == "microfacet" and not NDFS[nd].masking_allowed(mk):
         return ("masking", f"ndf {nd!r} has no Smith Lambda: use masking = 'v_cavity' with it, not {mk!r}")
-    if o["estimator"] == "sobol_vndf" and NDFS[nd].vndf is None:
+    if o["estimator"] == "sobol_vndf" and NDFS[nd].sample_vndf is None:
         return (
             "estimator",
             f"'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not ndf = {nd!r}"
@@ -216,7 +195,7 @@ def check_spec(spec) -> tuple[str, str] | None:
 
 
 def terms_of(o: dict) -> tuple[str, str, str]:
-    """(integrand form, ndf, masking) of a spec's options (lutbake.terms.sets.model_terms)."""
+    """(integrand form, ndf, masking) of a spec's options (lutbake.integrands.specular.model_terms)."""
     return model_terms(o.get("model", "microfacet"), o["ndf"], o["masking"])
 
 
@@ -286,12 +265,30 @@ def texel_grid(axes: list[Axis]) -> tuple[np.ndarray, np.ndarray]:
     return np.repeat(y_axis.values(), x_axis.count), np.tile(x_axis.alpha(), y_axis.count)
 
 
-def plan(spec) -> Plan:
+def grid_for(axes: list[Axis], integrand, param=None, repeat: int = 1) -> Grid:
+    """The texels of a [(z,) y, x] specular table: (NoV, alpha) of the [y, x] grid (either axis order), row-major,
+    tiled ``repeat`` times (z slowest), and the per-texel ``param`` (f0 of specular_3d; 0 otherwise)."""
+    nov, alpha = (np.tile(x, repeat) for x in texel_grid(axes[-2:]))
+    param = np.zeros(len(nov), np.float32) if param is None else param
+    return Grid(
+        axes,
+        {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": param},
+        grazing=nov,
+        alpha=alpha.astype(np.float64),
+    )
+
+
+def specular_extra(integrand) -> dict[str, str]:
+    return {"alpha_policy": alpha_policy(integrand.mirror is not None)}
+
+
+def plan(spec) -> TexelPlan:
     o = spec.options
     axes = axes_for(o)
-    nov, alpha = texel_grid(axes)
     form, nd, mk = terms_of(o)
-    nch = N_CHANNELS[o["layout"]]
+    base = engine_diffuse.BASE_LAYOUT.get(o["layout"], o["layout"])  # the specular integrand's layout
+    nch = N_CHANNELS[base]
+    integrand = specular_integrand(nd, mk, base, form, nch)
     cloth = {"cloth": "D_charlie + V_ashikhmin"} if o["layout"] == "multiscatter_cloth" else {}
     terms = {**terms_record(o, "schlick"), "layout": o["layout"], **cloth}
     if o["layout"] in SHEEN_LAYOUTS:
@@ -308,34 +305,24 @@ def plan(spec) -> Plan:
             "layout": o["layout"],
             "gauss_legendre_panels": "the GGX CDF in theta_h (panelling only; the integrand is the sheen lobe)",
         }
-    base = engine_layouts.BASE_LAYOUT.get(o["layout"], o["layout"])
     if base != o["layout"]:
-        nch = N_CHANNELS[base]
         terms["diffuse"] = "disney (Burley 2012, HDRP DisneyDiffuseNoPI / 1.03571), minus 0.5"
-    plan = specular.hemisphere_plan(
-        key=(nd, mk, base, o["estimator"], form),
-        nov=nov,
-        alpha=alpha,
-        param=None,
-        samples=o["samples"],
-        seed=o["seed"],
-        nch=nch,
-        kernel_channels=3 if base in SHEEN_LAYOUTS else nch,
-        axes=axes,
+    plan = per_texel_plan(
+        integrand,
+        estimator_for(o["estimator"], o["samples"], o["seed"]),
+        grid_for(axes, integrand),
         channels=CHANNELS[o["layout"]],
         reconstruction=reconstruction(o["layout"], axes),
         terms=terms,
+        extra=specular_extra(integrand),
     )
     if base != o["layout"]:
-        plan = engine_layouts.with_diffuse_channel(plan, nov, engine_layouts.perceptual_roughness_grid(axes))
+        nov = texel_grid(axes)[0]
+        plan = engine_diffuse.with_diffuse_channel(plan, nov, engine_diffuse.perceptual_roughness_grid(axes))
     return plan
 
 
-DFG = Kind(
-    "dfg",
-    "split-sum specular DFG: NoV x roughness, scale/bias or multiscatter (Σ Fc·V, Σ V) channels",
-    KEYS,
-    plan,
-    aliases=("split_sum",),
-    check=check_spec,
-)
+SAMPLES_DOC = "integrand evaluations per texel; omitted: the estimator's default quality"
+SPECULAR_ESTIMATION = Estimation(ESTIMATORS, "gauss_legendre", SAMPLES_DOC)
+DESCRIPTION = "split-sum specular DFG: NoV x roughness, scale/bias or multiscatter (Σ Fc·V, Σ V) channels"
+DFG = declare("dfg", DESCRIPTION, KEYS, plan, SPECULAR_ESTIMATION, aliases=("split_sum",), check=check_spec)

@@ -1,20 +1,27 @@
-"""Table kinds: a registry with aliases and a validating lookup (``lutbake list`` prints it)."""
+"""Table kinds: declarations, a registry with aliases and a validating lookup (``lutbake list`` prints it).
+
+Every kind is one module here that declares its keys, axes, channels and reconstruction text and names its
+integrand (lutbake.integrands) and estimator (lutbake.sampling); ``base.declare`` adds the keys every kind has
+(name, kind, format, dtype, seed, samples, estimator). The texel cap is config.MAX_TEXELS, for every kind.
+"""
 
 from __future__ import annotations
 
-from .base import Kind
 from .albedo import ALBEDO, ALBEDO_AVG
-from .dfg import DFG
-from .specular3d import SPECULAR_3D
-from .diffuse import DIFFUSE
-from .aniso import SPECULAR_ANISO
-from .diffuse3d import DIFFUSE_3D
+from .base import Key, Kind
 from .btf import BTF
+from .dfg import DFG
+from .diffuse import DIFFUSE
+from .diffuse_3d import DIFFUSE_3D
+from .specular_3d import SPECULAR_3D
+from .specular_aniso import SPECULAR_ANISO
 
 KINDS: dict[str, Kind] = {
     k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D, SPECULAR_ANISO, DIFFUSE, DIFFUSE_3D, BTF)
 }
 ALIASES: dict[str, str] = {alias: k.name for k in KINDS.values() for alias in k.aliases}
+
+__all__ = ["ALIASES", "KINDS", "Key", "Kind", "lookup_kind"]
 
 
 def lookup_kind(name: str) -> Kind:

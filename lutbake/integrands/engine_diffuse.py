@@ -1,6 +1,6 @@
 """dfg layouts that add an engine's pre-integrated diffuse term as channel B (Unity HDRP PreIntegratedFGD).
 
-``multiscatter_disney``: R = ∫ f/F Fc (n.l), G = ∫ f/F (n.l) (the multiscatter layout, lutbake.tables.dfg), and
+``multiscatter_disney``: R = ∫ f/F Fc (n.l), G = ∫ f/F (n.l) (the multiscatter layout, lutbake.kinds.dfg), and
     B = (1/pi) ∫ Fd_disney_hdrp(n.v, n.l, l.v, r) (n.l) dω_l - 0.5
 the Disney diffuse FGD that HDRP stores shifted by -0.5 (its shader adds 0.5 back: diffuseFGD = preFGD.z + 0.5;
 preIntegratedFGD_GGXDisneyDiffuse.shader, PreIntegratedFGD.hlsl). r is the perceptual roughness, alpha = r^2.
@@ -19,13 +19,14 @@ import functools
 import numpy as np
 import warp as wp
 
+from ..sampling.plan import TexelPlan
 from ..terms.engine_diffuse import Fd_disney_hdrp
-from .base import Plan
 
 DIFFUSE_ORDER = 24  # Gauss-Legendre nodes per dimension (mu, phi)
 HDRP_DIFFUSE_OFFSET = 0.5  # HDRP stores the Disney FGD minus 0.5 (range [0.5, 1.5] -> [0, 1] for its UNORM target)
 LAYOUTS = {
-    "multiscatter_disney": "multiscatter + B = (1/pi) ∫ Fd_disney (n.l) dω - 0.5: Unity HDRP PreIntegratedFGD_GGXDisneyDiffuse",
+    "multiscatter_disney": "multiscatter + B = (1/pi) ∫ Fd_disney (n.l) dω - 0.5: Unity HDRP "
+    "PreIntegratedFGD_GGXDisneyDiffuse",
 }
 CHANNELS = {
     "multiscatter_disney": {
@@ -90,7 +91,7 @@ def disney_fgd(nov: np.ndarray, perceptual_roughness: np.ndarray, device: str = 
     return out.numpy()
 
 
-def with_diffuse_channel(plan: Plan, nov: np.ndarray, perceptual_roughness: np.ndarray) -> Plan:
+def with_diffuse_channel(plan: TexelPlan, nov: np.ndarray, perceptual_roughness: np.ndarray) -> TexelPlan:
     """The plan of the base layout with channel B = disney_fgd - HDRP_DIFFUSE_OFFSET appended (same tiles)."""
     base_tile = plan.run_tile
 

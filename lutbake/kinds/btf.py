@@ -1,6 +1,6 @@
 """Kind ``btf``: a diffuse BRDF of four scalars, f(θ_l, θ_v, φ; σ) (rho = 1, f0 baked), tabulated as one 3D block
 per σ slice: the seed's "BTF-like techniques" for the microfacet diffuse model (Eq. 4, integrated over m by
-lutbake.tables.diffuse.fd_microfacet_for) or any closed model (``model = "fitted"`` for Eq. 8, to diff the
+lutbake.sampling.facets) or any closed model (``model = "fitted"`` for Eq. 8, to diff the
 fit against the integral).
 
 Layout (one EXR, lutbake.io.exr): a multi-part file with one part per σ slice (z; σ of the slice in the
@@ -10,6 +10,8 @@ hold (φ, view) flattened: image row = iφ * N_v + i_v (the φ axis has dim ``y_
 - ``angles``: x = θ_l in [0, π/2], y = θ_v in [0, π/2], y_block = φ in [0, π] (radians).
 φ is the azimuth between l and v; f is even in φ, so [0, π] (cos φ in [-1, 1]) covers every pair.
 Reciprocity f(l, v) = f(v, l) makes every (φ, σ) block symmetric when the x and y grids agree (tested).
+Edge policy (lutbake.edge, the same on the light and the view axis): cosines >= NOV_MIN, angles <= acos(NOV_MIN),
+so the endpoint texel convention lists and integrates the same clamped value on both axes.
 """
 
 from __future__ import annotations
@@ -17,11 +19,15 @@ from __future__ import annotations
 import json
 
 import numpy as np
-import warp as wp
 
-from ..axes import TEXELS, Axis
-from . import diffuse, diffuse_albedo
-from .base import Key, Kind, Plan
+from ..axes import TEXELS, Axis, sigma_alpha
+from ..edge import effective_alpha
+from ..integrands.diffuse import DIFFUSE_MODELS, diffuse_integrand, f0_factor
+from ..sampling.diffuse import PointEvaluation, PointSobol
+from ..sampling.panels import n_tail_cuts_np
+from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from . import diffuse
+from .base import Estimation, Key, declare
 
 PARAMETRISATIONS = {
     "cosines": "x = NoL in [0, 1], y = NoV in [0, 1], row blocks = cos(phi) in [-1, 1]",
@@ -30,11 +36,8 @@ PARAMETRISATIONS = {
 DEFAULT_ORDER = 12  # GL order of the m-integral (docs/diffuse.md: measured relative errors on the 16 x 32^3 grid)
 GRAZING_COS = 0.15  # texels with n.l and n.v both below it get order + GRAZING_EXTRA
 GRAZING_EXTRA = 8
-ESTIMATE_EXTRA = 8  # the error estimate re-evaluates probe texels at their order + 8
 
 KEYS = {
-    "name": diffuse.KEYS["name"],
-    "kind": diffuse.KEYS["kind"],
     "size": Key("size", "int_pair", [32, 32], "[light, view] texel counts (columns, rows per phi block)", minimum=1),
     "phi_size": Key("phi_size", "int", 32, "azimuth texel count (row blocks)", minimum=1, maximum=4096),
     "sigma_size": Key("sigma_size", "int", 16, "sigma slice count (z, one EXR part each)", minimum=1, maximum=1024),
@@ -51,7 +54,7 @@ KEYS = {
     "parametrisation": Key(
         "parametrisation", "str", "cosines", "what the light, view and azimuth axes hold", PARAMETRISATIONS
     ),
-    "model": Key("model", "str", "microfacet", "the diffuse BRDF tabulated", diffuse.MODELS),
+    "model": Key("model", "str", "microfacet", "the diffuse BRDF tabulated", DIFFUSE_MODELS),
     "f0": Key(
         "f0",
         "float",
@@ -62,17 +65,6 @@ KEYS = {
     ),
     "sigma_to_alpha": diffuse.KEYS["sigma_to_alpha"],
     "facet_fresnel": diffuse.KEYS["facet_fresnel"],
-    "samples": Key(
-        "samples",
-        "int",
-        None,
-        "Gauss-Legendre order n of the m-integral (microfacet: up to "
-        "(K + 3) x 4 n^2 facet normals per texel, K the tan(theta_m) panels); omitted: 12; closed models "
-        "ignore it",
-        minimum=2,
-        maximum=64,
-    ),
-    "dtype": diffuse.KEYS["dtype"],
     "texel": Key("texel", "str", "center", "texel convention of every axis", TEXELS),
 }
 RECONSTRUCTION = (
@@ -87,11 +79,12 @@ RECONSTRUCTION = (
 def axes_for(o: dict) -> list[Axis]:
     nl, nv = o["size"]
     tx = o["texel"]
+    am = o["sigma_to_alpha"]
     if o["sigma_values"] is not None:
         vals = tuple(float(x) for x in o["sigma_values"])
-        sig = Axis("sigma", "z", len(vals), vals[0], vals[-1], texel=tx, mapping="listed", listed=vals)
+        sig = Axis("sigma", "z", len(vals), vals[0], vals[-1], texel=tx, mapping="listed", listed=vals, alpha_map=am)
     else:
-        sig = Axis("sigma", "z", o["sigma_size"], *o["sigma_range"], texel=tx)
+        sig = Axis("sigma", "z", o["sigma_size"], *o["sigma_range"], texel=tx, alpha_map=am)
     if o["parametrisation"] == "cosines":
         return [
             sig,
@@ -124,114 +117,102 @@ def directions(axes: list[Axis], parametrisation: str) -> tuple[np.ndarray, np.n
     return l, v, S.reshape(-1)
 
 
-def plan(spec) -> Plan:
+def texel_count(o: dict) -> int:
+    """size x phi_size x sigma_size (or the sigma_values count)"""
+    ns = o["sigma_size"] if o["sigma_values"] is None else len(o["sigma_values"])
+    return o["size"][0] * o["size"][1] * o["phi_size"] * ns
+
+
+DEFAULT_SOBOL = 4096
+MAX_GL_ORDER = 64
+
+
+def check_spec(spec) -> tuple[str, str] | None:
+    o = spec.options
+    if o["estimator"] == "sobol_ndf" and o["model"] != "microfacet":
+        return (
+            "estimator",
+            f"'sobol_ndf' samples the microfacet model's m-integral; model {o['model']!r} is closed "
+            "form (use 'gauss_legendre')",
+        )
+    if o["estimator"] == "gauss_legendre" and o["samples"] is not None and o["samples"] > MAX_GL_ORDER:
+        return ("samples", f"with estimator 'gauss_legendre' samples is the GL order: at most {MAX_GL_ORDER}")
+    return None
+
+
+SAMPLES_DOC = (
+    "gauss_legendre: the Gauss-Legendre order n of the m-integral (2 to 64; microfacet: up to (K + 3) x 4 n^2 "
+    "facet normals per texel, K the tan(theta_m) panels); omitted: 12; closed models ignore it. sobol_ndf: "
+    "the number of facet normals (default 4096)"
+)
+BTF_ESTIMATORS = {
+    "gauss_legendre": "the microfacet model's m-integral by Gauss-Legendre panels (lutbake.sampling.facets); closed "
+    "models are evaluated in closed form",
+    "sobol_ndf": "the microfacet model's m-integral by scrambled Sobol' facet normals from GGX's D(m)(n.m) "
+    "(samples = points, default 4096): a cross-check",
+}
+
+
+def plan(spec) -> TexelPlan:
     o = spec.options
     axes = axes_for(o)
     l, v, sigma = directions(axes, o["parametrisation"])
     model, ff = o["model"], o["facet_fresnel"]
-    order = o["samples"] or DEFAULT_ORDER
+    order = (o["samples"] if o["estimator"] == "gauss_legendre" else None) or DEFAULT_ORDER
     integrated = model == "microfacet"
-
     # texels with light and view both grazing hold the smallest values (f ~ 1e-5 in back-scattering): their
     # relative error converges last, so they get order + GRAZING_EXTRA (about 1 % of the texels)
     orders = np.where((l[:, 2] < GRAZING_COS) & (v[:, 2] < GRAZING_COS), order + GRAZING_EXTRA, order)
-
-    def run(idx, extra, device):
-        idx = np.arange(len(sigma))[idx]
-        out = np.empty((len(idx), 1))
-        for n in np.unique(orders[idx]):
-            sel = orders[idx] == n
-            out[sel, 0] = diffuse.eval_brdf(
-                model,
-                l[idx[sel]],
-                v[idx[sel]],
-                sigma[idx[sel]],
-                o["f0"],
-                ff,
-                o["sigma_to_alpha"],
-                int(n) + extra,
-                device=device,
-            )
-        return out
-
-    def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
-        n = len(sigma)
-        grazing = np.flatnonzero((l[:, 2] <= l[:, 2].min()) | (v[:, 2] <= v[:, 2].min()))
-        both = np.flatnonzero((l[:, 2] <= l[:, 2].min()) & (v[:, 2] <= v[:, 2].min()))
-        idx = np.unique(
-            np.concatenate([np.arange(0, n, max(1, n // 512)), grazing[:: max(1, len(grazing) // 128)], both])
-        )
-        ref = run(idx, ESTIMATE_EXTRA, device)[:, 0]
-        got = data.reshape(n, -1)[idx, 0]
-        ok = np.abs(ref) > 1e-6
-        rel = float(np.max(np.abs(got - ref)[ok] / np.abs(ref[ok]))) if ok.any() else 0.0
-        ab = float(np.max(np.abs(got - ref)))
-        return rel, (
-            f"max relative |orders - orders + {ESTIMATE_EXTRA}| / |orders + {ESTIMATE_EXTRA}| over "
-            f"{int(ok.sum())} probe texels (strided + most grazing light or view + both most grazing; "
-            f"|f| > 1e-6); max abs {ab:.3e}"
-        )
-
     sig_axis = axes[0]
+    alpha = sigma_alpha(sigma.astype(np.float32), o["sigma_to_alpha"])
+    grid = Grid(
+        axes,
+        {"l": l, "v": v, "sigma": sigma, "alpha": effective_alpha(alpha, False), "order": orders},
+        grazing=np.minimum(l[:, 2], v[:, 2]),
+        alpha=alpha,
+    )
     terms = {
         "model": model,
         "f0": str(o["f0"]),
-        "f0_factor": diffuse.f0_factor(model, ff),
+        "f0_factor": f0_factor(model, ff),
         "parametrisation": o["parametrisation"],
     }
     if integrated:
         terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff, sigma_to_alpha=o["sigma_to_alpha"])
     extra = {
-        "f0_factor": diffuse.f0_factor(model, ff),
+        "f0_factor": f0_factor(model, ff),
         "f0": repr(o["f0"]),
         "rho": "1",
         "parametrisation": o["parametrisation"],
         "layout": "part = sigma slice; row = phi_index * N_view + view_index; column = light_index",
         "sigma_values": json.dumps([float(s) for s in sig_axis.values()]),
-        "sigma_alpha": json.dumps([float(a) for a in diffuse.alpha_from_sigma(sig_axis.values(), o["sigma_to_alpha"])]),
+        **diffuse.sigma_record(sig_axis),
     }
     per = 1
     if integrated:  # at most (K + 3) u panels (K + 1 geometric ones, cut at u_l and u_v) x 4 arcs x n^2
-        a = diffuse.alpha_from_sigma(sig_axis.values(), o["sigma_to_alpha"]).astype(np.float64)
-        k = np.clip(
-            np.ceil(np.log(diffuse_albedo.TAIL_TAN / a) / np.log(diffuse_albedo.TAIL_RATIO)),
-            1,
-            diffuse_albedo.MAX_TAIL_CUTS,
-        )
-        per = int(round(float(np.mean(k + 3)) * 4 * order * order))
-    key = (model, ff)
-    return Plan(
-        axes=axes,
+        a = effective_alpha(sigma_alpha(sig_axis.values(), o["sigma_to_alpha"]), False)
+        per = int(round(float(np.mean(n_tail_cuts_np(a) + 3)) * 4 * order * order))
+    estimator = PointEvaluation(o["f0"], name="gauss_legendre" if integrated else "closed_form", evaluations=per)
+    if o["estimator"] == "sobol_ndf":
+        estimator = PointSobol(o["samples"] or DEFAULT_SOBOL, o["seed"], f0=o["f0"])
+    return per_texel_plan(
+        diffuse_integrand(model, ff),
+        estimator,
+        grid,
         channels={"f": "the BRDF f_r(l, v) for rho = 1 at the baked f0 (1/sr; radiance = f E0 (n.l))"},
         reconstruction=RECONSTRUCTION,
-        n_texels=len(sigma),
-        n_channels=1,
-        run_tile=lambda s, e, d: run(slice(s, e), 0, d),
-        prepare=lambda d: wp.load_module(diffuse.brdf_kernel_for(*key).module, device=d),
-        samples=per,
-        estimator="gauss_legendre" if integrated else "closed_form",
         terms=terms,
-        cost=float(len(sigma)) * per,
         extra=extra,
-        error_estimate=error_estimate if integrated else None,
+        relative_error=True,
+        error_estimate=integrated,
     )
 
 
-def check_spec(spec) -> str | None:
-    o = spec.options
-    ns = o["sigma_size"] if o["sigma_values"] is None else len(o["sigma_values"])
-    n = o["size"][0] * o["size"][1] * o["phi_size"] * ns
-    if n > 1 << 26:
-        return f"size x phi_size x sigma_size = {n} texels: at most {1 << 26}"
-    return None
-
-
-BTF = Kind(
-    "btf",
-    "the diffuse BRDF of four scalars as sigma slices of (light, view, azimuth) blocks (cosines or "
-    "angles), microfacet (Eq. 4 integrated) or fitted (Eq. 8) or any diffuse model",
-    KEYS,
-    plan,
-    aliases=("diffuse_btf",),
-    check=check_spec,
+DESCRIPTION = (
+    "the diffuse BRDF of four scalars as sigma slices of (light, view, azimuth) blocks (cosines or angles), "
+    "microfacet (Eq. 4 integrated) or fitted (Eq. 8) or any diffuse model"
+)
+ESTIMATION = Estimation(BTF_ESTIMATORS, "gauss_legendre", SAMPLES_DOC, samples_min=2)
+BTF = declare(
+    "btf", DESCRIPTION, KEYS, plan, ESTIMATION, aliases=("diffuse_btf",), check=check_spec, texels=texel_count
 )

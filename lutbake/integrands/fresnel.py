@@ -14,6 +14,7 @@ import functools
 import numpy as np
 import warp as wp
 
+from ..sampling.arrays import Floats
 from ..terms import fresnel as fr
 from ..terms.metals import LAZANYI_ALPHA
 
@@ -31,14 +32,7 @@ COLUMNS = tuple(FRESNELS)
 @functools.lru_cache(maxsize=None)
 def _kernel():
     @wp.kernel(enable_backward=False, module="unique")
-    def eval_fresnel(
-        f0: wp.array(dtype=float),
-        n: wp.array(dtype=float),
-        k: wp.array(dtype=float),
-        a: wp.array(dtype=float),
-        c: wp.array(dtype=float),
-        out: wp.array2d(dtype=float),
-    ):
+    def eval_fresnel(f0: Floats, n: Floats, k: Floats, a: Floats, c: Floats, out: wp.array2d(dtype=float)):
         i = wp.tid()
         out[i, 0] = fr.F_schlick(f0[i], c[i])
         out[i, 1] = fr.F_schlick_sg(f0[i], c[i])
