@@ -464,6 +464,13 @@ def audit(
         raise ValueError(f"metric {metric!r}: allowed {', '.join(METRICS)}")
     lut: LutFile = read_lut(path, shape=shape)
     rows, cols, fch = lut.data.shape
+    bad = ~np.isfinite(lut.data)
+    if bad.any():
+        r, c, ch = (int(x) for x in np.argwhere(bad)[0])
+        raise ValueError(
+            f"{path}: {int(bad.sum())} non-finite values (NaN/Inf), the first at row {r}, column {c}, "
+            f"channel {'RGBA'[ch] if ch < 4 else ch}: a LUT must hold finite values"
+        )
     conv = conventions(**(conv_args or {}), shape=(rows, cols))
     integ = Integrator(conv, workers)
     from .kinds.dfg import CHANNELS

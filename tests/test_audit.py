@@ -172,3 +172,16 @@ def test_unity_hdrp_table_audits_clean_and_its_sqrt_axis_flip_is_found(tmp_path)
     q = tmp_path / "hdrp_flipped.npy"
     np.save(q, table.data[:, ::-1])
     assert run(q, preset="unity-hdrp").extra["chosen"] == "columns_flipped"
+
+
+def test_cli_rejects_non_finite_values_and_undeclared_text_layouts(clean, tmp_path):
+    p = tmp_path / "nan.npy"
+    bad = clean.astype(np.float32).copy()
+    bad[3, 5, 1] = np.nan
+    np.save(p, bad)
+    res = CliRunner().invoke(main, ["audit", str(p)])
+    assert res.exit_code == 2 and "row 3, column 5, channel G" in res.output
+    js = tmp_path / "lut.js"
+    js.write_text("const DATA = new Uint16Array( [ 0x3c00, 0x0000 ] );\n")
+    res = CliRunner().invoke(main, ["audit", str(js)])
+    assert res.exit_code == 2 and "--shape" in res.output
