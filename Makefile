@@ -8,13 +8,15 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 OUT    ?= outputs
 CONFIGS := $(wildcard configs/*.toml)
-PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-eevee unreal unity-hdrp godot bevy threejs
+PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-eevee unreal blender-eevee-btdf blender-eevee-bsdf \
+           openpbr turquin ltc-ggx ltc-threejs ltc-eevee ltc-hdrp \
+           unity-hdrp godot bevy threejs
 SOURCES := $(shell find lutbake -name '*.py' -o -name '*.toml' 2>/dev/null)
 WORKERS ?=
 FORCE   ?=
 LUTS_STAMP := $(OUT)/.luts.stamp
 
-.PHONY: lint luts test validate bench clean venv help force-luts figures bench-diffuse
+.PHONY: lint luts test validate bench clean venv help force-luts figures bench-diffuse bench-ltc
 
 help:
 	@echo "make luts | test | validate | clean"
@@ -64,3 +66,9 @@ clean:
 # every kind against converged references, C and numpy baselines: outputs/bench/report.json + accuracy_vs_time.png
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench.py
+	$(BIN)/python benchmarks/bench_dielectric.py
+	$(BIN)/python benchmarks/bench_ltc.py
+
+# LTC fits (kind ltc): fit time per lobe at 64^2, the straight-port baseline, area-light errors: outputs/bench/ltc.json
+bench-ltc: $(STAMP)
+	$(BIN)/python benchmarks/bench_ltc.py

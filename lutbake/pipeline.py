@@ -32,6 +32,8 @@ def bake_table(
     if plan.error_estimate is not None:
         err, how = plan.error_estimate(data.reshape(plan.n_texels, plan.n_channels), device)
         extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)
+    if plan.attributes_after is not None:
+        extra.update(plan.attributes_after(data))
     table = Table(
         spec.name,
         spec.kind,

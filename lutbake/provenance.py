@@ -19,7 +19,7 @@ from .config import TableSpec
 
 PACKAGE = Path(__file__).parent
 # the modules whose source defines what a table holds (kernels, terms, estimators, kinds, axes, edge policy)
-HASH_SOURCES = ("terms/*.py", "integrands/*.py", "sampling/*.py", "kinds/*.py", "axes.py", "edge.py")
+HASH_SOURCES = ("terms/*.py", "integrands/*.py", "sampling/*.py", "kinds/*.py", "ltc/*.py", "axes.py", "edge.py")
 HASH_ATTRIBUTE = "content_hash"
 
 

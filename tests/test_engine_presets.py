@@ -11,7 +11,8 @@ REPO = Path(__file__).resolve().parents[1]
 
 def test_make_luts_batch_loads_with_unique_names():
     """configs/*.toml and the Makefile's PRESETS, as `make luts` passes them to one `lutbake bake`."""
-    line = next(x for x in (REPO / "Makefile").read_text().splitlines() if x.startswith("PRESETS ?="))
+    text = (REPO / "Makefile").read_text().replace("\\\n", " ")  # join continued lines
+    line = next(x for x in text.splitlines() if x.startswith("PRESETS ?="))
     names = line.split("?=", 1)[1].split()
     assert {"unity-hdrp", "godot", "bevy", "threejs"} <= set(names)
     specs = load_configs(sorted((REPO / "configs").glob("*.toml")) + [presets()[n] for n in names])

@@ -69,6 +69,9 @@ AGREEMENT = [
         "sobol_cosine",
         5.0e-3,
     ),
+    # LTC: magnitude / fresnel by GL panels vs Sobol' NDF sampling (16384 points), and the fits that depend on them
+    # through Heitz's metric: measured 2.0e-3 (magnitude at the grazing row), 1.6e-3 on the matrix coefficients
+    ("ltc", {"size": [4, 4], "samples": 16384}, "gauss_legendre", "sobol_ndf", 5.0e-3),
     # f itself (values 0.09 .. 0.6): the m-integral by GL panels vs Sobol' facet normals (measured 2.0e-3 at 65536)
     (
         "btf",
@@ -76,6 +79,21 @@ AGREEMENT = [
         "gauss_legendre",
         "sobol_ndf",
         AGREEMENT_TOL_ANISO,
+    ),
+    # the dielectric kinds: panelled GL split at every kink vs GGX visible-normal Sobol' (16384 points), eta both sides
+    (
+        "dielectric",
+        {"size": [4, 3], "ior_size": 2, "ior_range": [0.7, 1.5], "roughness_range": [0.3, 1.0]},
+        "gauss_legendre",
+        "sobol_vndf",
+        AGREEMENT_TOL_QMC,
+    ),
+    (
+        "dielectric_avg",
+        {"roughness_size": 3, "ior_size": 2, "ior_range": [0.7, 1.5], "roughness_range": [0.3, 1.0], "mu_order": 6},
+        "gauss_legendre",
+        "sobol_vndf",
+        AGREEMENT_TOL_QMC,
     ),
 ]
 
@@ -164,7 +182,7 @@ LAYERS = [
     {"io"},
     {"terms"},
     {"sampling"},
-    {"integrands"},
+    {"integrands", "ltc"},
     {"kinds"},
     {"config"},
     {"executor", "provenance"},

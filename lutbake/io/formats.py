@@ -32,9 +32,18 @@ FORMATS = {
     "dds": "DDS with DX10 header: R16G16_FLOAT / R32G32_FLOAT / RGBA16F / RGBA32F, 2D or 3D + .json sidecar",
     "ktx2": "KTX 2.0: VK_FORMAT_R16G16_SFLOAT / R32G32_SFLOAT / RGBA16/32, 2D or 3D, metadata in key/value data",
     "h": "C/C++ header: half-float bits (dtype half) or floats (float32), conventions in a comment block",
+    "openpbr_h": "OpenPBR's energy-table header: UNORM16 uint16_t arrays under its names (layout openpbr only)",
 }
 PNG_SLACK = 1.0e-3  # values this close outside [0, 1] are integration noise (e.g. E = 1 + 3e-5): clipped
-EXTENSIONS = {"exr": ".exr", "npy": ".npy", "png16": ".png", "dds": ".dds", "ktx2": ".ktx2", "h": ".h"}
+EXTENSIONS = {
+    "exr": ".exr",
+    "npy": ".npy",
+    "png16": ".png",
+    "dds": ".dds",
+    "ktx2": ".ktx2",
+    "h": ".h",
+    "openpbr_h": ".h",
+}
 
 
 def _sidecar(table: Table, path: Path, fmt: str, extra: dict | None = None) -> None:
@@ -223,6 +232,12 @@ def write_header(table: Table, path, dtype: str = "float32") -> Path:
     return path
 
 
+def write_openpbr(table: Table, path, dtype: str = "float32") -> Path:
+    from .openpbr import write_openpbr_header
+
+    return write_openpbr_header(table, path, dtype)
+
+
 WRITERS = {
     "exr": write_exr,
     "npy": write_npy,
@@ -230,7 +245,13 @@ WRITERS = {
     "dds": write_dds,
     "ktx2": write_ktx2,
     "h": write_header,
+    "openpbr_h": write_openpbr,
 }
+# the LTC engine layouts (kind ltc only): lutbake.io.ltc
+from . import ltc as _ltc_export  # noqa: E402
+
+WRITERS.update(_ltc_export.WRITERS)
+EXTENSIONS.update(_ltc_export.EXTENSIONS)
 
 
 def _register_code_arrays() -> None:

@@ -11,13 +11,28 @@ from .albedo import ALBEDO, ALBEDO_AVG
 from .base import Key, Kind
 from .btf import BTF
 from .dfg import DFG
+from .dielectric import DIELECTRIC, DIELECTRIC_AVG
 from .diffuse import DIFFUSE
 from .diffuse_3d import DIFFUSE_3D
+from .ltc import LTC
 from .specular_3d import SPECULAR_3D
 from .specular_aniso import SPECULAR_ANISO
 
 KINDS: dict[str, Kind] = {
-    k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D, SPECULAR_ANISO, DIFFUSE, DIFFUSE_3D, BTF)
+    k.name: k
+    for k in (
+        DFG,
+        ALBEDO,
+        ALBEDO_AVG,
+        SPECULAR_3D,
+        SPECULAR_ANISO,
+        DIFFUSE,
+        DIFFUSE_3D,
+        BTF,
+        DIELECTRIC,
+        DIELECTRIC_AVG,
+        LTC,
+    )
 }
 ALIASES: dict[str, str] = {alias: k.name for k in KINDS.values() for alias in k.aliases}
 

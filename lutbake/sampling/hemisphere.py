@@ -113,6 +113,64 @@ def horizon_scale(cos_v: wp.float64, alpha: wp.float64):
     return alpha * cos_v / wp.sqrt(cos_v * cos_v + alpha * alpha * (wp.float64(1.0) - cos_v * cos_v))
 
 
+@wp.func
+def texel_view(t: wp.vec3):
+    """A texel (n.v, alpha, param) unpacked: (v, alpha, param, alpha as float64, cos theta_v, sin theta_v,
+    horizon_scale, theta_a, theta_b, atan(alpha)), the last three the anchors of the Gauss-Legendre panels
+    (theta_a = (pi/2 - theta_v)/2: c* = -1; theta_b = pi/2 - theta_a: c* = +1; atan(alpha): the NDF peak)."""
+    v = view_dir(t[0])
+    a64 = wp.float64(t[1])
+    cos_v = wp.float64(v[2])
+    sin_v = wp.float64(v[0])
+    theta_a = wp.float64(0.5) * wp.atan2(cos_v, sin_v)
+    theta_b = PI64 * wp.float64(0.5) - theta_a
+    return v, t[1], t[2], a64, cos_v, sin_v, horizon_scale(cos_v, a64), theta_a, theta_b, wp.atan(a64)
+
+
+@functools.lru_cache(maxsize=None)
+def outer_variable_for(tan2_from_u, u_from_tan2):
+    """The outer variable of the Gauss-Legendre kernels: u = CDF(theta_h) on panels inside the NDF peak (``in_u``),
+    theta_h itself beyond. ``outer_range(t_lo, t_hi, in_u, alpha) -> (x_lo, dx)``; ``outer_node(x, w, in_u, alpha)
+    -> (cos theta_h, sin theta_h, w)`` with the theta_h weight times 2 pi sin(theta_h) (du = 2 pi D cos sin dtheta,
+    and g / p = g / (D cos))."""
+
+    @wp.func
+    def outer_range(t_lo: wp.float64, t_hi: wp.float64, in_u: bool, a64: wp.float64):
+        if in_u:
+            x_lo = u_from_tan2(wp.tan(t_lo) * wp.tan(t_lo), a64)
+            return x_lo, u_from_tan2(wp.tan(t_hi) * wp.tan(t_hi), a64) - x_lo
+        return t_lo, t_hi - t_lo
+
+    @wp.func
+    def outer_node(x: wp.float64, w: wp.float64, in_u: bool, a64: wp.float64):
+        if in_u:
+            tan2 = tan2_from_u(x, a64)
+            c = wp.float64(1.0) / wp.sqrt(wp.float64(1.0) + tan2)
+            return c, wp.sqrt(tan2) * c, w
+        sin_h = wp.sin(x)
+        return wp.cos(x), sin_h, w * wp.float64(2.0) * PI64 * sin_h
+
+    return outer_range, outer_node
+
+
+@functools.lru_cache(maxsize=None)
+def facet_weight_for(integrand, pdf):
+    """``facet_weight(v, h, alpha, param, in_u)``: g(h) / p(h) where the outer variable is the NDF's CDF u (D cancels;
+    0 where p = 0), g(h) where it is theta_h itself."""
+
+    @wp.func
+    def facet_weight(v: wp.vec3, h: wp.vec3, a: float, prm: float, in_u: bool):
+        g = integrand(v, h, a, prm)
+        if in_u:
+            p = pdf(v, h, a)
+            if p > 0.0:
+                return g / p
+            return g * 0.0
+        return g
+
+    return facet_weight
+
+
 def make_gauss_legendre(spec):
     """Product Gauss-Legendre over panels in theta_h (module docstring). Per panel [t_lo, t_hi]:
     - the outer variable is u = CDF(theta_h) on the NDF-peak panel [0, atan(alpha)] (the weight is
@@ -122,31 +180,20 @@ def make_gauss_legendre(spec):
       sinh map that resolves G2's pole at n.l = -horizon_scale next to the cut.
     Kernel inputs: per-texel (n.v, alpha, param); GL (node, weight) pairs on [0, 1] for the outer (rule_u) and
     inner (rule_p) variables. ``spec``: an integrand record (g, vec, acc, distribution, mirror)."""
-    integrand, vec_type, acc_type, mirror = spec.g, spec.vec, spec.acc, spec.mirror
-    pdf, tan2_from_u, u_from_tan2 = (
-        spec.distribution.pdf_ndf,
-        spec.distribution.tan2_from_u,
-        spec.distribution.u_from_tan2,
-    )
+    vec_type, acc_type, mirror = spec.vec, spec.acc, spec.mirror
+    outer_range, outer_node = outer_variable_for(spec.distribution.tan2_from_u, spec.distribution.u_from_tan2)
+    facet_weight = facet_weight_for(spec.g, spec.distribution.pdf_ndf)
     nch = vec_type._length_
     smooth = mirror is not None
 
     @wp.kernel(enable_backward=False, module="unique")
     def gauss_legendre_kernel(texel: wp.array(dtype=wp.vec3), rule_u: Rule, rule_p: Rule, out: Rows64):
         i = wp.tid()
-        a = texel[i][1]
-        prm = texel[i][2]
-        a64 = wp.float64(a)
-        v = view_dir(texel[i][0])
-        cos_v = wp.float64(v[2])
-        sin_v = wp.float64(v[0])
+        # theta_b: c* = +1, nothing beyond reflects above the horizon
+        v, a, prm, a64, cos_v, sin_v, eps_l, theta_a, theta_b, theta_peak = texel_view(texel[i])
         zero = wp.float64(0.0)
         one = wp.float64(1.0)
         two = wp.float64(2.0)
-        eps_l = horizon_scale(cos_v, a64)
-        theta_a = wp.float64(0.5) * wp.atan2(cos_v, sin_v)  # c* = -1: (pi/2 - theta_v) / 2
-        theta_b = PI64 * wp.float64(0.5) - theta_a  # c* = +1: nothing beyond reflects above the horizon
-        theta_peak = wp.atan(a64)
         acc = acc_type()
         t_lo = zero
         if wp.static(smooth):
@@ -156,12 +203,7 @@ def make_gauss_legendre(spec):
             t_hi = next_theta(t_lo, theta_a, theta_peak)
             in_b = t_lo >= theta_a
             in_u = t_hi <= theta_peak
-            x_lo = t_lo
-            x_hi = t_hi
-            if in_u:
-                x_lo = u_from_tan2(wp.tan(t_lo) * wp.tan(t_lo), a64)
-                x_hi = u_from_tan2(wp.tan(t_hi) * wp.tan(t_hi), a64)
-            dx = x_hi - x_lo
+            x_lo, dx = outer_range(t_lo, t_hi, in_u, a64)
             for k in range(rule_u.shape[0]):
                 s = rule_u[k][0]
                 x = x_lo + dx * s
@@ -169,14 +211,7 @@ def make_gauss_legendre(spec):
                 if in_b:  # smoothstep: removes the sqrt-like ends of acos(c*) at c* = +-1
                     x = x_lo + dx * s * s * (wp.float64(3.0) - two * s)
                     wk = rule_u[k][1] * dx * wp.float64(6.0) * s * (one - s)
-                cos_h = wp.cos(x)
-                sin_h = wp.sin(x)
-                if in_u:
-                    tan2 = tan2_from_u(x, a64)
-                    cos_h = one / wp.sqrt(one + tan2)
-                    sin_h = wp.sqrt(tan2) * cos_h
-                else:
-                    wk = wk * two * PI64 * sin_h  # du = 2 pi D cos sin dtheta, and g / p = g / (D cos)
+                cos_h, sin_h, wk = outer_node(x, wk, in_u, a64)
                 phimax = PI64
                 eps = PI64  # sinh-map scale; >= phimax makes the map nearly linear
                 if in_b:
@@ -194,15 +229,9 @@ def make_gauss_legendre(spec):
                     phi = phimax - eps * wp.sinh(arg)
                     w = wk * rule_p[j][1] * eps * wp.cosh(arg) * big_a
                     h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
-                    g = integrand(v, h, a, prm)
-                    if in_u:
-                        p = pdf(v, h, a)
-                        if p > 0.0:
-                            for c in range(wp.static(nch)):
-                                acc[c] = acc[c] + w * wp.float64(g[c] / p)
-                    else:
-                        for c in range(wp.static(nch)):
-                            acc[c] = acc[c] + w * wp.float64(g[c])
+                    gw = facet_weight(v, h, a, prm, in_u)
+                    for c in range(wp.static(nch)):
+                        acc[c] = acc[c] + w * wp.float64(gw[c])
             t_lo = t_hi
         for c in range(wp.static(nch)):
             out[i, c] = acc[c] / PI64
@@ -305,16 +334,20 @@ class GaussLegendre:
     def samples(self, inputs: dict) -> np.ndarray:
         return np.full(len(inputs["nov"]), 3 * self.order**2)
 
+    def _kernel(self, integrand):
+        """The kernel of this quadrature for ``integrand`` (a subclass may supply another panelling)."""
+        return gl_kernel(integrand)
+
     def prepare(self, integrand, device: str) -> None:
-        load(gl_kernel(integrand), device)
+        load(self._kernel(integrand), device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         rule = wp.array(np.stack(points.gauss_legendre(self.order), axis=1), dtype=wp.vec2d, device=device)
-        return _launch(gl_kernel(integrand), inputs, [rule, rule], integrand.kernel_channels, device)
+        return _launch(self._kernel(integrand), inputs, [rule, rule], integrand.kernel_channels, device)
 
     def refined(self):
         n = self.order
-        return GaussLegendre(3 * (n + 4) ** 2), f"order {n} - order {n + 4}"
+        return replace(self, budget=3 * (n + 4) ** 2), f"order {n} - order {n + 4}"
 
 
 @dataclass(frozen=True)

@@ -45,6 +45,8 @@ class TexelPlan:
     extra: dict[str, str] = field(default_factory=dict)
     # (flat float64 data (n_texels, n_channels), device) -> (estimated max error, how it was estimated)
     error_estimate: Callable[[np.ndarray, str], tuple[float, str]] | None = None
+    # (data of plan.shape) -> extra lutbake:* attributes known only after the bake (ltc: fit-error statistics)
+    attributes_after: Callable[[np.ndarray], dict[str, str]] | None = None
 
     @property
     def shape(self) -> tuple[int, ...]:

@@ -554,6 +554,22 @@ def diffuse_albedo_le_one() -> CheckResult:
     )
 
 
+LTC_SPHERE_TOL = 1.0e-8  # the integrated sphere table vs Snyder's closed form, relative to the unclipped value
+
+
+def ltc_sphere_table_is_snyder() -> CheckResult:
+    """The LTC sphere/disk table (lutbake.ltc.sphere, baked by integration) against Snyder's closed form of the
+    horizon-clipped projected solid angle of a spherical cap (ltc_code fitLTC.cpp ihemi), on a 33 x 33 grid of
+    (elevation, half-angle), relative to the unclipped value pi sin^2 sigma."""
+    from ..ltc import sphere
+
+    omega, sigma = np.meshgrid(np.linspace(0.0, np.pi, 33), np.linspace(1e-3, np.pi / 2, 33))
+    got = sphere.cap_projected_solid_angle(omega, sigma)
+    want = np.vectorize(sphere.snyder_cap)(omega, sigma)
+    err = np.max(np.abs(got - want) / (np.pi * np.sin(sigma) ** 2))
+    return _result("ltc_sphere_table_is_snyder", err, LTC_SPHERE_TOL, "max |integrated - closed form| / (pi sin^2)")
+
+
 # --- registry ------------------------------------------------------------------------------------------
 
 
@@ -581,6 +597,10 @@ def _registry() -> dict:
     checks["diffuse_sigma0_is_lambert_eq6"] = diffuse_sigma0_is_lambert_eq6
     checks["diffuse_reciprocity"] = diffuse_reciprocity
     checks["diffuse_albedo_le_one"] = diffuse_albedo_le_one
+    from . import dielectric  # the rough dielectric BSDF's checks (imports _result from here)
+
+    checks.update(dielectric.CHECKS)
+    checks["ltc_sphere_table_is_snyder"] = ltc_sphere_table_is_snyder
     return checks
 
 
