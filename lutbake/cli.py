@@ -8,7 +8,7 @@ from pathlib import Path
 import click
 
 from . import __version__
-from .io.formats import WRITERS
+from .io.formats import FORMATS
 
 EXIT_CONFIG = 2
 
@@ -77,7 +77,7 @@ def main():
 @click.option(
     "--format",
     "fmt",
-    type=click.Choice(list(WRITERS)),
+    type=click.Choice(list(FORMATS)),
     default=None,
     help="Output format of every table (same as --set format=...; default: each table's `format`, exr).",
 )

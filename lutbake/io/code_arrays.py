@@ -2,6 +2,7 @@
 
 - ``js``: <name>.js, an ES module ``export const <NAME>``: a ``Uint16Array`` of IEEE half bits (dtype half, as
   three.js' DFGLUTData.js) or a ``Float32Array``; three.js ``new DataTexture(NAME, W, H, RGFormat, HalfFloatType)``.
+  An ``ltc`` table keeps three.js' own LTC module (``LTC_MAT_1`` / ``LTC_MAT_2``, lutbake.io.ltc).
 - ``wgsl``: <name>.wgsl, ``const <NAME>: array<f32, N>`` (dtype half: the half-rounded values, so the shader sees
   exactly the texture's values; no ``enable f16`` needed).
 - ``rs``: <name>.rs, ``pub const <NAME>: [u16; N]`` of half bits (``half::f16::from_bits``; wgpu ``Rg16Float``:
@@ -98,6 +99,10 @@ def _writer(fmt: str):
     def write(table: Table, path, dtype: str = "float32") -> Path:
         from .formats import _sidecar
 
+        if fmt == "js" and table.kind == "ltc":  # three.js' LTC_MAT_1 / LTC_MAT_2 module (lutbake.io.ltc)
+            from .ltc import write_js
+
+            return write_js(table, path, dtype)
         path = atomic_write_bytes(Path(path), source_text(table, fmt, dtype).encode("utf-8"))
         _sidecar(table, path, fmt)
         return path
