@@ -6,8 +6,27 @@ results = lutbake.bake(["configs/dfg.toml"], out_dir="outputs")
 
 __version__ = "0.1.0"
 
-from .api import BakeResult, bake, bake_table  # noqa: E402
-from .config import TableSpec, load_config, load_configs  # noqa: E402
-from .table import Table  # noqa: E402
+# imported on first use (PEP 562), so the command line starts without numpy/Warp and a Ctrl-C during those
+# imports is handled by lutbake._entry, not printed as a traceback
+_EXPORTS = {
+    "bake": "api",
+    "bake_table": "api",
+    "BakeResult": "api",
+    "TableSpec": "config",
+    "load_config": "config",
+    "load_configs": "config",
+    "Table": "table",
+}
+
+
+def __getattr__(name: str):
+    if name in _EXPORTS:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 __all__ = ["bake", "bake_table", "BakeResult", "load_config", "load_configs", "TableSpec", "Table", "__version__"]

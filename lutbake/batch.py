@@ -2,7 +2,8 @@
 
 - **Schedule first.** ``schedule()`` takes already-validated specs (``config.load_configs`` validates every
   config before anything runs) and decides, per table, its output path, its content hash
-  (lutbake.provenance) and whether it is up to date (*skipped*). Nothing is baked while scheduling.
+  (lutbake.provenance) and whether it is up to date (*skipped*: same content hash, and the stored bytes match
+  the sha256 recorded with it, lutbake.io.integrity). Nothing is baked while scheduling.
 - **Run.** ``run()`` bakes the pending tables on a small thread pool (tables in parallel, each on the
   tile executor; the result is bit-identical for any worker count). One failing table (a NaN, an
   exception in a kernel, a MemoryError) is marked ``failed`` and does not stop the others. Each table goes
@@ -18,11 +19,9 @@ from __future__ import annotations
 
 import contextlib
 import json
-import os
 import signal
 import threading
 import time
-import uuid
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import dataclass
@@ -32,7 +31,9 @@ from . import __version__
 from .config import TableSpec
 from .errors import LutbakeError
 from .executor import Cancelled, Progress, default_workers
+from .io.atomic import atomic_write_bytes, remove_stale_temps
 from .io.formats import output_path, write_table
+from .io.oserror import os_error_text
 from .pipeline import bake_table
 from .provenance import HASH_ATTRIBUTE, content_hash, read_header, sources_digest
 
@@ -108,10 +109,12 @@ def schedule(specs: list[TableSpec], out_dir, force: bool = False) -> list[Job]:
 def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.Event) -> Job:
     """Bake and write one table; any failure is recorded on the job, never raised."""
     t0 = time.perf_counter()
+    needed = 0
     try:
         if cancel.is_set():
             raise Cancelled(job.name)
         table, seconds, samples = bake_table(job.spec, workers, device, progress, cancel=cancel)
+        needed = table.data.nbytes
         if table.attributes.get(HASH_ATTRIBUTE) != job.content_hash:  # sources changed under a running batch
             raise RuntimeError("the lutbake sources changed while the batch ran; run it again")
         if cancel.is_set():
@@ -131,6 +134,12 @@ def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.E
         )
     except LutbakeError as e:
         job.status, job.message = "failed", str(e)
+    except OSError as e:  # the output could not be written: say why (a full disk, a read-only mount ...)
+        job.status = "failed"
+        job.message = (
+            f"{job.spec.source}: table '{job.name}': cannot write {job.path}: "
+            f"{os_error_text(e, job.path.parent, needed)}; the next run bakes it again"
+        )
     except Exception as e:  # a kernel error, an I/O error, anything: this table fails, the others go on
         job.status = "failed"
         job.message = f"{job.spec.source}: table '{job.name}': {type(e).__name__}: {e}; nothing written"
@@ -160,6 +169,8 @@ def run(
     ``interrupted``; finished files are kept). ``progress``: lutbake.executor.Progress, per table.
     """
     workers = workers or default_workers()
+    for d in sorted({j.path.parent for j in jobs}):
+        remove_stale_temps(d)  # left by writers that were killed before their rename
     pending = [j for j in jobs if j.status == "pending"]
     if not pending:
         return None
@@ -221,14 +232,8 @@ def write_report(path, jobs: list[Job], status: int, signum: int | None = None) 
         "counts": {s: sum(j.status == s for j in jobs) for s in STATUSES},
         "tables": [j.report() for j in jobs],
     }
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp")
-    try:
-        tmp.write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    remove_stale_temps(path.parent)  # a report writer killed before its rename left one
+    atomic_write_bytes(path, (json.dumps(doc, indent=2) + "\n").encode("utf-8"))
     return path
 
 

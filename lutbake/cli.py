@@ -85,8 +85,9 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.<ext> (EXR unless `format` / --format says otherwise).
 
     All configs are validated before any kernel runs; a bad config exits with status 2 and writes
-    nothing. A table whose output exists with the same content hash (its config, the lutbake version
-    and the kernels' source) is skipped ("skipped PATH (up to date)"); --force rebakes it. Tables bake
+    nothing; so does an out-dir or --report that cannot be written. A table whose output exists with
+    the same content hash (its config, the lutbake version and the kernels' source), and whose bytes
+    match the sha256 recorded with it, is skipped ("skipped PATH (up to date)"); --force rebakes it. Tables bake
     in parallel; each prints one line: path, shape, seconds, samples per texel. A table that fails
     does not stop the others; the exit status is then 1. Outputs are replaced atomically: Ctrl-C
     (exit 130) or SIGTERM (exit 143) keeps finished tables, writes no unfinished one, and lists the
@@ -100,9 +101,10 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
       lutbake bake configs/dfg.toml --set dfg.estimator=sobol_vndf --set dfg.samples=4096
       lutbake bake --preset unreal --format dds        # -> outputs/preintegrated_gf.dds (R16G16_FLOAT)
     """
-    from . import batch
+    from . import batch, preflight
     from .config import load_configs, preset_path
     from .errors import ConfigError
+    from .textsafe import escape_controls
 
     _quiet_warp()
     try:
@@ -112,18 +114,20 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
         if fmt:
             overrides = tuple(overrides) + (f'format="{fmt}"',)
         specs = load_configs(paths, overrides)
-        if out_dir.exists() and not out_dir.is_dir():
-            raise ConfigError("--out-dir", "out-dir", str(out_dir), message="exists and is not a directory")
-        if report is not None and report.is_dir():
-            raise ConfigError("--report", "report", str(report), message="is a directory")
+        preflight.check_out_dir(out_dir)
         if device == "cuda":
             import warp as wp
 
             if not wp.is_cuda_available():
                 raise ConfigError("--device", "device", "cuda", "cpu", "no CUDA device is available")
         jobs = batch.schedule(specs, out_dir, force=force)
+        preflight.check_outputs(jobs)
+        preflight.check_report(report, jobs, paths)
     except ConfigError as e:
         click.echo(f"error: {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    except RecursionError:  # a value nested too deeply for some check that slipped past load_configs
+        click.echo("error: a config or --set value is nested too deeply", err=True)
         sys.exit(EXIT_CONFIG)
     except KeyboardInterrupt:
         click.echo("interrupted (SIGINT) while planning: nothing was baked or written", err=True)
@@ -131,13 +135,15 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
 
     def on_done(job):
         if job.status == "baked":
-            click.echo(f"{job.path}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel")
+            click.echo(
+                f"{escape_controls(str(job.path))}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel"
+            )
         elif job.status == "failed":
-            click.echo(f"FAILED {job.name}: {job.message}", err=True)
+            click.echo(f"FAILED {job.name}: {escape_controls(job.message)}", err=True)
 
     for job in jobs:
         if job.status == "skipped":
-            click.echo(f"skipped {job.path} (up to date)")
+            click.echo(f"skipped {escape_controls(str(job.path))} (up to date)")
     pending = sum(j.status == "pending" for j in jobs)
     bars = progress if progress is not None else (sys.stderr.isatty() and pending == 1)
     signum = None
@@ -151,7 +157,17 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
                 job.status, job.message = "interrupted", "interrupted; nothing written"
     status = batch.exit_status(jobs, signum)
     if report is not None:
-        batch.write_report(report, jobs, status, signum)
+        try:
+            batch.write_report(report, jobs, status, signum)
+        except OSError as e:
+            from .io.oserror import os_error_text
+
+            click.echo(
+                f"error: cannot write the report {escape_controls(str(report))}: "
+                f"{escape_controls(os_error_text(e, report.parent))}",
+                err=True,
+            )
+            status = status or batch.EXIT_FAILED
     failed = [j.name for j in jobs if j.status == "failed"]
     unfinished = [j.name for j in jobs if j.status in ("interrupted", "pending")]
     if failed:

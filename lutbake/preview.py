@@ -42,9 +42,11 @@ def axis_from_meta(d: dict) -> Axis:
 
 
 def read_table(path: Path) -> tuple[np.ndarray, dict]:
-    """(data, attrs) from an EXR, or from a .npy with its .json sidecar."""
+    """(data, attrs) from an EXR, or from a .npy with its sidecar <name>.npy.json."""
     if path.suffix == ".npy":
-        side = path.with_suffix(".json")
+        from .io.integrity import sidecar_path
+
+        side = sidecar_path(path)
         if not side.is_file():
             raise ValueError(f"{path}: no sidecar {side.name} with the table's conventions")
         return np.load(path).astype(np.float32), json.loads(side.read_text())["lutbake"]

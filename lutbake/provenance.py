@@ -16,6 +16,7 @@ from pathlib import Path
 
 from . import __version__
 from .config import TableSpec
+from .io.integrity import verified_attributes
 
 PACKAGE = Path(__file__).parent
 # the modules whose source defines what a table holds (kernels, terms, estimators, kinds, axes, edge policy)
@@ -52,34 +53,10 @@ def content_hash(spec: TableSpec, digest: bytes | None = None) -> str:
 
 
 def read_header(path) -> dict[str, str] | None:
-    """The ``lutbake:*`` attributes of an existing output (prefix removed): an EXR's first part header,
-    or for the other formats their ``.json`` sidecar; None if missing or unreadable (not up to date)."""
-    path = Path(path)
-    if not path.is_file():
-        return None
-    if path.suffix != ".exr":
-        try:
-            doc = json.loads(path.with_suffix(".json").read_text(encoding="utf-8"))
-            meta = doc["lutbake"] if doc.get("file") == path.name else None
-            return {k[len("lutbake:") :] if k.startswith("lutbake:") else k: str(v) for k, v in meta.items()}
-        except Exception:  # no sidecar (ktx2, h) or a foreign one: rebake
-            return None
-    try:
-        import OpenImageIO as oiio
-
-        inp = oiio.ImageInput.open(str(path))
-        if inp is None:
-            oiio.geterror()
-            return None
-        try:
-            spec = inp.spec()
-            return {
-                p.name[len("lutbake:") :]: str(p.value) for p in spec.extra_attribs if p.name.startswith("lutbake:")
-            }
-        finally:
-            inp.close()
-    except Exception:  # a corrupt or foreign file is simply not up to date
-        return None
+    """The ``lutbake:*`` attributes of an existing output (prefix removed), only if the output passes its
+    integrity check (lutbake.io.integrity: the recorded sha256 of the stored bytes; for the non-EXR formats
+    the ``<file>.json`` sidecar written last); None if missing, corrupt or half-written (not up to date)."""
+    return verified_attributes(path)
 
 
 def warp_version() -> str:

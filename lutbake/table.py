@@ -35,7 +35,7 @@ CHANNEL_LETTERS = ("R", "G", "B", "A")
 DTYPES = {"float32": np.float32, "half": np.float16}
 # attributes lutbake writes itself; Table.attributes may not shadow them
 RESERVED = frozenset(
-    {"kind", "table", "axes", "channels", "channel_names", "reconstruction", "slice_index", "slice_value"}
+    {"kind", "table", "axes", "channels", "channel_names", "reconstruction", "slice_index", "slice_value", "data_hash"}
 )
 
 

@@ -148,7 +148,7 @@ def test_diffuse_bakes_as_npy_from_the_cli(tmp_path):
     r = CliRunner().invoke(main, ["bake", str(cfg), "--format", "npy", "--out-dir", str(tmp_path / "o")])
     assert r.exit_code == 0, r.output
     assert np.load(tmp_path / "o" / "d.npy").shape == (3, 4, 1)
-    assert json.loads((tmp_path / "o" / "d.json").read_text())["lutbake"]["kind"] == "diffuse"
+    assert json.loads((tmp_path / "o" / "d.npy.json").read_text())["lutbake"]["kind"] == "diffuse"
 
 
 def test_aniso_with_a_sheen_layout_exits_2_naming_the_key(tmp_path, monkeypatch):
@@ -178,19 +178,19 @@ def test_api_bake_skips_up_to_date_outputs_unless_forced(spec, tmp_path):
 # ---- import layers: no circle, no module imports upward ----------------------------------------------------------
 # lowest first; a module may import its own layer's siblings and any lower layer, never a higher one
 LAYERS = [
-    {"errors", "edge", "axes", "table"},
+    {"errors", "edge", "axes", "table", "textsafe"},
     {"io"},
     {"terms"},
     {"sampling"},
     {"integrands", "ltc"},
-    {"kinds"},
-    {"config"},
+    {"kinds", "value_bounds"},
+    {"config", "preflight"},
     {"executor", "provenance"},
     {"pipeline"},
     {"batch"},
     {"api"},
     {"validate", "figures", "preview", "audit", "size", "fit"},
-    {"cli", "cli_engines", "__main__", "__init__"},
+    {"cli", "cli_engines", "__main__", "__init__", "_entry"},
 ]
 LAYER_OF = {name: i for i, layer in enumerate(LAYERS) for name in layer}
 

@@ -20,6 +20,9 @@ File layout (the contract engines and ``lutbake inspect`` rely on):
   error, never written.
 - Writes are atomic: the file is written to a temporary sibling, fsynced, then renamed onto the
   target, so an interrupted or failed write never leaves a half-written file or clobbers the old one.
+- ``lutbake:data_hash`` (every part): the sha256 of the file's bytes with these 64 hex digits set to ``0``
+  (lutbake.io.integrity); a rerun skips the table only if it matches, so a truncated or garbled file is
+  baked again.
 """
 
 from __future__ import annotations
@@ -32,6 +35,7 @@ import numpy as np
 from ..table import CHANNEL_LETTERS, Table, attr_text, metadata
 from ..table import pixels as checked_pixels
 from .atomic import atomic_write
+from .integrity import HASH_KEY, PLACEHOLDER, seal_exr
 
 PREFIX = "lutbake:"
 EXR_TYPES = {"float32": "float", "half": "half"}
@@ -95,7 +99,7 @@ def write_exr(table: Table, path, dtype: str = "float32") -> Path:
     path = Path(path)
     data = checked_pixels(table, dtype)
     fmt = EXR_TYPES[dtype]
-    attrs = metadata(table)
+    attrs = {**metadata(table), HASH_KEY: PLACEHOLDER.decode()}  # sealed with the file's hash before the rename
     if data.ndim == 3:
         parts = [(None, attrs, data)]
     else:
@@ -110,7 +114,11 @@ def write_exr(table: Table, path, dtype: str = "float32") -> Path:
             for k in range(data.shape[0])
         ]
 
-    return atomic_write(path, lambda tmp: _write_oiio(tmp, parts, fmt))
+    def write(tmp):
+        _write_oiio(tmp, parts, fmt)
+        seal_exr(tmp)
+
+    return atomic_write(path, write)
 
 
 # --------------------------------------------------------------------------------------- reading

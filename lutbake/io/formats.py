@@ -3,17 +3,17 @@
 | format | file | pixel types | metadata |
 | --- | --- | --- | --- |
 | ``exr`` (default) | <name>.exr | float32 / half | ``lutbake:*`` header attributes (lutbake.io.exr) |
-| ``npy`` | <name>.npy + <name>.json | float32 / float16 array, table shape | sidecar JSON of the same attributes |
-| ``png16`` | <name>.png + <name>.json | 16-bit UNORM, linear | no sRGB/iCCP chunk; gAMA = 1.0 where written |
-| ``dds`` | <name>.dds + <name>.json | R16G16_FLOAT, R32G32_FLOAT, RGBA16F/32F ... | DX10 header (lutbake.io.dds) |
-| ``ktx2`` | <name>.ktx2 | VK_FORMAT_R16G16_SFLOAT, ... | key/value data (lutbake.io.ktx2) |
-| ``h`` | <name>.h | half-float bits (uint16_t) or float | the conventions in a comment block |
-Row 0 of every file is table row 0 (no flip); column 0 is x index 0. Every write is atomic.
+| ``npy`` | <name>.npy + <name>.npy.json | float32 / float16 array, table shape | sidecar JSON of the same attributes |
+| ``png16`` | <name>.png + <name>.png.json | 16-bit UNORM, linear | no sRGB/iCCP chunk; gAMA = 1.0 where written |
+| ``dds`` | <name>.dds + <name>.dds.json | R16G16_FLOAT, R32G32_FLOAT, RGBA16F/32F ... | DX10 header (lutbake.io.dds) |
+| ``ktx2`` | <name>.ktx2 + <name>.ktx2.json | VK_FORMAT_R16G16_SFLOAT, ... | key/value data (lutbake.io.ktx2) |
+| ``h`` | <name>.h + <name>.h.json | half-float bits (uint16_t) or float | the conventions in a comment block |
+Row 0 of every file is table row 0 (no flip); column 0 is x index 0. Every write is atomic; the sidecar
+``<file>.json`` is written last and names the sha256 of the data file (lutbake.io.integrity).
 """
 
 from __future__ import annotations
 
-import json
 import re
 from pathlib import Path
 
@@ -24,6 +24,7 @@ from ..table import pixels as checked_pixels
 from . import dds, ktx2
 from .atomic import atomic_write, atomic_write_bytes
 from .exr import write_exr
+from .integrity import legacy_sidecar, write_sidecar
 
 FORMATS = {
     "exr": "OpenEXR via OpenImageIO, float32 or half, lutbake:* header attributes (default)",
@@ -47,15 +48,12 @@ EXTENSIONS = {
 
 
 def _sidecar(table: Table, path: Path, fmt: str, extra: dict | None = None) -> None:
-    meta = {k: v for k, v in metadata(table).items()}
-    doc = {
-        "file": path.name,
-        "format": fmt,
-        "row_order": "file row 0 = table row 0 (y index 0); column 0 = x index 0",
-        **(extra or {}),
-        "lutbake": meta,
-    }
-    atomic_write_bytes(path.with_suffix(".json"), (json.dumps(doc, indent=1, ensure_ascii=False) + "\n").encode())
+    """The last step of every non-EXR write: ``<file>.json`` naming the data's sha256 (lutbake.io.integrity);
+    a pre-issue-11 ``<stem>.json`` that described this file is removed (it would contradict the new one)."""
+    write_sidecar(path, fmt, metadata(table), extra)
+    old = legacy_sidecar(path)
+    if old is not None:
+        old.unlink(missing_ok=True)
 
 
 def write_npy(table: Table, path, dtype: str = "float32") -> Path:

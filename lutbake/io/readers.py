@@ -12,7 +12,7 @@
 A text array's layout must be declared: ``#define *_HEIGHT/_WIDTH/_CHANNELS`` (lutbake's C header), the
 ``lutbake:shape`` line of lutbake's JS/WGSL/Rust comment block, or ``shape=(rows, columns, channels)``.
 Row 0 of the result is the first row stored in the file (no flip). A JSON sidecar beside the file
-(lutbake's, or /work/shared/refs style) is returned in ``sidecar``.
+(lutbake's ``<file>.json``, or a ``<stem>.json`` provenance note) is returned in ``sidecar``.
 """
 
 from __future__ import annotations
@@ -119,10 +119,11 @@ def read_lut(path, shape=None) -> LutFile:
     if not path.is_file():
         raise ValueError(f"{path}: no such file")
     attrs, sidecar = {}, {}
-    side = path.with_suffix(".json")
-    if side.is_file():
-        sidecar = json.loads(side.read_text())
-        attrs = sidecar.get("lutbake", {})
+    for side in (path.with_name(path.name + ".json"), path.with_suffix(".json")):  # lutbake's, then refs style
+        if side.is_file():
+            sidecar = json.loads(side.read_text())
+            attrs = sidecar.get("lutbake", {})
+            break
     if ext == ".exr":
         data, attrs = read_exr(path)
         storage = "float32"
