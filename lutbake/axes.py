@@ -38,6 +38,8 @@ TEXELS = {"center": "t = (i + 0.5) / N", "endpoint": "t = i / (N - 1)"}
 MAPPINGS = {
     "linear": "value = lo + (hi - lo) * t",
     "one_minus_t2": "value = lo + (hi - lo) * (1 - t^2), i.e. t = sqrt(1 - value) on [0, 1] (Blender EEVEE NoV)",
+    "square": "value = lo + (hi - lo) * t^2, i.e. t = sqrt(value) on [0, 1] (Unity HDRP PreIntegratedFGD: "
+    "x = sqrt(NoV))",
     "texel_offset": "value = lo + (hi - lo) * min(t + 1/N, 1): one texel past the texel centre "
     "(Filament cmgen's roughness rows, r = clamp((H - y + 0.5)/H, 0, 1) in image row y)",
     "listed": "value = values[i], listed in the config (not evenly spaced in general: map a parameter to a "
@@ -89,6 +91,8 @@ class Axis:
     def _map(self, t: np.ndarray) -> np.ndarray:
         if self.mapping == "one_minus_t2":
             s = 1.0 - t * t
+        elif self.mapping == "square":
+            s = t * t
         elif self.mapping == "texel_offset":
             s = np.minimum(t + 1.0 / self.count, 1.0)
         else:
@@ -117,6 +121,8 @@ class Axis:
         s = (x - self.lo) / (self.hi - self.lo) if self.hi > self.lo else np.zeros_like(x)
         if self.mapping == "one_minus_t2":
             t = np.sqrt(np.clip(1.0 - s, 0.0, 1.0))
+        elif self.mapping == "square":
+            t = np.sqrt(np.clip(s, 0.0, 1.0))
         elif self.mapping == "texel_offset":
             t = s - 1.0 / self.count
         else:
@@ -135,7 +141,9 @@ class Axis:
         if self.mapping == "listed":
             return f"(fractional index of x among the listed values + 0.5) / {n}"
         s = "x" if (self.lo, self.hi) == (0.0, 1.0) else f"(x - {self.lo:g}) / {self.hi - self.lo:g}"
-        t = {"linear": s, "one_minus_t2": f"sqrt(1 - {s})", "texel_offset": f"{s} - 1/{n}"}[self.mapping]
+        t = {"linear": s, "one_minus_t2": f"sqrt(1 - {s})", "square": f"sqrt({s})", "texel_offset": f"{s} - 1/{n}"}[
+            self.mapping
+        ]
         u = t if self.texel == "center" else f"({t}) * {n - 1}/{n} + 0.5/{n}"
         return f"1 - ({u})" if self.order == "hi_first" else u
 

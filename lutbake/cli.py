@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from . import __version__
+from .io.formats import FORMATS
 
 EXIT_CONFIG = 2
 
@@ -83,7 +84,7 @@ def main():
 @click.option(
     "--format",
     "fmt",
-    type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h", "openpbr_h"]),
+    type=click.Choice(list(FORMATS)),
     default=None,
     help="Output format of every table (same as --set format=...; default: each table's `format`, exr).",
 )
@@ -387,6 +388,11 @@ def preview(file, out):
         sys.exit(EXIT_CONFIG)
     click.echo(str(path))
 
+
+from .cli_engines import audit, fit, size  # noqa: E402  (commands for shipping tables to engines)
+
+for _command in (audit, size, fit):
+    main.add_command(_command)
 
 if __name__ == "__main__":
     main()

@@ -20,8 +20,9 @@ from __future__ import annotations
 
 # dfg layouts whose channels are weighted single-scattering albedos (each weight in [0, 1]), and the others
 UNIT_LAYOUTS = frozenset({"scale_bias", "multiscatter", "scale_bias_f82"})
+# multiscatter_disney (Unity HDRP): B = Disney FGD - 0.5 spans [-0.028, 1.0036] on endpoint texels (NoV = 0 rows)
 ABOVE_ONE_LAYOUTS = frozenset(
-    {"multiscatter_cloth", "charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped"}
+    {"multiscatter_cloth", "charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped", "multiscatter_disney"}
 )
 # specular models whose directional albedo is at most 1 (energy conserving), and the others
 UNIT_SPECULAR_MODELS = frozenset({"microfacet", "cook_torrance", "ashikhmin_shirley"})

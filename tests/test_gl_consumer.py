@@ -123,6 +123,10 @@ def load(path, fmt):
         return read_dds_spec(Path(path).read_bytes())[0]
     if fmt == "ktx2":
         return read_ktx2_spec(Path(path).read_bytes())[0]
+    if fmt == "ktx2zst":  # zstd parsing is checked by an independent reader in test_code_arrays
+        from lutbake.io.ktx2 import decode
+
+        return np.ascontiguousarray(decode(Path(path).read_bytes())[0])
     if fmt == "png16":
         import OpenImageIO as oiio
 
@@ -157,6 +161,15 @@ CASES = [  # (config, format, dtype, GLSL uv expression, tolerance vs the integr
         "float32",
         "lutbake_eevee_uv(p.x, p.y, float(textureSize(lut, 0).x))",
     ),
+    # unity-hdrp's axes (its specular channels; B is checked in test_engine_diffuse)
+    (
+        {"layout": "multiscatter", "texel": "endpoint", "nov_mapping": "square"},
+        "exr",
+        "float32",
+        "lutbake_hdrp_uv(p.x, p.y, float(textureSize(lut, 0).x))",
+    ),
+    ({}, "ktx2zst", "half", "lutbake_dfg_uv(p.x, p.y)"),  # bevy
+    ({"axis_order": "roughness_x"}, "dds", "half", "lutbake_threejs_uv(p.x, p.y)"),  # threejs' axes
 ]
 
 

@@ -189,8 +189,8 @@ LAYERS = [
     {"pipeline"},
     {"batch"},
     {"api"},
-    {"validate", "figures", "preview"},
-    {"cli", "__main__", "__init__", "_entry"},
+    {"validate", "figures", "preview", "audit", "size", "fit"},
+    {"cli", "cli_engines", "__main__", "__init__", "_entry"},
 ]
 LAYER_OF = {name: i for i, layer in enumerate(LAYERS) for name in layer}
 

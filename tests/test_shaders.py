@@ -19,7 +19,8 @@ float4 main(float4 pos : SV_Position, float3 p : TEXCOORD0) : SV_Target {
     float3 a = lutbake_split_sum(t.xy, p) + lutbake_multiscatter_E(t.xy, p) * lutbake_energy_compensation(t.xy, p);
     a += lutbake_eevee_f82(t.xyz, p, 1.0.xxx, 0.5.xxx) + lutbake_split_sum_f90(t.xy, p, 1.0.xxx);
     float2 uv = lutbake_dfg_uv(p.x, p.y) + lutbake_filament_corrected_uv(p.x, p.y)
-              + lutbake_filament_shipped_uv(p.x, p.y, 128.0);
+              + lutbake_filament_shipped_uv(p.x, p.y, 128.0) + lutbake_hdrp_uv(p.x, p.y, 64.0)
+              + lutbake_threejs_uv(p.x, p.y) + lutbake_hdrp_diffuse_fgd(t.xyz);
     return float4(a, uv.x + uv.y + lutbake_u_center(p.z) + lutbake_u_hi_first(p.z) + lutbake_u_endpoint(p.z, 8.0));
 }
 """

@@ -38,7 +38,11 @@ UNIT = (
     + [("dielectric", {"layout": "energy"})]
 )
 ABOVE = (
-    [("dfg", {"layout": lay}) for lay in sorted(vb.ABOVE_ONE_LAYOUTS)]
+    # multiscatter_disney leaves [0, 1] only where its endpoint texels reach NoV = 0 (unity-hdrp's convention)
+    [
+        ("dfg", {"layout": lay, **({"texel": "endpoint"} if lay == "multiscatter_disney" else {})})
+        for lay in sorted(vb.ABOVE_ONE_LAYOUTS)
+    ]
     + [(k, {"model": m}) for k in ("dfg", "albedo") for m in sorted(vb.ABOVE_ONE_SPECULAR_MODELS)]
     + [(k, {"model": m}) for k in ("diffuse", "diffuse_3d") for m in sorted(vb.ABOVE_ONE_DIFFUSE_MODELS)]
     + [("btf", {"model": "microfacet"})]

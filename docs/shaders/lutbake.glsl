@@ -27,6 +27,15 @@ vec2 lutbake_filament_shipped_uv(float NoV, float roughness, float H) {
     return vec2(NoV, 1.0 - (roughness - 1.0 / H));
 }
 
+// preset unity-hdrp (PreIntegratedFGD): x = sqrt(NoV), y = perceptual roughness, both endpoints, N = 64
+// (HDRP's Remap01ToHalfTexelCoord(float2(sqrt(NdotV), perceptualRoughness), 64)).
+vec2 lutbake_hdrp_uv(float NoV, float roughness, float N) {
+    return vec2(lutbake_u_endpoint(sqrt(max(NoV, 0.0)), N), lutbake_u_endpoint(roughness, N));
+}
+// preset threejs (DFGLUTData.js): columns = roughness, rows = NoV, texel centres: texture2D(dfgLUT, vec2(roughness, dotNV)).
+vec2 lutbake_threejs_uv(float NoV, float roughness) { return vec2(roughness, NoV); }
+// presets godot, bevy: as lutbake_dfg_uv (columns NoV, rows r, texel centres).
+
 // ---- reconstruction ---------------------------------------------------------------------------
 // layout scale_bias (R = scale, G = bias): E = f0 * scale + f90 * bias (f90 = 1 in the Schlick split sum).
 vec3 lutbake_split_sum(vec2 t, vec3 f0) { return f0 * t.x + t.y; }
@@ -34,6 +43,8 @@ vec3 lutbake_split_sum_f90(vec2 t, vec3 f0, vec3 f90) { return f0 * t.x + f90 * 
 // layout multiscatter (R = integral Fc f, G = integral f): E = mix(R, G, f0); Filament's energy compensation.
 vec3 lutbake_multiscatter_E(vec2 t, vec3 f0) { return mix(vec3(t.x), vec3(t.y), f0); }
 vec3 lutbake_energy_compensation(vec2 t, vec3 f0) { return 1.0 + f0 * (1.0 / t.y - 1.0); }
+// layout multiscatter_disney (Unity HDRP): B = Disney diffuse FGD - 0.5.
+float lutbake_hdrp_diffuse_fgd(vec3 t) { return t.z + 0.5; }
 // layout scale_bias_f82 (Blender EEVEE): F82-tint metals, B = integral f/F (v.h)(1 - v.h)^6 (n.l).
 vec3 lutbake_eevee_f82(vec3 t, vec3 f0, vec3 f90, vec3 f82_tint) {
     const float x = 6.0 / 7.0;

@@ -15,11 +15,16 @@ float2 lutbake_filament_corrected_uv(float NoV, float roughness) { return float2
 float2 lutbake_filament_shipped_uv(float NoV, float roughness, float H) {
     return float2(NoV, 1.0 - (roughness - 1.0 / H));
 }
+float2 lutbake_hdrp_uv(float NoV, float roughness, float N) {
+    return float2(lutbake_u_endpoint(sqrt(max(NoV, 0.0)), N), lutbake_u_endpoint(roughness, N));
+}
+float2 lutbake_threejs_uv(float NoV, float roughness) { return float2(roughness, NoV); }
 
 float3 lutbake_split_sum(float2 t, float3 f0) { return f0 * t.x + t.y; }
 float3 lutbake_split_sum_f90(float2 t, float3 f0, float3 f90) { return f0 * t.x + f90 * t.y; }
 float3 lutbake_multiscatter_E(float2 t, float3 f0) { return lerp(t.xxx, t.yyy, f0); }
 float3 lutbake_energy_compensation(float2 t, float3 f0) { return 1.0 + f0 * (1.0 / t.y - 1.0); }
+float lutbake_hdrp_diffuse_fgd(float3 t) { return t.z + 0.5; }
 float3 lutbake_eevee_f82(float3 t, float3 f0, float3 f90, float3 f82_tint) {
     const float x = 6.0 / 7.0;
     float3 b = lerp(f0, 1.0.xxx, pow(x, 5.0)) * (7.0 / pow(x, 6.0)) * (1.0 - f82_tint);

@@ -1,5 +1,8 @@
 """KTX 2.0 writer, per the Khronos KTX File Format Specification 2.0 and the Khronos Data Format
-Specification 1.3 (basic data format descriptor). Uncompressed, one mip level, no supercompression:
+Specification 1.3 (basic data format descriptor). One mip level, uncompressed or, with
+``supercompression="zstd"``, supercompressionScheme 2 (Zstandard, level ZSTD_LEVEL): the level's bytes are one
+zstd frame, ``byteLength`` the compressed and ``uncompressedByteLength`` the raw size (KTX 2.0 §3.12.2, §4.1;
+Bevy's proposed DFG LUT is a zstd KTX2):
 - 2D tables (y, x, C) -> a 2D texture; 3D tables (z, y, x, C) -> a 3D texture (pixelDepth = z), or, with
   ``array=True``, a 2D array texture (layerCount = z).
 - vkFormat by channel count and dtype: 1 -> R16_SFLOAT / R32_SFLOAT, 2 -> R16G16_SFLOAT / R32G32_SFLOAT,
@@ -29,6 +32,9 @@ KHR_DF_TRANSFER_LINEAR = 1
 KHR_DF_CHANNEL = (0, 1, 2, 15)  # R, G, B, A
 KHR_DF_SAMPLE_DATATYPE_FLOAT = 0x80
 KHR_DF_SAMPLE_DATATYPE_SIGNED = 0x40
+SUPERCOMPRESSION = {"none": 0, "zstd": 2}  # KTX 2.0 supercompressionScheme values (BasisLZ = 1, ZLIB = 3)
+ZSTD_LEVEL = 19  # deterministic output for a given zstandard version; a LUT is compressed once
+FROM_VK_FORMAT = {v: k for k, v in VK_FORMAT.items()}
 
 
 def _dfd(nch: int, bytes_per_channel: int) -> bytes:
@@ -61,9 +67,13 @@ def _kvd(pairs: dict[str, str]) -> bytes:
 
 
 def encode(
-    pixels: np.ndarray, metadata: dict[str, str] | None = None, array: bool = False, writer: str = "lutbake"
+    pixels: np.ndarray,
+    metadata: dict[str, str] | None = None,
+    array: bool = False,
+    writer: str = "lutbake",
+    supercompression: str = "none",
 ) -> bytes:
-    """KTX2 bytes for a (y, x, C) or (z, y, x, C) float16/float32 array."""
+    """KTX2 bytes for a (y, x, C) or (z, y, x, C) float16/float32 array; ``supercompression`` "none" or "zstd"."""
     dtype = "half" if pixels.dtype == np.float16 else "float32"
     data = np.ascontiguousarray(gpu_channels(pixels))
     nch = data.shape[-1]
@@ -83,9 +93,51 @@ def encode(
     end = kvd_off + len(kvd)
     align = math.lcm(nch * type_size, 4)
     level_off = end + (-end % align)
-    level = data.astype(data.dtype.newbyteorder("<"), copy=False).tobytes()
-    head = IDENTIFIER + struct.pack("<9I", VK_FORMAT[(dtype, nch)], type_size, width, height, depth, layers, 1, 1, 0)
+    raw = data.astype(data.dtype.newbyteorder("<"), copy=False).tobytes()
+    scheme = SUPERCOMPRESSION[supercompression]
+    if scheme:
+        import zstandard
+
+        level = zstandard.ZstdCompressor(level=ZSTD_LEVEL).compress(raw)
+        level_off = end  # supercompressed levels need no alignment (KTX 2.0 §3.9.7: mipPadding only if scheme 0)
+        vk_type_size = 1  # typeSize must be 1 when supercompressed (§3.6)
+    else:
+        level, vk_type_size = raw, type_size
+    head = IDENTIFIER + struct.pack(
+        "<9I", VK_FORMAT[(dtype, nch)], vk_type_size, width, height, depth, layers, 1, 1, scheme
+    )
     head += struct.pack("<IIIIQQ", dfd_off, len(dfd), kvd_off, len(kvd), 0, 0)
-    head += struct.pack("<QQQ", level_off, len(level), len(level))
+    head += struct.pack("<QQQ", level_off, len(level), len(raw))
     assert len(head) == header_len
     return head + dfd + kvd + b"\0" * (level_off - end) + level
+
+
+def decode(blob: bytes) -> tuple[np.ndarray, dict[str, str]]:
+    """Read a one-level float KTX2 (what ``encode`` writes, uncompressed or zstd): (array, key/value data).
+    2D -> (y, x, C); 3D or array -> (z, y, x, C). Rows in file order (KTXorientation ``rd``: row 0 first)."""
+    if blob[:12] != IDENTIFIER:
+        raise ValueError("not a KTX 2.0 file (bad identifier)")
+    vk, _, width, height, depth, layers, faces, levels, scheme = struct.unpack_from("<9I", blob, 12)
+    if vk not in FROM_VK_FORMAT:
+        raise ValueError(
+            f"KTX2 vkFormat {vk} is not a float format lutbake reads ({', '.join(VK_FORMAT_NAMES.values())})"
+        )
+    if scheme not in SUPERCOMPRESSION.values():
+        raise ValueError(f"KTX2 supercompressionScheme {scheme}: only none (0) and Zstandard (2) are read")
+    dfd_off, dfd_len, kvd_off, kvd_len, _, _ = struct.unpack_from("<IIIIQQ", blob, 48)
+    level_off, level_len, raw_len = struct.unpack_from("<QQQ", blob, 80)
+    level = blob[level_off : level_off + level_len]
+    if scheme:
+        import zstandard
+
+        level = zstandard.ZstdDecompressor().decompress(level, max_output_size=raw_len)
+    pairs, pos = {}, kvd_off
+    while pos < kvd_off + kvd_len:
+        (n,) = struct.unpack_from("<I", blob, pos)
+        key, _, value = blob[pos + 4 : pos + 4 + n].partition(b"\0")
+        pairs[key.decode("utf-8")] = value.rstrip(b"\0").decode("utf-8")
+        pos += 4 + n + (-n % 4)
+    dtype, nch = FROM_VK_FORMAT[vk]
+    npdt = np.dtype("<f2" if dtype == "half" else "<f4")
+    shape = ((max(depth, layers),) if (depth or layers) else ()) + (height, width, nch)
+    return np.frombuffer(level, dtype=npdt, count=int(np.prod(shape))).reshape(shape), pairs

@@ -25,7 +25,9 @@ import numpy as np
 
 from ..axes import MAPPINGS, ORDERS, ROUGHNESS_PARAMS, TEXELS, Axis
 from ..edge import alpha_policy
-from ..integrands.specular import N_CHANNELS, SHEEN_LAYOUTS, SPECULAR_MODELS, model_terms, specular_integrand
+from ..integrands import engine_diffuse
+from ..integrands.specular import N_CHANNELS as SPECULAR_CHANNELS
+from ..integrands.specular import SHEEN_LAYOUTS, SPECULAR_MODELS, model_terms, specular_integrand
 from ..sampling.hemisphere import ESTIMATORS, estimator_for
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from ..terms.distributions import MASKINGS, NDFS
@@ -106,11 +108,15 @@ RECONSTRUCTION["sheen_albedo"] = (
 )
 RECONSTRUCTION["charlie_clamped"] = RECONSTRUCTION["charlie"]
 RECONSTRUCTION["sheen_albedo_clamped"] = RECONSTRUCTION["sheen_albedo"]
+N_CHANNELS = {**SPECULAR_CHANNELS, **{k: 3 for k in engine_diffuse.LAYOUTS}}
+LAYOUTS.update(engine_diffuse.LAYOUTS)
+CHANNELS.update(engine_diffuse.CHANNELS)
+RECONSTRUCTION.update(engine_diffuse.RECONSTRUCTION)
 AXIS_ORDERS = {
     "nov_x": "columns (x) = NoV, rows (y) = roughness: sample at vec2(NoV, roughness) (Filament, glTF, UE4)",
     "roughness_x": "columns (x) = roughness, rows (y) = NoV: sample at vec2(roughness, NoV-coordinate) (Blender EEVEE)",
 }
-NOV_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "one_minus_t2")}
+NOV_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "one_minus_t2", "square")}
 ROUGHNESS_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "texel_offset")}
 
 KEYS = {
@@ -281,8 +287,9 @@ def plan(spec) -> TexelPlan:
     o = spec.options
     axes = axes_for(o)
     form, nd, mk = terms_of(o)
-    nch = N_CHANNELS[o["layout"]]
-    integrand = specular_integrand(nd, mk, o["layout"], form, nch)
+    base = engine_diffuse.BASE_LAYOUT.get(o["layout"], o["layout"])  # the specular integrand's layout
+    nch = N_CHANNELS[base]
+    integrand = specular_integrand(nd, mk, base, form, nch)
     cloth = {"cloth": "D_charlie + V_ashikhmin"} if o["layout"] == "multiscatter_cloth" else {}
     terms = {**terms_record(o, "schlick"), "layout": o["layout"], **cloth}
     if o["layout"] in SHEEN_LAYOUTS:
@@ -299,7 +306,9 @@ def plan(spec) -> TexelPlan:
             "layout": o["layout"],
             "gauss_legendre_panels": "the GGX CDF in theta_h (panelling only; the integrand is the sheen lobe)",
         }
-    return per_texel_plan(
+    if base != o["layout"]:
+        terms["diffuse"] = "disney (Burley 2012, HDRP DisneyDiffuseNoPI / 1.03571), minus 0.5"
+    plan = per_texel_plan(
         integrand,
         estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
         grid_for(axes, integrand),
@@ -308,6 +317,10 @@ def plan(spec) -> TexelPlan:
         terms=terms,
         extra=specular_extra(integrand),
     )
+    if base != o["layout"]:
+        nov = texel_grid(axes)[0]
+        plan = engine_diffuse.with_diffuse_channel(plan, nov, engine_diffuse.perceptual_roughness_grid(axes))
+    return plan
 
 
 SAMPLES_DOC = "integrand evaluations per texel; omitted: the estimator's default quality"

@@ -1,0 +1,230 @@
+"""CLI commands for shipping tables to engines: ``audit``, ``size``, ``fit`` (registered by lutbake.cli)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+EXIT_CONFIG = 2
+
+
+def _quiet():
+    from .cli import _quiet_warp
+
+    _quiet_warp()
+
+
+def _shape(text: str | None):
+    if text is None:
+        return None
+    try:
+        parts = tuple(int(p) for p in text.lower().split("x"))
+    except ValueError:
+        parts = ()
+    if len(parts) != 3 or min(parts) < 1:
+        raise click.BadParameter(f"{text!r}: expected ROWSxCOLUMNSxCHANNELS, e.g. 16x16x2", param_hint="--shape")
+    return parts
+
+
+@click.command()
+@click.argument("file", type=click.Path(path_type=Path))
+@click.option(
+    "--preset", default=None, metavar="NAME", help="Conventions of a preset (lutbake list); default 'default'."
+)
+@click.option("--config", type=click.Path(path_type=Path), default=None, help="Conventions of a config's first table.")
+@click.option(
+    "--set",
+    "overrides",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Override a convention key (texel, row_order, roughness, layout, ...); the size is the file's.",
+)
+@click.option(
+    "--tolerance",
+    type=float,
+    default=1e-3,
+    show_default=True,
+    help="Exit 0 when the chosen error metric is within this, 1 otherwise.",
+)
+@click.option(
+    "--metric",
+    type=click.Choice(["max", "p99", "mean"]),
+    default="max",
+    show_default=True,
+    help="Which |file - converged| statistic is held against --tolerance.",
+)
+@click.option(
+    "--max-side",
+    type=click.IntRange(min=2),
+    default=128,
+    show_default=True,
+    help="Re-integrate at most this many rows and columns (strided subset, last row/column included).",
+)
+@click.option(
+    "--shape",
+    default=None,
+    metavar="RxCxC",
+    help="Layout of a text array (C header / JS / WGSL / Rust) whose file does not declare it, e.g. 16x16x2.",
+)
+@click.option(
+    "--error-map",
+    type=click.Path(path_type=Path),
+    default=None,
+    metavar="PNG",
+    help="Write |file - converged| per channel with labelled axes.",
+)
+@click.option("--json", "as_json", is_flag=True, help="Print the report as JSON (for CI).")
+@click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
+def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, error_map, as_json, workers):
+    """Compare the LUT FILE with a converged re-bake under declared conventions and diagnose mistakes.
+
+    Reports max/mean/percentile |file - converged| per channel and where the maximum sits, tests each usual
+    hand-over mistake against the data (flipped/swapped axes, half- and one-texel offsets, alpha vs
+    perceptual roughness, sRGB decoding, swapped channels, the other split-sum layout) and names the one that
+    explains the data, the storage quantisation and the Monte-Carlo noise (estimated sample count).
+    Exit 0 when within --tolerance, 1 otherwise, 2 on a bad option, file or config.
+
+    \b
+    Examples:
+      lutbake audit dfg.dds --preset filament
+      lutbake audit lut_ggx.png --preset gltf --error-map lut_ggx.err.png --json
+      lutbake audit brdf.h --set texel=endpoint --set axis_order=roughness_x --shape 64x64x3
+    """
+    from .audit import audit as run_audit
+    from .audit import report_json
+    from .errors import ConfigError
+
+    _quiet()
+    if preset and config:
+        click.echo("error: give --preset or --config, not both", err=True)
+        sys.exit(EXIT_CONFIG)
+    try:
+        report = run_audit(
+            file,
+            {"preset": preset, "config": config, "overrides": overrides},
+            tolerance=tolerance,
+            metric=metric,
+            max_side=max_side,
+            error_map=error_map,
+            shape=_shape(shape),
+            workers=workers,
+        )
+    except ConfigError as e:
+        click.echo(f"error: {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    except (OSError, ValueError) as e:
+        click.echo(f"error: {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    click.echo(report_json(report) if as_json else report.text())
+    sys.exit(0 if report.passed else 1)
+
+
+@click.command()
+@click.option(
+    "--preset", default=None, metavar="NAME", help="Conventions of a preset (lutbake list); default 'default'."
+)
+@click.option("--config", type=click.Path(path_type=Path), default=None, help="Conventions of a config's first table.")
+@click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE", help="Override a convention key.")
+@click.option("--max-error", type=float, required=True, help="Target max |bilinear(table) - integral| between texels.")
+@click.option(
+    "--sizes",
+    default="8,16,32,64,128,256,512",
+    show_default=True,
+    help="Square sizes N to try, in increasing order (stops once every format meets the target).",
+)
+@click.option(
+    "--nov-min",
+    type=click.FloatRange(0.0, 1.0),
+    default=0.0,
+    show_default=True,
+    help="Measure only where NoV >= this (the grazing corner never converges on a linear NoV axis).",
+)
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+@click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
+def size(preset, config, overrides, max_error, sizes, nov_min, as_json, workers):
+    """Smallest N x N resolution per storage format (UNORM8/10/16, F16, F32) whose max error after bilinear
+    filtering, measured between texels against the integral, is within --max-error.
+
+    \b
+    Examples:
+      lutbake size --preset default --max-error 1e-3
+      lutbake size --preset unity-hdrp --max-error 1e-4 --nov-min 0.05 --json
+    """
+    import json
+
+    from .errors import ConfigError
+    from .size import smallest_sizes
+
+    _quiet()
+    try:
+        ns = tuple(int(s) for s in sizes.split(","))
+        if not ns or min(ns) < 2:
+            raise ValueError
+    except ValueError:
+        click.echo(f"error: --sizes {sizes!r}: a comma-separated list of integers >= 2", err=True)
+        sys.exit(EXIT_CONFIG)
+    if max_error <= 0:
+        click.echo("error: --max-error must be > 0", err=True)
+        sys.exit(EXIT_CONFIG)
+    try:
+        result = smallest_sizes(
+            {"preset": preset, "config": config, "overrides": overrides},
+            max_error,
+            ns,
+            workers=workers,
+            nov_min=nov_min,
+        )
+    except (ConfigError, OSError, ValueError) as e:
+        click.echo(f"error: {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    click.echo(json.dumps(result.as_dict(), indent=1) if as_json else result.text())
+
+
+@click.command()
+@click.argument("family", type=click.Choice(["karis-mobile", "gotanda-eq8"]))
+@click.option("--lang", type=click.Choice(["glsl", "hlsl"]), default="glsl", show_default=True)
+@click.option(
+    "-o",
+    "--out",
+    type=click.Path(path_type=Path, dir_okay=False),
+    default=None,
+    help="Write the shader function here (default: print it after the error table).",
+)
+@click.option("--json", "as_json", is_flag=True, help="Print constants and errors as JSON.")
+def fit(family, lang, out, as_json):
+    """Refit a published closed form to lutbake's integral and emit it as GLSL/HLSL with its measured error
+    (published constants vs refit, side by side).
+
+    \b
+    Examples:
+      lutbake fit karis-mobile --lang hlsl -o env_brdf_approx.hlsl
+      lutbake fit gotanda-eq8 --json
+    """
+    import json
+
+    from .fit import fit as run_fit
+    from .io.atomic import atomic_write_bytes
+
+    _quiet()
+    result = run_fit(family)
+    if as_json:
+        click.echo(
+            json.dumps(
+                {
+                    "family": family,
+                    "published": list(result.published),
+                    "refit": list(result.refit),
+                    "errors": result.errors,
+                },
+                indent=1,
+            )
+        )
+    else:
+        click.echo(result.text())
+    if out is not None:
+        atomic_write_bytes(out, result.code[lang].encode())
+        click.echo(str(out))
+    elif not as_json:
+        click.echo(result.code[lang])

@@ -1,0 +1,123 @@
+"""dfg layouts that add an engine's pre-integrated diffuse term as channel B (Unity HDRP PreIntegratedFGD).
+
+``multiscatter_disney``: R = ∫ f/F Fc (n.l), G = ∫ f/F (n.l) (the multiscatter layout, lutbake.kinds.dfg), and
+    B = (1/pi) ∫ Fd_disney_hdrp(n.v, n.l, l.v, r) (n.l) dω_l - 0.5
+the Disney diffuse FGD that HDRP stores shifted by -0.5 (its shader adds 0.5 back: diffuseFGD = preFGD.z + 0.5;
+preIntegratedFGD_GGXDisneyDiffuse.shader, PreIntegratedFGD.hlsl). r is the perceptual roughness, alpha = r^2.
+
+The diffuse integral is smooth over the hemisphere (no lobe), so it has its own quadrature: product Gauss-Legendre
+in mu = n.l in (0, 1) and phi in (0, pi) (the integrand is even in phi), with the cosine folded in:
+    (1/pi) ∫ g (n.l) dω = (2/pi) ∫_0^pi ∫_0^1 g(mu, phi) mu dmu dphi.
+The integrand is a polynomial in mu and cos(phi) times sqrt(1 - mu^2) (through l.v): DIFFUSE_ORDER nodes per
+dimension reach 1e-9 (tested against scipy's adaptive quadrature).
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import warp as wp
+
+from ..sampling.plan import TexelPlan
+from ..terms.engine_diffuse import Fd_disney_hdrp
+
+DIFFUSE_ORDER = 24  # Gauss-Legendre nodes per dimension (mu, phi)
+HDRP_DIFFUSE_OFFSET = 0.5  # HDRP stores the Disney FGD minus 0.5 (range [0.5, 1.5] -> [0, 1] for its UNORM target)
+LAYOUTS = {
+    "multiscatter_disney": "multiscatter + B = (1/pi) ∫ Fd_disney (n.l) dω - 0.5: Unity HDRP "
+    "PreIntegratedFGD_GGXDisneyDiffuse",
+}
+CHANNELS = {
+    "multiscatter_disney": {
+        "fc": "∫ f/F (1 - v.h)^5 (n.l) dω_l: the f90 weight (HDRP preFGD.x)",
+        "e_ss": "∫ f/F (n.l) dω_l: E with F = 1, HDRP's 'reflectivity' (preFGD.y)",
+        "disney_fgd_minus_half": "(1/pi) ∫ Fd_disney(n.v, n.l, l.v, r) (n.l) dω_l - 0.5, Burley diffuse without 1/pi "
+        "normalised by 1.03571 as HDRP's DisneyDiffuseNoPI (preFGD.z; diffuseFGD = z + 0.5)",
+    },
+}
+RECONSTRUCTION = {
+    "multiscatter_disney": "uv = Remap01ToHalfTexelCoord(vec2(sqrt(NoV), perceptualRoughness), 64); t = texture(lut, "
+    "uv).rgb; specularFGD = mix(t.r, t.g, f0); diffuseFGD = t.b + 0.5; reflectivity = t.g",
+}
+BASE_LAYOUT = {"multiscatter_disney": "multiscatter"}
+
+
+@functools.lru_cache(maxsize=None)
+def diffuse_kernel():
+    @wp.kernel(enable_backward=False)
+    def disney_fgd(
+        nov: wp.array(dtype=float),
+        r: wp.array(dtype=float),
+        x: wp.array(dtype=wp.float64),
+        w: wp.array(dtype=wp.float64),
+        out: wp.array(dtype=wp.float64),
+    ):
+        i = wp.tid()
+        NoV = nov[i]
+        v = wp.vec3(wp.sqrt(wp.max(1.0 - NoV * NoV, 0.0)), 0.0, NoV)
+        acc = wp.float64(0.0)
+        n = x.shape[0]
+        for a in range(n):
+            mu = float(wp.float64(0.5) * (x[a] + wp.float64(1.0)))
+            sin_l = wp.sqrt(wp.max(1.0 - mu * mu, 0.0))
+            for b in range(n):
+                phi = float(wp.float64(0.5) * (x[b] + wp.float64(1.0))) * wp.pi
+                l = wp.vec3(sin_l * wp.cos(phi), sin_l * wp.sin(phi), mu)
+                g = Fd_disney_hdrp(NoV, mu, wp.dot(l, v), r[i]) * mu
+                acc += w[a] * w[b] * wp.float64(g)
+        # (2/pi) * (1/2 for mu in (0, 1)) * (pi/2 for phi in (0, pi)) = 1/2
+        out[i] = acc * wp.float64(0.5)
+
+    return disney_fgd
+
+
+def disney_fgd(nov: np.ndarray, perceptual_roughness: np.ndarray, device: str = "cpu") -> np.ndarray:
+    """(1/pi) ∫ Fd_disney_hdrp (n.l) dω_l at every (NoV, r), float64 (no -0.5 offset)."""
+    x, w = np.polynomial.legendre.leggauss(DIFFUSE_ORDER)
+    out = wp.zeros(len(nov), dtype=wp.float64, device=device)
+    wp.launch(
+        diffuse_kernel(),
+        dim=len(nov),
+        device=device,
+        inputs=[
+            wp.array(np.ascontiguousarray(nov, np.float32), dtype=float, device=device),
+            wp.array(np.ascontiguousarray(perceptual_roughness, np.float32), dtype=float, device=device),
+            wp.array(x, dtype=wp.float64, device=device),
+            wp.array(w, dtype=wp.float64, device=device),
+            out,
+        ],
+    )
+    return out.numpy()
+
+
+def with_diffuse_channel(plan: TexelPlan, nov: np.ndarray, perceptual_roughness: np.ndarray) -> TexelPlan:
+    """The plan of the base layout with channel B = disney_fgd - HDRP_DIFFUSE_OFFSET appended (same tiles)."""
+    base_tile = plan.run_tile
+
+    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
+        b = disney_fgd(nov[start:stop], perceptual_roughness[start:stop], device) - HDRP_DIFFUSE_OFFSET
+        return np.concatenate([base_tile(start, stop, device), b[:, None]], axis=1)
+
+    base_prepare = plan.prepare
+
+    def prepare(device: str) -> None:
+        base_prepare(device)
+        wp.load_module(diffuse_kernel().module, device=device)
+
+    base_estimate = plan.error_estimate
+    nch = plan.n_channels
+    if base_estimate is not None:  # the specular channels' estimate; B's quadrature is checked in the tests
+        plan.error_estimate = lambda data, device: base_estimate(np.ascontiguousarray(data[:, :nch]), device)
+    plan.run_tile, plan.prepare, plan.n_channels = run_tile, prepare, nch + 1
+    return plan
+
+
+def perceptual_roughness_grid(axes) -> np.ndarray:
+    """Per-texel perceptual roughness of a [y, x] dfg grid (row-major), from the roughness axis' values."""
+    y_axis, x_axis = axes
+    rough, other = (y_axis, x_axis) if x_axis.name == "NoV" else (x_axis, y_axis)
+    r = rough.values().astype(np.float64)
+    if rough.name == "alpha":
+        r = np.sqrt(r)
+    return np.repeat(r, other.count) if rough is y_axis else np.tile(r, other.count)

@@ -1,0 +1,187 @@
+"""lutbake audit: finds, on its own, the known defects of shipped tables and of broken copies of a lutbake table.
+
+Shipped tables (tests/data, provenance in the .json beside each): Filament cmgen's DFG (one-texel roughness
+offset, 1024 Hammersley samples, half floats) and the glTF Sample Viewer's lut_ggx (8-bit, 1024 samples).
+Broken copies of a lutbake table are built here: sRGB-decoded, rows flipped, half-texel shifted.
+"""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from lutbake.audit import audit
+from lutbake.cli import main
+from lutbake.integrands.specular import hemisphere_integral
+
+DATA = Path(__file__).parent / "data"
+N = 32  # side of the lutbake tables the broken copies are made of
+MAX_SIDE = 32  # audit subset in these tests (speed)
+CLEAN_TOL = 1e-5  # a lutbake table re-audited under its own conventions: GL 432 vs GL 432 at the same points
+FILAMENT_SAMPLES = 1024  # cmgen's DFG sample count (filament_dfg.json)
+GLTF_SAMPLES = 1024  # glTF IBL sampler's lut_ggx sample count (khronos_lut_ggx_u8.json)
+SAMPLES_FACTOR = 2.0  # the estimated sample count must lie within this factor of the generator's
+
+
+def dfg_at(r_rows: np.ndarray, nov_cols: np.ndarray) -> np.ndarray:
+    """scale/bias at perceptual roughness r (rows) x NoV (columns): lutbake's integrand at points built here."""
+    nov, r = np.meshgrid(nov_cols, r_rows)
+    out = hemisphere_integral("ggx", "smith_height_correlated", "scale_bias", nov.ravel(), r.ravel() ** 2)
+    return out.reshape(len(r_rows), len(nov_cols), 2)
+
+
+@pytest.fixture(scope="module")
+def clean():
+    c = (np.arange(N) + 0.5) / N
+    return dfg_at(c, c)
+
+
+def srgb_decode(v):
+    """IEC 61966-2-1 EOTF, written out here independently of lutbake.audit."""
+    return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
+
+
+def run(path, **kw):
+    return audit(path, {"preset": kw.pop("preset", "default")}, max_side=MAX_SIDE, **kw)
+
+
+def test_filament_shipped_table_one_texel_roughness_offset_found():
+    r = run(DATA / "filament_dfg.npz", preset="filament-corrected")
+    assert r.extra["chosen"] == "roughness_offset_+1"
+    assert "convention mismatch" in r.diagnosis[0]
+    assert r.quantisation["kind"] == "half"
+    assert FILAMENT_SAMPLES / SAMPLES_FACTOR <= r.noise["samples"] <= FILAMENT_SAMPLES * SAMPLES_FACTOR
+    assert not r.passed
+
+
+def test_filament_preset_conventions_fit_the_shipped_table():
+    r = run(DATA / "filament_dfg.npz", preset="filament")
+    assert r.extra["chosen"] == "nominal"
+    nominal = next(h for h in r.hypotheses if h["name"] == "nominal")
+    others = [h["rms"] for h in r.hypotheses if h["name"] != "nominal"]
+    assert nominal["rms"] < 0.1 * min(others)
+
+
+def test_gltf_lut_ggx_8bit_quantisation_and_sample_noise_found():
+    r = run(DATA / "khronos_lut_ggx_u8.npz", preset="gltf")
+    assert r.extra["chosen"] == "nominal"
+    assert r.quantisation["kind"] == "unorm8"
+    np.testing.assert_allclose(r.quantisation["step"], 1 / 255)
+    assert r.noise["detected"]
+    assert r.noise["rms_residual"] > 1.5 * r.noise["rms_quantisation_alone"]
+    assert GLTF_SAMPLES / SAMPLES_FACTOR <= r.noise["samples"] <= GLTF_SAMPLES * SAMPLES_FACTOR
+
+
+def test_clean_lutbake_table_passes_and_shows_no_defect(clean, tmp_path):
+    p = tmp_path / "clean.npy"
+    np.save(p, clean.astype(np.float32))
+    r = run(p, tolerance=CLEAN_TOL)
+    assert r.passed and r.extra["chosen"] == "nominal"
+    assert r.quantisation["kind"] == "float"
+    assert not r.noise["detected"]
+
+
+@pytest.mark.parametrize(
+    "name, make, expected",
+    [
+        ("srgb", lambda t: srgb_decode(t), "srgb_decoded"),
+        ("flipped", lambda t: t[::-1], "rows_flipped"),
+        ("swapped", lambda t: t[..., ::-1], "channels_swapped"),
+    ],
+)
+def test_broken_copy_is_diagnosed(clean, tmp_path, name, make, expected):
+    p = tmp_path / f"{name}.npy"
+    np.save(p, make(clean).astype(np.float32))
+    r = run(p)
+    assert r.extra["chosen"] == expected, r.text()
+    assert not r.passed
+
+
+@pytest.mark.parametrize("shift", [-0.5, 0.5])
+def test_half_texel_shifted_copy_is_diagnosed(tmp_path, shift):
+    c = (np.arange(N) + 0.5) / N
+    shifted = dfg_at(np.clip(c + shift / N, 0, 1), c)  # roughness rows hold r = (i + 0.5 + shift)/N
+    p = tmp_path / "shifted.npy"
+    np.save(p, shifted.astype(np.float32))
+    r = run(p)
+    assert r.extra["chosen"] == f"roughness_offset_{shift:+g}", r.text()
+
+
+def test_audit_reads_png16_exr_ktx2_and_a_c_header(clean, tmp_path):
+    from lutbake.axes import Axis
+    from lutbake.io.formats import write_table
+    from lutbake.table import Table
+
+    axes = [Axis("perceptual_roughness", "y", N), Axis("NoV", "x", N)]
+    table = Table("t", "dfg", clean.astype(np.float32), axes, {"scale": "", "bias": ""}, "")
+    for fmt, tol in (("png16", 1 / 65535), ("exr", CLEAN_TOL), ("ktx2", 1e-3), ("h", 1e-3)):
+        path = write_table(table, tmp_path, fmt, "half" if fmt in ("ktx2", "h") else "float32")
+        r = run(path, tolerance=tol)
+        assert r.passed and r.extra["chosen"] == "nominal", (fmt, r.text())
+
+
+def test_cli_json_exit_codes_and_error_map(clean, tmp_path):
+    p = tmp_path / "flipped.npy"
+    np.save(p, clean[::-1].astype(np.float32))
+    png = tmp_path / "err.png"
+    res = CliRunner().invoke(main, ["audit", str(p), "--json", "--max-side", "16", "--error-map", str(png)])
+    assert res.exit_code == 1, res.output
+    doc = json.loads(res.output)
+    assert doc["extra"]["chosen"] == "rows_flipped" and not doc["passed"]
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    q = tmp_path / "clean.npy"
+    np.save(q, clean.astype(np.float32))
+    res = CliRunner().invoke(main, ["audit", str(q), "--max-side", "16", "--tolerance", "1e-5"])
+    assert res.exit_code == 0, res.output
+    assert "PASS" in res.output
+    res = CliRunner().invoke(main, ["audit", str(q), "--preset", "no-such-engine"])
+    assert res.exit_code == 2 and "no-such-engine" in res.output
+
+
+def test_threejs_shipped_js_array_fits_the_threejs_preset():
+    r = run(DATA / "threejs_dfg_lut.js", preset="threejs", shape=(16, 16, 2))
+    assert r.extra["chosen"] == "nominal" and r.quantisation["kind"] == "half"
+    nominal = next(h for h in r.hypotheses if h["name"] == "nominal")
+    assert nominal["rms"] < 0.1 * min(h["rms"] for h in r.hypotheses if h["name"] != "nominal")
+
+
+def test_threejs_shipped_table_is_height_correlated_not_separable():
+    hc = run(DATA / "threejs_dfg_lut.js", preset="threejs", shape=(16, 16, 2))
+    sep = audit(
+        DATA / "threejs_dfg_lut.js",
+        {"preset": "threejs", "overrides": ["masking=smith_separable"]},
+        max_side=MAX_SIDE,
+        shape=(16, 16, 2),
+    )
+    assert hc.hypotheses[0]["rms"] < 0.1 * sep.hypotheses[0]["rms"]
+
+
+def test_unity_hdrp_table_audits_clean_and_its_sqrt_axis_flip_is_found(tmp_path):
+    """A lutbake unity-hdrp table (Disney channel B, x = sqrt(NoV), endpoints) re-audited under its preset."""
+    import lutbake
+    from lutbake.config import load_config, preset_path
+
+    spec = load_config(preset_path("unity-hdrp"), [(None, "size", [16, 16])])[0]
+    table, _, _ = lutbake.bake_table(spec)
+    p = tmp_path / "hdrp.npy"
+    np.save(p, table.data)
+    r = run(p, preset="unity-hdrp", tolerance=CLEAN_TOL)
+    assert r.passed and r.extra["chosen"] == "nominal", r.text()
+    q = tmp_path / "hdrp_flipped.npy"
+    np.save(q, table.data[:, ::-1])
+    assert run(q, preset="unity-hdrp").extra["chosen"] == "columns_flipped"
+
+
+def test_cli_rejects_non_finite_values_and_undeclared_text_layouts(clean, tmp_path):
+    p = tmp_path / "nan.npy"
+    bad = clean.astype(np.float32).copy()
+    bad[3, 5, 1] = np.nan
+    np.save(p, bad)
+    res = CliRunner().invoke(main, ["audit", str(p)])
+    assert res.exit_code == 2 and "row 3, column 5, channel G" in res.output
+    js = tmp_path / "lut.js"
+    js.write_text("const DATA = new Uint16Array( [ 0x3c00, 0x0000 ] );\n")
+    res = CliRunner().invoke(main, ["audit", str(js)])
+    assert res.exit_code == 2 and "--shape" in res.output
