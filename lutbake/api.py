@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import batch
+from . import batch, preflight
 from .config import TableSpec, load_configs
 from .errors import TableError
 from .executor import Progress
@@ -61,7 +61,9 @@ def bake(
             if on_result:
                 on_result(results[-1])
         return results
+    preflight.check_out_dir(out_dir)
     jobs = batch.schedule(specs, out_dir, force=force)
+    preflight.check_outputs(jobs)
     results: dict[int, BakeResult] = {}
 
     def done(job: batch.Job):

@@ -87,10 +87,23 @@ def check_out_dir(out_dir) -> None:
 
 def check_outputs(jobs) -> None:
     """Every output path and sidecar path must be a regular file or absent (a directory or device there fails
-    the rename after the bake)."""
+    the rename after the bake); a ``png16`` output must be a 2D table (PNG has no depth: the table's shape comes
+    from its plan, which runs no kernel)."""
     from .io.integrity import sidecar_path
+    from .kinds import lookup_kind
 
     for job in jobs:
+        if job.status == "pending" and job.spec.options.get("format") == "png16":
+            shape = lookup_kind(job.spec.kind).plan(job.spec).shape
+            if len(shape) > 3:
+                raise ConfigError(
+                    job.spec.source,
+                    "format",
+                    "png16",
+                    "exr, npy, dds, ktx2, h",
+                    f"png16 holds 2D tables only; this table is {' x '.join(map(str, shape[:-1]))} texels",
+                    table=job.name,
+                )
         paths = (job.path,) if job.path.suffix == ".exr" else (job.path, sidecar_path(job.path))
         for p in paths:
             if os.path.lexists(p) and not p.is_symlink() and not p.is_file():

@@ -112,6 +112,26 @@ def test_png16_of_a_table_above_one_is_refused_at_plan_time(tmp_path, no_kernel)
     assert not (tmp_path / "o").exists()
 
 
+def test_png16_of_a_3d_table_is_refused_at_plan_time(tmp_path, no_kernel):
+    p = tmp_path / "s3.toml"
+    p.write_text('[[table]]\nname = "s3"\nkind = "specular_3d"\nsize = [8, 8]\nf0_size = 4\nformat = "png16"\n')
+    refused(bake(p, "--out-dir", tmp_path / "o"), "'format'", "png16 holds 2D tables only", "4 x 8 x 8")
+    assert not (tmp_path / "o").exists()
+
+
+def test_python_api_makes_the_same_plan_time_checks(cfg, tmp_path, no_kernel):
+    import lutbake
+    from lutbake.errors import ConfigError
+
+    (tmp_path / "f").write_text("")
+    with pytest.raises(ConfigError, match="is a file, not a directory"):
+        lutbake.bake([cfg], out_dir=tmp_path / "f" / "o")
+    p = tmp_path / "s3.toml"
+    p.write_text('[[table]]\nname = "s3"\nkind = "specular_3d"\nsize = [8, 8]\nf0_size = 4\nformat = "png16"\n')
+    with pytest.raises(ConfigError, match="png16 holds 2D tables only"):
+        lutbake.bake([p], out_dir=tmp_path / "o")
+
+
 # --------------------------------------------------------- items 4 and 8: --report checked up front
 
 
