@@ -185,19 +185,24 @@ def _first_comment(path: Path) -> str:
 @main.command()
 @click.argument("file", type=click.Path(path_type=Path))
 def inspect(file):
-    """Print a baked table's kind, axes, channels, reconstruction, provenance and statistics.
+    """Print what a table file holds: kind, axes, channels, reconstruction, provenance and statistics.
+
+    Reads every format lutbake writes, recognised by its first bytes (EXR, .npy, PNG, DDS, KTX2, C
+    header, and the .json sidecars, with the data file they name); a table without lutbake metadata
+    (as an engine ships it) gets its format, size, channels and value ranges.
 
     \b
-    Example:
+    Examples:
       lutbake inspect outputs/dfg.exr
+      lutbake inspect outputs/filament_dfg.dds      # metadata from its .json sidecar
     """
-    from .io.exr import describe_exr
+    from .errors import LutbakeError
+    from .io.describe import describe
 
-    _quiet_warp()
     try:
-        click.echo(describe_exr(file))
-    except (OSError, ValueError) as e:
-        click.echo(f"error: {file}: {e}", err=True)
+        click.echo(describe(file), nl=False)
+    except (LutbakeError, OSError) as e:
+        click.echo(f"error: {e}", err=True)
         sys.exit(EXIT_CONFIG)
 
 
@@ -254,13 +259,16 @@ def validate():
 @click.option("-o", "--out", type=click.Path(path_type=Path), default=None,
               help="PNG to write (default: FILE's stem + .preview.png beside it).")
 def preview(file, out):
-    """Render a PNG of a baked table: each channel colour-mapped with labelled axes, and (dfg) a row of
-    spheres lit with the split-sum through the table. Reads EXR, or .npy with its .json sidecar.
+    """Render a PNG of a table file (any format lutbake writes; see inspect): 1D tables as curves, 2D
+    tables as colour-mapped channels with labelled axes, 3D tables as labelled slice grids, btf tables as
+    light x view images per sigma and phi; and, where the table has a split-sum reconstruction, a row of
+    spheres shaded with it.
 
     \b
     Example:
       lutbake preview outputs/dfg.exr        # -> outputs/dfg.preview.png
     """
+    from .errors import LutbakeError
     from .preview import render
 
     try:
@@ -268,8 +276,8 @@ def preview(file, out):
     except ImportError as e:
         click.echo(f"error: preview needs matplotlib (pip install 'lutbake[plot]'): {e}", err=True)
         sys.exit(EXIT_CONFIG)
-    except (OSError, ValueError, KeyError) as e:
-        click.echo(f"error: {file}: {e}", err=True)
+    except (LutbakeError, OSError) as e:
+        click.echo(f"error: {e}", err=True)
         sys.exit(EXIT_CONFIG)
     click.echo(str(path))
 

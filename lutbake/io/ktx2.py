@@ -1,4 +1,4 @@
-"""KTX 2.0 writer, per the Khronos KTX File Format Specification 2.0 and the Khronos Data Format
+"""KTX 2.0 writer and reader, per the Khronos KTX File Format Specification 2.0 and the Khronos Data Format
 Specification 1.3 (basic data format descriptor). Uncompressed, one mip level, no supercompression:
 - 2D tables (y, x, C) -> a 2D texture; 3D tables (z, y, x, C) -> a 3D texture (pixelDepth = z), or, with
   ``array=True``, a 2D array texture (layerCount = z).
@@ -90,3 +90,53 @@ def encode(pixels: np.ndarray, metadata: dict[str, str] | None = None, array: bo
     head += struct.pack("<QQQ", level_off, len(level), len(level))
     assert len(head) == header_len
     return head + dfd + kvd + b"\0" * (level_off - end) + level
+
+
+FROM_VK = {v: k for k, v in VK_FORMAT.items()}
+
+
+def _kv_pairs(blob: bytes, start: int, length: int) -> dict[str, str]:
+    """Key/value data: repeated (u32 keyAndValueByteLength, key NUL value NUL, padding to 4 bytes)."""
+    pairs, pos, end = {}, start, start + length
+    while pos + 4 <= end:
+        (n,) = struct.unpack_from("<I", blob, pos)
+        if n == 0 or pos + 4 + n > end:
+            raise ValueError(f"KTX2 key/value entry at byte {pos} runs past the key/value data")
+        key, sep, value = blob[pos + 4:pos + 4 + n].partition(b"\0")
+        if not sep:
+            raise ValueError(f"KTX2 key/value entry at byte {pos} has no NUL after its key")
+        pairs[key.decode("utf-8", "replace")] = value.rstrip(b"\0").decode("utf-8", "replace")
+        pos += 4 + n + (-n % 4)
+    return pairs
+
+
+def decode(blob: bytes) -> tuple[np.ndarray, dict]:
+    """Read an uncompressed float KTX 2.0 file (what ``encode`` writes): (array (y, x, C), or (z, y, x, C)
+    for a 3D or array texture, as stored; facts incl. the key/value data). Only level 0 is read. Every
+    offset and size is checked against the file length first; a ValueError says what is wrong."""
+    if blob[:12] != IDENTIFIER:
+        raise ValueError("not a KTX 2.0 file (bad identifier)")
+    if len(blob) < 104:
+        raise ValueError(f"KTX2 file of {len(blob)} bytes is shorter than its header (104 bytes)")
+    vk, type_size, width, height, depth, layers, faces, levels, scheme = struct.unpack_from("<9I", blob, 12)
+    _, _, kvd_off, kvd_len, _, _ = struct.unpack_from("<4I2Q", blob, 48)
+    level_off, level_len, _ = struct.unpack_from("<3Q", blob, 80)
+    if vk not in FROM_VK:
+        raise ValueError(f"vkFormat {vk} is not one lutbake reads ({', '.join(VK_FORMAT_NAMES.values())})")
+    if scheme != 0:
+        raise ValueError(f"KTX2 supercompression scheme {scheme} (lutbake reads uncompressed files only)")
+    if faces != 1:
+        raise ValueError(f"KTX2 with {faces} faces (lutbake reads 2D, 3D and array textures)")
+    if kvd_off + kvd_len > len(blob):
+        raise ValueError(f"KTX2 key/value data [{kvd_off}, +{kvd_len}) runs past the file ({len(blob)} bytes)")
+    dtype, nch = FROM_VK[vk]
+    npdt = np.dtype("<f2" if dtype == "half" else "<f4")
+    shape = ((depth,) if depth else (layers,) if layers else ()) + (height, width, nch)
+    need = int(np.prod(shape, dtype=object)) * npdt.itemsize
+    if min(shape) < 1 or need > level_len or level_off + need > len(blob):
+        raise ValueError(f"KTX2 header says {' x '.join(map(str, shape))} {VK_FORMAT_NAMES[vk]} ({need} bytes) but "
+                         f"level 0 holds {level_len} bytes at offset {level_off} of a {len(blob)}-byte file")
+    arr = np.frombuffer(blob, dtype=npdt, count=int(np.prod(shape)), offset=level_off).reshape(shape)
+    kv = _kv_pairs(blob, kvd_off, kvd_len)
+    return arr, {"vk_format": VK_FORMAT_NAMES[vk], "dimension": "3D" if depth else "2D array" if layers else "2D",
+                 "levels": max(levels, 1), "key_value": kv}

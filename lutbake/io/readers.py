@@ -1,0 +1,440 @@
+"""Read every file lutbake writes, and the tables engines ship: one reader per format, chosen by the
+file's first bytes (its magic number), never by its extension.
+
+| format | magic | pixels | lutbake metadata |
+| --- | --- | --- | --- |
+| EXR | ``76 2f 31 01`` | OpenImageIO, any channels, every part (a 3D table: one part per z slice) | ``lutbake:*`` header attributes |
+| NumPy | ``\\x93NUMPY`` | ``np.load`` (no pickles), 2 to 4 dimensions | the ``.json`` sidecar |
+| PNG | ``\\x89PNG\\r\\n\\x1a\\n`` | OpenImageIO; 16-bit codes / 65535 (8-bit / 255), linear | the ``.json`` sidecar |
+| DDS | ``DDS `` | lutbake.io.dds.decode (DX10 float formats, which OpenImageIO 3.x cannot read) | the ``.json`` sidecar |
+| KTX2 | ``«KTX 20»\\r\\n\\x1a\\n`` | lutbake.io.ktx2.decode | ``lutbake:metadata`` key/value, else the sidecar |
+| C header | text from ``/*``, ``//`` or ``#`` | the ``static const`` array and its ``_WIDTH`` ... macros | the ``.json`` sidecar |
+| sidecar | text from ``{`` | the data file it names (``"file"``) | its ``"lutbake"`` object |
+
+``read(path)`` returns a :class:`LoadedFile` (pixels as stored, including a GPU format's padding
+channel); ``table_view(loaded)`` checks the metadata against the pixels and returns a
+:class:`TableView` (axes rebuilt as :class:`lutbake.axes.Axis`, channels trimmed to the table's). A
+file lutbake cannot read, or metadata that does not fit its pixels, raises :class:`ReadError`: one line
+that names the file once and says what is wrong. A file without lutbake metadata still reads: format,
+size, channels and values.
+"""
+from __future__ import annotations
+
+import json
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..axes import IMAGE_DIMS, MAPPINGS, ORDERS, TEXELS, Axis
+from ..errors import LutbakeError
+from . import dds, ktx2
+
+PREFIX = "lutbake:"
+MAGIC_BYTES = 16  # enough to tell every format apart
+MAX_AXIS_COUNT = 1 << 20  # no lutbake axis is longer (the texel cap is 2^24 in all)
+MAX_FILE_BYTES = 4 << 30  # a table is at most 2^24 texels x 4 channels x 4 bytes = 256 MiB; headers are text
+EXR_MAGIC = b"\x76\x2f\x31\x01"
+NPY_MAGIC = b"\x93NUMPY"
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+FORMAT_NAMES = {"exr": "OpenEXR", "npy": "NumPy .npy", "png": "PNG", "dds": "DDS", "ktx2": "KTX 2.0",
+                "h": "C header", "sidecar": "lutbake .json sidecar"}
+
+
+class ReadError(LutbakeError, ValueError):
+    """A file lutbake cannot read, or metadata that does not fit the file (the message names the file)."""
+
+
+@dataclass
+class LoadedFile:
+    path: Path
+    format: str  # a key of FORMAT_NAMES
+    data: np.ndarray | None  # float32, (y, x, C) or (z, y, x, C), as stored; None: a sidecar whose data is missing
+    attrs: dict[str, str]  # lutbake attributes without the prefix; {} when the file carries none
+    meta_source: str | None  # where ``attrs`` came from ("EXR header", "sidecar dfg.json", ...)
+    facts: dict = field(default_factory=dict)  # what the container says: pixel type, texture format, parts ...
+    notes: list[str] = field(default_factory=list)  # why metadata is missing, and the like
+
+
+@dataclass
+class TableView:
+    """A read table with its metadata checked against its pixels (``kind`` None: no lutbake metadata)."""
+
+    loaded: LoadedFile
+    data: np.ndarray  # float32, (y, x, C) or (z, y, x, C), channels trimmed to the table's
+    axes: list[Axis]  # [] without metadata
+    channel_names: list[str]  # one per channel of ``data``
+    meanings: list[str]
+    kind: str | None
+    name: str
+    terms: dict
+    reconstruction: str
+
+    @property
+    def attrs(self) -> dict[str, str]:
+        return self.loaded.attrs
+
+
+def sniff(path: Path) -> str:
+    """The format of ``path`` from its first bytes (FORMAT_NAMES); ReadError for anything else."""
+    if not path.exists():
+        raise ReadError(f"{path}: no such file")
+    if not path.is_file():
+        raise ReadError(f"{path}: not a regular file")
+    with open(path, "rb") as f:
+        head = f.read(MAGIC_BYTES)
+    for magic, fmt in ((EXR_MAGIC, "exr"), (NPY_MAGIC, "npy"), (PNG_MAGIC, "png"), (dds.MAGIC, "dds"),
+                       (ktx2.IDENTIFIER, "ktx2")):
+        if head.startswith(magic):
+            return fmt
+    text = head.lstrip(b"\xef\xbb\xbf \t\r\n")
+    if text.startswith(b"{"):
+        return "sidecar"
+    if text.startswith((b"/*", b"//", b"#")):
+        return "h"
+    shown = head[:8].hex(" ") if head else "nothing (an empty file)"
+    raise ReadError(f"{path}: not a format lutbake reads (EXR, npy, PNG, DDS, KTX2, C header, .json sidecar): "
+                    f"it starts with {shown}")
+
+
+def read(path) -> LoadedFile:
+    """Read any file lutbake writes (see the module docstring), dispatched by its magic bytes."""
+    path = Path(path)
+    fmt = sniff(path)
+    size = path.stat().st_size
+    if size > MAX_FILE_BYTES:
+        raise ReadError(f"{path}: {size} bytes is larger than any table lutbake writes ({MAX_FILE_BYTES} bytes)")
+    try:
+        return READERS[fmt](path)
+    except (LutbakeError, MemoryError):
+        raise
+    except OSError as e:
+        raise ReadError(f"{path}: cannot read: {e.strerror or e}") from None
+    except (ValueError, KeyError, TypeError, IndexError, OverflowError, UnicodeDecodeError, EOFError) as e:
+        raise ReadError(f"{path}: not a readable {FORMAT_NAMES[fmt]} file: {e}") from None
+
+
+# ------------------------------------------------------------------------------------------ readers
+
+
+def _as_table_array(arr: np.ndarray) -> np.ndarray:
+    """float32 (y, x, C) or (z, y, x, C): a 2D array gains a channel axis."""
+    if arr.dtype.kind not in "fiub":
+        raise ValueError(f"array of dtype {arr.dtype} holds no numbers")
+    if arr.ndim == 2:
+        arr = arr[..., None]
+    if arr.ndim not in (3, 4) or arr.shape[-1] > 4 or 0 in arr.shape:
+        raise ValueError(f"array of shape {arr.shape} is not a table: lutbake reads (y, x), (y, x, C) or "
+                         "(z, y, x, C) with 1 to 4 channels")
+    return np.ascontiguousarray(arr, dtype=np.float32)
+
+
+def _exr_attrs(spec) -> dict[str, str]:
+    return {p.name[len(PREFIX):]: p.value if isinstance(p.value, str) else json.dumps(p.value)
+            for p in spec.extra_attribs if p.name.startswith(PREFIX)}
+
+
+def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
+    """Every part of an EXR: (float32 pixels (y, x, C), lutbake attributes, facts). Channels R, G, B, A
+    come in that order; any other channel names are kept in file order."""
+    import OpenImageIO as oiio  # imported here: only EXR and PNG need it
+
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
+    parts = []
+    try:
+        k = 0
+        while inp.seek_subimage(k, 0):
+            spec = inp.spec()
+            names = list(spec.channelnames)
+            rgba = [c for c in "RGBA" if c in names]
+            order = rgba if len(rgba) == len(names) else names
+            arr = inp.read_image(k, 0, 0, len(names), "float")
+            if arr is None:
+                raise ValueError(f"cannot read the pixels of part {k}: {inp.geterror()}")
+            arr = np.asarray(arr, dtype=np.float32).reshape(spec.height, spec.width, len(names))
+            arr = np.ascontiguousarray(arr[..., [names.index(c) for c in order]])
+            facts = {"pixel_type": str(spec.format), "compression": spec.getattribute("compression"),
+                     "part": spec.getattribute("name") or spec.getattribute("oiio:subimagename"), "channels": order}
+            parts.append((arr, _exr_attrs(spec), facts))
+            k += 1
+    finally:
+        inp.close()
+    if not parts:
+        raise ValueError("no image part")
+    return parts
+
+
+def read_exr(path: Path) -> LoadedFile:
+    parts = exr_parts(path)
+    shapes = {p[0].shape for p in parts}
+    if len(shapes) != 1:
+        raise ValueError(f"its parts have different shapes {sorted(shapes)}")
+    attrs = {k: v for k, v in parts[0][1].items() if k not in ("slice_index", "slice_value")}
+    facts = {**parts[0][2], "parts": [(f["part"], a.get("slice_value")) for _, a, f in parts]}
+    if len(parts) == 1 and "slice_index" not in parts[0][1]:
+        data = parts[0][0]
+    else:
+        order = [int(a.get("slice_index", k)) for k, (_, a, _) in enumerate(parts)]
+        if sorted(order) != list(range(len(order))):
+            raise ValueError(f"slice indices {order} are not 0..{len(order) - 1}")
+        data = np.stack([parts[order.index(k)][0] for k in range(len(order))])
+    return LoadedFile(path, "exr", data, attrs, "EXR header" if attrs else None, facts)
+
+
+def read_npy(path: Path) -> LoadedFile:
+    arr = np.load(path, mmap_mode="r", allow_pickle=False)
+    data = _as_table_array(np.asarray(arr))
+    return _with_sidecar(LoadedFile(path, "npy", data, {}, None, {"dtype": str(arr.dtype), "shape": list(arr.shape)}))
+
+
+def read_png(path: Path) -> LoadedFile:
+    import OpenImageIO as oiio
+
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
+    try:
+        spec = inp.spec()
+        bits = 16 if str(spec.format) == "uint16" else 8
+        arr = inp.read_image("uint16" if bits == 16 else "uint8")
+        if arr is None:
+            raise ValueError(inp.geterror())
+        codes = np.asarray(arr).reshape(spec.height, spec.width, spec.nchannels)
+    finally:
+        inp.close()
+    data = _as_table_array(codes.astype(np.float64) / float((1 << bits) - 1))
+    facts = {"bit_depth": bits, "channels": list(spec.channelnames), "encoding": f"code / {(1 << bits) - 1}"}
+    return _with_sidecar(LoadedFile(path, "png", data, {}, None, facts))
+
+
+def read_dds(path: Path) -> LoadedFile:
+    arr, facts = dds.decode(path.read_bytes())
+    return _with_sidecar(LoadedFile(path, "dds", _as_table_array(arr), {}, None, facts))
+
+
+def read_ktx2(path: Path) -> LoadedFile:
+    arr, facts = ktx2.decode(path.read_bytes())
+    kv = facts.pop("key_value")
+    facts.update({k: v for k, v in kv.items() if k.startswith("KTX")})
+    loaded = LoadedFile(path, "ktx2", _as_table_array(arr), {}, None, facts)
+    if "lutbake:metadata" in kv:
+        try:
+            meta = json.loads(kv["lutbake:metadata"])
+        except json.JSONDecodeError as e:
+            raise ReadError(f"{path}: key/value lutbake:metadata is not valid JSON ({e})") from None
+        loaded.attrs, loaded.meta_source = _string_attrs(meta, path, "key/value lutbake:metadata"), "KTX2 key/value data"
+        return loaded
+    return _with_sidecar(loaded)
+
+
+_DEFINE = re.compile(r"^#define\s+(\w+?)_(DEPTH|HEIGHT|WIDTH|CHANNELS)\s+(\d+)\s*$", re.M)
+_ARRAY = re.compile(r"static\s+const\s+(uint16_t|float)\s+(\w+)\s*\[[^\]]*\]\s*=\s*\{([^}]*)\}", re.S)
+
+
+def read_header(path: Path) -> LoadedFile:
+    """A C header as lutbake writes it (lutbake.io.formats.header_text): size macros and one flat array
+    of floats or binary16 bit patterns."""
+    text = path.read_text(encoding="utf-8")
+    m = _ARRAY.search(text)
+    if m is None:
+        raise ValueError("no 'static const float|uint16_t NAME[...] = {...}' array")
+    ctype, ident, body = m.groups()
+    dims = {k: int(v) for macro, k, v in _DEFINE.findall(text) if macro == ident.upper()}
+    if not {"HEIGHT", "WIDTH", "CHANNELS"} <= set(dims):
+        raise ValueError(f"no {ident.upper()}_HEIGHT / _WIDTH / _CHANNELS macros for array {ident}")
+    shape = tuple(dims[k] for k in ("DEPTH", "HEIGHT", "WIDTH", "CHANNELS") if k in dims)
+    items = [s for s in (x.strip() for x in body.split(",")) if s]
+    if math.prod(shape) != len(items):
+        raise ValueError(f"array {ident} has {len(items)} values, its macros say {' x '.join(map(str, shape))}")
+    if ctype == "uint16_t":
+        data = np.array([int(s, 0) for s in items], dtype=np.uint16).view(np.float16)
+    else:
+        data = np.array([s.rstrip("fF") for s in items], dtype=np.float64)
+    loaded = LoadedFile(path, "h", _as_table_array(data.reshape(shape)), {}, None,
+                        {"array": ident, "element_type": ctype + (" (binary16 bits)" if ctype == "uint16_t" else "")})
+    return _with_sidecar(loaded)
+
+
+def _load_sidecar(path: Path) -> dict:
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as e:
+        raise ReadError(f"{path}: sidecar is not valid JSON ({e})") from None
+    if not isinstance(doc, dict):
+        raise ReadError(f"{path}: a sidecar is a JSON object with a 'lutbake' object, got {type(doc).__name__}")
+    if "lutbake" not in doc:
+        raise ReadError(f"{path}: JSON without a 'lutbake' object: not a lutbake sidecar")
+    doc["lutbake"] = _string_attrs(doc["lutbake"], path, "key 'lutbake'")
+    return doc
+
+
+def _string_attrs(meta, where: Path, what: str) -> dict[str, str]:
+    if not isinstance(meta, dict):
+        raise ReadError(f"{where}: {what} must be a JSON object of lutbake attributes, got {type(meta).__name__} "
+                        f"{json.dumps(meta)[:40]}")
+    bad = [k for k, v in meta.items() if not isinstance(v, str)]
+    if bad:
+        raise ReadError(f"{where}: {what}: attribute {bad[0]!r} must be a string, got {type(meta[bad[0]]).__name__}")
+    return dict(meta)
+
+
+def sidecar_candidates(path: Path) -> list[Path]:
+    """Where the sidecar of a data file may be: <name>.<ext>.json, then <name>.json."""
+    return [path.with_name(path.name + ".json"), path.with_suffix(".json")]
+
+
+def _with_sidecar(loaded: LoadedFile) -> LoadedFile:
+    """Attach the attributes of the sidecar that names this file (a sidecar naming another file is skipped)."""
+    for side in sidecar_candidates(loaded.path):
+        if not side.is_file() or side == loaded.path:
+            continue
+        doc = _load_sidecar(side)
+        named = doc.get("file")
+        if named not in (None, loaded.path.name):
+            loaded.notes.append(f"{side.name} describes {named}, not this file")
+            continue
+        loaded.attrs, loaded.meta_source = doc["lutbake"], f"sidecar {side.name}"
+        return loaded
+    if not loaded.notes:
+        loaded.notes.append(f"no sidecar ({' or '.join(p.name for p in sidecar_candidates(loaded.path))})")
+    return loaded
+
+
+def read_sidecar(path: Path) -> LoadedFile:
+    """A sidecar: its attributes, with the pixels of the data file it names (beside it) when present."""
+    doc = _load_sidecar(path)
+    named = doc.get("file")
+    facts = {k: v for k, v in doc.items() if k != "lutbake"}
+    if isinstance(named, str) and named and Path(named).name == named and (path.parent / named).is_file():
+        data_path = path.parent / named
+        if sniff(data_path) == "sidecar":
+            raise ReadError(f"{path}: names another sidecar ({named}) as its data file")
+        inner = READERS[sniff(data_path)](data_path)
+        facts = {**facts, "data_file": named, "data_format": FORMAT_NAMES[inner.format], **inner.facts}
+        return LoadedFile(path, "sidecar", inner.data, doc["lutbake"], f"sidecar {path.name}", facts)
+    note = f"its data file {named!r} is not beside it" if named else "it names no data file"
+    return LoadedFile(path, "sidecar", None, doc["lutbake"], f"sidecar {path.name}", facts, [note])
+
+
+READERS = {"exr": read_exr, "npy": read_npy, "png": read_png, "dds": read_dds, "ktx2": read_ktx2, "h": read_header,
+           "sidecar": read_sidecar}
+
+
+# ------------------------------------------------------------------------------- metadata vs pixels
+
+
+def _json_attr(loaded: LoadedFile, key: str, kind: type, default):
+    where = f"{loaded.path}: {'lutbake:' if loaded.format == 'exr' else 'lutbake.'}{key}"
+    if key not in loaded.attrs:
+        if default is None:
+            raise ReadError(f"{where} is missing (every lutbake table records it)")
+        return default
+    try:
+        value = json.loads(loaded.attrs[key])
+    except json.JSONDecodeError as e:
+        raise ReadError(f"{where} is not valid JSON ({e})") from None
+    if not isinstance(value, kind):
+        raise ReadError(f"{where} must be a JSON {'list' if kind is list else 'object'}, got "
+                        f"{loaded.attrs[key][:60]}")
+    return value
+
+
+def _number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def axis_from_meta(d: dict, where: str = "axis") -> Axis:
+    """An Axis rebuilt from its ``lutbake:axes`` entry (Axis.describe()), every field checked."""
+    def bad(msg):
+        raise ReadError(f"{where}: {msg}")
+
+    if not isinstance(d, dict):
+        bad(f"each axis must be a JSON object, got {json.dumps(d)[:40]}")
+    name = d.get("name")
+    if not isinstance(name, str) or not name:
+        bad(f"an axis needs a 'name' string, got {json.dumps(d)[:60]}")
+    where = f"{where} {name!r}"
+    count = d.get("count")
+    if isinstance(count, float) and count.is_integer():
+        count = int(count)
+    if not isinstance(count, int) or isinstance(count, bool) or not 1 <= count <= MAX_AXIS_COUNT:
+        bad(f"count {count!r} is not an integer in [1, {MAX_AXIS_COUNT}]")
+    choices = {"dim": IMAGE_DIMS, "texel": TEXELS, "mapping": MAPPINGS, "order": ORDERS}
+    defaults = {"dim": None, "texel": "center", "mapping": "linear", "order": "lo_first"}
+    v = {}
+    for key, allowed in choices.items():
+        v[key] = d.get(key, defaults[key])
+        if v[key] not in allowed:
+            bad(f"{key} {v[key]!r} is not one of {', '.join(allowed)}")
+    rng = d.get("range", [0.0, 1.0])
+    if not (isinstance(rng, list) and len(rng) == 2 and all(map(_number, rng))):
+        bad(f"range {json.dumps(rng)[:40]} is not [lo, hi]")
+    clamp = d.get("clamp")
+    if clamp is not None and not (isinstance(clamp, list) and len(clamp) == 2 and all(map(_number, clamp))):
+        bad(f"clamp {json.dumps(clamp)[:40]} is not [lo, hi]")
+    listed = ()
+    if v["mapping"] == "listed":
+        vals = d.get("values")
+        if not (isinstance(vals, list) and len(vals) == count and all(map(_number, vals))):
+            bad(f"mapping 'listed' needs {count} numeric values")
+        listed = tuple(float(x) for x in vals)
+    return Axis(name, v["dim"], count, float(rng[0]), float(rng[1]), texel=v["texel"], mapping=v["mapping"],
+                order=v["order"], clamp=tuple(clamp) if clamp else None, listed=listed)
+
+
+def _check_axes_fit(path: Path, axes: list[Axis], shape: tuple[int, ...]) -> None:
+    """Every axis' count matches the pixels along its image dimension (a y_block axis divides the rows)."""
+    sizes = {"z": shape[0] if len(shape) == 4 else 1, "y": shape[-3], "x": shape[-2]}
+    words = {"z": "slices", "y": "rows", "x": "columns", "y_block": "row blocks"}
+    dims = [a.dim for a in axes]
+    if len(set(dims)) != len(dims):
+        raise ReadError(f"{path}: lutbake axes: two axes share an image dimension: {dims}")
+    blocks = [a for a in axes if a.dim == "y_block"]
+    if blocks:
+        if sizes["y"] % blocks[0].count:
+            raise ReadError(f"{path}: lutbake axes: {sizes['y']} rows do not split into {blocks[0].count} row blocks")
+        sizes["y_block"], sizes["y"] = blocks[0].count, sizes["y"] // blocks[0].count
+    for a in axes:
+        if a.count != sizes[a.dim]:
+            raise ReadError(f"{path}: lutbake axes: axis {a.name!r} ({a.dim}) has count {a.count} but the image "
+                            f"has {sizes[a.dim]} {words[a.dim]} (shape {' x '.join(map(str, shape))})")
+    missing = [d for d in ("z", "y") if sizes[d] > 1 and d not in dims]
+    if "x" not in dims or missing:
+        raise ReadError(f"{path}: lutbake axes {[a.name for a in axes]} do not cover the image's "
+                        f"{', '.join(words[d] for d in ['x'] + missing)} (shape {' x '.join(map(str, shape))})")
+
+
+def table_view(loaded: LoadedFile) -> TableView:
+    """The table in a read file, its metadata checked against its pixels (ReadError if they disagree)."""
+    if loaded.data is None:
+        raise ReadError(f"{loaded.path}: {loaded.notes[0] if loaded.notes else 'no pixels'}")
+    data, path = loaded.data, loaded.path
+    if not loaded.attrs:
+        nch = data.shape[-1]
+        return TableView(loaded, data, [], [f"channel {c}" for c in "RGBA"[:nch]], [""] * nch, None, path.stem, {}, "")
+    if "kind" not in loaded.attrs:
+        raise ReadError(f"{path}: lutbake metadata ({loaded.meta_source}) without 'kind'")
+    axes_meta = _json_attr(loaded, "axes", list, None)
+    where = f"{path}: {'lutbake:' if loaded.format == 'exr' else 'lutbake.'}axes"
+    axes = [axis_from_meta(d, where) for d in axes_meta]
+    _check_axes_fit(path, axes, data.shape)
+    names = _json_attr(loaded, "channel_names", dict, {})
+    meanings = _json_attr(loaded, "channels", dict, {})
+    letters = [c for c in "RGBA" if c in names] or list("RGBA"[:data.shape[-1]])
+    if len(letters) > data.shape[-1]:
+        raise ReadError(f"{path}: lutbake channel_names lists {len(letters)} channels, the file holds "
+                        f"{data.shape[-1]}")
+    data = data[..., :len(letters)]  # drop a GPU format's padding (PNG B = 0, DDS/KTX2 A = 1)
+    terms = _json_attr(loaded, "terms", dict, {})
+    return TableView(loaded, data, axes, [str(names.get(c, f"channel {c}")) for c in letters],
+                     [str(meanings.get(c, "")) for c in letters], loaded.attrs["kind"],
+                     loaded.attrs.get("table", path.stem), terms, loaded.attrs.get("reconstruction", ""))
+
+
+def read_table(path) -> TableView:
+    """``table_view(read(path))``."""
+    return table_view(read(path))
