@@ -35,7 +35,9 @@ def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu",
     """Bake one spec into a Table (nothing written). Raises TableError if a value is not finite;
     executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
     from .batch import content_hash
+    from .warp_runtime import init_warp
 
+    init_warp()  # quiet unless LUTBAKE_VERBOSE (lutbake.warp_runtime)
     plan = lookup_kind(spec.kind).plan(spec)
     with Timer() as t:
         data = execute(plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel)

@@ -1,0 +1,59 @@
+"""Warp, started quietly. Warp prints a banner and one line per module load (at its INFO log level), and
+its native library prints "Warp CUDA warning: Could not find or load the NVIDIA CUDA driver" to the
+process' stderr on every machine without a GPU. lutbake's commands and its Python API print their own
+lines only, unless asked: ``LUTBAKE_VERBOSE=1`` in the environment (``lutbake --verbose ...``) keeps
+everything Warp says.
+"""
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import sys
+import threading
+
+VERBOSE_ENV = "LUTBAKE_VERBOSE"
+_LOCK = threading.Lock()
+_started = False
+
+
+def verbose() -> bool:
+    """True when LUTBAKE_VERBOSE is set to anything but '', 0, false, no, off."""
+    return os.environ.get(VERBOSE_ENV, "").strip().lower() not in ("", "0", "false", "no", "off")
+
+
+@contextlib.contextmanager
+def _stderr_silenced():
+    """Point file descriptor 2 at /dev/null (native code writes there, not to sys.stderr)."""
+    try:
+        sys.stderr.flush()
+    except (AttributeError, ValueError):
+        pass
+    saved = os.dup(2)
+    try:
+        with open(os.devnull, "wb") as null:
+            os.dup2(null.fileno(), 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
+def init_warp():
+    """Import and initialise Warp once per process, quietly unless ``verbose()``; returns the module.
+    Every lutbake entry point that runs kernels calls it first (lutbake.api.bake_table, the checks,
+    the figures), so the first kernel load already happens at the chosen log level."""
+    global _started
+    import warp as wp
+
+    loud = verbose()
+    wp.config.log_level = logging.INFO if loud else logging.WARNING
+    with _LOCK:
+        if not _started:
+            if loud:
+                wp.init()
+            else:
+                with _stderr_silenced():
+                    wp.init()
+            _started = True
+    return wp
