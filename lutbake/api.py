@@ -35,9 +35,6 @@ def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu",
     """Bake one spec into a Table (nothing written). Raises TableError if a value is not finite;
     executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
     from .batch import content_hash
-    from .warp_runtime import init_warp
-
-    init_warp()  # quiet unless LUTBAKE_VERBOSE (lutbake.warp_runtime)
     plan = lookup_kind(spec.kind).plan(spec)
     with Timer() as t:
         data = execute(plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel)
@@ -63,6 +60,20 @@ def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu",
     table = Table(spec.name, spec.kind, data.astype(np.float32), plan.axes, plan.channels, plan.reconstruction,
                   attributes)
     return table, t.seconds, plan.samples
+
+
+def samples_note(spec: TableSpec, effective: int | None) -> str:
+    """Why a table integrates ``effective`` samples per texel when its config asked for another number
+    ('' when they agree or none was asked): each quadrature rounds the budget to its own grid."""
+    from .tables import specular
+
+    asked = spec.options.get("samples")
+    if not asked or effective is None or asked == effective:
+        return ""
+    rule = specular.samples_note(spec.options.get("estimator", ""), asked)
+    if rule and specular.effective_samples(spec.options.get("estimator", ""), asked) == effective:
+        return rule
+    return f"samples = {asked} asked; the {spec.kind} quadrature evaluates {effective} per texel (docs/config.md)"
 
 
 def bake(configs, out_dir="outputs", overrides=(), workers: int | None = None, device: str = "cpu",

@@ -22,7 +22,7 @@ def main(verbose):
     Examples:
       lutbake bake configs/dfg.toml                  # -> outputs/dfg.exr
       lutbake bake configs/*.toml --out-dir build/luts --workers 2
-      lutbake bake --preset default --set samples=2048 --set dtype=half
+      lutbake bake --preset default --set samples=2048 --set dtype=half --out-dir outputs/examples
       lutbake inspect outputs/dfg.exr
       lutbake preview outputs/dfg.exr                # -> outputs/dfg.preview.png
       lutbake list
@@ -73,6 +73,7 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
       lutbake bake --preset unreal --format dds        # -> outputs/preintegrated_gf.dds (R16G16_FLOAT)
     """
     from . import batch
+    from .api import samples_note
     from .config import load_configs, preset_path
     from .errors import ConfigError
 
@@ -102,7 +103,9 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
 
     def on_done(job):
         if job.status == "baked":
-            click.echo(f"{job.path}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel")
+            note = samples_note(job.spec, job.samples)
+            click.echo(f"{job.path}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel"
+                       + (f" ({note})" if note else ""))
         elif job.status == "failed":
             click.echo(f"FAILED {job.name}: {job.message}", err=True)
 

@@ -54,9 +54,6 @@ def curves(fig: Figure, theta: np.ndarray, models=MODELS, sigma_to_alpha: str = 
            order: int = 12) -> dict[str, np.ndarray]:
     """L_r = f_r (n.l) per model along the figure's abscissa."""
     from .tables.diffuse import eval_brdf
-    from .warp_runtime import init_warp
-
-    init_warp()
 
     l, v = directions(fig, theta)
     out = {}

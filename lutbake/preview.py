@@ -36,8 +36,8 @@ UNITS = {"phi": "rad", "theta_l": "rad", "theta_v": "rad"}
 SYMBOLS = {"sigma": "σ", "phi": "φ", "cos_phi": "cos φ", "theta_l": "θ_l", "theta_v": "θ_v", "NoV": "n·v",
            "NoL": "n·l", "alpha": "α", "perceptual_roughness": "perceptual roughness r", "f0": "f0"}
 ROUGHNESS_AXES = ("perceptual_roughness", "alpha")
-MEANING_WIDTH, MEANING_LINES = 44, 4
-CHARS_PER_INCH = 13  # of 9-point text: where the figure title wraps  # characters per line and lines of a channel's meaning under its name
+MEANING_WIDTH, MEANING_LINES = 44, 4  # characters per line and lines of a channel's meaning under its name
+CHARS_PER_INCH = 13  # of 9-point text: where the figure title wraps
 
 
 def _label(axis: Axis) -> str:
@@ -97,12 +97,18 @@ def split_sum(view: TableView):
     if view.kind in ("dfg", "specular_aniso") and nch >= 2:
         zmid = float(z.values()[z.count // 2]) if z is not None else None
         where = f", {_short(z, zmid)}" if z is not None else ""
-        if layout in ("scale_bias", "scale_bias_f82"):
-            return (f"E = f0 R + G, f0 = gold{where}", lambda nov, r: SPHERE_F0 * at(nov, r, zmid)[..., 0:1] +
-                    at(nov, r, zmid)[..., 1:2], False)
-        if layout in ("multiscatter", "multiscatter_cloth"):
-            return (f"E = (1 - f0) R + f0 G, f0 = gold{where}", lambda nov, r: (
-                (1 - SPHERE_F0) * at(nov, r, zmid)[..., 0:1] + SPHERE_F0 * at(nov, r, zmid)[..., 1:2]), False)
+        if layout in ("scale_bias", "scale_bias_f82"):  # Karis 2013: E = f0 * scale + bias
+            def E_scale_bias(nov, r):
+                t = at(nov, r, zmid)
+                return SPHERE_F0 * t[..., 0:1] + t[..., 1:2]
+
+            return f"E = f0 R + G, f0 = gold{where}", E_scale_bias, False
+        if layout in ("multiscatter", "multiscatter_cloth"):  # Filament: E = mix(R, G, f0)
+            def E_multiscatter(nov, r):
+                t = at(nov, r, zmid)
+                return (1 - SPHERE_F0) * t[..., 0:1] + SPHERE_F0 * t[..., 1:2]
+
+            return f"E = (1 - f0) R + f0 G, f0 = gold{where}", E_multiscatter, False
         if layout in ("charlie", "charlie_clamped") and nch >= 3:
             # the sheen lobe is broad: its prefiltered (Charlie) environment is close to the mean radiance
             return ("sheen = prefiltered_charlie sheenColor B, sheenColor = white", lambda nov, r: SHEEN_COLOR *
@@ -287,8 +293,8 @@ def _sphere_row(canvas, view, spheres):
         ax.axis("off")
 
 
-def render(path, out=None) -> Path:
-    """Write the preview PNG of the table at ``path`` (default: <path stem>.preview.png beside it)."""
+def figure(path):
+    """The preview of the table file at ``path`` as a matplotlib Figure (Agg; close it when done)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -308,9 +314,20 @@ def render(path, out=None) -> Path:
         fig, inches = _fig_2d(plt, view, spheres)
     note = "" if spheres or not view.kind else f"\n(no sphere row: {view.kind} has no split-sum reconstruction)"
     fig.suptitle(_suptitle(view, path, int(inches * CHARS_PER_INCH)) + note, fontsize=9)
-    out = Path(out) if out else path.with_name(path.stem + ".preview.png")
+    return fig
+
+
+def render(path, out=None, dpi: int = 100) -> Path:
+    """Write the preview PNG of the table at ``path`` (default: <path stem>.preview.png beside it)."""
+    import matplotlib.pyplot as plt
+
     from .io.atomic import atomic_write
 
-    atomic_write(out, lambda tmp: fig.savefig(tmp, format="png"))
-    plt.close(fig)
+    path = Path(path)
+    fig = figure(path)
+    out = Path(out) if out else path.with_name(path.stem + ".preview.png")
+    try:
+        atomic_write(out, lambda tmp: fig.savefig(tmp, format="png", dpi=dpi))
+    finally:
+        plt.close(fig)
     return out

@@ -23,7 +23,7 @@ def verbose() -> bool:
 
 
 @contextlib.contextmanager
-def _stderr_silenced():
+def stderr_silenced():
     """Point file descriptor 2 at /dev/null (native code writes there, not to sys.stderr)."""
     try:
         sys.stderr.flush()
@@ -41,8 +41,8 @@ def _stderr_silenced():
 
 def init_warp():
     """Import and initialise Warp once per process, quietly unless ``verbose()``; returns the module.
-    Every lutbake entry point that runs kernels calls it first (lutbake.api.bake_table, the checks,
-    the figures), so the first kernel load already happens at the chosen log level."""
+    ``lutbake.terms`` calls it on import: every lutbake kernel is built from its terms, so Warp is started
+    (and its log level set) before any lutbake kernel loads, from the CLI and the Python API alike."""
     global _started
     import warp as wp
 
@@ -53,7 +53,7 @@ def init_warp():
             if loud:
                 wp.init()
             else:
-                with _stderr_silenced():
+                with stderr_silenced():
                     wp.init()
             _started = True
     return wp

@@ -3,12 +3,12 @@ file's first bytes (its magic number), never by its extension.
 
 | format | magic | pixels | lutbake metadata |
 | --- | --- | --- | --- |
-| EXR | ``76 2f 31 01`` | OpenImageIO, any channels, every part (a 3D table: one part per z slice) | ``lutbake:*`` header attributes |
+| EXR | ``76 2f 31 01`` | OpenImageIO, any channels, every part (3D: a part per z) | ``lutbake:*`` attributes |
 | NumPy | ``\\x93NUMPY`` | ``np.load`` (no pickles), 2 to 4 dimensions | the ``.json`` sidecar |
-| PNG | ``\\x89PNG\\r\\n\\x1a\\n`` | OpenImageIO; 16-bit codes / 65535 (8-bit / 255), linear | the ``.json`` sidecar |
-| DDS | ``DDS `` | lutbake.io.dds.decode (DX10 float formats, which OpenImageIO 3.x cannot read) | the ``.json`` sidecar |
-| KTX2 | ``«KTX 20»\\r\\n\\x1a\\n`` | lutbake.io.ktx2.decode | ``lutbake:metadata`` key/value, else the sidecar |
-| C header | text from ``/*``, ``//`` or ``#`` | the ``static const`` array and its ``_WIDTH`` ... macros | the ``.json`` sidecar |
+| PNG | ``\\x89PNG\\r\\n\\x1a\\n`` | OpenImageIO; codes / 65535 (8-bit: / 255), linear | the ``.json`` sidecar |
+| DDS | ``DDS `` | lutbake.io.dds.decode (DX10 float formats; OpenImageIO 3.x reads none) | the ``.json`` sidecar |
+| KTX2 | ``«KTX 20»\\r\\n\\x1a\\n`` | lutbake.io.ktx2.decode | ``lutbake:metadata`` key/value, else sidecar |
+| C header | text from ``/*``, ``//`` or ``#`` | its ``static const`` array and size macros | the ``.json`` sidecar |
 | sidecar | text from ``{`` | the data file it names (``"file"``) | its ``"lutbake"`` object |
 
 ``read(path)`` returns a :class:`LoadedFile` (pixels as stored, including a GPU format's padding
@@ -30,6 +30,7 @@ import numpy as np
 
 from ..axes import IMAGE_DIMS, MAPPINGS, ORDERS, TEXELS, Axis
 from ..errors import LutbakeError
+from ..warp_runtime import stderr_silenced
 from . import dds, ktx2
 
 PREFIX = "lutbake:"
@@ -44,7 +45,10 @@ FORMAT_NAMES = {"exr": "OpenEXR", "npy": "NumPy .npy", "png": "PNG", "dds": "DDS
 
 
 class ReadError(LutbakeError, ValueError):
-    """A file lutbake cannot read, or metadata that does not fit the file (the message names the file)."""
+    """A file lutbake cannot read, or metadata that does not fit the file: one line that names the file."""
+
+    def __init__(self, message: str):
+        super().__init__("; ".join(line.strip() for line in str(message).splitlines() if line.strip()))
 
 
 @dataclass
@@ -141,7 +145,8 @@ def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
     come in that order; any other channel names are kept in file order."""
     import OpenImageIO as oiio  # imported here: only EXR and PNG need it
 
-    inp = oiio.ImageInput.open(str(path))
+    with stderr_silenced():  # libpng / OpenEXR print their own complaints; the ReadError says it once
+        inp = oiio.ImageInput.open(str(path))
     if inp is None:
         raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
     parts = []
@@ -152,7 +157,8 @@ def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
             names = list(spec.channelnames)
             rgba = [c for c in "RGBA" if c in names]
             order = rgba if len(rgba) == len(names) else names
-            arr = inp.read_image(k, 0, 0, len(names), "float")
+            with stderr_silenced():
+                arr = inp.read_image(k, 0, 0, len(names), "float")
             if arr is None:
                 raise ValueError(f"cannot read the pixels of part {k}: {inp.geterror()}")
             arr = np.asarray(arr, dtype=np.float32).reshape(spec.height, spec.width, len(names))
@@ -194,13 +200,15 @@ def read_npy(path: Path) -> LoadedFile:
 def read_png(path: Path) -> LoadedFile:
     import OpenImageIO as oiio
 
-    inp = oiio.ImageInput.open(str(path))
+    with stderr_silenced():
+        inp = oiio.ImageInput.open(str(path))
     if inp is None:
         raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
     try:
         spec = inp.spec()
         bits = 16 if str(spec.format) == "uint16" else 8
-        arr = inp.read_image("uint16" if bits == 16 else "uint8")
+        with stderr_silenced():
+            arr = inp.read_image("uint16" if bits == 16 else "uint8")
         if arr is None:
             raise ValueError(inp.geterror())
         codes = np.asarray(arr).reshape(spec.height, spec.width, spec.nchannels)
@@ -226,7 +234,8 @@ def read_ktx2(path: Path) -> LoadedFile:
             meta = json.loads(kv["lutbake:metadata"])
         except json.JSONDecodeError as e:
             raise ReadError(f"{path}: key/value lutbake:metadata is not valid JSON ({e})") from None
-        loaded.attrs, loaded.meta_source = _string_attrs(meta, path, "key/value lutbake:metadata"), "KTX2 key/value data"
+        loaded.attrs = _string_attrs(meta, path, "key/value lutbake:metadata")
+        loaded.meta_source = "KTX2 key/value data"
         return loaded
     return _with_sidecar(loaded)
 

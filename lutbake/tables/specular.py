@@ -274,6 +274,19 @@ def effective_samples(estimator: str, samples: int) -> int:
     return samples
 
 
+def samples_note(estimator: str, samples: int | None) -> str:
+    """Why ``effective_samples`` differs from the ``samples`` asked for ('' when it does not)."""
+    if samples is None or effective_samples(estimator, samples) == samples:
+        return ""
+    if estimator == "gauss_legendre":
+        n = gl_order(samples)
+        return (f"samples = {samples} asked; gauss_legendre integrates 3 regions x n x n points with "
+                f"n = round(sqrt({samples} / 3)) = {n}: 3 x {n}^2 = {3 * n * n}")
+    if estimator.startswith("sobol"):
+        return f"samples = {samples} asked; Sobol' points come in powers of two: {effective_samples(estimator, samples)}"
+    return ""
+
+
 def point_arrays(estimator: str, samples: int, seed: int, device: str) -> list:
     """The estimator's point-set arrays, as kernel inputs after (nov, alpha)."""
     if estimator == "gauss_legendre":

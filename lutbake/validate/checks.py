@@ -565,9 +565,6 @@ CHECKS: dict = _registry()
 
 def run_all(names=None) -> list[CheckResult]:
     """Run the named checks (all of ``CHECKS`` by default) in registry order."""
-    from ..warp_runtime import init_warp
-
-    init_warp()
     names = list(CHECKS) if names is None else list(names)
     unknown = [n for n in names if n not in CHECKS]
     if unknown:
