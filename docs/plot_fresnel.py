@@ -19,6 +19,7 @@ import numpy as np  # noqa: E402
 from lutbake.tables.fresnel import evaluate  # noqa: E402
 from lutbake.terms.metals import fit_lazanyi_a  # noqa: E402
 
+DEFAULT_OUT = Path(__file__).resolve().parents[1] / "outputs" / "figures"  # never docs/figures (tracked)
 AL = (1.3, 7.48)
 ETA = 1.5
 
@@ -55,4 +56,4 @@ def main(out: Path) -> None:
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parents[1] / "outputs" / "figures")
+    main(Path(sys.argv[1]) if len(sys.argv) > 1 else DEFAULT_OUT)

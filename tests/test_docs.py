@@ -19,3 +19,20 @@ def test_every_kind_key_and_value_is_documented():
 def test_readme_gives_the_two_commands():
     readme = (ROOT / "README.md").read_text()
     assert "make luts" in readme and "make test" in readme
+
+
+def test_readme_is_a_quick_start_with_a_table_of_contents_and_no_outside_references():
+    import re
+
+    readme = (ROOT / "README.md").read_text()
+    assert len(readme.splitlines()) <= 60  # one screen of quick start, then links
+    for topic in ("kinds", "presets", "formats", "conventions", "accuracy", "batch"):
+        assert f"(docs/{topic}.md)" in readme, topic
+    for page in re.findall(r"\]\(([^)#]+)", readme):
+        assert page.startswith("http") or (ROOT / page).exists(), page
+    docs = "".join(p.read_text() for p in (ROOT / "docs").glob("*.md"))
+    for text in (readme, docs):
+        for outside in ("../shared", "seeds/", "lecture 003", "issue-6", "the seed's", "EQUATIONS.md"):
+            assert outside not in text, outside
+    for page in re.findall(r"\]\(([^)#]+)", docs):
+        assert page.startswith("http") or (ROOT / "docs" / page).exists(), page
