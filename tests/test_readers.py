@@ -173,3 +173,16 @@ def test_missing_file_and_directory_are_one_clean_line(tmp_path):
 
 def test_read_error_is_a_value_error():
     assert issubclass(ReadError, ValueError)
+
+
+def test_the_bake_report_is_described_and_not_taken_for_a_sidecar(tmp_path):
+    cfg = tmp_path / "c.toml"
+    cfg.write_text('[[table]]\nname = "report"\nkind = "dfg"\nsize = [8, 4]\nsamples = 48\nformat = "npy"\n')
+    out = tmp_path / "o"
+    r = CliRunner().invoke(main, ["bake", str(cfg), "--out-dir", str(out), "--report", str(out / "run.json")])
+    assert r.exit_code == 0, r.output
+    r = inspect(out / "run.json")
+    assert r.exit_code == 0 and "bake report" in r.output and "baked" in r.output and "report.npy" in r.output
+    r = CliRunner().invoke(main, ["preview", str(out / "run.json"), "-o", str(tmp_path / "x.png")])
+    assert_one_line_error(r, out / "run.json", "holds no pixels")
+    assert inspect(out / "report.npy").exit_code == 0  # its sidecar report.json is the table's, not a report

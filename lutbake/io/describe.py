@@ -35,6 +35,8 @@ def _container(loaded: LoadedFile) -> str:
         return f"array {f['array']} of {f['element_type']}"
     if "data_file" in f:
         return f"describes {f['data_file']} ({f['data_format']})"
+    if loaded.format == "report":
+        return f"{len(f.get('tables') or [])} table(s)"
     return "no data file"
 
 
@@ -55,11 +57,28 @@ def _statistics(data: np.ndarray, names: list[str]) -> list[str]:
     return lines
 
 
+def _report_lines(doc: dict) -> list[str]:
+    counts = doc.get("counts") if isinstance(doc.get("counts"), dict) else {}
+    lines = [f"  lutbake {doc.get('lutbake_version')}, exit status {doc.get('exit_status')}"
+             + (f", interrupted by {doc['interrupted_by']}" if doc.get("interrupted_by") else ""),
+             "  " + ", ".join(f"{v} {k}" for k, v in counts.items()), "tables:"]
+    for t in doc.get("tables") if isinstance(doc.get("tables"), list) else []:
+        if isinstance(t, dict):
+            secs = t.get("seconds")
+            lines.append(f"  {t.get('status', '?'):<11} {t.get('path') or t.get('name')}"
+                         + (f"  {secs:.2f} s" if isinstance(secs, (int, float)) else "")
+                         + (f"  error estimate {t['error_estimate']}" if t.get("error_estimate") else "")
+                         + (f"  ({t['message']})" if t.get("message") else ""))
+    return lines
+
+
 def describe(path) -> str:
     """The report ``lutbake inspect FILE`` prints (raises readers.ReadError, naming the file once)."""
     path = Path(path)
     loaded = read(path)
     lines = [str(path), f"  format: {FORMAT_NAMES[loaded.format]}, {_container(loaded)}"]
+    if loaded.format == "report":
+        return "\n".join(lines + _report_lines(loaded.facts)) + "\n"
     if loaded.data is None:
         lines.append(f"  metadata only: {loaded.notes[0]}")
         lines += [f"  {k}: {v if len(v) <= LONG_VALUE else v[:LONG_VALUE] + ' ...'}" for k, v in loaded.attrs.items()]

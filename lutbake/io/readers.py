@@ -41,7 +41,7 @@ EXR_MAGIC = b"\x76\x2f\x31\x01"
 NPY_MAGIC = b"\x93NUMPY"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 FORMAT_NAMES = {"exr": "OpenEXR", "npy": "NumPy .npy", "png": "PNG", "dds": "DDS", "ktx2": "KTX 2.0",
-                "h": "C header", "sidecar": "lutbake .json sidecar"}
+                "h": "C header", "sidecar": "lutbake .json sidecar", "report": "lutbake bake report (--report)"}
 
 
 class ReadError(LutbakeError, ValueError):
@@ -268,11 +268,19 @@ def read_header(path: Path) -> LoadedFile:
     return _with_sidecar(loaded)
 
 
-def _load_sidecar(path: Path) -> dict:
+def _is_report(doc) -> bool:
+    return isinstance(doc, dict) and "lutbake" not in doc and {"lutbake_version", "tables"} <= set(doc)
+
+
+def _load_json(path: Path):
     try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
+        return json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as e:
         raise ReadError(f"{path}: sidecar is not valid JSON ({e})") from None
+
+
+def _load_sidecar(path: Path, doc=None) -> dict:
+    doc = _load_json(path) if doc is None else doc
     if not isinstance(doc, dict):
         raise ReadError(f"{path}: a sidecar is a JSON object with a 'lutbake' object, got {type(doc).__name__}")
     if "lutbake" not in doc:
@@ -299,7 +307,7 @@ def sidecar_candidates(path: Path) -> list[Path]:
 def _with_sidecar(loaded: LoadedFile) -> LoadedFile:
     """Attach the attributes of the sidecar that names this file (a sidecar naming another file is skipped)."""
     for side in sidecar_candidates(loaded.path):
-        if not side.is_file() or side == loaded.path:
+        if not side.is_file() or side == loaded.path or _is_report(_load_json(side)):
             continue
         doc = _load_sidecar(side)
         named = doc.get("file")
@@ -314,8 +322,12 @@ def _with_sidecar(loaded: LoadedFile) -> LoadedFile:
 
 
 def read_sidecar(path: Path) -> LoadedFile:
-    """A sidecar: its attributes, with the pixels of the data file it names (beside it) when present."""
-    doc = _load_sidecar(path)
+    """A sidecar: its attributes, with the pixels of the data file it names (beside it) when present.
+    A bake report (``lutbake bake --report``) reads as format "report": facts only, no pixels."""
+    doc = _load_json(path)
+    if _is_report(doc):
+        return LoadedFile(path, "report", None, {}, None, doc, ["a bake report: it lists tables and holds no pixels"])
+    doc = _load_sidecar(path, doc)
     named = doc.get("file")
     facts = {k: v for k, v in doc.items() if k != "lutbake"}
     if isinstance(named, str) and named and Path(named).name == named and (path.parent / named).is_file():
