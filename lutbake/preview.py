@@ -37,6 +37,7 @@ SYMBOLS = {"sigma": "σ", "phi": "φ", "cos_phi": "cos φ", "theta_l": "θ_l", "
            "NoL": "n·l", "alpha": "α", "perceptual_roughness": "perceptual roughness r", "f0": "f0"}
 ROUGHNESS_AXES = ("perceptual_roughness", "alpha")
 MEANING_WIDTH, MEANING_LINES = 44, 4  # characters per line and lines of a channel's meaning under its name
+CLIP_PERCENTILE, CLIP_RATIO = 99.0, 3.0  # colour scale: see _color_range
 CHARS_PER_INCH = 13  # of 9-point text: where the figure title wraps
 
 
@@ -165,6 +166,16 @@ def _image(fig, ax, img, y_axis, x_axis, vmin=None, vmax=None, labels=(True, Tru
     return im
 
 
+def _color_range(values: np.ndarray) -> tuple[float, float, str]:
+    """(vmin, vmax, note): the full range, or up to the CLIP_PERCENTILE when a few texels (a grazing corner)
+    are far above the rest, so the rest stays readable; the note says so and gives the true maximum."""
+    lo, hi = float(values.min()), float(values.max())
+    top = float(np.percentile(values, CLIP_PERCENTILE))
+    if hi - lo > CLIP_RATIO * (top - lo) > 0:
+        return lo, top, f"\ncolours clipped at the {CLIP_PERCENTILE:g}th percentile {top:.3g} (max {hi:.3g})"
+    return lo, hi, ""
+
+
 def _channel_title(view: TableView, c: int) -> str:
     name, meaning = view.channel_names[c], view.meanings[c]
     meaning = meaning.split(": ", 1)[1] if meaning.startswith(name + ": ") else meaning
@@ -226,8 +237,9 @@ def _fig_2d(plt, view, spheres):
     y_axis, x_axis = _axis_by_dim(view, "y"), _axis_by_dim(view, "x")
     for c in range(nch):
         ax = canvas.add_subplot(1, max(nch, 2), c + 1)
-        _image(canvas, ax, view.data[..., c], y_axis, x_axis)
-        ax.set_title(_channel_title(view, c), fontsize=8, loc="left")
+        vmin, vmax, clipped = _color_range(view.data[..., c])
+        _image(canvas, ax, view.data[..., c], y_axis, x_axis, vmin, vmax)
+        ax.set_title(_channel_title(view, c) + clipped, fontsize=8, loc="left")
     if spheres:
         _sphere_row(row, view, spheres)
     return fig, width
@@ -242,14 +254,14 @@ def _fig_3d(plt, view, spheres):
     fig, canvas, row = _canvases(plt, width, 2.9 * nch + 0.4, spheres)
     zvals = z_axis.values() if z_axis is not None else None
     for c in range(nch):
-        vmin, vmax = float(data[..., c].min()), float(data[..., c].max())
+        vmin, vmax, clipped = _color_range(data[..., c])
         axes = []
         for j, k in enumerate(picks):
             ax = canvas.add_subplot(nch, len(picks), c * len(picks) + j + 1)
             im = _image(canvas, ax, data[k, ..., c], y_axis, x_axis, vmin, vmax,
                         labels=(c == nch - 1, j == 0), bar=False)
             where = _short(z_axis, zvals[k]) if z_axis is not None else f"slice {k}"
-            ax.set_title(f"{where}  (slice {k})" if j else f"{_channel_title(view, c)}\n{where}  (slice {k})",
+            ax.set_title(f"{where}  (slice {k})" if j else f"{_channel_title(view, c)}{clipped}\n{where}  (slice {k})",
                          fontsize=8, loc="left")
             axes.append(ax)
         canvas.colorbar(im, ax=axes, fraction=0.02, pad=0.02).ax.tick_params(labelsize=7)
@@ -285,7 +297,8 @@ def _sphere_row(canvas, view, spheres):
     canvas.suptitle(f"spheres lit by a sky, ground and sun environment: {how}", fontsize=8)
     rough = next(a for a in view.axes if a.name in ROUGHNESS_AXES)
     vals = rough.values()
-    for k, v in enumerate(np.linspace(float(vals.min()), float(vals.max()), N_SPHERES)):
+    lo, hi = float(vals.min()), float(vals.max())
+    for k, v in enumerate(lo + (hi - lo) * np.linspace(0.05, 0.95, N_SPHERES)):
         ax = canvas.add_subplot(1, N_SPHERES, k + 1)
         perceptual = 1.0 if broad else float(np.sqrt(v)) if rough.name == "alpha" else float(v)
         ax.imshow(sphere(E, float(v), perceptual))
