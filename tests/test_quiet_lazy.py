@@ -8,8 +8,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-from lutbake.io.formats import write_table
 from test_formats import table2d
+
+from lutbake.io.formats import write_table
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = '[[table]]\nname = "small"\nkind = "dfg"\nsize = [8, 4]\nsamples = 48\n'
@@ -24,8 +25,8 @@ def python(code: str, env_extra=None, cwd=None) -> subprocess.CompletedProcess:
 
 def loaded_after(args: list[str]) -> list[str]:
     """Which heavy modules a `lutbake ARGS` run (in a fresh interpreter) imported."""
-    code = ("import json, sys\nfrom lutbake.cli import main\ntry:\n    main(%r)\nexcept SystemExit:\n    pass\n"
-            "print(json.dumps([m for m in %r if m in sys.modules]))" % (args, HEAVY))
+    code = (f"import json, sys\nfrom lutbake.cli import main\ntry:\n    main({args!r})\nexcept SystemExit:\n    pass\n"
+            f"print(json.dumps([m for m in {HEAVY!r} if m in sys.modules]))")
     r = python(code)
     assert r.returncode == 0, r.stderr
     return json.loads(r.stdout.strip().splitlines()[-1])
@@ -50,8 +51,7 @@ def test_preview_imports_no_warp_or_scipy(tmp_path):
 
 
 def test_import_lutbake_is_lazy():
-    r = python("import sys, lutbake; print([m for m in %r if m in sys.modules]); print(lutbake.bake.__module__)"
-               % (HEAVY,))
+    r = python(f"import sys, lutbake; print([m for m in {HEAVY!r} if m in sys.modules]); print(lutbake.bake.__module__)")
     assert r.stdout.split("\n")[:2] == ["[]", "lutbake.api"], r.stdout
 
 

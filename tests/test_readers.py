@@ -7,11 +7,11 @@ import shutil
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from test_formats import read_dds_spec, read_ktx2_spec, table2d, table3d
 
 from lutbake.cli import main
 from lutbake.io.formats import FORMATS, write_table
 from lutbake.io.readers import ReadError, read, read_table
-from test_formats import read_dds_spec, read_ktx2_spec, table2d, table3d
 
 HALF = {"half": np.float16, "float32": np.float32}
 
