@@ -51,7 +51,8 @@ def test_preview_imports_no_warp_or_scipy(tmp_path):
 
 
 def test_import_lutbake_is_lazy():
-    r = python(f"import sys, lutbake; print([m for m in {HEAVY!r} if m in sys.modules]); print(lutbake.bake.__module__)")
+    code = f"import sys, lutbake; print([m for m in {HEAVY!r} if m in sys.modules]); print(lutbake.bake.__module__)"
+    r = python(code)
     assert r.stdout.split("\n")[:2] == ["[]", "lutbake.api"], r.stdout
 
 
