@@ -10,6 +10,7 @@ the digest of lutbake's kernel sources. Baselines measured in the same run:
 - a vectorised numpy implementation of the same estimator,
 - Filament cmgen's estimator: 1024 Hammersley points, NDF importance sampling.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -38,7 +39,7 @@ from lutbake.sampling import points  # noqa: E402
 from lutbake.tables import KINDS  # noqa: E402
 
 OUT = ROOT / "outputs" / "bench"
-REF_GL_SAMPLES = 3 * 40 ** 2  # reference order n = 40
+REF_GL_SAMPLES = 3 * 40**2  # reference order n = 40
 DFG = {"kind": "dfg", "size": [128, 128]}
 
 
@@ -69,6 +70,7 @@ def errors(got, ref):
 
 # --- the same estimator outside Warp --------------------------------------------------------------------
 
+
 def vndf_inputs(n_side=128, n_points=1024, seed=0):
     t = (np.arange(n_side) + 0.5) / n_side
     nov = np.maximum(np.tile(t, n_side), 1e-4).astype(np.float32)
@@ -83,7 +85,7 @@ def numpy_vndf(nov, alpha, pts, chunk=256):
     out = np.zeros((len(nov), 2))
     u1, u2 = pts[None, :, 0], pts[None, :, 1]
     for s in range(0, len(nov), chunk):
-        c, a = nov[s:s + chunk, None], alpha[s:s + chunk, None]
+        c, a = nov[s : s + chunk, None], alpha[s : s + chunk, None]
         vx = np.sqrt(np.maximum(f32(1) - c * c, f32(0)))
         sx, inv = a * vx, None
         inv = f32(1) / np.sqrt(sx * sx + c * c)
@@ -110,9 +112,9 @@ def numpy_vndf(nov, alpha, pts, chunk=256):
         g = D * voh / (c * (f32(1) + lv + lam(nol)))
         ratio = np.where(ok & (p > 0), g / np.where(p > 0, p, f32(1)), f32(0))
         m = np.clip(f32(1) - voh, f32(0), f32(1))
-        fc = m ** 5
-        out[s:s + chunk, 0] = np.sum(((f32(1) - fc) * ratio).astype(np.float64), axis=1) / pts.shape[0]
-        out[s:s + chunk, 1] = np.sum((fc * ratio).astype(np.float64), axis=1) / pts.shape[0]
+        fc = m**5
+        out[s : s + chunk, 0] = np.sum(((f32(1) - fc) * ratio).astype(np.float64), axis=1) / pts.shape[0]
+        out[s : s + chunk, 1] = np.sum((fc * ratio).astype(np.float64), axis=1) / pts.shape[0]
     return out
 
 
@@ -122,8 +124,10 @@ def c_vndf(nov, alpha, pts, threads):
     if cc is None:
         return None
     exe, inp, outp = OUT / "dfg_vndf", OUT / "vndf_in.bin", OUT / "vndf_out.bin"
-    subprocess.run([cc, "-O3", "-march=native", "-fopenmp", str(ROOT / "benchmarks" / "dfg_vndf.c"), "-lm", "-o",
-                    str(exe)], check=True)
+    subprocess.run(
+        [cc, "-O3", "-march=native", "-fopenmp", str(ROOT / "benchmarks" / "dfg_vndf.c"), "-lm", "-o", str(exe)],
+        check=True,
+    )
     with open(inp, "wb") as f:
         np.array([len(nov), len(pts)], np.int32).tofile(f)
         nov.tofile(f), alpha.tofile(f), pts.tofile(f)
@@ -140,8 +144,14 @@ def machine():
         model = next(line.split(":", 1)[1].strip() for line in open("/proc/cpuinfo") if line.startswith("model name"))
     except (OSError, StopIteration):
         pass
-    return {"cpu": model or platform.processor(), "cores": default_workers(), "python": platform.python_version(),
-            "warp": wp.config.version, "numpy": np.__version__, "platform": platform.platform()}
+    return {
+        "cpu": model or platform.processor(),
+        "cores": default_workers(),
+        "python": platform.python_version(),
+        "warp": wp.config.version,
+        "numpy": np.__version__,
+        "platform": platform.platform(),
+    }
 
 
 def main(argv=None):
@@ -160,9 +170,11 @@ def main(argv=None):
     ref, ref_s = cached("dfg128", {**DFG, "samples": REF_GL_SAMPLES}, w)
     report["reference_dfg"] = {"estimator": "gauss_legendre", "samples": REF_GL_SAMPLES, "seconds": ref_s}
     report["reference_dfg"]["independent_check"] = independent_check(ref)
-    budgets = {"gauss_legendre": [3 * n * n for n in ((8, 12) if args.quick else (6, 8, 10, 12, 16))],
-               "sobol_vndf": [1024] if args.quick else [256, 1024, 4096, 16384],
-               "hammersley_ndf": [1024]}
+    budgets = {
+        "gauss_legendre": [3 * n * n for n in ((8, 12) if args.quick else (6, 8, 10, 12, 16))],
+        "sobol_vndf": [1024] if args.quick else [256, 1024, 4096, 16384],
+        "hammersley_ndf": [1024],
+    }
     rows = []
     for est, bs in budgets.items():
         bake({**DFG, "size": [4, 4], "estimator": est}, w)  # compile outside the timings
@@ -170,16 +182,22 @@ def main(argv=None):
             data, secs, samples = bake({**DFG, "estimator": est, "samples": b}, w)
             emax, emean = errors(data, ref)
             label = "filament_style_hammersley_1024" if est == "hammersley_ndf" else est
-            rows.append({"estimator": label, "samples": samples, "seconds": secs, "max_error": emax,
-                         "mean_error": emean})
+            rows.append(
+                {"estimator": label, "samples": samples, "seconds": secs, "max_error": emax, "mean_error": emean}
+            )
             print(f"dfg 128^2 {label:<32} {samples:>6} samples  {secs:7.3f} s  max {emax:.2e}  mean {emean:.2e}")
     report["cases"]["dfg_128"] = rows
-    default = min((r for r in rows if r["estimator"] == "gauss_legendre" and r["samples"] == 432),
-                  key=lambda r: r["seconds"], default=None)
+    default = min(
+        (r for r in rows if r["estimator"] == "gauss_legendre" and r["samples"] == 432),
+        key=lambda r: r["seconds"],
+        default=None,
+    )
     if default:
         report["targets"]["dfg_128: max error <= 1e-5 in <= 1 s"] = {
-            "max_error": default["max_error"], "seconds": default["seconds"],
-            "met": default["max_error"] <= 1e-5 and default["seconds"] <= 1.0}
+            "max_error": default["max_error"],
+            "seconds": default["seconds"],
+            "met": default["max_error"] <= 1e-5 and default["seconds"] <= 1.0,
+        }
 
     # ---- throughput: the same estimator in Warp, C and numpy ----------------------------------------------
     nov, alpha, pts = vndf_inputs()
@@ -190,8 +208,11 @@ def main(argv=None):
     warp_vals = bake({**DFG, "estimator": "sobol_vndf", "samples": 1024}, w)[0].reshape(-1, 2)
     if c is not None:
         cvals, csecs = c
-        base.update(c_seconds=csecs, warp_over_c_throughput=csecs / warp_row["seconds"],
-                    c_vs_warp_max_diff=float(np.abs(cvals - warp_vals).max()))
+        base.update(
+            c_seconds=csecs,
+            warp_over_c_throughput=csecs / warp_row["seconds"],
+            c_vs_warp_max_diff=float(np.abs(cvals - warp_vals).max()),
+        )
     t0 = time.perf_counter()
     nvals = numpy_vndf(nov, alpha, pts)
     base.update(numpy_seconds=time.perf_counter() - t0, numpy_vs_warp_max_diff=float(np.abs(nvals - warp_vals).max()))
@@ -199,21 +220,29 @@ def main(argv=None):
     base["evaluations"] = evals
     report["baselines"] = base
     report["targets"]["warp throughput >= 0.5 x C (same estimator)"] = {
-        "ratio": base.get("warp_over_c_throughput"), "met": base.get("warp_over_c_throughput", 0) >= 0.5}
+        "ratio": base.get("warp_over_c_throughput"),
+        "met": base.get("warp_over_c_throughput", 0) >= 0.5,
+    }
     print(json.dumps(base, indent=1))
 
     # ---- albedo 32^2 and albedo_avg ---------------------------------------------------------------------------
-    for name, kw, target in [("albedo_32", {"kind": "albedo", "size": [32, 32]}, 1e-5),
-                             ("albedo_avg_32", {"kind": "albedo_avg", "roughness_size": 32}, 1e-5)]:
+    for name, kw, target in [
+        ("albedo_32", {"kind": "albedo", "size": [32, 32]}, 1e-5),
+        ("albedo_avg_32", {"kind": "albedo_avg", "roughness_size": 32}, 1e-5),
+    ]:
         if kw["kind"] not in KINDS:
             continue
         r, _ = cached(name, {**kw, "samples": REF_GL_SAMPLES}, w)
         data, secs, samples = bake(kw, w)
         emax, emean = errors(data, r)
-        report["cases"][name] = [{"estimator": "gauss_legendre", "samples": samples, "seconds": secs,
-                                  "max_error": emax, "mean_error": emean}]
-        report["targets"][f"{name}: max error <= {target:g}"] = {"max_error": emax, "seconds": secs,
-                                                                 "met": emax <= target}
+        report["cases"][name] = [
+            {"estimator": "gauss_legendre", "samples": samples, "seconds": secs, "max_error": emax, "mean_error": emean}
+        ]
+        report["targets"][f"{name}: max error <= {target:g}"] = {
+            "max_error": emax,
+            "seconds": secs,
+            "met": emax <= target,
+        }
         print(f"{name:<12} {samples:>6} samples  {secs:7.3f} s  max {emax:.2e}")
 
     for extra in EXTRA_CASES:
@@ -234,16 +263,20 @@ def diffuse_cases(report, workers, quick):
     r = bench_diffuse.bench_diffuse()
     report["cases"]["diffuse_64"] = [r]
     report["targets"]["diffuse_64 microfacet: max error <= 1e-4 in <= 30 s"] = {
-        "max_error": r["max_abs_error"], "seconds": r["seconds"],
-        "met": r["max_abs_error"] <= 1e-4 and r["seconds"] <= 30}
+        "max_error": r["max_abs_error"],
+        "seconds": r["seconds"],
+        "met": r["max_abs_error"] <= 1e-4 and r["seconds"] <= 30,
+    }
     print(f"diffuse 64^2 microfacet  {r['seconds']:7.2f} s  max {r['max_abs_error']:.2e}")
     if quick:
         return
     b = bench_diffuse.bench_btf()
     report["cases"]["btf_16x32"] = [b]
     report["targets"]["btf 16 x 32^3: max relative error <= 1e-4 in <= 600 s"] = {
-        "max_rel_error": b["max_rel_error"], "seconds": b["seconds"],
-        "met": b["max_rel_error"] <= 1e-4 and b["seconds"] <= 600}
+        "max_rel_error": b["max_rel_error"],
+        "seconds": b["seconds"],
+        "met": b["max_rel_error"] <= 1e-4 and b["seconds"] <= 600,
+    }
     print(f"btf 16 x 32^3            {b['seconds']:7.2f} s  max rel {b['max_rel_error']:.2e}")
 
 
@@ -265,7 +298,9 @@ def independent_check(ref):
     for iy, ix in sorted(idx):
         nov = float(np.float32(max(t[ix], 1e-4)))
         alpha = float(np.float32(max(t[iy] ** 2, 1e-4)))
-        worst = max(worst, float(np.abs(reference_dfg(nov, alpha, "ggx", "smith_height_correlated") - ref[iy, ix]).max()))
+        worst = max(
+            worst, float(np.abs(reference_dfg(nov, alpha, "ggx", "smith_height_correlated") - ref[iy, ix]).max())
+        )
     return {"texels": len(idx), "max_abs_diff": worst, "method": "numpy GL over (theta_l, phi_l), graded panels"}
 
 

@@ -6,6 +6,7 @@ against the *nested* rule (l outside, m inside: a different integrator) at order
 4 000 random texels plus every texel with light and view both at the most grazing angle.
 Run: PYTHONPATH=. python benchmarks/bench_diffuse.py [--skip-btf]  (writes outputs/bench/diffuse.json)
 """
+
 from __future__ import annotations
 
 import json
@@ -46,11 +47,17 @@ def bench_diffuse() -> dict:
     nested = D.albedo("microfacet", nov[pick].astype(np.float32), sigma[pick], 0.0, "eq6", "sigma", order=16)
     err = np.abs(table.data[..., 0].reshape(-1) - ref)
     i = int(np.argmax(err))
-    return {"kind": "diffuse", "size": "64x64", "seconds": round(seconds, 2), "samples_per_texel": samples,
-            "max_abs_error": float(err.max()), "at": {"NoV": float(nov[i]), "sigma": float(sigma[i])},
-            "error_estimate": float(table.attributes["error_estimate"]),
-            "reference_vs_nested_rule_max_abs": float(np.max(np.abs(ref[pick] - nested))),
-            "target": "<= 1e-4 max abs in <= 30 s"}
+    return {
+        "kind": "diffuse",
+        "size": "64x64",
+        "seconds": round(seconds, 2),
+        "samples_per_texel": samples,
+        "max_abs_error": float(err.max()),
+        "at": {"NoV": float(nov[i]), "sigma": float(sigma[i])},
+        "error_estimate": float(table.attributes["error_estimate"]),
+        "reference_vs_nested_rule_max_abs": float(np.max(np.abs(ref[pick] - nested))),
+        "target": "<= 1e-4 max abs in <= 30 s",
+    }
 
 
 def bench_btf() -> dict:
@@ -64,17 +71,26 @@ def bench_btf() -> dict:
     ref = D.eval_brdf("microfacet", l[idx], v[idx], sig[idx], order=40)
     ok = np.abs(ref) > 1e-6
     rel = np.abs(flat[idx] - ref)[ok] / np.abs(ref[ok])
-    return {"kind": "btf", "size": "16 x 32^3", "seconds": round(seconds, 2), "samples_per_texel": samples,
-            "max_rel_error": float(rel.max()), "p99_rel_error": float(np.quantile(rel, 0.99)),
-            "texels_checked": int(ok.sum()), "error_estimate": float(table.attributes["error_estimate"]),
-            "target": "<= 1e-4 relative in <= 600 s"}
+    return {
+        "kind": "btf",
+        "size": "16 x 32^3",
+        "seconds": round(seconds, 2),
+        "samples_per_texel": samples,
+        "max_rel_error": float(rel.max()),
+        "p99_rel_error": float(np.quantile(rel, 0.99)),
+        "texels_checked": int(ok.sum()),
+        "error_estimate": float(table.attributes["error_estimate"]),
+        "target": "<= 1e-4 relative in <= 600 s",
+    }
 
 
 def main() -> None:
     OUT.mkdir(parents=True, exist_ok=True)
     t0 = time.time()
-    res = {"machine": f"{os.cpu_count()} CPU cores, load average {os.getloadavg()[0]:.2f} at start",
-           "results": [bench_diffuse()]}
+    res = {
+        "machine": f"{os.cpu_count()} CPU cores, load average {os.getloadavg()[0]:.2f} at start",
+        "results": [bench_diffuse()],
+    }
     if "--skip-btf" not in sys.argv:
         res["results"].append(bench_btf())
     res["total_seconds"] = round(time.time() - t0, 1)

@@ -6,10 +6,18 @@
 The names below are imported on first use (PEP 562), so ``import lutbake`` and the commands that do
 not bake (``lutbake --help``, ``list``, ``inspect``, ``preview``) never load Warp.
 """
+
 __version__ = "0.1.0"
 
-_EXPORTS = {"bake": "api", "bake_table": "api", "BakeResult": "api", "load_config": "config",
-            "load_configs": "config", "TableSpec": "config", "Table": "table"}
+_EXPORTS = {
+    "bake": "api",
+    "bake_table": "api",
+    "BakeResult": "api",
+    "load_config": "config",
+    "load_configs": "config",
+    "TableSpec": "config",
+    "Table": "table",
+}
 __all__ = ["bake", "bake_table", "BakeResult", "load_config", "load_configs", "TableSpec", "Table", "__version__"]
 
 

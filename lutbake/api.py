@@ -1,4 +1,5 @@
 """The public Python API: ``bake`` a config (or specs) into tables and files."""
+
 from __future__ import annotations
 
 import json
@@ -30,11 +31,13 @@ def _warp_version() -> str:
     return wp.config.version
 
 
-def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: bool | None = None,
-               cancel=None) -> tuple[Table, float, int]:
+def bake_table(
+    spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: bool | None = None, cancel=None
+) -> tuple[Table, float, int]:
     """Bake one spec into a Table (nothing written). Raises TableError if a value is not finite;
     executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
     from .batch import content_hash
+
     plan = lookup_kind(spec.kind).plan(spec)
     with Timer() as t:
         data = execute(plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel)
@@ -57,8 +60,9 @@ def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu",
         **extra,
         "content_hash": content_hash(spec),  # what makes the file current (lutbake.batch)
     }
-    table = Table(spec.name, spec.kind, data.astype(np.float32), plan.axes, plan.channels, plan.reconstruction,
-                  attributes)
+    table = Table(
+        spec.name, spec.kind, data.astype(np.float32), plan.axes, plan.channels, plan.reconstruction, attributes
+    )
     return table, t.seconds, plan.samples
 
 
@@ -76,8 +80,16 @@ def samples_note(spec: TableSpec, effective: int | None) -> str:
     return f"samples = {asked} asked; the {spec.kind} quadrature evaluates {effective} per texel (docs/config.md)"
 
 
-def bake(configs, out_dir="outputs", overrides=(), workers: int | None = None, device: str = "cpu",
-         write: bool = True, progress: bool | None = None, on_result=None) -> list[BakeResult]:
+def bake(
+    configs,
+    out_dir="outputs",
+    overrides=(),
+    workers: int | None = None,
+    device: str = "cpu",
+    write: bool = True,
+    progress: bool | None = None,
+    on_result=None,
+) -> list[BakeResult]:
     """Validate every config, then bake each table and write ``out_dir/<name>.<ext>`` (key ``format``,
     default EXR) atomically.
 

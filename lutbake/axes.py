@@ -17,6 +17,7 @@ bilinear sampler reconstructs the table at a parameter value; ``uv_formula`` say
 A roughness axis also carries the NDF alpha at every index: alpha = r^2 for ``perceptual_roughness``,
 alpha = value for ``alpha``.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -25,16 +26,20 @@ import numpy as np
 
 from .edge import ALPHA_MIN, NOV_MIN
 
-IMAGE_DIMS = {"x": "columns", "y": "rows", "z": "slices",
-              "y_block": "row blocks: image row = (y_block index) * (count of the y axis) + (y index)"}
+IMAGE_DIMS = {
+    "x": "columns",
+    "y": "rows",
+    "z": "slices",
+    "y_block": "row blocks: image row = (y_block index) * (count of the y axis) + (y index)",
+}
 TEXELS = {"center": "t = (i + 0.5) / N", "endpoint": "t = i / (N - 1)"}
 MAPPINGS = {
     "linear": "value = lo + (hi - lo) * t",
     "one_minus_t2": "value = lo + (hi - lo) * (1 - t^2), i.e. t = sqrt(1 - value) on [0, 1] (Blender EEVEE NoV)",
     "texel_offset": "value = lo + (hi - lo) * min(t + 1/N, 1): one texel past the texel centre "
-                    "(Filament cmgen's roughness rows, r = clamp((H - y + 0.5)/H, 0, 1) in image row y)",
+    "(Filament cmgen's roughness rows, r = clamp((H - y + 0.5)/H, 0, 1) in image row y)",
     "listed": "value = values[i], listed in the config (not evenly spaced in general: map a parameter to a "
-              "fractional index by searching the values)",
+    "fractional index by searching the values)",
 }
 ORDERS = {
     "lo_first": "index 0 (first row / column) holds t near 0",

@@ -16,6 +16,7 @@
   so an unfinished table never appears or replaces a good file, and the next run resumes only the
   tables that did not finish (their outputs are missing or stale).
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -69,8 +70,12 @@ def sources_digest() -> bytes:
 def content_hash(spec: TableSpec, digest: bytes | None = None) -> str:
     """The hex sha256 of (spec.toml(), lutbake version, source digest): what makes an output current."""
     h = hashlib.sha256()
-    for part in (b"lutbake-content-hash-v1", spec.toml().encode(), __version__.encode(),
-                 digest if digest is not None else sources_digest()):
+    for part in (
+        b"lutbake-content-hash-v1",
+        spec.toml().encode(),
+        __version__.encode(),
+        digest if digest is not None else sources_digest(),
+    ):
         h.update(str(len(part)).encode() + b"\0" + part)
     return h.hexdigest()
 
@@ -85,7 +90,7 @@ def read_header(path) -> dict[str, str] | None:
         try:
             doc = json.loads(path.with_suffix(".json").read_text(encoding="utf-8"))
             meta = doc["lutbake"] if doc.get("file") == path.name else None
-            return {k[len("lutbake:"):] if k.startswith("lutbake:") else k: str(v) for k, v in meta.items()}
+            return {k[len("lutbake:") :] if k.startswith("lutbake:") else k: str(v) for k, v in meta.items()}
         except Exception:  # no sidecar (ktx2, h) or a foreign one: rebake
             return None
     try:
@@ -97,8 +102,9 @@ def read_header(path) -> dict[str, str] | None:
             return None
         try:
             spec = inp.spec()
-            return {p.name[len("lutbake:"):]: str(p.value) for p in spec.extra_attribs
-                    if p.name.startswith("lutbake:")}
+            return {
+                p.name[len("lutbake:") :]: str(p.value) for p in spec.extra_attribs if p.name.startswith("lutbake:")
+            }
         finally:
             inp.close()
     except Exception:  # a corrupt or foreign file is simply not up to date
@@ -124,9 +130,16 @@ class Job:
         return self.spec.name
 
     def report(self) -> dict:
-        return {"name": self.name, "status": self.status, "path": str(self.path), "content_hash": self.content_hash,
-                "seconds": self.seconds, "samples": self.samples, "error_estimate": self.error_estimate,
-                "message": self.message}
+        return {
+            "name": self.name,
+            "status": self.status,
+            "path": str(self.path),
+            "content_hash": self.content_hash,
+            "seconds": self.seconds,
+            "samples": self.samples,
+            "error_estimate": self.error_estimate,
+            "message": self.message,
+        }
 
 
 def _float_or_none(text) -> float | None:
@@ -159,6 +172,7 @@ def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.E
     from .api import bake_table
     from .errors import LutbakeError
     from .executor import Cancelled
+
     t0 = time.perf_counter()
     try:
         if cancel.is_set():
@@ -168,13 +182,19 @@ def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.E
             raise RuntimeError("the lutbake sources changed while the batch ran; run it again")
         if cancel.is_set():
             raise Cancelled(job.name)
-        write_table(table, job.path.parent, job.spec.options.get("format", "exr"),
-                    dtype=job.spec.options.get("dtype", "float32"))
+        write_table(
+            table,
+            job.path.parent,
+            job.spec.options.get("format", "exr"),
+            dtype=job.spec.options.get("dtype", "float32"),
+        )
     except Cancelled:
         job.status, job.message = "interrupted", "interrupted before its file was written; nothing written"
     except MemoryError as e:
         job.status = "failed"
-        job.message = f"{job.spec.source}: table '{job.name}': out of memory{': ' + str(e) if str(e) else ''}; nothing written"
+        job.message = (
+            f"{job.spec.source}: table '{job.name}': out of memory{': ' + str(e) if str(e) else ''}; nothing written"
+        )
     except LutbakeError as e:
         job.status, job.message = "failed", str(e)
     except Exception as e:  # a kernel error, an I/O error, anything: this table fails, the others go on
@@ -189,8 +209,14 @@ def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.E
     return job
 
 
-def run(jobs: list[Job], workers: int | None = None, device: str = "cpu", progress: bool | None = None,
-        on_done: Callable[[Job], None] | None = None, poll: float = 0.2) -> int | None:
+def run(
+    jobs: list[Job],
+    workers: int | None = None,
+    device: str = "cpu",
+    progress: bool | None = None,
+    on_done: Callable[[Job], None] | None = None,
+    poll: float = 0.2,
+) -> int | None:
     """Bake every ``pending`` job; ``on_done(job)`` is called in the calling thread as each finishes.
 
     Tables run on min(workers, pending) threads, each on the tile executor with ``workers`` tile threads:

@@ -1,4 +1,5 @@
 """The ``lutbake`` command line: a thin layer over lutbake.api."""
+
 from __future__ import annotations
 
 import sys
@@ -13,8 +14,12 @@ EXIT_CONFIG = 2
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
 @click.version_option(__version__, prog_name="lutbake")
-@click.option("-v", "--verbose", is_flag=True,
-              help="Keep Warp's banner, CUDA-driver warning and module-load lines (same as LUTBAKE_VERBOSE=1).")
+@click.option(
+    "-v",
+    "--verbose",
+    is_flag=True,
+    help="Keep Warp's banner, CUDA-driver warning and module-load lines (same as LUTBAKE_VERBOSE=1).",
+)
 def main(verbose):
     """Bake pre-integrated BRDF lookup tables (split-sum DFG, ...) into EXR files.
 
@@ -39,20 +44,44 @@ def main(verbose):
 @main.command()
 @click.argument("configs", nargs=-1, type=click.Path(path_type=Path))
 @click.option("--preset", "presets", multiple=True, metavar="NAME", help="Bake a preset config (lutbake list).")
-@click.option("--out-dir", type=click.Path(path_type=Path), default=Path("outputs"), show_default=True,
-              help="Directory the EXRs are written to.")
-@click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE",
-              help="Override a key in every table (KEY=VALUE) or one table (NAME.KEY=VALUE); VALUE is TOML.")
-@click.option("--workers", type=click.IntRange(min=1), default=None,
-              help="Worker threads (default: every core).")
-@click.option("--device", type=click.Choice(["cpu", "cuda"]), default="cpu", show_default=True,
-              help="Warp device the kernels run on.")
+@click.option(
+    "--out-dir",
+    type=click.Path(path_type=Path),
+    default=Path("outputs"),
+    show_default=True,
+    help="Directory the EXRs are written to.",
+)
+@click.option(
+    "--set",
+    "overrides",
+    multiple=True,
+    metavar="KEY=VALUE",
+    help="Override a key in every table (KEY=VALUE) or one table (NAME.KEY=VALUE); VALUE is TOML.",
+)
+@click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
+@click.option(
+    "--device",
+    type=click.Choice(["cpu", "cuda"]),
+    default="cpu",
+    show_default=True,
+    help="Warp device the kernels run on.",
+)
 @click.option("--progress/--no-progress", default=None, help="Progress bar (default: on a terminal, for long bakes).")
 @click.option("--force", is_flag=True, help="Rebake every table, even those whose output is up to date.")
-@click.option("--report", type=click.Path(path_type=Path, dir_okay=False), default=None, metavar="FILE.json",
-              help="Write a JSON summary: per table status, path, content hash, seconds, samples, error estimate.")
-@click.option("--format", "fmt", type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h"]), default=None,
-              help="Output format of every table (same as --set format=...; default: each table's `format`, exr).")
+@click.option(
+    "--report",
+    type=click.Path(path_type=Path, dir_okay=False),
+    default=None,
+    metavar="FILE.json",
+    help="Write a JSON summary: per table status, path, content hash, seconds, samples, error estimate.",
+)
+@click.option(
+    "--format",
+    "fmt",
+    type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h"]),
+    default=None,
+    help="Output format of every table (same as --set format=...; default: each table's `format`, exr).",
+)
 def bake(configs, presets, out_dir, overrides, workers, device, progress, force, report, fmt):
     """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.<ext> (EXR unless `format` / --format says otherwise).
 
@@ -104,8 +133,10 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     def on_done(job):
         if job.status == "baked":
             note = samples_note(job.spec, job.samples)
-            click.echo(f"{job.path}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel"
-                       + (f" ({note})" if note else ""))
+            click.echo(
+                f"{job.path}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel"
+                + (f" ({note})" if note else "")
+            )
         elif job.status == "failed":
             click.echo(f"FAILED {job.name}: {job.message}", err=True)
 
@@ -129,9 +160,11 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     if failed:
         click.echo(f"{len(failed)} of {len(jobs)} tables failed: {', '.join(failed)}", err=True)
     if signum is not None:
-        click.echo(f"interrupted ({batch.signal_name(signum)}): {len(unfinished)} of {len(jobs)} tables did not "
-                   f"finish: {', '.join(unfinished) or '-'}; run the same command again to bake only those",
-                   err=True)
+        click.echo(
+            f"interrupted ({batch.signal_name(signum)}): {len(unfinished)} of {len(jobs)} tables did not "
+            f"finish: {', '.join(unfinished) or '-'}; run the same command again to bake only those",
+            err=True,
+        )
     sys.exit(status)
 
 
@@ -154,8 +187,10 @@ def list_():
             click.echo(f"  {k:<26} {v}")
         click.echo()
 
-    section("Table kinds (kind = ...)", {k.name + (f" ({', '.join(k.aliases)})" if k.aliases else ""): k.description
-                                         for k in KINDS.values()})
+    section(
+        "Table kinds (kind = ...)",
+        {k.name + (f" ({', '.join(k.aliases)})" if k.aliases else ""): k.description for k in KINDS.values()},
+    )
     section("NDFs (ndf = ...)", {k: v.description for k, v in NDFS.items()})
     section("Masking-shadowing (masking = ...)", MASKINGS)
     section("Models (dfg, albedo, albedo_avg, specular_3d: model = ...)", MODELS)
@@ -165,8 +200,9 @@ def list_():
     from .terms.metals import METALS
 
     section("Fresnel (specular_3d: fresnel = ...; dfg factors Schlick out)", FRESNELS)
-    section("Metals (specular_3d: metal = ...)", {k: f"n+ik R,G,B = {m.n} + i{m.k}; {m.source}"
-                                                  for k, m in METALS.items()})
+    section(
+        "Metals (specular_3d: metal = ...)", {k: f"n+ik R,G,B = {m.n} + i{m.k}; {m.source}" for k, m in METALS.items()}
+    )
     section("DFG layouts (layout = ...)", LAYOUTS)
     section("Estimators (estimator = ...)", ESTIMATORS)
     section("Diffuse models (kind = diffuse, model = ...)", DIFFUSE_MODELS)
@@ -208,12 +244,27 @@ def inspect(file):
 
 
 @main.command()
-@click.option("--out-dir", type=click.Path(path_type=Path), default=Path("outputs/figures"), show_default=True,
-              help="Directory the PNGs are written to.")
-@click.option("--sigma-to-alpha", type=click.Choice(["sigma", "sigma_squared"]), default="sigma", show_default=True,
-              help="GGX alpha from sigma for the integrated microfacet model.")
-@click.option("--order", type=click.IntRange(min=2, max=64), default=12, show_default=True,
-              help="Gauss-Legendre order of the microfacet integral over m.")
+@click.option(
+    "--out-dir",
+    type=click.Path(path_type=Path),
+    default=Path("outputs/figures"),
+    show_default=True,
+    help="Directory the PNGs are written to.",
+)
+@click.option(
+    "--sigma-to-alpha",
+    type=click.Choice(["sigma", "sigma_squared"]),
+    default="sigma",
+    show_default=True,
+    help="GGX alpha from sigma for the integrated microfacet model.",
+)
+@click.option(
+    "--order",
+    type=click.IntRange(min=2, max=64),
+    default=12,
+    show_default=True,
+    help="Gauss-Legendre order of the microfacet integral over m.",
+)
 @click.option("--no-png", is_flag=True, help="Only print the error table.")
 def plot(out_dir, sigma_to_alpha, order, no_png):
     """Reproduce the seed's Figures 11-15 (settings of Figures 6-10): Oren-Nayar, Oren-Nayar with Fresnel,
@@ -228,13 +279,19 @@ def plot(out_dir, sigma_to_alpha, order, no_png):
     if not no_png:
         for p in plot_all(out_dir, sigma_to_alpha, order):
             click.echo(str(p))
-    click.echo(f"fitted (Eq. 8) vs integrated (Eq. 4), alpha from sigma: {sigma_to_alpha}; errors in units of the "
-               "integrated curve's maximum")
-    click.echo(f"{'figure':<7}{'abscissa':<9}{'fixed cos':>10}{'cos phi':>9}{'sigma':>7}{'max err':>9}{'rms err':>9}"
-               f"{'at deg':>8}")
+    click.echo(
+        f"fitted (Eq. 8) vs integrated (Eq. 4), alpha from sigma: {sigma_to_alpha}; errors in units of the "
+        "integrated curve's maximum"
+    )
+    click.echo(
+        f"{'figure':<7}{'abscissa':<9}{'fixed cos':>10}{'cos phi':>9}{'sigma':>7}{'max err':>9}{'rms err':>9}"
+        f"{'at deg':>8}"
+    )
     for r in error_table(sigma_to_alpha=sigma_to_alpha, order=order):
-        click.echo(f"{r['figure']:<7}{r['vary']:<9}{r['fixed_cos']:>10.3f}{r['cos_phi']:>9.3f}{r['sigma']:>7.2f}"
-                   f"{r['max_err']:>9.3f}{r['rms_err']:>9.3f}{r['argmax_deg']:>8.0f}")
+        click.echo(
+            f"{r['figure']:<7}{r['vary']:<9}{r['fixed_cos']:>10.3f}{r['cos_phi']:>9.3f}{r['sigma']:>7.2f}"
+            f"{r['max_err']:>9.3f}{r['rms_err']:>9.3f}{r['argmax_deg']:>8.0f}"
+        )
 
 
 @main.command()
@@ -261,8 +318,13 @@ def validate():
 
 @main.command()
 @click.argument("file", type=click.Path(path_type=Path))
-@click.option("-o", "--out", type=click.Path(path_type=Path), default=None,
-              help="PNG to write (default: FILE's stem + .preview.png beside it).")
+@click.option(
+    "-o",
+    "--out",
+    type=click.Path(path_type=Path),
+    default=None,
+    help="PNG to write (default: FILE's stem + .preview.png beside it).",
+)
 def preview(file, out):
     """Render a PNG of a table file (any format lutbake writes; see inspect): 1D tables as curves, 2D
     tables as colour-mapped channels with labelled axes, 3D tables as labelled slice grids, btf tables as

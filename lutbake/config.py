@@ -4,6 +4,7 @@ Every key is checked at load, before any kernel runs; an error names the file, t
 the bad value and the allowed values (lutbake.errors.ConfigError). Unknown keys are errors.
 A config holds one or more ``[[table]]`` entries (docs/config.md lists every key).
 """
+
 from __future__ import annotations
 
 import math
@@ -32,7 +33,9 @@ def human_bytes(n: int) -> str:
         k += 1
     if k == len(units) - 1 and n >= 1024 ** (k + 1):
         return f"~2^{n.bit_length() - 1} B"
-    return f"{n / 1024 ** k:.1f} {units[k]}" if k else f"{n} B"
+    return f"{n / 1024**k:.1f} {units[k]}" if k else f"{n} B"
+
+
 PRESET_DIR = Path(__file__).parent / "presets"
 
 
@@ -98,7 +101,11 @@ def _check_value(key: Key, value, file, table) -> Any:
             fail(f"must be <= {_num(key.maximum)}")
         return value
     if key.type == "int_pair":
-        if not isinstance(value, list) or len(value) != 2 or any(isinstance(x, bool) or not isinstance(x, int) for x in value):
+        if (
+            not isinstance(value, list)
+            or len(value) != 2
+            or any(isinstance(x, bool) or not isinstance(x, int) for x in value)
+        ):
             fail("must be a list of two integers, e.g. [128, 128]")
         if any(x < (key.minimum or 1) for x in value):
             fail("sizes must be >= 1")
@@ -112,8 +119,11 @@ def _check_value(key: Key, value, file, table) -> Any:
             fail(f"must be <= {key.maximum:g}")
         return float(value)
     if key.type == "float_range":
-        if (not isinstance(value, list) or len(value) != 2
-                or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in value)):
+        if (
+            not isinstance(value, list)
+            or len(value) != 2
+            or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in value)
+        ):
             fail("must be a list of two numbers [lo, hi]")
         lo, hi = (float(x) for x in value)
         if not (math.isfinite(lo) and math.isfinite(hi)):
@@ -122,8 +132,11 @@ def _check_value(key: Key, value, file, table) -> Any:
             fail(f"must satisfy {key.minimum:g} <= lo <= hi <= {key.maximum:g}")
         return [lo, hi]
     if key.type == "float_list":
-        if (not isinstance(value, list) or not 1 <= len(value) <= MAX_LIST
-                or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in value)):
+        if (
+            not isinstance(value, list)
+            or not 1 <= len(value) <= MAX_LIST
+            or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in value)
+        ):
             fail(f"must be a list of 1 to {MAX_LIST} numbers, e.g. [0.0, 0.25, 0.5]")
         xs = [float(x) for x in value]
         if not all(math.isfinite(x) for x in xs):
@@ -151,8 +164,9 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
         raise ConfigError(file, "kind", raw["kind"], ", ".join(KINDS), "is not a known table kind", label) from None
     unknown = sorted(set(raw) - set(kind.keys))
     if unknown:
-        raise ConfigError(file, unknown[0], raw[unknown[0]], ", ".join(kind.keys),
-                          f"is not a key of kind '{kind.name}'", label)
+        raise ConfigError(
+            file, unknown[0], raw[unknown[0]], ", ".join(kind.keys), f"is not a key of kind '{kind.name}'", label
+        )
     options: dict[str, Any] = {}
     for k in kind.keys.values():
         if k.name in raw:
@@ -165,10 +179,14 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
     spec = TableSpec(options["name"], kind.name, MappingProxyType(options), str(file), index)
     texels = math.prod(options.get("size", [1]))
     if texels > MAX_TEXELS:
-        raise ConfigError(file, "size", options["size"],
-                          f"at most {MAX_TEXELS} texels = {human_bytes(MAX_TEXELS * BYTES_PER_TEXEL)}",
-                          f"{texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} of memory while "
-                          "baking", label)
+        raise ConfigError(
+            file,
+            "size",
+            options["size"],
+            f"at most {MAX_TEXELS} texels = {human_bytes(MAX_TEXELS * BYTES_PER_TEXEL)}",
+            f"{texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} of memory while baking",
+            label,
+        )
     if kind.check is not None:
         msg = kind.check(spec)
         if msg:
@@ -232,8 +250,13 @@ def load_configs(paths, overrides=()) -> list[TableSpec]:
     for p in paths:
         for s in load_config(p, ovr):
             if s.name in seen:
-                raise ConfigError(s.source, "name", s.name, None,
-                                  f"duplicate table name (also in {seen[s.name]}): outputs would collide")
+                raise ConfigError(
+                    s.source,
+                    "name",
+                    s.name,
+                    None,
+                    f"duplicate table name (also in {seen[s.name]}): outputs would collide",
+                )
             seen[s.name] = s.source
             specs.append(s)
     names = {n for n, _, _ in ovr if n is not None}

@@ -10,6 +10,7 @@ back-facing samples uses a constant from here, so the behaviour is written down 
   the masking functions return 0 and integrands contribute nothing. No term ever divides by a cosine
   that has not passed this test, so no NaN or Inf can reach a table.
 """
+
 ALPHA_MIN = 1.0e-4
 NOV_MIN = 1.0e-4
 COS_EPS = 1.0e-7

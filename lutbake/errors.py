@@ -1,4 +1,5 @@
 """Errors users see. A ConfigError always names the file, the key, the bad value and what is allowed."""
+
 from __future__ import annotations
 
 
@@ -7,8 +8,15 @@ class LutbakeError(Exception):
 
 
 class ConfigError(LutbakeError):
-    def __init__(self, file, key: str | None, value=None, allowed: str | None = None, message: str | None = None,
-                 table: str | None = None):
+    def __init__(
+        self,
+        file,
+        key: str | None,
+        value=None,
+        allowed: str | None = None,
+        message: str | None = None,
+        table: str | None = None,
+    ):
         self.file, self.key, self.value, self.allowed, self.table = str(file), key, value, allowed, table
         where = self.file
         if table is not None:

@@ -4,6 +4,7 @@ Warp's CPU launches run one kernel on one core and release the GIL (ctypes), so 
 cores busy. A tile is a fixed range of texels (independent of the worker count) and every texel is
 computed alone, so the output is bit-identical for any number of workers.
 """
+
 from __future__ import annotations
 
 import os
@@ -33,8 +34,14 @@ def tiles(n: int, size: int = TILE_TEXELS) -> list[tuple[int, int]]:
     return [(s, min(s + size, n)) for s in range(0, n, size)]
 
 
-def execute(plan: Plan, workers: int | None = None, device: str = "cpu", progress: bool | None = None,
-            label: str = "", cancel: threading.Event | None = None) -> np.ndarray:
+def execute(
+    plan: Plan,
+    workers: int | None = None,
+    device: str = "cpu",
+    progress: bool | None = None,
+    label: str = "",
+    cancel: threading.Event | None = None,
+) -> np.ndarray:
     """Evaluate every tile of ``plan``; returns float64 data of shape plan.shape.
 
     ``cancel``: when set (by another thread), no further tile starts and Cancelled is raised."""
@@ -55,8 +62,9 @@ def execute(plan: Plan, workers: int | None = None, device: str = "cpu", progres
         out[s:e] = plan.run_tile(s, e, device)
         return e - s
 
-    with click.progressbar(length=plan.n_texels, label=label, file=sys.stderr if progress else open(os.devnull, "w"),
-                           show_eta=True) as bar:
+    with click.progressbar(
+        length=plan.n_texels, label=label, file=sys.stderr if progress else open(os.devnull, "w"), show_eta=True
+    ) as bar:
         if workers == 1 or device != "cpu":
             for b in parts:
                 bar.update(work(b))

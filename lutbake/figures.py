@@ -4,6 +4,7 @@ configurations, and the fitted model's error against the integrated microfacet m
 Every figure plots L_r = f_r (n.l) (radiance for unit irradiance, rho = 1, f0 = 0.04) against theta_l
 (n.e and cos phi fixed) or against theta_e (n.l and cos phi fixed); phi is the azimuth between l and e.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -44,14 +45,20 @@ def directions(fig: Figure, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     s = np.sin(theta)
     cf = fig.fixed_cos
     sf = np.sqrt(max(1.0 - cf * cf, 0.0))
-    sp = np.sqrt(max(1.0 - fig.cos_phi ** 2, 0.0))
+    sp = np.sqrt(max(1.0 - fig.cos_phi**2, 0.0))
     moving = np.stack([s * fig.cos_phi, s * sp, c], -1)
     fixed = np.broadcast_to(np.array([sf, 0.0, cf]), moving.shape)
     return (moving, fixed) if fig.vary == "theta_l" else (fixed, moving)
 
 
-def curves(fig: Figure, theta: np.ndarray, models=MODELS, sigma_to_alpha: str = "sigma", facet_fresnel: str = "eq6",
-           order: int = 12) -> dict[str, np.ndarray]:
+def curves(
+    fig: Figure,
+    theta: np.ndarray,
+    models=MODELS,
+    sigma_to_alpha: str = "sigma",
+    facet_fresnel: str = "eq6",
+    order: int = 12,
+) -> dict[str, np.ndarray]:
     """L_r = f_r (n.l) per model along the figure's abscissa."""
     from .tables.diffuse import eval_brdf
 
@@ -72,17 +79,33 @@ def error_table(theta=None, sigma_to_alpha: str = "sigma", fitted: str = "fitted
         ref, fit = c["microfacet"], c[fitted]
         scale = np.max(np.abs(ref))
         d = fit - ref
-        rows.append({"figure": fig.label, "vary": fig.vary, "fixed_cos": fig.fixed_cos, "cos_phi": fig.cos_phi,
-                     "sigma": fig.sigma, "max_err": float(np.max(np.abs(d)) / scale),
-                     "rms_err": float(np.sqrt(np.mean(d * d)) / scale),
-                     "argmax_deg": float(np.degrees(theta[np.argmax(np.abs(d))]))})
+        rows.append(
+            {
+                "figure": fig.label,
+                "vary": fig.vary,
+                "fixed_cos": fig.fixed_cos,
+                "cos_phi": fig.cos_phi,
+                "sigma": fig.sigma,
+                "max_err": float(np.max(np.abs(d)) / scale),
+                "rms_err": float(np.sqrt(np.mean(d * d)) / scale),
+                "argmax_deg": float(np.degrees(theta[np.argmax(np.abs(d))])),
+            }
+        )
     return rows
 
 
-COLOURS = {"oren_nayar": "tab:blue", "oren_nayar_fresnel": "tab:purple", "microfacet": "tab:green",
-           "fitted": "tab:orange"}
-LABELS = {"oren_nayar": "Oren-Nayar (Eq. 5)", "oren_nayar_fresnel": "Oren-Nayar with Fresnel (Eq. 7)",
-          "microfacet": "microfacet, integrated (Eq. 4)", "fitted": "fitted (Eq. 8)"}
+COLOURS = {
+    "oren_nayar": "tab:blue",
+    "oren_nayar_fresnel": "tab:purple",
+    "microfacet": "tab:green",
+    "fitted": "tab:orange",
+}
+LABELS = {
+    "oren_nayar": "Oren-Nayar (Eq. 5)",
+    "oren_nayar_fresnel": "Oren-Nayar with Fresnel (Eq. 7)",
+    "microfacet": "microfacet, integrated (Eq. 4)",
+    "fitted": "fitted (Eq. 8)",
+}
 
 
 def plot_all(out_dir, sigma_to_alpha: str = "sigma", order: int = 12) -> list:
@@ -104,11 +127,12 @@ def plot_all(out_dir, sigma_to_alpha: str = "sigma", order: int = 12) -> list:
         f, ax = plt.subplots(figsize=(5, 3.5))
         for m in models:
             key = "oren_nayar" if m == "oren_nayar_improved" else m
-            ax.plot(np.degrees(theta), c[m], color=COLOURS[key], label=LABELS[key],
-                    ls="--" if m == "fitted" else "-")
+            ax.plot(np.degrees(theta), c[m], color=COLOURS[key], label=LABELS[key], ls="--" if m == "fitted" else "-")
         fixed = "n·e" if fig.vary == "theta_l" else "n·l"
-        ax.set_title(f"Fig. {fig.label}: {fixed} = {fig.fixed_cos}, cos φ = {fig.cos_phi}, σ = {fig.sigma}, f0 = {F0}",
-                     fontsize=8)
+        ax.set_title(
+            f"Fig. {fig.label}: {fixed} = {fig.fixed_cos}, cos φ = {fig.cos_phi}, σ = {fig.sigma}, f0 = {F0}",
+            fontsize=8,
+        )
         ax.set_xlabel("θ_l (deg)" if fig.vary == "theta_l" else "θ_e (deg)")
         ax.set_ylabel("L_r (unit irradiance, ρ = 1)")
         ax.legend(fontsize=6)

@@ -14,6 +14,7 @@ environment with a sun, shaded with the file's own reconstruction, E looked up t
 (``Axis.uv``), so a wrong axis, flip or channel order shows up as an implausible sphere. Kinds with no
 split-sum reconstruction (albedo, diffuse, btf, the sheen albedo-scaling layouts) get no sphere row.
 """
+
 from __future__ import annotations
 
 import textwrap
@@ -33,8 +34,18 @@ SKY, GROUND = np.array([0.75, 0.82, 0.95]), np.array([0.06, 0.05, 0.04])  # a pa
 SUN_DIR = np.array([-0.45, 0.65, 0.6]) / np.linalg.norm([-0.45, 0.65, 0.6])
 SUN_POWER = 1.5  # integral of the sun's radiance over the sphere (its irradiance scale)
 UNITS = {"phi": "rad", "theta_l": "rad", "theta_v": "rad"}
-SYMBOLS = {"sigma": "σ", "phi": "φ", "cos_phi": "cos φ", "theta_l": "θ_l", "theta_v": "θ_v", "NoV": "n·v",
-           "NoL": "n·l", "alpha": "α", "perceptual_roughness": "perceptual roughness r", "f0": "f0"}
+SYMBOLS = {
+    "sigma": "σ",
+    "phi": "φ",
+    "cos_phi": "cos φ",
+    "theta_l": "θ_l",
+    "theta_v": "θ_v",
+    "NoV": "n·v",
+    "NoL": "n·l",
+    "alpha": "α",
+    "perceptual_roughness": "perceptual roughness r",
+    "f0": "f0",
+}
 ROUGHNESS_AXES = ("perceptual_roughness", "alpha")
 MEANING_WIDTH, MEANING_LINES = 44, 4  # characters per line and lines of a channel's meaning under its name
 CLIP_PERCENTILE, CLIP_RATIO = 99.0, 3.0  # colour scale: see _color_range
@@ -99,12 +110,14 @@ def split_sum(view: TableView):
         zmid = float(z.values()[z.count // 2]) if z is not None else None
         where = f", {_short(z, zmid)}" if z is not None else ""
         if layout in ("scale_bias", "scale_bias_f82"):  # Karis 2013: E = f0 * scale + bias
+
             def E_scale_bias(nov, r):
                 t = at(nov, r, zmid)
                 return SPHERE_F0 * t[..., 0:1] + t[..., 1:2]
 
             return f"E = f0 R + G, f0 = gold{where}", E_scale_bias, False
         if layout in ("multiscatter", "multiscatter_cloth"):  # Filament: E = mix(R, G, f0)
+
             def E_multiscatter(nov, r):
                 t = at(nov, r, zmid)
                 return (1 - SPHERE_F0) * t[..., 0:1] + SPHERE_F0 * t[..., 1:2]
@@ -112,13 +125,19 @@ def split_sum(view: TableView):
             return f"E = (1 - f0) R + f0 G, f0 = gold{where}", E_multiscatter, False
         if layout in ("charlie", "charlie_clamped") and nch >= 3:
             # the sheen lobe is broad: its prefiltered (Charlie) environment is close to the mean radiance
-            return ("sheen = prefiltered_charlie sheenColor B, sheenColor = white", lambda nov, r: SHEEN_COLOR *
-                    at(nov, r)[..., 2:3], True)
+            return (
+                "sheen = prefiltered_charlie sheenColor B, sheenColor = white",
+                lambda nov, r: SHEEN_COLOR * at(nov, r)[..., 2:3],
+                True,
+            )
         return None
     if view.kind == "specular_3d":
         if z is not None and z.name == "f0":
-            return ("E = T(n·v, r, f0) per RGB f0 of gold", lambda nov, r: np.concatenate(
-                [at(nov, r, f)[..., 0:1] for f in SPHERE_F0], axis=-1), False)
+            return (
+                "E = T(n·v, r, f0) per RGB f0 of gold",
+                lambda nov, r: np.concatenate([at(nov, r, f)[..., 0:1] for f in SPHERE_F0], axis=-1),
+                False,
+            )
         if z is None and nch == 3:
             return "E = T(n·v, r).rgb (the metal's own complex Fresnel)", lambda nov, r: at(nov, r), False
     return None
@@ -129,14 +148,14 @@ def sphere(E, roughness_value: float, perceptual: float, size: int = 128) -> np.
     E(n.v, roughness_value) (RGB); ``perceptual`` widens the prefilter."""
     s = (np.arange(size) + 0.5) / size * 2 - 1
     X, Y = np.meshgrid(s, -s)
-    inside = X ** 2 + Y ** 2 < 1
-    Z = np.sqrt(np.clip(1 - X ** 2 - Y ** 2, 0, 1))
+    inside = X**2 + Y**2 < 1
+    Z = np.sqrt(np.clip(1 - X**2 - Y**2, 0, 1))
     nov = np.clip(Z, 1e-4, 1.0)
     refl = np.stack([2 * nov * X, 2 * nov * Y, 2 * nov * Z - 1], -1)  # R = 2 (n.v) n - v, v = +z
     up = np.clip(0.5 + 0.5 * refl[..., 1], 0, 1)[..., None]
-    radiance = GROUND + (SKY - GROUND) * (up ** 0.5)
-    blur = perceptual ** 2  # the prefiltered sky tends to its average as roughness grows
-    w = max(2.0 * perceptual ** 4, 2e-4)  # a sun prefiltered by a lobe of solid angle ~ 2 pi w
+    radiance = GROUND + (SKY - GROUND) * (up**0.5)
+    blur = perceptual**2  # the prefiltered sky tends to its average as roughness grows
+    w = max(2.0 * perceptual**4, 2e-4)  # a sun prefiltered by a lobe of solid angle ~ 2 pi w
     sun = SUN_POWER * np.exp((refl @ SUN_DIR - 1) / w) / (2 * np.pi * w)
     prefiltered = (1 - blur) * radiance + blur * 0.5 * (SKY + GROUND) + np.minimum(sun, 50.0)[..., None]
     rgb = prefiltered * E(nov, np.full_like(nov, roughness_value))
@@ -181,7 +200,7 @@ def _channel_title(view: TableView, c: int) -> str:
     meaning = meaning.split(": ", 1)[1] if meaning.startswith(name + ": ") else meaning
     lines = textwrap.wrap(meaning, MEANING_WIDTH)
     if len(lines) > MEANING_LINES:
-        lines = lines[:MEANING_LINES - 1] + [textwrap.shorten(" ".join(lines[MEANING_LINES - 1:]), MEANING_WIDTH)]
+        lines = lines[: MEANING_LINES - 1] + [textwrap.shorten(" ".join(lines[MEANING_LINES - 1 :]), MEANING_WIDTH)]
     col = view.data[..., c]
     const = f"  (constant {float(col.flat[0]):.3g})" if col.size and col.min() == col.max() else ""
     return "\n".join([f"{'RGBA'[c]} = {name}{const}"] + lines)
@@ -222,8 +241,9 @@ SPHERE_ROW_INCHES = 3.2
 
 def _canvases(plt, width: float, grid_height: float, spheres):
     """The figure, the canvas the table is drawn on and (with spheres) the canvas of the sphere row."""
-    fig = plt.figure(figsize=(width, grid_height + (SPHERE_ROW_INCHES if spheres else 0) + 0.8), dpi=100,
-                     layout="constrained")
+    fig = plt.figure(
+        figsize=(width, grid_height + (SPHERE_ROW_INCHES if spheres else 0) + 0.8), dpi=100, layout="constrained"
+    )
     if not spheres:
         return fig, fig, None
     top, bottom = fig.subfigures(2, 1, height_ratios=[grid_height, SPHERE_ROW_INCHES])
@@ -258,11 +278,15 @@ def _fig_3d(plt, view, spheres):
         axes = []
         for j, k in enumerate(picks):
             ax = canvas.add_subplot(nch, len(picks), c * len(picks) + j + 1)
-            im = _image(canvas, ax, data[k, ..., c], y_axis, x_axis, vmin, vmax,
-                        labels=(c == nch - 1, j == 0), bar=False)
+            im = _image(
+                canvas, ax, data[k, ..., c], y_axis, x_axis, vmin, vmax, labels=(c == nch - 1, j == 0), bar=False
+            )
             where = _short(z_axis, zvals[k]) if z_axis is not None else f"slice {k}"
-            ax.set_title(f"{where}  (slice {k})" if j else f"{_channel_title(view, c)}{clipped}\n{where}  (slice {k})",
-                         fontsize=8, loc="left")
+            ax.set_title(
+                f"{where}  (slice {k})" if j else f"{_channel_title(view, c)}{clipped}\n{where}  (slice {k})",
+                fontsize=8,
+                loc="left",
+            )
             axes.append(ax)
         canvas.colorbar(im, ax=axes, fraction=0.02, pad=0.02).ax.tick_params(labelsize=7)
     if spheres:
@@ -283,7 +307,7 @@ def _fig_btf(plt, view):
     for i, k in enumerate(sig):
         for j, p in enumerate(phis):
             ax = fig.add_subplot(len(sig), len(phis), i * len(phis) + j + 1)
-            img = data[k, p * ny:(p + 1) * ny, :, 0]
+            img = data[k, p * ny : (p + 1) * ny, :, 0]
             im = _image(fig, ax, img, y_axis, x_axis, vmin, vmax, labels=(i == len(sig) - 1, j == 0), bar=False)
             where = _short(z_axis, zvals[k]) + ", " if z_axis is not None else ""
             ax.set_title(f"{where}{_short(block, pvals[p])}", fontsize=8)

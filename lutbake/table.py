@@ -1,4 +1,5 @@
 """The baked table: one object that writers and checks see."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field

@@ -4,6 +4,7 @@ process' stderr on every machine without a GPU. lutbake's commands and its Pytho
 lines only, unless asked: ``LUTBAKE_VERBOSE=1`` in the environment (``lutbake --verbose ...``) keeps
 everything Warp says.
 """
+
 from __future__ import annotations
 
 import contextlib

@@ -1,4 +1,5 @@
 """Shared test setup: Warp initialised once per session, without its banner."""
+
 import pytest
 import warp as wp
 

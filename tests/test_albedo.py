@@ -1,4 +1,5 @@
 """Kulla-Conty energy compensation: the albedo tables, and the white furnace of the compensated BRDF."""
+
 import numpy as np
 import pytest
 

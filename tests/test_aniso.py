@@ -3,6 +3,7 @@
 The estimator is QMC (3D Sobol'), the isotropic tables are product Gauss-Legendre (accurate to ~1e-7 for GGX):
 at anisotropy 0 the two must agree to the QMC error, which is what ANISO_ATOL states (measured below; printed).
 """
+
 import numpy as np
 import pytest
 
@@ -31,8 +32,9 @@ def bake(**kw):
 @pytest.fixture(scope="module")
 def ggx_ms():
     """Anisotropic GGX, multiscatter layout (G = E(F = 1)), anisotropy in {0, 0.5, 1} (endpoint texels)."""
-    return bake(kind="specular_aniso", size=SIZE, anisotropy_size=3, texel="endpoint", layout="multiscatter",
-                samples=SAMPLES)
+    return bake(
+        kind="specular_aniso", size=SIZE, anisotropy_size=3, texel="endpoint", layout="multiscatter", samples=SAMPLES
+    )
 
 
 def report(name, got, want):
@@ -73,12 +75,33 @@ def test_anisotropy_loses_energy_and_stays_below_one(ggx_ms):
 
 def test_negative_anisotropy_is_the_rotated_lobe():
     """a < 0 swaps alpha_x and alpha_y: seen from the tangent it is the a > 0 lobe seen from the bitangent."""
-    a = bake(kind="specular_aniso", size=[6, 3], anisotropy_size=1, anisotropy_range=[-0.8, -0.8],
-             view_azimuth="tangent", layout="multiscatter", samples=SAMPLES)
-    b = bake(kind="specular_aniso", size=[6, 3], anisotropy_size=1, anisotropy_range=[0.8, 0.8],
-             view_azimuth="bitangent", layout="multiscatter", samples=SAMPLES)
-    c = bake(kind="specular_aniso", size=[6, 3], anisotropy_size=1, anisotropy_range=[0.8, 0.8],
-             view_azimuth="tangent", layout="multiscatter", samples=SAMPLES)
+    a = bake(
+        kind="specular_aniso",
+        size=[6, 3],
+        anisotropy_size=1,
+        anisotropy_range=[-0.8, -0.8],
+        view_azimuth="tangent",
+        layout="multiscatter",
+        samples=SAMPLES,
+    )
+    b = bake(
+        kind="specular_aniso",
+        size=[6, 3],
+        anisotropy_size=1,
+        anisotropy_range=[0.8, 0.8],
+        view_azimuth="bitangent",
+        layout="multiscatter",
+        samples=SAMPLES,
+    )
+    c = bake(
+        kind="specular_aniso",
+        size=[6, 3],
+        anisotropy_size=1,
+        anisotropy_range=[0.8, 0.8],
+        view_azimuth="tangent",
+        layout="multiscatter",
+        samples=SAMPLES,
+    )
     np.testing.assert_allclose(a.data, b.data, atol=ANISO_ATOL)
     assert np.max(np.abs(a.data - c.data)) > 10 * ANISO_ATOL  # the view azimuth matters for a stretched lobe
 
@@ -86,10 +109,16 @@ def test_negative_anisotropy_is_the_rotated_lobe():
 def test_ashikhmin_shirley():
     """At anisotropy 0 it is the isotropic model = ashikhmin_shirley dfg table (gauss_legendre, 1728 samples);
     its E(F = 1) <= 1 for every anisotropy (the integrand over its own h density is (n.l)/max(n.l, n.v) <= 1)."""
-    t = bake(kind="specular_aniso", model="ashikhmin_shirley", size=SIZE, anisotropy_size=3, texel="endpoint",
-             layout="multiscatter", samples=SAMPLES)
-    iso = bake(kind="dfg", model="ashikhmin_shirley", size=SIZE, texel="endpoint", layout="multiscatter",
-               samples=1728)
+    t = bake(
+        kind="specular_aniso",
+        model="ashikhmin_shirley",
+        size=SIZE,
+        anisotropy_size=3,
+        texel="endpoint",
+        layout="multiscatter",
+        samples=SAMPLES,
+    )
+    iso = bake(kind="dfg", model="ashikhmin_shirley", size=SIZE, texel="endpoint", layout="multiscatter", samples=1728)
     assert report("Ashikhmin-Shirley multiscatter", t.data[0], iso.data) < ANISO_ATOL
     E = t.data[..., 1]
     print(f"Ashikhmin-Shirley max E(F = 1) = {E.max():.6f}")

@@ -1,5 +1,6 @@
 """Axis-convention keys of kind dfg: axis order, row order, NoV / roughness mappings, NoV clamp, and
 the texture coordinate each axis records for shaders (uv)."""
+
 import json
 
 import numpy as np
@@ -24,7 +25,9 @@ def default():
 
 def test_defaults_keep_nov_columns_and_smooth_first_row(default):
     assert [(a.name, a.dim, a.order, a.mapping) for a in default.axes] == [
-        ("perceptual_roughness", "y", "lo_first", "linear"), ("NoV", "x", "lo_first", "linear")]
+        ("perceptual_roughness", "y", "lo_first", "linear"),
+        ("NoV", "x", "lo_first", "linear"),
+    ]
 
 
 def test_roughness_x_transposes_the_table(default):
@@ -88,9 +91,11 @@ def test_axis_metadata_round_trips_through_the_preview_reader():
     from lutbake.axes import Axis
     from lutbake.io.readers import axis_from_meta
 
-    for a in (Axis("NoV", "y", 8, texel="endpoint", mapping="one_minus_t2", order="hi_first", clamp=(1e-4, 0.9999)),
-              Axis("perceptual_roughness", "x", 16, mapping="texel_offset"),
-              Axis("sigma", "z", 3, 0.1, 0.9, mapping="listed", listed=(0.1, 0.3, 0.9))):
+    for a in (
+        Axis("NoV", "y", 8, texel="endpoint", mapping="one_minus_t2", order="hi_first", clamp=(1e-4, 0.9999)),
+        Axis("perceptual_roughness", "x", 16, mapping="texel_offset"),
+        Axis("sigma", "z", 3, 0.1, 0.9, mapping="listed", listed=(0.1, 0.3, 0.9)),
+    ):
         b = axis_from_meta(a.describe())
         np.testing.assert_array_equal(b.values(), a.values())
         x = np.linspace(0.0, 1.0, 11)

@@ -1,4 +1,5 @@
 """The executor: bit-identical output for any worker count; the table's axes and values."""
+
 import numpy as np
 import pytest
 

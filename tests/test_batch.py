@@ -1,6 +1,7 @@
 """Batch runs (issue 7): incremental content-hash skips, --force, --report, one failing table does
 not stop the others, Ctrl-C / SIGTERM keep finished tables and write no unfinished one, two
 concurrent runs never corrupt a file, and the output is deterministic for any worker count."""
+
 import dataclasses
 import json
 import os
@@ -94,8 +95,16 @@ def test_content_hash_covers_config_version_and_kernel_sources(monkeypatch, tmp_
     monkeypatch.setattr(batch, "__version__", "9.9.9")
     assert batch.content_hash(s) != h
     rel = {f.relative_to(batch.PACKAGE).as_posix() for f in batch.source_files()}
-    for f in ("terms/ndf.py", "terms/masking.py", "terms/fresnel.py", "sampling/estimators.py",
-              "tables/dfg.py", "tables/specular.py", "axes.py", "edge.py"):
+    for f in (
+        "terms/ndf.py",
+        "terms/masking.py",
+        "terms/fresnel.py",
+        "sampling/estimators.py",
+        "tables/dfg.py",
+        "tables/specular.py",
+        "axes.py",
+        "edge.py",
+    ):
         assert f in rel
 
 
@@ -229,8 +238,9 @@ def test_two_concurrent_runs_never_corrupt_a_file(tmp_path):
     out = tmp_path / "out"
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     cmd = [sys.executable, "-m", "lutbake", "bake", str(cfg), "--out-dir", str(out), "--force", "--workers", "1"]
-    procs = [subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-             for _ in range(2)]
+    procs = [
+        subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(2)
+    ]
     for p in procs:
         stdout, stderr = p.communicate(timeout=120)
         assert p.returncode == 0, stderr
@@ -244,8 +254,12 @@ def test_two_concurrent_runs_never_corrupt_a_file(tmp_path):
 
 
 def test_same_config_gives_identical_pixels_and_headers_for_any_worker_count(tmp_path):
-    cfg = write_config(tmp_path, table("x", size=[24, 12]), table("y", size=[9, 5], estimator="sobol_ndf"),
-                       table("z", size=[7, 3], texel="endpoint", dtype="half"))
+    cfg = write_config(
+        tmp_path,
+        table("x", size=[24, 12]),
+        table("y", size=[9, 5], estimator="sobol_ndf"),
+        table("z", size=[7, 3], texel="endpoint", dtype="half"),
+    )
     runs = []
     for k, workers in enumerate(["1", "2", "2"]):
         out = tmp_path / f"out{k}"
@@ -277,8 +291,13 @@ def test_ctrl_c_on_a_real_process(tmp_path):
     cfg = write_config(tmp_path, table("first"), table("big", size=[256, 256], samples=432))
     out = tmp_path / "out"
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    p = subprocess.Popen([sys.executable, "-m", "lutbake", "bake", str(cfg), "--out-dir", str(out), "--workers", "1"],
-                         env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(
+        [sys.executable, "-m", "lutbake", "bake", str(cfg), "--out-dir", str(out), "--workers", "1"],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     deadline = time.monotonic() + 60
     while not (out / "first.exr").exists() and p.poll() is None and time.monotonic() < deadline:
         time.sleep(0.02)

@@ -1,5 +1,6 @@
 """Kind ``btf``: layout (sigma parts, phi row blocks), values against the BRDF, reciprocity, the sigma = 0 limit,
 the fitted variant, the EXR round trip and the metadata."""
+
 import json
 
 import numpy as np
@@ -13,8 +14,9 @@ from lutbake.tables import diffuse as D
 
 
 def spec(**kw):
-    return validate_table({"name": "b", "kind": "btf", "size": [5, 5], "phi_size": 3, "sigma_size": 2, **kw},
-                          "<test>", 0)
+    return validate_table(
+        {"name": "b", "kind": "btf", "size": [5, 5], "phi_size": 3, "sigma_size": 2, **kw}, "<test>", 0
+    )
 
 
 @pytest.fixture(scope="module")
@@ -24,8 +26,12 @@ def cosines():
 
 def test_shape_and_axes(cosines):
     assert cosines.data.shape == (2, 15, 5, 1)  # sigma parts, phi blocks x NoV rows, NoL columns
-    assert [(a.name, a.dim) for a in cosines.axes] == [("sigma", "z"), ("cos_phi", "y_block"), ("NoV", "y"),
-                                                       ("NoL", "x")]
+    assert [(a.name, a.dim) for a in cosines.axes] == [
+        ("sigma", "z"),
+        ("cos_phi", "y_block"),
+        ("NoV", "y"),
+        ("NoL", "x"),
+    ]
     assert json.loads(cosines.attributes["sigma_values"]) == pytest.approx([0.25, 0.75])
 
 
@@ -44,13 +50,15 @@ def test_every_block_is_symmetric_reciprocity(cosines):
 
 
 def test_sigma_0_slice_is_lambert_times_eq6():
-    t = bake_table(spec(parametrisation="angles", sigma_range=[0.0, 0.0], sigma_size=1, f0=0.04, size=[4, 4],
-                        phi_size=2), workers=1)[0]
+    t = bake_table(
+        spec(parametrisation="angles", sigma_range=[0.0, 0.0], sigma_size=1, f0=0.04, size=[4, 4], phi_size=2),
+        workers=1,
+    )[0]
     tl, tv = (np.cos(a.values().astype(np.float64)) for a in (t.axes[3], t.axes[2]))
     w = lambda c: 1 - (1 - c) ** 5  # noqa: E731
     ref = 1.05 * 0.96 * w(tv)[:, None] * w(tl)[None, :] / np.pi
     for p in range(2):  # no dependence on phi at sigma = 0
-        np.testing.assert_allclose(t.data[0, p * 4:(p + 1) * 4, :, 0], ref, rtol=2e-4)
+        np.testing.assert_allclose(t.data[0, p * 4 : (p + 1) * 4, :, 0], ref, rtol=2e-4)
 
 
 def test_fitted_variant_is_eq8_and_differs_from_the_integral(cosines):
@@ -85,8 +93,17 @@ def test_explicit_sigma_values_make_a_listed_axis(tmp_path):
     assert json.loads(attrs["sigma_values"]) == pytest.approx([0.0, 0.3, 0.35])
 
 
-@pytest.mark.parametrize("bad, fragment", [([0.3, 0.2], "increasing"), ([0.1, 1.5], "<= 1"), ([], "list of 1"),
-                                           ([0.1, "x"], "list of 1"), (0.5, "list of 1"), ([0.1, float("nan")], "finite")])
+@pytest.mark.parametrize(
+    "bad, fragment",
+    [
+        ([0.3, 0.2], "increasing"),
+        ([0.1, 1.5], "<= 1"),
+        ([], "list of 1"),
+        ([0.1, "x"], "list of 1"),
+        (0.5, "list of 1"),
+        ([0.1, float("nan")], "finite"),
+    ],
+)
 def test_bad_sigma_values_are_rejected(bad, fragment):
     with pytest.raises(ConfigError, match=fragment):
         spec(sigma_values=bad)

@@ -1,4 +1,5 @@
 """CLI smoke runs: bake, list, inspect, bad input (exit 2, nothing written), python -m lutbake."""
+
 import subprocess
 import sys
 
@@ -75,8 +76,12 @@ def test_preview_writes_a_png_for_exr_and_npy(tmp_path):
 
     pytest.importorskip("matplotlib", reason="lutbake preview needs matplotlib (the plot extra)")
     cfg = tmp_path / "c.toml"
-    cfg.write_text(CONFIG.replace('size = [16, 8]', 'size = [16, 8]\nlayout = "multiscatter"\n'
-                                  'row_order = "hi_first"\nroughness_mapping = "texel_offset"'))
+    cfg.write_text(
+        CONFIG.replace(
+            "size = [16, 8]",
+            'size = [16, 8]\nlayout = "multiscatter"\nrow_order = "hi_first"\nroughness_mapping = "texel_offset"',
+        )
+    )
     out = tmp_path / "out"
     for fmt in ("exr", "npy"):
         r = run("bake", str(cfg), "--out-dir", str(out), "--format", fmt)

@@ -1,4 +1,5 @@
 """Bad configs are rejected before any kernel runs, with the file, key, value and allowed values."""
+
 import pytest
 
 from lutbake.config import load_configs, parse_overrides
@@ -51,8 +52,11 @@ def test_defaults_are_filled_in(tmp_path):
     ],
 )
 def test_bad_key_names_file_key_and_allowed(tmp_path, line, key, fragment):
-    text = GOOD.replace('kind = "dfg"', line) if line.startswith("kind") else (
-        GOOD.replace('name = "dfg"', line) if line.startswith("name") else GOOD + line + "\n")
+    text = (
+        GOOD.replace('kind = "dfg"', line)
+        if line.startswith("kind")
+        else (GOOD.replace('name = "dfg"', line) if line.startswith("name") else GOOD + line + "\n")
+    )
     if line.startswith("size"):
         text = GOOD.replace("size = [16, 8]", line)
     p = write(tmp_path, text)

@@ -1,5 +1,6 @@
 """Kind ``diffuse_3d`` (NoV x sigma x f0): factoring forms reduce to the 2D table x g(f0); the exact dielectric
 form against the nested rule; the EXR layout (a part per f0 slice)."""
+
 import numpy as np
 import pytest
 

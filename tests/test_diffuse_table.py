@@ -1,4 +1,5 @@
 """Kind ``diffuse`` (AmbientBRDF, NoV x sigma): albedo invariants, the sigma = 0 limit, f0 factoring."""
+
 import numpy as np
 import pytest
 
@@ -49,8 +50,15 @@ def test_microfacet_f0_factors_out(microfacet):
     assert t.attributes["f0_factor"] == "(1 - f0)"
 
 
-@pytest.mark.parametrize("kv, fragment", [({"model": "phong"}, "lambert"), ({"f0": 1.5}, "<="),
-                                           ({"sigma_to_alpha": "cube"}, "sigma_squared"), ({"samples": 1}, ">= 2")])
+@pytest.mark.parametrize(
+    "kv, fragment",
+    [
+        ({"model": "phong"}, "lambert"),
+        ({"f0": 1.5}, "<="),
+        ({"sigma_to_alpha": "cube"}, "sigma_squared"),
+        ({"samples": 1}, ">= 2"),
+    ],
+)
 def test_bad_diffuse_keys_are_rejected(kv, fragment):
     with pytest.raises(ConfigError, match=fragment):
         spec(**kv)
@@ -78,8 +86,9 @@ def test_grazing_small_sigma_corner_is_converged():
     """The corner the old nested rule missed by 2.9e-3 (NoV = sigma = 1/128): the default orders against order 32."""
     from lutbake.tables import diffuse_albedo as A
 
-    t = bake_table(spec(model="microfacet", size=[4, 4], nov_range=[0.0, 0.0625], sigma_range=[0.0, 0.0625]),
-                   workers=1)[0]
+    t = bake_table(
+        spec(model="microfacet", size=[4, 4], nov_range=[0.0, 0.0625], sigma_range=[0.0, 0.0625]), workers=1
+    )[0]
     nov = np.tile(t.axes[1].values(), 4).astype(np.float64)
     alpha = np.repeat(t.axes[0].values(), 4).astype(np.float64)
     ref = A.albedo(nov, alpha, orders=np.full((16, 3), 32))

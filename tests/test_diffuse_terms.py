@@ -1,5 +1,6 @@
 """Diffuse terms (lutbake.terms.diffuse) against independent numpy references; the microfacet diffuse
 BRDF (Eq. 4) against a numpy reference integrator, its sigma = 0 limit and reciprocity."""
+
 import numpy as np
 import pytest
 import warp as wp
@@ -14,9 +15,15 @@ RECIP_RTOL = 1e-5
 
 
 @wp.kernel(enable_backward=False)
-def closed_forms(NoL: wp.array(dtype=float), NoV: wp.array(dtype=float), LoV: wp.array(dtype=float),
-                 sigma: wp.array(dtype=float), f0: wp.array(dtype=float), rho: wp.array(dtype=float),
-                 out: wp.array2d(dtype=float)):
+def closed_forms(
+    NoL: wp.array(dtype=float),
+    NoV: wp.array(dtype=float),
+    LoV: wp.array(dtype=float),
+    sigma: wp.array(dtype=float),
+    f0: wp.array(dtype=float),
+    rho: wp.array(dtype=float),
+    out: wp.array2d(dtype=float),
+):
     i = wp.tid()
     a, b, c, s, f, r = NoL[i], NoV[i], LoV[i], sigma[i], f0[i], rho[i]
     out[i, 0] = diffuse.Fd_lambert(r)
@@ -30,14 +37,17 @@ def closed_forms(NoL: wp.array(dtype=float), NoV: wp.array(dtype=float), LoV: wp
 
 
 def run_closed(NoL, NoV, LoV, sigma, f0, rho):
-    args = [np.ascontiguousarray(np.broadcast_to(np.asarray(x, np.float32), np.shape(NoL)))
-            for x in (NoL, NoV, LoV, sigma, f0, rho)]
+    args = [
+        np.ascontiguousarray(np.broadcast_to(np.asarray(x, np.float32), np.shape(NoL)))
+        for x in (NoL, NoV, LoV, sigma, f0, rho)
+    ]
     out = wp.zeros((len(args[0]), 8), dtype=float, device="cpu")
     wp.launch(closed_forms, dim=len(args[0]), inputs=[wp.array(a, dtype=float) for a in args] + [out], device="cpu")
     return out.numpy().astype(np.float64)
 
 
 # ---- numpy references, written from the seed's formulas with angles where the seed uses angles ----
+
 
 def ref_on_classic(rho, tl, tv, phi, sigma):
     A = 1 - 0.5 * sigma**2 / (sigma**2 + 0.57)
@@ -68,11 +78,19 @@ def ref_on_fresnel_radiance(rho, nl, nv, el, sigma, f0):
 def ref_fitted_radiance(nl, nv, el, sg, f0, slides=False):
     k = sg**2 + 1.36053
     second = (1 - (1 - nv) ** (5 - 4 * sg**2)) / k if slides else 1 - (1 - nv) ** (5 - 4 * sg**2) / k
-    Fr = ((1 - (0.542026 * sg**2 + 0.303573 * sg) / k) * second
-          * ((-0.733996 * sg**3 + 1.50912 * sg**2 - 1.16402 * sg) * (1 - nv) ** (1 + 1 / (39 * sg**4 + 1)) + 1))
-    Lm = (np.maximum(1 - 2 * sg, 0) * (1 - (1 - nl) ** 5) + np.minimum(2 * sg, 1)) * ((1 - 0.5 * sg) * nl + 0.5 * sg * nl**2)
-    Vd = sg**2 / ((sg**2 + 0.09) * (1.31072 + 0.995584 * nv)) * (
-        1 - (1 - nl) ** ((1 - 0.3726732 * nv**2) / (0.188566 + 0.388410 * nv)))
+    Fr = (
+        (1 - (0.542026 * sg**2 + 0.303573 * sg) / k)
+        * second
+        * ((-0.733996 * sg**3 + 1.50912 * sg**2 - 1.16402 * sg) * (1 - nv) ** (1 + 1 / (39 * sg**4 + 1)) + 1)
+    )
+    Lm = (np.maximum(1 - 2 * sg, 0) * (1 - (1 - nl) ** 5) + np.minimum(2 * sg, 1)) * (
+        (1 - 0.5 * sg) * nl + 0.5 * sg * nl**2
+    )
+    Vd = (
+        sg**2
+        / ((sg**2 + 0.09) * (1.31072 + 0.995584 * nv))
+        * (1 - (1 - nl) ** ((1 - 0.3726732 * nv**2) / (0.188566 + 0.388410 * nv)))
+    )
     s = el - nv * nl
     Bp = np.where(s < 0, 1.4 * nv * nl * s, s)
     return 21 / (20 * np.pi) * (1 - f0) * (Fr * Lm + Vd * Bp)
@@ -143,6 +161,7 @@ def test_terms_are_zero_below_the_horizon():
 
 # ---- the microfacet diffuse BRDF (Eq. 4) ----
 
+
 def ggx(cos_m, alpha):
     c2 = cos_m**2
     return alpha**2 / (np.pi * (c2 * alpha**2 + 1 - c2) ** 2)
@@ -188,8 +207,15 @@ def test_microfacet_inner_integral_matches_numpy_reference(alpha):
     l = np.array([unit(tl, pl) for tl, pl, _, _ in PAIRS])
     v = np.array([unit(tv, pv) for _, _, tv, pv in PAIRS])
     got = tdiff.eval_brdf("microfacet", l, v, alpha, f0=0.04, sigma_to_alpha="sigma", order=16)
-    ref = [ref_microfacet(l[i].astype(np.float32).astype(np.float64), v[i].astype(np.float32).astype(np.float64),
-                          np.float32(alpha), 0.04) for i in range(len(l))]
+    ref = [
+        ref_microfacet(
+            l[i].astype(np.float32).astype(np.float64),
+            v[i].astype(np.float32).astype(np.float64),
+            np.float32(alpha),
+            0.04,
+        )
+        for i in range(len(l))
+    ]
     np.testing.assert_allclose(got, ref, rtol=INNER_RTOL)
 
 
@@ -201,8 +227,9 @@ def test_microfacet_at_sigma_0_is_lambert_times_eq6():
     v = np.stack([unit(a, 0.0) for a in tv])
     got = tdiff.eval_brdf("microfacet", l, v, 0.0, f0=0.04, order=8)
     l32, v32 = l.astype(np.float32), v.astype(np.float32)
-    np.testing.assert_allclose(got, ref_fdiff(l32[:, 2].astype(float), v32[:, 2].astype(float), 0.04) / np.pi,
-                               rtol=LIMIT_RTOL)
+    np.testing.assert_allclose(
+        got, ref_fdiff(l32[:, 2].astype(float), v32[:, 2].astype(float), 0.04) / np.pi, rtol=LIMIT_RTOL
+    )
 
 
 def test_microfacet_is_reciprocal():

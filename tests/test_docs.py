@@ -1,4 +1,5 @@
 """Every registered kind, key and allowed value is documented in docs/config.md; README has the two commands."""
+
 from pathlib import Path
 
 from lutbake.tables import KINDS

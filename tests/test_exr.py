@@ -1,5 +1,6 @@
 """EXR writer: files written through OpenImageIO, checked with the OpenEXR project's own bindings
 (an independent reader), plus the round trip through read_exr, atomicity and the NaN/Inf policy."""
+
 from __future__ import annotations
 
 import json
@@ -24,7 +25,7 @@ PROVENANCE = {
     "estimator": "sobol_ggx_vndf",
     "samples": "1024",
     "seed": "7",
-    "config": "[table]\nkind = \"dfg\"\nsize = [8, 4]\n",
+    "config": '[table]\nkind = "dfg"\nsize = [8, 4]\n',
     "version": "0.1.0",
     "warp_version": "1.9.0",
 }
@@ -195,10 +196,30 @@ def test_describe_exr(tmp_path):
     out = write_exr(table_3d(), tmp_path / "spec3d.exr", dtype="half")
     text = describe(out)
     for needle in [
-        "specular_3d", "f0", "perceptual_roughness", "NoV", "slices", "rows", "columns",
-        "endpoint", "center", "alpha", "reflectance", "directional albedo",
-        "trilinear lookup", "sobol_ggx_vndf", "1024", "seed: 7", "0.1.0", "1.9.0",
-        "slice_2", "min", "max", "mean", "half", "zip",
+        "specular_3d",
+        "f0",
+        "perceptual_roughness",
+        "NoV",
+        "slices",
+        "rows",
+        "columns",
+        "endpoint",
+        "center",
+        "alpha",
+        "reflectance",
+        "directional albedo",
+        "trilinear lookup",
+        "sobol_ggx_vndf",
+        "1024",
+        "seed: 7",
+        "0.1.0",
+        "1.9.0",
+        "slice_2",
+        "min",
+        "max",
+        "mean",
+        "half",
+        "zip",
     ]:
         assert needle in text, needle
 

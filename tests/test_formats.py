@@ -1,6 +1,7 @@
 """Output formats: each file read back by an independent reader (OpenImageIO for PNG and EXR; readers
 written here from the DDS and KTX 2.0 specifications; a C compiler for the header) and compared with
 the table; atomic writes; the CLI's --format."""
+
 import json
 import shutil
 import struct
@@ -15,7 +16,7 @@ from lutbake.cli import main
 from lutbake.io.formats import FORMATS, write_table
 from lutbake.table import Table
 
-HALF_REL = 2.0 ** -11  # half-float relative rounding
+HALF_REL = 2.0**-11  # half-float relative rounding
 U16 = 1.0 / 65535
 
 
@@ -43,6 +44,7 @@ def expect_gpu(data, dtype):
 
 
 # ------------------------------------------------------------------ independent readers, from the specs
+
 
 def read_dds_spec(blob):
     """DDS per Microsoft's 'DDS file layout': magic, DDS_HEADER (124 bytes), DDS_HEADER_DXT10 (20 bytes)."""
@@ -101,7 +103,7 @@ def read_ktx2_spec(blob):
     kv, p = {}, kvd_off
     while p < kvd_off + kvd_len:
         (n,) = struct.unpack_from("<I", blob, p)
-        key, _, value = blob[p + 4:p + 4 + n].partition(b"\0")
+        key, _, value = blob[p + 4 : p + 4 + n].partition(b"\0")
         kv[key.decode()] = value.rstrip(b"\0").decode()
         p += 4 + n + (-n % 4)
     assert list(kv) == sorted(kv)
@@ -181,8 +183,8 @@ def png_chunks(blob):
     assert blob[:8] == b"\x89PNG\r\n\x1a\n"
     pos, out = 8, {}
     while pos < len(blob):
-        (n,) = struct.unpack(">I", blob[pos:pos + 4])
-        out.setdefault(blob[pos + 4:pos + 8].decode(), []).append(blob[pos + 8:pos + 8 + n])
+        (n,) = struct.unpack(">I", blob[pos : pos + 4])
+        out.setdefault(blob[pos + 4 : pos + 8].decode(), []).append(blob[pos + 8 : pos + 8 + n])
         pos += 12 + n
     return out
 
@@ -231,15 +233,26 @@ def test_c_header_compiles_and_holds_the_values(tmp_path, dtype):
     if cc is None:
         pytest.skip("no C compiler on PATH to compile the generated header")
     src = tmp_path / "main.c"
-    conv = ("float f; unsigned short b = lut[(y * LUT_WIDTH + x) * LUT_CHANNELS + c]; /* decode binary16 */\n"
+    conv = (
+        (
+            "float f; unsigned short b = lut[(y * LUT_WIDTH + x) * LUT_CHANNELS + c]; /* decode binary16 */\n"
             "int e = (b >> 10) & 31, m = b & 1023; f = e ? ldexpf(1024 + m, e - 25) : ldexpf(m, -24);\n"
-            "if (b & 0x8000) f = -f;\n") if dtype == "half" else "float f = lut[(y * LUT_WIDTH + x) * LUT_CHANNELS + c];\n"
-    src.write_text('#include <stdio.h>\n#include <math.h>\n#include "lut.h"\nint main(void) {\n'
-                   "for (int y = 0; y < LUT_HEIGHT; y++) for (int x = 0; x < LUT_WIDTH; x++)"
-                   " for (int c = 0; c < LUT_CHANNELS; c++) {\n" + conv + 'printf("%.9g\\n", f); }\nreturn 0; }\n')
+            "if (b & 0x8000) f = -f;\n"
+        )
+        if dtype == "half"
+        else "float f = lut[(y * LUT_WIDTH + x) * LUT_CHANNELS + c];\n"
+    )
+    src.write_text(
+        '#include <stdio.h>\n#include <math.h>\n#include "lut.h"\nint main(void) {\n'
+        "for (int y = 0; y < LUT_HEIGHT; y++) for (int x = 0; x < LUT_WIDTH; x++)"
+        " for (int c = 0; c < LUT_CHANNELS; c++) {\n" + conv + 'printf("%.9g\\n", f); }\nreturn 0; }\n'
+    )
     exe = tmp_path / "main"
-    subprocess.run([cc, "-std=c99", "-Wall", "-Werror", "-I", str(tmp_path), str(src), "-o", str(exe), "-lm"],
-                   check=True, capture_output=True)
+    subprocess.run(
+        [cc, "-std=c99", "-Wall", "-Werror", "-I", str(tmp_path), str(src), "-o", str(exe), "-lm"],
+        check=True,
+        capture_output=True,
+    )
     out = np.array(subprocess.run([str(exe)], check=True, capture_output=True, text=True).stdout.split(), float)
     want = t.data.astype(np.float16 if dtype == "half" else np.float32).astype(np.float64).ravel()
     np.testing.assert_array_equal(out.astype(np.float32), want.astype(np.float32))  # %.9g round-trips float32

@@ -1,5 +1,6 @@
 """Fresnel terms against numpy references written here (complex arithmetic, Snell's law), published
 values, and each approximation's maximum error against the exact curve (printed: pytest -s)."""
+
 import numpy as np
 import pytest
 
@@ -68,7 +69,9 @@ def test_every_term_is_one_at_grazing_and_f0_at_normal():
 
 
 LECTURE_F0 = {  # lecture 003, "Fresnel reflections at 0° for some materials" (linear)
-    "copper": (0.95, 0.64, 0.54), "gold": (1.00, 0.71, 0.29), "aluminium": (0.91, 0.92, 0.92),
+    "copper": (0.95, 0.64, 0.54),
+    "gold": (1.00, 0.71, 0.29),
+    "aluminium": (0.91, 0.92, 0.92),
     "silver": (0.95, 0.93, 0.88),
 }
 
@@ -94,17 +97,27 @@ def test_approximation_errors_table():
     for f0 in DIELECTRIC_F0:
         exact = fresnel_complex_ref(eta_from_f0(f0), C)
         got = evaluate(C, f0=f0)
-        rows.append((f"dielectric f0={f0:.2f} (eta={eta_from_f0(f0):.3f})",
-                     {k: np.max(np.abs(got[k] - exact)) for k in ("schlick", "schlick_sg", "improved_sg", "dielectric_f0")}))
+        rows.append(
+            (
+                f"dielectric f0={f0:.2f} (eta={eta_from_f0(f0):.3f})",
+                {k: np.max(np.abs(got[k] - exact)) for k in ("schlick", "schlick_sg", "improved_sg", "dielectric_f0")},
+            )
+        )
     for name, m in sorted(METALS.items()):
         for ch, (n, k) in zip("RGB", zip(m.n, m.k)):
             exact = fresnel_complex_ref(n + 1j * k, C)
             f0 = f0_of(n, k)
             a = fit_lazanyi_a(n, k)
             got = evaluate(C, f0=f0, n=n, k=k, a=a)
-            rows.append((f"{name} {ch} {n}+{k}i f0={f0:.3f} a={a:.3f}",
-                         {k_: np.max(np.abs(got[k_] - exact)) for k_ in ("schlick", "schlick_sg", "improved_sg",
-                                                                         "dielectric_f0", "lazanyi")}))
+            rows.append(
+                (
+                    f"{name} {ch} {n}+{k}i f0={f0:.3f} a={a:.3f}",
+                    {
+                        k_: np.max(np.abs(got[k_] - exact))
+                        for k_ in ("schlick", "schlick_sg", "improved_sg", "dielectric_f0", "lazanyi")
+                    },
+                )
+            )
     cols = ("schlick", "schlick_sg", "improved_sg", "dielectric_f0", "lazanyi")
     print("\n" + f"{'max |F - F_exact|':<44}" + "".join(f"{c:>14}" for c in cols))
     for label, errs in rows:

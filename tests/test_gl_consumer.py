@@ -8,6 +8,7 @@ functions, and the result is compared with
       integral, up to the interpolation error of the table, which must fall ~4x when the table size doubles:
       a half-texel convention error would only halve it).
 Skipped, with the reason, where no GL context can be created (no moderngl, no EGL/Mesa)."""
+
 from pathlib import Path
 
 import numpy as np
@@ -36,8 +37,9 @@ def ctx():
         except Exception as e:  # noqa: BLE001 - any failure means "no GL here"
             errors.append(f"{kw or 'default'}: {e}")
     else:
-        pytest.skip("no OpenGL 3.3 context can be created (needs libegl1 libegl-mesa0 libgl1-mesa-dri): "
-                    + " | ".join(errors))
+        pytest.skip(
+            "no OpenGL 3.3 context can be created (needs libegl1 libegl-mesa0 libgl1-mesa-dri): " + " | ".join(errors)
+        )
     yield c
     c.release()
 
@@ -68,9 +70,12 @@ def gl_sample(ctx, lut, dtype, uv_expr, points, dims=2):
             in vec3 in_p; in float in_i; flat out vec3 p;
             void main() {{ p = in_p; gl_Position = vec4((in_i + 0.5) / {n}.0 * 2.0 - 1.0, 0.0, 0.0, 1.0);
                            gl_PointSize = 1.0; }}""",
-        fragment_shader="#version 330\n" + SNIPPET.read_text() + f"""
+        fragment_shader="#version 330\n"
+        + SNIPPET.read_text()
+        + f"""
             uniform {sampler} lut; flat in vec3 p; out vec4 color;
-            void main() {{ color = vec4(0.0); color = texture(lut, {uv_expr}); }}""")
+            void main() {{ color = vec4(0.0); color = texture(lut, {uv_expr}); }}""",
+    )
     pts = np.concatenate([points, np.arange(n)[:, None]], axis=1).astype("f4")
     vbo = ctx.buffer(pts.tobytes())
     vao = ctx.vertex_array(prog, [(vbo, "3f 1f", "in_p", "in_i")])
@@ -92,16 +97,24 @@ def bilinear(lut, uv):
     x0, y0 = np.minimum(np.floor(x).astype(int), w - 2), np.minimum(np.floor(y).astype(int), h - 2)
     fx, fy = (x - x0)[:, None], (y - y0)[:, None]
     L = lut.astype(np.float64)
-    return ((1 - fy) * ((1 - fx) * L[y0, x0] + fx * L[y0, x0 + 1])
-            + fy * ((1 - fx) * L[y0 + 1, x0] + fx * L[y0 + 1, x0 + 1]))
+    return (1 - fy) * ((1 - fx) * L[y0, x0] + fx * L[y0, x0 + 1]) + fy * (
+        (1 - fx) * L[y0 + 1, x0] + fx * L[y0 + 1, x0 + 1]
+    )
 
 
 def cpu_integral(options, nov, rough):
     """lutbake's own CPU evaluation of the table's integral at arbitrary (NoV, perceptual roughness)."""
     k = specular.kernel_for(options["ndf"], options["masking"], options["layout"], "gauss_legendre")
     alpha = np.maximum(np.asarray(rough, np.float64) ** 2, 1e-4)
-    return specular.integrate(k, np.asarray(nov, np.float32), alpha.astype(np.float32), "gauss_legendre",
-                              432, 0, specular.N_CHANNELS[options["layout"]])
+    return specular.integrate(
+        k,
+        np.asarray(nov, np.float32),
+        alpha.astype(np.float32),
+        "gauss_legendre",
+        432,
+        0,
+        specular.N_CHANNELS[options["layout"]],
+    )
 
 
 def random_points(n=N_POINTS, lo=0.03, hi=0.97):
@@ -138,11 +151,24 @@ CASES = [  # (config, format, dtype, GLSL uv expression, tolerance vs the integr
     ({}, "ktx2", "float32", "lutbake_dfg_uv(p.x, p.y)"),
     ({}, "png16", "float32", "lutbake_dfg_uv(p.x, p.y)"),
     ({"layout": "multiscatter", "row_order": "hi_first"}, "dds", "half", "lutbake_filament_corrected_uv(p.x, p.y)"),
-    ({"layout": "multiscatter", "row_order": "hi_first", "roughness_mapping": "texel_offset"}, "ktx2", "half",
-     "lutbake_filament_shipped_uv(p.x, p.y, float(textureSize(lut, 0).y))"),
-    ({"masking": "smith_separable", "texel": "endpoint", "axis_order": "roughness_x",
-      "nov_mapping": "one_minus_t2", "nov_clamp": [1e-4, 0.9999]}, "exr", "float32",
-     "lutbake_eevee_uv(p.x, p.y, float(textureSize(lut, 0).x))"),
+    (
+        {"layout": "multiscatter", "row_order": "hi_first", "roughness_mapping": "texel_offset"},
+        "ktx2",
+        "half",
+        "lutbake_filament_shipped_uv(p.x, p.y, float(textureSize(lut, 0).y))",
+    ),
+    (
+        {
+            "masking": "smith_separable",
+            "texel": "endpoint",
+            "axis_order": "roughness_x",
+            "nov_mapping": "one_minus_t2",
+            "nov_clamp": [1e-4, 0.9999],
+        },
+        "exr",
+        "float32",
+        "lutbake_eevee_uv(p.x, p.y, float(textureSize(lut, 0).x))",
+    ),
 ]
 
 
@@ -190,8 +216,10 @@ def test_gl_samples_a_3d_texture_at_random_points(ctx, tmp_path):
     table = Table("vol", "specular_3d", vol.astype(np.float32), axes, {"E": "f0 scale + bias"}, "E", {})
     points = random_points(lo=0.03, hi=0.97)
     points[:, 2] = np.clip(points[:, 2], 1 / 16, 15 / 16)
-    want = points[:, 2:3] * cpu_integral(spec.options, points[:, 0], points[:, 1])[:, :1] + \
-        cpu_integral(spec.options, points[:, 0], points[:, 1])[:, 1:2]
+    want = (
+        points[:, 2:3] * cpu_integral(spec.options, points[:, 0], points[:, 1])[:, :1]
+        + cpu_integral(spec.options, points[:, 0], points[:, 1])[:, 1:2]
+    )
     for fmt in ("dds", "ktx2"):
         path = write_table(table, tmp_path, fmt, "half")
         texels = load(path, fmt)

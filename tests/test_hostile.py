@@ -4,6 +4,7 @@ conflicting options, hostile --set overrides and garbage documents.
 
 Each must raise a ConfigError naming the file and the key, and through the CLI exit with status 2,
 print no traceback and write nothing."""
+
 import json
 import math
 import os
@@ -22,12 +23,14 @@ from lutbake.tables.dfg import KEYS, MAX_SAMPLES
 
 # In CI (CI set) the examples are derandomized: the same inputs every run, so a landing never hinges on a
 # random draw; locally hypothesis explores new inputs each run.
-SETTINGS = settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow],
-                    derandomize=bool(os.environ.get("CI")))
+SETTINGS = settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow], derandomize=bool(os.environ.get("CI"))
+)
 BASE = {"name": "ok", "kind": "dfg", "size": [8, 4], "samples": 48}
 
 
 # ----------------------------------------------------------------------------------- TOML writing
+
 
 def tv(v) -> str:
     """A TOML value for any JSON-like Python value (nan/inf too; strings escaped)."""
@@ -55,6 +58,7 @@ def toml_tables(*tables) -> str:
 
 
 # ------------------------------------------------------------------------------------- the check
+
 
 def assert_rejected(text: str | bytes, key: str | None, fragment: str | None = None, overrides=(), extra=None):
     """``text`` as a config file: ConfigError naming the file and the key; CLI exit 2, nothing written."""
@@ -93,50 +97,72 @@ def with_key(key, value, **more):
 
 # ---------------------------------------------------------------------------------- value sources
 
-scalars = st.one_of(st.booleans(), st.integers(-(2**70), 2**70), st.floats(allow_nan=True, allow_infinity=True),
-                    st.text(max_size=12))
-values = st.recursive(scalars, lambda inner: st.one_of(st.lists(inner, max_size=4),
-                                                       st.dictionaries(st.text(max_size=5), inner, max_size=3)),
-                      max_leaves=6)
+scalars = st.one_of(
+    st.booleans(), st.integers(-(2**70), 2**70), st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=12)
+)
+values = st.recursive(
+    scalars,
+    lambda inner: st.one_of(st.lists(inner, max_size=4), st.dictionaries(st.text(max_size=5), inner, max_size=3)),
+    max_leaves=6,
+)
 
 
 def bad_for(key):
     """Values of ``key`` that are always invalid."""
     k = KEYS[key]
-    not_str = st.one_of(st.booleans(), st.integers(), st.floats(), st.lists(scalars, max_size=3),
-                        st.dictionaries(st.text(max_size=4), scalars, max_size=2))
+    not_str = st.one_of(
+        st.booleans(),
+        st.integers(),
+        st.floats(),
+        st.lists(scalars, max_size=3),
+        st.dictionaries(st.text(max_size=4), scalars, max_size=2),
+    )
     if k.type in ("str", "name"):
         if k.type == "name":
             return st.one_of(not_str, st.text(max_size=140).filter(lambda s: not NAME_RE.match(s)))
         return st.one_of(not_str, st.text(max_size=20).filter(lambda s: s not in k.choices and s != "split_sum"))
     if k.type == "int":
         hi = int(k.maximum) if k.maximum is not None else 2**64
-        return st.one_of(st.floats(), st.text(max_size=8), st.booleans(), st.lists(st.integers(1, 9), max_size=2),
-                         st.integers(max_value=int(k.minimum) - 1), st.integers(min_value=hi + 1, max_value=hi * 4))
+        return st.one_of(
+            st.floats(),
+            st.text(max_size=8),
+            st.booleans(),
+            st.lists(st.integers(1, 9), max_size=2),
+            st.integers(max_value=int(k.minimum) - 1),
+            st.integers(min_value=hi + 1, max_value=hi * 4),
+        )
     if k.type == "int_pair":
         return st.one_of(
-            st.integers(), st.text(max_size=6), st.floats(),
+            st.integers(),
+            st.text(max_size=6),
+            st.floats(),
             st.lists(st.integers(1, 64), max_size=5).filter(lambda v: len(v) != 2),
             st.tuples(st.integers(max_value=0), st.integers(1, 64)).map(list),
             st.tuples(st.integers(1, 64), st.integers(max_value=0)).map(list),
             st.tuples(st.floats(), st.integers(1, 9)).map(list),
-            st.tuples(st.integers(1, 9), st.one_of(st.text(max_size=3), st.booleans())).map(list))
+            st.tuples(st.integers(1, 9), st.one_of(st.text(max_size=3), st.booleans())).map(list),
+        )
     if k.type == "float_range":
         unit = st.floats(0.0, 1.0)
         return st.one_of(
-            st.integers(), st.text(max_size=6), st.booleans(),
+            st.integers(),
+            st.text(max_size=6),
+            st.booleans(),
             st.lists(unit, max_size=4).filter(lambda v: len(v) != 2),
-            st.tuples(st.floats(allow_nan=True, allow_infinity=True).filter(lambda x: not math.isfinite(x)),
-                      unit).map(list),
+            st.tuples(st.floats(allow_nan=True, allow_infinity=True).filter(lambda x: not math.isfinite(x)), unit).map(
+                list
+            ),
             st.tuples(unit, st.sampled_from([math.nan, math.inf, -math.inf])).map(list),
             st.tuples(unit, unit).filter(lambda v: v[0] > v[1]).map(list),
             st.tuples(st.floats(max_value=-1e-9, allow_nan=False, allow_infinity=False), unit).map(list),
             st.tuples(unit, st.floats(min_value=1.0000001, allow_nan=False, allow_infinity=False)).map(list),
-            st.tuples(unit, st.text(max_size=3)).map(list))
+            st.tuples(unit, st.text(max_size=3)).map(list),
+        )
     raise AssertionError(key)
 
 
 # -------------------------------------------------------------------------------------------- tests
+
 
 @SETTINGS
 @given(key=st.text(min_size=1, max_size=24).filter(lambda k: k not in KEYS), value=values)
@@ -155,24 +181,53 @@ def test_wrong_types_and_values_for_every_key(data, key):
 
 
 @SETTINGS
-@given(value=st.one_of(st.text(max_size=8).filter(lambda s: s not in ("dfg", "split_sum")), st.integers(),
-                       st.lists(st.text(max_size=3), max_size=2)))
+@given(
+    value=st.one_of(
+        st.text(max_size=8).filter(lambda s: s not in ("dfg", "split_sum")),
+        st.integers(),
+        st.lists(st.text(max_size=3), max_size=2),
+    )
+)
 def test_bad_kind(value):
     assert_rejected(with_key("kind", value), "kind")
 
 
 @SETTINGS
-@given(name=st.one_of(st.text(max_size=140), st.sampled_from(["../../x", "..", "../x", "/etc/passwd", "a/b", "a\\b",
-                                                               "C:\\x", "x.exr", "", " ", "x" * 129, "ｄｆｇ", "名前",
-                                                               "dfg\x00", "dfg\n", "é", "🙂", "-" * 129]))
-       .filter(lambda s: not NAME_RE.match(s)))
+@given(
+    name=st.one_of(
+        st.text(max_size=140),
+        st.sampled_from(
+            [
+                "../../x",
+                "..",
+                "../x",
+                "/etc/passwd",
+                "a/b",
+                "a\\b",
+                "C:\\x",
+                "x.exr",
+                "",
+                " ",
+                "x" * 129,
+                "ｄｆｇ",
+                "名前",
+                "dfg\x00",
+                "dfg\n",
+                "é",
+                "🙂",
+                "-" * 129,
+            ]
+        ),
+    ).filter(lambda s: not NAME_RE.match(s))
+)
 def test_unicode_and_path_traversal_names(name):
     assert_rejected(with_key("name", name), "name", "letters")
 
 
 @SETTINGS
-@given(size=st.tuples(st.integers(1, 10**30), st.integers(1, 10**30)).filter(lambda s: s[0] * s[1] > MAX_TEXELS)
-       .map(list))
+@given(
+    size=st.tuples(st.integers(1, 10**30), st.integers(1, 10**30)).filter(lambda s: s[0] * s[1] > MAX_TEXELS).map(list)
+)
 @example(size=[100000, 100000])
 @example(size=[2**26, 2])
 @example(size=[10**200, 10**200])
@@ -194,10 +249,15 @@ def test_zero_negative_and_huge_samples(samples):
 
 
 @SETTINGS
-@given(key=st.sampled_from(["nov_range", "roughness_range"]),
-       rng=st.tuples(st.sampled_from([0.0, 0.5, math.nan, math.inf, -math.inf]),
-                     st.sampled_from([1.0, math.nan, math.inf, -math.inf])).filter(
-                         lambda r: not all(map(math.isfinite, r))).map(list))
+@given(
+    key=st.sampled_from(["nov_range", "roughness_range"]),
+    rng=st.tuples(
+        st.sampled_from([0.0, 0.5, math.nan, math.inf, -math.inf]),
+        st.sampled_from([1.0, math.nan, math.inf, -math.inf]),
+    )
+    .filter(lambda r: not all(map(math.isfinite, r)))
+    .map(list),
+)
 def test_nan_and_inf_in_ranges(key, rng):
     assert_rejected(with_key(key, rng), key, "finite")
 
@@ -218,22 +278,48 @@ def test_duplicate_table_names(name, across):
         assert_rejected(toml_tables(t, {**t, "layout": "multiscatter"}), "name", "duplicate")
 
 
-@pytest.mark.parametrize("opts, key, fragment", [
-    ({"estimator": "sobol_vndf", "ndf": "beckmann"}, "estimator", "visible-normal"),
-])
+@pytest.mark.parametrize(
+    "opts, key, fragment",
+    [
+        ({"estimator": "sobol_vndf", "ndf": "beckmann"}, "estimator", "visible-normal"),
+    ],
+)
 def test_conflicting_options(opts, key, fragment):
     assert_rejected(toml_tables({**BASE, **opts}), key, fragment)
     assert_rejected(toml_tables({**BASE, "ndf": "beckmann"}), key, fragment, overrides=["estimator=sobol_vndf"])
 
 
 @SETTINGS
-@given(override=st.sampled_from([
-    "size=[0,0]", "size=[100000,100000]", "name=../../x", "nov_range=[nan, 1.0]", "roughness_range=[0.0, inf]",
-    "samples=inf", "samples=-3", "samples=0", "seed=-1", "nosuch=1", "ghost.samples=3", "=1", "ok.=1",
-    "ndf=phong", "dtype=float16", "kind=nope", "size=\"big\"", "layout=[1,2]", "estimator=sobol_vndf",
-]) | st.builds("{}={}".format, st.text(max_size=8).filter(
-    lambda k: "=" not in k and "." not in k and k.strip() == k and k not in KEYS),
-                st.text(max_size=8)))
+@given(
+    override=st.sampled_from(
+        [
+            "size=[0,0]",
+            "size=[100000,100000]",
+            "name=../../x",
+            "nov_range=[nan, 1.0]",
+            "roughness_range=[0.0, inf]",
+            "samples=inf",
+            "samples=-3",
+            "samples=0",
+            "seed=-1",
+            "nosuch=1",
+            "ghost.samples=3",
+            "=1",
+            "ok.=1",
+            "ndf=phong",
+            "dtype=float16",
+            "kind=nope",
+            'size="big"',
+            "layout=[1,2]",
+            "estimator=sobol_vndf",
+        ]
+    )
+    | st.builds(
+        "{}={}".format,
+        st.text(max_size=8).filter(lambda k: "=" not in k and "." not in k and k.strip() == k and k not in KEYS),
+        st.text(max_size=8),
+    )
+)
 def test_hostile_set_overrides(override):
     base = toml_tables({**BASE, "ndf": "beckmann"})
     key = override.split("=", 1)[0].rpartition(".")[2] if "=" in override else override

@@ -1,5 +1,6 @@
 """The lecture's models (003) as term sets of dfg / albedo / specular_3d: Cook-Torrance, normalized Blinn-Phong,
 isotropic Ashikhmin-Shirley; and the config rules that keep a model's terms fixed."""
+
 import numpy as np
 import pytest
 
@@ -65,12 +66,15 @@ def test_ashikhmin_shirley_isotropic_energy_le_one():
     np.testing.assert_allclose(s3.data[..., 0], want, atol=1e-6)
 
 
-@pytest.mark.parametrize("kw, match", [
-    ({"model": "cook_torrance", "ndf": "ggx", "masking": "smith_separable"}, "fixes the NDF"),
-    ({"ndf": "blinn_phong"}, "no Smith Lambda"),
-    ({"model": "blinn_phong", "estimator": "sobol_vndf"}, "sobol_vndf"),
-    ({"model": "phong"}, "model"),
-])
+@pytest.mark.parametrize(
+    "kw, match",
+    [
+        ({"model": "cook_torrance", "ndf": "ggx", "masking": "smith_separable"}, "fixes the NDF"),
+        ({"ndf": "blinn_phong"}, "no Smith Lambda"),
+        ({"model": "blinn_phong", "estimator": "sobol_vndf"}, "sobol_vndf"),
+        ({"model": "phong"}, "model"),
+    ],
+)
 def test_model_config_rules(kw, match):
     with pytest.raises(ConfigError, match=match):
         spec(kind="dfg", **kw)

@@ -1,6 +1,7 @@
 """`lutbake inspect` and `lutbake preview` read every file `make luts` writes: every table of configs/*.toml and
 of the Makefile's PRESETS, baked here at small sizes (their kinds, layouts, formats and conventions unchanged),
 plus the formats `make luts` does not use (npy, ktx2); every data file and every .json sidecar."""
+
 import re
 import tomllib
 from pathlib import Path
@@ -69,7 +70,16 @@ def test_preview_draws_every_file_make_luts_writes(luts, tmp_path):
         titles = [t for ax in fig.axes for t in (ax.get_title(), ax.get_title(loc="left")) if t]
         plt.close(fig)
         assert p.name in fig.get_suptitle() and titles, p
-    for name in ("dfg.exr", "lut_charlie.exr", "albedo_avg.exr", "specular_3d_dielectric_f0.exr", "btf_fitted.exr",
-                 "filament_dfg.dds", "eevee_brdf_ggx.h", "lut_ggx.png", "ktx2/dfg.ktx2"):
+    for name in (
+        "dfg.exr",
+        "lut_charlie.exr",
+        "albedo_avg.exr",
+        "specular_3d_dielectric_f0.exr",
+        "btf_fitted.exr",
+        "filament_dfg.dds",
+        "eevee_brdf_ggx.h",
+        "lut_ggx.png",
+        "ktx2/dfg.ktx2",
+    ):
         out = render(luts / name, tmp_path / f"{name.replace('/', '_')}.png", dpi=PREVIEW_DPI)
         assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name

@@ -1,4 +1,5 @@
 """Smoke test of ``lutbake plot``: the seed's figures are written as PNGs and the fitted-vs-integrated table printed."""
+
 import pytest
 from click.testing import CliRunner
 

@@ -5,6 +5,7 @@ and measures max and mean |baked - shipped| per channel. Tolerances come from th
 precision and noise, stated at each test: lutbake integrates to convergence (~1e-7), the engines used
 1024..262144 quasi-random samples in float32 and stored half floats or 8-bit codes.
 """
+
 from pathlib import Path
 
 import numpy as np
@@ -14,7 +15,7 @@ from lutbake.api import bake_table
 from lutbake.config import load_config, preset_path, presets
 
 REFS = Path(__file__).resolve().parents[1].parent / "shared" / "refs"
-HALF_ULP_AT_1 = 2.0 ** -11  # half-float rounding error just below 1 (spacing 2^-11 in [0.5, 1))
+HALF_ULP_AT_1 = 2.0**-11  # half-float rounding error just below 1 (spacing 2^-11 in [0.5, 1))
 U8_HALF_STEP = 0.5 / 255  # 8-bit UNORM rounding
 
 

@@ -1,6 +1,7 @@
 """lutbake preview: a picture that fits every kind (1D curves, 3D slice grids labelled with their z value, btf
 light x view images per sigma and phi), readable titles, and spheres shaded with the table's own
 reconstruction (through its axes' uv), omitted where a kind has none."""
+
 import json
 
 import numpy as np
@@ -18,8 +19,15 @@ LOOKUP_TOL = 1e-6  # float32 table values, float64 interpolation weights
 
 
 def make(tmp_path, kind, data, axes, channels, terms=None, name="t"):
-    t = Table(name, kind, np.asarray(data, np.float32), axes, channels, "see docs",
-              {"terms": json.dumps(terms or {}), "estimator": "gauss_legendre", "samples": "432"})
+    t = Table(
+        name,
+        kind,
+        np.asarray(data, np.float32),
+        axes,
+        channels,
+        "see docs",
+        {"terms": json.dumps(terms or {}), "estimator": "gauss_legendre", "samples": "432"},
+    )
     return write_table(t, tmp_path, "exr")
 
 
@@ -71,8 +79,14 @@ def test_spheres_follow_each_layouts_reconstruction(tmp_path):
 def test_kinds_without_a_split_sum_get_no_sphere_row_and_say_so(tmp_path, kind, layout):
     axes = [Axis("perceptual_roughness" if kind != "diffuse" else "sigma", "y", 4), Axis("NoV", "x", 5)]
     nch = 2 if layout else 1
-    p = make(tmp_path, kind, np.full((4, 5, nch), 0.5), axes, {f"c{i}": "x" for i in range(nch)},
-             {"layout": layout} if layout else {})
+    p = make(
+        tmp_path,
+        kind,
+        np.full((4, 5, nch), 0.5),
+        axes,
+        {f"c{i}": "x" for i in range(nch)},
+        {"layout": layout} if layout else {},
+    )
     assert split_sum(read_table(p)) is None
     fig = figure(p)
     assert "no sphere row" in fig.get_suptitle() and len(fig.axes) == 2 * nch  # images + colour bars
@@ -91,8 +105,14 @@ def test_1d_table_is_a_curve(tmp_path):
 
 def test_3d_table_is_a_grid_of_slices_labelled_with_their_z_value(tmp_path):
     axes = [Axis("f0", "z", 4, 0.0, 1.0), Axis("perceptual_roughness", "y", 5), Axis("NoV", "x", 6)]
-    p = make(tmp_path, "specular_3d", np.random.default_rng(1).random((4, 5, 6, 1)), axes, {"e": "E"},
-             {"fresnel": "dielectric_f0"})
+    p = make(
+        tmp_path,
+        "specular_3d",
+        np.random.default_rng(1).random((4, 5, 6, 1)),
+        axes,
+        {"e": "E"},
+        {"fresnel": "dielectric_f0"},
+    )
     fig = figure(p)
     labels = titles(fig)
     for k, v in enumerate(axes[0].values()):
@@ -102,8 +122,12 @@ def test_3d_table_is_a_grid_of_slices_labelled_with_their_z_value(tmp_path):
 
 
 def test_btf_is_light_by_view_images_per_sigma_and_phi(tmp_path):
-    axes = [Axis("sigma", "z", 3, 0.0, 1.0), Axis("phi", "y_block", 4, 0.0, np.pi),
-            Axis("theta_v", "y", 5, 0.0, np.pi / 2), Axis("theta_l", "x", 6, 0.0, np.pi / 2)]
+    axes = [
+        Axis("sigma", "z", 3, 0.0, 1.0),
+        Axis("phi", "y_block", 4, 0.0, np.pi),
+        Axis("theta_v", "y", 5, 0.0, np.pi / 2),
+        Axis("theta_l", "x", 6, 0.0, np.pi / 2),
+    ]
     p = make(tmp_path, "btf", np.random.default_rng(2).random((3, 20, 6, 1)), axes, {"f": "BRDF"})
     fig = figure(p)
     images = [ax for ax in fig.axes if ax.get_images()]
@@ -118,8 +142,14 @@ def test_btf_is_light_by_view_images_per_sigma_and_phi(tmp_path):
 def test_titles_are_words_not_json(tmp_path):
     axes = [Axis("perceptual_roughness", "y", 4), Axis("NoV", "x", 4)]
     data = np.random.default_rng(3).random((4, 4, 2))
-    p = make(tmp_path, "dfg", data, axes, {"scale": "multiplies f0", "bias": "added"},
-             {"ndf": "ggx", "masking": "smith_height_correlated", "layout": "scale_bias"})
+    p = make(
+        tmp_path,
+        "dfg",
+        data,
+        axes,
+        {"scale": "multiplies f0", "bias": "added"},
+        {"ndf": "ggx", "masking": "smith_height_correlated", "layout": "scale_bias"},
+    )
     fig = figure(p)
     title = fig.get_suptitle()
     assert "{" not in title and '"' not in title

@@ -2,6 +2,7 @@
 when asked), the commands that do not bake import neither Warp, SciPy nor OpenImageIO where they need not,
 a bake explains a rounded sample count, `make luts` asks lutbake every time (which notices a table
 overwritten with other settings), and `make figures` writes under outputs/ only."""
+
 import json
 import os
 import subprocess
@@ -25,8 +26,10 @@ def python(code: str, env_extra=None, cwd=None) -> subprocess.CompletedProcess:
 
 def loaded_after(args: list[str]) -> list[str]:
     """Which heavy modules a `lutbake ARGS` run (in a fresh interpreter) imported."""
-    code = (f"import json, sys\nfrom lutbake.cli import main\ntry:\n    main({args!r})\nexcept SystemExit:\n    pass\n"
-            f"print(json.dumps([m for m in {HEAVY!r} if m in sys.modules]))")
+    code = (
+        f"import json, sys\nfrom lutbake.cli import main\ntry:\n    main({args!r})\nexcept SystemExit:\n    pass\n"
+        f"print(json.dumps([m for m in {HEAVY!r} if m in sys.modules]))"
+    )
     r = python(code)
     assert r.returncode == 0, r.stderr
     return json.loads(r.stdout.strip().splitlines()[-1])
@@ -115,8 +118,9 @@ def test_a_table_overwritten_with_other_settings_is_rebaked(tmp_path):
 def test_make_figures_writes_under_outputs_and_leaves_tracked_figures_alone(tmp_path):
     import runpy
 
-    r = subprocess.run(["make", "-n", "figures", f"OUT={tmp_path}", "VENV=.venv"], capture_output=True, text=True,
-                       cwd=ROOT)
+    r = subprocess.run(
+        ["make", "-n", "figures", f"OUT={tmp_path}", "VENV=.venv"], capture_output=True, text=True, cwd=ROOT
+    )
     assert r.returncode == 0 and f"docs/plot_fresnel.py {tmp_path}/figures" in r.stdout, r.stdout
     script = runpy.run_path(str(ROOT / "docs" / "plot_fresnel.py"))  # not as __main__: nothing drawn yet
     assert script["DEFAULT_OUT"] == ROOT / "outputs" / "figures"

@@ -1,6 +1,7 @@
 """lutbake.io.readers: every format lutbake writes reads back (checked against the independent readers of
 test_formats where they exist), dispatched by magic bytes not by extension; a LUT without lutbake metadata
 is described; malformed files and metadata give one clean line naming the file once, never a traceback."""
+
 import json
 import shutil
 

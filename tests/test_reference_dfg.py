@@ -12,6 +12,7 @@ Composite Gauss-Legendre in both angles, with panels graded geometrically toward
 (where G2 varies on the scale min(n.v, alpha)); the rule is converged to ~1e-8 at these texels
 (doubling the nodes per panel changes it by less than that).
 """
+
 import numpy as np
 import pytest
 from scipy.special import erf
@@ -37,21 +38,22 @@ def texels():
 
 # --- numpy terms ------------------------------------------------------------------------------------
 
+
 def D_ggx(cos_h, alpha):
     c2 = cos_h * cos_h
     tan2 = np.maximum(1.0 - c2, 0.0) / c2
-    return 1.0 / (np.pi * alpha ** 2 * c2 * c2 * (1.0 + tan2 / alpha ** 2) ** 2)
+    return 1.0 / (np.pi * alpha**2 * c2 * c2 * (1.0 + tan2 / alpha**2) ** 2)
 
 
 def D_beckmann(cos_h, alpha):
     c2 = cos_h * cos_h
     tan2 = np.maximum(1.0 - c2, 0.0) / c2
-    return np.exp(-tan2 / alpha ** 2) / (np.pi * alpha ** 2 * c2 * c2)
+    return np.exp(-tan2 / alpha**2) / (np.pi * alpha**2 * c2 * c2)
 
 
 def Lambda_ggx(c, alpha):
     tan2 = np.maximum(1.0 - c * c, 0.0) / (c * c)
-    return 0.5 * (np.sqrt(1.0 + alpha ** 2 * tan2) - 1.0)
+    return 0.5 * (np.sqrt(1.0 + alpha**2 * tan2) - 1.0)
 
 
 def Lambda_beckmann(c, alpha):
@@ -77,6 +79,7 @@ def G2(masking, lv, ll, noh=None, nov=None, nol=None, voh=None):
 
 
 # --- the reference integrator ---------------------------------------------------------------------------
+
 
 def graded_edges(lo, hi, anchors):
     """lo, hi, and for each (anchor, first) the anchor and anchor +- first * PANEL_RATIO^j inside [lo, hi]."""
@@ -122,8 +125,10 @@ def reference_dfg(nov, alpha, ndf, masking, n=GL_NODES):
 def references():
     """Reference (scale, bias) per texel for both term sets, computed once."""
     nov, alpha = texels()
-    return {key: np.array([reference_dfg(n, a, *key) for n, a in zip(nov, alpha)])
-            for key in [("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"), ("beckmann", "v_cavity")]}
+    return {
+        key: np.array([reference_dfg(n, a, *key) for n, a in zip(nov, alpha)])
+        for key in [("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"), ("beckmann", "v_cavity")]
+    }
 
 
 def test_reference_integrator_is_converged():
@@ -133,8 +138,9 @@ def test_reference_integrator_is_converged():
             # V-cavity's min() has kinks inside the domain that the panels do not follow: algebraic convergence,
             # measured 5e-6 (16 nodes) and 3e-6 (32 nodes) from 64 nodes per panel
             atol = REFERENCE_ATOL / (10 if key[1] == "v_cavity" else 100)
-            np.testing.assert_allclose(reference_dfg(n, a, *key), reference_dfg(n, a, *key, n=2 * GL_NODES),
-                                       rtol=0.0, atol=atol)
+            np.testing.assert_allclose(
+                reference_dfg(n, a, *key), reference_dfg(n, a, *key, n=2 * GL_NODES), rtol=0.0, atol=atol
+            )
 
 
 def table(ndf, masking, estimator, samples, form="microfacet"):
@@ -172,7 +178,9 @@ def test_dfg_cook_torrance_gauss_legendre_matches_reference(references):
     from lutbake.config import validate_table
     from lutbake.tables.dfg import terms_of
 
-    form, ndf, masking = terms_of(validate_table({"name": "t", "kind": "dfg", "model": "cook_torrance"}, "<test>", 0).options)
+    form, ndf, masking = terms_of(
+        validate_table({"name": "t", "kind": "dfg", "model": "cook_torrance"}, "<test>", 0).options
+    )
     # the same kinks slow the table's Gauss-Legendre too: measured max error 8.4e-4 at 432 samples (the default),
     # 8.4e-5 at 1152, 4.2e-5 at 4608; scrambled Sobol' NDF sampling with 2^20 points agrees with the reference to 3.5e-7
     got = table(ndf, masking, "gauss_legendre", 4608, form)

@@ -1,5 +1,6 @@
 """The shipped shader snippets (docs/shaders/): HLSL compiles (glslangValidator's HLSL front end, when
 installed) and defines the same functions as the GLSL file, which the GL consumer test compiles and runs."""
+
 import re
 import shutil
 import subprocess
@@ -37,6 +38,9 @@ def test_hlsl_snippet_compiles(tmp_path):
         pytest.skip("glslangValidator is not installed (Debian: apt-get install glslang-tools); HLSL not compiled")
     src = tmp_path / "t.hlsl"
     src.write_text((SHADERS / "lutbake.hlsl").read_text() + HLSL_MAIN)
-    r = subprocess.run([tool, "-D", "-V", "-S", "frag", "-e", "main", "-o", str(tmp_path / "t.spv"), str(src)],
-                       capture_output=True, text=True)
+    r = subprocess.run(
+        [tool, "-D", "-V", "-S", "frag", "-e", "main", "-o", str(tmp_path / "t.spv"), str(src)],
+        capture_output=True,
+        text=True,
+    )
     assert r.returncode == 0, r.stdout + r.stderr

@@ -3,6 +3,7 @@
 
 The baked channels are checked against an independent brute-force midpoint rule over l in numpy (the
 terms written out again from the KHR spec's GLSL, not lutbake's @wp.funcs)."""
+
 import numpy as np
 import pytest
 
@@ -80,7 +81,9 @@ def test_charlie_channel_agrees_with_an_independent_quadrature(charlie):
     rough, nov = table.axes
     for y, x in TEXELS:
         a, c = float(rough.alpha()[y]), float(nov.values()[x])
-        np.testing.assert_allclose(table.data[y, x, 2], brute_force(a, c, "ashikhmin"), rtol=2e-5)  # measured 7.2e-6 (3072 samples); the midpoint rule: 2.8e-6
+        np.testing.assert_allclose(
+            table.data[y, x, 2], brute_force(a, c, "ashikhmin"), rtol=2e-5
+        )  # measured 7.2e-6 (3072 samples); the midpoint rule: 2.8e-6
 
 
 def test_sheen_albedo_agrees_with_an_independent_quadrature(sheen_e):
@@ -109,8 +112,12 @@ def test_sheen_albedo_le_one_except_the_grazing_smooth_corner():
 def test_sheen_layouts_reject_qmc_and_other_terms(tmp_path):
     p = tmp_path / "s.toml"
     for layout in ("charlie", "sheen_albedo"):
-        for extra, key in (('estimator = "sobol_vndf"', "estimator"), ('estimator = "hammersley_ndf"', "estimator"),
-                           ('ndf = "beckmann"', "layout"), ('model = "blinn_phong"', "layout")):
+        for extra, key in (
+            ('estimator = "sobol_vndf"', "estimator"),
+            ('estimator = "hammersley_ndf"', "estimator"),
+            ('ndf = "beckmann"', "layout"),
+            ('model = "blinn_phong"', "layout"),
+        ):
             p.write_text(f'[[table]]\nname = "s"\nkind = "dfg"\nlayout = "{layout}"\n{extra}\n')
             with pytest.raises(ConfigError) as e:
                 load_config(p)

@@ -1,4 +1,5 @@
 """specular_3d: with Schlick it is the dfg table (f0 scale + bias); metals reach their mirror limit."""
+
 import numpy as np
 import pytest
 

@@ -6,6 +6,7 @@ Domain note: alpha = 0 is outside the NDFs' domain (D is a Dirac delta there: 0/
 edge policy (lutbake.edge.ALPHA_MIN) clamps every table's alpha, which test_tables_clamp_alpha_zero
 checks. The raw D values at alpha = 0 are listed in OUT_OF_DOMAIN and checked to be the only exception.
 """
+
 import itertools
 import logging
 
@@ -18,8 +19,14 @@ from lutbake.config import validate_table
 from lutbake.edge import ALPHA_MIN, COS_EPS, NOV_MIN
 from lutbake.tables import specular
 from lutbake.terms.fresnel import F_dielectric, F_dielectric_f0, F_schlick
-from lutbake.terms.masking import (G1_smith, G2_smith_height_correlated, G2_smith_separable, G2_v_cavity,
-                                   Lambda_beckmann, Lambda_ggx)
+from lutbake.terms.masking import (
+    G1_smith,
+    G2_smith_height_correlated,
+    G2_smith_separable,
+    G2_v_cavity,
+    Lambda_beckmann,
+    Lambda_ggx,
+)
 from lutbake.terms.ndf import D_beckmann, D_ggx
 
 wp.config.log_level = logging.WARNING
@@ -28,15 +35,33 @@ COSINES = np.array([-1.0, -0.5, -1e-8, 0.0, 1e-8, COS_EPS, 1e-6, 1e-4, 1e-2, 0.5
 ALPHAS = np.array([0.0, ALPHA_MIN, 1e-3, 0.1, 0.5, 1.0], np.float32)
 F0S = np.array([0.0, 1e-6, 0.04, 0.5, 0.999, 1.0], np.float32)
 ETAS = np.array([1.0, 1.0 + 1e-6, 1.5, 4.0, 1e3, 1e6], np.float32)
-TERMS = ["D_ggx", "D_beckmann", "Lambda_ggx", "Lambda_beckmann", "G1_smith(ggx)", "G1_smith(beckmann)",
-         "G2_smith_height_correlated(ggx)", "G2_smith_height_correlated(beckmann)", "G2_smith_separable(ggx)",
-         "G2_smith_separable(beckmann)", "G2_v_cavity", "F_schlick", "F_dielectric", "F_dielectric_f0"]
+TERMS = [
+    "D_ggx",
+    "D_beckmann",
+    "Lambda_ggx",
+    "Lambda_beckmann",
+    "G1_smith(ggx)",
+    "G1_smith(beckmann)",
+    "G2_smith_height_correlated(ggx)",
+    "G2_smith_height_correlated(beckmann)",
+    "G2_smith_separable(ggx)",
+    "G2_smith_separable(beckmann)",
+    "G2_v_cavity",
+    "F_schlick",
+    "F_dielectric",
+    "F_dielectric_f0",
+]
 OUT_OF_DOMAIN = {"D_ggx", "D_beckmann"}  # at alpha = 0 only (see the module docstring)
 
 
 @wp.kernel
-def sweep(cos: wp.array(dtype=float), alphas: wp.array(dtype=float), f0s: wp.array(dtype=float),
-          etas: wp.array(dtype=float), out: wp.array(dtype=float, ndim=2)):
+def sweep(
+    cos: wp.array(dtype=float),
+    alphas: wp.array(dtype=float),
+    f0s: wp.array(dtype=float),
+    etas: wp.array(dtype=float),
+    out: wp.array(dtype=float, ndim=2),
+):
     # one thread per (c1, c2, alpha, f0): the direction cosines n.h = c1 and c2 for the second one
     i, j, k, m = wp.tid()
     row = ((i * cos.shape[0] + j) * alphas.shape[0] + k) * f0s.shape[0] + m
@@ -75,8 +100,16 @@ def swept():
 
 def _where(values, bad):
     idx = np.argwhere(bad)[:5]
-    return [dict(cos=float(COSINES[i]), cos2=float(COSINES[j]), alpha=float(ALPHAS[k]), f0=float(F0S[m]),
-                 value=float(values[i, j, k, m])) for i, j, k, m in idx]
+    return [
+        dict(
+            cos=float(COSINES[i]),
+            cos2=float(COSINES[j]),
+            alpha=float(ALPHAS[k]),
+            f0=float(F0S[m]),
+            value=float(values[i, j, k, m]),
+        )
+        for i, j, k, m in idx
+    ]
 
 
 @pytest.mark.parametrize("t", range(len(TERMS)), ids=TERMS)
@@ -116,31 +149,58 @@ def test_raw_d_at_alpha_zero_is_the_only_exception(swept):
 
 
 def test_tables_clamp_alpha_zero_and_grazing_nov():
-    t = bake_table(validate_table({"name": "edge", "kind": "dfg", "size": [3, 3], "samples": 48,
-                                   "texel": "endpoint", "roughness": "alpha"}, "<test>", 0), workers=1)[0]
+    t = bake_table(
+        validate_table(
+            {"name": "edge", "kind": "dfg", "size": [3, 3], "samples": 48, "texel": "endpoint", "roughness": "alpha"},
+            "<test>",
+            0,
+        ),
+        workers=1,
+    )[0]
     rough, nov = t.axes
     assert rough.alpha()[0] == pytest.approx(ALPHA_MIN) and nov.values()[0] == pytest.approx(NOV_MIN)
 
 
 # (ndf, masking, layout, estimator) of every dfg kernel
-KERNELS = [k for k in itertools.product(("ggx", "beckmann"), ("smith_height_correlated", "smith_separable", "v_cavity"),
-                                        ("scale_bias", "multiscatter"),
-                                        ("gauss_legendre", "sobol_vndf", "sobol_ndf", "hammersley_ndf"))
-           if not (k[0] == "beckmann" and k[3] == "sobol_vndf")]
+KERNELS = [
+    k
+    for k in itertools.product(
+        ("ggx", "beckmann"),
+        ("smith_height_correlated", "smith_separable", "v_cavity"),
+        ("scale_bias", "multiscatter"),
+        ("gauss_legendre", "sobol_vndf", "sobol_ndf", "hammersley_ndf"),
+    )
+    if not (k[0] == "beckmann" and k[3] == "sobol_vndf")
+]
 
 
 @pytest.mark.parametrize("key", KERNELS, ids=["-".join(k) for k in KERNELS])
 def test_dfg_kernels_are_finite_at_extreme_texels(key):
     """The raw kernels (no axis clamps) at NoV in {0, 1e-8, NOV_MIN, 1} and alpha in {ALPHA_MIN, 1}, and
     every kind of table through the config at its extreme texels (alpha 0 and NoV 0 clamped by policy)."""
-    nov, alpha = (a.ravel() for a in np.meshgrid(np.float32([0.0, 1e-8, NOV_MIN, 0.5, 1.0]),
-                                                 np.float32([ALPHA_MIN, 1e-3, 0.5, 1.0])))
+    nov, alpha = (
+        a.ravel()
+        for a in np.meshgrid(np.float32([0.0, 1e-8, NOV_MIN, 0.5, 1.0]), np.float32([ALPHA_MIN, 1e-3, 0.5, 1.0]))
+    )
     kernel = specular.kernel_for(*key)
     r = specular.integrate(kernel, nov, alpha, key[3], 48, 0, 2)
     bad = ~np.isfinite(r).all(axis=1)
     assert not bad.any(), f"{key}: NaN/Inf at (NoV, alpha) = {list(zip(nov[bad], alpha[bad]))}"
     assert np.all(r >= -1e-6)
     ndf, masking, layout, est = key
-    spec = validate_table({"name": "x", "kind": "dfg", "size": [2, 2], "samples": 48, "texel": "endpoint",
-                           "ndf": ndf, "masking": masking, "layout": layout, "estimator": est}, "<test>", 0)
+    spec = validate_table(
+        {
+            "name": "x",
+            "kind": "dfg",
+            "size": [2, 2],
+            "samples": 48,
+            "texel": "endpoint",
+            "ndf": ndf,
+            "masking": masking,
+            "layout": layout,
+            "estimator": est,
+        },
+        "<test>",
+        0,
+    )
     assert np.all(np.isfinite(bake_table(spec, workers=1)[0].data))

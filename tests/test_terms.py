@@ -3,6 +3,7 @@
 The references use the textbook forms (tan-based NDFs, Lambda from tan, scipy's erf, Fresnel from Snell's
 law), not the terms' rearrangements, and run in float64 on the float32-rounded inputs the terms see.
 """
+
 import numpy as np
 import pytest
 from scipy.special import erf
@@ -12,7 +13,9 @@ from lutbake.validate.probe import BRDF_PAIRS, TERM_NAMES, evaluate_brdfs, evalu
 
 # Tolerances: the terms compute in float32 (unit roundoff 6e-8).
 D_RTOL = 1.0e-6
-D_BECKMANN_RTOL_PER_EXPONENT = 2.0e-7  # exp(-x): x = tan^2/alpha^2 takes ~3 float32 roundings (3 x 6e-8 relative), amplified by x
+D_BECKMANN_RTOL_PER_EXPONENT = (
+    2.0e-7  # exp(-x): x = tan^2/alpha^2 takes ~3 float32 roundings (3 x 6e-8 relative), amplified by x
+)
 D_BECKMANN_ATOL = 1.0e-30  # exp(-x) underflows float32 (denormals below 1.2e-38)
 LAMBDA_RTOL = 2.0e-6
 LAMBDA_ATOL = 3.0e-7  # Lambda ~ 0 near normal view: (sqrt(...)/c - 1) and (erf(a) - 1) cancel in float32
@@ -48,6 +51,7 @@ def half_vectors(n=257, seed=1):
 
 # --- numpy references ------------------------------------------------------------------------------
 
+
 def tan2_of(h):
     h = f32(h)
     return (h[..., 0] ** 2 + h[..., 1] ** 2) / h[..., 2] ** 2
@@ -57,14 +61,14 @@ def ref_D_ggx(h, alpha):
     """Walter et al. 2007, Eq. 33: alpha^2 / (pi cos^4 (alpha^2 + tan^2)^2)."""
     c = f32(h)[..., 2]
     a2 = f32(alpha) ** 2
-    return a2 / (np.pi * c ** 4 * (a2 + tan2_of(h)) ** 2)
+    return a2 / (np.pi * c**4 * (a2 + tan2_of(h)) ** 2)
 
 
 def ref_D_beckmann(h, alpha):
     """Walter et al. 2007, Eq. 25: exp(-tan^2 / alpha^2) / (pi alpha^2 cos^4)."""
     c = f32(h)[..., 2]
     a2 = f32(alpha) ** 2
-    return np.exp(-tan2_of(h) / a2) / (np.pi * a2 * c ** 4)
+    return np.exp(-tan2_of(h) / a2) / (np.pi * a2 * c**4)
 
 
 def ref_Lambda_ggx(c, alpha):
@@ -130,14 +134,15 @@ def ref_F_dielectric(eta, cos_i):
     F = (r_s^2 + r_p^2)/2. cos_t^2 = 1 - sin_t^2 = 1 - (1 - cos_i^2)/eta^2 is evaluated as (eta^2 - 1 + cos_i^2)/eta^2
     (no cancellation at grazing). At cos_i = 0 the limit 1 (for eta = 1, 0/0: the terms' convention, 1)."""
     eta, cos_i = np.broadcast_arrays(f32(eta), f32(cos_i))
-    cos_t = np.sqrt(eta ** 2 - 1.0 + cos_i ** 2) / eta
+    cos_t = np.sqrt(eta**2 - 1.0 + cos_i**2) / eta
     with np.errstate(invalid="ignore"):
         rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t)
         rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t)
-    return np.where(cos_i > 0.0, 0.5 * (rs ** 2 + rp ** 2), 1.0)
+    return np.where(cos_i > 0.0, 0.5 * (rs**2 + rp**2), 1.0)
 
 
 # --- NDFs ------------------------------------------------------------------------------------------------
+
 
 def test_D_ggx_matches_numpy():
     h, alpha = half_vectors()[:, None, :], ALPHAS[None, :]
@@ -191,6 +196,7 @@ def test_D_peak_value_is_one_over_pi_alpha2(ndf):
 
 
 # --- masking-shadowing ---------------------------------------------------------------------------------------
+
 
 def test_Lambda_ggx_matches_numpy():
     c = hemisphere_cosines()[:, None]
@@ -301,10 +307,10 @@ def test_F_dielectric_landmarks():
     np.testing.assert_allclose(t, [0.04, 1.0, (0.33 / 2.33) ** 2], rtol=1e-6)
     eta = 1.5
     cos_b = np.cos(np.arctan(eta))
-    cos_t = np.sqrt(1.0 - (1.0 - cos_b ** 2) / eta ** 2)
+    cos_t = np.sqrt(1.0 - (1.0 - cos_b**2) / eta**2)
     rs = (cos_b - eta * cos_t) / (cos_b + eta * cos_t)
     got = evaluate_terms(eta=eta, cos_theta=cos_b)["F_dielectric"]
-    np.testing.assert_allclose(got, 0.5 * rs ** 2, rtol=1e-5)
+    np.testing.assert_allclose(got, 0.5 * rs**2, rtol=1e-5)
 
 
 def test_F_dielectric_f0_matches_snell_fresnel():
@@ -330,6 +336,7 @@ def test_F_dielectric_f0_of_one_is_one():
 
 # --- the assembled BRDF -----------------------------------------------------------------------------------------
 
+
 @pytest.mark.parametrize("ndf,masking", BRDF_PAIRS)
 def test_specular_brdf_matches_numpy(ndf, masking):
     """f = D G2 F_schlick / (4 (n.l)(n.v)) (Gotanda 2014, Eq. 1) from the numpy references."""
@@ -354,8 +361,18 @@ EDGE_COS = np.array([0.0, 1e-8, 1.0])
 
 
 def edge_sweep(alphas):
-    grids = np.meshgrid(np.arange(len(EDGE_H)), np.asarray(alphas), EDGE_COS, EDGE_COS, EDGE_COS, EDGE_COS,
-                        np.array([0.0, 1.0]), np.array([1.0, 1.5]), EDGE_COS, indexing="ij")
+    grids = np.meshgrid(
+        np.arange(len(EDGE_H)),
+        np.asarray(alphas),
+        EDGE_COS,
+        EDGE_COS,
+        EDGE_COS,
+        EDGE_COS,
+        np.array([0.0, 1.0]),
+        np.array([1.0, 1.5]),
+        EDGE_COS,
+        indexing="ij",
+    )
     hi, alpha, nov, nol, voh, loh, f0, eta, c = (g.ravel() for g in grids)
     h = EDGE_H[hi]
     return h, evaluate_terms(h=h, alpha=alpha, nov=nov, nol=nol, voh=voh, loh=loh, f0=f0, eta=eta, cos_theta=c)
@@ -391,12 +408,23 @@ def test_terms_other_than_D_are_finite_at_alpha_zero():
 
 @pytest.mark.parametrize("ndf,masking", BRDF_PAIRS)
 def test_specular_brdf_is_finite_on_edge_sweep(ndf, masking):
-    d = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [-1.0, 0.0, 0.0], [1.0, 0.0, 1e-8], [-1.0, 0.0, 1e-8],
-                  [0.0, 0.0, -1.0], [0.6, 0.0, 0.8], [-0.6, 0.0, 0.8]])
+    d = np.array(
+        [
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [1.0, 0.0, 1e-8],
+            [-1.0, 0.0, 1e-8],
+            [0.0, 0.0, -1.0],
+            [0.6, 0.0, 0.8],
+            [-0.6, 0.0, 0.8],
+        ]
+    )
     d = d / np.linalg.norm(d, axis=-1, keepdims=True)
     li, vi, ai, fi = np.meshgrid(np.arange(len(d)), np.arange(len(d)), np.arange(2), np.arange(2), indexing="ij")
-    f = evaluate_brdfs(d[li.ravel()], d[vi.ravel()], np.array([ALPHA_MIN, 1.0])[ai.ravel()],
-                       np.array([0.0, 1.0])[fi.ravel()])[(ndf, masking)]
+    f = evaluate_brdfs(
+        d[li.ravel()], d[vi.ravel()], np.array([ALPHA_MIN, 1.0])[ai.ravel()], np.array([0.0, 1.0])[fi.ravel()]
+    )[(ndf, masking)]
     assert np.all(np.isfinite(f)) and np.all(f >= 0.0)
 
 

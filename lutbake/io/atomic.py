@@ -1,5 +1,6 @@
 """Atomic file writes shared by every writer: write a temporary sibling, fsync, rename onto the target.
 An interrupted or failed write never leaves a half-written file and never clobbers the old one."""
+
 from __future__ import annotations
 
 import os

@@ -7,6 +7,7 @@ Always the DX10 extension header (FourCC ``DX10``), one mip level, no compressio
   3 or 4 -> R16G16B16A16_FLOAT / R32G32B32A32_FLOAT (a 3-channel table gets A = 1, as Filament's cmgen).
 - Rows are stored first row first: DDS row 0 (the top row in D3D, v = 0) is table row 0.
 """
+
 from __future__ import annotations
 
 import struct
@@ -22,11 +23,21 @@ DDSCAPS2_VOLUME = 0x200000
 DIM_TEXTURE2D, DIM_TEXTURE3D = 3, 4
 # DXGI_FORMAT values (dxgiformat.h)
 DXGI = {
-    ("half", 1): 54, ("half", 2): 34, ("half", 4): 10,  # R16_FLOAT, R16G16_FLOAT, R16G16B16A16_FLOAT
-    ("float32", 1): 41, ("float32", 2): 16, ("float32", 4): 2,  # R32_FLOAT, R32G32_FLOAT, R32G32B32A32_FLOAT
+    ("half", 1): 54,
+    ("half", 2): 34,
+    ("half", 4): 10,  # R16_FLOAT, R16G16_FLOAT, R16G16B16A16_FLOAT
+    ("float32", 1): 41,
+    ("float32", 2): 16,
+    ("float32", 4): 2,  # R32_FLOAT, R32G32_FLOAT, R32G32B32A32_FLOAT
 }
-DXGI_NAMES = {54: "R16_FLOAT", 34: "R16G16_FLOAT", 10: "R16G16B16A16_FLOAT",
-              41: "R32_FLOAT", 16: "R32G32_FLOAT", 2: "R32G32B32A32_FLOAT"}
+DXGI_NAMES = {
+    54: "R16_FLOAT",
+    34: "R16G16_FLOAT",
+    10: "R16G16B16A16_FLOAT",
+    41: "R32_FLOAT",
+    16: "R32G32_FLOAT",
+    2: "R32G32B32A32_FLOAT",
+}
 FROM_DXGI = {v: k for k, v in DXGI.items()}
 
 
@@ -84,8 +95,14 @@ def decode(blob: bytes) -> tuple[np.ndarray, dict]:
     shape = ((depth,) if dim == DIM_TEXTURE3D else ()) + (height, width, nch)
     need = 148 + int(np.prod(shape, dtype=object)) * npdt.itemsize
     if min(shape) < 1 or need > len(blob):
-        raise ValueError(f"DDS header says {' x '.join(map(str, shape))} {DXGI_NAMES[fmt]} ({need} bytes) but the "
-                         f"file holds {len(blob)} bytes")
+        raise ValueError(
+            f"DDS header says {' x '.join(map(str, shape))} {DXGI_NAMES[fmt]} ({need} bytes) but the "
+            f"file holds {len(blob)} bytes"
+        )
     arr = np.frombuffer(blob, dtype=npdt, count=int(np.prod(shape)), offset=148).reshape(shape)
-    return arr, {"dxgi_format": DXGI_NAMES[fmt], "dimension": "TEXTURE3D" if dim == DIM_TEXTURE3D else "TEXTURE2D",
-                 "mips": mips, "array_size": array_size}
+    return arr, {
+        "dxgi_format": DXGI_NAMES[fmt],
+        "dimension": "TEXTURE3D" if dim == DIM_TEXTURE3D else "TEXTURE2D",
+        "mips": mips,
+        "array_size": array_size,
+    }

@@ -1,6 +1,7 @@
 """``lutbake inspect FILE``: what a table file holds, in words, for every format lutbake reads
 (lutbake.io.readers). With lutbake metadata: kind, axes, channels, reconstruction, provenance and
 per-channel statistics; without (a LUT an engine ships): format, size, channels and value ranges."""
+
 from __future__ import annotations
 
 import json
@@ -59,16 +60,21 @@ def _statistics(data: np.ndarray, names: list[str]) -> list[str]:
 
 def _report_lines(doc: dict) -> list[str]:
     counts = doc.get("counts") if isinstance(doc.get("counts"), dict) else {}
-    lines = [f"  lutbake {doc.get('lutbake_version')}, exit status {doc.get('exit_status')}"
-             + (f", interrupted by {doc['interrupted_by']}" if doc.get("interrupted_by") else ""),
-             "  " + ", ".join(f"{v} {k}" for k, v in counts.items()), "tables:"]
+    lines = [
+        f"  lutbake {doc.get('lutbake_version')}, exit status {doc.get('exit_status')}"
+        + (f", interrupted by {doc['interrupted_by']}" if doc.get("interrupted_by") else ""),
+        "  " + ", ".join(f"{v} {k}" for k, v in counts.items()),
+        "tables:",
+    ]
     for t in doc.get("tables") if isinstance(doc.get("tables"), list) else []:
         if isinstance(t, dict):
             secs = t.get("seconds")
-            lines.append(f"  {t.get('status', '?'):<11} {t.get('path') or t.get('name')}"
-                         + (f"  {secs:.2f} s" if isinstance(secs, (int, float)) else "")
-                         + (f"  error estimate {t['error_estimate']}" if t.get("error_estimate") else "")
-                         + (f"  ({t['message']})" if t.get("message") else ""))
+            lines.append(
+                f"  {t.get('status', '?'):<11} {t.get('path') or t.get('name')}"
+                + (f"  {secs:.2f} s" if isinstance(secs, (int, float)) else "")
+                + (f"  error estimate {t['error_estimate']}" if t.get("error_estimate") else "")
+                + (f"  ({t['message']})" if t.get("message") else "")
+            )
     return lines
 
 
@@ -86,26 +92,36 @@ def describe(path) -> str:
     view = table_view(loaded)
     if view.kind is None:
         lines.append(f"  image: {_image_line(view.data)}")
-        lines.append("  no lutbake metadata (" + "; ".join(loaded.notes or ["none in the file"]) + "): "
-                     "axes, channel meanings and provenance unknown")
-        letters = loaded.facts.get("channels") or list("RGBA"[:view.data.shape[-1]])
+        lines.append(
+            "  no lutbake metadata (" + "; ".join(loaded.notes or ["none in the file"]) + "): "
+            "axes, channel meanings and provenance unknown"
+        )
+        letters = loaded.facts.get("channels") or list("RGBA"[: view.data.shape[-1]])
         return "\n".join(lines + _statistics(view.data, [str(c) for c in letters])) + "\n"
 
     attrs = loaded.attrs
     lines.append(f"  metadata: {loaded.meta_source}")
     lines.append(f"  kind: {view.kind}   table: {view.name}")
-    lines.append(f"  image: {_image_line(view.data)}" + (f" (+{loaded.data.shape[-1] - view.data.shape[-1]} padding "
-                                                         "channel(s) in the file)"
-                                                         if loaded.data.shape[-1] > view.data.shape[-1] else ""))
+    lines.append(
+        f"  image: {_image_line(view.data)}"
+        + (
+            f" (+{loaded.data.shape[-1] - view.data.shape[-1]} padding channel(s) in the file)"
+            if loaded.data.shape[-1] > view.data.shape[-1]
+            else ""
+        )
+    )
     lines.append("  row 0 = y index 0, column 0 = x index 0 (no flip)")
     lines.append("axes:")
     raw_axes = json.loads(attrs["axes"])
     for ax, d in zip(view.axes, raw_axes):
         values = ax.values()
-        lines.append(f"  {ax.name}: {ax.dim} ({d.get('image', ax.dim)}), count {ax.count}, range [{_fmt(ax.lo)}, "
-                     f"{_fmt(ax.hi)}]")
-        lines.append(f"    texel {ax.texel} ({d.get('texel_formula', '')}), mapping {ax.mapping} "
-                     f"({d.get('mapping_formula', '')})")
+        lines.append(
+            f"  {ax.name}: {ax.dim} ({d.get('image', ax.dim)}), count {ax.count}, range [{_fmt(ax.lo)}, {_fmt(ax.hi)}]"
+        )
+        lines.append(
+            f"    texel {ax.texel} ({d.get('texel_formula', '')}), mapping {ax.mapping} "
+            f"({d.get('mapping_formula', '')})"
+        )
         lines.append(f"    index 0 = {_fmt(values[0])}, index {ax.count - 1} = {_fmt(values[-1])}")
         lines.append(f"    order {ax.order}; sample at {d.get('uv_formula') or 'u = ' + ax.uv_formula()}")
         alpha = ax.alpha()

@@ -20,6 +20,7 @@ File layout (the contract engines and ``lutbake inspect`` rely on):
 - Writes are atomic: the file is written to a temporary sibling, fsynced, then renamed onto the
   target, so an interrupted or failed write never leaves a half-written file or clobbers the old one.
 """
+
 from __future__ import annotations
 
 import json
@@ -64,16 +65,13 @@ def _check_table(table: Table, dtype: str) -> np.ndarray:
         raise ValueError(f"table {table.name!r}: dtype must be one of {sorted(DTYPES)}, got {dtype!r}")
     data = np.asarray(table.data)
     if data.ndim not in (3, 4):
-        raise ValueError(
-            f"table {table.name!r}: data must be (y, x, C) or (z, y, x, C), got shape {data.shape}"
-        )
+        raise ValueError(f"table {table.name!r}: data must be (y, x, C) or (z, y, x, C), got shape {data.shape}")
     nch = data.shape[-1]
     if not 1 <= nch <= 4:
         raise ValueError(f"table {table.name!r}: an EXR holds 1 to 4 channels, the data has {nch}")
     if len(table.channels) != nch:
         raise ValueError(
-            f"table {table.name!r}: {len(table.channels)} channel names {list(table.channels)} "
-            f"for {nch} data channels"
+            f"table {table.name!r}: {len(table.channels)} channel names {list(table.channels)} for {nch} data channels"
         )
     if data.dtype.kind not in "fiu":
         raise ValueError(f"table {table.name!r}: data must be numeric, got dtype {data.dtype}")
@@ -85,8 +83,10 @@ def _check_table(table: Table, dtype: str) -> np.ndarray:
     if blocks:  # a 4th axis flattened into the rows: row = block index * (y count) + y index
         y_axes = [a for a in table.axes if a.dim == "y"]
         if not y_axes or sizes["y"] % blocks[0].count:
-            raise ValueError(f"table {table.name!r}: a y_block axis needs a y axis and {sizes['y']} rows divisible "
-                             f"by its count {blocks[0].count}")
+            raise ValueError(
+                f"table {table.name!r}: a y_block axis needs a y axis and {sizes['y']} rows divisible "
+                f"by its count {blocks[0].count}"
+            )
         sizes["y_block"] = blocks[0].count
         sizes["y"] //= blocks[0].count
     for axis in table.axes:
@@ -101,9 +101,7 @@ def _check_table(table: Table, dtype: str) -> np.ndarray:
         raise ValueError(f"table {table.name!r}: a 3D table needs an axis with dim 'z'")
     clash = RESERVED.intersection(table.attributes)
     if clash:
-        raise ValueError(
-            f"table {table.name!r}: attributes {sorted(clash)} are reserved (lutbake writes them itself)"
-        )
+        raise ValueError(f"table {table.name!r}: attributes {sorted(clash)} are reserved (lutbake writes them itself)")
 
     with np.errstate(over="ignore", invalid="ignore"):
         out = np.ascontiguousarray(data, dtype=DTYPES[dtype][1])
@@ -225,8 +223,9 @@ def _read_parts(path) -> tuple[list[np.ndarray], list[dict[str, str]], list[dict
         raise ValueError(f"{path}: not a readable EXR ({e})") from None
     for k, (arr, attrs, facts) in enumerate(parts):
         if "kind" not in attrs:
-            raise ValueError(f"{path}: not a lutbake EXR (part {k} has no lutbake:kind attribute; "
-                             "was it written by lutbake?)")
+            raise ValueError(
+                f"{path}: not a lutbake EXR (part {k} has no lutbake:kind attribute; was it written by lutbake?)"
+            )
         if not facts["channels"] or any(c not in CHANNEL_LETTERS for c in facts["channels"]):
             raise ValueError(f"{path}: part {k} has channels {facts['channels']}; lutbake writes R, G, B, A only")
     shapes = {p[0].shape for p in parts}

@@ -8,6 +8,7 @@ Specification 1.3 (basic data format descriptor). Uncompressed, one mip level, n
 - Key/value data: ``KTXorientation`` = ``rd`` (``rdi`` for 3D): x to the right, y down, i.e. the first
   stored row is table row 0; ``KTXwriter``; and ``lutbake:metadata`` (JSON of the lutbake attributes).
 """
+
 from __future__ import annotations
 
 import json
@@ -20,11 +21,21 @@ from .dds import gpu_channels
 
 IDENTIFIER = bytes([0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A])
 VK_FORMAT = {
-    ("half", 1): 76, ("half", 2): 83, ("half", 4): 97,  # VK_FORMAT_R16_SFLOAT, R16G16_SFLOAT, R16G16B16A16_SFLOAT
-    ("float32", 1): 100, ("float32", 2): 103, ("float32", 4): 109,  # R32_SFLOAT, R32G32_SFLOAT, R32G32B32A32_SFLOAT
+    ("half", 1): 76,
+    ("half", 2): 83,
+    ("half", 4): 97,  # VK_FORMAT_R16_SFLOAT, R16G16_SFLOAT, R16G16B16A16_SFLOAT
+    ("float32", 1): 100,
+    ("float32", 2): 103,
+    ("float32", 4): 109,  # R32_SFLOAT, R32G32_SFLOAT, R32G32B32A32_SFLOAT
 }
-VK_FORMAT_NAMES = {76: "VK_FORMAT_R16_SFLOAT", 83: "VK_FORMAT_R16G16_SFLOAT", 97: "VK_FORMAT_R16G16B16A16_SFLOAT",
-                   100: "VK_FORMAT_R32_SFLOAT", 103: "VK_FORMAT_R32G32_SFLOAT", 109: "VK_FORMAT_R32G32B32A32_SFLOAT"}
+VK_FORMAT_NAMES = {
+    76: "VK_FORMAT_R16_SFLOAT",
+    83: "VK_FORMAT_R16G16_SFLOAT",
+    97: "VK_FORMAT_R16G16B16A16_SFLOAT",
+    100: "VK_FORMAT_R32_SFLOAT",
+    103: "VK_FORMAT_R32G32_SFLOAT",
+    109: "VK_FORMAT_R32G32B32A32_SFLOAT",
+}
 KHR_DF_MODEL_RGBSDA = 1
 KHR_DF_PRIMARIES_BT709 = 1
 KHR_DF_TRANSFER_LINEAR = 1
@@ -62,8 +73,9 @@ def _kvd(pairs: dict[str, str]) -> bytes:
     return out
 
 
-def encode(pixels: np.ndarray, metadata: dict[str, str] | None = None, array: bool = False,
-           writer: str = "lutbake") -> bytes:
+def encode(
+    pixels: np.ndarray, metadata: dict[str, str] | None = None, array: bool = False, writer: str = "lutbake"
+) -> bytes:
     """KTX2 bytes for a (y, x, C) or (z, y, x, C) float16/float32 array."""
     dtype = "half" if pixels.dtype == np.float16 else "float32"
     data = np.ascontiguousarray(gpu_channels(pixels))
@@ -102,7 +114,7 @@ def _kv_pairs(blob: bytes, start: int, length: int) -> dict[str, str]:
         (n,) = struct.unpack_from("<I", blob, pos)
         if n == 0 or pos + 4 + n > end:
             raise ValueError(f"KTX2 key/value entry at byte {pos} runs past the key/value data")
-        key, sep, value = blob[pos + 4:pos + 4 + n].partition(b"\0")
+        key, sep, value = blob[pos + 4 : pos + 4 + n].partition(b"\0")
         if not sep:
             raise ValueError(f"KTX2 key/value entry at byte {pos} has no NUL after its key")
         pairs[key.decode("utf-8", "replace")] = value.rstrip(b"\0").decode("utf-8", "replace")
@@ -134,9 +146,15 @@ def decode(blob: bytes) -> tuple[np.ndarray, dict]:
     shape = ((depth,) if depth else (layers,) if layers else ()) + (height, width, nch)
     need = int(np.prod(shape, dtype=object)) * npdt.itemsize
     if min(shape) < 1 or need > level_len or level_off + need > len(blob):
-        raise ValueError(f"KTX2 header says {' x '.join(map(str, shape))} {VK_FORMAT_NAMES[vk]} ({need} bytes) but "
-                         f"level 0 holds {level_len} bytes at offset {level_off} of a {len(blob)}-byte file")
+        raise ValueError(
+            f"KTX2 header says {' x '.join(map(str, shape))} {VK_FORMAT_NAMES[vk]} ({need} bytes) but "
+            f"level 0 holds {level_len} bytes at offset {level_off} of a {len(blob)}-byte file"
+        )
     arr = np.frombuffer(blob, dtype=npdt, count=int(np.prod(shape)), offset=level_off).reshape(shape)
     kv = _kv_pairs(blob, kvd_off, kvd_len)
-    return arr, {"vk_format": VK_FORMAT_NAMES[vk], "dimension": "3D" if depth else "2D array" if layers else "2D",
-                 "levels": max(levels, 1), "key_value": kv}
+    return arr, {
+        "vk_format": VK_FORMAT_NAMES[vk],
+        "dimension": "3D" if depth else "2D array" if layers else "2D",
+        "levels": max(levels, 1),
+        "key_value": kv,
+    }

@@ -18,6 +18,7 @@ file lutbake cannot read, or metadata that does not fit its pixels, raises :clas
 that names the file once and says what is wrong. A file without lutbake metadata still reads: format,
 size, channels and values.
 """
+
 from __future__ import annotations
 
 import json
@@ -40,8 +41,16 @@ MAX_FILE_BYTES = 4 << 30  # a table is at most 2^24 texels x 4 channels x 4 byte
 EXR_MAGIC = b"\x76\x2f\x31\x01"
 NPY_MAGIC = b"\x93NUMPY"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
-FORMAT_NAMES = {"exr": "OpenEXR", "npy": "NumPy .npy", "png": "PNG", "dds": "DDS", "ktx2": "KTX 2.0",
-                "h": "C header", "sidecar": "lutbake .json sidecar", "report": "lutbake bake report (--report)"}
+FORMAT_NAMES = {
+    "exr": "OpenEXR",
+    "npy": "NumPy .npy",
+    "png": "PNG",
+    "dds": "DDS",
+    "ktx2": "KTX 2.0",
+    "h": "C header",
+    "sidecar": "lutbake .json sidecar",
+    "report": "lutbake bake report (--report)",
+}
 
 
 class ReadError(LutbakeError, ValueError):
@@ -89,8 +98,13 @@ def sniff(path: Path) -> str:
         raise ReadError(f"{path}: not a regular file")
     with open(path, "rb") as f:
         head = f.read(MAGIC_BYTES)
-    for magic, fmt in ((EXR_MAGIC, "exr"), (NPY_MAGIC, "npy"), (PNG_MAGIC, "png"), (dds.MAGIC, "dds"),
-                       (ktx2.IDENTIFIER, "ktx2")):
+    for magic, fmt in (
+        (EXR_MAGIC, "exr"),
+        (NPY_MAGIC, "npy"),
+        (PNG_MAGIC, "png"),
+        (dds.MAGIC, "dds"),
+        (ktx2.IDENTIFIER, "ktx2"),
+    ):
         if head.startswith(magic):
             return fmt
     text = head.lstrip(b"\xef\xbb\xbf \t\r\n")
@@ -99,8 +113,10 @@ def sniff(path: Path) -> str:
     if text.startswith((b"/*", b"//", b"#")):
         return "h"
     shown = head[:8].hex(" ") if head else "nothing (an empty file)"
-    raise ReadError(f"{path}: not a format lutbake reads (EXR, npy, PNG, DDS, KTX2, C header, .json sidecar): "
-                    f"it starts with {shown}")
+    raise ReadError(
+        f"{path}: not a format lutbake reads (EXR, npy, PNG, DDS, KTX2, C header, .json sidecar): "
+        f"it starts with {shown}"
+    )
 
 
 def read(path) -> LoadedFile:
@@ -130,14 +146,19 @@ def _as_table_array(arr: np.ndarray) -> np.ndarray:
     if arr.ndim == 2:
         arr = arr[..., None]
     if arr.ndim not in (3, 4) or arr.shape[-1] > 4 or 0 in arr.shape:
-        raise ValueError(f"array of shape {arr.shape} is not a table: lutbake reads (y, x), (y, x, C) or "
-                         "(z, y, x, C) with 1 to 4 channels")
+        raise ValueError(
+            f"array of shape {arr.shape} is not a table: lutbake reads (y, x), (y, x, C) or "
+            "(z, y, x, C) with 1 to 4 channels"
+        )
     return np.ascontiguousarray(arr, dtype=np.float32)
 
 
 def _exr_attrs(spec) -> dict[str, str]:
-    return {p.name[len(PREFIX):]: p.value if isinstance(p.value, str) else json.dumps(p.value)
-            for p in spec.extra_attribs if p.name.startswith(PREFIX)}
+    return {
+        p.name[len(PREFIX) :]: p.value if isinstance(p.value, str) else json.dumps(p.value)
+        for p in spec.extra_attribs
+        if p.name.startswith(PREFIX)
+    }
 
 
 def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
@@ -163,8 +184,12 @@ def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
                 raise ValueError(f"cannot read the pixels of part {k}: {inp.geterror()}")
             arr = np.asarray(arr, dtype=np.float32).reshape(spec.height, spec.width, len(names))
             arr = np.ascontiguousarray(arr[..., [names.index(c) for c in order]])
-            facts = {"pixel_type": str(spec.format), "compression": spec.getattribute("compression"),
-                     "part": spec.getattribute("name") or spec.getattribute("oiio:subimagename"), "channels": order}
+            facts = {
+                "pixel_type": str(spec.format),
+                "compression": spec.getattribute("compression"),
+                "part": spec.getattribute("name") or spec.getattribute("oiio:subimagename"),
+                "channels": order,
+            }
             parts.append((arr, _exr_attrs(spec), facts))
             k += 1
     finally:
@@ -263,8 +288,14 @@ def read_header(path: Path) -> LoadedFile:
         data = np.array([int(s, 0) for s in items], dtype=np.uint16).view(np.float16)
     else:
         data = np.array([s.rstrip("fF") for s in items], dtype=np.float64)
-    loaded = LoadedFile(path, "h", _as_table_array(data.reshape(shape)), {}, None,
-                        {"array": ident, "element_type": ctype + (" (binary16 bits)" if ctype == "uint16_t" else "")})
+    loaded = LoadedFile(
+        path,
+        "h",
+        _as_table_array(data.reshape(shape)),
+        {},
+        None,
+        {"array": ident, "element_type": ctype + (" (binary16 bits)" if ctype == "uint16_t" else "")},
+    )
     return _with_sidecar(loaded)
 
 
@@ -291,8 +322,10 @@ def _load_sidecar(path: Path, doc=None) -> dict:
 
 def _string_attrs(meta, where: Path, what: str) -> dict[str, str]:
     if not isinstance(meta, dict):
-        raise ReadError(f"{where}: {what} must be a JSON object of lutbake attributes, got {type(meta).__name__} "
-                        f"{json.dumps(meta)[:40]}")
+        raise ReadError(
+            f"{where}: {what} must be a JSON object of lutbake attributes, got {type(meta).__name__} "
+            f"{json.dumps(meta)[:40]}"
+        )
     bad = [k for k, v in meta.items() if not isinstance(v, str)]
     if bad:
         raise ReadError(f"{where}: {what}: attribute {bad[0]!r} must be a string, got {type(meta[bad[0]]).__name__}")
@@ -341,8 +374,15 @@ def read_sidecar(path: Path) -> LoadedFile:
     return LoadedFile(path, "sidecar", None, doc["lutbake"], f"sidecar {path.name}", facts, [note])
 
 
-READERS = {"exr": read_exr, "npy": read_npy, "png": read_png, "dds": read_dds, "ktx2": read_ktx2, "h": read_header,
-           "sidecar": read_sidecar}
+READERS = {
+    "exr": read_exr,
+    "npy": read_npy,
+    "png": read_png,
+    "dds": read_dds,
+    "ktx2": read_ktx2,
+    "h": read_header,
+    "sidecar": read_sidecar,
+}
 
 
 # ------------------------------------------------------------------------------- metadata vs pixels
@@ -359,8 +399,7 @@ def _json_attr(loaded: LoadedFile, key: str, kind: type, default):
     except json.JSONDecodeError as e:
         raise ReadError(f"{where} is not valid JSON ({e})") from None
     if not isinstance(value, kind):
-        raise ReadError(f"{where} must be a JSON {'list' if kind is list else 'object'}, got "
-                        f"{loaded.attrs[key][:60]}")
+        raise ReadError(f"{where} must be a JSON {'list' if kind is list else 'object'}, got {loaded.attrs[key][:60]}")
     return value
 
 
@@ -370,6 +409,7 @@ def _number(x) -> bool:
 
 def axis_from_meta(d: dict, where: str = "axis") -> Axis:
     """An Axis rebuilt from its ``lutbake:axes`` entry (Axis.describe()), every field checked."""
+
     def bad(msg):
         raise ReadError(f"{where}: {msg}")
 
@@ -403,8 +443,18 @@ def axis_from_meta(d: dict, where: str = "axis") -> Axis:
         if not (isinstance(vals, list) and len(vals) == count and all(map(_number, vals))):
             bad(f"mapping 'listed' needs {count} numeric values")
         listed = tuple(float(x) for x in vals)
-    return Axis(name, v["dim"], count, float(rng[0]), float(rng[1]), texel=v["texel"], mapping=v["mapping"],
-                order=v["order"], clamp=tuple(clamp) if clamp else None, listed=listed)
+    return Axis(
+        name,
+        v["dim"],
+        count,
+        float(rng[0]),
+        float(rng[1]),
+        texel=v["texel"],
+        mapping=v["mapping"],
+        order=v["order"],
+        clamp=tuple(clamp) if clamp else None,
+        listed=listed,
+    )
 
 
 def _check_axes_fit(path: Path, axes: list[Axis], shape: tuple[int, ...]) -> None:
@@ -421,12 +471,16 @@ def _check_axes_fit(path: Path, axes: list[Axis], shape: tuple[int, ...]) -> Non
         sizes["y_block"], sizes["y"] = blocks[0].count, sizes["y"] // blocks[0].count
     for a in axes:
         if a.count != sizes[a.dim]:
-            raise ReadError(f"{path}: lutbake axes: axis {a.name!r} ({a.dim}) has count {a.count} but the image "
-                            f"has {sizes[a.dim]} {words[a.dim]} (shape {' x '.join(map(str, shape))})")
+            raise ReadError(
+                f"{path}: lutbake axes: axis {a.name!r} ({a.dim}) has count {a.count} but the image "
+                f"has {sizes[a.dim]} {words[a.dim]} (shape {' x '.join(map(str, shape))})"
+            )
     missing = [d for d in ("z", "y") if sizes[d] > 1 and d not in dims]
     if "x" not in dims or missing:
-        raise ReadError(f"{path}: lutbake axes {[a.name for a in axes]} do not cover the image's "
-                        f"{', '.join(words[d] for d in ['x'] + missing)} (shape {' x '.join(map(str, shape))})")
+        raise ReadError(
+            f"{path}: lutbake axes {[a.name for a in axes]} do not cover the image's "
+            f"{', '.join(words[d] for d in ['x'] + missing)} (shape {' x '.join(map(str, shape))})"
+        )
 
 
 def table_view(loaded: LoadedFile) -> TableView:
@@ -445,15 +499,22 @@ def table_view(loaded: LoadedFile) -> TableView:
     _check_axes_fit(path, axes, data.shape)
     names = _json_attr(loaded, "channel_names", dict, {})
     meanings = _json_attr(loaded, "channels", dict, {})
-    letters = [c for c in "RGBA" if c in names] or list("RGBA"[:data.shape[-1]])
+    letters = [c for c in "RGBA" if c in names] or list("RGBA"[: data.shape[-1]])
     if len(letters) > data.shape[-1]:
-        raise ReadError(f"{path}: lutbake channel_names lists {len(letters)} channels, the file holds "
-                        f"{data.shape[-1]}")
-    data = data[..., :len(letters)]  # drop a GPU format's padding (PNG B = 0, DDS/KTX2 A = 1)
+        raise ReadError(f"{path}: lutbake channel_names lists {len(letters)} channels, the file holds {data.shape[-1]}")
+    data = data[..., : len(letters)]  # drop a GPU format's padding (PNG B = 0, DDS/KTX2 A = 1)
     terms = _json_attr(loaded, "terms", dict, {})
-    return TableView(loaded, data, axes, [str(names.get(c, f"channel {c}")) for c in letters],
-                     [str(meanings.get(c, "")) for c in letters], loaded.attrs["kind"],
-                     loaded.attrs.get("table", path.stem), terms, loaded.attrs.get("reconstruction", ""))
+    return TableView(
+        loaded,
+        data,
+        axes,
+        [str(names.get(c, f"channel {c}")) for c in letters],
+        [str(meanings.get(c, "")) for c in letters],
+        loaded.attrs["kind"],
+        loaded.attrs.get("table", path.stem),
+        terms,
+        loaded.attrs.get("reconstruction", ""),
+    )
 
 
 def read_table(path) -> TableView:

@@ -32,6 +32,7 @@ Estimators (each a factory ``make_*(integrand, pdf, ...)`` returning a Warp kern
 All accumulate in float64; per-sample terms run in float32; the domain maps run in float64 because
 1 - u underflows float32 for small alpha.
 """
+
 from __future__ import annotations
 
 import math

@@ -1,4 +1,5 @@
 """Deterministic point sets on [0, 1) and [0, 1)^2, computed in float64 on the host."""
+
 from __future__ import annotations
 
 import functools

@@ -1,4 +1,5 @@
 """Table kinds: a registry with aliases and a validating lookup (``lutbake list`` prints it)."""
+
 from __future__ import annotations
 
 from .base import Kind
@@ -10,7 +11,9 @@ from .aniso import SPECULAR_ANISO
 from .diffuse3d import DIFFUSE_3D
 from .btf import BTF
 
-KINDS: dict[str, Kind] = {k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D, SPECULAR_ANISO, DIFFUSE, DIFFUSE_3D, BTF)}
+KINDS: dict[str, Kind] = {
+    k.name: k for k in (DFG, ALBEDO, ALBEDO_AVG, SPECULAR_3D, SPECULAR_ANISO, DIFFUSE, DIFFUSE_3D, BTF)
+}
 ALIASES: dict[str, str] = {alias: k.name for k in KINDS.values() for alias in k.aliases}
 
 

@@ -11,6 +11,7 @@ tests/test_albedo.py). With Fresnel, f_ms is scaled by
 E is the `dfg` integral with channels (1, 0) (lutbake.tables.specular.channels_albedo); E_avg runs the same
 kernel at Gauss-Legendre nodes in mu (MU_PANELS, mu_order nodes each) and sums 2 w E mu per roughness.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -26,13 +27,20 @@ ALBEDO_RECONSTRUCTION = (
     "E_v = texture(albedo, vec2(NoV, roughness)).r; E_l = texture(albedo, vec2(NoL, roughness)).r; "
     "E_avg = texture(albedo_avg, vec2(roughness, 0.5)).r; "
     "f_ms = (1 - E_v) (1 - E_l) / (pi (1 - E_avg)) * F_ms, F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)); "
-    "or, for image-based lighting, specular *= 1 + f0 (1 / E_v - 1)")
+    "or, for image-based lighting, specular *= 1 + f0 (1 / E_v - 1)"
+)
 
 AVG_KEYS = {
     **dfg.COMMON_KEYS,
     "roughness_size": Key("roughness_size", "int", 128, "roughness texel count (the table is one row)", minimum=1),
-    "mu_order": Key("mu_order", "int", 24, "Gauss-Legendre nodes in mu = n.v per panel (two panels, split at 0.2)",
-                    minimum=2, maximum=256),
+    "mu_order": Key(
+        "mu_order",
+        "int",
+        24,
+        "Gauss-Legendre nodes in mu = n.v per panel (two panels, split at 0.2)",
+        minimum=2,
+        maximum=256,
+    ),
     **{k: dfg.KEYS[k] for k in ("roughness", "ndf", "masking", "model", "texel", "roughness_range")},
 }
 AVG_CHANNELS = {"e_avg": "E_avg = 2 ∫ E(mu) mu dmu: hemispherical albedo with F = 1"}
@@ -45,9 +53,18 @@ def plan_albedo(spec) -> Plan:
     nov, alpha = dfg.texel_grid(axes)
     form, nd, mk = dfg.terms_of(o)
     return specular.hemisphere_plan(
-        key=(nd, mk, "albedo", o["estimator"], form), nov=nov, alpha=alpha, param=None,
-        samples=o["samples"], seed=o["seed"], nch=1, axes=axes, channels=ALBEDO_CHANNELS,
-        reconstruction=ALBEDO_RECONSTRUCTION, terms=dfg.terms_record(o, "none (F = 1)"))
+        key=(nd, mk, "albedo", o["estimator"], form),
+        nov=nov,
+        alpha=alpha,
+        param=None,
+        samples=o["samples"],
+        seed=o["seed"],
+        nch=1,
+        axes=axes,
+        channels=ALBEDO_CHANNELS,
+        reconstruction=ALBEDO_RECONSTRUCTION,
+        terms=dfg.terms_record(o, "none (F = 1)"),
+    )
 
 
 def avg_roughness_axis(o: dict) -> Axis:
@@ -74,14 +91,35 @@ def plan_albedo_avg(spec) -> Plan:
         return (2.0 * E @ (w * mu))[:, None]
 
     eff = specular.effective_samples(est, samples)
-    return Plan(axes=[rough], channels=AVG_CHANNELS, reconstruction=AVG_RECONSTRUCTION, n_texels=rough.count,
-                n_channels=1, run_tile=run_tile, prepare=lambda d: specular.load(specular.kernel_for(*key), d),
-                samples=eff * len(mu), estimator=est,
-                terms=dfg.terms_record(o, "none (F = 1)"),
-                cost=float(rough.count) * len(mu) * eff, extra={"mu_nodes": str(len(mu))})
+    return Plan(
+        axes=[rough],
+        channels=AVG_CHANNELS,
+        reconstruction=AVG_RECONSTRUCTION,
+        n_texels=rough.count,
+        n_channels=1,
+        run_tile=run_tile,
+        prepare=lambda d: specular.load(specular.kernel_for(*key), d),
+        samples=eff * len(mu),
+        estimator=est,
+        terms=dfg.terms_record(o, "none (F = 1)"),
+        cost=float(rough.count) * len(mu) * eff,
+        extra={"mu_nodes": str(len(mu))},
+    )
 
 
-ALBEDO = Kind("albedo", "Kulla-Conty directional albedo E(NoV, roughness) with F = 1 (R = E)", ALBEDO_KEYS,
-              plan_albedo, aliases=("e_ss",), check=dfg.check_spec)
-ALBEDO_AVG = Kind("albedo_avg", "Kulla-Conty average albedo E_avg(roughness) = 2 ∫ E mu dmu: one row",
-                  AVG_KEYS, plan_albedo_avg, aliases=("e_avg",), check=dfg.check_spec)
+ALBEDO = Kind(
+    "albedo",
+    "Kulla-Conty directional albedo E(NoV, roughness) with F = 1 (R = E)",
+    ALBEDO_KEYS,
+    plan_albedo,
+    aliases=("e_ss",),
+    check=dfg.check_spec,
+)
+ALBEDO_AVG = Kind(
+    "albedo_avg",
+    "Kulla-Conty average albedo E_avg(roughness) = 2 ∫ E mu dmu: one row",
+    AVG_KEYS,
+    plan_albedo_avg,
+    aliases=("e_avg",),
+    check=dfg.check_spec,
+)

@@ -30,6 +30,7 @@ Estimator (``sobol``): scrambled 3D Sobol' points (u1, u2, u3): phi_v = 2 pi u3 
 Both weights are bounded by 1, so the QMC error is that of a bounded integrand with a kink at the horizon
 (measured in tests/test_aniso.py against the isotropic gauss_legendre tables).
 """
+
 from __future__ import annotations
 
 import functools
@@ -55,8 +56,10 @@ VIEW_AZIMUTHS = {
     "bitangent": "phi_v = pi/2: v in the plane of the bitangent and the normal",
 }
 PHI_V = {"average": -1.0, "tangent": 0.0, "bitangent": 0.5 * np.pi}
-ESTIMATORS = {"sobol": "scrambled 3D Sobol' points: h by anisotropic GGX VNDF sampling (microfacet) or the "
-                       "Ashikhmin-Shirley h sampling; phi_v = 2 pi u3 when averaged"}
+ESTIMATORS = {
+    "sobol": "scrambled 3D Sobol' points: h by anisotropic GGX VNDF sampling (microfacet) or the "
+    "Ashikhmin-Shirley h sampling; phi_v = 2 pi u3 when averaged"
+}
 DEFAULT_SAMPLES = 16384
 
 KEYS = {
@@ -66,18 +69,25 @@ KEYS = {
     "layout": dfg.KEYS["layout"],
     **{k: dfg.KEYS[k] for k in ("size", "roughness", "texel", "nov_range", "roughness_range")},
     "anisotropy_size": Key("anisotropy_size", "int", 8, "anisotropy slice count (z)", minimum=1, maximum=1024),
-    "anisotropy_range": Key("anisotropy_range", "float_range", [0.0, 1.0],
-                            "anisotropy at t = 0 and t = 1 (same texel convention); a < 0 stretches along B",
-                            minimum=-1.0, maximum=1.0),
+    "anisotropy_range": Key(
+        "anisotropy_range",
+        "float_range",
+        [0.0, 1.0],
+        "anisotropy at t = 0 and t = 1 (same texel convention); a < 0 stretches along B",
+        minimum=-1.0,
+        maximum=1.0,
+    ),
     "view_azimuth": Key("view_azimuth", "str", "average", "the view azimuth about n, from the tangent", VIEW_AZIMUTHS),
 }
 RECONSTRUCTION = {
     "scale_bias": "load part k as layer k of a 3D texture; t = texture(lut3d, vec3(NoV, roughness, anisotropy)).rg; "
-                  "specular = prefiltered * (f0 * t.r + t.g) (texel centres on all three axes)",
+    "specular = prefiltered * (f0 * t.r + t.g) (texel centres on all three axes)",
     "multiscatter": "t = texture(lut3d, vec3(NoV, roughness, anisotropy)).rg; E = mix(t.r, t.g, f0); "
-                    "energy compensation = 1 + f0 (1 / t.g - 1)",
+    "energy compensation = 1 + f0 (1 / t.g - 1)",
 }
-AXES_FORMULA = "aspect = sqrt(1 - 0.9 |a|); alpha_x = alpha / aspect, alpha_y = alpha * aspect (a >= 0; swapped for a < 0)"
+AXES_FORMULA = (
+    "aspect = sqrt(1 - 0.9 |a|); alpha_x = alpha / aspect, alpha_y = alpha * aspect (a >= 0; swapped for a < 0)"
+)
 
 
 def alpha_xy(alpha: np.ndarray, aniso: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -153,8 +163,10 @@ def integrate(kernel, nov, alpha_x, alpha_y, phi_v, samples: int, seed: int, dev
     n = len(nov)
     pts = np.clip(points.sobol3(samples, seed), 0.0, np.nextafter(np.float32(1.0), np.float32(0.0))).astype(np.float32)
     out = wp.zeros((n, 2), dtype=wp.float64, device=device)
-    inputs = [wp.array(np.ascontiguousarray(a, dtype=np.float32), dtype=float, device=device)
-              for a in (nov, alpha_x, alpha_y, phi_v)]
+    inputs = [
+        wp.array(np.ascontiguousarray(a, dtype=np.float32), dtype=float, device=device)
+        for a in (nov, alpha_x, alpha_y, phi_v)
+    ]
     wp.launch(kernel, dim=n, inputs=inputs + [wp.array(pts, dtype=float, device=device), out], device=device)
     return out.numpy()
 
@@ -180,18 +192,37 @@ def plan(spec) -> Plan:
 
     def run_tile(start: int, stop: int, device: str) -> np.ndarray:
         k = kernel_for(*key)
-        return integrate(k, nov[start:stop], ax[start:stop], ay[start:stop], phi[start:stop], samples, o["seed"], device)
+        return integrate(
+            k, nov[start:stop], ax[start:stop], ay[start:stop], phi[start:stop], samples, o["seed"], device
+        )
 
-    terms = {"model": o["model"], "ndf": "ggx_aniso" if o["model"] == "microfacet" else "ashikhmin_shirley",
-             "masking": "smith_height_correlated (anisotropic Lambda)" if o["model"] == "microfacet"
-             else "none (implicit in the lobe)", "fresnel": "schlick", "layout": o["layout"]}
-    return Plan(axes=axes, channels=dfg.CHANNELS[o["layout"]], reconstruction=RECONSTRUCTION[o["layout"]],
-                n_texels=len(nov), n_channels=2, run_tile=run_tile,
-                prepare=lambda d: specular.load(kernel_for(*key), d), samples=eff, estimator=o["estimator"],
-                terms=terms, cost=float(len(nov)) * eff,
-                extra={"view_azimuth": f"{o['view_azimuth']}: {VIEW_AZIMUTHS[o['view_azimuth']]}",
-                       "anisotropy_mapping": f"Burley 2012, Addenda B.2: {AXES_FORMULA}",
-                       "tangent_frame": "T = +x (phi = 0), B = +y, n = +z"})
+    terms = {
+        "model": o["model"],
+        "ndf": "ggx_aniso" if o["model"] == "microfacet" else "ashikhmin_shirley",
+        "masking": "smith_height_correlated (anisotropic Lambda)"
+        if o["model"] == "microfacet"
+        else "none (implicit in the lobe)",
+        "fresnel": "schlick",
+        "layout": o["layout"],
+    }
+    return Plan(
+        axes=axes,
+        channels=dfg.CHANNELS[o["layout"]],
+        reconstruction=RECONSTRUCTION[o["layout"]],
+        n_texels=len(nov),
+        n_channels=2,
+        run_tile=run_tile,
+        prepare=lambda d: specular.load(kernel_for(*key), d),
+        samples=eff,
+        estimator=o["estimator"],
+        terms=terms,
+        cost=float(len(nov)) * eff,
+        extra={
+            "view_azimuth": f"{o['view_azimuth']}: {VIEW_AZIMUTHS[o['view_azimuth']]}",
+            "anisotropy_mapping": f"Burley 2012, Addenda B.2: {AXES_FORMULA}",
+            "tangent_frame": "T = +x (phi = 0), B = +y, n = +z",
+        },
+    )
 
 
 def check_spec(spec) -> tuple[str, str] | None:
@@ -202,6 +233,12 @@ def check_spec(spec) -> tuple[str, str] | None:
     return None
 
 
-SPECULAR_ANISO = Kind("specular_aniso", "anisotropic split-sum: NoV x roughness x anisotropy slices (anisotropic "
-                      "GGX or Ashikhmin-Shirley), scale/bias or multiscatter", KEYS, plan,
-                      aliases=("aniso",), check=check_spec)
+SPECULAR_ANISO = Kind(
+    "specular_aniso",
+    "anisotropic split-sum: NoV x roughness x anisotropy slices (anisotropic "
+    "GGX or Ashikhmin-Shirley), scale/bias or multiscatter",
+    KEYS,
+    plan,
+    aliases=("aniso",),
+    check=check_spec,
+)

@@ -6,6 +6,7 @@ the texel count and ``run_tile(start, stop, device)``: a pure function of (spec,
 returns the float64 values of texels [start, stop) in row-major order (y slowest), so tiles can be
 handed to any worker, thread or cluster, and the result is bit-identical however they are cut.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field

@@ -11,6 +11,7 @@ hold (φ, view) flattened: image row = iφ * N_v + i_v (the φ axis has dim ``y_
 φ is the azimuth between l and v; f is even in φ, so [0, π] (cos φ in [-1, 1]) covers every pair.
 Reciprocity f(l, v) = f(v, l) makes every (φ, σ) block symmetric when the x and y grids agree (tested).
 """
+
 from __future__ import annotations
 
 import json
@@ -38,19 +39,39 @@ KEYS = {
     "phi_size": Key("phi_size", "int", 32, "azimuth texel count (row blocks)", minimum=1, maximum=4096),
     "sigma_size": Key("sigma_size", "int", 16, "sigma slice count (z, one EXR part each)", minimum=1, maximum=1024),
     "sigma_range": diffuse.KEYS["sigma_range"],
-    "sigma_values": Key("sigma_values", "float_list", None, "explicit sigma of every slice, strictly increasing "
-                        "(replaces sigma_size and sigma_range; the axis mapping is then 'listed')",
-                        minimum=0.0, maximum=1.0),
-    "parametrisation": Key("parametrisation", "str", "cosines", "what the light, view and azimuth axes hold",
-                           PARAMETRISATIONS),
+    "sigma_values": Key(
+        "sigma_values",
+        "float_list",
+        None,
+        "explicit sigma of every slice, strictly increasing "
+        "(replaces sigma_size and sigma_range; the axis mapping is then 'listed')",
+        minimum=0.0,
+        maximum=1.0,
+    ),
+    "parametrisation": Key(
+        "parametrisation", "str", "cosines", "what the light, view and azimuth axes hold", PARAMETRISATIONS
+    ),
     "model": Key("model", "str", "microfacet", "the diffuse BRDF tabulated", diffuse.MODELS),
-    "f0": Key("f0", "float", 0.0, "Fresnel reflectance at normal incidence baked in (lutbake:f0_factor: how it "
-              "scales)", minimum=0.0, maximum=0.999),
+    "f0": Key(
+        "f0",
+        "float",
+        0.0,
+        "Fresnel reflectance at normal incidence baked in (lutbake:f0_factor: how it scales)",
+        minimum=0.0,
+        maximum=0.999,
+    ),
     "sigma_to_alpha": diffuse.KEYS["sigma_to_alpha"],
     "facet_fresnel": diffuse.KEYS["facet_fresnel"],
-    "samples": Key("samples", "int", None, "Gauss-Legendre order n of the m-integral (microfacet: up to "
-                   "(K + 3) x 4 n^2 facet normals per texel, K the tan(theta_m) panels); omitted: 12; closed models "
-                   "ignore it", minimum=2, maximum=64),
+    "samples": Key(
+        "samples",
+        "int",
+        None,
+        "Gauss-Legendre order n of the m-integral (microfacet: up to "
+        "(K + 3) x 4 n^2 facet normals per texel, K the tan(theta_m) panels); omitted: 12; closed models "
+        "ignore it",
+        minimum=2,
+        maximum=64,
+    ),
     "dtype": diffuse.KEYS["dtype"],
     "texel": Key("texel", "str", "center", "texel convention of every axis", TEXELS),
 }
@@ -59,7 +80,8 @@ RECONSTRUCTION = (
     "view_index. Texel centres (t = (i + 0.5) / N) on every axis: x = (light param) * N_l - 0.5, y = (view param) * "
     "N_v - 0.5, p = (phi param) * N_phi - 0.5; fetch bilinearly at row p0 * N_v + clamp(y, 0, N_v - 1) for the two "
     "phi blocks p0 = floor(p), p0 + 1 (clamped), lerp by fract(p), and lerp the two sigma parts: "
-    "f = rho * value * g(f0) / g(f0_baked) (lutbake:f0_factor); radiance = f * E0 * NoL")
+    "f = rho * value * g(f0) / g(f0_baked) (lutbake:f0_factor); radiance = f * E0 * NoL"
+)
 
 
 def axes_for(o: dict) -> list[Axis]:
@@ -71,11 +93,19 @@ def axes_for(o: dict) -> list[Axis]:
     else:
         sig = Axis("sigma", "z", o["sigma_size"], *o["sigma_range"], texel=tx)
     if o["parametrisation"] == "cosines":
-        return [sig, Axis("cos_phi", "y_block", o["phi_size"], -1.0, 1.0, texel=tx),
-                Axis("NoV", "y", nv, 0.0, 1.0, texel=tx), Axis("NoL", "x", nl, 0.0, 1.0, texel=tx)]
+        return [
+            sig,
+            Axis("cos_phi", "y_block", o["phi_size"], -1.0, 1.0, texel=tx),
+            Axis("NoV", "y", nv, 0.0, 1.0, texel=tx),
+            Axis("NoL", "x", nl, 0.0, 1.0, texel=tx),
+        ]
     half_pi = float(np.pi / 2)
-    return [sig, Axis("phi", "y_block", o["phi_size"], 0.0, float(np.pi), texel=tx),
-            Axis("theta_v", "y", nv, 0.0, half_pi, texel=tx), Axis("theta_l", "x", nl, 0.0, half_pi, texel=tx)]
+    return [
+        sig,
+        Axis("phi", "y_block", o["phi_size"], 0.0, float(np.pi), texel=tx),
+        Axis("theta_v", "y", nv, 0.0, half_pi, texel=tx),
+        Axis("theta_l", "x", nl, 0.0, half_pi, texel=tx),
+    ]
 
 
 def directions(axes: list[Axis], parametrisation: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -111,50 +141,80 @@ def plan(spec) -> Plan:
         out = np.empty((len(idx), 1))
         for n in np.unique(orders[idx]):
             sel = orders[idx] == n
-            out[sel, 0] = diffuse.eval_brdf(model, l[idx[sel]], v[idx[sel]], sigma[idx[sel]], o["f0"], ff,
-                                            o["sigma_to_alpha"], int(n) + extra, device=device)
+            out[sel, 0] = diffuse.eval_brdf(
+                model,
+                l[idx[sel]],
+                v[idx[sel]],
+                sigma[idx[sel]],
+                o["f0"],
+                ff,
+                o["sigma_to_alpha"],
+                int(n) + extra,
+                device=device,
+            )
         return out
 
     def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
         n = len(sigma)
         grazing = np.flatnonzero((l[:, 2] <= l[:, 2].min()) | (v[:, 2] <= v[:, 2].min()))
         both = np.flatnonzero((l[:, 2] <= l[:, 2].min()) & (v[:, 2] <= v[:, 2].min()))
-        idx = np.unique(np.concatenate([np.arange(0, n, max(1, n // 512)), grazing[:: max(1, len(grazing) // 128)],
-                                        both]))
+        idx = np.unique(
+            np.concatenate([np.arange(0, n, max(1, n // 512)), grazing[:: max(1, len(grazing) // 128)], both])
+        )
         ref = run(idx, ESTIMATE_EXTRA, device)[:, 0]
         got = data.reshape(n, -1)[idx, 0]
         ok = np.abs(ref) > 1e-6
         rel = float(np.max(np.abs(got - ref)[ok] / np.abs(ref[ok]))) if ok.any() else 0.0
         ab = float(np.max(np.abs(got - ref)))
-        return rel, (f"max relative |orders - orders + {ESTIMATE_EXTRA}| / |orders + {ESTIMATE_EXTRA}| over "
-                     f"{int(ok.sum())} probe texels (strided + most grazing light or view + both most grazing; "
-                     f"|f| > 1e-6); max abs {ab:.3e}")
+        return rel, (
+            f"max relative |orders - orders + {ESTIMATE_EXTRA}| / |orders + {ESTIMATE_EXTRA}| over "
+            f"{int(ok.sum())} probe texels (strided + most grazing light or view + both most grazing; "
+            f"|f| > 1e-6); max abs {ab:.3e}"
+        )
 
     sig_axis = axes[0]
-    terms = {"model": model, "f0": str(o["f0"]), "f0_factor": diffuse.f0_factor(model, ff),
-             "parametrisation": o["parametrisation"]}
+    terms = {
+        "model": model,
+        "f0": str(o["f0"]),
+        "f0_factor": diffuse.f0_factor(model, ff),
+        "parametrisation": o["parametrisation"],
+    }
     if integrated:
         terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff, sigma_to_alpha=o["sigma_to_alpha"])
-    extra = {"f0_factor": diffuse.f0_factor(model, ff), "f0": repr(o["f0"]), "rho": "1",
-             "parametrisation": o["parametrisation"], "layout": "part = sigma slice; row = phi_index * N_view + "
-             "view_index; column = light_index",
-             "sigma_values": json.dumps([float(s) for s in sig_axis.values()]),
-             "sigma_alpha": json.dumps([float(a) for a in diffuse.alpha_from_sigma(sig_axis.values(),
-                                                                                     o["sigma_to_alpha"])])}
+    extra = {
+        "f0_factor": diffuse.f0_factor(model, ff),
+        "f0": repr(o["f0"]),
+        "rho": "1",
+        "parametrisation": o["parametrisation"],
+        "layout": "part = sigma slice; row = phi_index * N_view + view_index; column = light_index",
+        "sigma_values": json.dumps([float(s) for s in sig_axis.values()]),
+        "sigma_alpha": json.dumps([float(a) for a in diffuse.alpha_from_sigma(sig_axis.values(), o["sigma_to_alpha"])]),
+    }
     per = 1
     if integrated:  # at most (K + 3) u panels (K + 1 geometric ones, cut at u_l and u_v) x 4 arcs x n^2
         a = diffuse.alpha_from_sigma(sig_axis.values(), o["sigma_to_alpha"]).astype(np.float64)
-        k = np.clip(np.ceil(np.log(diffuse_albedo.TAIL_TAN / a) / np.log(diffuse_albedo.TAIL_RATIO)), 1,
-                    diffuse_albedo.MAX_TAIL_CUTS)
+        k = np.clip(
+            np.ceil(np.log(diffuse_albedo.TAIL_TAN / a) / np.log(diffuse_albedo.TAIL_RATIO)),
+            1,
+            diffuse_albedo.MAX_TAIL_CUTS,
+        )
         per = int(round(float(np.mean(k + 3)) * 4 * order * order))
     key = (model, ff)
-    return Plan(axes=axes,
-                channels={"f": "the BRDF f_r(l, v) for rho = 1 at the baked f0 (1/sr; radiance = f E0 (n.l))"},
-                reconstruction=RECONSTRUCTION, n_texels=len(sigma), n_channels=1,
-                run_tile=lambda s, e, d: run(slice(s, e), 0, d),
-                prepare=lambda d: wp.load_module(diffuse.brdf_kernel_for(*key).module, device=d),
-                samples=per, estimator="gauss_legendre" if integrated else "closed_form", terms=terms,
-                cost=float(len(sigma)) * per, extra=extra, error_estimate=error_estimate if integrated else None)
+    return Plan(
+        axes=axes,
+        channels={"f": "the BRDF f_r(l, v) for rho = 1 at the baked f0 (1/sr; radiance = f E0 (n.l))"},
+        reconstruction=RECONSTRUCTION,
+        n_texels=len(sigma),
+        n_channels=1,
+        run_tile=lambda s, e, d: run(slice(s, e), 0, d),
+        prepare=lambda d: wp.load_module(diffuse.brdf_kernel_for(*key).module, device=d),
+        samples=per,
+        estimator="gauss_legendre" if integrated else "closed_form",
+        terms=terms,
+        cost=float(len(sigma)) * per,
+        extra=extra,
+        error_estimate=error_estimate if integrated else None,
+    )
 
 
 def check_spec(spec) -> str | None:
@@ -166,6 +226,12 @@ def check_spec(spec) -> str | None:
     return None
 
 
-BTF = Kind("btf", "the diffuse BRDF of four scalars as sigma slices of (light, view, azimuth) blocks (cosines or "
-           "angles), microfacet (Eq. 4 integrated) or fitted (Eq. 8) or any diffuse model", KEYS, plan,
-           aliases=("diffuse_btf",), check=check_spec)
+BTF = Kind(
+    "btf",
+    "the diffuse BRDF of four scalars as sigma slices of (light, view, azimuth) blocks (cosines or "
+    "angles), microfacet (Eq. 4 integrated) or fitted (Eq. 8) or any diffuse model",
+    KEYS,
+    plan,
+    aliases=("diffuse_btf",),
+    check=check_spec,
+)

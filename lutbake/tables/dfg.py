@@ -15,6 +15,7 @@ Axes, by default: x (columns) = NoV, y (rows) = roughness; image row 0 is the fi
 the value) and ``nov_clamp`` (lutbake.axes).
 The integral and its estimators are derived in lutbake.sampling.estimators.
 """
+
 from __future__ import annotations
 
 import re
@@ -36,57 +37,71 @@ LAYOUTS = {
     "scale_bias_f82": "scale_bias + B = ∫ f/F (v.h)(1 - v.h)^6 (n.l): the F82-tint term (Blender EEVEE)",
     "multiscatter_cloth": "multiscatter + B = ∫ D_charlie V_ashikhmin (n.l): cloth DV (Filament --ibl-dfg-cloth)",
     "charlie": "sheen lobe alone: R = G = 0, B = ∫ D_charlie V_ashikhmin (n.l): the glTF Sample Viewer's lut_charlie "
-               "(KHR_materials_sheen IBL; gauss_legendre only)",
+    "(KHR_materials_sheen IBL; gauss_legendre only)",
     "sheen_albedo": "sheen lobe alone: R = E = ∫ D_charlie V_charlie (n.l) (KHR_materials_sheen albedo scaling, Charlie "
-                    "visibility), G = the same with V_ashikhmin (gauss_legendre only)",
+    "visibility), G = the same with V_ashikhmin (gauss_legendre only)",
     "charlie_clamped": "charlie with V_ashikhmin clamped to [0, 1]: the glTF Sample Viewer's LUT() integrand exactly",
     "sheen_albedo_clamped": "sheen_albedo with each V clamped to [0, 1], as the glTF Sample Viewer's V_Sheen / V_Ashikhmin",
 }
 SHEEN_LAYOUTS = specular.SHEEN_LAYOUTS
 CHANNELS = {
-    "scale_bias": {"scale": "∫ f/F (1 - (1 - v.h)^5) (n.l) dω_l: multiplies f0",
-                   "bias": "∫ f/F (1 - v.h)^5 (n.l) dω_l: added"},
-    "multiscatter": {"fc": "∫ f/F (1 - v.h)^5 (n.l) dω_l: the f90 = 1 weight",
-                     "e_ss": "∫ f/F (n.l) dω_l: single-scattering directional albedo with F = 1"},
+    "scale_bias": {
+        "scale": "∫ f/F (1 - (1 - v.h)^5) (n.l) dω_l: multiplies f0",
+        "bias": "∫ f/F (1 - v.h)^5 (n.l) dω_l: added",
+    },
+    "multiscatter": {
+        "fc": "∫ f/F (1 - v.h)^5 (n.l) dω_l: the f90 = 1 weight",
+        "e_ss": "∫ f/F (n.l) dω_l: single-scattering directional albedo with F = 1",
+    },
 }
 CHANNELS["scale_bias_f82"] = {
     **CHANNELS["scale_bias"],
-    "f82": "∫ f/F (v.h)(1 - v.h)^6 (n.l) dω_l: the F82-tint term (Hoffman 2023 / Blender EEVEE metal_bias)"}
+    "f82": "∫ f/F (v.h)(1 - v.h)^6 (n.l) dω_l: the F82-tint term (Hoffman 2023 / Blender EEVEE metal_bias)",
+}
 CHANNELS["multiscatter_cloth"] = {
     **CHANNELS["multiscatter"],
     "cloth_dv": "∫ D_charlie(h; alpha) V_ashikhmin (n.l) dω_l, no Fresnel: sheen/cloth directional albedo "
-                "(Estevez & Kulla 2017 NDF, Ashikhmin 2007 visibility 1/(4 (n.l + n.v - (n.l)(n.v))))"}
+    "(Estevez & Kulla 2017 NDF, Ashikhmin 2007 visibility 1/(4 (n.l + n.v - (n.l)(n.v))))",
+}
 CHANNELS["charlie"] = {
     "zero_r": "0 (the viewer's lut_charlie leaves R empty)",
     "zero_g": "0",
     "charlie_dv": "∫ D_charlie(h; alpha) V_ashikhmin (n.l) dω_l, no Fresnel: the sheen lobe's DFG for IBL "
-                  "(Estevez & Kulla 2017 NDF, Ashikhmin & Premoze 2007 visibility 1/(4 (n.l + n.v - (n.l)(n.v))))"}
+    "(Estevez & Kulla 2017 NDF, Ashikhmin & Premoze 2007 visibility 1/(4 (n.l + n.v - (n.l)(n.v))))",
+}
 CHANNELS["sheen_albedo"] = {
     "sheen_e": "E(n.v) = ∫ D_charlie V_charlie (n.l) dω_l: directional albedo of the KHR_materials_sheen BRDF with its "
-               "Charlie visibility 1/((1 + Lambda(n.v) + Lambda(n.l)) 4 (n.v)(n.l)) (Estevez & Kulla 2017 fit)",
+    "Charlie visibility 1/((1 + Lambda(n.v) + Lambda(n.l)) 4 (n.v)(n.l)) (Estevez & Kulla 2017 fit)",
     "sheen_e_ashikhmin": "∫ D_charlie V_ashikhmin (n.l) dω_l: the same with the spec's cheaper Ashikhmin visibility "
-                         "(may exceed 1: not energy conserving, as the spec warns)"}
+    "(may exceed 1: not energy conserving, as the spec warns)",
+}
 CHANNELS["charlie_clamped"] = {**CHANNELS["charlie"], "charlie_dv": "∫ D_charlie min(V_ashikhmin, 1) (n.l) dω_l"}
-CHANNELS["sheen_albedo_clamped"] = {"sheen_e": "∫ D_charlie min(V_charlie, 1) (n.l) dω_l",
-                                    "sheen_e_ashikhmin": "∫ D_charlie min(V_ashikhmin, 1) (n.l) dω_l"}
+CHANNELS["sheen_albedo_clamped"] = {
+    "sheen_e": "∫ D_charlie min(V_charlie, 1) (n.l) dω_l",
+    "sheen_e_ashikhmin": "∫ D_charlie min(V_ashikhmin, 1) (n.l) dω_l",
+}
 RECONSTRUCTION = {
     "scale_bias": "uv = vec2(NoV, roughness) (texel centres per lutbake:axes); t = texture(lut, uv).rg; "
-                  "specular = prefiltered * (f0 * t.r + t.g)",
+    "specular = prefiltered * (f0 * t.r + t.g)",
     "multiscatter": "uv = vec2(NoV, roughness); t = texture(lut, uv).rg; E = mix(t.r, t.g, f0) = (1 - f0) t.r + f0 t.g; "
-                    "specular = prefiltered * E; energy compensation = 1 + f0 (1 / t.g - 1)",
+    "specular = prefiltered * E; energy compensation = 1 + f0 (1 / t.g - 1)",
 }
 RECONSTRUCTION["scale_bias_f82"] = (
     RECONSTRUCTION["scale_bias"] + "; F82 tint (Blender EEVEE): b = mix(f0, 1, (6/7)^5) * 7/(6/7)^6 * (1 - f82_tint), "
-    "specular = prefiltered * (f0 * t.r + f90 * t.g - b * t.b)")
+    "specular = prefiltered * (f0 * t.r + f90 * t.g - b * t.b)"
+)
 RECONSTRUCTION["multiscatter_cloth"] = (
-    RECONSTRUCTION["multiscatter"] + "; cloth/sheen: sheen = prefiltered_charlie * sheen_color * t.b")
+    RECONSTRUCTION["multiscatter"] + "; cloth/sheen: sheen = prefiltered_charlie * sheen_color * t.b"
+)
 RECONSTRUCTION["charlie"] = (
     "uv = vec2(NoV, roughness); KHR_materials_sheen IBL (glTF Sample Viewer getIBLRadianceCharlie): "
-    "sheen = prefiltered_charlie * sheenColor * texture(lut, uv).b, at uv = vec2(NdotV, sheenRoughness)")
+    "sheen = prefiltered_charlie * sheenColor * texture(lut, uv).b, at uv = vec2(NdotV, sheenRoughness)"
+)
 RECONSTRUCTION["sheen_albedo"] = (
     "uv = vec2(NoV, roughness); KHR_materials_sheen albedo scaling: E = texture(lut, uv).r at uv = vec2(NdotV, "
     "sheenRoughness); sheenAlbedoScaling = 1 - max3(sheenColor) * E (or min over E(NdotV), E(NdotL)); "
-    "f = f_sheen + (f_diffuse + f_specular) * sheenAlbedoScaling; .g is E with Ashikhmin visibility")
+    "f = f_sheen + (f_diffuse + f_specular) * sheenAlbedoScaling; .g is E with Ashikhmin visibility"
+)
 RECONSTRUCTION["charlie_clamped"] = RECONSTRUCTION["charlie"]
 RECONSTRUCTION["sheen_albedo_clamped"] = RECONSTRUCTION["sheen_albedo"]
 N_CHANNELS = specular.N_CHANNELS
@@ -98,14 +113,25 @@ NOV_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "one_minus_t2")}
 ROUGHNESS_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "texel_offset")}
 
 COMMON_KEYS = {
-    "name": Key("name", "name", None, "output stem: <out-dir>/<name>.<ext> (ext per format); letters, digits, - and _ only", required=True),
+    "name": Key(
+        "name",
+        "name",
+        None,
+        "output stem: <out-dir>/<name>.<ext> (ext per format); letters, digits, - and _ only",
+        required=True,
+    ),
     "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
-    "samples": Key("samples", "int", None, "integrand evaluations per texel; omitted: the estimator's default "
-                   "quality", minimum=1, maximum=MAX_SAMPLES),
+    "samples": Key(
+        "samples",
+        "int",
+        None,
+        "integrand evaluations per texel; omitted: the estimator's default quality",
+        minimum=1,
+        maximum=MAX_SAMPLES,
+    ),
     "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}),
     "estimator": Key("estimator", "str", "gauss_legendre", "how the integral is estimated", specular.ESTIMATORS),
-    "seed": Key("seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0,
-                maximum=MAX_SEED),
+    "seed": Key("seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0, maximum=MAX_SEED),
     "format": Key("format", "str", "exr", "output file format: <out-dir>/<name>.<ext>", FORMATS),
 }
 
@@ -115,19 +141,31 @@ KEYS = {
     "roughness": Key("roughness", "str", "perceptual", "what the roughness axis holds", ROUGHNESS_PARAMS),
     "ndf": Key("ndf", "str", "ggx", "normal distribution function", {k: v.description for k, v in NDFS.items()}),
     "masking": Key("masking", "str", "smith_height_correlated", "masking-shadowing G2", MASKINGS),
-    "model": Key("model", "str", "microfacet", "the BRDF's term set (lecture 003); other than microfacet, it fixes "
-                  "ndf and masking (leave them unset)", MODELS),
+    "model": Key(
+        "model",
+        "str",
+        "microfacet",
+        "the BRDF's term set (lecture 003); other than microfacet, it fixes ndf and masking (leave them unset)",
+        MODELS,
+    ),
     "layout": Key("layout", "str", "scale_bias", "channel layout", LAYOUTS),
     "texel": Key("texel", "str", "center", "texel convention of both axes", TEXELS),
     "nov_range": Key("nov_range", "float_range", [0.0, 1.0], "NoV at t = 0 and t = 1", minimum=0.0, maximum=1.0),
-    "roughness_range": Key("roughness_range", "float_range", [0.0, 1.0], "roughness at t = 0 and t = 1",
-                           minimum=0.0, maximum=1.0),
+    "roughness_range": Key(
+        "roughness_range", "float_range", [0.0, 1.0], "roughness at t = 0 and t = 1", minimum=0.0, maximum=1.0
+    ),
     "axis_order": Key("axis_order", "str", "nov_x", "which quantity runs along the columns (x)", AXIS_ORDERS),
     "row_order": Key("row_order", "str", "lo_first", "which end of the row (y) axis is image row 0", ORDERS),
     "nov_mapping": Key("nov_mapping", "str", "linear", "how t maps to NoV", NOV_MAPPINGS),
     "roughness_mapping": Key("roughness_mapping", "str", "linear", "how t maps to roughness", ROUGHNESS_MAPPINGS),
-    "nov_clamp": Key("nov_clamp", "float_range", [0.0, 1.0], "NoV clamped to [lo, hi] after the mapping "
-                     "(Blender EEVEE: [1e-4, 0.9999])", minimum=0.0, maximum=1.0),
+    "nov_clamp": Key(
+        "nov_clamp",
+        "float_range",
+        [0.0, 1.0],
+        "NoV clamped to [lo, hi] after the mapping (Blender EEVEE: [1e-4, 0.9999])",
+        minimum=0.0,
+        maximum=1.0,
+    ),
 }
 
 
@@ -136,24 +174,39 @@ def check_spec(spec) -> tuple[str, str] | None:
     o = spec.options
     model = o.get("model", "microfacet")
     if model != "microfacet" and (o["ndf"], o["masking"]) != (KEYS["ndf"].default, KEYS["masking"].default):
-        return ("model", f"{model!r} fixes the NDF and the masking; ndf and masking are only for model = 'microfacet' "
-                         f"(got ndf = {o['ndf']!r}, masking = {o['masking']!r})")
+        return (
+            "model",
+            f"{model!r} fixes the NDF and the masking; ndf and masking are only for model = 'microfacet' "
+            f"(got ndf = {o['ndf']!r}, masking = {o['masking']!r})",
+        )
     form, nd, mk = terms_of(o)
     if form == "microfacet" and not pair_allowed(nd, mk):
         return ("masking", f"ndf {nd!r} has no Smith Lambda: use masking = 'v_cavity' with it, not {mk!r}")
     if o["estimator"] == "sobol_vndf" and NDFS[nd].vndf is None:
-        return ("estimator", f"'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not ndf = {nd!r}"
-                             + (f" (model {model!r})" if model != "microfacet" else ""))
+        return (
+            "estimator",
+            f"'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not ndf = {nd!r}"
+            + (f" (model {model!r})" if model != "microfacet" else ""),
+        )
     if o.get("layout") == "multiscatter_cloth" and o["estimator"] != "gauss_legendre":
-        return ("estimator", "layout 'multiscatter_cloth' needs estimator 'gauss_legendre': the QMC estimators draw "
-                             "h from the GGX NDF and miss the Charlie NDF's grazing lobe of the cloth channel")
+        return (
+            "estimator",
+            "layout 'multiscatter_cloth' needs estimator 'gauss_legendre': the QMC estimators draw "
+            "h from the GGX NDF and miss the Charlie NDF's grazing lobe of the cloth channel",
+        )
     if o.get("layout") in SHEEN_LAYOUTS:
         if o["estimator"] != "gauss_legendre":
-            return ("estimator", f"layout {o['layout']!r} needs estimator 'gauss_legendre': the QMC estimators draw h "
-                                 f"from the GGX NDF and miss the Charlie NDF's grazing lobe (got {o['estimator']!r})")
+            return (
+                "estimator",
+                f"layout {o['layout']!r} needs estimator 'gauss_legendre': the QMC estimators draw h "
+                f"from the GGX NDF and miss the Charlie NDF's grazing lobe (got {o['estimator']!r})",
+            )
         if model != "microfacet" or (o["ndf"], o["masking"]) != (KEYS["ndf"].default, KEYS["masking"].default):
-            return ("layout", f"layout {o['layout']!r} integrates the sheen lobe (Charlie NDF) alone: leave model, ndf "
-                              "and masking unset")
+            return (
+                "layout",
+                f"layout {o['layout']!r} integrates the sheen lobe (Charlie NDF) alone: leave model, ndf "
+                "and masking unset",
+            )
     if o.get("roughness_mapping") == "texel_offset" and o["texel"] != "center":
         return ("roughness_mapping", "'texel_offset' is defined on texel centres (texel = 'center')")
     return None
@@ -170,9 +223,13 @@ def terms_record(o: dict, fresnel: str) -> dict:
     model = o.get("model", "microfacet")
     if form == "microfacet":
         return {"model": model, "ndf": nd, "masking": mk, "fresnel": fresnel}
-    return {"model": model, "ndf": f"{model} lobe (sampled with the blinn_phong CDF)",
-            "masking": "none (implicit in the lobe)", "fresnel": fresnel,
-            "shininess": "s = 2 / alpha^2 - 2"}
+    return {
+        "model": model,
+        "ndf": f"{model} lobe (sampled with the blinn_phong CDF)",
+        "masking": "none (implicit in the lobe)",
+        "fresnel": fresnel,
+        "shininess": "s = 2 / alpha^2 - 2",
+    }
 
 
 def axes_for(o: dict) -> list[Axis]:
@@ -182,11 +239,25 @@ def axes_for(o: dict) -> list[Axis]:
     nov_x = o.get("axis_order", "nov_x") == "nov_x"
     row_order = o.get("row_order", "lo_first")
     clamp = o.get("nov_clamp", [0.0, 1.0])
-    rough = Axis(rname, "x" if not nov_x else "y", n_rough, *o["roughness_range"], texel=o["texel"],
-                 mapping=o.get("roughness_mapping", "linear"), order="lo_first" if not nov_x else row_order)
-    nov = Axis("NoV", "x" if nov_x else "y", n_nov, *o["nov_range"], texel=o["texel"],
-               mapping=o.get("nov_mapping", "linear"), order=row_order if not nov_x else "lo_first",
-               clamp=None if list(clamp) == [0.0, 1.0] else tuple(clamp))
+    rough = Axis(
+        rname,
+        "x" if not nov_x else "y",
+        n_rough,
+        *o["roughness_range"],
+        texel=o["texel"],
+        mapping=o.get("roughness_mapping", "linear"),
+        order="lo_first" if not nov_x else row_order,
+    )
+    nov = Axis(
+        "NoV",
+        "x" if nov_x else "y",
+        n_nov,
+        *o["nov_range"],
+        texel=o["texel"],
+        mapping=o.get("nov_mapping", "linear"),
+        order=row_order if not nov_x else "lo_first",
+        clamp=None if list(clamp) == [0.0, 1.0] else tuple(clamp),
+    )
     return [rough, nov] if nov_x else [nov, rough]
 
 
@@ -200,7 +271,8 @@ def reconstruction(layout: str, axes: list[Axis]) -> str:
     uv = f"uv = vec2({u(x_axis)}, {u(y_axis)})"
     text = RECONSTRUCTION[layout]
     return text.replace("uv = vec2(NoV, roughness) (texel centres per lutbake:axes)", uv).replace(
-        "uv = vec2(NoV, roughness)", uv)
+        "uv = vec2(NoV, roughness)", uv
+    )
 
 
 def texel_grid(axes: list[Axis]) -> tuple[np.ndarray, np.ndarray]:
@@ -220,18 +292,40 @@ def plan(spec) -> Plan:
     cloth = {"cloth": "D_charlie + V_ashikhmin"} if o["layout"] == "multiscatter_cloth" else {}
     terms = {**terms_record(o, "schlick"), "layout": o["layout"], **cloth}
     if o["layout"] in SHEEN_LAYOUTS:
-        vis = ("ashikhmin" if o["layout"].startswith("charlie") else
-               "R: charlie (Estevez-Kulla Lambda fit), G: ashikhmin")
+        vis = (
+            "ashikhmin" if o["layout"].startswith("charlie") else "R: charlie (Estevez-Kulla Lambda fit), G: ashikhmin"
+        )
         if o["layout"].endswith("_clamped"):
             vis += " (V clamped to [0, 1], as the glTF Sample Viewer)"
-        terms = {"model": "sheen", "ndf": "charlie (alpha = the roughness axis' alpha)", "masking": vis,
-                 "fresnel": "none (F = 1)", "layout": o["layout"],
-                 "gauss_legendre_panels": "the GGX CDF in theta_h (panelling only; the integrand is the sheen lobe)"}
+        terms = {
+            "model": "sheen",
+            "ndf": "charlie (alpha = the roughness axis' alpha)",
+            "masking": vis,
+            "fresnel": "none (F = 1)",
+            "layout": o["layout"],
+            "gauss_legendre_panels": "the GGX CDF in theta_h (panelling only; the integrand is the sheen lobe)",
+        }
     return specular.hemisphere_plan(
-        key=(nd, mk, o["layout"], o["estimator"], form), nov=nov, alpha=alpha, param=None,
-        samples=o["samples"], seed=o["seed"], nch=nch, kernel_channels=3 if o["layout"] in SHEEN_LAYOUTS else nch,
-        axes=axes, channels=CHANNELS[o["layout"]], reconstruction=reconstruction(o["layout"], axes), terms=terms)
+        key=(nd, mk, o["layout"], o["estimator"], form),
+        nov=nov,
+        alpha=alpha,
+        param=None,
+        samples=o["samples"],
+        seed=o["seed"],
+        nch=nch,
+        kernel_channels=3 if o["layout"] in SHEEN_LAYOUTS else nch,
+        axes=axes,
+        channels=CHANNELS[o["layout"]],
+        reconstruction=reconstruction(o["layout"], axes),
+        terms=terms,
+    )
 
 
-DFG = Kind("dfg", "split-sum specular DFG: NoV x roughness, scale/bias or multiscatter (Σ Fc·V, Σ V) channels",
-           KEYS, plan, aliases=("split_sum",), check=check_spec)
+DFG = Kind(
+    "dfg",
+    "split-sum specular DFG: NoV x roughness, scale/bias or multiscatter (Σ Fc·V, Σ V) channels",
+    KEYS,
+    plan,
+    aliases=("split_sum",),
+    check=check_spec,
+)

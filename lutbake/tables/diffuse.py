@@ -22,6 +22,7 @@ AmbientBRDF (directional reflectance under uniform white light, rho = 1):
 with n-point GL on 2 x 2 panels: n.l split at n.v (the max(n.l, n.v) kink of Oren-Nayar) and phi_l at pi/2
 (s = l.v - (n.l)(n.v) changes sign there: the branches of Eq. 5, 7, 8 and the max(0, cos phi) of Oren-Nayar).
 """
+
 from __future__ import annotations
 
 import functools
@@ -45,10 +46,13 @@ FACET_FRESNEL = {
     "eq6": "Eq. 6 on each facet: 21/20 (1 - f0)(1 - (1 - m.l)^5)(1 - (1 - m.v)^5); E scales with (1 - f0)",
     "schlick": "(1 - F(m.l))(1 - F(m.v)), F Schlick: (1 - f0)^2 (1 - (1 - m.l)^5)(1 - (1 - m.v)^5); E scales with (1 - f0)^2",
     "dielectric_f0": "(1 - F(m.l))(1 - F(m.v)), F the exact dielectric Fresnel of Eq. 2 written with f0: f0 does not "
-                     "factor out (kind diffuse_3d bakes an f0 axis; kind diffuse bakes the given f0 only)",
+    "factor out (kind diffuse_3d bakes an f0 axis; kind diffuse bakes the given f0 only)",
 }
-FACET_FUNCS = {"eq6": diffuse.F_facet_eq6, "schlick": diffuse.F_facet_schlick,
-               "dielectric_f0": diffuse.F_facet_dielectric_f0}
+FACET_FUNCS = {
+    "eq6": diffuse.F_facet_eq6,
+    "schlick": diffuse.F_facet_schlick,
+    "dielectric_f0": diffuse.F_facet_dielectric_f0,
+}
 SIGMA_TO_ALPHA = {
     "sigma": "GGX alpha = sigma",
     "sigma_squared": "GGX alpha = sigma^2 (sigma as a perceptual roughness)",
@@ -118,8 +122,9 @@ def fd_microfacet_for(facet_fresnel: str):
     Ff = FACET_FUNCS[facet_fresnel]
 
     @wp.func
-    def fd_microfacet(l: wp.vec3, v: wp.vec3, alpha: float, f0: float,
-                      xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64)):
+    def fd_microfacet(
+        l: wp.vec3, v: wp.vec3, alpha: float, f0: float, xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64)
+    ):
         NoL = l[2]
         NoV = v[2]
         if NoL <= COS_EPS or NoV <= COS_EPS:
@@ -244,8 +249,15 @@ def brdf_for(model: str, facet_fresnel: str = "eq6"):
         fm = fd_microfacet_for(facet_fresnel)
 
         @wp.func
-        def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float,
-                 xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64)):
+        def brdf(
+            l: wp.vec3,
+            v: wp.vec3,
+            sigma: float,
+            alpha: float,
+            f0: float,
+            xg: wp.array(dtype=wp.float64),
+            wg: wp.array(dtype=wp.float64),
+        ):
             return fm(l, v, alpha, f0, xg, wg)
 
         return brdf
@@ -259,9 +271,17 @@ def brdf_for(model: str, facet_fresnel: str = "eq6"):
         "fitted_slides": diffuse.Fd_gotanda_fitted_slides,
     }
     if model == "lambert":
+
         @wp.func
-        def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float,
-                 xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64)):
+        def brdf(
+            l: wp.vec3,
+            v: wp.vec3,
+            sigma: float,
+            alpha: float,
+            f0: float,
+            xg: wp.array(dtype=wp.float64),
+            wg: wp.array(dtype=wp.float64),
+        ):
             if l[2] <= COS_EPS or v[2] <= COS_EPS:
                 return wp.float64(0.0)
             return wp.float64(diffuse.Fd_lambert(1.0))
@@ -269,15 +289,29 @@ def brdf_for(model: str, facet_fresnel: str = "eq6"):
         F = closed[model]
 
         @wp.func
-        def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float,
-                 xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64)):
+        def brdf(
+            l: wp.vec3,
+            v: wp.vec3,
+            sigma: float,
+            alpha: float,
+            f0: float,
+            xg: wp.array(dtype=wp.float64),
+            wg: wp.array(dtype=wp.float64),
+        ):
             return wp.float64(F(1.0, l[2], v[2], wp.dot(l, v), sigma))
     elif model in with_f0:
         F = with_f0[model]
 
         @wp.func
-        def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float,
-                 xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64)):
+        def brdf(
+            l: wp.vec3,
+            v: wp.vec3,
+            sigma: float,
+            alpha: float,
+            f0: float,
+            xg: wp.array(dtype=wp.float64),
+            wg: wp.array(dtype=wp.float64),
+        ):
             return wp.float64(F(1.0, l[2], v[2], wp.dot(l, v), sigma, f0))
     else:
         raise KeyError(model)
@@ -291,10 +325,17 @@ def albedo_kernel_for(model: str, facet_fresnel: str = "eq6"):
     brdf = brdf_for(model, facet_fresnel)
 
     @wp.kernel(enable_backward=False, module="unique")
-    def albedo_kernel(nov: wp.array(dtype=float), sigma: wp.array(dtype=float), alpha: wp.array(dtype=float),
-                      f0: float, xo: wp.array(dtype=wp.float64), wo: wp.array(dtype=wp.float64),
-                      xg: wp.array(dtype=wp.float64), wg: wp.array(dtype=wp.float64),
-                      out: wp.array2d(dtype=wp.float64)):
+    def albedo_kernel(
+        nov: wp.array(dtype=float),
+        sigma: wp.array(dtype=float),
+        alpha: wp.array(dtype=float),
+        f0: float,
+        xo: wp.array(dtype=wp.float64),
+        wo: wp.array(dtype=wp.float64),
+        xg: wp.array(dtype=wp.float64),
+        wg: wp.array(dtype=wp.float64),
+        out: wp.array2d(dtype=wp.float64),
+    ):
         i = wp.tid()
         v = view_dir(nov[i])
         cv = wp.float64(v[2])
@@ -327,9 +368,16 @@ def brdf_kernel_for(model: str, facet_fresnel: str = "eq6"):
     brdf = brdf_for(model, facet_fresnel)
 
     @wp.kernel(enable_backward=False, module="unique")
-    def brdf_kernel(l: wp.array(dtype=wp.vec3), v: wp.array(dtype=wp.vec3), sigma: wp.array(dtype=float),
-                    alpha: wp.array(dtype=float), f0: float, xg: wp.array(dtype=wp.float64),
-                    wg: wp.array(dtype=wp.float64), out: wp.array(dtype=wp.float64)):
+    def brdf_kernel(
+        l: wp.array(dtype=wp.vec3),
+        v: wp.array(dtype=wp.vec3),
+        sigma: wp.array(dtype=float),
+        alpha: wp.array(dtype=float),
+        f0: float,
+        xg: wp.array(dtype=wp.float64),
+        wg: wp.array(dtype=wp.float64),
+        out: wp.array(dtype=wp.float64),
+    ):
         i = wp.tid()
         out[i] = brdf(l[i], v[i], sigma[i], alpha[i], f0, xg, wg)
 
@@ -348,8 +396,17 @@ def _gl(n: int, device: str):
     return [wp.array(x, dtype=wp.float64, device=device), wp.array(w, dtype=wp.float64, device=device)]
 
 
-def eval_brdf(model: str, l: np.ndarray, v: np.ndarray, sigma, f0: float = 0.0, facet_fresnel: str = "eq6",
-              sigma_to_alpha: str = "sigma", order: int = 8, device: str = "cpu") -> np.ndarray:
+def eval_brdf(
+    model: str,
+    l: np.ndarray,
+    v: np.ndarray,
+    sigma,
+    f0: float = 0.0,
+    facet_fresnel: str = "eq6",
+    sigma_to_alpha: str = "sigma",
+    order: int = 8,
+    device: str = "cpu",
+) -> np.ndarray:
     """f(l_i, v_i) for unit direction arrays (N, 3) (n = +z), rho = 1; float64 (N,)."""
     l = np.ascontiguousarray(l, dtype=np.float32).reshape(-1, 3)
     v = np.ascontiguousarray(v, dtype=np.float32).reshape(-1, 3)
@@ -358,24 +415,54 @@ def eval_brdf(model: str, l: np.ndarray, v: np.ndarray, sigma, f0: float = 0.0, 
     a = alpha_from_sigma(s, sigma_to_alpha)
     out = wp.zeros(n, dtype=wp.float64, device=device)
     k = brdf_kernel_for(model, facet_fresnel)
-    wp.launch(k, dim=n, inputs=[wp.array(l, dtype=wp.vec3, device=device), wp.array(v, dtype=wp.vec3, device=device),
-                                wp.array(s, dtype=float, device=device), wp.array(a, dtype=float, device=device),
-                                float(f0), *_gl(order, device), out], device=device)
+    wp.launch(
+        k,
+        dim=n,
+        inputs=[
+            wp.array(l, dtype=wp.vec3, device=device),
+            wp.array(v, dtype=wp.vec3, device=device),
+            wp.array(s, dtype=float, device=device),
+            wp.array(a, dtype=float, device=device),
+            float(f0),
+            *_gl(order, device),
+            out,
+        ],
+        device=device,
+    )
     return out.numpy()
 
 
-def albedo(model: str, nov: np.ndarray, sigma: np.ndarray, f0: float = 0.0, facet_fresnel: str = "eq6",
-           sigma_to_alpha: str = "sigma", order: int = 8, outer_order: int | None = None,
-           device: str = "cpu") -> np.ndarray:
+def albedo(
+    model: str,
+    nov: np.ndarray,
+    sigma: np.ndarray,
+    f0: float = 0.0,
+    facet_fresnel: str = "eq6",
+    sigma_to_alpha: str = "sigma",
+    order: int = 8,
+    outer_order: int | None = None,
+    device: str = "cpu",
+) -> np.ndarray:
     """E(nov_i, sigma_i) = ∫ f (n.l) dω_l (rho = 1), float64 (N,)."""
     nov = np.ascontiguousarray(nov, dtype=np.float32)
     s = np.ascontiguousarray(np.broadcast_to(np.asarray(sigma, dtype=np.float32), nov.shape))
     a = alpha_from_sigma(s, sigma_to_alpha)
     out = wp.zeros((len(nov), 1), dtype=wp.float64, device=device)
     k = albedo_kernel_for(model, facet_fresnel)
-    wp.launch(k, dim=len(nov), inputs=[wp.array(nov, dtype=float, device=device), wp.array(s, dtype=float, device=device),
-                                       wp.array(a, dtype=float, device=device), float(f0),
-                                       *_gl(outer_order or order, device), *_gl(order, device), out], device=device)
+    wp.launch(
+        k,
+        dim=len(nov),
+        inputs=[
+            wp.array(nov, dtype=float, device=device),
+            wp.array(s, dtype=float, device=device),
+            wp.array(a, dtype=float, device=device),
+            float(f0),
+            *_gl(outer_order or order, device),
+            *_gl(order, device),
+            out,
+        ],
+        device=device,
+    )
     return out.numpy()[:, 0]
 
 
@@ -385,29 +472,47 @@ DEFAULT_ORDER = {"microfacet": 12}  # base GL order (lutbake.tables.diffuse_albe
 CLOSED_ORDER = 24
 
 KEYS = {
-    "name": Key("name", "name", None, "output stem: <out-dir>/<name>.exr; letters, digits, - and _ only", required=True),
+    "name": Key(
+        "name", "name", None, "output stem: <out-dir>/<name>.exr; letters, digits, - and _ only", required=True
+    ),
     "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
     "size": Key("size", "int_pair", [64, 64], "[NoV, sigma] texel counts", minimum=1),
     "model": Key("model", "str", "microfacet", "the diffuse model integrated", MODELS),
-    "f0": Key("f0", "float", 0.0, "Fresnel reflectance at normal incidence the table is baked for; every model is "
-              "g(f0) times an f0-free function (metadata lutbake:f0_factor), so f0 = 0 bakes the f0-free table",
-              minimum=0.0, maximum=0.999),
+    "f0": Key(
+        "f0",
+        "float",
+        0.0,
+        "Fresnel reflectance at normal incidence the table is baked for; every model is "
+        "g(f0) times an f0-free function (metadata lutbake:f0_factor), so f0 = 0 bakes the f0-free table",
+        minimum=0.0,
+        maximum=0.999,
+    ),
     "sigma_to_alpha": Key("sigma_to_alpha", "str", "sigma", "GGX alpha from sigma (microfacet model)", SIGMA_TO_ALPHA),
-    "facet_fresnel": Key("facet_fresnel", "str", "eq6", "Fresnel transmission on each facet (microfacet model)",
-                         FACET_FRESNEL),
-    "samples": Key("samples", "int", None, "Gauss-Legendre order n per panel and dimension; microfacet: the base "
-                   "order of the swapped integral (lutbake.tables.diffuse_albedo: 4 n^3 + n^2 evaluations per "
-                   "texel per u panel, 1.5 n in u and n.l where NoV < 0.1), closed forms: outer 4 n^2 directions "
-                   "l; omitted: 12 for microfacet, 24 otherwise", minimum=2, maximum=64),
+    "facet_fresnel": Key(
+        "facet_fresnel", "str", "eq6", "Fresnel transmission on each facet (microfacet model)", FACET_FRESNEL
+    ),
+    "samples": Key(
+        "samples",
+        "int",
+        None,
+        "Gauss-Legendre order n per panel and dimension; microfacet: the base "
+        "order of the swapped integral (lutbake.tables.diffuse_albedo: 4 n^3 + n^2 evaluations per "
+        "texel per u panel, 1.5 n in u and n.l where NoV < 0.1), closed forms: outer 4 n^2 directions "
+        "l; omitted: 12 for microfacet, 24 otherwise",
+        minimum=2,
+        maximum=64,
+    ),
     "dtype": Key("dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}),
     "texel": Key("texel", "str", "center", "texel convention of both axes", TEXELS),
     "nov_range": Key("nov_range", "float_range", [0.0, 1.0], "NoV at t = 0 and t = 1", minimum=0.0, maximum=1.0),
     "sigma_range": Key("sigma_range", "float_range", [0.0, 1.0], "sigma at t = 0 and t = 1", minimum=0.0, maximum=1.0),
 }
 
-RECONSTRUCTION = ("uv = vec2(NoV, sigma) (texel centres per lutbake:axes); E = texture(lut, uv).r; "
-                  "diffuse = albedo * (irradiance / pi) * E * g(f0) / g(f0_baked), irradiance = ∫ L cos dω "
-                  "(g = lutbake:f0_factor; with f0_baked = 0: diffuse = albedo * (irradiance / pi) * E * g(f0))")
+RECONSTRUCTION = (
+    "uv = vec2(NoV, sigma) (texel centres per lutbake:axes); E = texture(lut, uv).r; "
+    "diffuse = albedo * (irradiance / pi) * E * g(f0) / g(f0_baked), irradiance = ∫ L cos dω "
+    "(g = lutbake:f0_factor; with f0_baked = 0: diffuse = albedo * (irradiance / pi) * E * g(f0))"
+)
 
 
 def order_for(o: dict) -> int:
@@ -419,8 +524,10 @@ def plan(spec) -> Plan:
 
     o = spec.options
     n_nov, n_sigma = o["size"]
-    axes = [Axis("sigma", "y", n_sigma, *o["sigma_range"], texel=o["texel"]),
-            Axis("NoV", "x", n_nov, *o["nov_range"], texel=o["texel"])]
+    axes = [
+        Axis("sigma", "y", n_sigma, *o["sigma_range"], texel=o["texel"]),
+        Axis("NoV", "x", n_nov, *o["nov_range"], texel=o["texel"]),
+    ]
     sig_axis, nov_axis = axes
     nov = np.tile(nov_axis.values(), n_sigma)
     sigma = np.repeat(sig_axis.values(), n_nov)
@@ -429,17 +536,28 @@ def plan(spec) -> Plan:
     order = order_for(o)
     terms = {"model": model, "f0": str(o["f0"]), "f0_factor": f0_factor(model, ff)}
     if model == "microfacet":
-        terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff,
-                     sigma_to_alpha=o["sigma_to_alpha"])
-    extra = {"f0_factor": f0_factor(model, ff), "f0": repr(o["f0"]), "rho": "1",
-             "sigma_alpha": json.dumps([float(a) for a in alpha_from_sigma(sig_axis.values(), o["sigma_to_alpha"])])}
-    fields = dict(axes=axes, channels={"E": "∫ f_r (n.l) dω_l for rho = 1 at the baked f0: directional diffuse "
-                                            "reflectance under uniform white light"},
-                  reconstruction=RECONSTRUCTION, terms=terms, extra=extra)
+        terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff, sigma_to_alpha=o["sigma_to_alpha"])
+    extra = {
+        "f0_factor": f0_factor(model, ff),
+        "f0": repr(o["f0"]),
+        "rho": "1",
+        "sigma_alpha": json.dumps([float(a) for a in alpha_from_sigma(sig_axis.values(), o["sigma_to_alpha"])]),
+    }
+    fields = dict(
+        axes=axes,
+        channels={
+            "E": "∫ f_r (n.l) dω_l for rho = 1 at the baked f0: directional diffuse "
+            "reflectance under uniform white light"
+        },
+        reconstruction=RECONSTRUCTION,
+        terms=terms,
+        extra=extra,
+    )
     if model == "microfacet":
         alpha = alpha_from_sigma(sigma, o["sigma_to_alpha"])
-        return diffuse_albedo.microfacet_albedo_plan(nov=nov, alpha=alpha, f0=np.full(len(nov), o["f0"]),
-                                                     facet_fresnel=ff, order=order, **fields)
+        return diffuse_albedo.microfacet_albedo_plan(
+            nov=nov, alpha=alpha, f0=np.full(len(nov), o["f0"]), facet_fresnel=ff, order=order, **fields
+        )
     key = (model, ff)
 
     def prepare(device: str) -> None:
@@ -452,16 +570,31 @@ def plan(spec) -> Plan:
         return run(slice(start, stop), order, device)
 
     def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
-        idx = np.unique(np.concatenate([np.arange(0, len(nov), max(1, len(nov) // 256)),
-                                        np.flatnonzero(nov <= nov.min())]))
+        idx = np.unique(
+            np.concatenate([np.arange(0, len(nov), max(1, len(nov) // 256)), np.flatnonzero(nov <= nov.min())])
+        )
         err = float(np.max(np.abs(data[idx] - run(idx, order + 8, device))))
         return err, f"max |order {order} - order {order + 8}| over {len(idx)} probe texels (strided + most grazing NoV)"
 
     evals = 4 * order * order
-    return Plan(n_texels=len(nov), n_channels=1, run_tile=run_tile, prepare=prepare, samples=evals,
-                estimator="gauss_legendre", cost=float(len(nov)) * evals, error_estimate=error_estimate, **fields)
+    return Plan(
+        n_texels=len(nov),
+        n_channels=1,
+        run_tile=run_tile,
+        prepare=prepare,
+        samples=evals,
+        estimator="gauss_legendre",
+        cost=float(len(nov)) * evals,
+        error_estimate=error_estimate,
+        **fields,
+    )
 
 
-DIFFUSE = Kind("diffuse", "diffuse AmbientBRDF: NoV x sigma, E = ∫ f_r (n.l) dω_l for Lambert, Oren-Nayar variants, "
-               "Gotanda's fitted model or the integrated microfacet model (Eq. 4)", KEYS, plan,
-               aliases=("ambient_brdf_diffuse",))
+DIFFUSE = Kind(
+    "diffuse",
+    "diffuse AmbientBRDF: NoV x sigma, E = ∫ f_r (n.l) dω_l for Lambert, Oren-Nayar variants, "
+    "Gotanda's fitted model or the integrated microfacet model (Eq. 4)",
+    KEYS,
+    plan,
+    aliases=("ambient_brdf_diffuse",),
+)

@@ -28,6 +28,7 @@ Cost per texel: P n_u (4 n_μ n_φ + n_φ) evaluations (P u panels), against 48 
 direct nested rule (n = 8: 196 608). Orders per texel are chosen by ``orders_for`` (1.5 x at grazing
 view), and the error estimate re-integrates probe texels with every order + 8.
 """
+
 from __future__ import annotations
 
 import functools
@@ -99,8 +100,17 @@ def albedo_kernel_for(facet_fresnel: str):
     T = FACET_SPLIT[facet_fresnel][0]
 
     @wp.func
-    def arc_integral(cm: wp.float64, sm: wp.float64, cx: wp.float64, sx: wp.float64, f0: wp.float64,
-                     xp: wp.array2d(dtype=wp.float64), wpp: wp.array2d(dtype=wp.float64), rp: int, n: int):
+    def arc_integral(
+        cm: wp.float64,
+        sm: wp.float64,
+        cx: wp.float64,
+        sx: wp.float64,
+        f0: wp.float64,
+        xp: wp.array2d(dtype=wp.float64),
+        wpp: wp.array2d(dtype=wp.float64),
+        rp: int,
+        n: int,
+    ):
         """∫ (m.x)+ T(m.x) dφ over the arc where m.x > 0 (2 ∫_0^w, the arc being symmetric)."""
         w = half_arc(cm, sm, cx, sx)
         acc = wp.float64(0.0)
@@ -120,10 +130,16 @@ def albedo_kernel_for(facet_fresnel: str):
         return (hi - lo) * wp.float64(6.0) * s * (wp.float64(1.0) - s)
 
     @wp.kernel(enable_backward=False, module="unique")
-    def albedo_kernel(nov: wp.array(dtype=wp.float64), alpha: wp.array(dtype=wp.float64),
-                      f0: wp.array(dtype=wp.float64), rule: wp.array2d(dtype=int),
-                      xs: wp.array2d(dtype=wp.float64), ws: wp.array2d(dtype=wp.float64),
-                      ns: wp.array(dtype=int), out: wp.array2d(dtype=wp.float64)):
+    def albedo_kernel(
+        nov: wp.array(dtype=wp.float64),
+        alpha: wp.array(dtype=wp.float64),
+        f0: wp.array(dtype=wp.float64),
+        rule: wp.array2d(dtype=int),
+        xs: wp.array2d(dtype=wp.float64),
+        ws: wp.array2d(dtype=wp.float64),
+        ns: wp.array(dtype=int),
+        out: wp.array2d(dtype=wp.float64),
+    ):
         i = wp.tid()
         one = wp.float64(1.0)
         zero = wp.float64(0.0)
@@ -234,8 +250,11 @@ def rules(device: str):
         x, w = points.gauss_legendre(n)
         xs[n, :n], ws[n, :n] = x, w
     ns = np.arange(MAX_ORDER + 1, dtype=np.int32)
-    return (wp.array(xs, dtype=wp.float64, device=device), wp.array(ws, dtype=wp.float64, device=device),
-            wp.array(ns, dtype=int, device=device))
+    return (
+        wp.array(xs, dtype=wp.float64, device=device),
+        wp.array(ws, dtype=wp.float64, device=device),
+        wp.array(ns, dtype=int, device=device),
+    )
 
 
 def orders_for(nov: np.ndarray, alpha: np.ndarray, base: int) -> np.ndarray:
@@ -247,8 +266,15 @@ def orders_for(nov: np.ndarray, alpha: np.ndarray, base: int) -> np.ndarray:
     return np.minimum(o, MAX_ORDER)
 
 
-def albedo(nov, alpha, f0=0.0, facet_fresnel: str = "eq6", order: int = 12, orders: np.ndarray | None = None,
-           device: str = "cpu") -> np.ndarray:
+def albedo(
+    nov,
+    alpha,
+    f0=0.0,
+    facet_fresnel: str = "eq6",
+    order: int = 12,
+    orders: np.ndarray | None = None,
+    device: str = "cpu",
+) -> np.ndarray:
     """E(nov_i) for GGX alpha_i and f0 (rho = 1), float64 (N,). ``orders``: (N, 3) per texel (u, μ, φ);
     omitted: ``orders_for(nov, alpha, order)``."""
     nov = np.ascontiguousarray(nov, dtype=np.float64).reshape(-1)
@@ -259,10 +285,19 @@ def albedo(nov, alpha, f0=0.0, facet_fresnel: str = "eq6", order: int = 12, orde
         orders = orders_for(nov, alpha, order)
     orders = np.ascontiguousarray(np.minimum(orders, MAX_ORDER), dtype=np.int32)
     out = wp.zeros((n, 1), dtype=wp.float64, device=device)
-    wp.launch(albedo_kernel_for(facet_fresnel), dim=n,
-              inputs=[wp.array(nov, dtype=wp.float64, device=device), wp.array(alpha, dtype=wp.float64, device=device),
-                      wp.array(f0a, dtype=wp.float64, device=device), wp.array(orders, dtype=int, device=device),
-                      *rules(device), out], device=device)
+    wp.launch(
+        albedo_kernel_for(facet_fresnel),
+        dim=n,
+        inputs=[
+            wp.array(nov, dtype=wp.float64, device=device),
+            wp.array(alpha, dtype=wp.float64, device=device),
+            wp.array(f0a, dtype=wp.float64, device=device),
+            wp.array(orders, dtype=int, device=device),
+            *rules(device),
+            out,
+        ],
+        device=device,
+    )
     c = FACET_SPLIT[facet_fresnel][1]
     return out.numpy()[:, 0] * np.array([c(x) for x in f0a]) if n else np.zeros(0)
 
@@ -275,8 +310,11 @@ def u_panels(nov: np.ndarray, alpha: np.ndarray) -> np.ndarray:
     u_v = c * c / (alpha * alpha * (1 - c * c) + c * c)
     r2 = TAIL_RATIO ** (2.0 * np.arange(1, MAX_TAIL_CUTS + 1))
     cuts = r2 / (1 + r2)
-    on_cut = np.zeros(len(c), bool) if len(c) == 0 else np.any(np.isclose(u_v[:, None], cuts[None, :], rtol=0, atol=0)
-                                                                 | (u_v[:, None] >= 1.0), axis=1)
+    on_cut = (
+        np.zeros(len(c), bool)
+        if len(c) == 0
+        else np.any(np.isclose(u_v[:, None], cuts[None, :], rtol=0, atol=0) | (u_v[:, None] >= 1.0), axis=1)
+    )
     return k + 1 + (~on_cut)
 
 
@@ -298,8 +336,9 @@ def probe_indices(nov: np.ndarray, alpha: np.ndarray, budget: int = 256) -> np.n
     return np.unique(np.concatenate([strided, hard, small]))
 
 
-def microfacet_albedo_plan(*, nov: np.ndarray, alpha: np.ndarray, f0: np.ndarray, facet_fresnel: str, order: int,
-                           **plan_fields):
+def microfacet_albedo_plan(
+    *, nov: np.ndarray, alpha: np.ndarray, f0: np.ndarray, facet_fresnel: str, order: int, **plan_fields
+):
     """Plan of a table whose texel i is E(nov[i], alpha[i], f0[i]) of the microfacet model (one channel),
     with per-texel orders (orders_for) and an error estimate from re-integrating probe texels at orders + 8."""
     from .base import Plan
@@ -311,18 +350,29 @@ def microfacet_albedo_plan(*, nov: np.ndarray, alpha: np.ndarray, f0: np.ndarray
     evals = evaluations(orders, nov, alpha)
 
     def run_tile(start: int, stop: int, device: str) -> np.ndarray:
-        return albedo(nov[start:stop], alpha[start:stop], f0[start:stop], facet_fresnel,
-                      orders=orders[start:stop], device=device)[:, None]
+        return albedo(
+            nov[start:stop], alpha[start:stop], f0[start:stop], facet_fresnel, orders=orders[start:stop], device=device
+        )[:, None]
 
     def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
         idx = probe_indices(nov, alpha)
-        other = albedo(nov[idx], alpha[idx], f0[idx], facet_fresnel, orders=orders[idx] + ESTIMATE_EXTRA_ORDER,
-                       device=device)
+        other = albedo(
+            nov[idx], alpha[idx], f0[idx], facet_fresnel, orders=orders[idx] + ESTIMATE_EXTRA_ORDER, device=device
+        )
         err = float(np.max(np.abs(data.reshape(len(nov), -1)[idx, 0] - other)))
-        return err, (f"max |orders (n_u, n_mu, n_phi) - orders + {ESTIMATE_EXTRA_ORDER}| over {len(idx)} probe texels "
-                     "(strided + most grazing NoV + smallest alpha)")
+        return err, (
+            f"max |orders (n_u, n_mu, n_phi) - orders + {ESTIMATE_EXTRA_ORDER}| over {len(idx)} probe texels "
+            "(strided + most grazing NoV + smallest alpha)"
+        )
 
-    return Plan(n_texels=len(nov), n_channels=1, run_tile=run_tile,
-                prepare=lambda d: wp.load_module(albedo_kernel_for(facet_fresnel).module, device=d),
-                samples=int(round(evals.mean())), estimator="gauss_legendre_swapped", cost=float(evals.sum()),
-                error_estimate=error_estimate, **plan_fields)
+    return Plan(
+        n_texels=len(nov),
+        n_channels=1,
+        run_tile=run_tile,
+        prepare=lambda d: wp.load_module(albedo_kernel_for(facet_fresnel).module, device=d),
+        samples=int(round(evals.mean())),
+        estimator="gauss_legendre_swapped",
+        cost=float(evals.sum()),
+        error_estimate=error_estimate,
+        **plan_fields,
+    )

@@ -6,6 +6,7 @@ averages F_avg (Kulla & Conty 2017, "Revisiting physically based shading at Imag
 For Schlick it is closed form, F_avg = f0 + (1 - f0)/21 = (20 f0 + 1)/21. Kulla-Conty's multiple-scattering
 Fresnel uses it: F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)).
 """
+
 from __future__ import annotations
 
 import functools
@@ -30,8 +31,14 @@ COLUMNS = tuple(FRESNELS)
 @functools.lru_cache(maxsize=None)
 def _kernel():
     @wp.kernel(enable_backward=False, module="unique")
-    def eval_fresnel(f0: wp.array(dtype=float), n: wp.array(dtype=float), k: wp.array(dtype=float),
-                     a: wp.array(dtype=float), c: wp.array(dtype=float), out: wp.array2d(dtype=float)):
+    def eval_fresnel(
+        f0: wp.array(dtype=float),
+        n: wp.array(dtype=float),
+        k: wp.array(dtype=float),
+        a: wp.array(dtype=float),
+        c: wp.array(dtype=float),
+        out: wp.array2d(dtype=float),
+    ):
         i = wp.tid()
         out[i, 0] = fr.F_schlick(f0[i], c[i])
         out[i, 1] = fr.F_schlick_sg(f0[i], c[i])

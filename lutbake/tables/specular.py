@@ -12,6 +12,7 @@ with Schlick F = f0 (1 - Fc) + Fc, Fc = (1 - v.h)^5 (Karis 2013):
 The cloth layout adds a channel with its own BRDF, D_charlie V_ashikhmin (no Fresnel), whose integrand
 in the same measure is D_charlie V_ashikhmin (n.l) 4 (v.h) (Filament's DFV_Charlie_Uniform).
 """
+
 from __future__ import annotations
 
 import functools
@@ -76,13 +77,28 @@ def channels_multiscatter3(VoH: float, f0: float):
     return wp.vec3(fresnel.Fc_schlick(VoH), 1.0, 0.0)
 
 
-CHANNEL_FUNCS = {"scale_bias": channels_scale_bias, "multiscatter": channels_multiscatter,
-                 "albedo": channels_albedo, "F:schlick": channels_F_schlick, "F:schlick_sg": channels_F_schlick_sg,
-                 "F:improved_sg": channels_F_improved_sg, "F:dielectric_f0": channels_F_dielectric_f0,
-                 "scale_bias_f82": channels_scale_bias_f82}
+CHANNEL_FUNCS = {
+    "scale_bias": channels_scale_bias,
+    "multiscatter": channels_multiscatter,
+    "albedo": channels_albedo,
+    "F:schlick": channels_F_schlick,
+    "F:schlick_sg": channels_F_schlick_sg,
+    "F:improved_sg": channels_F_improved_sg,
+    "F:dielectric_f0": channels_F_dielectric_f0,
+    "scale_bias_f82": channels_scale_bias_f82,
+}
 THREE_CHANNELS = {"scale_bias_f82", "multiscatter_cloth", "charlie", "charlie_clamped"}
-N_CHANNELS = {"scale_bias": 2, "multiscatter": 2, "albedo": 2, "scale_bias_f82": 3, "multiscatter_cloth": 3,
-              "charlie": 3, "sheen_albedo": 2, "charlie_clamped": 3, "sheen_albedo_clamped": 2}
+N_CHANNELS = {
+    "scale_bias": 2,
+    "multiscatter": 2,
+    "albedo": 2,
+    "scale_bias_f82": 3,
+    "multiscatter_cloth": 3,
+    "charlie": 3,
+    "sheen_albedo": 2,
+    "charlie_clamped": 3,
+    "sheen_albedo_clamped": 2,
+}
 # the sheen lobe alone: no GGX term (sheen_integrand_for); *_clamped: V clamped to [0, 1] (the viewer's shaders)
 SHEEN_LAYOUTS = ("charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped")
 
@@ -94,14 +110,15 @@ def channels_for(channels_name: str):
     if channels_name in CHANNEL_FUNCS:
         return CHANNEL_FUNCS[channels_name], (wp.vec3 if channels_name in THREE_CHANNELS else wp.vec2)
     if channels_name.startswith("metal:"):
-        m = metals.lookup_metal(channels_name[len("metal:"):])
+        m = metals.lookup_metal(channels_name[len("metal:") :])
         nr, ng, nb = (float(x) for x in m.n)
         kr, kg, kb = (float(x) for x in m.k)
 
         @wp.func
         def channels_metal(VoH: float, f0: float):
-            return wp.vec3(fresnel.F_conductor(nr, kr, VoH), fresnel.F_conductor(ng, kg, VoH),
-                           fresnel.F_conductor(nb, kb, VoH))
+            return wp.vec3(
+                fresnel.F_conductor(nr, kr, VoH), fresnel.F_conductor(ng, kg, VoH), fresnel.F_conductor(nb, kb, VoH)
+            )
 
         return channels_metal, wp.vec3
     raise KeyError(channels_name)
@@ -129,11 +146,13 @@ def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: st
         def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
             return D(h, alpha) * G2(v[2], l[2], h[2], VoH, alpha) * VoH / v[2]
     elif form == "blinn_phong":
+
         @wp.func
         def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
             s = ndf.shininess_from_alpha(alpha)
             return (s + 8.0) / (8.0 * wp.pi) * wp.exp(s * ndf.log_cos(h)) * 4.0 * l[2] * VoH
     elif form == "ashikhmin_shirley":
+
         @wp.func
         def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
             s = ndf.shininess_from_alpha(alpha)
@@ -230,7 +249,7 @@ def sheen_integrand_for(layout: str):
 
 ESTIMATORS = {
     "gauss_legendre": "deterministic product Gauss-Legendre over panels in theta_h (or CDF(theta_h)) and phi, "
-                      "split exactly at the horizon (default; converges exponentially)",
+    "split exactly at the horizon (default; converges exponentially)",
     "sobol_vndf": "scrambled Sobol' points, GGX visible-normal sampling (Dupuy & Benyoub 2023)",
     "sobol_ndf": "scrambled Sobol' points, NDF importance sampling of D(h)(n.h)",
     "hammersley_ndf": "Hammersley points, NDF importance sampling (Filament cmgen's estimator)",
@@ -280,10 +299,14 @@ def samples_note(estimator: str, samples: int | None) -> str:
         return ""
     if estimator == "gauss_legendre":
         n = gl_order(samples)
-        return (f"samples = {samples} asked; gauss_legendre integrates 3 regions x n x n points with "
-                f"n = round(sqrt({samples} / 3)) = {n}: 3 x {n}^2 = {3 * n * n}")
+        return (
+            f"samples = {samples} asked; gauss_legendre integrates 3 regions x n x n points with "
+            f"n = round(sqrt({samples} / 3)) = {n}: 3 x {n}^2 = {3 * n * n}"
+        )
     if estimator.startswith("sobol"):
-        return f"samples = {samples} asked; Sobol' points come in powers of two: {effective_samples(estimator, samples)}"
+        return (
+            f"samples = {samples} asked; Sobol' points come in powers of two: {effective_samples(estimator, samples)}"
+        )
     return ""
 
 
@@ -302,17 +325,28 @@ def point_arrays(estimator: str, samples: int, seed: int, device: str) -> list:
     return [wp.array(pts, dtype=float, device=device), wp.array(w, dtype=wp.float64, device=device)]
 
 
-def integrate(kernel, nov: np.ndarray, alpha: np.ndarray, estimator: str, samples: int, seed: int,
-              nch: int, device: str = "cpu", param: np.ndarray | None = None) -> np.ndarray:
+def integrate(
+    kernel,
+    nov: np.ndarray,
+    alpha: np.ndarray,
+    estimator: str,
+    samples: int,
+    seed: int,
+    nch: int,
+    device: str = "cpu",
+    param: np.ndarray | None = None,
+) -> np.ndarray:
     """Run one launch over texels (nov[i], alpha[i], param[i]) -> float64 array (len, nch);
     ``param`` (the integrand's per-texel scalar, e.g. f0) defaults to 0."""
     n = len(nov)
     out = wp.zeros((n, nch), dtype=wp.float64, device=device)
     if param is None:
         param = np.zeros(n, dtype=np.float32)
-    inputs = [wp.array(np.ascontiguousarray(nov, dtype=np.float32), dtype=float, device=device),
-              wp.array(np.ascontiguousarray(alpha, dtype=np.float32), dtype=float, device=device),
-              wp.array(np.ascontiguousarray(param, dtype=np.float32), dtype=float, device=device)]
+    inputs = [
+        wp.array(np.ascontiguousarray(nov, dtype=np.float32), dtype=float, device=device),
+        wp.array(np.ascontiguousarray(alpha, dtype=np.float32), dtype=float, device=device),
+        wp.array(np.ascontiguousarray(param, dtype=np.float32), dtype=float, device=device),
+    ]
     inputs += point_arrays(estimator, samples, seed, device)
     wp.launch(kernel, dim=n, inputs=inputs + [out], device=device)
     return out.numpy()
@@ -334,8 +368,18 @@ def probe_indices(nov: np.ndarray) -> np.ndarray:
     return np.unique(np.concatenate([strided, grazing[:: max(1, len(grazing) // 64)]]))
 
 
-def hemisphere_plan(*, key: tuple, nov: np.ndarray, alpha: np.ndarray, param: np.ndarray | None, samples: int | None,
-                    seed: int, nch: int, kernel_channels: int = 2, **plan_fields) -> Plan:
+def hemisphere_plan(
+    *,
+    key: tuple,
+    nov: np.ndarray,
+    alpha: np.ndarray,
+    param: np.ndarray | None,
+    samples: int | None,
+    seed: int,
+    nch: int,
+    kernel_channels: int = 2,
+    **plan_fields,
+) -> Plan:
     """The plan of every table that is a per-texel integral of ``kernel_for(*key)``: texel i integrates
     (nov[i], alpha[i], param[i]); the first ``nch`` of the kernel's channels are kept.
 
@@ -364,6 +408,14 @@ def hemisphere_plan(*, key: tuple, nov: np.ndarray, alpha: np.ndarray, param: np
         return err, f"{how} over {len(idx)} probe texels (strided + most grazing NoV)"
 
     eff = effective_samples(est, samples)
-    return Plan(n_texels=len(nov), n_channels=nch, run_tile=run_tile,
-                prepare=lambda d: load(kernel_for(*key), d), samples=eff, estimator=est,
-                cost=float(len(nov)) * eff, error_estimate=error_estimate, **plan_fields)
+    return Plan(
+        n_texels=len(nov),
+        n_channels=nch,
+        run_tile=run_tile,
+        prepare=lambda d: load(kernel_for(*key), d),
+        samples=eff,
+        estimator=est,
+        cost=float(len(nov)) * eff,
+        error_estimate=error_estimate,
+        **plan_fields,
+    )

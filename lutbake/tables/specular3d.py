@@ -10,6 +10,7 @@ part's lutbake:slice_value). For Schlick it collapses to the dfg table: E = f0 s
 (tests/test_specular3d.py). With ``metal = "<name>"`` the table is 2D, NoV x roughness, and R, G, B hold
 E with F = F_conductor(n_c + i k_c, v.h) for the metal's three wavelengths (lutbake.terms.metals).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -27,16 +28,26 @@ FRESNEL_CHOICES = {
 }
 KEYS = {
     **{k: v for k, v in dfg.KEYS.items() if k != "layout"},
-    "fresnel": Key("fresnel", "str", "dielectric_f0", "the Fresnel term integrated (ignored with metal)", FRESNEL_CHOICES),
+    "fresnel": Key(
+        "fresnel", "str", "dielectric_f0", "the Fresnel term integrated (ignored with metal)", FRESNEL_CHOICES
+    ),
     "f0_size": Key("f0_size", "int", 16, "f0 slice count (z); ignored with metal", minimum=1, maximum=1024),
-    "f0_range": Key("f0_range", "float_range", [0.0, 1.0], "f0 at t = 0 and t = 1 (same texel convention)",
-                    minimum=0.0, maximum=1.0),
-    "metal": Key("metal", "str", None, "a conductor by name: a 2D NoV x roughness RGB table with exact complex "
-                 "Fresnel instead of the f0 slices", {k: m.source for k, m in METALS.items()}),
+    "f0_range": Key(
+        "f0_range", "float_range", [0.0, 1.0], "f0 at t = 0 and t = 1 (same texel convention)", minimum=0.0, maximum=1.0
+    ),
+    "metal": Key(
+        "metal",
+        "str",
+        None,
+        "a conductor by name: a 2D NoV x roughness RGB table with exact complex Fresnel instead of the f0 slices",
+        {k: m.source for k, m in METALS.items()},
+    ),
 }
-RECONSTRUCTION_3D = ("load part k as layer k of a 3D texture; E = texture(lut3d, vec3(NoV, roughness, f0)).r "
-                     "(texel centres on all three axes: trilinear filtering interpolates f0 between slices); "
-                     "specular = prefiltered * E")
+RECONSTRUCTION_3D = (
+    "load part k as layer k of a 3D texture; E = texture(lut3d, vec3(NoV, roughness, f0)).r "
+    "(texel centres on all three axes: trilinear filtering interpolates f0 between slices); "
+    "specular = prefiltered * E"
+)
 RECONSTRUCTION_METAL = "E = texture(lut, vec2(NoV, roughness)).rgb; specular = prefiltered * E (per channel)"
 
 
@@ -64,8 +75,10 @@ def plan(spec) -> Plan:
     nch = 3 if metal else 1
     if metal:
         m = METALS[metal]
-        channels = {f"e_{c}": f"E with F_conductor({n} + {k}i) at {w:g} nm" for c, n, k, w in
-                    zip("rgb", m.n, m.k, m.wavelengths_nm)}
+        channels = {
+            f"e_{c}": f"E with F_conductor({n} + {k}i) at {w:g} nm"
+            for c, n, k, w in zip("rgb", m.n, m.k, m.wavelengths_nm)
+        }
         terms = {**dfg.terms_record(o, "conductor"), "metal": metal}
         extra = {"metal_source": m.source}
     else:
@@ -73,9 +86,20 @@ def plan(spec) -> Plan:
         terms = dfg.terms_record(o, o["fresnel"])
         extra = {}
     return specular.hemisphere_plan(
-        key=key, nov=nov, alpha=alpha, param=f0, samples=o["samples"], seed=o["seed"], nch=nch,
-        kernel_channels=nch if metal else 2, axes=axes, channels=channels,
-        reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D, terms=terms, extra=extra)
+        key=key,
+        nov=nov,
+        alpha=alpha,
+        param=f0,
+        samples=o["samples"],
+        seed=o["seed"],
+        nch=nch,
+        kernel_channels=nch if metal else 2,
+        axes=axes,
+        channels=channels,
+        reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D,
+        terms=terms,
+        extra=extra,
+    )
 
 
 def check_spec(spec) -> tuple[str, str] | None:
@@ -89,6 +113,12 @@ def check_spec(spec) -> tuple[str, str] | None:
     return None
 
 
-SPECULAR_3D = Kind("specular_3d", "specular AmbientBRDF for any Fresnel: NoV x roughness x f0 slices (R = E), "
-                   "or NoV x roughness RGB for a named metal", KEYS, plan, aliases=("ambient_brdf_3d",),
-                   check=check_spec)
+SPECULAR_3D = Kind(
+    "specular_3d",
+    "specular AmbientBRDF for any Fresnel: NoV x roughness x f0 slices (R = E), "
+    "or NoV x roughness RGB for a named metal",
+    KEYS,
+    plan,
+    aliases=("ambient_brdf_3d",),
+    check=check_spec,
+)

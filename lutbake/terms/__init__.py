@@ -5,6 +5,7 @@ Naming follows the math: ``D_`` normal distributions, ``Lambda_``/``G1_``/``G2_`
 (docs/notation.md); ``alpha`` is always the NDF parameter, never a perceptual roughness.
 Host code picks terms by name through the registries in :mod:`lutbake.registry`.
 """
+
 from ..warp_runtime import init_warp
 
 # Every lutbake kernel is composed of these terms, so any module that can launch one has imported this

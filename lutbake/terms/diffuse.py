@@ -11,6 +11,7 @@ Arguments are cosines in the shading frame: NoL, NoV and LoV = l.v, whence
 Edge policy (lutbake.edge): every term returns 0 when NoL or NoV <= COS_EPS (light or view below the
 horizon). sigma is the roughness of Gotanda's models, in [0, 1].
 """
+
 import warp as wp
 
 from ..edge import COS_EPS
@@ -120,9 +121,13 @@ def gotanda_fitted_radiance(NoL: float, NoV: float, LoV: float, sigma: float, sl
     fr3 = (-0.733996 * s3 + 1.50912 * s2 - 1.16402 * s1) * wp.pow(omv, 1.0 + 1.0 / (39.0 * s4 + 1.0)) + 1.0
     Fr = fr1 * fr2 * fr3
     Lm = (wp.max(1.0 - 2.0 * s1, 0.0) * pow5_weight(NoL) + wp.min(2.0 * s1, 1.0)) * (
-        (1.0 - 0.5 * s1) * NoL + 0.5 * s1 * NoL * NoL)
-    Vd = s2 / ((s2 + 0.09) * (1.31072 + 0.995584 * NoV)) * (
-        1.0 - wp.pow(oml, (1.0 - 0.3726732 * NoV * NoV) / (0.188566 + 0.388410 * NoV)))
+        (1.0 - 0.5 * s1) * NoL + 0.5 * s1 * NoL * NoL
+    )
+    Vd = (
+        s2
+        / ((s2 + 0.09) * (1.31072 + 0.995584 * NoV))
+        * (1.0 - wp.pow(oml, (1.0 - 0.3726732 * NoV * NoV) / (0.188566 + 0.388410 * NoV)))
+    )
     s = LoV - NoL * NoV
     Bp = s
     if s < 0.0:

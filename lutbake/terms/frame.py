@@ -1,4 +1,5 @@
 """Shading-frame helpers: n = +z, v in the xz-plane with v.x >= 0 (docs/notation.md)."""
+
 import warp as wp
 
 

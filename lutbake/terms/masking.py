@@ -4,6 +4,7 @@ Smith G1(v) = 1 / (1 + Lambda(v)) (Heitz 2014, JCGT 3(2), Eq. 43). G2 takes Lamb
 Smith form composes with any NDF's Lambda. Every function returns 0 for a back-facing direction
 (cosine <= COS_EPS); at n.v -> 0, Lambda -> alpha / (2 n.v) and G -> 0 linearly.
 """
+
 import warp as wp
 
 from ..edge import COS_EPS

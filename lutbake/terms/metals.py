@@ -13,6 +13,7 @@ The tests check the f0 every entry implies against the lecture's table of linear
 reflections at 0° for some materials"); spectrally integrated RGB differs from three wavelengths, so
 the tolerance is loose (0.15).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -38,8 +39,13 @@ class Metal:
 
 _JC = "Johnson & Christy 1972, Table I (1.88, 2.26, 2.75 eV)"
 METALS = {
-    "aluminium": Metal("aluminium", (610.0, 550.0, 450.0), (1.3, 0.958, 0.618), (7.48, 6.69, 5.47),
-                       "R: Gotanda 2014 course notes, Fig. 2 (610 nm); G, B: Rakic 1998"),
+    "aluminium": Metal(
+        "aluminium",
+        (610.0, 550.0, 450.0),
+        (1.3, 0.958, 0.618),
+        (7.48, 6.69, 5.47),
+        "R: Gotanda 2014 course notes, Fig. 2 (610 nm); G, B: Rakic 1998",
+    ),
     "gold": Metal("gold", (659.0, 549.0, 451.0), (0.14, 0.43, 1.38), (3.697, 2.455, 1.914), _JC),
     "silver": Metal("silver", (659.0, 549.0, 451.0), (0.05, 0.06, 0.04), (4.483, 3.586, 2.657), _JC),
     "copper": Metal("copper", (659.0, 549.0, 451.0), (0.21, 1.02, 1.24), (4.205, 2.577, 2.397), _JC),
@@ -81,4 +87,3 @@ def fit_lazanyi_a(n: float, k: float, alpha: float = LAZANYI_ALPHA, samples: int
     r = lazanyi_np(n, k, 0.0, c, alpha) - conductor_np(n, k, c)
     w = c * (1 - c) ** alpha
     return float(np.sum(r * w) / np.sum(w * w))
-

@@ -5,6 +5,7 @@ Every D is normalised so that the projected microfacet area is one, ∫ D(m) (n.
 are the inverse and forward CDFs of the polar angle under the density D(m)(n.m) (float64: they feed
 quadrature breakpoints where 1 - u underflows float32 for small alpha).
 """
+
 import warp as wp
 
 from ..edge import COS_EPS
@@ -82,6 +83,7 @@ def sample_vndf_ggx(v: wp.vec3, alpha: float, u1: float, u2: float):
 # lecture's "roughness = sqrt(2 / (2 + shininess))"): with it Blinn-Phong and Beckmann of the same alpha nearly
 # coincide, and (s + 2) / (2 pi) = 1 / (pi alpha^2).
 
+
 @wp.func
 def log1p64(x: wp.float64):
     if wp.abs(x) < wp.float64(1.0e-4):
@@ -141,6 +143,7 @@ def u_from_tan2_blinn_phong(tan2: wp.float64, alpha: wp.float64):
 
 # --- anisotropic GGX (Heitz 2014, JCGT 3(2), Eq. 85; tangent = +x, bitangent = +y) -----------------------
 
+
 @wp.func
 def D_ggx_aniso(h: wp.vec3, alpha_x: float, alpha_y: float):
     """Anisotropic GGX: D = 1 / (pi ax ay ((h.x/ax)^2 + (h.y/ay)^2 + (h.z)^2)^2); 0 for n.h <= 0.
@@ -166,6 +169,7 @@ def sample_vndf_ggx_aniso(v: wp.vec3, alpha_x: float, alpha_y: float, u1: float,
 
 
 # --- Ashikhmin-Shirley 2000 ("An anisotropic Phong BRDF model", JGT 5(2)) -------------------------------
+
 
 @wp.func
 def D_ashikhmin_shirley(h: wp.vec3, nu: float, nv: float):

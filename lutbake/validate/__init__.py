@@ -3,6 +3,7 @@
 :mod:`.probe` evaluates the ``@wp.func`` terms at arrays of host inputs (one compiled Warp module);
 :mod:`.checks` turns them into named checks with stated tolerances (``run_all()``).
 """
+
 from .checks import CHECKS, CheckResult, run_all
 from .probe import BRDF_PAIRS, TERM_NAMES, evaluate_brdfs, evaluate_terms
 

@@ -11,6 +11,7 @@ variables), with panels graded geometrically towards every point where the integ
 (the NDF peak) or loses smoothness (a cut where v.m = 0), and the term values come from the Warp
 ``@wp.func``s themselves (:mod:`.probe`).
 """
+
 from __future__ import annotations
 
 import functools
@@ -64,8 +65,12 @@ FURNACE_ALPHAS = (1.0e-3, 1.0e-2, 0.1, 0.5, 1.0)
 ALBEDO_COUNT = 24  # texel-centre grid in n.v and perceptual roughness, plus the clamped edges
 MIRROR_NOVS = tuple(np.linspace(0.05, 1.0, 20))  # below ~0.05, Lambda(alpha = 1e-4) is not yet negligible
 ALBEDO_MASKINGS = ("smith_height_correlated", "smith_separable")
-DFG_MIRROR_PAIRS = (("ggx", "smith_height_correlated"), ("beckmann", "smith_separable"), ("beckmann", "v_cavity"),
-                    ("blinn_phong", "v_cavity"))
+DFG_MIRROR_PAIRS = (
+    ("ggx", "smith_height_correlated"),
+    ("beckmann", "smith_separable"),
+    ("beckmann", "v_cavity"),
+    ("blinn_phong", "v_cavity"),
+)
 RECIPROCITY_SAMPLES = 4096
 ESTIMATOR_TEXELS = ((0.1, 0.04), (0.3, 1.0), (0.5, 0.25), (0.9, 0.64), (1.0, 0.01))  # (n.v, alpha)
 ESTIMATOR_QMC_SAMPLES = 1 << 16
@@ -100,10 +105,11 @@ class CheckResult:
 
     def lines(self) -> list[str]:
         """The report: status and name, then one labelled line per number."""
-        return ([f"{'PASS' if self.passed else 'FAIL'}  {self.name}",
-                 f"      measured   {self.measured:.3e}   = {self.what}",
-                 f"      tolerance  {self.tolerance:.1e}   (pass: measured <= tolerance)"]
-                + [f"      {text}" for text in self.secondary])
+        return [
+            f"{'PASS' if self.passed else 'FAIL'}  {self.name}",
+            f"      measured   {self.measured:.3e}   = {self.what}",
+            f"      tolerance  {self.tolerance:.1e}   (pass: measured <= tolerance)",
+        ] + [f"      {text}" for text in self.secondary]
 
     def __str__(self) -> str:
         return "\n".join(self.lines())
@@ -111,8 +117,9 @@ class CheckResult:
 
 def _result(name: str, measured: float, tolerance: float, detail: str, notes: tuple[str, ...] = ()) -> CheckResult:
     measured = float(measured)
-    return CheckResult(name, measured, tolerance, bool(np.isfinite(measured) and measured <= tolerance), detail,
-                       tuple(notes))
+    return CheckResult(
+        name, measured, tolerance, bool(np.isfinite(measured) and measured <= tolerance), detail, tuple(notes)
+    )
 
 
 def summary(results: list[CheckResult]) -> str:
@@ -122,6 +129,7 @@ def summary(results: list[CheckResult]) -> str:
 
 
 # --- quadrature helpers --------------------------------------------------------------------------
+
 
 def _graded_edges(lo: float, hi: float, anchors: list[tuple[float, float]]) -> np.ndarray:
     """Panel edges on [lo, hi]: the ends, every anchor a, and a +- first * PANEL_RATIO^j inside [lo, hi]
@@ -152,6 +160,7 @@ def _h(theta: np.ndarray, phi: np.ndarray | float = 0.0) -> np.ndarray:
 
 # --- NDF normalisation -----------------------------------------------------------------------------
 
+
 def ndf_projected_area_is_one(ndf_name: str) -> CheckResult:
     """∫ D(m)(n.m) dω_m = 2 pi ∫_0^{pi/2} D(theta) cos(theta) sin(theta) dtheta = 1 (Walter et al. 2007, Eq. 4),
     composite GL in theta, panels graded geometrically from the pole at the NDF's scale atan(alpha)."""
@@ -161,8 +170,12 @@ def ndf_projected_area_is_one(ndf_name: str) -> CheckResult:
         D = evaluate_terms(h=_h(theta), alpha=alpha)[f"D_{ndf_name}"].astype(np.float64)
         errors.append(abs(2.0 * np.pi * np.sum(w * D * np.cos(theta) * np.sin(theta)) - 1.0))
     k = int(np.argmax(errors))
-    return _result(f"ndf_projected_area_is_one[{ndf_name}]", errors[k], PROJECTED_AREA_TOL,
-                   f"max |∫D(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS}; worst at alpha={PROJECTED_AREA_ALPHAS[k]}")
+    return _result(
+        f"ndf_projected_area_is_one[{ndf_name}]",
+        errors[k],
+        PROJECTED_AREA_TOL,
+        f"max |∫D(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS}; worst at alpha={PROJECTED_AREA_ALPHAS[k]}",
+    )
 
 
 def charlie_projected_area_is_one() -> CheckResult:
@@ -175,9 +188,13 @@ def charlie_projected_area_is_one() -> CheckResult:
         D = evaluate_terms(h=_h(theta), alpha=alpha)["D_charlie"].astype(np.float64)
         errors.append(abs(2.0 * np.pi * np.sum(w * D * np.cos(theta) * np.sin(theta)) - 1.0))
     k = int(np.argmax(errors))
-    return _result("ndf_projected_area_is_one[charlie]", errors[k], CHARLIE_AREA_TOL,
-                   f"max |∫D_charlie(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS}; worst at "
-                   f"alpha={PROJECTED_AREA_ALPHAS[k]}")
+    return _result(
+        "ndf_projected_area_is_one[charlie]",
+        errors[k],
+        CHARLIE_AREA_TOL,
+        f"max |∫D_charlie(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS}; worst at "
+        f"alpha={PROJECTED_AREA_ALPHAS[k]}",
+    )
 
 
 def weak_white_furnace(ndf_name: str) -> CheckResult:
@@ -212,9 +229,13 @@ def weak_white_furnace(ndf_name: str) -> CheckResult:
             errors.append(abs(integral - nov))
             where.append((nov, alpha))
     k = int(np.argmax(errors))
-    return _result(f"weak_white_furnace[{ndf_name}]", errors[k], WEAK_FURNACE_TOL,
-                   f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over n.v in {FURNACE_NOVS} x alpha in {FURNACE_ALPHAS}; "
-                   f"worst at (n.v, alpha)={where[k]}")
+    return _result(
+        f"weak_white_furnace[{ndf_name}]",
+        errors[k],
+        WEAK_FURNACE_TOL,
+        f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over n.v in {FURNACE_NOVS} x alpha in {FURNACE_ALPHAS}; "
+        f"worst at (n.v, alpha)={where[k]}",
+    )
 
 
 def _aniso_pairs(alphas=PROJECTED_AREA_ALPHAS) -> list[tuple[float, float, float, float]]:
@@ -259,9 +280,13 @@ def ndf_projected_area_is_one_aniso() -> CheckResult:
     alpha in PROJECTED_AREA_ALPHAS x anisotropy in ANISOTROPIES (Burley mapping); composite GL in theta graded
     from the pole at atan(min(alpha_x, alpha_y)) and in phi graded towards both axes."""
     err, where = _aniso_measure("D_ggx_aniso", lambda t: np.cos(t) * np.sin(t))
-    return _result("ndf_projected_area_is_one[ggx_aniso]", err, ANISO_AREA_TOL,
-                   f"max |∫D(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS} x anisotropy in {ANISOTROPIES}; "
-                   f"worst at (alpha, a)={where}")
+    return _result(
+        "ndf_projected_area_is_one[ggx_aniso]",
+        err,
+        ANISO_AREA_TOL,
+        f"max |∫D(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS} x anisotropy in {ANISOTROPIES}; "
+        f"worst at (alpha, a)={where}",
+    )
 
 
 def ashikhmin_shirley_density_is_one() -> CheckResult:
@@ -269,9 +294,13 @@ def ashikhmin_shirley_density_is_one() -> CheckResult:
     1 over the hemisphere (a solid-angle density: ∫ p_h dω = 1, not the projected area), for nu, nv of the
     same (alpha_x, alpha_y) pairs (nu = max(2/alpha_x^2 - 2, 0))."""
     err, where = _aniso_measure("D_ashikhmin_shirley", lambda t: np.sin(t), horizon=True)
-    return _result("ashikhmin_shirley_density_is_one", err, AS_DENSITY_TOL,
-                   f"max |∫p_h dω - 1| over alpha in {PROJECTED_AREA_ALPHAS} x anisotropy in {ANISOTROPIES}; "
-                   f"worst at (alpha, a)={where}")
+    return _result(
+        "ashikhmin_shirley_density_is_one",
+        err,
+        AS_DENSITY_TOL,
+        f"max |∫p_h dω - 1| over alpha in {PROJECTED_AREA_ALPHAS} x anisotropy in {ANISOTROPIES}; "
+        f"worst at (alpha, a)={where}",
+    )
 
 
 def weak_white_furnace_aniso() -> CheckResult:
@@ -303,9 +332,13 @@ def weak_white_furnace_aniso() -> CheckResult:
                 errors.append(abs(integral - nov))
                 where.append((nov, round(phi_v, 4), alpha, a))
     k = int(np.argmax(errors))
-    return _result("weak_white_furnace[ggx_aniso]", errors[k], ANISO_FURNACE_TOL,
-                   f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over n.v in {ANISO_FURNACE_NOVS} x phi_v in {{0, pi/4, pi/2}} "
-                   f"x alpha in {ANISO_FURNACE_ALPHAS} x anisotropy in {ANISOTROPIES}; worst at (n.v, phi_v, alpha, a)={where[k]}")
+    return _result(
+        "weak_white_furnace[ggx_aniso]",
+        errors[k],
+        ANISO_FURNACE_TOL,
+        f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over n.v in {ANISO_FURNACE_NOVS} x phi_v in {{0, pi/4, pi/2}} "
+        f"x alpha in {ANISO_FURNACE_ALPHAS} x anisotropy in {ANISOTROPIES}; worst at (n.v, phi_v, alpha, a)={where[k]}",
+    )
 
 
 def kulla_conty_residual(E: np.ndarray, E_avg: np.ndarray, mu: np.ndarray) -> np.ndarray:
@@ -339,22 +372,37 @@ def kulla_conty_white_furnace() -> CheckResult:
     loss = float(np.max(1.0 - e.data[..., 0]))
     smooth = rough < 0.1
     rows = ", ".join(f"r={r:.3f}: {w:.1e}" for r, w in zip(rough[smooth], worst[smooth]))
-    return _result("kulla_conty_white_furnace", measured, KC_FURNACE_TOL,
-                   "max |E + E_ms - 1| over the roughness rows with r >= 0.1 (inf if any row exceeds "
-                   f"{KC_FURNACE_TOL_SMOOTHEST:.0e})",
-                   (f"rows with r < 0.1: max |E + E_ms - 1| {rows}; their own tolerance {KC_FURNACE_TOL_SMOOTHEST:.0e} "
-                    f"(their loss sits inside the first n.v texel of the {KC_N_MU}-column table)",
-                    f"uncompensated max loss 1 - E (before Kulla-Conty): {loss:.3f}"))
+    return _result(
+        "kulla_conty_white_furnace",
+        measured,
+        KC_FURNACE_TOL,
+        "max |E + E_ms - 1| over the roughness rows with r >= 0.1 (inf if any row exceeds "
+        f"{KC_FURNACE_TOL_SMOOTHEST:.0e})",
+        (
+            f"rows with r < 0.1: max |E + E_ms - 1| {rows}; their own tolerance {KC_FURNACE_TOL_SMOOTHEST:.0e} "
+            f"(their loss sits inside the first n.v texel of the {KC_N_MU}-column table)",
+            f"uncompensated max loss 1 - E (before Kulla-Conty): {loss:.3f}",
+        ),
+    )
 
 
 # --- tables ------------------------------------------------------------------------------------------
 
-def _integrate(ndf_name: str, masking_name: str, channels: str, nov, alpha, estimator: str = "gauss_legendre",
-               samples: int | None = None) -> np.ndarray:
+
+def _integrate(
+    ndf_name: str,
+    masking_name: str,
+    channels: str,
+    nov,
+    alpha,
+    estimator: str = "gauss_legendre",
+    samples: int | None = None,
+) -> np.ndarray:
     kernel = specular.kernel_for(ndf_name, masking_name, channels, estimator)
     samples = specular.DEFAULT_SAMPLES[estimator] if samples is None else samples
-    return specular.integrate(kernel, np.asarray(nov, np.float32), np.asarray(alpha, np.float32), estimator,
-                              samples, SEED, 2)
+    return specular.integrate(
+        kernel, np.asarray(nov, np.float32), np.asarray(alpha, np.float32), estimator, samples, SEED, 2
+    )
 
 
 def albedo_le_one_and_mirror_limit(ndf_name: str, masking_name: str) -> CheckResult:
@@ -370,11 +418,17 @@ def albedo_le_one_and_mirror_limit(ndf_name: str, masking_name: str) -> CheckRes
     i, j = np.unravel_index(np.argmax(E), E.shape)
     mirror = _integrate(ndf_name, masking_name, "albedo", MIRROR_NOVS, np.full(len(MIRROR_NOVS), ALPHA_MIN))[:, 0]
     mirror_err = float(np.max(np.abs(mirror - 1.0)))
-    return _result(f"albedo_le_one_and_mirror_limit[{ndf_name},{masking_name}]", max(excess, mirror_err), ALBEDO_TOL,
-                   f"the larger of max(E - 1) on a {len(novs)}x{len(alphas)} (n.v, alpha) grid and max "
-                   f"|E(alpha={ALPHA_MIN}) - 1| for n.v in [0.05, 1]",
-                   (f"max(E - 1) = {excess:.3e} at (n.v, alpha) = ({N[i, j]:.4g}, {A[i, j]:.4g})",
-                    f"max |E(alpha={ALPHA_MIN}) - 1| = {mirror_err:.3e}"))
+    return _result(
+        f"albedo_le_one_and_mirror_limit[{ndf_name},{masking_name}]",
+        max(excess, mirror_err),
+        ALBEDO_TOL,
+        f"the larger of max(E - 1) on a {len(novs)}x{len(alphas)} (n.v, alpha) grid and max "
+        f"|E(alpha={ALPHA_MIN}) - 1| for n.v in [0.05, 1]",
+        (
+            f"max(E - 1) = {excess:.3e} at (n.v, alpha) = ({N[i, j]:.4g}, {A[i, j]:.4g})",
+            f"max |E(alpha={ALPHA_MIN}) - 1| = {mirror_err:.3e}",
+        ),
+    )
 
 
 def dfg_mirror_limit(ndf_name: str, masking_name: str) -> CheckResult:
@@ -385,9 +439,13 @@ def dfg_mirror_limit(ndf_name: str, masking_name: str) -> CheckResult:
     fc = (1.0 - nov.astype(np.float32).astype(np.float64)) ** 5
     err = np.maximum(np.abs(sb[:, 0] - (1.0 - fc)), np.abs(sb[:, 1] - fc))
     k = int(np.argmax(err))
-    return _result(f"dfg_mirror_limit[{ndf_name},{masking_name}]", err[k], DFG_MIRROR_TOL,
-                   f"max over n.v in [0.05, 1] of |scale - (1-(1-n.v)^5)|, |bias - (1-n.v)^5| at alpha={ALPHA_MIN}; "
-                   f"worst at n.v={nov[k]:.4g}")
+    return _result(
+        f"dfg_mirror_limit[{ndf_name},{masking_name}]",
+        err[k],
+        DFG_MIRROR_TOL,
+        f"max over n.v in [0.05, 1] of |scale - (1-(1-n.v)^5)|, |bias - (1-n.v)^5| at alpha={ALPHA_MIN}; "
+        f"worst at n.v={nov[k]:.4g}",
+    )
 
 
 def estimators_agree() -> CheckResult:
@@ -398,12 +456,17 @@ def estimators_agree() -> CheckResult:
     qmc = _integrate("ggx", "smith_height_correlated", "scale_bias", nov, alpha, "sobol_vndf", ESTIMATOR_QMC_SAMPLES)
     err = np.abs(gl - qmc)
     k = int(np.argmax(err.max(axis=1)))
-    return _result("estimators_agree", err.max(), ESTIMATOR_AGREEMENT_TOL,
-                   f"max |gauss_legendre - sobol_vndf(2^16)| over (n.v, alpha) in {ESTIMATOR_TEXELS}, "
-                   f"channels scale, bias; worst at {ESTIMATOR_TEXELS[k]}")
+    return _result(
+        "estimators_agree",
+        err.max(),
+        ESTIMATOR_AGREEMENT_TOL,
+        f"max |gauss_legendre - sobol_vndf(2^16)| over (n.v, alpha) in {ESTIMATOR_TEXELS}, "
+        f"channels scale, bias; worst at {ESTIMATOR_TEXELS[k]}",
+    )
 
 
 # --- BRDF and Fresnel identities ---------------------------------------------------------------------
+
 
 @functools.lru_cache(maxsize=1)
 def _reciprocity_brdfs() -> tuple[dict, dict]:
@@ -431,8 +494,12 @@ def reciprocity(ndf_name: str, masking_name: str) -> CheckResult:
     scale = np.maximum(np.maximum(np.abs(a), np.abs(b)), np.finfo(np.float64).tiny)
     rel = np.where((a == 0.0) & (b == 0.0), 0.0, np.abs(a - b) / scale)
     nonzero = int(np.count_nonzero(a))
-    return _result(f"reciprocity[{ndf_name},{masking_name}]", rel.max(), RECIPROCITY_RTOL,
-                   f"max relative |f(l,v) - f(v,l)| over {RECIPROCITY_SAMPLES} random pairs ({nonzero} nonzero)")
+    return _result(
+        f"reciprocity[{ndf_name},{masking_name}]",
+        rel.max(),
+        RECIPROCITY_RTOL,
+        f"max relative |f(l,v) - f(v,l)| over {RECIPROCITY_SAMPLES} random pairs ({nonzero} nonzero)",
+    )
 
 
 def fresnel_eq2_is_exact_dielectric() -> CheckResult:
@@ -445,9 +512,13 @@ def fresnel_eq2_is_exact_dielectric() -> CheckResult:
     exact = evaluate_terms(eta=(1.0 + s) / (1.0 - s), cos_theta=c)["F_dielectric"].astype(np.float64)
     err = np.abs(eq2 - exact)
     i, j = np.unravel_index(np.argmax(err), err.shape)
-    return _result("fresnel_eq2_is_exact_dielectric", err.max(), FRESNEL_EQ2_TOL,
-                   f"max |F_dielectric_f0(f0, c) - F_dielectric(eta(f0), c)| on 96 f0 x 101 c; "
-                   f"worst at (f0, c)=({f0[i, 0]:.3g}, {c[0, j]:.3g})")
+    return _result(
+        "fresnel_eq2_is_exact_dielectric",
+        err.max(),
+        FRESNEL_EQ2_TOL,
+        f"max |F_dielectric_f0(f0, c) - F_dielectric(eta(f0), c)| on 96 f0 x 101 c; "
+        f"worst at (f0, c)=({f0[i, 0]:.3g}, {c[0, j]:.3g})",
+    )
 
 
 def schlick_endpoints() -> CheckResult:
@@ -457,9 +528,13 @@ def schlick_endpoints() -> CheckResult:
     at_grazing = evaluate_terms(f0=f0, cos_theta=0.0)["F_schlick"].astype(np.float64)
     err_n = np.max(np.abs(at_normal - f0.astype(np.float32)))
     err_g = np.max(np.abs(at_grazing - 1.0))
-    return _result("schlick_endpoints", max(err_n, err_g), SCHLICK_ENDPOINT_TOL,
-                   "the larger of max |F(f0, 1) - f0| and max |F(f0, 0) - 1| over 101 f0 in [0, 1]",
-                   (f"max |F(f0, 1) - f0| = {err_n:.3e}", f"max |F(f0, 0) - 1| = {err_g:.3e}"))
+    return _result(
+        "schlick_endpoints",
+        max(err_n, err_g),
+        SCHLICK_ENDPOINT_TOL,
+        "the larger of max |F(f0, 1) - f0| and max |F(f0, 0) - 1| over 101 f0 in [0, 1]",
+        (f"max |F(f0, 1) - f0| = {err_n:.3e}", f"max |F(f0, 0) - 1| = {err_g:.3e}"),
+    )
 
 
 # --- microfacet diffuse (Gotanda 2014, Eq. 4) ---------------------------------------------------------
@@ -495,8 +570,12 @@ def diffuse_sigma0_is_lambert_eq6() -> CheckResult:
         w = lambda c: 1 - (1 - c) ** 5  # noqa: E731
         ref = 1.05 * (1 - f0) * w(l[:, 2]) * w(v[:, 2]) / np.pi
         worst = max(worst, float(np.max(np.abs(f - ref) / ref)))
-    return _result("diffuse_sigma0_is_lambert_eq6", worst, DIFFUSE_SIGMA0_RTOL,
-                   f"max relative over {DIFFUSE_PAIRS} random pairs x f0 in (0, 0.04, 0.5), GL order {DIFFUSE_ORDER}")
+    return _result(
+        "diffuse_sigma0_is_lambert_eq6",
+        worst,
+        DIFFUSE_SIGMA0_RTOL,
+        f"max relative over {DIFFUSE_PAIRS} random pairs x f0 in (0, 0.04, 0.5), GL order {DIFFUSE_ORDER}",
+    )
 
 
 def diffuse_reciprocity() -> CheckResult:
@@ -508,8 +587,12 @@ def diffuse_reciprocity() -> CheckResult:
     a = eval_brdf("microfacet", l, v, sigma, 0.04, "eq6", "sigma", DIFFUSE_ORDER)
     b = eval_brdf("microfacet", v, l, sigma, 0.04, "eq6", "sigma", DIFFUSE_ORDER)
     rel = np.abs(a - b) / np.maximum(np.maximum(a, b), 1e-30)
-    return _result("diffuse_reciprocity", float(rel.max()), DIFFUSE_RECIPROCITY_RTOL,
-                   f"max relative over {DIFFUSE_PAIRS} random pairs, sigma in [0.05, 1]")
+    return _result(
+        "diffuse_reciprocity",
+        float(rel.max()),
+        DIFFUSE_RECIPROCITY_RTOL,
+        f"max relative over {DIFFUSE_PAIRS} random pairs, sigma in [0.05, 1]",
+    )
 
 
 def diffuse_albedo_le_one() -> CheckResult:
@@ -526,12 +609,17 @@ def diffuse_albedo_le_one() -> CheckResult:
             e = diffuse_albedo.albedo(N, A, f0, form, order=DIFFUSE_ORDER)
             top = max(top, float(e.max()))
             worst = max(worst, float(np.max(e - 1.0)))
-    return _result("diffuse_albedo_le_one", max(worst, 0.0), DIFFUSE_ALBEDO_TOL,
-                   f"max(0, E - 1) over {len(N)} (NoV, alpha) x f0 in (0, 0.04, 0.5) x facet forms eq6, schlick, "
-                   "dielectric_f0", (f"max E = {top:.7f}",))
+    return _result(
+        "diffuse_albedo_le_one",
+        max(worst, 0.0),
+        DIFFUSE_ALBEDO_TOL,
+        f"max(0, E - 1) over {len(N)} (NoV, alpha) x f0 in (0, 0.04, 0.5) x facet forms eq6, schlick, dielectric_f0",
+        (f"max E = {top:.7f}",),
+    )
 
 
 # --- registry ------------------------------------------------------------------------------------------
+
 
 def _registry() -> dict:
     checks = {}

@@ -26,6 +26,7 @@ Host API (inputs broadcast against each other; ``h``, ``l``, ``v`` carry a trail
         left to a reciprocity check is the order of G2's and the denominator's arguments
         (Gotanda 2014 course notes, Eq. 1), 0 where n.l or n.v <= COS_EPS.
 """
+
 from __future__ import annotations
 
 import functools
@@ -43,6 +44,7 @@ wp.set_module_options({"enable_backward": False})
 @wp.struct
 class TermInputs:
     """One input record: every term reads the fields it needs (see the module docstring)."""
+
     h: wp.vec3
     v: wp.vec3
     alpha: float
@@ -57,6 +59,7 @@ class TermInputs:
 
 
 # --- one probe per term: a wp.func TermInputs -> float, paired with its output name ---------------
+
 
 def _ndf_probes(ndf_name: str) -> list:
     nd = NDFS[ndf_name]
@@ -145,11 +148,20 @@ BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MA
 _PROBES = (
     [p for n in NDFS for p in _ndf_probes(n)]
     + [_g2_probe(n, m) for n, m in BRDF_PAIRS]
-    + [("D_ggx_aniso", _probe_D_ggx_aniso), ("Lambda_ggx_aniso", _probe_Lambda_ggx_aniso),
-       ("D_ashikhmin_shirley", _probe_D_ashikhmin_shirley), ("D_charlie", _probe_D_charlie),
-       ("V_charlie", _probe_V_charlie)]
-    + [("G2_v_cavity", _probe_G2_v_cavity), ("F_schlick", _probe_F_schlick), ("Fc_schlick", _probe_Fc_schlick),
-       ("F_dielectric", _probe_F_dielectric), ("F_dielectric_f0", _probe_F_dielectric_f0)]
+    + [
+        ("D_ggx_aniso", _probe_D_ggx_aniso),
+        ("Lambda_ggx_aniso", _probe_Lambda_ggx_aniso),
+        ("D_ashikhmin_shirley", _probe_D_ashikhmin_shirley),
+        ("D_charlie", _probe_D_charlie),
+        ("V_charlie", _probe_V_charlie),
+    ]
+    + [
+        ("G2_v_cavity", _probe_G2_v_cavity),
+        ("F_schlick", _probe_F_schlick),
+        ("Fc_schlick", _probe_Fc_schlick),
+        ("F_dielectric", _probe_F_dielectric),
+        ("F_dielectric_f0", _probe_F_dielectric_f0),
+    ]
 )
 TERM_NAMES: tuple[str, ...] = tuple(name for name, _ in _PROBES)
 _PROBE_FUNCS = [f for _, f in _PROBES]
@@ -188,6 +200,7 @@ def _terms_kernel(
 
 
 # --- full specular BRDFs ------------------------------------------------------------------------
+
 
 @functools.lru_cache(maxsize=None)
 def brdf_for(ndf_name: str, masking_name: str):
@@ -231,6 +244,7 @@ def _brdf_kernel(
 
 # --- host side ------------------------------------------------------------------------------------
 
+
 def _vec_and_scalars(vecs: dict, scalars: dict) -> tuple[tuple, dict]:
     """Broadcast (..., 3) vectors and (...) scalars to one shape; return it and flat float32 arrays."""
     vecs = {k: np.asarray(a, dtype=np.float32) for k, a in vecs.items()}
@@ -244,8 +258,21 @@ def _vec_and_scalars(vecs: dict, scalars: dict) -> tuple[tuple, dict]:
     return shape, flat
 
 
-def evaluate_terms(*, h=(0.0, 0.0, 1.0), v=(0.0, 0.0, 1.0), alpha=0.5, alpha_y=None, nov=1.0, nol=1.0, voh=1.0,
-                   loh=1.0, f0=0.04, eta=1.5, cos_theta=1.0, device: str = "cpu") -> dict[str, np.ndarray]:
+def evaluate_terms(
+    *,
+    h=(0.0, 0.0, 1.0),
+    v=(0.0, 0.0, 1.0),
+    alpha=0.5,
+    alpha_y=None,
+    nov=1.0,
+    nol=1.0,
+    voh=1.0,
+    loh=1.0,
+    f0=0.04,
+    eta=1.5,
+    cos_theta=1.0,
+    device: str = "cpu",
+) -> dict[str, np.ndarray]:
     """Every term of ``TERM_NAMES`` at the broadcast inputs (module docstring) -> {name: float32 array}.
     ``h`` is in the shading frame (n = +z) and is used as given (not normalised); n.h for G2 is h.z.
     The anisotropic terms read ``alpha`` as alpha_x (tangent, +x), ``alpha_y`` (default: alpha) and the
@@ -253,14 +280,25 @@ def evaluate_terms(*, h=(0.0, 0.0, 1.0), v=(0.0, 0.0, 1.0), alpha=0.5, alpha_y=N
     alpha_y = alpha if alpha_y is None else alpha_y
     shape, x = _vec_and_scalars(
         {"h": h, "v": v},
-        {"alpha": alpha, "alpha_y": alpha_y, "nov": nov, "nol": nol, "voh": voh, "loh": loh, "f0": f0, "eta": eta,
-         "cos_theta": cos_theta},
+        {
+            "alpha": alpha,
+            "alpha_y": alpha_y,
+            "nov": nov,
+            "nol": nol,
+            "voh": voh,
+            "loh": loh,
+            "f0": f0,
+            "eta": eta,
+            "cos_theta": cos_theta,
+        },
     )
     n = int(np.prod(shape, dtype=np.int64))
     out = wp.zeros((n, len(TERM_NAMES)), dtype=float, device=device)
     inputs = [wp.array(x[k], dtype=wp.vec3, device=device) for k in ("h", "v")]
-    inputs += [wp.array(x[k], dtype=float, device=device)
-               for k in ("alpha", "alpha_y", "nov", "nol", "voh", "loh", "f0", "eta", "cos_theta")]
+    inputs += [
+        wp.array(x[k], dtype=float, device=device)
+        for k in ("alpha", "alpha_y", "nov", "nol", "voh", "loh", "f0", "eta", "cos_theta")
+    ]
     if n:
         wp.launch(_terms_kernel, dim=n, inputs=inputs + [out], device=device)
     res = out.numpy()
@@ -273,8 +311,12 @@ def evaluate_brdfs(l, v, alpha, f0=0.04, device: str = "cpu") -> dict[tuple[str,
     shape, x = _vec_and_scalars({"l": l, "v": v}, {"alpha": alpha, "f0": f0})
     n = int(np.prod(shape, dtype=np.int64))
     out = wp.zeros((n, len(BRDF_PAIRS)), dtype=float, device=device)
-    inputs = [wp.array(x["l"], dtype=wp.vec3, device=device), wp.array(x["v"], dtype=wp.vec3, device=device),
-              wp.array(x["alpha"], dtype=float, device=device), wp.array(x["f0"], dtype=float, device=device)]
+    inputs = [
+        wp.array(x["l"], dtype=wp.vec3, device=device),
+        wp.array(x["v"], dtype=wp.vec3, device=device),
+        wp.array(x["alpha"], dtype=float, device=device),
+        wp.array(x["f0"], dtype=float, device=device),
+    ]
     if n:
         wp.launch(_brdf_kernel, dim=n, inputs=inputs + [out], device=device)
     res = out.numpy()
