@@ -1,18 +1,19 @@
 # lutbake — the two commands of the README, and a few more.
 #   make luts      create the venv if missing, install, bake every config in configs/ and every engine
 #                  preset (PRESETS) into outputs/
-#   make test      create the venv if missing, install, run the test suite
+#   make test      create the venv if missing, install, run ruff (check + format --check), then the test suite
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 OUT    ?= outputs
 CONFIGS := $(wildcard configs/*.toml)
-PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-eevee unreal
+PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-eevee unreal blender-eevee-btdf blender-eevee-bsdf \
+           openpbr turquin ltc-ggx ltc-threejs ltc-eevee ltc-hdrp
 WORKERS ?=
 FORCE   ?=
 
-.PHONY: luts test validate bench clean venv help figures bench-diffuse
+.PHONY: lint luts test validate bench clean venv help figures bench-diffuse bench-ltc
 
 help:
 	@echo "make luts | test | validate | figures | bench | clean"
@@ -38,7 +39,11 @@ figures: $(STAMP)
 	$(BIN)/lutbake plot --out-dir $(OUT)/figures
 	$(BIN)/python docs/plot_fresnel.py $(OUT)/figures
 
-test: $(STAMP)
+lint: $(STAMP)
+	$(BIN)/ruff check lutbake tests benchmarks
+	$(BIN)/ruff format --check lutbake tests benchmarks
+
+test: $(STAMP) lint
 	@$(BIN)/python -c "import moderngl; moderngl.create_standalone_context(backend='egl').release()" 2>/dev/null \
 		|| echo "note: no EGL OpenGL here; the GL consumer test will skip (Debian: apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri)"
 	$(BIN)/python -m pytest -q
@@ -56,3 +61,9 @@ clean:
 # every kind against converged references, C and numpy baselines: outputs/bench/report.json + accuracy_vs_time.png
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench.py
+	$(BIN)/python benchmarks/bench_dielectric.py
+	$(BIN)/python benchmarks/bench_ltc.py
+
+# LTC fits (kind ltc): fit time per lobe at 64^2, the straight-port baseline, area-light errors: outputs/bench/ltc.json
+bench-ltc: $(STAMP)
+	$(BIN)/python benchmarks/bench_ltc.py

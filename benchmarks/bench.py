@@ -16,7 +16,6 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
-import os
 import platform
 import shutil
 import subprocess
@@ -32,11 +31,11 @@ sys.path.insert(0, str(ROOT))
 import warp as wp  # noqa: E402
 
 from lutbake.api import bake_table  # noqa: E402
-from lutbake.batch import sources_digest  # noqa: E402
 from lutbake.config import validate_table  # noqa: E402
 from lutbake.executor import default_workers  # noqa: E402
+from lutbake.kinds import KINDS  # noqa: E402
+from lutbake.provenance import sources_digest  # noqa: E402
 from lutbake.sampling import points  # noqa: E402
-from lutbake.tables import KINDS  # noqa: E402
 
 OUT = ROOT / "outputs" / "bench"
 REF_GL_SAMPLES = 3 * 40**2  # reference order n = 40

@@ -25,8 +25,11 @@ import warp as wp  # noqa: E402
 wp.config.quiet = True
 
 from lutbake.api import bake_table  # noqa: E402
+from lutbake.axes import sigma_alpha  # noqa: E402
 from lutbake.config import load_config, validate_table  # noqa: E402
-from lutbake.tables import btf, diffuse as D, diffuse_albedo as A  # noqa: E402
+from lutbake.edge import effective_alpha  # noqa: E402
+from lutbake.integrands import diffuse as D  # noqa: E402
+from lutbake.kinds import btf  # noqa: E402
 
 OUT = ROOT / "outputs" / "bench"
 
@@ -36,15 +39,15 @@ def bench_diffuse() -> dict:
     table, seconds, samples = bake_table(spec, workers=2)
     nov = np.tile(table.axes[1].values(), 64).astype(np.float64)
     sigma = np.repeat(table.axes[0].values(), 64)
-    alpha = D.alpha_from_sigma(sigma, "sigma").astype(np.float64)
+    alpha = effective_alpha(sigma_alpha(sigma, "sigma"), False).astype(np.float64)
     cache = OUT / "diffuse_ref_64_order32.npy"
     if cache.exists():
         ref = np.load(cache)
     else:
-        ref = A.albedo(nov, alpha, orders=np.full((len(nov), 3), 32))
+        ref = D.albedo_swapped(nov, alpha, orders=np.full((len(nov), 3), 32))
         np.save(cache, ref)
     pick = np.array([0, 5, 64 * 3 + 1, 64 * 20 + 40, 64 * 63 + 63, 64 * 40 + 2, 64 * 10 + 10, 64 * 63])
-    nested = D.albedo("microfacet", nov[pick].astype(np.float32), sigma[pick], 0.0, "eq6", "sigma", order=16)
+    nested = D.albedo_gl("microfacet", nov[pick].astype(np.float32), sigma[pick], 0.0, "eq6", "sigma", order=16)
     err = np.abs(table.data[..., 0].reshape(-1) - ref)
     i = int(np.argmax(err))
     return {

@@ -1,82 +1,55 @@
-"""The public Python API: ``bake`` a config (or specs) into tables and files."""
+"""The public Python API: ``bake`` configs (or specs) into tables and files, through the same path as the CLI.
+
+    bake(configs) = config.load_configs -> batch.schedule (skip what is up to date unless ``force``) -> batch.run
+Each table goes through lutbake.pipeline.bake_table (``bake_table`` here: one table, nothing written).
+"""
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
-from . import __version__
+from . import batch
 from .config import TableSpec, load_configs
 from .errors import TableError
-from .executor import Timer, execute
+from .executor import Progress
+from .pipeline import bake_table
 from .table import Table
-from .tables import lookup_kind
+
+__all__ = ["BakeResult", "bake", "bake_table"]
 
 
 @dataclass
 class BakeResult:
+    """One table of ``bake``: its spec, the baked Table (None when ``skipped``: its output was up to date), the
+    written path, seconds, samples per texel and the status (baked or skipped)."""
+
     spec: TableSpec
-    table: Table
+    table: Table | None
     path: Path | None
     seconds: float
-    samples: int
-
-
-def _warp_version() -> str:
-    import warp as wp
-
-    return wp.config.version
-
-
-def bake_table(
-    spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: bool | None = None, cancel=None
-) -> tuple[Table, float, int]:
-    """Bake one spec into a Table (nothing written). Raises TableError if a value is not finite;
-    executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
-    from .batch import content_hash
-
-    plan = lookup_kind(spec.kind).plan(spec)
-    with Timer() as t:
-        data = execute(plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel)
-    if not np.all(np.isfinite(data)):
-        bad = int(np.size(data) - np.count_nonzero(np.isfinite(data)))
-        raise TableError(f"{spec.source}: table '{spec.name}': {bad} non-finite values; nothing written")
-    extra = dict(plan.extra)
-    if plan.error_estimate is not None:
-        err, how = plan.error_estimate(data.reshape(plan.n_texels, plan.n_channels), device)
-        extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)
-    attributes = {
-        "terms": json.dumps(plan.terms),
-        "estimator": plan.estimator,
-        "samples": str(plan.samples),
-        "seed": str(spec.options.get("seed", 0)),
-        "config": spec.toml(),
-        "config_file": Path(spec.source).name,
-        "version": __version__,
-        "warp_version": _warp_version(),
-        **extra,
-        "content_hash": content_hash(spec),  # what makes the file current (lutbake.batch)
-    }
-    table = Table(
-        spec.name, spec.kind, data.astype(np.float32), plan.axes, plan.channels, plan.reconstruction, attributes
-    )
-    return table, t.seconds, plan.samples
+    samples: int | None
+    status: str = "baked"
 
 
 def samples_note(spec: TableSpec, effective: int | None) -> str:
     """Why a table integrates ``effective`` samples per texel when its config asked for another number
     ('' when they agree or none was asked): each quadrature rounds the budget to its own grid."""
-    from .tables import specular
-
     asked = spec.options.get("samples")
     if not asked or effective is None or asked == effective:
         return ""
-    rule = specular.samples_note(spec.options.get("estimator", ""), asked)
-    if rule and specular.effective_samples(spec.options.get("estimator", ""), asked) == effective:
-        return rule
+    estimator = spec.options.get("estimator", "")
+    if estimator == "gauss_legendre":
+        from .sampling.hemisphere import gl_order
+
+        n = gl_order(asked)
+        if 3 * n * n == effective:
+            return (
+                f"samples = {asked} asked; gauss_legendre integrates 3 regions x n x n points with "
+                f"n = round(sqrt({asked} / 3)) = {n}: 3 x {n}^2 = {effective}"
+            )
+    if estimator.startswith("sobol") and effective == 1 << (asked - 1).bit_length():
+        return f"samples = {asked} asked; Sobol' points come in powers of two: {effective}"
     return f"samples = {asked} asked; the {spec.kind} quadrature evaluates {effective} per texel (docs/config.md)"
 
 
@@ -87,27 +60,44 @@ def bake(
     workers: int | None = None,
     device: str = "cpu",
     write: bool = True,
-    progress: bool | None = None,
+    progress: Progress | None = None,
     on_result=None,
+    force: bool = False,
 ) -> list[BakeResult]:
-    """Validate every config, then bake each table and write ``out_dir/<name>.<ext>`` (key ``format``,
-    default EXR) atomically.
+    """Validate every config, then bake each table and write ``out_dir/<name>.<ext>`` (key ``format``, default
+    EXR) atomically; a table whose output is up to date (same content hash, lutbake.provenance) is skipped unless
+    ``force``. ``write=False`` bakes every table and writes nothing.
 
-    ``configs``: paths to TOML files, or TableSpecs. Nothing runs unless every config is valid.
+    ``configs``: paths to TOML files, or TableSpecs. Nothing runs unless every config is valid. A table that
+    fails raises TableError (after the other tables finished). ``on_result(BakeResult)`` is called as each ends.
     """
-    from .io.formats import write_table
-
     specs = [c for c in configs if isinstance(c, TableSpec)]
     paths = [c for c in configs if not isinstance(c, TableSpec)]
     specs += load_configs(paths, overrides) if paths else []
-    results = []
-    for spec in specs:
-        table, seconds, samples = bake_table(spec, workers, device, progress)
-        path = None
-        if write:
-            path = write_table(table, out_dir, spec.options.get("format", "exr"), spec.options.get("dtype", "float32"))
-        r = BakeResult(spec, table, path, seconds, samples)
-        if on_result:
+    if not write:
+        results = []
+        for spec in specs:
+            table, seconds, samples = bake_table(spec, workers, device, progress)
+            results.append(BakeResult(spec, table, None, seconds, samples))
+            if on_result:
+                on_result(results[-1])
+        return results
+    jobs = batch.schedule(specs, out_dir, force=force)
+    results: dict[int, BakeResult] = {}
+
+    def done(job: batch.Job):
+        r = BakeResult(job.spec, job.table, job.path, job.seconds or 0.0, job.samples, job.status)
+        results[id(job)] = r
+        if on_result and job.status in ("baked", "skipped"):
             on_result(r)
-        results.append(r)
-    return results
+
+    for job in jobs:
+        if job.status == "skipped":
+            done(job)
+    signum = batch.run(jobs, workers, device, progress, on_done=done)
+    if signum is not None:
+        raise KeyboardInterrupt(batch.signal_name(signum))
+    failed = [j for j in jobs if j.status == "failed"]
+    if failed:
+        raise TableError("; ".join(j.message for j in failed))
+    return [results[id(j)] for j in jobs]

@@ -9,13 +9,15 @@ An axis maps an index i in [0, count) to a parameter in three explicit steps:
    (Blender EEVEE's NoV rows, t = sqrt(1 - NoV)); ``texel_offset`` value = lo + (hi - lo) min(t + 1/N, 1)
    (Filament cmgen's roughness rows, one texel rougher than their centres). Then ``clamp`` = [a, b]
    (optional) clamps the value (Blender: NoV in [1e-4, 0.9999]).
-3. edge policy (lutbake.edge): n.v >= NOV_MIN, alpha >= ALPHA_MIN. The clamped value is the one
-   integrated and the one listed in the EXR metadata (``values`` / ``alpha``).
+3. edge policy (lutbake.edge.axis_edge): every cosine axis (NoV, NoL) >= NOV_MIN, every polar-angle axis
+   (theta_v, theta_l) <= acos(NOV_MIN). The clamped value is the one integrated and the one listed in the
+   metadata (``values``; ``edge`` says the rule). alpha -> 0 is not clamped here: ``alpha`` lists the axis'
+   alpha, and the integrand takes the exact mirror limit or clamps (lutbake.edge.effective_alpha).
 Index 0 is the first value: image row 0 holds y index 0, column 0 holds x index 0.
 ``uv(value)`` inverts the chain: the texture coordinate (0 = first texel's outer edge) at which a
 bilinear sampler reconstructs the table at a parameter value; ``uv_formula`` says it for shaders.
 A roughness axis also carries the NDF alpha at every index: alpha = r^2 for ``perceptual_roughness``,
-alpha = value for ``alpha``.
+alpha = value for ``alpha``, and a ``sigma`` axis the GGX alpha of its ``alpha_map`` (SIGMA_TO_ALPHA).
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .edge import ALPHA_MIN, NOV_MIN
+from .edge import axis_edge, axis_edge_text
 
 IMAGE_DIMS = {
     "x": "columns",
@@ -45,10 +47,20 @@ ORDERS = {
     "lo_first": "index 0 (first row / column) holds t near 0",
     "hi_first": "index 0 holds t near 1: index i holds t of index N - 1 - i (a vertical flip of lo_first)",
 }
+SIGMA_TO_ALPHA = {
+    "sigma": "GGX alpha = sigma",
+    "sigma_squared": "GGX alpha = sigma^2 (sigma as a perceptual roughness)",
+}
 ROUGHNESS_PARAMS = {
     "perceptual": "the axis holds perceptual roughness r; alpha = r^2",
     "alpha": "the axis holds the NDF alpha directly",
 }
+
+
+def sigma_alpha(sigma, mapping: str) -> np.ndarray:
+    """GGX alpha (float64, unclamped) of sigma under ``mapping`` (SIGMA_TO_ALPHA)."""
+    s = np.asarray(sigma, dtype=np.float64)
+    return s if mapping == "sigma" else s * s
 
 
 @dataclass(frozen=True)
@@ -63,6 +75,7 @@ class Axis:
     order: str = "lo_first"
     clamp: tuple[float, float] | None = None
     listed: tuple[float, ...] = ()  # mapping "listed": the value of every index (count = len(listed))
+    alpha_map: str | None = None  # a sigma axis: its SIGMA_TO_ALPHA mapping
 
     def t(self) -> np.ndarray:
         """The texture-space parameter t in [0, 1] at every index (after ``order``)."""
@@ -91,9 +104,7 @@ class Axis:
             v = np.asarray(self.listed, dtype=np.float64)
         else:
             v = self._map(self.t())
-        if self.name == "NoV":
-            v = np.maximum(v, NOV_MIN)
-        return v.astype(np.float32)
+        return axis_edge(self.name, v).astype(np.float32)
 
     def uv(self, value) -> np.ndarray:
         """Texture coordinate (0..1 across the image along this axis, 0 = outer edge of index 0) at
@@ -129,14 +140,16 @@ class Axis:
         return f"1 - ({u})" if self.order == "hi_first" else u
 
     def alpha(self) -> np.ndarray | None:
-        """NDF alpha at every index for a roughness axis (None otherwise)."""
+        """NDF alpha at every index (float32) for a roughness or sigma axis (None otherwise); unclamped: the
+        integrands apply the alpha -> 0 policy (lutbake.edge.effective_alpha)."""
+        v = self.values().astype(np.float64)
         if self.name == "perceptual_roughness":
-            a = self.values().astype(np.float64) ** 2
-        elif self.name == "alpha":
-            a = self.values().astype(np.float64)
-        else:
-            return None
-        return np.maximum(a, ALPHA_MIN).astype(np.float32)
+            return (v**2).astype(np.float32)
+        if self.name == "alpha":
+            return v.astype(np.float32)
+        if self.name == "sigma" and self.alpha_map is not None:
+            return sigma_alpha(v, self.alpha_map).astype(np.float32)
+        return None
 
     def describe(self) -> dict:
         d = {
@@ -156,8 +169,17 @@ class Axis:
             "first": f"index 0 = {float(self.values()[0]):.9g}",
             "values": [float(x) for x in self.values()],
         }
+        edge = axis_edge_text(self.name)
+        if edge:
+            d["edge"] = edge
         a = self.alpha()
         if a is not None:
             d["alpha"] = [float(x) for x in a]
-            d["alpha_formula"] = "alpha = r^2" if self.name == "perceptual_roughness" else "alpha = value"
+            d["alpha_formula"] = (
+                "alpha = value"
+                if self.name == "alpha"
+                else SIGMA_TO_ALPHA[self.alpha_map]
+                if self.name == "sigma"
+                else "alpha = r^2"
+            )
         return d

@@ -1,15 +1,13 @@
-"""Batch runs that never lose work: content hashes, planning, parallel tables, interrupts, reports.
+"""Batch runs that never lose work: scheduling, parallel tables, interrupts, reports.
 
-- **Content hash.** Every output records ``lutbake:content_hash`` = sha256 of the table's canonical
-  TOML (``TableSpec.toml()``), the lutbake version and the source text of the modules that define
-  the kernels and terms (``HASH_SOURCES``). A table whose output exists with the same hash is
-  *skipped*; anything else (no file, unreadable file, other hash) is baked again.
-- **Plan first.** ``plan()`` takes already-validated specs (``config.load_configs`` validates every
-  config before anything runs) and decides, per table, its output path, its hash and whether it is
-  up to date. Nothing is baked while planning.
+- **Schedule first.** ``schedule()`` takes already-validated specs (``config.load_configs`` validates every
+  config before anything runs) and decides, per table, its output path, its content hash
+  (lutbake.provenance) and whether it is up to date (*skipped*: same content hash, and the stored bytes match
+  the sha256 recorded with it, lutbake.io.integrity). Nothing is baked while scheduling.
 - **Run.** ``run()`` bakes the pending tables on a small thread pool (tables in parallel, each on the
   tile executor; the result is bit-identical for any worker count). One failing table (a NaN, an
-  exception in a kernel, a MemoryError) is marked ``failed`` and does not stop the others.
+  exception in a kernel, a MemoryError) is marked ``failed`` and does not stop the others. Each table goes
+  through lutbake.pipeline.bake_table, as in the Python API (lutbake.api.bake is schedule + run).
 - **Interrupts.** A KeyboardInterrupt (SIGINT) or ``Interrupted`` (raised by the SIGTERM handler of
   ``signal_handlers()``) while the main thread waits cancels every table that has not written its
   file: those are marked ``interrupted``; finished files stay. Writes are atomic (io.exr.write_exr),
@@ -20,26 +18,25 @@
 from __future__ import annotations
 
 import contextlib
-import hashlib
 import json
-import os
 import signal
 import threading
 import time
-import uuid
+from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 from . import __version__
-from .io.formats import output_path, write_table
 from .config import TableSpec
+from .errors import LutbakeError
+from .executor import Cancelled, Progress, default_workers
+from .io.atomic import atomic_write_bytes, remove_stale_temps
+from .io.formats import output_path, write_table
+from .io.oserror import os_error_text
+from .pipeline import bake_table
+from .provenance import HASH_ATTRIBUTE, content_hash, read_header, sources_digest
 
-PACKAGE = Path(__file__).parent
-# the modules whose source defines what a table holds (kernels, terms, estimators, axes, edge policy)
-HASH_SOURCES = ("terms/*.py", "sampling/*.py", "tables/*.py", "axes.py", "edge.py")
-HASH_ATTRIBUTE = "content_hash"
 STATUSES = ("baked", "skipped", "failed", "interrupted")
 EXIT_OK, EXIT_FAILED, EXIT_SIGINT, EXIT_SIGTERM = 0, 1, 130, 143
 
@@ -50,65 +47,6 @@ class Interrupted(BaseException):
     def __init__(self, signum: int = signal.SIGTERM):
         super().__init__(signal.Signals(signum).name)
         self.signum = signum
-
-
-def source_files() -> list[Path]:
-    """The source files that enter every content hash, sorted by their path in the package."""
-    files = {f for pattern in HASH_SOURCES for f in PACKAGE.glob(pattern) if f.is_file()}
-    return sorted(files, key=lambda f: f.relative_to(PACKAGE).as_posix())
-
-
-def sources_digest() -> bytes:
-    """sha256 over (relative path, text) of every file in source_files()."""
-    h = hashlib.sha256()
-    for f in source_files():
-        data = f.read_bytes()
-        h.update(f.relative_to(PACKAGE).as_posix().encode() + b"\0" + str(len(data)).encode() + b"\0" + data)
-    return h.digest()
-
-
-def content_hash(spec: TableSpec, digest: bytes | None = None) -> str:
-    """The hex sha256 of (spec.toml(), lutbake version, source digest): what makes an output current."""
-    h = hashlib.sha256()
-    for part in (
-        b"lutbake-content-hash-v1",
-        spec.toml().encode(),
-        __version__.encode(),
-        digest if digest is not None else sources_digest(),
-    ):
-        h.update(str(len(part)).encode() + b"\0" + part)
-    return h.hexdigest()
-
-
-def read_header(path) -> dict[str, str] | None:
-    """The ``lutbake:*`` attributes of an existing output (prefix removed): an EXR's first part header,
-    or for the other formats their ``.json`` sidecar; None if missing or unreadable (not up to date)."""
-    path = Path(path)
-    if not path.is_file():
-        return None
-    if path.suffix != ".exr":
-        try:
-            doc = json.loads(path.with_suffix(".json").read_text(encoding="utf-8"))
-            meta = doc["lutbake"] if doc.get("file") == path.name else None
-            return {k[len("lutbake:") :] if k.startswith("lutbake:") else k: str(v) for k, v in meta.items()}
-        except Exception:  # no sidecar (ktx2, h) or a foreign one: rebake
-            return None
-    try:
-        import OpenImageIO as oiio
-
-        inp = oiio.ImageInput.open(str(path))
-        if inp is None:
-            oiio.geterror()
-            return None
-        try:
-            spec = inp.spec()
-            return {
-                p.name[len("lutbake:") :]: str(p.value) for p in spec.extra_attribs if p.name.startswith("lutbake:")
-            }
-        finally:
-            inp.close()
-    except Exception:  # a corrupt or foreign file is simply not up to date
-        return None
 
 
 @dataclass
@@ -124,6 +62,7 @@ class Job:
     error_estimate: float | None = None
     message: str = ""
     shape: str = ""
+    table: object = None  # the baked lutbake.table.Table, once baked
 
     @property
     def name(self) -> str:
@@ -149,7 +88,7 @@ def _float_or_none(text) -> float | None:
         return None
 
 
-def plan(specs: list[TableSpec], out_dir, force: bool = False) -> list[Job]:
+def schedule(specs: list[TableSpec], out_dir, force: bool = False) -> list[Job]:
     """One Job per (validated) spec: output path, content hash, and ``skipped`` if the output exists
     with that hash (unless ``force``). Runs no kernel."""
     digest = sources_digest()
@@ -169,15 +108,13 @@ def plan(specs: list[TableSpec], out_dir, force: bool = False) -> list[Job]:
 
 def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.Event) -> Job:
     """Bake and write one table; any failure is recorded on the job, never raised."""
-    from .api import bake_table
-    from .errors import LutbakeError
-    from .executor import Cancelled
-
     t0 = time.perf_counter()
+    needed = 0
     try:
         if cancel.is_set():
             raise Cancelled(job.name)
         table, seconds, samples = bake_table(job.spec, workers, device, progress, cancel=cancel)
+        needed = table.data.nbytes
         if table.attributes.get(HASH_ATTRIBUTE) != job.content_hash:  # sources changed under a running batch
             raise RuntimeError("the lutbake sources changed while the batch ran; run it again")
         if cancel.is_set():
@@ -197,11 +134,17 @@ def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.E
         )
     except LutbakeError as e:
         job.status, job.message = "failed", str(e)
+    except OSError as e:  # the output could not be written: say why (a full disk, a read-only mount ...)
+        job.status = "failed"
+        job.message = (
+            f"{job.spec.source}: table '{job.name}': cannot write {job.path}: "
+            f"{os_error_text(e, job.path.parent, needed)}; the next run bakes it again"
+        )
     except Exception as e:  # a kernel error, an I/O error, anything: this table fails, the others go on
         job.status = "failed"
         job.message = f"{job.spec.source}: table '{job.name}': {type(e).__name__}: {e}; nothing written"
     else:
-        job.status, job.seconds, job.samples = "baked", seconds, samples
+        job.status, job.seconds, job.samples, job.table = "baked", seconds, samples, table
         job.error_estimate = _float_or_none(table.attributes.get("error_estimate"))
         job.shape = "x".join(str(a.count) for a in table.axes) + f"x{len(table.channels)}"
         return job
@@ -213,7 +156,7 @@ def run(
     jobs: list[Job],
     workers: int | None = None,
     device: str = "cpu",
-    progress: bool | None = None,
+    progress: Progress | None = None,
     on_done: Callable[[Job], None] | None = None,
     poll: float = 0.2,
 ) -> int | None:
@@ -223,18 +166,16 @@ def run(
     a big table keeps every core busy after the small ones are done (the OS shares the cores while
     several tables run; the result is bit-identical either way).
     Returns None, or the signal number if the run was interrupted (the unfinished jobs are then marked
-    ``interrupted``; finished files are kept).
+    ``interrupted``; finished files are kept). ``progress``: lutbake.executor.Progress, per table.
     """
-    from .executor import default_workers
-
     workers = workers or default_workers()
+    for d in sorted({j.path.parent for j in jobs}):
+        remove_stale_temps(d)  # left by writers that were killed before their rename
     pending = [j for j in jobs if j.status == "pending"]
     if not pending:
         return None
     threads = max(1, min(workers, len(pending)))
     per_table = workers
-    if threads > 1 and progress is None:
-        progress = False  # several bars at once would interleave
     cancel = threading.Event()
     pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="lutbake-table")
     futures: dict = {}
@@ -291,14 +232,8 @@ def write_report(path, jobs: list[Job], status: int, signum: int | None = None) 
         "counts": {s: sum(j.status == s for j in jobs) for s in STATUSES},
         "tables": [j.report() for j in jobs],
     }
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp")
-    try:
-        tmp.write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    remove_stale_temps(path.parent)  # a report writer killed before its rename left one
+    atomic_write_bytes(path, (json.dumps(doc, indent=2) + "\n").encode("utf-8"))
     return path
 
 

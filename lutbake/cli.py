@@ -12,6 +12,17 @@ from . import __version__
 EXIT_CONFIG = 2
 
 
+def out_dir_option(default: str, what: str):
+    """The shared ``--out-dir`` option of the commands that write files."""
+    return click.option(
+        "--out-dir",
+        type=click.Path(path_type=Path),
+        default=Path(default),
+        show_default=True,
+        help=f"Directory the {what} are written to.",
+    )
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
 @click.version_option(__version__, prog_name="lutbake")
 @click.option(
@@ -44,13 +55,7 @@ def main(verbose):
 @main.command()
 @click.argument("configs", nargs=-1, type=click.Path(path_type=Path))
 @click.option("--preset", "presets", multiple=True, metavar="NAME", help="Bake a preset config (lutbake list).")
-@click.option(
-    "--out-dir",
-    type=click.Path(path_type=Path),
-    default=Path("outputs"),
-    show_default=True,
-    help="Directory the EXRs are written to.",
-)
+@out_dir_option("outputs", "tables")
 @click.option(
     "--set",
     "overrides",
@@ -60,11 +65,7 @@ def main(verbose):
 )
 @click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
 @click.option(
-    "--device",
-    type=click.Choice(["cpu", "cuda"]),
-    default="cpu",
-    show_default=True,
-    help="Warp device the kernels run on.",
+    "--device", type=click.Choice(["cpu", "cuda"]), default="cpu", help="Warp device of the kernels: cpu, cuda."
 )
 @click.option("--progress/--no-progress", default=None, help="Progress bar (default: on a terminal, for long bakes).")
 @click.option("--force", is_flag=True, help="Rebake every table, even those whose output is up to date.")
@@ -78,7 +79,7 @@ def main(verbose):
 @click.option(
     "--format",
     "fmt",
-    type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h"]),
+    type=click.Choice(["exr", "npy", "png16", "dds", "ktx2", "h", "openpbr_h"]),
     default=None,
     help="Output format of every table (same as --set format=...; default: each table's `format`, exr).",
 )
@@ -86,8 +87,9 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.<ext> (EXR unless `format` / --format says otherwise).
 
     All configs are validated before any kernel runs; a bad config exits with status 2 and writes
-    nothing. A table whose output exists with the same content hash (its config, the lutbake version
-    and the kernels' source) is skipped ("skipped PATH (up to date)"); --force rebakes it. Tables bake
+    nothing; so does an out-dir or --report that cannot be written. A table whose output exists with
+    the same content hash (its config, the lutbake version and the kernels' source), and whose bytes
+    match the sha256 recorded with it, is skipped ("skipped PATH (up to date)"); --force rebakes it. Tables bake
     in parallel; each prints one line: path, shape, seconds, samples per texel. A table that fails
     does not stop the others; the exit status is then 1. Outputs are replaced atomically: Ctrl-C
     (exit 130) or SIGTERM (exit 143) keeps finished tables, writes no unfinished one, and lists the
@@ -101,10 +103,11 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
       lutbake bake configs/dfg.toml --set dfg.estimator=sobol_vndf --set dfg.samples=4096
       lutbake bake --preset unreal --format dds        # -> outputs/preintegrated_gf.dds (R16G16_FLOAT)
     """
-    from . import batch
+    from . import batch, preflight
     from .api import samples_note
     from .config import load_configs, preset_path
     from .errors import ConfigError
+    from .textsafe import escape_controls
 
     try:
         paths = [preset_path(p) for p in presets] + list(configs)
@@ -113,18 +116,20 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
         if fmt:
             overrides = tuple(overrides) + (f'format="{fmt}"',)
         specs = load_configs(paths, overrides)
-        if out_dir.exists() and not out_dir.is_dir():
-            raise ConfigError("--out-dir", "out-dir", str(out_dir), message="exists and is not a directory")
-        if report is not None and report.is_dir():
-            raise ConfigError("--report", "report", str(report), message="is a directory")
+        preflight.check_out_dir(out_dir)
         if device == "cuda":
             from .warp_runtime import init_warp
 
             if not init_warp().is_cuda_available():
                 raise ConfigError("--device", "device", "cuda", "cpu", "no CUDA device is available")
-        jobs = batch.plan(specs, out_dir, force=force)
+        jobs = batch.schedule(specs, out_dir, force=force)
+        preflight.check_outputs(jobs)
+        preflight.check_report(report, jobs, paths)
     except ConfigError as e:
         click.echo(f"error: {e}", err=True)
+        sys.exit(EXIT_CONFIG)
+    except RecursionError:  # a value nested too deeply for some check that slipped past load_configs
+        click.echo("error: a config or --set value is nested too deeply", err=True)
         sys.exit(EXIT_CONFIG)
     except KeyboardInterrupt:
         click.echo("interrupted (SIGINT) while planning: nothing was baked or written", err=True)
@@ -134,19 +139,21 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
         if job.status == "baked":
             note = samples_note(job.spec, job.samples)
             click.echo(
-                f"{job.path}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel"
+                f"{escape_controls(str(job.path))}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel"
                 + (f" ({note})" if note else "")
             )
         elif job.status == "failed":
-            click.echo(f"FAILED {job.name}: {job.message}", err=True)
+            click.echo(f"FAILED {job.name}: {escape_controls(job.message)}", err=True)
 
     for job in jobs:
         if job.status == "skipped":
-            click.echo(f"skipped {job.path} (up to date)")
+            click.echo(f"skipped {escape_controls(str(job.path))} (up to date)")
+    pending = sum(j.status == "pending" for j in jobs)
+    bars = progress if progress is not None else (sys.stderr.isatty() and pending == 1)
     signum = None
     try:
         with batch.signal_handlers():
-            signum = batch.run(jobs, workers, device, progress, on_done=on_done)
+            signum = batch.run(jobs, workers, device, progress_bars if bars else None, on_done=on_done)
     except (KeyboardInterrupt, batch.Interrupted) as e:  # a second Ctrl-C while tables wind down
         signum = getattr(e, "signum", 2)
         for job in jobs:
@@ -154,7 +161,17 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
                 job.status, job.message = "interrupted", "interrupted; nothing written"
     status = batch.exit_status(jobs, signum)
     if report is not None:
-        batch.write_report(report, jobs, status, signum)
+        try:
+            batch.write_report(report, jobs, status, signum)
+        except OSError as e:
+            from .io.oserror import os_error_text
+
+            click.echo(
+                f"error: cannot write the report {escape_controls(str(report))}: "
+                f"{escape_controls(os_error_text(e, report.parent))}",
+                err=True,
+            )
+            status = status or batch.EXIT_FAILED
     failed = [j.name for j in jobs if j.status == "failed"]
     unfinished = [j.name for j in jobs if j.status in ("interrupted", "pending")]
     if failed:
@@ -168,18 +185,44 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     sys.exit(status)
 
 
+PROGRESS_MIN_EVALS = 1.5e7  # about a second of work on two busy cores: show a bar above it
+
+
+def progress_bars(label: str, n_texels: int, cost: float):
+    """lutbake.executor.Progress drawn as a click progress bar on stderr (tables above PROGRESS_MIN_EVALS)."""
+    if cost <= PROGRESS_MIN_EVALS:
+        return None
+    bar = click.progressbar(length=n_texels, label=label, file=sys.stderr, show_eta=True)
+    bar.__enter__()
+    left = [n_texels]
+
+    def update(n: int) -> None:
+        bar.update(n)
+        left[0] -= n
+        if left[0] <= 0:
+            bar.__exit__(None, None, None)
+
+    return update
+
+
 @main.command("list")
 def list_():
     """List table kinds, selectable terms, estimators and presets."""
     from .axes import TEXELS
     from .config import presets
+    from .integrands.anisotropic import ANISO_MODELS
+    from .integrands.diffuse import DIFFUSE_MODELS
+    from .integrands.fresnel import FRESNELS
+    from .integrands.specular import SPECULAR_MODELS
     from .io.formats import FORMATS
-    from .tables import KINDS
-    from .tables.dfg import LAYOUTS
-    from .tables.diffuse import MODELS as DIFFUSE_MODELS
-    from .tables.specular import ESTIMATORS
-    from .tables import aniso
-    from .terms.sets import MASKINGS, MODELS, NDFS
+    from .kinds import KINDS
+    from .kinds.dfg import LAYOUTS
+    from .kinds.diffuse import DIFFUSE_ESTIMATORS
+    from .kinds.specular_aniso import VIEW_AZIMUTHS
+    from .sampling.anisotropic import ANISO_ESTIMATORS
+    from .sampling.hemisphere import ESTIMATORS
+    from .terms.distributions import MASKINGS, NDFS
+    from .terms.metals import METALS
 
     def section(title, items):
         click.echo(click.style(title, bold=True))
@@ -193,20 +236,19 @@ def list_():
     )
     section("NDFs (ndf = ...)", {k: v.description for k, v in NDFS.items()})
     section("Masking-shadowing (masking = ...)", MASKINGS)
-    section("Models (dfg, albedo, albedo_avg, specular_3d: model = ...)", MODELS)
-    section("Anisotropic models (specular_aniso: model = ...)", aniso.MODELS)
-    section("View azimuth (specular_aniso: view_azimuth = ...)", aniso.VIEW_AZIMUTHS)
-    from .tables.fresnel import FRESNELS
-    from .terms.metals import METALS
+    section("Models (dfg, albedo, albedo_avg, specular_3d: model = ...)", SPECULAR_MODELS)
+    section("Anisotropic models (specular_aniso: model = ...)", ANISO_MODELS)
+    section("View azimuth (specular_aniso: view_azimuth = ...)", VIEW_AZIMUTHS)
 
     section("Fresnel (specular_3d: fresnel = ...; dfg factors Schlick out)", FRESNELS)
     section(
         "Metals (specular_3d: metal = ...)", {k: f"n+ik R,G,B = {m.n} + i{m.k}; {m.source}" for k, m in METALS.items()}
     )
     section("DFG layouts (layout = ...)", LAYOUTS)
-    section("Estimators (estimator = ...)", ESTIMATORS)
+    section("Estimators (dfg, albedo, albedo_avg, specular_3d: estimator = ...)", ESTIMATORS)
     section("Diffuse models (kind = diffuse, model = ...)", DIFFUSE_MODELS)
-    section("Estimators (specular_aniso: estimator = ...)", aniso.ESTIMATORS)
+    section("Estimators (diffuse, diffuse_3d: estimator = ...)", DIFFUSE_ESTIMATORS)
+    section("Estimators (specular_aniso: estimator = ...)", ANISO_ESTIMATORS)
     section("Texel conventions (texel = ...)", TEXELS)
     section("Output formats (format = ... / --format)", FORMATS)
     section("Presets (--preset NAME)", {k: _first_comment(p) for k, p in presets().items()})
@@ -244,13 +286,7 @@ def inspect(file):
 
 
 @main.command()
-@click.option(
-    "--out-dir",
-    type=click.Path(path_type=Path),
-    default=Path("outputs/figures"),
-    show_default=True,
-    help="Directory the PNGs are written to.",
-)
+@out_dir_option("outputs/figures", "PNGs")
 @click.option(
     "--sigma-to-alpha",
     type=click.Choice(["sigma", "sigma_squared"]),
@@ -267,7 +303,7 @@ def inspect(file):
 )
 @click.option("--no-png", is_flag=True, help="Only print the error table.")
 def plot(out_dir, sigma_to_alpha, order, no_png):
-    """Reproduce the seed's Figures 11-15 (settings of Figures 6-10): Oren-Nayar, Oren-Nayar with Fresnel,
+    """Reproduce Figures 11-15 of Gotanda 2014 (settings of its Figures 6-10): Oren-Nayar, Oren-Nayar with Fresnel,
     the integrated microfacet model and the fitted model; print the fitted model's error per figure.
 
     \b

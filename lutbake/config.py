@@ -10,17 +10,19 @@ from __future__ import annotations
 import math
 import re
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import MappingProxyType
-from typing import Any, Mapping
+from typing import Any
 
 from .errors import ConfigError
-from .tables import KINDS, lookup_kind
-from .tables.base import Key
+from .kinds import KINDS, Key, lookup_kind
+from .preflight import config_file_problem, nesting_problem
+from .value_bounds import unit_range
 
-NAME_RE = re.compile(r"^[A-Za-z0-9_-]{1,128}$")
-MAX_TEXELS = 1 << 26  # 64 Mi texels; float64 accumulation of 4 channels = 2 GiB
+NAME_RE = re.compile(r"[A-Za-z0-9_-]{1,128}")  # use fullmatch: "$" would accept a final newline
+MAX_TEXELS = 1 << 26  # 64 Mi texels of any kind (Kind.texels); float64 accumulation of 4 channels = 2 GiB
 BYTES_PER_TEXEL = 32  # float64 x 4 channels while baking
 MAX_LIST = 1024  # entries of a float_list key
 
@@ -87,7 +89,7 @@ def _check_value(key: Key, value, file, table) -> Any:
     if key.type in ("str", "name"):
         if not isinstance(value, str):
             fail("must be a string", ", ".join(key.choices) if key.choices else None)
-        if key.type == "name" and not NAME_RE.match(value):
+        if key.type == "name" and not NAME_RE.fullmatch(value):
             fail("must be 1-128 letters, digits, '-' or '_' (it names the output file)")
         if key.choices is not None and value not in key.choices:
             fail("is not a known value", ", ".join(key.choices))
@@ -177,16 +179,30 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
             options[k.name] = list(k.default) if isinstance(k.default, list) else k.default
     options["kind"] = kind.name
     spec = TableSpec(options["name"], kind.name, MappingProxyType(options), str(file), index)
-    texels = math.prod(options.get("size", [1]))
+    texels = kind.texels(options)
     if texels > MAX_TEXELS:
+        size_keys = [k for k in options if k == "size" or k.endswith("_size")]  # the key to name: size, else ...
+        size_key = "size" if "size" in options else (size_keys[0] if size_keys else "size")
         raise ConfigError(
             file,
-            "size",
-            options["size"],
+            size_key,
+            options.get(size_key),
             f"at most {MAX_TEXELS} texels = {human_bytes(MAX_TEXELS * BYTES_PER_TEXEL)}",
-            f"{texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} of memory while baking",
+            f"{kind.texels_doc} = {texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} "
+            "of memory while baking",
             label,
         )
+    if options.get("format") == "png16":
+        reason = unit_range(spec)
+        if reason:
+            raise ConfigError(
+                file,
+                "format",
+                "png16",
+                "exr, npy, dds, ktx2, h",
+                f"png16 stores values in [0, 1] only, and this table's {reason}",
+                label,
+            )
     if kind.check is not None:
         msg = kind.check(spec)
         if msg:
@@ -205,10 +221,15 @@ def parse_overrides(items: tuple[str, ...] | list[str]) -> list[tuple[str | None
             raise ConfigError("--set", item, message="must look like KEY=VALUE or TABLE.KEY=VALUE")
         lhs, rhs = item.split("=", 1)
         table, _, key = lhs.strip().rpartition(".")
+        problem = nesting_problem(rhs)
+        if problem:
+            raise ConfigError("--set", key.strip(), message=f"VALUE: {problem}")
         try:
             value = tomllib.loads(f"v = {rhs.strip()}")["v"]
         except tomllib.TOMLDecodeError:
             value = rhs.strip()  # a bare word: a string
+        except RecursionError:
+            raise ConfigError("--set", key.strip(), message="VALUE is nested too deeply") from None
         out.append((table or None, key, value))
     return out
 
@@ -216,10 +237,17 @@ def parse_overrides(items: tuple[str, ...] | list[str]) -> list[tuple[str | None
 def load_config(path, overrides=()) -> list[TableSpec]:
     """Read and validate one TOML config; ``overrides`` from parse_overrides() are applied first."""
     path = Path(path)
-    if not path.is_file():
-        raise ConfigError(path, None, message="no such config file")
+    problem = config_file_problem(path)
+    if problem:
+        raise ConfigError(path, None, message=problem)
     try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+        text = path.read_text(encoding="utf-8")
+        problem = nesting_problem(text)
+        if problem:
+            raise ConfigError(path, None, message=f"invalid config: {problem}")
+        doc = tomllib.loads(text)
+    except RecursionError:
+        raise ConfigError(path, None, message="invalid TOML: arrays, tables or dotted keys nested too deeply") from None
     except (tomllib.TOMLDecodeError, UnicodeDecodeError, ValueError) as e:
         raise ConfigError(path, None, message=f"invalid TOML: {e}") from None
     except OSError as e:

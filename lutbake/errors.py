@@ -1,6 +1,10 @@
-"""Errors users see. A ConfigError always names the file, the key, the bad value and what is allowed."""
+"""Errors users see. A ConfigError always names the file, the key, the bad value and what is allowed.
+Keys and values are shown repr-escaped and bounded (lutbake.textsafe): no terminal escape sequence and no
+RecursionError reaches the user."""
 
 from __future__ import annotations
+
+from .textsafe import escape_controls, safe_repr
 
 
 class LutbakeError(Exception):
@@ -23,13 +27,14 @@ class ConfigError(LutbakeError):
             where += f": table {table}"
         parts = [where]
         if key is not None:
-            parts.append(f"key '{key}' = {value!r}" if value is not None else f"key '{key}'")
+            shown = safe_repr(key)
+            parts.append(f"key {shown} = {safe_repr(value)}" if value is not None else f"key {shown}")
         text = ": ".join(parts)
         if message:
             text += f": {message}"
         if allowed:
             text += f" (allowed: {allowed})"
-        super().__init__(text)
+        super().__init__(escape_controls(text))
 
 
 class TableError(LutbakeError):

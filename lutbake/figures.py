@@ -36,7 +36,7 @@ FIGURES = [
     Figure("14b", "theta_v", 0.866, 1.0, 0.7),
     Figure("15", "theta_v", 0.259, 0.985, 0.8),
 ]
-MODELS = ("oren_nayar", "oren_nayar_fresnel", "microfacet", "fitted")
+FIGURE_MODELS = ("oren_nayar", "oren_nayar_fresnel", "microfacet", "fitted")
 
 
 def directions(fig: Figure, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -54,13 +54,13 @@ def directions(fig: Figure, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def curves(
     fig: Figure,
     theta: np.ndarray,
-    models=MODELS,
+    models=FIGURE_MODELS,
     sigma_to_alpha: str = "sigma",
     facet_fresnel: str = "eq6",
     order: int = 12,
 ) -> dict[str, np.ndarray]:
     """L_r = f_r (n.l) per model along the figure's abscissa."""
-    from .tables.diffuse import eval_brdf
+    from .integrands.diffuse import eval_brdf
 
     l, v = directions(fig, theta)
     out = {}

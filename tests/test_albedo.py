@@ -3,8 +3,6 @@
 import numpy as np
 import pytest
 
-from lutbake.api import bake_table
-from lutbake.config import validate_table
 from lutbake.validate.checks import KC_FURNACE_TOL as FURNACE_TOL
 from lutbake.validate.checks import KC_FURNACE_TOL_SMOOTHEST as FURNACE_TOL_SMOOTHEST
 from lutbake.validate.checks import KC_N_MU as N_MU
@@ -15,14 +13,10 @@ from lutbake.validate.checks import kulla_conty_residual as white_furnace
 # documents them; this test prints the per-row residuals.
 
 
-def spec(**kw):
-    return validate_table(kw, "<test>", 0)
-
-
 @pytest.fixture(scope="module")
-def tables():
-    e = bake_table(spec(name="e", kind="albedo", size=[N_MU, N_ROUGH]), workers=2)[0]
-    avg = bake_table(spec(name="a", kind="albedo_avg", roughness_size=N_ROUGH), workers=2)[0]
+def tables(bake):
+    e = bake(name="e", kind="albedo", size=[N_MU, N_ROUGH])
+    avg = bake(name="a", kind="albedo_avg", roughness_size=N_ROUGH)
     return e, avg
 
 
@@ -35,9 +29,9 @@ def test_albedo_avg_is_one_row_over_the_same_roughness(tables):
     assert E_avg[0] == pytest.approx(1.0, abs=1e-4)  # near-mirror GGX loses (almost) nothing
 
 
-def test_albedo_is_dfg_multiscatter_green(tables):
+def test_albedo_is_dfg_multiscatter_green(tables, bake):
     e, _ = tables
-    ms = bake_table(spec(name="d", kind="dfg", size=[N_MU, N_ROUGH], layout="multiscatter"), workers=2)[0]
+    ms = bake(name="d", kind="dfg", size=[N_MU, N_ROUGH], layout="multiscatter")
     np.testing.assert_allclose(e.data[..., 0], ms.data[..., 1], atol=1e-6)
 
 

@@ -15,11 +15,11 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from lutbake import api, batch
+from lutbake import batch, pipeline, provenance
 from lutbake.cli import main
 from lutbake.config import load_configs
 from lutbake.io.exr import read_exr
-from lutbake.tables import lookup_kind
+from lutbake.kinds import lookup_kind
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -38,6 +38,10 @@ def write_config(tmp_path, *tables, name="c.toml"):
 
 def bake(*args):
     return CliRunner().invoke(main, ["bake", *map(str, args)])
+
+
+def drop_data_hash(attrs):
+    return {k: v for k, v in attrs.items() if k != "data_hash"}
 
 
 def lutbake_header(path):
@@ -59,7 +63,7 @@ def test_rerun_skips_up_to_date_tables_and_force_rebakes(three):
     assert sorted(mtimes) == ["a.exr", "b.exr", "c.exr"]
     specs = load_configs([cfg])
     for s in specs:
-        assert lutbake_header(out / f"{s.name}.exr")["content_hash"] == batch.content_hash(s)
+        assert lutbake_header(out / f"{s.name}.exr")["content_hash"] == provenance.content_hash(s)
 
     r = bake(cfg, "--out-dir", out)
     assert r.exit_code == 0, r.output
@@ -88,20 +92,20 @@ def test_a_one_line_config_change_rebakes_only_that_table(three):
 def test_content_hash_covers_config_version_and_kernel_sources(monkeypatch, tmp_path):
     (s,) = load_configs([write_config(tmp_path, table("a"))])
     (s2,) = load_configs([write_config(tmp_path, table("a", samples=49), name="d.toml")])
-    h = batch.content_hash(s)
-    assert len(h) == 64 and h == batch.content_hash(s)
-    assert batch.content_hash(s2) != h
-    assert batch.content_hash(s, b"other sources") != h
-    monkeypatch.setattr(batch, "__version__", "9.9.9")
-    assert batch.content_hash(s) != h
-    rel = {f.relative_to(batch.PACKAGE).as_posix() for f in batch.source_files()}
+    h = provenance.content_hash(s)
+    assert len(h) == 64 and h == provenance.content_hash(s)
+    assert provenance.content_hash(s2) != h
+    assert provenance.content_hash(s, b"other sources") != h
+    monkeypatch.setattr(provenance, "__version__", "9.9.9")
+    assert provenance.content_hash(s) != h
+    rel = {f.relative_to(provenance.PACKAGE).as_posix() for f in provenance.source_files()}
     for f in (
         "terms/ndf.py",
         "terms/masking.py",
         "terms/fresnel.py",
-        "sampling/estimators.py",
-        "tables/dfg.py",
-        "tables/specular.py",
+        "sampling/hemisphere.py",
+        "kinds/dfg.py",
+        "integrands/specular.py",
         "axes.py",
         "edge.py",
     ):
@@ -117,20 +121,28 @@ def test_a_corrupt_or_foreign_output_is_rebaked(three):
     assert lutbake_header(out / "a.exr")["kind"] == "dfg"
 
 
-def _sabotage(monkeypatch, how):
-    """Make the tables named in ``how`` fail in their run_tile: name -> 'raise' | 'nan' | 'oom'."""
-    real = api.lookup_kind
+def wrap_run_tile(monkeypatch, wrappers):
+    """The tables named in ``wrappers`` bake with ``wrappers[name](run_tile)`` as their plan's run_tile."""
+    real = pipeline.lookup_kind
 
     def lookup(name):
         kind = real(name)
 
         def plan(spec):
             p = kind.plan(spec)
-            mode = how.get(spec.name)
-            if mode is None:
-                return p
-            orig = p.run_tile
+            wrap = wrappers.get(spec.name)
+            return p if wrap is None else dataclasses.replace(p, run_tile=wrap(p.run_tile))
 
+        return dataclasses.replace(kind, plan=plan)
+
+    monkeypatch.setattr(pipeline, "lookup_kind", lookup)
+
+
+def _sabotage(monkeypatch, how):
+    """Make the tables named in ``how`` fail in their run_tile: name -> 'raise' | 'nan' | 'oom'."""
+
+    def failing(mode):
+        def wrap(orig):
             def run_tile(s, e, d):
                 if mode == "raise":
                     raise RuntimeError("kernel exploded")
@@ -138,11 +150,11 @@ def _sabotage(monkeypatch, how):
                     raise MemoryError()
                 return np.full_like(orig(s, e, d), np.nan)
 
-            return dataclasses.replace(p, run_tile=run_tile)
+            return run_tile
 
-        return dataclasses.replace(kind, plan=plan)
+        return wrap
 
-    monkeypatch.setattr(api, "lookup_kind", lookup)
+    wrap_run_tile(monkeypatch, {name: failing(mode) for name, mode in how.items()})
 
 
 def test_one_failing_table_does_not_stop_the_others(monkeypatch, tmp_path):
@@ -185,36 +197,36 @@ def test_report_has_every_field(three):
     assert [t["status"] for t in doc["tables"]] == ["skipped", "skipped", "skipped", "baked"]
 
 
+@pytest.fixture
+def terminal_sigint():
+    """SIGINT raises KeyboardInterrupt, as in a terminal (a shell's background job inherits SIG_IGN for it)."""
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)
+
+
 @pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
-def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatch, tmp_path, signum, code):
+def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(
+    monkeypatch, tmp_path, signum, code, terminal_sigint
+):
     cfg = write_config(tmp_path, table("first"), table("slow", size=[64, 32]), table("last"))
     out = tmp_path / "out"
     out.mkdir()
     stale = out / "slow.exr"
     stale.write_bytes(b"a good file from an older run")
-    real = api.lookup_kind
 
-    def lookup(name):
-        kind = real(name)
+    def interrupted(orig):
+        def run_tile(s, e, d):
+            if s == 0:
+                os.kill(os.getpid(), signum)  # Ctrl-C / SIGTERM arrives while this table bakes
+            time.sleep(0.3)
+            return orig(s, e, d)
 
-        def plan(spec):
-            p = kind.plan(spec)
-            if spec.name != "slow":
-                return p
-            orig = p.run_tile
+        return run_tile
 
-            def run_tile(s, e, d):
-                if s == 0:
-                    os.kill(os.getpid(), signum)  # Ctrl-C / SIGTERM arrives while this table bakes
-                time.sleep(0.3)
-                return orig(s, e, d)
-
-            return dataclasses.replace(p, run_tile=run_tile)
-
-        return dataclasses.replace(kind, plan=plan)
-
-    monkeypatch.setattr(api, "lookup_kind", lookup)
+    wrap_run_tile(monkeypatch, {"slow": interrupted})
     rep = tmp_path / "r.json"
+    handlers = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
     r = bake(cfg, "--out-dir", out, "--workers", "1", "--report", rep)
     assert r.exit_code == code, r.output
     assert "Traceback" not in r.output
@@ -224,7 +236,7 @@ def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(monkeypatc
     doc = json.loads(rep.read_text())
     assert [t["status"] for t in doc["tables"]] == ["baked", "interrupted", "interrupted"]
     assert doc["exit_status"] == code and doc["interrupted_by"] == signal.Signals(signum).name
-    assert signal.getsignal(signal.SIGTERM) is not None  # handler restored (no exception)
+    assert {s: signal.getsignal(s) for s in handlers} == handlers  # the bake's SIGTERM handler is gone again
     # the next run resumes only the tables that did not finish
     monkeypatch.undo()
     r = bake(cfg, "--out-dir", out)
@@ -246,7 +258,7 @@ def test_two_concurrent_runs_never_corrupt_a_file(tmp_path):
         assert p.returncode == 0, stderr
         assert stdout.count("samples/texel") == 4
     assert sorted(p.name for p in out.iterdir()) == [f"t{i}.exr" for i in range(4)]
-    ref = {t.name: t for t, _, _ in (api.bake_table(s, workers=1) for s in load_configs([cfg]))}
+    ref = {t.name: t for t, _, _ in (pipeline.bake_table(s, workers=1) for s in load_configs([cfg]))}
     for i in range(4):
         data, attrs = read_exr(out / f"t{i}.exr")
         assert np.array_equal(data, ref[f"t{i}"].data)
@@ -269,19 +281,21 @@ def test_same_config_gives_identical_pixels_and_headers_for_any_worker_count(tmp
     for other in runs[1:]:
         for n in "xyz":
             assert np.array_equal(runs[0][n][0], other[n][0])
-            assert runs[0][n][1] == other[n][1]  # every lutbake:* attribute, content_hash included
+            # every lutbake:* attribute, content_hash included, but data_hash: the sha256 of the file's
+            # bytes, which hold OpenImageIO's capDate (the write time; docs/batch.md)
+            assert drop_data_hash(runs[0][n][1]) == drop_data_hash(other[n][1])
 
 
 def test_api_plan_and_run_without_the_cli(tmp_path):
     specs = load_configs([write_config(tmp_path, table("p"), table("q"))])
-    jobs = batch.plan(specs, tmp_path / "o")
+    jobs = batch.schedule(specs, tmp_path / "o")
     assert [j.status for j in jobs] == ["pending", "pending"]
     seen = []
     assert batch.run(jobs, workers=2, on_done=seen.append) is None
     assert sorted(j.name for j in seen) == ["p", "q"] and all(j.status == "baked" for j in jobs)
     assert batch.exit_status(jobs, None) == 0
-    assert [j.status for j in batch.plan(specs, tmp_path / "o")] == ["skipped", "skipped"]
-    assert [j.status for j in batch.plan(specs, tmp_path / "o", force=True)] == ["pending", "pending"]
+    assert [j.status for j in batch.schedule(specs, tmp_path / "o")] == ["skipped", "skipped"]
+    assert [j.status for j in batch.schedule(specs, tmp_path / "o", force=True)] == ["pending", "pending"]
     assert lookup_kind("dfg").name == "dfg"
 
 
@@ -291,12 +305,15 @@ def test_ctrl_c_on_a_real_process(tmp_path):
     cfg = write_config(tmp_path, table("first"), table("big", size=[256, 256], samples=432))
     out = tmp_path / "out"
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    # a child inherits SIG_IGN for SIGINT from a shell's background job (`make test &`), and Python then
+    # installs no KeyboardInterrupt handler: restore the default so the signal is delivered as from a terminal
     p = subprocess.Popen(
         [sys.executable, "-m", "lutbake", "bake", str(cfg), "--out-dir", str(out), "--workers", "1"],
         env=env,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     deadline = time.monotonic() + 60
     while not (out / "first.exr").exists() and p.poll() is None and time.monotonic() < deadline:
@@ -317,7 +334,7 @@ def test_every_format_is_skipped_when_up_to_date(tmp_path, fmt, ext):
     out = tmp_path / "out"
     first = bake(cfg, "--out-dir", out)
     assert first.exit_code == 0, first.output
-    assert (out / f"t{ext}").is_file() and (out / "t.json").is_file()
+    assert (out / f"t{ext}").is_file() and (out / f"t{ext}.json").is_file()
     again = bake(cfg, "--out-dir", out)
     assert again.exit_code == 0 and f"skipped {out / ('t' + ext)} (up to date)" in again.output
     changed = bake(cfg, "--out-dir", out, "--set", "samples=64")

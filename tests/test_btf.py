@@ -6,22 +6,16 @@ import json
 import numpy as np
 import pytest
 
-from lutbake.api import bake_table
-from lutbake.config import validate_table
 from lutbake.errors import ConfigError
+from lutbake.integrands import diffuse as D
 from lutbake.io.exr import read_exr, write_exr
-from lutbake.tables import diffuse as D
 
-
-def spec(**kw):
-    return validate_table(
-        {"name": "b", "kind": "btf", "size": [5, 5], "phi_size": 3, "sigma_size": 2, **kw}, "<test>", 0
-    )
+BTF = {"name": "b", "kind": "btf", "size": [5, 5], "phi_size": 3, "sigma_size": 2}
 
 
 @pytest.fixture(scope="module")
-def cosines():
-    return bake_table(spec(parametrisation="cosines", samples=8), workers=2)[0]
+def cosines(bake):
+    return bake(BTF, parametrisation="cosines", samples=8)
 
 
 def test_shape_and_axes(cosines):
@@ -49,11 +43,10 @@ def test_every_block_is_symmetric_reciprocity(cosines):
     np.testing.assert_allclose(d, d.transpose(0, 1, 3, 2), rtol=1e-5, atol=1e-7)
 
 
-def test_sigma_0_slice_is_lambert_times_eq6():
-    t = bake_table(
-        spec(parametrisation="angles", sigma_range=[0.0, 0.0], sigma_size=1, f0=0.04, size=[4, 4], phi_size=2),
-        workers=1,
-    )[0]
+def test_sigma_0_slice_is_lambert_times_eq6(bake):
+    t = bake(
+        BTF, parametrisation="angles", sigma_range=[0.0, 0.0], sigma_size=1, f0=0.04, size=[4, 4], phi_size=2, workers=1
+    )
     tl, tv = (np.cos(a.values().astype(np.float64)) for a in (t.axes[3], t.axes[2]))
     w = lambda c: 1 - (1 - c) ** 5  # noqa: E731
     ref = 1.05 * 0.96 * w(tv)[:, None] * w(tl)[None, :] / np.pi
@@ -61,8 +54,8 @@ def test_sigma_0_slice_is_lambert_times_eq6():
         np.testing.assert_allclose(t.data[0, p * 4 : (p + 1) * 4, :, 0], ref, rtol=2e-4)
 
 
-def test_fitted_variant_is_eq8_and_differs_from_the_integral(cosines):
-    t = bake_table(spec(parametrisation="cosines", model="fitted"), workers=1)[0]
+def test_fitted_variant_is_eq8_and_differs_from_the_integral(cosines, bake):
+    t = bake(BTF, parametrisation="cosines", model="fitted", workers=1)
     assert t.attributes["estimator"] == "closed_form" and "error_estimate" not in t.attributes
     rel = np.abs(t.data - cosines.data) / cosines.data.max()
     assert 1e-3 < rel.max() < 1.0  # close (the fit), not equal
@@ -77,13 +70,13 @@ def test_exr_round_trip_has_a_part_per_sigma_slice(cosines, tmp_path):
     assert attrs["parametrisation"] == "cosines" and float(attrs["error_estimate"]) < 1e-4
 
 
-def test_too_many_texels_is_rejected():
+def test_too_many_texels_is_rejected(spec):
     with pytest.raises(ConfigError, match="phi_size"):
-        spec(size=[1024, 1024], phi_size=1024, sigma_size=64)
+        spec(BTF, size=[1024, 1024], phi_size=1024, sigma_size=64)
 
 
-def test_explicit_sigma_values_make_a_listed_axis(tmp_path):
-    t = bake_table(spec(model="fitted", sigma_values=[0.0, 0.3, 0.35]), workers=1)[0]
+def test_explicit_sigma_values_make_a_listed_axis(tmp_path, bake):
+    t = bake(BTF, model="fitted", sigma_values=[0.0, 0.3, 0.35], workers=1)
     assert t.data.shape == (3, 15, 5, 1)
     assert t.axes[0].mapping == "listed"
     np.testing.assert_allclose(t.axes[0].values(), [0.0, 0.3, 0.35], rtol=1e-7)
@@ -104,6 +97,6 @@ def test_explicit_sigma_values_make_a_listed_axis(tmp_path):
         ([0.1, float("nan")], "finite"),
     ],
 )
-def test_bad_sigma_values_are_rejected(bad, fragment):
+def test_bad_sigma_values_are_rejected(bad, fragment, spec):
     with pytest.raises(ConfigError, match=fragment):
-        spec(sigma_values=bad)
+        spec(BTF, sigma_values=bad)

@@ -107,7 +107,7 @@ def test_spec_toml_round_trips(tmp_path):
 def test_every_key_of_every_kind_is_documented():
     from pathlib import Path
 
-    from lutbake.tables import KINDS
+    from lutbake.kinds import KINDS
 
     doc = (Path(__file__).parent.parent / "docs" / "config.md").read_text()
     for kind in KINDS.values():

@@ -3,33 +3,30 @@
 import numpy as np
 import pytest
 
-from lutbake.api import bake_table
-from lutbake.config import validate_table
 from lutbake.errors import ConfigError
 
 LIMIT_ATOL = 2e-4  # sigma = 0 row of the microfacet table vs (1 - f0)(1 - (1 - NoV)^5)
 
 
-def spec(**kw):
-    return validate_table({"name": "d", "kind": "diffuse", "size": [6, 4], **kw}, "<test>", 0)
+DIFFUSE = {"name": "d", "kind": "diffuse", "size": [6, 4]}
 
 
-def test_lambert_albedo_is_one():
-    t = bake_table(spec(model="lambert"), workers=1)[0]
+def test_lambert_albedo_is_one(bake):
+    t = bake(DIFFUSE, model="lambert", workers=1)
     assert t.data.shape == (4, 6, 1)
     np.testing.assert_allclose(t.data, 1.0, atol=1e-6)
 
 
-def test_oren_nayar_row_at_sigma_0_is_lambert():
-    t = bake_table(spec(model="oren_nayar", texel="endpoint", size=[5, 3]), workers=1)[0]
+def test_oren_nayar_row_at_sigma_0_is_lambert(bake):
+    t = bake(DIFFUSE, model="oren_nayar", texel="endpoint", size=[5, 3], workers=1)
     np.testing.assert_allclose(t.data[0, :, 0], 1.0, atol=1e-6)
     # the qualitative model is not energy conserving: at grazing view its albedo exceeds 1 (1.013 at sigma = 0.5)
     assert np.all(t.data > 0) and t.data[1, 0, 0] > 1.0
 
 
 @pytest.fixture(scope="module")
-def microfacet():
-    return bake_table(spec(model="microfacet", texel="endpoint", size=[5, 4]), workers=2)[0]
+def microfacet(bake):
+    return bake(DIFFUSE, model="microfacet", texel="endpoint", size=[5, 4])
 
 
 def test_microfacet_sigma_0_row_is_lambert_times_eq6_albedo(microfacet):
@@ -44,8 +41,8 @@ def test_microfacet_albedo_is_at_most_one_and_positive(microfacet):
     assert np.all(microfacet.data[:, 1:] > 0.0)
 
 
-def test_microfacet_f0_factors_out(microfacet):
-    t = bake_table(spec(model="microfacet", texel="endpoint", size=[5, 4], f0=0.04), workers=1)[0]
+def test_microfacet_f0_factors_out(microfacet, bake):
+    t = bake(DIFFUSE, model="microfacet", texel="endpoint", size=[5, 4], f0=0.04, workers=1)
     np.testing.assert_allclose(t.data, 0.96 * microfacet.data, rtol=1e-5, atol=1e-7)
     assert t.attributes["f0_factor"] == "(1 - f0)"
 
@@ -59,21 +56,23 @@ def test_microfacet_f0_factors_out(microfacet):
         ({"samples": 1}, ">= 2"),
     ],
 )
-def test_bad_diffuse_keys_are_rejected(kv, fragment):
+def test_bad_diffuse_keys_are_rejected(kv, fragment, spec):
     with pytest.raises(ConfigError, match=fragment):
-        spec(**kv)
+        spec(DIFFUSE, **kv)
 
 
 def test_swapped_albedo_matches_the_nested_rule():
-    """The table's integrator (m outside, l inside: lutbake.tables.diffuse_albedo) against the direct nested
-    rule (l outside, Eq. 4's m-integral inside: tables.diffuse.albedo), grazing and small-sigma texels included."""
-    from lutbake.tables import diffuse as D
-    from lutbake.tables import diffuse_albedo as A
+    """The table's integrator (m outside, l inside: lutbake.sampling.swapped) against the direct nested
+    rule (l outside, Eq. 4's m-integral inside: integrands.diffuse.albedo_gl), grazing and small-sigma texels
+    included."""
+    from lutbake.axes import sigma_alpha
+    from lutbake.edge import effective_alpha
+    from lutbake.integrands import diffuse as D
 
     nov = np.array([0.05, 0.2, 0.5, 0.9, 1.0, 0.3], np.float32)
     sigma = np.array([0.05, 0.5, 0.3, 1.0, 0.1, 0.02], np.float32)
-    nested = D.albedo("microfacet", nov, sigma, 0.04, "eq6", "sigma", order=12)
-    swapped = A.albedo(nov, D.alpha_from_sigma(sigma, "sigma"), 0.04, "eq6")
+    nested = D.albedo_gl("microfacet", nov, sigma, 0.04, "eq6", "sigma", order=12)
+    swapped = D.albedo_swapped(nov, effective_alpha(sigma_alpha(sigma, "sigma"), False), 0.04, "eq6")
     np.testing.assert_allclose(swapped, nested, atol=5e-5)
 
 
@@ -82,14 +81,12 @@ def test_microfacet_table_records_its_error_estimate(microfacet):
     assert "probe texels" in microfacet.attributes["error_estimate_method"]
 
 
-def test_grazing_small_sigma_corner_is_converged():
+def test_grazing_small_sigma_corner_is_converged(bake):
     """The corner the old nested rule missed by 2.9e-3 (NoV = sigma = 1/128): the default orders against order 32."""
-    from lutbake.tables import diffuse_albedo as A
+    from lutbake.integrands import diffuse as D
 
-    t = bake_table(
-        spec(model="microfacet", size=[4, 4], nov_range=[0.0, 0.0625], sigma_range=[0.0, 0.0625]), workers=1
-    )[0]
+    t = bake(DIFFUSE, model="microfacet", size=[4, 4], nov_range=[0.0, 0.0625], sigma_range=[0.0, 0.0625], workers=1)
     nov = np.tile(t.axes[1].values(), 4).astype(np.float64)
     alpha = np.repeat(t.axes[0].values(), 4).astype(np.float64)
-    ref = A.albedo(nov, alpha, orders=np.full((16, 3), 32))
+    ref = D.albedo_swapped(nov, alpha, orders=np.full((16, 3), 32))
     np.testing.assert_allclose(t.data[..., 0].reshape(-1), ref, atol=1e-6)

@@ -2,7 +2,7 @@
 
 from pathlib import Path
 
-from lutbake.tables import KINDS
+from lutbake.kinds import KINDS
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -13,11 +13,11 @@ OpenEXR = pytest.importorskip("OpenEXR")
 pytest.importorskip("OpenImageIO")
 
 from lutbake.axes import Axis  # noqa: E402
+from lutbake.io import atomic as atomic_mod  # noqa: E402
+from lutbake.io import exr as exr_mod  # noqa: E402
 from lutbake.io import read_exr, write_exr  # noqa: E402
 from lutbake.io.describe import describe  # noqa: E402
 from lutbake.io.readers import ReadError  # noqa: E402
-from lutbake.io import atomic as atomic_mod  # noqa: E402
-from lutbake.io import exr as exr_mod  # noqa: E402
 from lutbake.table import Table  # noqa: E402
 
 PROVENANCE = {

@@ -14,6 +14,7 @@ from click.testing import CliRunner
 from lutbake.axes import Axis
 from lutbake.cli import main
 from lutbake.io.formats import FORMATS, write_table
+from lutbake.io.integrity import sidecar_path
 from lutbake.table import Table
 
 HALF_REL = 2.0**-11  # half-float relative rounding
@@ -86,7 +87,7 @@ def read_ktx2_spec(blob):
     assert w0 == 0 and (w1 & 0xFFFF) == 2
     block = w1 >> 16
     nsamples = (block - 24) // 16
-    model, prim, transfer, dflags = w2 & 0xFF, (w2 >> 8) & 0xFF, (w2 >> 16) & 0xFF, w2 >> 24
+    model, prim, transfer, _dflags = w2 & 0xFF, (w2 >> 8) & 0xFF, (w2 >> 16) & 0xFF, w2 >> 24
     assert (model, prim, transfer) == (1, 1, 1)  # RGBSDA, BT709, LINEAR (never sRGB = 2)
     channels = []
     for s in range(nsamples):
@@ -129,7 +130,7 @@ def test_dds_read_back_from_the_spec(tmp_path, dtype, nch):
     p = write_table(t, tmp_path, "dds", dtype)
     arr, fmt = read_dds_spec(p.read_bytes())
     np.testing.assert_array_equal(arr, expect_gpu(t.data, dtype))
-    meta = json.loads(p.with_suffix(".json").read_text())
+    meta = json.loads(sidecar_path(p).read_text())
     assert meta["dxgi_format"].endswith("_FLOAT") and meta["lutbake"]["kind"] == "dfg"
 
 
@@ -219,7 +220,7 @@ def test_npy_round_trip_with_sidecar(tmp_path):
     arr = np.load(p)
     assert arr.dtype == np.float16 and arr.shape == t.data.shape
     np.testing.assert_array_equal(arr, t.data.astype(np.float16))
-    side = json.loads(p.with_suffix(".json").read_text())
+    side = json.loads(sidecar_path(p).read_text())
     assert side["shape"] == list(t.data.shape) and "axes" in side["lutbake"]
 
 

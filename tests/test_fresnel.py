@@ -4,7 +4,7 @@ values, and each approximation's maximum error against the exact curve (printed:
 import numpy as np
 import pytest
 
-from lutbake.tables.fresnel import evaluate, f_avg
+from lutbake.integrands.fresnel import evaluate, f_avg
 from lutbake.terms.metals import LAZANYI_ALPHA, METALS, fit_lazanyi_a, lookup_metal
 
 F32_TOL = 2e-6  # float32 evaluation of an O(1) expression

@@ -13,13 +13,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from lutbake.api import bake_table
-from lutbake.config import validate_table
-from lutbake.io.formats import write_table
-from lutbake.tables import specular
-
 from test_formats import read_dds_spec, read_ktx2_spec
+
+from lutbake.integrands import specular
+from lutbake.io.formats import write_table
 
 SNIPPET = Path(__file__).resolve().parents[1] / "docs" / "shaders" / "lutbake.glsl"
 N_POINTS = 512
@@ -104,26 +101,17 @@ def bilinear(lut, uv):
 
 def cpu_integral(options, nov, rough):
     """lutbake's own CPU evaluation of the table's integral at arbitrary (NoV, perceptual roughness)."""
-    k = specular.kernel_for(options["ndf"], options["masking"], options["layout"], "gauss_legendre")
-    alpha = np.maximum(np.asarray(rough, np.float64) ** 2, 1e-4)
-    return specular.integrate(
-        k,
-        np.asarray(nov, np.float32),
-        alpha.astype(np.float32),
-        "gauss_legendre",
-        432,
-        0,
-        specular.N_CHANNELS[options["layout"]],
-    )
+    alpha = np.asarray(rough, np.float64) ** 2
+    return specular.hemisphere_integral(
+        options["ndf"], options["masking"], options["layout"], nov, alpha, "gauss_legendre", 432
+    )[:, : specular.N_CHANNELS[options["layout"]]]
 
 
 def random_points(n=N_POINTS, lo=0.03, hi=0.97):
     return np.stack([RNG.uniform(lo, hi, n), RNG.uniform(lo, hi, n), RNG.uniform(0.02, 0.98, n)], axis=1)
 
 
-def bake(**kw):
-    spec = validate_table({"name": "gl", "kind": "dfg", **kw}, "<gl test>", 0)
-    return spec, bake_table(spec, workers=2)[0]
+GL_TABLE = {"name": "gl", "kind": "dfg"}
 
 
 def load(path, fmt):
@@ -173,12 +161,13 @@ CASES = [  # (config, format, dtype, GLSL uv expression, tolerance vs the integr
 
 
 @pytest.mark.parametrize("case", range(len(CASES)))
-def test_gl_samples_baked_2d_tables_at_random_points(ctx, tmp_path, case):
+def test_gl_samples_baked_2d_tables_at_random_points(ctx, tmp_path, case, spec, bake):
     config, fmt, dtype, uv_expr = CASES[case]
     points = random_points()
     errors, means = {}, {}
     for n in (32, 64):
-        spec, table = bake(size=[n, n], dtype=dtype, **config)
+        keys = {**GL_TABLE, "size": [n, n], "dtype": dtype, **config}
+        options, table = spec(keys).options, bake(keys)
         path = write_table(table, tmp_path / str(n), fmt, dtype)
         texels = load(path, fmt)
         got = gl_sample(ctx, texels, dtype, uv_expr, points)
@@ -191,7 +180,7 @@ def test_gl_samples_baked_2d_tables_at_random_points(ctx, tmp_path, case):
         cpu = bilinear(texels.astype(np.float64) / (65535 if fmt == "png16" else 1), uv)
         np.testing.assert_allclose(got[:, :nch], cpu[:, :nch], atol=2e-3 / n + 1e-5)
         # (b) ... and what it returns is the integral, up to the table's interpolation error
-        want = cpu_integral(spec.options, points[:, 0], points[:, 1])
+        want = cpu_integral(options, points[:, 0], points[:, 1])
         errors[n] = np.abs(got[:, :nch] - want).max()
         # the convergence check runs on the float32 table (the file may round to half: ~1e-4 noise)
         means[n] = np.abs(bilinear(table.data, uv)[:, :nch] - want).mean()
@@ -202,14 +191,14 @@ def test_gl_samples_baked_2d_tables_at_random_points(ctx, tmp_path, case):
     assert means[32] / means[64] > 3.0, means
 
 
-def test_gl_samples_a_3d_texture_at_random_points(ctx, tmp_path):
+def test_gl_samples_a_3d_texture_at_random_points(ctx, tmp_path, spec, bake):
     """No 3D table kind exists yet, so the 3D path is checked with E(NoV, r, f0) = f0 scale + bias stacked
     over 8 f0 slices at texel centres, written as DDS and KTX2 volume textures: trilinear filtering is
     exact in f0 (E is linear in it), so the error budget is the 2D table's."""
     from lutbake.axes import Axis
     from lutbake.table import Table
 
-    spec, t2 = bake(size=[64, 64])
+    options, t2 = spec(GL_TABLE, size=[64, 64]).options, bake(GL_TABLE, size=[64, 64])
     f0 = (np.arange(8) + 0.5) / 8
     vol = f0[:, None, None, None] * t2.data[None, ..., :1] + t2.data[None, ..., 1:2]
     axes = [Axis("f0", "z", 8)] + t2.axes
@@ -217,8 +206,8 @@ def test_gl_samples_a_3d_texture_at_random_points(ctx, tmp_path):
     points = random_points(lo=0.03, hi=0.97)
     points[:, 2] = np.clip(points[:, 2], 1 / 16, 15 / 16)
     want = (
-        points[:, 2:3] * cpu_integral(spec.options, points[:, 0], points[:, 1])[:, :1]
-        + cpu_integral(spec.options, points[:, 0], points[:, 1])[:, 1:2]
+        points[:, 2:3] * cpu_integral(options, points[:, 0], points[:, 1])[:, :1]
+        + cpu_integral(options, points[:, 0], points[:, 1])[:, 1:2]
     )
     for fmt in ("dds", "ktx2"):
         path = write_table(table, tmp_path, fmt, "half")

@@ -4,35 +4,25 @@ isotropic Ashikhmin-Shirley; and the config rules that keep a model's terms fixe
 import numpy as np
 import pytest
 
-from lutbake.api import bake_table
-from lutbake.config import validate_table
 from lutbake.errors import ConfigError
 
 SIZE = [12, 8]
 
 
-def spec(**kw):
-    return validate_table({"name": "t", **kw}, "<test>", 0)
-
-
-def bake(**kw):
-    return bake_table(spec(**kw), workers=2)[0]
-
-
-def test_cook_torrance_is_beckmann_v_cavity_bit_for_bit():
+def test_cook_torrance_is_beckmann_v_cavity_bit_for_bit(bake):
     ct = bake(kind="dfg", model="cook_torrance", size=SIZE)
     mf = bake(kind="dfg", ndf="beckmann", masking="v_cavity", size=SIZE)
     np.testing.assert_array_equal(ct.data, mf.data)
     assert '"model": "cook_torrance"' in ct.attributes["terms"] and '"ndf": "beckmann"' in ct.attributes["terms"]
 
 
-def test_blinn_phong_lobe_at_shininess_zero_is_lambertian():
+def test_blinn_phong_lobe_at_shininess_zero_is_lambertian(bake):
     """s = 0 (alpha = 1): f = F (0 + 8)/(8 pi) = F / pi, so E(F = 1) = ∫ (n.l)/pi dω = 1 for every n.v."""
     e = bake(kind="albedo", model="blinn_phong", size=[16, 1], roughness_range=[1.0, 1.0])
     np.testing.assert_allclose(e.data[..., 0], 1.0, atol=1e-6)
 
 
-def test_blinn_phong_lobe_energy():
+def test_blinn_phong_lobe_energy(bake):
     """(s + 8)/(8 pi) is an approximate normalisation: E(F = 1) exceeds 1 by a few percent (measured max 1.075 at
     n.v = 1, alpha = 0.42 on a 64 x 64 endpoint grid), and the microfacet form with the normalized Blinn-Phong NDF
     and V-cavity stays <= 1."""
@@ -43,7 +33,7 @@ def test_blinn_phong_lobe_energy():
     assert mf.data.max() <= 1.0 + 1e-6
 
 
-def test_blinn_phong_ndf_is_close_to_beckmann():
+def test_blinn_phong_ndf_is_close_to_beckmann(bake):
     """With s = 2/alpha^2 - 2 the two NDFs nearly coincide for small alpha (Walter et al. 2007, Sec. 5.2): the
     V-cavity dfg tables of the smooth rows agree closely."""
     bp = bake(kind="dfg", ndf="blinn_phong", masking="v_cavity", size=SIZE, roughness_range=[0.0, 0.4])
@@ -53,7 +43,7 @@ def test_blinn_phong_ndf_is_close_to_beckmann():
     assert err < 0.01
 
 
-def test_ashikhmin_shirley_isotropic_energy_le_one():
+def test_ashikhmin_shirley_isotropic_energy_le_one(bake):
     """Ashikhmin-Shirley: E(F = 1) <= 1 (its integrand over its own h density is (n.l)/max(n.l, n.v)), and
     specular_3d with Schlick F is f0 scale + bias of the dfg table, as for every model."""
     e = bake(kind="albedo", model="ashikhmin_shirley", size=SIZE, samples=1728)
@@ -75,6 +65,6 @@ def test_ashikhmin_shirley_isotropic_energy_le_one():
         ({"model": "phong"}, "model"),
     ],
 )
-def test_model_config_rules(kw, match):
+def test_model_config_rules(kw, match, spec):
     with pytest.raises(ConfigError, match=match):
         spec(kind="dfg", **kw)

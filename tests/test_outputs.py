@@ -13,7 +13,7 @@ from lutbake.api import bake_table
 from lutbake.cli import main
 from lutbake.config import preset_path, validate_table
 from lutbake.io.formats import FORMATS, write_table
-from lutbake.tables import lookup_kind
+from lutbake.kinds import lookup_kind
 
 ROOT = Path(__file__).resolve().parents[1]
 SMALL = {"size": [8, 6], "roughness_size": 8, "f0_size": 3, "anisotropy_size": 3, "phi_size": 3, "sigma_size": 3}

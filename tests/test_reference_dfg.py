@@ -8,7 +8,8 @@ not over the half vector as the package's estimators do, with its own numpy D an
     dω_l = sin(theta_l) dtheta_l dphi_l, theta_l in [0, pi/2], phi_l in [0, 2 pi] (twice [0, pi] by symmetry).
 
 Composite Gauss-Legendre in both angles, with panels graded geometrically towards the mirror direction
-(theta_l = theta_v, phi_l = pi for v at phi = 0, where D peaks: width ~2 alpha in theta_l, ~2 alpha (n.v) in phi_l) and towards the horizon theta_l = pi/2
+(theta_l = theta_v, phi_l = pi for v at phi = 0, where D peaks: width ~2 alpha in theta_l, ~2 alpha (n.v) in
+phi_l) and towards the horizon theta_l = pi/2
 (where G2 varies on the scale min(n.v, alpha)); the rule is converged to ~1e-8 at these texels
 (doubling the nodes per panel changes it by less than that).
 """
@@ -17,7 +18,7 @@ import numpy as np
 import pytest
 from scipy.special import erf
 
-from lutbake.tables.specular import integrate, kernel_for
+from lutbake.integrands.specular import hemisphere_integral
 
 REFERENCE_ATOL = 1.0e-4  # |table - reference| per channel
 QMC_SAMPLES = 1 << 16
@@ -145,7 +146,7 @@ def test_reference_integrator_is_converged():
 
 def table(ndf, masking, estimator, samples, form="microfacet"):
     nov, alpha = texels()
-    return integrate(kernel_for(ndf, masking, "scale_bias", estimator, form), nov, alpha, estimator, samples, SEED, 2)
+    return hemisphere_integral(ndf, masking, "scale_bias", nov, alpha, estimator, samples, SEED, form=form)
 
 
 def report(got, want):
@@ -172,15 +173,13 @@ def test_dfg_beckmann_separable_gauss_legendre_matches_reference(references):
     np.testing.assert_allclose(got, references[("beckmann", "smith_separable")], rtol=0.0, atol=REFERENCE_ATOL)
 
 
-def test_dfg_cook_torrance_gauss_legendre_matches_reference(references):
+def test_dfg_cook_torrance_gauss_legendre_matches_reference(references, spec):
     """The lecture's Cook-Torrance (Beckmann D with 1/pi, V-cavity G, Schlick F): the table kernel of
-    model = "cook_torrance" (lutbake.terms.sets.model_terms) against the reference with the V-cavity G written here."""
-    from lutbake.config import validate_table
-    from lutbake.tables.dfg import terms_of
+    model = "cook_torrance" (lutbake.integrands.specular.model_terms) against the reference with the V-cavity G
+    written here."""
+    from lutbake.kinds.dfg import terms_of
 
-    form, ndf, masking = terms_of(
-        validate_table({"name": "t", "kind": "dfg", "model": "cook_torrance"}, "<test>", 0).options
-    )
+    form, ndf, masking = terms_of(spec(kind="dfg", model="cook_torrance").options)
     # the same kinks slow the table's Gauss-Legendre too: measured max error 8.4e-4 at 432 samples (the default),
     # 8.4e-5 at 1152, 4.2e-5 at 4608; scrambled Sobol' NDF sampling with 2^20 points agrees with the reference to 3.5e-7
     got = table(ndf, masking, "gauss_legendre", 4608, form)

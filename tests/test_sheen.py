@@ -1,64 +1,33 @@
 """KHR_materials_sheen tables: dfg layouts `charlie` (the glTF Sample Viewer's lut_charlie) and `sheen_albedo`
 (the spec's albedo-scaling E), and the presets gltf-charlie / gltf-sheen-e.
 
-The baked channels are checked against an independent brute-force midpoint rule over l in numpy (the
-terms written out again from the KHR spec's GLSL, not lutbake's @wp.funcs)."""
+The baked channels are checked against an independent converged quadrature over l in numpy (the terms
+written out again from the KHR spec's GLSL, not lutbake's @wp.funcs): conftest.integrate_charlie."""
 
 import numpy as np
 import pytest
 
-from lutbake.api import bake_table
-from lutbake.config import load_config, parse_overrides, preset_path, presets
+from lutbake.config import load_config, presets
 from lutbake.errors import ConfigError
 from lutbake.validate.checks import CHECKS
 
-
-def bake_preset(name, *overrides):
-    (spec,) = load_config(preset_path(name), parse_overrides(list(overrides)))
-    return spec, bake_table(spec)[0]
-
-
-def lambda_sheen(c, a):
-    """KHR_materials_sheen README, "Sheen visibility" (Estevez & Kulla 2017 fit)."""
-    t = (1 - a) ** 2
-    A, B, C = 21.5473 + 3.7772 * t, 3.82987 - 0.50552 * t, 0.19823 - 0.03022 * t
-    D, E = -1.97760 + 0.70367 * t, -4.32054 - 0.53913 * t
-
-    def l(x):
-        return A / (1 + B * np.abs(x) ** C) + D * x + E
-
-    return np.where(np.abs(c) < 0.5, np.exp(l(c)), np.exp(2 * l(0.5) - l(1 - c)))
-
-
-def brute_force(alpha, nov, vis, n=3000, clamp=False):
-    """∫ D_charlie V (n.l) dω_l by the midpoint rule in (theta_l, phi_l in [0, pi]) x 2 (symmetry)."""
-    th = (np.arange(n) + 0.5) / n * np.pi / 2
-    ph = (np.arange(n) + 0.5) / n * np.pi
-    T, P = np.meshgrid(th, ph, indexing="ij")
-    l = np.stack([np.sin(T) * np.cos(P), np.sin(T) * np.sin(P), np.cos(T)], -1)
-    h = l + [np.sqrt(1 - nov * nov), 0, nov]
-    h /= np.linalg.norm(h, axis=-1, keepdims=True)
-    D = (2 + 1 / alpha) * (h[..., 0] ** 2 + h[..., 1] ** 2) ** (0.5 / alpha) / (2 * np.pi)
-    nl = l[..., 2]
-    if vis == "ashikhmin":
-        V = 1 / (4 * (nl + nov - nl * nov))
-    else:
-        V = 1 / ((1 + lambda_sheen(nov, alpha) + lambda_sheen(nl, alpha)) * 4 * nov * nl)
-    if clamp:
-        V = np.minimum(V, 1.0)
-    return 2 * np.sum(D * V * nl * np.sin(T)) * (np.pi / 2 / n) * (np.pi / n)
-
+# Baked channel vs the converged graded reference (conftest.integrate_charlie), relative: lutbake's own
+# quadrature error plus float32 storage. Measured worst over the texels below: 7.3e-6 (charlie, sheen E
+# with Ashikhmin V), 6.0e-6 (sheen E with the Charlie V); the clamped layouts 1.4e-5 / 2.4e-5 (the kink of
+# min(V, 1) lies inside a panel of the table's Gauss-Legendre rule; the reference has a panel break there).
+CHANNEL_RTOL = 2e-5
+CLAMPED_RTOL = 5e-5  # was 1e-4 against a 3000x3000 midpoint rule (itself within 1e-6 of the reference there)
 
 TEXELS = [(0, 0), (0, 5), (5, 0), (16, 16), (31, 0), (31, 31), (10, 25)]  # (row = alpha, column = NoV) of 32²
 
 
 @pytest.fixture(scope="module")
-def sheen_e():
+def sheen_e(bake_preset):
     return bake_preset("gltf-sheen-e", "size=[32, 32]")
 
 
 @pytest.fixture(scope="module")
-def charlie():
+def charlie(bake_preset):
     return bake_preset("gltf-charlie", "size=[32, 32]")
 
 
@@ -76,26 +45,20 @@ def test_presets_exist_with_the_viewer_axes(charlie, sheen_e):
     assert np.all(charlie[1].data[..., :2] == 0)  # the viewer's lut_charlie: value in .b
 
 
-def test_charlie_channel_agrees_with_an_independent_quadrature(charlie):
-    _, table = charlie
+@pytest.mark.parametrize(
+    "preset, channel, visibility", [("charlie", 2, "ashikhmin"), ("sheen_e", 0, "charlie"), ("sheen_e", 1, "ashikhmin")]
+)
+def test_channel_agrees_with_an_independent_quadrature(request, charlie_reference, preset, channel, visibility):
+    """lut_charlie .b = ∫ D_charlie V_Ashikhmin (n.l); sheen E = the same with the spec's Charlie visibility
+    (channel 0) and with Ashikhmin's (channel 1)."""
+    _, table = request.getfixturevalue(preset)
     rough, nov = table.axes
     for y, x in TEXELS:
         a, c = float(rough.alpha()[y]), float(nov.values()[x])
-        np.testing.assert_allclose(
-            table.data[y, x, 2], brute_force(a, c, "ashikhmin"), rtol=2e-5
-        )  # measured 7.2e-6 (3072 samples); the midpoint rule: 2.8e-6
+        np.testing.assert_allclose(table.data[y, x, channel], charlie_reference(a, c, visibility), rtol=CHANNEL_RTOL)
 
 
-def test_sheen_albedo_agrees_with_an_independent_quadrature(sheen_e):
-    _, table = sheen_e
-    rough, nov = table.axes
-    for y, x in TEXELS:
-        a, c = float(rough.alpha()[y]), float(nov.values()[x])
-        np.testing.assert_allclose(table.data[y, x, 0], brute_force(a, c, "charlie"), rtol=2e-5)
-        np.testing.assert_allclose(table.data[y, x, 1], brute_force(a, c, "ashikhmin"), rtol=2e-5)
-
-
-def test_sheen_albedo_le_one_except_the_grazing_smooth_corner():
+def test_sheen_albedo_le_one_except_the_grazing_smooth_corner(bake_preset):
     """With the spec's Charlie visibility E <= 1 except where n.v < 0.04 and alpha < 0.06 (the preset's 64² grid):
     there the unclamped Lambda fit lets V exceed 1 (E reaches 2.19 at n.v = alpha = 1/128). With Ashikhmin's
     visibility E exceeds 1 over a larger corner (3.68 at most), as the spec warns (not energy conserving)."""
@@ -131,9 +94,9 @@ def test_charlie_projected_area_check_passes():
     assert r.passed, r
 
 
-def test_clamped_layouts_are_the_viewers_integrand():
-    """*_clamped clamp V to [0, 1] as the viewer's V_Ashikhmin / V_Sheen: against the brute-force rule with the
-    same clamp, and never above the unclamped tables (at alpha = 0.5, NoV = 0.1 the clamp removes 2.7 %)."""
+def test_clamped_layouts_are_the_viewers_integrand(bake_preset, charlie_reference):
+    """*_clamped clamp V to [0, 1] as the viewer's V_Ashikhmin / V_Sheen: against the reference with the same
+    clamp, and never above the unclamped tables (at alpha = 0.5, NoV = 0.1 the clamp removes 2.7 %)."""
     _, clamped = bake_preset("gltf-charlie", "size=[16, 16]", "layout=charlie_clamped")
     _, plain = bake_preset("gltf-charlie", "size=[16, 16]")
     _, e_clamped = bake_preset("gltf-sheen-e", "size=[16, 16]", "layout=sheen_albedo_clamped")
@@ -142,7 +105,9 @@ def test_clamped_layouts_are_the_viewers_integrand():
     rough, nov = clamped.axes
     for y, x in [(0, 0), (8, 1), (15, 15)]:
         a, c = float(rough.alpha()[y]), float(nov.values()[x])
-        # the clamp puts a kink (min(V, 1)) inside the domain, which neither rule resolves: measured 2.4e-5
-        np.testing.assert_allclose(clamped.data[y, x, 2], brute_force(a, c, "ashikhmin", clamp=True), rtol=1e-4)
-        np.testing.assert_allclose(e_clamped.data[y, x, 0], brute_force(a, c, "charlie", clamp=True), rtol=1e-4)
+        want_charlie = charlie_reference(a, c, "ashikhmin", clamp=True)
+        np.testing.assert_allclose(clamped.data[y, x, 2], want_charlie, rtol=CLAMPED_RTOL)
+        np.testing.assert_allclose(
+            e_clamped.data[y, x, 0], charlie_reference(a, c, "charlie", clamp=True), rtol=CLAMPED_RTOL
+        )
     assert e_clamped.data[..., 0].max() <= 1.0  # the clamp also removes the corner's E > 1 (measured max below)

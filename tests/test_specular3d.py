@@ -3,22 +3,16 @@
 import numpy as np
 import pytest
 
-from lutbake.api import bake_table
-from lutbake.config import validate_table
-from lutbake.tables.fresnel import evaluate
+from lutbake.integrands.fresnel import evaluate
 from lutbake.terms.metals import METALS
 
 SIZE = [20, 10]
 COLLAPSE_TOL = 1e-6
 
 
-def spec(**kw):
-    return validate_table({"name": "t", "size": SIZE, **kw}, "<test>", 0)
-
-
-def test_specular_3d_schlick_is_f0_scale_plus_bias_of_dfg():
-    t3 = bake_table(spec(kind="specular_3d", fresnel="schlick", f0_size=5), workers=2)[0]
-    d = bake_table(spec(kind="dfg"), workers=2)[0]
+def test_specular_3d_schlick_is_f0_scale_plus_bias_of_dfg(bake):
+    t3 = bake(kind="specular_3d", size=SIZE, fresnel="schlick", f0_size=5)
+    d = bake(kind="dfg", size=SIZE)
     assert t3.data.shape == (5, SIZE[1], SIZE[0], 1)
     assert [a.dim for a in t3.axes] == ["z", "y", "x"]
     f0 = t3.axes[0].values().astype(np.float64)
@@ -27,8 +21,8 @@ def test_specular_3d_schlick_is_f0_scale_plus_bias_of_dfg():
     np.testing.assert_allclose(t3.data[..., 0], want, atol=COLLAPSE_TOL)
 
 
-def test_specular_3d_metal_reaches_the_conductor_mirror_limit():
-    t = bake_table(spec(kind="specular_3d", metal="aluminium", size=[20, 40]), workers=2)[0]
+def test_specular_3d_metal_reaches_the_conductor_mirror_limit(bake):
+    t = bake(kind="specular_3d", metal="aluminium", size=[20, 40])
     assert t.data.shape == (40, 20, 3)
     nov = t.axes[1].values().astype(np.float64)
     m = METALS["aluminium"]
@@ -38,6 +32,6 @@ def test_specular_3d_metal_reaches_the_conductor_mirror_limit():
     assert np.all(t.data <= 1.0) and np.all(np.diff(t.data[:, -1, :], axis=0) < 0)
 
 
-def test_metal_key_is_validated():
+def test_metal_key_is_validated(spec):
     with pytest.raises(Exception, match="aluminium"):
         spec(kind="specular_3d", metal="unobtainium")

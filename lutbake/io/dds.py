@@ -21,23 +21,18 @@ DDPF_FOURCC = 0x4
 DDSCAPS_TEXTURE = 0x1000
 DDSCAPS2_VOLUME = 0x200000
 DIM_TEXTURE2D, DIM_TEXTURE3D = 3, 4
-# DXGI_FORMAT values (dxgiformat.h)
-DXGI = {
-    ("half", 1): 54,
-    ("half", 2): 34,
-    ("half", 4): 10,  # R16_FLOAT, R16G16_FLOAT, R16G16B16A16_FLOAT
-    ("float32", 1): 41,
-    ("float32", 2): 16,
-    ("float32", 4): 2,  # R32_FLOAT, R32G32_FLOAT, R32G32B32A32_FLOAT
-}
-DXGI_NAMES = {
-    54: "R16_FLOAT",
-    34: "R16G16_FLOAT",
-    10: "R16G16B16A16_FLOAT",
-    41: "R32_FLOAT",
-    16: "R32G32_FLOAT",
-    2: "R32G32B32A32_FLOAT",
-}
+# (pixel type, channels) of every GPU format written: half / float32 x 1, 2 or 4 channels (3 gain A = 1)
+PIXEL_FORMATS = [(dtype, n) for dtype in ("half", "float32") for n in (1, 2, 4)]
+
+
+def layout_name(dtype: str, n: int) -> str:
+    """ "R16G16" for ("half", 2): the channel letters with their bits, as DXGI and Vulkan spell a format."""
+    return "".join(f"{c}{16 if dtype == 'half' else 32}" for c in "RGBA"[:n])
+
+
+# DXGI_FORMAT values (dxgiformat.h): R16_FLOAT, R16G16_FLOAT, R16G16B16A16_FLOAT, R32_FLOAT, R32G32_FLOAT, ...
+DXGI = dict(zip(PIXEL_FORMATS, (54, 34, 10, 41, 16, 2)))
+DXGI_NAMES = {code: layout_name(*key) + "_FLOAT" for key, code in DXGI.items()}
 FROM_DXGI = {v: k for k, v in DXGI.items()}
 
 

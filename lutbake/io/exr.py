@@ -6,7 +6,8 @@ File layout (the contract engines and ``lutbake inspect`` rely on):
   table is written as ``R``, ``G`` only). Pixel type float32 or half, zip compression (lossless).
 - Image row 0 holds y index 0 and column 0 holds x index 0: no vertical flip, whatever engines do.
 - A 2D table (data (y, x, C)) is one single-part EXR. A fourth axis (kind ``btf``) is flattened into the
-  rows: its dim is ``y_block`` and image row = (y_block index) * (count of the y axis) + (y index). A 3D table (data (z, y, x, C)) is a multi-part
+  rows: its dim is ``y_block`` and image row = (y_block index) * (count of the y axis) + (y index).
+  A 3D table (data (z, y, x, C)) is a multi-part
   EXR with one part per z index, named ``slice_<k>`` and carrying ``lutbake:slice_index`` and
   ``lutbake:slice_value`` (the z axis value at that index).
 - Every part carries the string attributes ``lutbake:kind``, ``lutbake:table`` (the table's name),
@@ -19,26 +20,25 @@ File layout (the contract engines and ``lutbake inspect`` rely on):
   error, never written.
 - Writes are atomic: the file is written to a temporary sibling, fsynced, then renamed onto the
   target, so an interrupted or failed write never leaves a half-written file or clobbers the old one.
+- ``lutbake:data_hash`` (every part): the sha256 of the file's bytes with these 64 hex digits set to ``0``
+  (lutbake.io.integrity); a rerun skips the table only if it matches, so a truncated or garbled file is
+  baked again.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
-from ..table import Table
+from ..table import CHANNEL_LETTERS, Table, metadata
+from ..table import pixels as checked_pixels
 from .atomic import atomic_write
+from .integrity import HASH_KEY, PLACEHOLDER, seal_exr
 
 PREFIX = "lutbake:"
-CHANNEL_LETTERS = ("R", "G", "B", "A")
-DTYPES = {"float32": ("float", np.float32), "half": ("half", np.float16)}
+EXR_TYPES = {"float32": "float", "half": "half"}
 COMPRESSION = "zip"
-# attributes lutbake writes itself; Table.attributes may not shadow them
-RESERVED = frozenset(
-    {"kind", "table", "axes", "channels", "channel_names", "reconstruction", "slice_index", "slice_value"}
-)
 PER_PART = frozenset({"slice_index", "slice_value"})
 
 
@@ -49,91 +49,6 @@ def _oiio():
 
 
 # --------------------------------------------------------------------------------------- writing
-
-
-def _attr_text(value) -> str:
-    if isinstance(value, str):
-        return value
-    if isinstance(value, (dict, list, tuple)):
-        return json.dumps(value, sort_keys=isinstance(value, dict))
-    return str(value)
-
-
-def _check_table(table: Table, dtype: str) -> np.ndarray:
-    """The array to write (float32 or float16, C-contiguous, (z,) y, x, C), after every check."""
-    if dtype not in DTYPES:
-        raise ValueError(f"table {table.name!r}: dtype must be one of {sorted(DTYPES)}, got {dtype!r}")
-    data = np.asarray(table.data)
-    if data.ndim not in (3, 4):
-        raise ValueError(f"table {table.name!r}: data must be (y, x, C) or (z, y, x, C), got shape {data.shape}")
-    nch = data.shape[-1]
-    if not 1 <= nch <= 4:
-        raise ValueError(f"table {table.name!r}: an EXR holds 1 to 4 channels, the data has {nch}")
-    if len(table.channels) != nch:
-        raise ValueError(
-            f"table {table.name!r}: {len(table.channels)} channel names {list(table.channels)} for {nch} data channels"
-        )
-    if data.dtype.kind not in "fiu":
-        raise ValueError(f"table {table.name!r}: data must be numeric, got dtype {data.dtype}")
-    sizes = {"z": data.shape[0] if data.ndim == 4 else 1, "y": data.shape[-3], "x": data.shape[-2]}
-    dims = [a.dim for a in table.axes]
-    if len(set(dims)) != len(dims):
-        raise ValueError(f"table {table.name!r}: two axes share an image dimension: {dims}")
-    blocks = [a for a in table.axes if a.dim == "y_block"]
-    if blocks:  # a 4th axis flattened into the rows: row = block index * (y count) + y index
-        y_axes = [a for a in table.axes if a.dim == "y"]
-        if not y_axes or sizes["y"] % blocks[0].count:
-            raise ValueError(
-                f"table {table.name!r}: a y_block axis needs a y axis and {sizes['y']} rows divisible "
-                f"by its count {blocks[0].count}"
-            )
-        sizes["y_block"] = blocks[0].count
-        sizes["y"] //= blocks[0].count
-    for axis in table.axes:
-        if axis.dim not in sizes:
-            raise ValueError(f"table {table.name!r}: axis {axis.name!r} has unknown dim {axis.dim!r}")
-        if axis.count != sizes[axis.dim]:
-            raise ValueError(
-                f"table {table.name!r}: axis {axis.name!r} ({axis.dim}) has count {axis.count} "
-                f"but the data has {sizes[axis.dim]} along {axis.dim} (shape {data.shape})"
-            )
-    if data.ndim == 4 and "z" not in dims:
-        raise ValueError(f"table {table.name!r}: a 3D table needs an axis with dim 'z'")
-    clash = RESERVED.intersection(table.attributes)
-    if clash:
-        raise ValueError(f"table {table.name!r}: attributes {sorted(clash)} are reserved (lutbake writes them itself)")
-
-    with np.errstate(over="ignore", invalid="ignore"):
-        out = np.ascontiguousarray(data, dtype=DTYPES[dtype][1])
-    bad = ~np.isfinite(out)
-    if bad.any():
-        names = list(table.channels)
-        idx = tuple(int(i) for i in np.argwhere(bad)[0])
-        src = data[idx]
-        what = "NaN" if np.isnan(src) else ("Inf" if np.isinf(src) else f"{float(src)!r} (overflows {dtype})")
-        raise ValueError(
-            f"table {table.name!r}: {int(bad.sum())} non-finite value(s) in {dtype}; first at index "
-            f"{idx} (channel {names[idx[-1]]!r}): {what}. Refusing to write a table with NaN/Inf."
-        )
-    return out
-
-
-def _header(table: Table) -> dict[str, str]:
-    letters = CHANNEL_LETTERS[: len(table.channels)]
-    attrs = {
-        "kind": table.kind,
-        "table": table.name,
-        "axes": json.dumps([a.describe() for a in table.axes]),
-        "channels": json.dumps(
-            {c: f"{name}: {meaning}" for c, (name, meaning) in zip(letters, table.channels.items())},
-            ensure_ascii=False,
-        ),
-        "channel_names": json.dumps(dict(zip(letters, table.channels)), ensure_ascii=False),
-        "reconstruction": table.reconstruction,
-    }
-    for key, value in table.attributes.items():
-        attrs[str(key)] = _attr_text(value)
-    return attrs
 
 
 def _spec(oiio, width: int, height: int, nch: int, fmt: str, attrs: dict[str, str]):
@@ -181,11 +96,11 @@ def write_exr(table: Table, path, dtype: str = "float32") -> Path:
     an existing file at ``path`` is left untouched and no temporary file remains.
     """
     path = Path(path)
-    pixels = _check_table(table, dtype)
-    fmt = DTYPES[dtype][0]
-    attrs = _header(table)
-    if pixels.ndim == 3:
-        parts = [(None, attrs, pixels)]
+    data = checked_pixels(table, dtype)
+    fmt = EXR_TYPES[dtype]
+    attrs = {**metadata(table), HASH_KEY: PLACEHOLDER.decode()}  # sealed with the file's hash before the rename
+    if data.ndim == 3:
+        parts = [(None, attrs, data)]
     else:
         z_axis = next(a for a in table.axes if a.dim == "z")
         z_values = z_axis.values()
@@ -193,12 +108,16 @@ def write_exr(table: Table, path, dtype: str = "float32") -> Path:
             (
                 f"slice_{k}",
                 {**attrs, "slice_index": str(k), "slice_value": f"{float(z_values[k]):.9g}"},
-                pixels[k],
+                data[k],
             )
-            for k in range(pixels.shape[0])
+            for k in range(data.shape[0])
         ]
 
-    return atomic_write(path, lambda tmp: _write_oiio(tmp, parts, fmt))
+    def write(tmp):
+        _write_oiio(tmp, parts, fmt)
+        seal_exr(tmp)
+
+    return atomic_write(path, write)
 
 
 # --------------------------------------------------------------------------------------- reading
@@ -221,7 +140,7 @@ def _read_parts(path) -> tuple[list[np.ndarray], list[dict[str, str]], list[dict
         parts = exr_parts(path)
     except ValueError as e:
         raise ValueError(f"{path}: not a readable EXR ({e})") from None
-    for k, (arr, attrs, facts) in enumerate(parts):
+    for k, (_, attrs, facts) in enumerate(parts):
         if "kind" not in attrs:
             raise ValueError(
                 f"{path}: not a lutbake EXR (part {k} has no lutbake:kind attribute; was it written by lutbake?)"

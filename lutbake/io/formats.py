@@ -3,26 +3,28 @@
 | format | file | pixel types | metadata |
 | --- | --- | --- | --- |
 | ``exr`` (default) | <name>.exr | float32 / half | ``lutbake:*`` header attributes (lutbake.io.exr) |
-| ``npy`` | <name>.npy + <name>.json | float32 / float16 array, table shape | sidecar JSON of the same attributes |
-| ``png16`` | <name>.png + <name>.json | 16-bit UNORM, linear | no sRGB/iCCP chunk; gAMA = 1.0 where written |
-| ``dds`` | <name>.dds + <name>.json | R16G16_FLOAT, R32G32_FLOAT, RGBA16F/32F ... | DX10 header (lutbake.io.dds) |
-| ``ktx2`` | <name>.ktx2 | VK_FORMAT_R16G16_SFLOAT, ... | key/value data (lutbake.io.ktx2) |
-| ``h`` | <name>.h | half-float bits (uint16_t) or float | the conventions in a comment block |
-Row 0 of every file is table row 0 (no flip); column 0 is x index 0. Every write is atomic.
+| ``npy`` | <name>.npy + <name>.npy.json | float32 / float16 array, table shape | sidecar JSON of the same attributes |
+| ``png16`` | <name>.png + <name>.png.json | 16-bit UNORM, linear | no sRGB/iCCP chunk; gAMA = 1.0 where written |
+| ``dds`` | <name>.dds + <name>.dds.json | R16G16_FLOAT, R32G32_FLOAT, RGBA16F/32F ... | DX10 header (lutbake.io.dds) |
+| ``ktx2`` | <name>.ktx2 + <name>.ktx2.json | VK_FORMAT_R16G16_SFLOAT, ... | key/value data (lutbake.io.ktx2) |
+| ``h`` | <name>.h + <name>.h.json | half-float bits (uint16_t) or float | the conventions in a comment block |
+Row 0 of every file is table row 0 (no flip); column 0 is x index 0. Every write is atomic; the sidecar
+``<file>.json`` is written last and names the sha256 of the data file (lutbake.io.integrity).
 """
 
 from __future__ import annotations
 
-import json
 import re
 from pathlib import Path
 
 import numpy as np
 
-from ..table import Table
+from ..table import Table, metadata
+from ..table import pixels as checked_pixels
 from . import dds, ktx2
 from .atomic import atomic_write, atomic_write_bytes
-from .exr import _check_table, _header, write_exr
+from .exr import write_exr
+from .integrity import legacy_sidecar, write_sidecar
 
 FORMATS = {
     "exr": "OpenEXR via OpenImageIO, float32 or half, lutbake:* header attributes (default)",
@@ -31,30 +33,31 @@ FORMATS = {
     "dds": "DDS with DX10 header: R16G16_FLOAT / R32G32_FLOAT / RGBA16F / RGBA32F, 2D or 3D + .json sidecar",
     "ktx2": "KTX 2.0: VK_FORMAT_R16G16_SFLOAT / R32G32_SFLOAT / RGBA16/32, 2D or 3D, metadata in key/value data",
     "h": "C/C++ header: half-float bits (dtype half) or floats (float32), conventions in a comment block",
+    "openpbr_h": "OpenPBR's energy-table header: UNORM16 uint16_t arrays under its names (layout openpbr only)",
 }
 PNG_SLACK = 1.0e-3  # values this close outside [0, 1] are integration noise (e.g. E = 1 + 3e-5): clipped
-EXTENSIONS = {"exr": ".exr", "npy": ".npy", "png16": ".png", "dds": ".dds", "ktx2": ".ktx2", "h": ".h"}
-
-
-def metadata(table: Table) -> dict[str, str]:
-    """The lutbake attributes every format carries (as the EXR header's lutbake:* strings)."""
-    return _header(table)
+EXTENSIONS = {
+    "exr": ".exr",
+    "npy": ".npy",
+    "png16": ".png",
+    "dds": ".dds",
+    "ktx2": ".ktx2",
+    "h": ".h",
+    "openpbr_h": ".h",
+}
 
 
 def _sidecar(table: Table, path: Path, fmt: str, extra: dict | None = None) -> None:
-    meta = {k: v for k, v in metadata(table).items()}
-    doc = {
-        "file": path.name,
-        "format": fmt,
-        "row_order": "file row 0 = table row 0 (y index 0); column 0 = x index 0",
-        **(extra or {}),
-        "lutbake": meta,
-    }
-    atomic_write_bytes(path.with_suffix(".json"), (json.dumps(doc, indent=1, ensure_ascii=False) + "\n").encode())
+    """The last step of every non-EXR write: ``<file>.json`` naming the data's sha256 (lutbake.io.integrity);
+    a pre-issue-11 ``<stem>.json`` that described this file is removed (it would contradict the new one)."""
+    write_sidecar(path, fmt, metadata(table), extra)
+    old = legacy_sidecar(path)
+    if old is not None:
+        old.unlink(missing_ok=True)
 
 
 def write_npy(table: Table, path, dtype: str = "float32") -> Path:
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write(path, lambda tmp: np.save(tmp, pixels, allow_pickle=False))
     _sidecar(table, path, "npy", {"dtype": str(pixels.dtype), "shape": list(pixels.shape)})
@@ -67,7 +70,7 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
     outside [0, 1] are clipped; anything further out is an error (the format cannot hold it)."""
     import OpenImageIO as oiio
 
-    pixels = _check_table(table, "float32")
+    pixels = checked_pixels(table, "float32")
     path = Path(path)
     if pixels.ndim != 3:
         raise ValueError(f"table {table.name!r}: png16 holds 2D tables only; use dds, ktx2, exr or npy for 3D")
@@ -117,7 +120,7 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
 
 
 def write_dds(table: Table, path, dtype: str = "float32") -> Path:
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write_bytes(path, dds.encode(pixels))
     fmt = dds.DXGI_NAMES[dds.DXGI[(dtype, 4 if pixels.shape[-1] == 3 else pixels.shape[-1])]]
@@ -128,7 +131,7 @@ def write_dds(table: Table, path, dtype: str = "float32") -> Path:
 def write_ktx2(table: Table, path, dtype: str = "float32", array: bool = False) -> Path:
     from .. import __version__
 
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write_bytes(path, ktx2.encode(pixels, metadata(table), array=array, writer=f"lutbake {__version__}"))
     _sidecar(table, path, "ktx2", {"array": array})
@@ -146,7 +149,7 @@ def header_text(table: Table, dtype: str = "float32") -> str:
     element ((z * HEIGHT + y) * WIDTH + x) * CHANNELS + c."""
     from .. import __version__
 
-    pixels = _check_table(table, dtype)
+    pixels = checked_pixels(table, dtype)
     ident = _c_ident(table.name)
     macro = ident.upper()
     dims = pixels.shape
@@ -214,6 +217,12 @@ def write_header(table: Table, path, dtype: str = "float32") -> Path:
     return path
 
 
+def write_openpbr(table: Table, path, dtype: str = "float32") -> Path:
+    from .openpbr import write_openpbr_header
+
+    return write_openpbr_header(table, path, dtype)
+
+
 WRITERS = {
     "exr": write_exr,
     "npy": write_npy,
@@ -221,7 +230,13 @@ WRITERS = {
     "dds": write_dds,
     "ktx2": write_ktx2,
     "h": write_header,
+    "openpbr_h": write_openpbr,
 }
+# the LTC engine layouts (kind ltc only): lutbake.io.ltc
+from . import ltc as _ltc_export  # noqa: E402
+
+WRITERS.update(_ltc_export.WRITERS)
+EXTENSIONS.update(_ltc_export.EXTENSIONS)
 
 
 def output_path(out_dir, name: str, fmt: str) -> Path:

@@ -17,25 +17,12 @@ import struct
 
 import numpy as np
 
-from .dds import gpu_channels
+from .dds import PIXEL_FORMATS, gpu_channels, layout_name
 
 IDENTIFIER = bytes([0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A])
-VK_FORMAT = {
-    ("half", 1): 76,
-    ("half", 2): 83,
-    ("half", 4): 97,  # VK_FORMAT_R16_SFLOAT, R16G16_SFLOAT, R16G16B16A16_SFLOAT
-    ("float32", 1): 100,
-    ("float32", 2): 103,
-    ("float32", 4): 109,  # R32_SFLOAT, R32G32_SFLOAT, R32G32B32A32_SFLOAT
-}
-VK_FORMAT_NAMES = {
-    76: "VK_FORMAT_R16_SFLOAT",
-    83: "VK_FORMAT_R16G16_SFLOAT",
-    97: "VK_FORMAT_R16G16B16A16_SFLOAT",
-    100: "VK_FORMAT_R32_SFLOAT",
-    103: "VK_FORMAT_R32G32_SFLOAT",
-    109: "VK_FORMAT_R32G32B32A32_SFLOAT",
-}
+# VkFormat values (vulkan_core.h): VK_FORMAT_R16_SFLOAT, R16G16_SFLOAT, R16G16B16A16_SFLOAT, R32_SFLOAT, ...
+VK_FORMAT = dict(zip(PIXEL_FORMATS, (76, 83, 97, 100, 103, 109)))
+VK_FORMAT_NAMES = {code: f"VK_FORMAT_{layout_name(*key)}_SFLOAT" for key, code in VK_FORMAT.items()}
 KHR_DF_MODEL_RGBSDA = 1
 KHR_DF_PRIMARIES_BT709 = 1
 KHR_DF_TRANSFER_LINEAR = 1

@@ -1,6 +1,8 @@
-"""Estimators: how an integral over the hemisphere is turned into a weighted sum.
+"""Quadratures: every way lutbake turns a per-texel integral into a weighted sum, and the one texel plan.
 
-Host side (:mod:`.points`) builds deterministic point sets; device side (:mod:`.estimators`) is a
-set of kernel factories that take an integrand ``@wp.func`` and return a kernel integrating it per
-texel. Integrands live in :mod:`lutbake.tables`, grids in :mod:`lutbake.axes`.
+:mod:`.plan` composes integrand x estimator x grid (``per_texel_plan``); :mod:`.points` builds deterministic
+point sets; :mod:`.hemisphere` (specular, over h), :mod:`.anisotropic` (3D Sobol'), :mod:`.diffuse` (over l, and
+point evaluation), :mod:`.swapped` (the swapped-integral diffuse albedo), :mod:`.facets` (the microfacet diffuse
+m-integral) and :mod:`.panels` (their shared panel rules) hold the estimators: kernel factories that close over an
+integrand's ``@wp.func``s. Integrands live in :mod:`lutbake.integrands`, grids in :mod:`lutbake.axes`.
 """

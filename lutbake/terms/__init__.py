@@ -3,7 +3,8 @@
 Naming follows the math: ``D_`` normal distributions, ``Lambda_``/``G1_``/``G2_`` masking-shadowing,
 ``F_`` Fresnel, ``Fd_`` diffuse. Arguments are cosines named ``NoV``, ``NoL``, ``NoH``, ``VoH``
 (docs/notation.md); ``alpha`` is always the NDF parameter, never a perceptual roughness.
-Host code picks terms by name through the registries in :mod:`lutbake.registry`.
+Host code picks terms by name: one ``Distribution`` object per NDF in :mod:`.distributions`
+(with the masking forms), composed into integrands by :mod:`lutbake.integrands`.
 """
 
 from ..warp_runtime import init_warp

@@ -1,6 +1,6 @@
 """Diffuse BRDF terms: Lambert, Oren-Nayar (classic, improved, with Fresnel), the diffuse Fresnel
 factor and Gotanda's fitted microfacet-diffuse model; the microfacet model itself (Eq. 4), which has
-no closed form, is integrated in lutbake.tables.diffuse.
+no closed form, is integrated in lutbake.sampling.facets (the BRDF) and lutbake.sampling.swapped (its albedo).
 
 Convention (all ``Fd_*``): the value returned is the **BRDF** f_r (1/sr), for albedo ``rho``. The seeds
 write radiance L_r for an irradiance E0 from direction l (L_r = f_r E0 (n.l)); those forms are divided by
@@ -44,6 +44,14 @@ def Fd_lambert(rho: float):
 
 
 @wp.func
+def oren_nayar_AB(sigma: float, a_denominator: float):
+    """Oren-Nayar's (A, B) = (1 - 0.5 sigma^2 / (sigma^2 + a_denominator), 0.45 sigma^2 / (sigma^2 + 0.09)):
+    a_denominator = 0.57 in the classic model (Oren & Nayar 1994), 0.65 in Gotanda 2014, Eq. 5 and 7."""
+    s2 = sigma * sigma
+    return wp.vec2(1.0 - 0.5 * s2 / (s2 + a_denominator), 0.45 * s2 / (s2 + 0.09))
+
+
+@wp.func
 def Fd_oren_nayar(rho: float, NoL: float, NoV: float, LoV: float, sigma: float):
     """Classic Oren-Nayar, qualitative model as taught in lecture 003 (Oren & Nayar 1994, Eq. 30):
     f = rho/pi (A + B max(0, cos phi) sin(a) tan(b)), a = max(theta_l, theta_v), b = min(theta_l, theta_v),
@@ -53,11 +61,9 @@ def Fd_oren_nayar(rho: float, NoL: float, NoV: float, LoV: float, sigma: float):
     reduce to Lambert at sigma = 0 and is taken as a layout slip. sigma = 0: exactly Lambert."""
     if NoL <= COS_EPS or NoV <= COS_EPS:
         return 0.0
-    s2 = sigma * sigma
-    A = 1.0 - 0.5 * s2 / (s2 + 0.57)
-    B = 0.45 * s2 / (s2 + 0.09)
+    AB = oren_nayar_AB(sigma, 0.57)
     s = LoV - NoL * NoV
-    return rho * INV_PI * (A + B * wp.max(s, 0.0) / wp.max(NoL, NoV))
+    return rho * INV_PI * (AB[0] + AB[1] * wp.max(s, 0.0) / wp.max(NoL, NoV))
 
 
 @wp.func
@@ -71,9 +77,9 @@ def Fd_oren_nayar_improved(rho: float, NoL: float, NoV: float, LoV: float, sigma
     viewer (n.l -> 0, cos phi < 0), so the radiance is clamped at 0. sigma = 0: exactly Lambert."""
     if NoL <= COS_EPS or NoV <= COS_EPS:
         return 0.0
-    s2 = sigma * sigma
-    A = 1.0 - 0.5 * s2 / (s2 + 0.65)
-    B = 0.45 * s2 / (s2 + 0.09)
+    AB = oren_nayar_AB(sigma, 0.65)
+    A = AB[0]
+    B = AB[1]
     s = LoV - NoL * NoV
     radiance = NoL * A + B * s
     if s >= 0.0:
@@ -93,10 +99,10 @@ def Fd_oren_nayar_fresnel(rho: float, NoL: float, NoV: float, LoV: float, sigma:
     Returned as the BRDF L_r / (E0 n.l)."""
     if NoL <= COS_EPS or NoV <= COS_EPS:
         return 0.0
-    s2 = sigma * sigma
-    A = 1.0 - 0.5 * s2 / (s2 + 0.65)
-    B = 0.45 * s2 / (s2 + 0.09)
+    AB = oren_nayar_AB(sigma, 0.65)
     s = LoV - NoL * NoV
+    A = AB[0]
+    B = AB[1]
     radiance = 1.05 * pow5_weight(NoL) * pow5_weight(NoV) * NoL * A + B * s * wp.min(1.0, NoL / NoV)
     return rho * INV_PI * (1.0 - f0) * wp.max(radiance, 0.0) / NoL
 
@@ -175,3 +181,22 @@ def F_facet_dielectric_f0(MoL: float, MoV: float, f0: float):
     """Per-facet transmission (1 - F(m.l))(1 - F(m.v)) with F the exact dielectric Fresnel written with f0
     (Eq. 2): not of the form g(f0) x (an f0-free function), hence kind diffuse_3d (an f0 axis)."""
     return (1.0 - F_dielectric_f0(f0, MoL)) * (1.0 - F_dielectric_f0(f0, MoV))
+
+
+# --- per-facet transmissions in float64, for the swapped-integral albedo (lutbake.sampling.swapped) ----------
+# Every F_facet above is c(f0) T(m.l) T(m.v): Eq. 6 and Schlick with T = 1 - (1 - c)^5 and c(f0) = 21/20 (1 - f0)
+# or (1 - f0)^2; the exact dielectric with T = 1 - F(f0, c) and c(f0) = 1.
+
+
+@wp.func
+def T_pow5(c: wp.float64, f0: wp.float64):
+    """1 - (1 - c)^5: the transmission shape of Eq. 6 and of 1 - F_Schlick (its f0 factor is in c(f0))."""
+    m = wp.float64(1.0) - c
+    m2 = m * m
+    return wp.float64(1.0) - m2 * m2 * m
+
+
+@wp.func
+def T_dielectric_f0(c: wp.float64, f0: wp.float64):
+    """1 - F(f0, c) with F the exact dielectric Fresnel of Eq. 2 (evaluated in float32, as the terms)."""
+    return wp.float64(1.0) - wp.float64(F_dielectric_f0(float(f0), float(c)))

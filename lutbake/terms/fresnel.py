@@ -1,5 +1,6 @@
-"""Fresnel reflectance terms (Gotanda 2014 course notes, Sec. 2 and Eqs. 2-3; docs/notation.md). ``cos_theta`` is the cosine between the direction and the
-microfacet normal (v.h for a specular BRDF); every term returns f0 at cos = 1 and 1 at cos = 0."""
+"""Fresnel reflectance terms (Gotanda 2014 course notes, Sec. 2 and Eqs. 2-3; docs/notation.md).
+``cos_theta`` is the cosine between the direction and the microfacet normal (v.h for a specular BRDF); every term
+returns f0 at cos = 1 and 1 at cos = 0."""
 
 import warp as wp
 

@@ -122,3 +122,10 @@ def G2_smith_joint_approx(NoV: float, NoL: float, alpha: float):
     if NoV <= COS_EPS or NoL <= COS_EPS:
         return 0.0
     return 2.0 * NoL * NoV / (NoL * (NoV * (1.0 - alpha) + alpha) + NoV * (NoL * (1.0 - alpha) + alpha))
+
+
+@wp.func
+def Lambda_ggx64(NoX: wp.float64, alpha: wp.float64):
+    """Lambda_ggx in float64, for n.x > 0 (the swapped-integral albedo's nodes never reach the horizon)."""
+    c2 = NoX * NoX
+    return wp.float64(0.5) * (wp.sqrt(c2 + alpha * alpha * (wp.float64(1.0) - c2)) / NoX - wp.float64(1.0))

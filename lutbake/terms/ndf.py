@@ -67,15 +67,23 @@ def u_from_tan2_beckmann(tan2: wp.float64, alpha: wp.float64):
 
 
 @wp.func
-def sample_vndf_ggx(v: wp.vec3, alpha: float, u1: float, u2: float):
-    """Visible-normal sample of isotropic GGX by spherical caps (Dupuy & Benyoub 2023, Listing 3;
-    equivalent to Heitz 2018). Density: pdf(h) = G1(v) max(0, v.h) D(h) / (n.v)."""
-    vh = wp.normalize(wp.vec3(alpha * v[0], alpha * v[1], v[2]))
+def sample_vndf_ggx_aniso(v: wp.vec3, alpha_x: float, alpha_y: float, u1: float, u2: float):
+    """Visible-normal sample of anisotropic GGX (Heitz 2018, JCGT 7(4); spherical caps, Dupuy & Benyoub 2023):
+    stretch v by (ax, ay, 1), sample the visible hemisphere, unstretch. pdf = G1(v) max(0, v.h) D(h) / (n.v)."""
+    vh = wp.normalize(wp.vec3(alpha_x * v[0], alpha_y * v[1], v[2]))
     phi = 2.0 * wp.pi * u1
     z = (1.0 - u2) * (1.0 + vh[2]) - vh[2]
     s = wp.sqrt(wp.clamp(1.0 - z * z, 0.0, 1.0))
     nh = wp.vec3(s * wp.cos(phi), s * wp.sin(phi), z) + vh
-    return wp.normalize(wp.vec3(alpha * nh[0], alpha * nh[1], wp.max(nh[2], 0.0)))
+    return wp.normalize(wp.vec3(alpha_x * nh[0], alpha_y * nh[1], wp.max(nh[2], 0.0)))
+
+
+@wp.func
+def sample_vndf_ggx(v: wp.vec3, alpha: float, u1: float, u2: float):
+    """Visible-normal sample of isotropic GGX by spherical caps (Dupuy & Benyoub 2023, Listing 3;
+    equivalent to Heitz 2018): the anisotropic sampler at alpha_x = alpha_y = alpha.
+    Density: pdf(h) = G1(v) max(0, v.h) D(h) / (n.v)."""
+    return sample_vndf_ggx_aniso(v, alpha, alpha, u1, u2)
 
 
 # --- normalized Blinn-Phong ---------------------------------------------------------------------------
@@ -154,18 +162,6 @@ def D_ggx_aniso(h: wp.vec3, alpha_x: float, alpha_y: float):
     y = h[1] / alpha_y
     d = x * x + y * y + h[2] * h[2]
     return INV_PI / (alpha_x * alpha_y * d * d)
-
-
-@wp.func
-def sample_vndf_ggx_aniso(v: wp.vec3, alpha_x: float, alpha_y: float, u1: float, u2: float):
-    """Visible-normal sample of anisotropic GGX (Heitz 2018, JCGT 7(4); spherical caps, Dupuy & Benyoub 2023):
-    stretch v by (ax, ay, 1), sample the visible hemisphere, unstretch. pdf = G1(v) max(0, v.h) D(h) / (n.v)."""
-    vh = wp.normalize(wp.vec3(alpha_x * v[0], alpha_y * v[1], v[2]))
-    phi = 2.0 * wp.pi * u1
-    z = (1.0 - u2) * (1.0 + vh[2]) - vh[2]
-    s = wp.sqrt(wp.clamp(1.0 - z * z, 0.0, 1.0))
-    nh = wp.vec3(s * wp.cos(phi), s * wp.sin(phi), z) + vh
-    return wp.normalize(wp.vec3(alpha_x * nh[0], alpha_y * nh[1], wp.max(nh[2], 0.0)))
 
 
 # --- Ashikhmin-Shirley 2000 ("An anisotropic Phong BRDF model", JGT 5(2)) -------------------------------

@@ -20,9 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..edge import ALPHA_MIN, NOV_MIN
+from ..integrands.specular import hemisphere_integral
 from ..sampling import points
-from ..tables import specular
-from ..terms.sets import NDFS, SMITH_NDFS
+from ..terms.distributions import NDFS, SMITH_NDFS
 from .probe import BRDF_PAIRS, evaluate_brdfs, evaluate_terms
 
 # Tolerances (absolute unless said otherwise). The terms run in float32: ~1e-7 is the floor.
@@ -54,7 +54,11 @@ KC_FURNACE_TOL_SMOOTHEST = 5.0e-3  # every row
 
 # Grids.
 PROJECTED_AREA_ALPHAS = (1.0e-3, 1.0e-2, 0.1, 0.5, 1.0)
-ANISOTROPIES = (0.5, 1.0, -1.0)  # with PROJECTED_AREA_ALPHAS, through the Burley mapping (tables.aniso.alpha_xy)
+ANISOTROPIES = (
+    0.5,
+    1.0,
+    -1.0,
+)  # with PROJECTED_AREA_ALPHAS, through the Burley mapping (integrands.anisotropic.alpha_xy)
 ANISO_FURNACE_NOVS = (0.1, 0.5, 1.0)
 ANISO_FURNACE_PHIS = (0.0, np.pi / 4, np.pi / 2)
 ANISO_FURNACE_ALPHAS = (1.0e-2, 0.3)
@@ -164,37 +168,29 @@ def _h(theta: np.ndarray, phi: np.ndarray | float = 0.0) -> np.ndarray:
 def ndf_projected_area_is_one(ndf_name: str) -> CheckResult:
     """∫ D(m)(n.m) dω_m = 2 pi ∫_0^{pi/2} D(theta) cos(theta) sin(theta) dtheta = 1 (Walter et al. 2007, Eq. 4),
     composite GL in theta, panels graded geometrically from the pole at the NDF's scale atan(alpha)."""
+    err, detail = _projected_area(f"D_{ndf_name}", lambda alpha: (0.0, np.arctan(alpha) / 16.0))
+    return _result(f"ndf_projected_area_is_one[{ndf_name}]", err, PROJECTED_AREA_TOL, detail)
+
+
+def _projected_area(term: str, grade_at) -> tuple[float, str]:
+    """max over PROJECTED_AREA_ALPHAS of |2 pi ∫ D cos sin dtheta - 1| for the term ``term``, by composite GL with
+    panels graded towards grade_at(alpha) = (point, scale); and the check's detail line."""
     errors = []
     for alpha in PROJECTED_AREA_ALPHAS:
-        theta, w = _composite_gl(_graded_edges(0.0, np.pi / 2, [(0.0, np.arctan(alpha) / 16.0)]))
-        D = evaluate_terms(h=_h(theta), alpha=alpha)[f"D_{ndf_name}"].astype(np.float64)
+        theta, w = _composite_gl(_graded_edges(0.0, np.pi / 2, [grade_at(alpha)]))
+        D = evaluate_terms(h=_h(theta), alpha=alpha)[term].astype(np.float64)
         errors.append(abs(2.0 * np.pi * np.sum(w * D * np.cos(theta) * np.sin(theta)) - 1.0))
     k = int(np.argmax(errors))
-    return _result(
-        f"ndf_projected_area_is_one[{ndf_name}]",
-        errors[k],
-        PROJECTED_AREA_TOL,
-        f"max |∫D(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS}; worst at alpha={PROJECTED_AREA_ALPHAS[k]}",
-    )
+    where = f"worst at alpha={PROJECTED_AREA_ALPHAS[k]}"
+    return errors[k], f"max |∫{term}(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS}; {where}"
 
 
 def charlie_projected_area_is_one() -> CheckResult:
     """The Charlie sheen NDF (Estevez & Kulla 2017), D = (2 + 1/alpha) sin(theta)^(1/alpha) / (2 pi), is
     normalised in projected area: 2 pi ∫ D cos sin dtheta = 1. Its mass sits within ~sqrt(alpha) of the
     horizon, so the panels are graded towards theta = pi/2."""
-    errors = []
-    for alpha in PROJECTED_AREA_ALPHAS:
-        theta, w = _composite_gl(_graded_edges(0.0, np.pi / 2, [(np.pi / 2, np.sqrt(alpha) / 16.0)]))
-        D = evaluate_terms(h=_h(theta), alpha=alpha)["D_charlie"].astype(np.float64)
-        errors.append(abs(2.0 * np.pi * np.sum(w * D * np.cos(theta) * np.sin(theta)) - 1.0))
-    k = int(np.argmax(errors))
-    return _result(
-        "ndf_projected_area_is_one[charlie]",
-        errors[k],
-        CHARLIE_AREA_TOL,
-        f"max |∫D_charlie(m)(n.m)dω - 1| over alpha in {PROJECTED_AREA_ALPHAS}; worst at "
-        f"alpha={PROJECTED_AREA_ALPHAS[k]}",
-    )
+    err, detail = _projected_area("D_charlie", lambda alpha: (np.pi / 2, np.sqrt(alpha) / 16.0))
+    return _result("ndf_projected_area_is_one[charlie]", err, CHARLIE_AREA_TOL, detail)
 
 
 def weak_white_furnace(ndf_name: str) -> CheckResult:
@@ -229,18 +225,14 @@ def weak_white_furnace(ndf_name: str) -> CheckResult:
             errors.append(abs(integral - nov))
             where.append((nov, alpha))
     k = int(np.argmax(errors))
-    return _result(
-        f"weak_white_furnace[{ndf_name}]",
-        errors[k],
-        WEAK_FURNACE_TOL,
-        f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over n.v in {FURNACE_NOVS} x alpha in {FURNACE_ALPHAS}; "
-        f"worst at (n.v, alpha)={where[k]}",
-    )
+    grid = f"n.v in {FURNACE_NOVS} x alpha in {FURNACE_ALPHAS}"
+    detail = f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over {grid}; worst at (n.v, alpha)={where[k]}"
+    return _result(f"weak_white_furnace[{ndf_name}]", errors[k], WEAK_FURNACE_TOL, detail)
 
 
 def _aniso_pairs(alphas=PROJECTED_AREA_ALPHAS) -> list[tuple[float, float, float, float]]:
     """(alpha, a, alpha_x, alpha_y) through the Burley mapping of the specular_aniso kind."""
-    from ..tables.aniso import alpha_xy
+    from ..integrands.anisotropic import alpha_xy
 
     out = []
     for alpha in alphas:
@@ -358,8 +350,8 @@ def kulla_conty_white_furnace() -> CheckResult:
     KC_N_MU x KC_N_ROUGH) and ``albedo_avg`` tables and measures max |E + E_ms - 1| per roughness row
     (kulla_conty_residual). Measured: the worst row with r >= 0.1 (tolerance KC_FURNACE_TOL); the smoothest rows
     must stay within KC_FURNACE_TOL_SMOOTHEST (module constants)."""
-    from ..api import bake_table
     from ..config import validate_table
+    from ..pipeline import bake_table
 
     e = bake_table(validate_table({"name": "e", "kind": "albedo", "size": [KC_N_MU, KC_N_ROUGH]}, "<check>", 0))[0]
     avg = bake_table(validate_table({"name": "a", "kind": "albedo_avg", "roughness_size": KC_N_ROUGH}, "<check>", 0))[0]
@@ -389,20 +381,8 @@ def kulla_conty_white_furnace() -> CheckResult:
 # --- tables ------------------------------------------------------------------------------------------
 
 
-def _integrate(
-    ndf_name: str,
-    masking_name: str,
-    channels: str,
-    nov,
-    alpha,
-    estimator: str = "gauss_legendre",
-    samples: int | None = None,
-) -> np.ndarray:
-    kernel = specular.kernel_for(ndf_name, masking_name, channels, estimator)
-    samples = specular.DEFAULT_SAMPLES[estimator] if samples is None else samples
-    return specular.integrate(
-        kernel, np.asarray(nov, np.float32), np.asarray(alpha, np.float32), estimator, samples, SEED, 2
-    )
+# (ndf, masking, channels, nov, alpha, estimator="gauss_legendre", samples=None) -> (N, C), at the checks' seed
+_integrate = functools.partial(hemisphere_integral, seed=SEED)
 
 
 def albedo_le_one_and_mirror_limit(ndf_name: str, masking_name: str) -> CheckResult:
@@ -439,13 +419,9 @@ def dfg_mirror_limit(ndf_name: str, masking_name: str) -> CheckResult:
     fc = (1.0 - nov.astype(np.float32).astype(np.float64)) ** 5
     err = np.maximum(np.abs(sb[:, 0] - (1.0 - fc)), np.abs(sb[:, 1] - fc))
     k = int(np.argmax(err))
-    return _result(
-        f"dfg_mirror_limit[{ndf_name},{masking_name}]",
-        err[k],
-        DFG_MIRROR_TOL,
-        f"max over n.v in [0.05, 1] of |scale - (1-(1-n.v)^5)|, |bias - (1-n.v)^5| at alpha={ALPHA_MIN}; "
-        f"worst at n.v={nov[k]:.4g}",
-    )
+    what = f"|scale - (1-(1-n.v)^5)|, |bias - (1-n.v)^5| at alpha={ALPHA_MIN}"
+    detail = f"max over n.v in [0.05, 1] of {what}; worst at n.v={nov[k]:.4g}"
+    return _result(f"dfg_mirror_limit[{ndf_name},{masking_name}]", err[k], DFG_MIRROR_TOL, detail)
 
 
 def estimators_agree() -> CheckResult:
@@ -486,7 +462,7 @@ def _reciprocity_brdfs() -> tuple[dict, dict]:
 
 
 def reciprocity(ndf_name: str, masking_name: str) -> CheckResult:
-    """Helmholtz reciprocity f(l, v) = f(v, l) of the assembled specular BRDF (probe.brdf_for) at
+    """Helmholtz reciprocity f(l, v) = f(v, l) of the assembled specular BRDF (probe.specular_brdf_for) at
     random direction pairs (n.l, n.v biased towards grazing), alpha = r^2, r in [0.1, 1], f0 in [0, 1]."""
     fwd, bwd = _reciprocity_brdfs()
     a = fwd[(ndf_name, masking_name)].astype(np.float64)
@@ -561,7 +537,7 @@ def _random_pairs(n: int, seed: int, min_cos: float = 0.0):
 def diffuse_sigma0_is_lambert_eq6() -> CheckResult:
     """At sigma = 0 (alpha = ALPHA_MIN) the microfacet diffuse BRDF (Eq. 4, facets with Eq. 6) is Lambert x Eq. 6:
     F_diff(n.l, n.v, f0) / pi, for every pair with n.l, n.v >= 0.1 (the limit needs alpha << n.x)."""
-    from ..tables.diffuse import eval_brdf
+    from ..integrands.diffuse import eval_brdf
 
     l, v = _random_pairs(DIFFUSE_PAIRS, SEED, 0.1)
     worst = 0.0
@@ -580,7 +556,7 @@ def diffuse_sigma0_is_lambert_eq6() -> CheckResult:
 
 def diffuse_reciprocity() -> CheckResult:
     """f(l, v) = f(v, l) for the microfacet diffuse BRDF, random pairs (grazing included), sigma 0.05 .. 1."""
-    from ..tables.diffuse import eval_brdf
+    from ..integrands.diffuse import eval_brdf
 
     l, v = _random_pairs(DIFFUSE_PAIRS, SEED + 1)
     sigma = np.random.default_rng(SEED + 2).uniform(0.05, 1.0, DIFFUSE_PAIRS)
@@ -598,7 +574,7 @@ def diffuse_reciprocity() -> CheckResult:
 def diffuse_albedo_le_one() -> CheckResult:
     """The directional albedo E(v) = ∫ f (n.l) dω_l of the microfacet diffuse model is <= 1 for every NoV, sigma, f0
     and per-facet Fresnel form (rho = 1): measured max(0, max E - 1)."""
-    from ..tables import diffuse_albedo
+    from ..integrands.diffuse import albedo_swapped
 
     nov = np.array([NOV_MIN, 0.01, 0.05, 0.2, 0.5, 0.8, 1.0])
     alpha = np.array([ALPHA_MIN, 0.01, 0.1, 0.3, 0.6, 1.0])
@@ -606,7 +582,7 @@ def diffuse_albedo_le_one() -> CheckResult:
     worst, top = 0.0, 0.0
     for form in ("eq6", "schlick", "dielectric_f0"):
         for f0 in (0.0, 0.04, 0.5):
-            e = diffuse_albedo.albedo(N, A, f0, form, order=DIFFUSE_ORDER)
+            e = albedo_swapped(N, A, f0, form, order=DIFFUSE_ORDER)
             top = max(top, float(e.max()))
             worst = max(worst, float(np.max(e - 1.0)))
     return _result(
@@ -616,6 +592,22 @@ def diffuse_albedo_le_one() -> CheckResult:
         f"max(0, E - 1) over {len(N)} (NoV, alpha) x f0 in (0, 0.04, 0.5) x facet forms eq6, schlick, dielectric_f0",
         (f"max E = {top:.7f}",),
     )
+
+
+LTC_SPHERE_TOL = 1.0e-8  # the integrated sphere table vs Snyder's closed form, relative to the unclipped value
+
+
+def ltc_sphere_table_is_snyder() -> CheckResult:
+    """The LTC sphere/disk table (lutbake.ltc.sphere, baked by integration) against Snyder's closed form of the
+    horizon-clipped projected solid angle of a spherical cap (ltc_code fitLTC.cpp ihemi), on a 33 x 33 grid of
+    (elevation, half-angle), relative to the unclipped value pi sin^2 sigma."""
+    from ..ltc import sphere
+
+    omega, sigma = np.meshgrid(np.linspace(0.0, np.pi, 33), np.linspace(1e-3, np.pi / 2, 33))
+    got = sphere.cap_projected_solid_angle(omega, sigma)
+    want = np.vectorize(sphere.snyder_cap)(omega, sigma)
+    err = np.max(np.abs(got - want) / (np.pi * np.sin(sigma) ** 2))
+    return _result("ltc_sphere_table_is_snyder", err, LTC_SPHERE_TOL, "max |integrated - closed form| / (pi sin^2)")
 
 
 # --- registry ------------------------------------------------------------------------------------------
@@ -645,6 +637,10 @@ def _registry() -> dict:
     checks["diffuse_sigma0_is_lambert_eq6"] = diffuse_sigma0_is_lambert_eq6
     checks["diffuse_reciprocity"] = diffuse_reciprocity
     checks["diffuse_albedo_le_one"] = diffuse_albedo_le_one
+    from . import dielectric  # the rough dielectric BSDF's checks (imports _result from here)
+
+    checks.update(dielectric.CHECKS)
+    checks["ltc_sphere_table_is_snyder"] = ltc_sphere_table_is_snyder
     return checks
 
 

@@ -9,10 +9,10 @@ Host API (inputs broadcast against each other; ``h``, ``l``, ``v`` carry a trail
 
     evaluate_terms(h=..., alpha=..., nov=..., nol=..., voh=..., loh=..., f0=..., eta=..., cos_theta=...)
         -> {term name: array}, names in ``TERM_NAMES``:
-        D_<ndf>            D(h, alpha)                                  for every NDF in sets.NDFS
+        D_<ndf>            D(h, alpha)                                  for every NDF in distributions.NDFS
         Lambda_<ndf>       Lambda(nov, alpha)
         G1_smith_<ndf>     G1_smith(Lambda(nov, alpha))
-        G2[<ndf>,<masking>]  sets.G2_for(ndf, masking)(nov, nol, h.z, voh, alpha)  (the composed G2 tables use)
+        G2[<ndf>,<masking>]  NDFS[ndf].G2(masking)(nov, nol, h.z, voh, alpha)  (the composed G2 tables use)
         G2_v_cavity        G2_v_cavity(h.z, nov, nol, voh, loh)          (with its own l.h)
         D_ggx_aniso        D_ggx_aniso(h, alpha, alpha_y)               (alpha = alpha_x along the tangent +x)
         Lambda_ggx_aniso   Lambda_ggx_aniso(v, alpha, alpha_y)
@@ -36,7 +36,7 @@ import warp as wp
 
 from ..edge import COS_EPS
 from ..terms import fresnel, masking, ndf
-from ..terms.sets import MASKINGS, NDFS, G2_for, pair_allowed
+from ..terms.distributions import MASKINGS, NDFS
 
 wp.set_module_options({"enable_backward": False})
 
@@ -84,7 +84,7 @@ def _ndf_probes(ndf_name: str) -> list:
 
 
 def _g2_probe(ndf_name: str, masking_name: str) -> tuple:
-    G2 = G2_for(ndf_name, masking_name)
+    G2 = NDFS[ndf_name].G2(masking_name)
 
     @wp.func
     def probe_G2(x: TermInputs):
@@ -143,7 +143,7 @@ def _probe_V_charlie(x: TermInputs):
     return masking.V_charlie(x.nov, x.nol, x.alpha)
 
 
-BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS if pair_allowed(n, m))
+BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS if NDFS[n].masking_allowed(m))
 
 _PROBES = (
     [p for n in NDFS for p in _ndf_probes(n)]
@@ -167,34 +167,25 @@ TERM_NAMES: tuple[str, ...] = tuple(name for name, _ in _PROBES)
 _PROBE_FUNCS = [f for _, f in _PROBES]
 
 
+SCALARS = ("alpha", "alpha_y", "nov", "nol", "voh", "loh", "f0", "eta", "cos_theta")  # _terms_kernel's s columns
+
+
 @wp.kernel
-def _terms_kernel(
-    h: wp.array(dtype=wp.vec3),
-    v: wp.array(dtype=wp.vec3),
-    alpha: wp.array(dtype=float),
-    alpha_y: wp.array(dtype=float),
-    nov: wp.array(dtype=float),
-    nol: wp.array(dtype=float),
-    voh: wp.array(dtype=float),
-    loh: wp.array(dtype=float),
-    f0: wp.array(dtype=float),
-    eta: wp.array(dtype=float),
-    cos_theta: wp.array(dtype=float),
-    out: wp.array2d(dtype=float),
-):
+def _terms_kernel(hv: wp.array2d(dtype=wp.vec3), s: wp.array2d(dtype=float), out: wp.array2d(dtype=float)):
+    """hv[i] = (h, v); s[i] = SCALARS in order."""
     i = wp.tid()
     x = TermInputs()
-    x.h = h[i]
-    x.v = v[i]
-    x.alpha = alpha[i]
-    x.alpha_y = alpha_y[i]
-    x.nov = nov[i]
-    x.nol = nol[i]
-    x.voh = voh[i]
-    x.loh = loh[i]
-    x.f0 = f0[i]
-    x.eta = eta[i]
-    x.cos_theta = cos_theta[i]
+    x.h = hv[i, 0]
+    x.v = hv[i, 1]
+    x.alpha = s[i, 0]
+    x.alpha_y = s[i, 1]
+    x.nov = s[i, 2]
+    x.nol = s[i, 3]
+    x.voh = s[i, 4]
+    x.loh = s[i, 5]
+    x.f0 = s[i, 6]
+    x.eta = s[i, 7]
+    x.cos_theta = s[i, 8]
     for k in range(wp.static(len(_PROBE_FUNCS))):
         out[i, k] = wp.static(_PROBE_FUNCS[k])(x)
 
@@ -203,11 +194,11 @@ def _terms_kernel(
 
 
 @functools.lru_cache(maxsize=None)
-def brdf_for(ndf_name: str, masking_name: str):
+def specular_brdf_for(ndf_name: str, masking_name: str):
     """``f(l, v, alpha, f0)``: the Cook-Torrance specular BRDF of one (NDF, masking) pair with Schlick F,
     assembled from the terms exactly as tables assemble it (module docstring)."""
     D = NDFS[ndf_name].D
-    G2 = G2_for(ndf_name, masking_name)
+    G2 = NDFS[ndf_name].G2(masking_name)
 
     @wp.func
     def brdf(l: wp.vec3, v: wp.vec3, alpha: float, f0: float):
@@ -226,20 +217,15 @@ def brdf_for(ndf_name: str, masking_name: str):
     return brdf
 
 
-_BRDF_FUNCS = [brdf_for(n, m) for n, m in BRDF_PAIRS]
+_BRDF_FUNCS = [specular_brdf_for(n, m) for n, m in BRDF_PAIRS]
 
 
 @wp.kernel
-def _brdf_kernel(
-    l: wp.array(dtype=wp.vec3),
-    v: wp.array(dtype=wp.vec3),
-    alpha: wp.array(dtype=float),
-    f0: wp.array(dtype=float),
-    out: wp.array2d(dtype=float),
-):
+def _brdf_kernel(lv: wp.array2d(dtype=wp.vec3), alpha_f0: wp.array(dtype=wp.vec2), out: wp.array2d(dtype=float)):
+    """lv[i] = (l, v); alpha_f0[i] = (alpha, f0)."""
     i = wp.tid()
     for k in range(wp.static(len(_BRDF_FUNCS))):
-        out[i, k] = wp.static(_BRDF_FUNCS[k])(l[i], v[i], alpha[i], f0[i])
+        out[i, k] = wp.static(_BRDF_FUNCS[k])(lv[i, 0], lv[i, 1], alpha_f0[i][0], alpha_f0[i][1])
 
 
 # --- host side ------------------------------------------------------------------------------------
@@ -294,11 +280,9 @@ def evaluate_terms(
     )
     n = int(np.prod(shape, dtype=np.int64))
     out = wp.zeros((n, len(TERM_NAMES)), dtype=float, device=device)
-    inputs = [wp.array(x[k], dtype=wp.vec3, device=device) for k in ("h", "v")]
-    inputs += [
-        wp.array(x[k], dtype=float, device=device)
-        for k in ("alpha", "alpha_y", "nov", "nol", "voh", "loh", "f0", "eta", "cos_theta")
-    ]
+    hv = np.ascontiguousarray(np.stack([x["h"], x["v"]], axis=1), dtype=np.float32)
+    sc = np.ascontiguousarray(np.stack([x[k] for k in SCALARS], axis=1), dtype=np.float32)
+    inputs = [wp.array(hv, dtype=wp.vec3, device=device), wp.array(sc, dtype=float, device=device)]
     if n:
         wp.launch(_terms_kernel, dim=n, inputs=inputs + [out], device=device)
     res = out.numpy()
@@ -311,12 +295,9 @@ def evaluate_brdfs(l, v, alpha, f0=0.04, device: str = "cpu") -> dict[tuple[str,
     shape, x = _vec_and_scalars({"l": l, "v": v}, {"alpha": alpha, "f0": f0})
     n = int(np.prod(shape, dtype=np.int64))
     out = wp.zeros((n, len(BRDF_PAIRS)), dtype=float, device=device)
-    inputs = [
-        wp.array(x["l"], dtype=wp.vec3, device=device),
-        wp.array(x["v"], dtype=wp.vec3, device=device),
-        wp.array(x["alpha"], dtype=float, device=device),
-        wp.array(x["f0"], dtype=float, device=device),
-    ]
+    lv = np.ascontiguousarray(np.stack([x["l"], x["v"]], axis=1), dtype=np.float32)
+    af = np.ascontiguousarray(np.stack([x["alpha"], x["f0"]], axis=1), dtype=np.float32)
+    inputs = [wp.array(lv, dtype=wp.vec3, device=device), wp.array(af, dtype=wp.vec2, device=device)]
     if n:
         wp.launch(_brdf_kernel, dim=n, inputs=inputs + [out], device=device)
     res = out.numpy()

@@ -1,0 +1,124 @@
+"""Integrands of the rough dielectric BSDF (Walter, Marschner, Li & Torrance 2007, "Microfacet models for refraction
+through rough surfaces", Eqs. 20-21) in the half-vector measure, for the energy tables of lutbake.kinds.dielectric.
+
+For a view v (n.v = mu > 0, on the incident side, relative index eta = eta_o / eta_i), both lobes are written over
+the same microfacet normal h (v.h > 0, n.h > 0):
+    reflection    o = l = reflect(v, h),  dω_l = 4 (v.h) dω_h                       (Walter Eq. 14)
+    transmission  o = t = refract(v, h, eta),  dω_h / dω_t = eta^2 |t.h| / (v.h + eta t.h)^2   (Walter Eq. 17)
+so that
+    E_R(mu) = ∫ f_r |n.l| dω_l = ∫ F(v.h) D(h) G2(v, l) (v.h) / mu  [n.l > 0] dω_h
+    E_T(mu) = ∫ f_t |n.t| dω_t = ∫ (1 - F(v.h)) D(h) G2(v, t) (v.h) / mu  [n.t < 0, no TIR] dω_h
+(the Jacobian cancels f_t's |i.h||o.h| eta_o^2 / (eta_i i.h + eta_o o.h)^2 exactly). G2(v, o) is the Smith term
+"generalised for transmission": evaluated with |n.o| on either side (separable G1(v) G1(o), or height-correlated
+1 / (1 + Lambda(v) + Lambda(o)), the form pbrt-v4's DielectricBxDF uses for both lobes).
+
+A *Fresnel mode* picks the channels (each a weight of the two lobes at the same h):
+    exact        (F w_R, (1 - F) w_T, F w_R + (1 - F) w_T)        E_R, E_T, E_R + E_T
+    exact_metal  (F w_R, (1 - F) w_T, w_R)                         E_R, E_T and E(F = 1) (OpenPBR's metal table)
+    eevee        ((1 - s) w_R, s w_R, (1 - s) w_T)                 Blender EEVEE's split sum with Schlick:
+                 s = (1 - |x.h|)^5, x = v for eta >= 1 (ggx_btdf_gt_one), x = t for eta < 1 (ggx_bsdf_split_sum;
+                 s = 1 under total internal reflection, where EEVEE's refract() returns 0)
+with w_R = D G2(v, l) (v.h) / mu [n.l > 0] and w_T = D G2(v, t) (v.h) / mu [n.t < 0].
+"""
+
+from __future__ import annotations
+
+import functools
+
+import warp as wp
+
+from ..edge import COS_EPS
+from ..terms import fresnel
+from ..terms.dielectric import cos_transmitted, refract
+from ..terms.distributions import NDFS
+from ..terms.frame import reflect
+from .specular import SpecularIntegrand
+
+FRESNEL_MODES = {
+    "exact": "(E_R, E_T, E_R + E_T) with the exact dielectric Fresnel (Walter et al. 2007, Eq. 22; TIR included)",
+    "exact_metal": "(E_R, E_T, E with F = 1): OpenPBR's dielectric and metal tables from one integral",
+    "eevee": "Blender EEVEE's Schlick split sum: (scale, bias, transmission_factor), s = (1 - |x.h|)^5",
+}
+MASKINGS = ("smith_separable", "smith_height_correlated")
+
+
+@functools.lru_cache(maxsize=None)
+def integrand_for(ndf_name: str, masking_name: str, mode: str):
+    """``g(v, h, alpha, eta) -> wp.vec3`` (module docstring); 0 for v.h, n.v <= COS_EPS or n.h <= 0."""
+    if mode not in FRESNEL_MODES:
+        raise KeyError(f"unknown Fresnel mode {mode!r}; valid: {', '.join(FRESNEL_MODES)}")
+    if masking_name not in MASKINGS:
+        raise KeyError(f"masking {masking_name!r} is not defined for transmission; valid: {', '.join(MASKINGS)}")
+    D = NDFS[ndf_name].D
+    G2 = NDFS[ndf_name].G2(masking_name)
+
+    @wp.func
+    def integrand(v: wp.vec3, h: wp.vec3, alpha: float, eta: float):
+        NoV = v[2]
+        VoH = wp.dot(v, h)
+        if NoV <= COS_EPS or VoH <= COS_EPS or h[2] <= 0.0:
+            return wp.vec3()
+        w = D(h, alpha) * VoH / NoV
+        NoL = reflect(v, h)[2]
+        w_r = w * 0.0  # dynamic (a literal is a constant to Warp)
+        if NoL > COS_EPS:
+            w_r = w * G2(NoV, NoL, h[2], VoH, alpha)
+        t = refract(v, h, eta)
+        NoT = -t[2]
+        w_t = w * 0.0
+        if NoT > COS_EPS:
+            w_t = w * G2(NoV, NoT, h[2], VoH, alpha)
+        if wp.static(mode == "eevee"):
+            x = VoH
+            if eta < 1.0:
+                x = -wp.dot(t, h)  # 0 under TIR: s = 1
+            s = fresnel.Fc_schlick(x)
+            return wp.vec3((1.0 - s) * w_r, s * w_r, (1.0 - s) * w_t)
+        F = fresnel.F_dielectric(eta, VoH)
+        if wp.static(mode == "exact_metal"):
+            return wp.vec3(F * w_r, (1.0 - F) * w_t, w_r)
+        return wp.vec3(F * w_r, (1.0 - F) * w_t, F * w_r + (1.0 - F) * w_t)
+
+    return integrand
+
+
+@functools.lru_cache(maxsize=None)
+def mirror_for(mode: str):
+    """The exact alpha -> 0 limit (lutbake.edge): D -> delta about n, so h = n, v.h = mu, G2 -> 1, and each lobe
+    keeps its Fresnel weight at mu: E_R = F(mu, eta), E_T = 1 - F(mu, eta) (0 under total internal reflection)."""
+
+    @wp.func
+    def mirror(v: wp.vec3, eta: float):
+        mu = v[2]
+        if mu <= COS_EPS:
+            return wp.vec3()
+        ct = cos_transmitted(eta, mu)
+        w_t = wp.where(ct > COS_EPS, 1.0, 0.0)
+        if wp.static(mode == "eevee"):
+            x = mu
+            if eta < 1.0:
+                x = wp.max(ct, 0.0)  # the refracted cosine; 0 under TIR: s = 1
+            s = fresnel.Fc_schlick(x)
+            return wp.vec3(1.0 - s, s, (1.0 - s) * w_t)
+        F = fresnel.F_dielectric(eta, mu)
+        if wp.static(mode == "exact_metal"):
+            return wp.vec3(F, (1.0 - F) * w_t, 1.0)
+        return wp.vec3(F, (1.0 - F) * w_t, F + (1.0 - F) * w_t)
+
+    return mirror
+
+
+@functools.lru_cache(maxsize=None)
+def dielectric_integrand(ndf_name: str, masking_name: str, mode: str, nch: int = 3) -> SpecularIntegrand:
+    """The integrand record (lutbake.integrands.specular.SpecularIntegrand: g, vec, distribution, mirror) of a
+    (terms, Fresnel mode) key; the kernels' per-texel ``param`` is the relative IOR eta."""
+    return SpecularIntegrand(
+        ("dielectric", ndf_name, masking_name, mode),
+        integrand_for(ndf_name, masking_name, mode),
+        wp.vec3,
+        wp.vec3d,
+        3,
+        nch,
+        NDFS[ndf_name],
+        mirror_for(mode),
+    )

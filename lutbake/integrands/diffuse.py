@@ -1,0 +1,188 @@
+"""Integrands of the diffuse tables: the diffuse BRDFs f(l, v) for rho = 1, as ``brdf(l, v, sigma, alpha, f0,
+rule) -> float64`` (closed forms ignore alpha and the GL arrays; the microfacet model of Gotanda 2014, Eq. 4, is
+integrated over m by lutbake.sampling.facets and ignores sigma).
+
+The record ``DiffuseIntegrand`` also carries, for the microfacet model, its facet transmission split
+F_facet = c(f0) T(m.l) T(m.v) (``transmission`` = T, ``f0_scale`` = c), which the swapped-integral albedo
+(lutbake.sampling.swapped) needs. alpha -> 0 has no closed form here: alpha is clamped to ALPHA_MIN (lutbake.edge).
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+from ..axes import sigma_alpha
+from ..edge import COS_EPS, effective_alpha
+from ..sampling.diffuse import DiffuseGaussLegendre, eval_points
+from ..sampling.facets import fd_microfacet_for
+from ..sampling.swapped import integrate_swapped
+from ..terms import diffuse
+
+FACET_FRESNEL = {
+    "eq6": "Eq. 6 on each facet: 21/20 (1 - f0)(1 - (1 - m.l)^5)(1 - (1 - m.v)^5); E scales with (1 - f0)",
+    "schlick": "(1 - F(m.l))(1 - F(m.v)), F Schlick: (1 - f0)^2 (1 - (1 - m.l)^5)(1 - (1 - m.v)^5); "
+    "E scales with (1 - f0)^2",
+    "dielectric_f0": "(1 - F(m.l))(1 - F(m.v)), F the exact dielectric Fresnel of Eq. 2 written with f0: f0 does not "
+    "factor out (kind diffuse_3d bakes an f0 axis; kind diffuse bakes the given f0 only)",
+}
+FACET_FUNCS = {
+    "eq6": diffuse.F_facet_eq6,
+    "schlick": diffuse.F_facet_schlick,
+    "dielectric_f0": diffuse.F_facet_dielectric_f0,
+}
+DIFFUSE_MODELS = {
+    "lambert": "Lambert, rho / pi",
+    "oren_nayar": "classic Oren-Nayar as taught in lecture 003 (A with 0.57)",
+    "oren_nayar_improved": "improved Oren-Nayar, Gotanda 2014 Eq. 5",
+    "oren_nayar_fresnel": "Oren-Nayar with Fresnel, Gotanda 2014 Eq. 7 ((1 - f0) counted once)",
+    "fitted": "Gotanda's fitted microfacet diffuse, Eq. 8 (course-notes reading)",
+    "fitted_slides": "Eq. 8 with the slides' reading of F_r's second factor",
+    "microfacet": "the microfacet diffuse model, Eq. 4, integrated over m (GGX, height-correlated Smith)",
+}
+
+
+F0_NONE = "none: f0 does not factor out; the table holds E at the baked f0 only (kind diffuse_3d has an f0 axis)"
+
+
+def f0_factor(model: str, facet_fresnel: str) -> str:
+    """How f0 enters a model: every model here is g(f0) times an f0-free function."""
+    if model in ("lambert", "oren_nayar", "oren_nayar_improved"):
+        return "1"
+    if model == "microfacet" and facet_fresnel == "schlick":
+        return "(1 - f0)^2"
+    if model == "microfacet" and facet_fresnel == "dielectric_f0":
+        return F0_NONE
+    return "(1 - f0)"
+
+
+# facet form -> (transmission T(c, f0), the f0 factor c(f0) as a Python function)
+FACET_SPLIT = {
+    "eq6": (diffuse.T_pow5, lambda f0: 1.05 * (1.0 - f0)),
+    "schlick": (diffuse.T_pow5, lambda f0: (1.0 - f0) ** 2),
+    "dielectric_f0": (diffuse.T_dielectric_f0, lambda f0: 1.0),
+}
+
+
+CLOSED_FORMS = {  # model -> (Fd_ term, whether it takes f0)
+    "oren_nayar": (diffuse.Fd_oren_nayar, False),
+    "oren_nayar_improved": (diffuse.Fd_oren_nayar_improved, False),
+    "oren_nayar_fresnel": (diffuse.Fd_oren_nayar_fresnel, True),
+    "fitted": (diffuse.Fd_gotanda_fitted, True),
+    "fitted_slides": (diffuse.Fd_gotanda_fitted_slides, True),
+}
+
+
+@functools.lru_cache(maxsize=None)
+def brdf_for(model: str, facet_fresnel: str = "eq6"):
+    """``brdf(l, v, sigma, alpha, f0, rule) -> float64``: the model's BRDF for rho = 1 (closed forms ignore alpha and
+    the GL rule (node, weight) of the microfacet model's m-integral; the microfacet model ignores sigma)."""
+    if model == "microfacet":
+        fm = fd_microfacet_for(FACET_FUNCS[facet_fresnel])
+
+        @wp.func
+        def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float, rule: wp.array(dtype=wp.vec2d)):
+            return fm(l, v, alpha, f0, rule)
+
+        return brdf
+    if model == "lambert":
+
+        @wp.func
+        def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float, rule: wp.array(dtype=wp.vec2d)):
+            if l[2] <= COS_EPS or v[2] <= COS_EPS:
+                return wp.float64(0.0)
+            return wp.float64(diffuse.Fd_lambert(1.0))
+
+        return brdf
+    F, with_f0 = CLOSED_FORMS[model]
+    if with_f0:
+
+        @wp.func
+        def closed(l: wp.vec3, v: wp.vec3, sigma: float, f0: float):
+            return F(1.0, l[2], v[2], wp.dot(l, v), sigma, f0)
+    else:
+
+        @wp.func
+        def closed(l: wp.vec3, v: wp.vec3, sigma: float, f0: float):
+            return F(1.0, l[2], v[2], wp.dot(l, v), sigma)
+
+    @wp.func
+    def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float, rule: wp.array(dtype=wp.vec2d)):
+        return wp.float64(closed(l, v, sigma, f0))
+
+    return brdf
+
+
+@dataclass(frozen=True)
+class DiffuseIntegrand:
+    """A diffuse BRDF (rho = 1) and, for the microfacet model, its facet transmission split (module docstring)."""
+
+    model: str
+    facet_fresnel: str
+    brdf: object
+    transmission: object | None
+    f0_scale: object | None
+    facet: object | None = None  # the microfacet model's F_facet(MoL, MoV, f0) (lutbake.sampling.facets)
+    nch: int = 1
+
+
+@functools.lru_cache(maxsize=None)
+def diffuse_integrand(model: str, facet_fresnel: str = "eq6") -> DiffuseIntegrand:
+    if model != "microfacet":
+        return DiffuseIntegrand(model, facet_fresnel, brdf_for(model, facet_fresnel), None, None)
+    T, c = FACET_SPLIT[facet_fresnel]
+    return DiffuseIntegrand(model, facet_fresnel, brdf_for(model, facet_fresnel), T, c, FACET_FUNCS[facet_fresnel])
+
+
+def _alpha(sigma, sigma_to_alpha: str):
+    return effective_alpha(sigma_alpha(np.asarray(sigma, np.float32), sigma_to_alpha), False)
+
+
+def eval_brdf(
+    model: str,
+    l: np.ndarray,
+    v: np.ndarray,
+    sigma,
+    f0: float = 0.0,
+    facet_fresnel: str = "eq6",
+    sigma_to_alpha: str = "sigma",
+    order: int = 8,
+    device: str = "cpu",
+) -> np.ndarray:
+    """Host helper: f(l_i, v_i) for unit direction arrays (N, 3) (n = +z), rho = 1, the microfacet model's m-rule
+    of ``order``; float64 (N,)."""
+    n = len(np.asarray(l).reshape(-1, 3))
+    s = np.broadcast_to(np.asarray(sigma, dtype=np.float32), (n,))
+    return eval_points(diffuse_integrand(model, facet_fresnel), l, v, s, _alpha(s, sigma_to_alpha), f0, order, device)
+
+
+def albedo_gl(
+    model: str,
+    nov,
+    sigma,
+    f0: float = 0.0,
+    facet_fresnel: str = "eq6",
+    sigma_to_alpha: str = "sigma",
+    order: int = 8,
+    outer_order: int | None = None,
+    device: str = "cpu",
+) -> np.ndarray:
+    """Host helper: E(nov_i, sigma_i) = ∫ f (n.l) dω_l (rho = 1) by GL over l on 2 x 2 panels
+    (lutbake.sampling.diffuse.DiffuseGaussLegendre), float64 (N,)."""
+    nov = np.ascontiguousarray(nov, dtype=np.float32)
+    s = np.ascontiguousarray(np.broadcast_to(np.asarray(sigma, dtype=np.float32), nov.shape))
+    inputs = {"nov": nov, "sigma": s, "alpha": _alpha(s, sigma_to_alpha), "f0": np.full(len(nov), f0)}
+    return DiffuseGaussLegendre(order, outer_order).evaluate(diffuse_integrand(model, facet_fresnel), inputs, device)[
+        :, 0
+    ]
+
+
+def albedo_swapped(
+    nov, alpha, f0=0.0, facet_fresnel: str = "eq6", order: int = 12, orders=None, device: str = "cpu"
+) -> np.ndarray:
+    """Host helper: the microfacet model's E(nov_i) for GGX alpha_i by the swapped integral
+    (lutbake.sampling.swapped), float64 (N,)."""
+    return integrate_swapped(diffuse_integrand("microfacet", facet_fresnel), nov, alpha, f0, order, orders, device)

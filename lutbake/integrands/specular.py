@@ -1,0 +1,330 @@
+"""Integrands of the specular tables: g(h) per texel, for the hemisphere estimators of lutbake.sampling.hemisphere.
+
+Cook-Torrance microfacet BRDF (Gotanda 2014 course notes, Eq. 1):
+    f(l, v) = D(h) F(v.h) G2(l, v, h) / (4 (n.l)(n.v))
+In the half-vector measure (see lutbake.sampling.hemisphere) the integrand is
+    g(h) = f (n.l) 4 (v.h) = D G2 F (v.h) / (n.v).
+A *channel function* replaces F by the weights that make the table's channels; for the split sum
+with Schlick F = f0 (1 - Fc) + Fc, Fc = (1 - v.h)^5 (Karis 2013):
+    scale_bias:   (1 - Fc, Fc)   -> E = f0 * scale + bias
+    multiscatter: (Fc, 1)        -> E = mix(R, G, f0) = (1 - f0) R + f0 G,  E(F = 1) = G
+    scale_bias_f82: (1 - Fc, Fc, (v.h)(1 - v.h)^6)   (Blender EEVEE's F82-tint term)
+The cloth layout adds a channel with its own BRDF, D_charlie V_ashikhmin (no Fresnel), whose integrand
+in the same measure is D_charlie V_ashikhmin (n.l) 4 (v.h) (Filament's DFV_Charlie_Uniform).
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+import warp as wp
+
+from ..edge import COS_EPS, effective_alpha
+from ..terms import fresnel, masking, metals, ndf
+from ..terms.distributions import NDFS, Distribution
+from ..terms.frame import reflect
+
+
+@wp.func
+def channels_scale_bias(VoH: float, f0: float):
+    Fc = fresnel.Fc_schlick(VoH)
+    return wp.vec2(1.0 - Fc, Fc)
+
+
+@wp.func
+def channels_multiscatter(VoH: float, f0: float):
+    return wp.vec2(fresnel.Fc_schlick(VoH), 1.0)
+
+
+@wp.func
+def channels_albedo(VoH: float, f0: float):
+    return wp.vec2(1.0, 0.0)
+
+
+def fresnel_channels(F):
+    """specular_3d: R = F(f0, v.h) for the texel's f0 (the kernel's per-texel param); G unused (0)."""
+
+    @wp.func
+    def channels_F(VoH: float, f0: float):
+        return wp.vec2(F(f0, VoH), 0.0)
+
+    return channels_F
+
+
+# Blender EEVEE's F82-tint layout: (1 - Fc, Fc, (v.h)(1 - v.h)^6)
+@wp.func
+def channels_scale_bias_f82(VoH: float, f0: float):
+    Fc = fresnel.Fc_schlick(VoH)
+    return wp.vec3(1.0 - Fc, Fc, VoH * Fc * wp.clamp(1.0 - VoH, 0.0, 1.0))
+
+
+@wp.func
+def channels_multiscatter3(VoH: float, f0: float):
+    return wp.vec3(fresnel.Fc_schlick(VoH), 1.0, 0.0)
+
+
+CHANNEL_FUNCS = {
+    "scale_bias": channels_scale_bias,
+    "multiscatter": channels_multiscatter,
+    "albedo": channels_albedo,
+    **{
+        f"F:{name}": fresnel_channels(getattr(fresnel, f"F_{name}"))
+        for name in ("schlick", "schlick_sg", "improved_sg", "dielectric_f0")
+    },
+    "scale_bias_f82": channels_scale_bias_f82,
+}
+THREE_CHANNELS = {"scale_bias_f82", "multiscatter_cloth", "charlie", "charlie_clamped"}
+N_CHANNELS = {
+    "scale_bias": 2,
+    "multiscatter": 2,
+    "albedo": 2,
+    "scale_bias_f82": 3,
+    "multiscatter_cloth": 3,
+    "charlie": 3,
+    "sheen_albedo": 2,
+    "charlie_clamped": 3,
+    "sheen_albedo_clamped": 2,
+}
+# the sheen lobe alone: no GGX term (sheen_integrand_for); *_clamped: V clamped to [0, 1] (the viewer's shaders)
+SHEEN_LAYOUTS = ("charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped")
+
+
+@functools.lru_cache(maxsize=None)
+def channels_for(channels_name: str):
+    """(channel wp.func (VoH, param) -> vec, vec type): a name of CHANNEL_FUNCS, or "metal:<name>"
+    for RGB = F_conductor(n_c, k_c, v.h) of a metal of lutbake.terms.metals (constants closed over)."""
+    if channels_name in CHANNEL_FUNCS:
+        return CHANNEL_FUNCS[channels_name], (wp.vec3 if channels_name in THREE_CHANNELS else wp.vec2)
+    if channels_name.startswith("metal:"):
+        m = metals.lookup_metal(channels_name[len("metal:") :])
+        nr, ng, nb = (float(x) for x in m.n)
+        kr, kg, kb = (float(x) for x in m.k)
+
+        @wp.func
+        def channels_metal(VoH: float, f0: float):
+            return wp.vec3(
+                fresnel.F_conductor(nr, kr, VoH), fresnel.F_conductor(ng, kg, VoH), fresnel.F_conductor(nb, kb, VoH)
+            )
+
+        return channels_metal, wp.vec3
+    raise KeyError(channels_name)
+
+
+def half_vector_integrand(lobe, vec, skip_below_horizon_h: bool):
+    """g(v, h, alpha, param) = lobe(v, h, l, v.h, alpha, param) with l = reflect(v, h), and 0 (``vec()``) where n.l,
+    v.h or n.v <= COS_EPS (back-facing; also n.h <= 0 if ``skip_below_horizon_h``): the common prologue of every
+    specular integrand."""
+
+    @wp.func
+    def integrand(v: wp.vec3, h: wp.vec3, alpha: float, param: float):
+        l = reflect(v, h)
+        VoH = wp.dot(v, h)
+        if l[2] <= COS_EPS or VoH <= COS_EPS or v[2] <= COS_EPS or (wp.static(skip_below_horizon_h) and h[2] <= 0.0):
+            return vec()
+        return lobe(v, h, l, VoH, alpha, param)
+
+    return integrand
+
+
+@functools.lru_cache(maxsize=None)
+def weight_for(ndf_name: str, masking_name: str, form: str):
+    """f (n.l) 4 (v.h) / F of an integrand form (``integrand_for``) at (v, h, l, v.h, alpha)."""
+    if form == "microfacet":
+        D = NDFS[ndf_name].D
+        G2 = NDFS[ndf_name].G2(masking_name)
+
+        @wp.func
+        def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
+            return D(h, alpha) * G2(v[2], l[2], h[2], VoH, alpha) * VoH / v[2]
+    elif form == "blinn_phong":
+
+        @wp.func
+        def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
+            s = ndf.shininess_from_alpha(alpha)
+            return (s + 8.0) / (8.0 * wp.pi) * wp.exp(s * ndf.log_cos(h)) * 4.0 * l[2] * VoH
+    elif form == "ashikhmin_shirley":
+
+        @wp.func
+        def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
+            s = ndf.shininess_from_alpha(alpha)
+            return (s + 1.0) / (2.0 * wp.pi) * wp.exp(s * ndf.log_cos(h)) * l[2] / wp.max(l[2], v[2])
+    else:
+        raise KeyError(form)
+    return weight
+
+
+@functools.lru_cache(maxsize=None)
+def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: str = "microfacet"):
+    """g(h) = f(l, v) (n.l) 4 (v.h) * channels(v.h, param), 0 where n.l, v.h or n.v <= COS_EPS (back-facing).
+    ``form`` (model_terms):
+        microfacet         f = D G2 / (4 (n.l)(n.v)) [x F]:          g = D G2 (v.h) / (n.v)
+        blinn_phong        f = (s + 8)/(8 pi) (n.h)^s [x F]:          g = (s + 8)/(8 pi) (n.h)^s 4 (n.l)(v.h)
+        ashikhmin_shirley  f = (s + 1)/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v)) [x F]:
+                                                                      g = (s + 1)/(2 pi) (n.h)^s (n.l) / max(n.l, n.v)
+    with s = 2 / alpha^2 - 2 for the last two (ndf_name, masking_name are then unused)."""
+    if channels_name == "multiscatter_cloth":
+        return cloth_integrand_for(ndf_name, masking_name)
+    if channels_name in SHEEN_LAYOUTS:
+        return sheen_integrand_for(channels_name)
+    ch, vec = channels_for(channels_name)
+    weight = weight_for(ndf_name, masking_name, form)
+
+    @wp.func
+    def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float):
+        return ch(VoH, param) * weight(v, h, l, VoH, alpha)
+
+    return half_vector_integrand(lobe, vec, True)
+
+
+@functools.lru_cache(maxsize=None)
+def cloth_integrand_for(ndf_name: str, masking_name: str):
+    """(Fc s, s, D_charlie V_ashikhmin (n.l) 4 (v.h)) with s = D G2 (v.h)/(n.v): the multiscatter
+    channels plus Filament's cloth DV (DFV_Charlie_Uniform), 0 where n.l or v.h <= COS_EPS (back-facing)."""
+    weight = weight_for(ndf_name, masking_name, "microfacet")
+
+    @wp.func
+    def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float):
+        cloth = ndf.D_charlie(h, alpha) * masking.V_ashikhmin(v[2], l[2]) * l[2] * 4.0 * VoH
+        return channels_multiscatter3(VoH, param) * weight(v, h, l, VoH, alpha) + wp.vec3(0.0, 0.0, cloth)
+
+    return half_vector_integrand(lobe, wp.vec3, False)
+
+
+@functools.lru_cache(maxsize=None)
+def sheen_integrand_for(layout: str):
+    """The sheen lobe f = D_charlie(h; alpha) V (KHR_materials_sheen, no Fresnel) alone, as g(h) = f (n.l) 4 (v.h):
+        charlie       (0, 0, D_charlie V_ashikhmin (n.l) 4 (v.h))   the glTF Sample Viewer's lut_charlie (read .b)
+        sheen_albedo  (D_charlie V_charlie (n.l) 4 (v.h), D_charlie V_ashikhmin (n.l) 4 (v.h))
+                      R: E(mu) with the spec's Charlie visibility, G: with Ashikhmin's
+    0 where n.l, v.h or n.v <= COS_EPS (back-facing). alpha is the texel's alpha (roughness = "alpha": the
+    sheenRoughness itself, as the KHR spec's D and Lambda fit use it). The ``*_clamped`` layouts clamp each V
+    to [0, 1], as the glTF Sample Viewer's V_Ashikhmin (ibl_filtering.frag) and V_Sheen (brdf.glsl) do."""
+    clamped = layout.endswith("_clamped")
+    vmax = 1.0 if clamped else 1.0e30
+    base = layout.removesuffix("_clamped")
+
+    @wp.func
+    def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float):
+        NoL = l[2]
+        NoV = v[2]
+        d = ndf.D_charlie(h, alpha) * NoL * 4.0 * VoH
+        ash = d * wp.min(masking.V_ashikhmin(NoV, NoL), wp.static(vmax))
+        if wp.static(base == "charlie"):
+            return wp.vec3(0.0, 0.0, ash)
+        return wp.vec3(d * wp.min(masking.V_charlie(NoV, NoL, alpha), wp.static(vmax)), ash, 0.0)
+
+    return half_vector_integrand(lobe, wp.vec3, False)
+
+
+# The lecture's models (003) as term sets of the dfg-like kinds (key ``model``). "microfacet" takes ``ndf`` and
+# ``masking`` from the config; the others fix them: (integrand form, NDF whose CDF the estimators sample, masking).
+SPECULAR_MODELS = {
+    "microfacet": "D G2 F / (4 (n.l)(n.v)) with the config's ndf and masking (default)",
+    "cook_torrance": "Cook & Torrance 1982 as in the lecture: Beckmann D (with 1/pi), V-cavity G, Schlick F; "
+    "the same as model = microfacet, ndf = beckmann, masking = v_cavity",
+    "blinn_phong": "the lecture's normalized Blinn-Phong lobe f = F (s + 8)/(8 pi) (n.h)^s, s = 2/alpha^2 - 2 "
+    "(no G; the lecture's (s + 8)/8 is this times pi, per unit irradiance)",
+    "ashikhmin_shirley": "Ashikhmin & Shirley 2000, isotropic (nu = nv = s = 2/alpha^2 - 2): "
+    "f = F sqrt((nu+1)(nv+1))/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v))",
+}
+
+
+def model_terms(model: str, ndf_name: str, masking_name: str) -> tuple[str, str, str]:
+    """(integrand form, ndf, masking) a model integrates: the form is "microfacet", "blinn_phong" or
+    "ashikhmin_shirley"; Cook-Torrance is the microfacet form with Beckmann and V-cavity."""
+    if model == "microfacet":
+        return "microfacet", ndf_name, masking_name
+    if model == "cook_torrance":
+        return "microfacet", "beckmann", "v_cavity"
+    if model in ("blinn_phong", "ashikhmin_shirley"):
+        return model, "blinn_phong", "none"
+    raise KeyError(model)
+
+
+@dataclass(frozen=True)
+class SpecularIntegrand:
+    """g(v, h, alpha, param) -> vec of one specular table, and what its estimators need beside it.
+
+    ``distribution``: the NDF whose CDF / pdf / sampler the estimators use; ``kernel_channels``: the length of
+    ``vec``, of which the first ``nch`` are kept; ``mirror(v, param) -> vec``: the exact alpha -> 0 limit where one
+    exists (the microfacet form: D -> delta about n, G2 -> 1 for n.v > 0, so E = channels(n.v, param); lutbake.edge),
+    else None and alpha is clamped to ALPHA_MIN."""
+
+    key: tuple
+    g: object
+    vec: type
+    acc: type
+    kernel_channels: int
+    nch: int
+    distribution: Distribution
+    mirror: object | None
+
+    def alpha_input(self, alpha) -> np.ndarray:
+        """The per-texel alpha the kernels receive (float32): lutbake.edge.effective_alpha."""
+        return effective_alpha(alpha, self.mirror is not None)
+
+
+@functools.lru_cache(maxsize=None)
+def mirror_for(channels_name: str):
+    """E at alpha = 0 for the microfacet form: the mirror direction l = reflect(v, n), h = n, v.h = n.v, G2 = 1."""
+    ch, vec = channels_for(channels_name)
+
+    @wp.func
+    def mirror(v: wp.vec3, param: float):
+        if v[2] <= COS_EPS:
+            return vec()
+        return ch(v[2], param)
+
+    return mirror
+
+
+@functools.lru_cache(maxsize=None)
+def specular_integrand(
+    ndf_name: str, masking_name: str, channels_name: str, form: str = "microfacet", nch: int | None = None
+) -> SpecularIntegrand:
+    """The integrand record of a (terms, channels, form) key, the first ``nch`` channels kept (all if None).
+    For the forms blinn_phong and ashikhmin_shirley ``ndf_name`` names the NDF the estimators sample and
+    ``masking_name`` is ignored. The layouts with a Charlie channel (cloth, sheen) have no mirror limit."""
+    if form != "microfacet":
+        masking_name = "none"
+    charlie = channels_name == "multiscatter_cloth" or channels_name in SHEEN_LAYOUTS
+    vec = wp.vec3 if charlie else channels_for(channels_name)[1]
+    k = vec._length_
+    mirror = mirror_for(channels_name) if form == "microfacet" and not charlie else None
+    return SpecularIntegrand(
+        (ndf_name, masking_name, channels_name, form),
+        integrand_for(ndf_name, masking_name, channels_name, form),
+        vec,
+        wp.vec3d if k == 3 else wp.vec2d,
+        k,
+        nch or k,
+        NDFS[ndf_name],
+        mirror,
+    )
+
+
+def hemisphere_integral(
+    ndf_name: str,
+    masking_name: str,
+    channels_name: str,
+    nov,
+    alpha,
+    estimator: str = "gauss_legendre",
+    samples: int | None = None,
+    seed: int = 0,
+    param=None,
+    form: str = "microfacet",
+    device: str = "cpu",
+) -> np.ndarray:
+    """Host helper (checks, tests, benchmarks): the integrand of (terms, channels, form) at texels (nov[i],
+    alpha[i], param[i]) by a hemisphere estimator (lutbake.sampling.hemisphere), every kernel channel, float64
+    (N, C). alpha goes through the edge policy (lutbake.edge.effective_alpha) as in a table."""
+    from ..sampling.hemisphere import estimator_for
+
+    integrand = specular_integrand(ndf_name, masking_name, channels_name, form)
+    nov = np.asarray(nov, np.float32)
+    param = np.zeros(len(nov), np.float32) if param is None else np.asarray(param, np.float32)
+    inputs = {"nov": nov, "alpha": integrand.alpha_input(np.asarray(alpha, np.float32)), "param": param}
+    return estimator_for(estimator, samples, seed).evaluate(integrand, inputs, device)

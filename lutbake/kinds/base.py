@@ -1,0 +1,97 @@
+"""What a table kind declares: its config keys (with types, defaults and docs), its estimators, and ``plan(spec)``,
+which names the kind's axes, channels, reconstruction text, integrand and estimator and hands them to
+lutbake.sampling.plan.per_texel_plan. The registry (lutbake.kinds) adds the keys every kind has (``COMMON_KEYS``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from ..io.formats import FORMATS
+
+MAX_SAMPLES = 1 << 24  # per texel; beyond this a point set alone needs > 128 MiB and a table takes days
+MAX_SEED = (1 << 64) - 1
+
+
+@dataclass(frozen=True)
+class Key:
+    """One config key: its type, default, allowed values (or a range) and a line of documentation."""
+
+    name: str
+    type: str  # "str", "int", "float", "int_pair", "float_range", "float_list", "name"
+    default: Any
+    doc: str
+    choices: dict[str, str] | None = None  # value -> description
+    minimum: float | None = None
+    maximum: float | None = None
+    required: bool = False
+
+
+@dataclass(frozen=True)
+class Kind:
+    """A table kind. ``keys``: every key (the registry's common keys first; see ``declare``); ``plan(spec)`` ->
+    lutbake.sampling.plan.TexelPlan; ``check(spec)``: cross-key rules, a message or (key, message)."""
+
+    name: str
+    description: str
+    keys: dict[str, Key]
+    plan: Callable[[Any], Any]
+    aliases: tuple[str, ...] = ()
+    check: Callable[[Any], str | tuple[str, str] | None] | None = None
+    texels: Callable[[Any], int] = lambda o: math.prod(o.get("size", [1]))  # texel count, for config.MAX_TEXELS
+    texels_doc: str = "size"  # the keys whose product ``texels`` is, for the error message
+
+
+@dataclass(frozen=True)
+class Estimation:
+    """The estimators a kind offers (name -> description), its default, and what ``samples`` means for it."""
+
+    estimators: dict[str, str]
+    default: str
+    samples_doc: str
+    samples_min: int = 1
+    samples_max: int = MAX_SAMPLES
+
+
+def common_keys(e: Estimation) -> dict[str, Key]:
+    """The keys every kind has: name, kind, format, dtype, seed, samples, estimator."""
+    return {
+        "name": Key(
+            "name",
+            "name",
+            None,
+            "output stem: <out-dir>/<name>.<ext> (ext per format); letters, digits, - and _ only",
+            required=True,
+        ),
+        "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),
+        "samples": Key("samples", "int", None, e.samples_doc, minimum=e.samples_min, maximum=e.samples_max),
+        "dtype": Key(
+            "dtype", "str", "float32", "pixel type written", {"float32": "32-bit float", "half": "16-bit float"}
+        ),
+        "estimator": Key("estimator", "str", e.default, "how the integral is estimated", e.estimators),
+        "seed": Key(
+            "seed", "int", 0, "scrambling seed of the Sobol' points (QMC estimators)", minimum=0, maximum=MAX_SEED
+        ),
+        "format": Key("format", "str", "exr", "output file format: <out-dir>/<name>.<ext>", FORMATS),
+    }
+
+
+def declare(
+    name: str,
+    description: str,
+    keys: dict[str, Key],
+    plan,
+    estimation: Estimation,
+    *,
+    aliases: tuple[str, ...] = (),
+    check=None,
+    texels=None,
+) -> Kind:
+    """A Kind with the common keys (``common_keys``) followed by its own ``keys``. ``texels(options)``: the texel
+    count (default: the product of ``size``); its docstring names the keys it multiplies (for the error message)."""
+    if texels is None:
+        return Kind(name, description, {**common_keys(estimation), **keys}, plan, aliases, check)
+    return Kind(name, description, {**common_keys(estimation), **keys}, plan, aliases, check, texels, texels.__doc__)

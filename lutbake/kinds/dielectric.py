@@ -1,0 +1,494 @@
+"""Kinds ``dielectric`` and ``dielectric_avg``: energy tables of the rough dielectric BSDF (Walter, Marschner, Li &
+Torrance 2007, "Microfacet models for refraction through rough surfaces") over the relative index of refraction.
+
+    E_R(mu, r, eta) = ∫ f_r |n.o| dω_o over the incident side,   E_T(mu, r, eta) = ∫ f_t |n.o| dω_o over the other side
+    E_avg(r, eta)   = 2 ∫_0^1 E(mu) mu dmu   (kind dielectric_avg; panels split at
+                                             mu = 0.2 and at cos theta_c for eta < 1)
+eta = eta_o / eta_i is the relative IOR seen from the view's side: eta > 1 outside a denser medium, eta < 1 inside it
+(total internal reflection past the critical angle). The integrands are lutbake.integrands.dielectric, the default
+quadrature lutbake.sampling.dielectric (panelled Gauss-Legendre split at every kink); docs/transmission.md has the
+derivation, every engine's conventions and the measured accuracy.
+
+Layouts (key ``layout``) fix the channels, and for the engine layouts the whole grid:
+    energy      z = IOR slices (ior_size, ior_range, ior_mapping), y/x = roughness / NoV as the dfg kind;
+                R = E_R, G = E_T, B = E_R + E_T (exact Fresnel)
+    eevee_btdf  Blender EEVEE's btdf_ggx[16][64][64][1] (eevee_lut_comp.glsl ggx_btdf_gt_one): z = perceptual roughness
+                k/15, y = sqrt(1 - NoV) (NoV clamped to [1e-4, 0.9999]), x = sqrt((eta - 1)/(eta + 1))
+                (its square clamped
+                to [1e-4, 0.9999]); all endpoint texels; R = transmission_factor with Schlick s = (1 - v.h)^5
+    eevee_bsdf  Blender EEVEE's bsdf_ggx[16][64][64][3] (ggx_bsdf_split_sum, eta < 1): z = roughness k/15,
+                x = eta^2 (eta clamped to [1e-4, 0.9999]), y centred on the critical angle: with c = sqrt(1 - eta^2),
+                y' = 2y - 1, NoV = clamp(c + y' (y' > 0 ? 1 - c : c), 1e-4, 0.9999); R = scale, G = bias,
+                B = transmission_factor with s = (1 - |t.h|)^5 (t refracted; s = 1 under TIR)
+    openpbr     adobe/openpbr-bsdf's [ior][alpha][cos] 32^3 tables: z = IOR (indices 0-15: 1/eta = 1 + 1.5 (15 - i)/15,
+                16-31: eta = 1 + 1.5 (i - 16)/15), y = sqrt(alpha) = i/31, x = cos theta = i/31 (0 clamped to NOV_MIN);
+                R = 1 - (E_R + E_T) (IdealDielectricEnergyComplement), G = 1 - E_R (OpaqueDielectricEnergyComplement),
+                B = 1 - E(F = 1) (IdealMetalEnergyComplement, the same in every IOR slice)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..axes import Axis
+from ..edge import alpha_policy
+from ..integrands.dielectric import MASKINGS, dielectric_integrand
+from ..sampling.dielectric import DielectricGaussLegendre
+from ..sampling.hemisphere import ESTIMATORS, QuasiMonteCarlo
+from ..sampling.plan import Grid, TexelPlan, per_texel_plan, probe_indices
+from ..terms.distributions import MASKINGS as ALL_MASKINGS
+from ..terms.distributions import NDFS
+from . import dfg
+from .base import Estimation, Key, declare
+
+DEFAULT_SAMPLES = {"gauss_legendre": 3 * 12**2, "sobol_vndf": 1 << 14, "sobol_ndf": 1 << 16, "hammersley_ndf": 1 << 16}
+EEVEE_SIZE = (16, 64, 64)  # UTIL_BTDF_LAYER_COUNT roughness layers x UTIL_TEX_SIZE^2
+EEVEE_CLAMP = (1.0e-4, 0.9999)  # eevee_lut_comp.glsl: NoV, f0-like x^2 (btdf) and eta (bsdf) clamps
+OPENPBR_SIZE = 32  # OpenPBR_EnergyTableSize
+OPENPBR_IOR_MAX = 2.5  # OpenPBR_IorMax
+
+LAYOUTS = {
+    "energy": "R = E_R, G = E_T, B = E_R + E_T over NoV x roughness x IOR (exact Fresnel)",
+    "eevee_btdf": "Blender EEVEE btdf_ggx[16][64][64][1]: Schlick transmission factor for eta > 1 (grid fixed)",
+    "eevee_bsdf": "Blender EEVEE bsdf_ggx[16][64][64][3]: Schlick scale, bias, transmission factor for eta < 1 "
+    "(grid fixed)",
+    "openpbr": "OpenPBR reference [ior][alpha][cos] 32^3: 1 - (E_R + E_T), 1 - E_R, 1 - E(F = 1) (grid fixed)",
+}
+MODE = {"energy": "exact", "eevee_btdf": "eevee", "eevee_bsdf": "eevee", "openpbr": "exact_metal"}
+CHANNELS = {
+    "energy": {
+        "e_r": "E_R = ∫ f_r |n.o| dω_o: directional reflectance of the rough interface",
+        "e_t": "E_T = ∫ f_t |n.o| dω_o: directional transmittance",
+        "e_sum": "E_R + E_T: single-scattering energy kept (1 - it is lost to multiple scattering)",
+    },
+    "eevee_btdf": {
+        "transmission_factor": "∫ (1 - (1 - v.h)^5) f_t/(1 - F) |n.o| dω_o: transmittance = (1 - F0) * this"
+    },
+    "eevee_bsdf": {
+        "scale": "∫ (1 - s) f_r/F |n.o| dω_o, s = (1 - |t.h|)^5 (1 under TIR): multiplies F0",
+        "bias": "∫ s f_r/F |n.o| dω_o: multiplies F90",
+        "transmission_factor": "∫ (1 - s) f_t/(1 - F) |n.o| dω_o: transmittance = (1 - F0) * this",
+    },
+    "openpbr": {
+        "ideal_dielectric_energy_complement": "1 - (E_R + E_T)",
+        "opaque_dielectric_energy_complement": "1 - E_R",
+        "ideal_metal_energy_complement": "1 - E with F = 1 (reflection only; independent of the IOR)",
+    },
+}
+AVG_CHANNELS = {
+    "energy": {"e_r_avg": "2 ∫ E_R mu dmu", "e_t_avg": "2 ∫ E_T mu dmu", "e_sum_avg": "2 ∫ (E_R + E_T) mu dmu"},
+    "openpbr": {
+        "ideal_dielectric_average_energy_complement": "1 - 2 ∫ (E_R + E_T) mu dmu",
+        "opaque_dielectric_average_energy_complement": "1 - 2 ∫ E_R mu dmu",
+        "ideal_metal_average_energy_complement": "1 - 2 ∫ E(F = 1) mu dmu",
+    },
+}
+RECONSTRUCTION = {
+    "energy": "E = texture(lut3d, vec3(u(NoV), u(roughness), u(eta))).rgb (texel conventions per lutbake:axes); "
+    "Turquin 2019 compensation of the dielectric lobe: f_ms-scaled = f * (1 + (1 - E_sum) / E_sum) = f / E_sum; "
+    "glass split sum: reflected = prefiltered_R * E_R, transmitted = prefiltered_T * E_T",
+    "eevee_btdf": "EEVEE bsdf_lut(): eta >= 1, coords = vec3(sqrt((eta - 1)/(eta + 1)), sqrt(1 - NoV), roughness); "
+    "xy = xy * 63/64 + 0.5/64; layer = roughness * 15, two layers mixed by fract (manual trilinear); "
+    "transmittance = (1 - F0) * t.r, reflectance = F0 * brdf.r + F90 * brdf.g (brdf_ggx split sum)",
+    "eevee_bsdf": "EEVEE bsdf_lut(): eta < 1, c = sqrt(1 - eta^2), y = (NoV - c) / (NoV > c ? 1 - c : c) * 0.5 + 0.5, "
+    "coords = saturate(vec3(eta^2, y, roughness)); xy = xy * 63/64 + 0.5/64; layer = roughness * 15 "
+    "(manual trilinear); reflectance = F0 * t.r + F90 * t.g, transmittance = (1 - F0) * t.b",
+    "openpbr": "openpbr_look_up_*_energy_complement(ior, alpha, cos): exact indices ior -> "
+    "(ior < 1 ? 15 - 15 (1/ior - 1)"
+    "/1.5 : 16 + 15 (ior - 1)/1.5), sqrt(alpha) * 31, cos * 31, clamped to [0, 31], trilinear over "
+    "array[ior][alpha][cos] (cos fastest); values UNORM16 / 65535",
+}
+AVG_RECONSTRUCTION = {
+    "energy": "E_avg = texture(lut2d, vec2(u(roughness), u(eta))).rgb: rows = IOR, columns = roughness",
+    "openpbr": "openpbr_look_up_*_average_energy_complement(ior, alpha): bilinear over array[ior][alpha] (alpha "
+    "fastest), indices as the 3D tables",
+}
+IOR_MAPPINGS = {
+    "linear": "eta = lo + (hi - lo) t (t per the texel convention)",
+    "symmetric": "OpenPBR's: the first N/2 indices hold 1/eta = hi - (hi - 1) i/(N/2 - 1) (eta from 1/hi up to 1), the "
+    "last N/2 hold eta = 1 + (hi - 1) i/(N/2 - 1) (1 up to hi); N even, lo ignored",
+}
+GEOMETRY_KEYS = {
+    k: dfg.KEYS[k]
+    for k in (
+        "roughness",
+        "texel",
+        "roughness_range",
+        "nov_range",
+        "axis_order",
+        "row_order",
+        "nov_mapping",
+        "roughness_mapping",
+        "nov_clamp",
+    )
+}
+KEYS = {
+    "layout": Key("layout", "str", "energy", "channels (and, for the engine layouts, the whole grid)", LAYOUTS),
+    "size": Key("size", "int_pair", [32, 32], "[NoV, roughness] texel counts (layout energy)", minimum=1),
+    "ior_size": Key("ior_size", "int", 32, "IOR slice count (z; layout energy)", minimum=1, maximum=1024),
+    "ior_range": Key(
+        "ior_range",
+        "float_range",
+        [1.0, 2.5],
+        "relative IOR eta = eta_o / eta_i at t = 0 and t = 1 (eta < 1: seen from inside)",
+        minimum=0.05,
+        maximum=20.0,
+    ),
+    "ior_mapping": Key("ior_mapping", "str", "linear", "how the IOR index maps to eta", IOR_MAPPINGS),
+    "ndf": Key(
+        "ndf",
+        "str",
+        "ggx",
+        "normal distribution function",
+        {k: v.description for k, v in NDFS.items() if v.Lambda is not None},
+    ),
+    "masking": Key(
+        "masking",
+        "str",
+        "smith_separable",
+        "Smith G2, evaluated with |n.o| on both sides",
+        {k: ALL_MASKINGS[k] for k in MASKINGS},
+    ),
+    **GEOMETRY_KEYS,
+}
+AVG_KEYS = {
+    **{
+        k: v
+        for k, v in KEYS.items()
+        if k not in ("size", "nov_range", "axis_order", "row_order", "nov_mapping", "nov_clamp", "layout")
+    },
+    "layout": Key("layout", "str", "energy", "channels (openpbr: the grid too)", {k: LAYOUTS[k] for k in AVG_CHANNELS}),
+    "roughness_size": Key("roughness_size", "int", 32, "roughness texel count (x; layout energy)", minimum=1),
+    "mu_order": Key(
+        "mu_order",
+        "int",
+        16,
+        "Gauss-Legendre nodes in mu per panel (panels split at 0.2 and cos theta_c)",
+        minimum=2,
+        maximum=256,
+    ),
+}
+
+
+def ior_values(n: int, lo: float, hi: float, texel: str, mapping: str) -> np.ndarray:
+    """eta at every index of an IOR axis (IOR_MAPPINGS)."""
+    if mapping == "symmetric":
+        half = n // 2
+        t = np.arange(half) / max(half - 1, 1)
+        return np.concatenate([1.0 / (hi - (hi - 1.0) * t), 1.0 + (hi - 1.0) * t])
+    t = Axis("t", "z", n, texel=texel).t()
+    return lo + (hi - lo) * t
+
+
+def eevee_btdf_ior(x: np.ndarray) -> np.ndarray:
+    """ggx_btdf_gt_one: f0 = clamp(x^2, 1e-4, 0.9999), ior = (1 + f0)/(1 - f0), i.e. x = sqrt((ior - 1)/(ior + 1))."""
+    f = np.clip(x * x, *EEVEE_CLAMP)
+    return (1.0 + f) / (1.0 - f)
+
+
+def eevee_bsdf_ior_nov(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """ggx_bsdf_split_sum: ior = clamp(sqrt(x), 1e-4, 0.9999) (the sine of the critical angle); with
+    c = sqrt(1 - saturate(ior^2)), y' = 2y - 1 scaled by (1 - c) above 0 and by c below,
+    NoV = clamp(y' + c, 1e-4, 0.9999)."""
+    ior = np.clip(np.sqrt(x), *EEVEE_CLAMP)
+    c = np.sqrt(1.0 - np.clip(ior * ior, 0.0, 1.0))
+    yp = 2.0 * y - 1.0
+    yp = yp * np.where(yp > 0.0, 1.0 - c, c)
+    return ior, np.clip(yp + c, *EEVEE_CLAMP)
+
+
+def texel_grid(o: dict) -> tuple[list[Axis], np.ndarray, np.ndarray, np.ndarray, dict]:
+    """(axes slowest first, per-texel NoV, alpha, eta in row-major order, extra metadata) of a layout."""
+    layout = o["layout"]
+    if layout in ("eevee_btdf", "eevee_bsdf"):
+        nz, ny, nx = EEVEE_SIZE
+        rough = Axis("perceptual_roughness", "z", nz, 0.0, 1.0, texel="endpoint")
+        t_x = np.arange(nx) / (nx - 1.0)
+        t_y = np.arange(ny) / (ny - 1.0)
+        X, Y = np.meshgrid(t_x, t_y)  # [y][x]
+        if layout == "eevee_btdf":
+            eta2 = eevee_btdf_ior(X)
+            nov2 = np.clip(1.0 - Y * Y, *EEVEE_CLAMP)
+            y_axis = Axis("NoV", "y", ny, 0.0, 1.0, texel="endpoint", mapping="one_minus_t2", clamp=EEVEE_CLAMP)
+            extra = {
+                "ior_axis": "x: t = i/63, eta = (1 + f)/(1 - f), f = clamp(t^2, 1e-4, 0.9999) "
+                "(t = sqrt((eta - 1)/(eta + 1)))"
+            }
+        else:
+            eta2, nov2 = eevee_bsdf_ior_nov(X, Y)
+            y_axis = Axis("nov_coordinate", "y", ny, 0.0, 1.0, texel="endpoint")
+            extra = {
+                "ior_axis": "x: t = i/63, eta = clamp(sqrt(t), 1e-4, 0.9999) (t = eta^2)",
+                "nov_axis": "y: t = j/63, c = sqrt(1 - eta^2), y' = 2t - 1, y' *= (y' > 0 ? 1 - c : c), "
+                "NoV = clamp(y' + c, 1e-4, 0.9999) (centred on the critical angle, per IOR column)",
+            }
+        x_axis = Axis("ior", "x", nx, listed=tuple(float(e) for e in eta2[0]), mapping="listed")
+        axes = [rough, y_axis, x_axis]
+        alpha = np.repeat(rough.alpha(), ny * nx)
+        return axes, np.tile(nov2.ravel(), nz), alpha, np.tile(eta2.ravel(), nz), extra
+    if layout == "openpbr":
+        n = OPENPBR_SIZE
+        etas = ior_values(n, 1.0 / OPENPBR_IOR_MAX, OPENPBR_IOR_MAX, "endpoint", "symmetric")
+        ior = Axis("ior", "z", n, listed=tuple(float(e) for e in etas), mapping="listed")
+        rough = Axis("perceptual_roughness", "y", n, 0.0, 1.0, texel="endpoint")
+        nov = Axis("NoV", "x", n, 0.0, 1.0, texel="endpoint")
+        grid = dfg.texel_grid([rough, nov])
+        return (
+            [ior, rough, nov],
+            np.tile(grid[0], n),
+            np.tile(grid[1], n),
+            np.repeat(etas, n * n),
+            {"ior_axis": IOR_MAPPINGS["symmetric"] + f", hi = {OPENPBR_IOR_MAX}"},
+        )
+    etas = ior_values(o["ior_size"], *o["ior_range"], o["texel"], o["ior_mapping"])
+    ior = Axis("ior", "z", len(etas), listed=tuple(float(e) for e in etas), mapping="listed")
+    yx = dfg.axes_for(o)
+    nov, alpha = dfg.texel_grid(yx)
+    return (
+        [ior] + yx,
+        np.tile(nov, len(etas)),
+        np.tile(alpha, len(etas)),
+        np.repeat(etas, len(nov)),
+        {"ior_axis": f"{IOR_MAPPINGS[o['ior_mapping']]}, range {list(o['ior_range'])}"},
+    )
+
+
+def terms_of(o: dict) -> tuple[str, str]:
+    """(ndf, masking) integrated: EEVEE's and OpenPBR's layouts fix GGX with separable Smith (their G_V G_L)."""
+    if o["layout"] in ("eevee_btdf", "eevee_bsdf", "openpbr"):
+        return "ggx", "smith_separable"
+    return o["ndf"], o["masking"]
+
+
+def estimator_for(name: str, samples: int | None = None, seed: int = 0):
+    """The dielectric kinds' estimator ``name``: the panelled Gauss-Legendre of lutbake.sampling.dielectric, or a
+    QMC estimator of lutbake.sampling.hemisphere (the same half-vector measure)."""
+    if name == "gauss_legendre":
+        return DielectricGaussLegendre(samples or DEFAULT_SAMPLES[name])
+    return QuasiMonteCarlo(name, samples or DEFAULT_SAMPLES[name], seed)
+
+
+def integrate(key: tuple, nov, alpha, eta, samples: int | None = None, seed: int = 0, device: str = "cpu"):
+    """Host helper (checks, tests, benchmarks): float64 (len, 3) integrals of the (ndf, masking, Fresnel mode)
+    integrand by ``estimator`` at texels (nov, alpha, eta); alpha through the edge policy as in a table."""
+    ndf_name, masking_name, mode, estimator = key
+    integrand = dielectric_integrand(ndf_name, masking_name, mode)
+    inputs = {
+        "nov": np.asarray(nov, np.float32),
+        "alpha": integrand.alpha_input(np.asarray(alpha, np.float32)),
+        "param": np.asarray(eta, np.float32),
+    }
+    return estimator_for(estimator, samples, seed).evaluate(integrand, inputs, device)
+
+
+def post_process(layout: str, e: np.ndarray) -> np.ndarray:
+    """The integrals (n, 3) -> the layout's channels: complements for openpbr, the transmission factor (channel 2)
+    for eevee_btdf."""
+    if layout == "openpbr":
+        return np.stack([1.0 - (e[:, 0] + e[:, 1]), 1.0 - e[:, 0], 1.0 - e[:, 2]], axis=1)
+    return e[:, 2:] if layout == "eevee_btdf" else e
+
+
+@dataclass(frozen=True)
+class LayoutChannels:
+    """An estimator whose values pass through ``post_process(layout)`` (its refinement too)."""
+
+    inner: object
+    layout: str
+
+    @property
+    def name(self) -> str:
+        return self.inner.name
+
+    def samples(self, inputs: dict) -> np.ndarray:
+        return self.inner.samples(inputs)
+
+    def prepare(self, integrand, device: str) -> None:
+        self.inner.prepare(integrand, device)
+
+    def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
+        return post_process(self.layout, self.inner.evaluate(integrand, inputs, device))
+
+    def refined(self):
+        inner, how = self.inner.refined()
+        return LayoutChannels(inner, self.layout), how
+
+
+def terms_record(key: tuple, layout: str) -> dict:
+    return {
+        "model": "rough dielectric BSDF (Walter et al. 2007)",
+        "ndf": key[0],
+        "masking": key[1],
+        "fresnel": key[2],
+        "layout": layout,
+    }
+
+
+def plan(spec) -> TexelPlan:
+    o = spec.options
+    layout = o["layout"]
+    axes, nov, alpha, eta, extra = texel_grid(o)
+    nd, mk = terms_of(o)
+    channels = CHANNELS[layout]
+    integrand = dielectric_integrand(nd, mk, MODE[layout], len(channels))
+    inputs = {
+        "nov": np.asarray(nov, np.float32),
+        "alpha": integrand.alpha_input(alpha),
+        "param": np.asarray(eta, np.float32),
+    }
+    grid = Grid(axes, inputs, grazing=inputs["nov"], alpha=np.asarray(alpha, np.float64))
+    est = LayoutChannels(estimator_for(o["estimator"], o["samples"], o["seed"]), layout)
+    return per_texel_plan(
+        integrand,
+        est,
+        grid,
+        channels=channels,
+        reconstruction=RECONSTRUCTION[layout],
+        terms=terms_record((nd, mk, MODE[layout]), layout),
+        extra={**extra, "alpha_policy": alpha_policy(True)},
+    )
+
+
+def mu_panels(eta: float, order: int) -> tuple[np.ndarray, np.ndarray]:
+    """GL nodes/weights on [0, 1] in mu, panels split at 0.2 and, for eta < 1, at cos theta_c = sqrt(1 - eta^2)
+    (where E(mu) has its total-internal-reflection kink in the smooth limit)."""
+    cuts = [0.0, 0.2, 1.0] + ([float(np.sqrt(1.0 - eta * eta))] if eta < 1.0 else [])
+    edges = np.unique(np.clip(cuts, 0.0, 1.0))
+    x, w = np.polynomial.legendre.leggauss(order)
+    lo, hi = edges[:-1, None], edges[1:, None]
+    return ((lo + (hi - lo) * (x + 1) / 2).ravel(), ((hi - lo) * w / 2).ravel())
+
+
+def avg_grid(o: dict) -> tuple[list[Axis], np.ndarray, np.ndarray]:
+    """(axes [ior (y), roughness (x)], alpha and eta per texel, row-major)."""
+    if o["layout"] == "openpbr":
+        n = OPENPBR_SIZE
+        etas = ior_values(n, 1.0 / OPENPBR_IOR_MAX, OPENPBR_IOR_MAX, "endpoint", "symmetric")
+        rough = Axis("perceptual_roughness", "x", n, 0.0, 1.0, texel="endpoint")
+    else:
+        etas = ior_values(o["ior_size"], *o["ior_range"], o["texel"], o["ior_mapping"])
+        rname = "perceptual_roughness" if o["roughness"] == "perceptual" else "alpha"
+        rough = Axis(
+            rname, "x", o["roughness_size"], *o["roughness_range"], texel=o["texel"], mapping=o["roughness_mapping"]
+        )
+    ior = Axis("ior", "y", len(etas), listed=tuple(float(e) for e in etas), mapping="listed")
+    return [ior, rough], np.tile(rough.alpha(), len(etas)), np.repeat(etas, rough.count)
+
+
+def plan_avg(spec) -> TexelPlan:
+    """E_avg per (eta, roughness) texel: the kernel at mu_panels(eta) nodes, reduced 2 sum w mu E per texel (the
+    node set depends on eta, so the reduction is here rather than in lutbake.sampling.plan.Grid)."""
+    o = spec.options
+    layout = o["layout"]
+    axes, alpha, eta = avg_grid(o)
+    nd, mk = terms_of(o)
+    integrand = dielectric_integrand(nd, mk, "exact_metal")
+    estimator = estimator_for(o["estimator"], o["samples"], o["seed"])
+    order = o["mu_order"]
+    nodes = [mu_panels(float(x), order) for x in eta]
+    counts = np.array([len(m) for m, _ in nodes])
+    grid = Grid(axes, {"alpha": alpha}, alpha=np.asarray(alpha, np.float64))
+
+    def run(idx, est, device):
+        t = np.arange(len(alpha))[idx]
+        mu = np.concatenate([nodes[k][0] for k in t])
+        inputs = {
+            "nov": mu.astype(np.float32),
+            "alpha": integrand.alpha_input(np.repeat(alpha[t], counts[t])),
+            "param": np.repeat(eta[t], counts[t]).astype(np.float32),
+        }
+        res = est.evaluate(integrand, inputs, device)
+        starts = np.concatenate([[0], np.cumsum(counts[t])])
+        avg = np.array([2.0 * (nodes[k][1] * nodes[k][0]) @ res[starts[j] : starts[j + 1]] for j, k in enumerate(t)])
+        if layout == "openpbr":
+            return post_process("openpbr", avg)
+        return np.stack([avg[:, 0], avg[:, 1], avg[:, 0] + avg[:, 1]], axis=1)
+
+    def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
+        idx = probe_indices(grid)
+        refined, how = estimator.refined()
+        err = float(np.max(np.abs(data.reshape(len(alpha), 3)[idx] - run(idx, refined, device))))
+        return err, f"max |{how}| over {len(idx)} strided probe texels"
+
+    per = int(estimator.samples({"nov": [0.0]})[0]) * int(counts.max())
+    return TexelPlan(
+        axes=axes,
+        channels=AVG_CHANNELS[layout],
+        reconstruction=AVG_RECONSTRUCTION[layout],
+        n_texels=len(alpha),
+        n_channels=3,
+        run_tile=lambda s, e, d: run(slice(s, e), estimator, d),
+        prepare=lambda d: estimator.prepare(integrand, d),
+        samples=per,
+        estimator=estimator.name,
+        terms=terms_record((nd, mk, "exact_metal"), layout),
+        cost=float(len(alpha)) * per,
+        extra={
+            "mu_quadrature": f"{order} Gauss-Legendre nodes per panel, panels split at mu = 0.2 and cos theta_c",
+            "alpha_policy": alpha_policy(True),
+        },
+        error_estimate=error_estimate,
+    )
+
+
+def check_spec(spec) -> tuple[str, str] | None:
+    o = spec.options
+    nd, _ = terms_of(o)
+    if o["estimator"] == "sobol_vndf" and NDFS[nd].sample_vndf is None:
+        return ("estimator", f"'sobol_vndf' needs ndf = 'ggx' (a visible-normal sampler), not {nd!r}")
+    if o.get("ior_mapping") == "symmetric" and (o["ior_range"][1] <= 1.0 or o["ior_size"] % 2):
+        return ("ior_mapping", "'symmetric' needs ior_range[1] > 1 (the largest eta) and an even ior_size")
+    if o["layout"] in ("eevee_btdf", "eevee_bsdf", "openpbr") and (o["ndf"], o["masking"]) != (
+        "ggx",
+        "smith_separable",
+    ):
+        return ("layout", f"layout {o['layout']!r} fixes ndf = 'ggx' and masking = 'smith_separable' (the engine's)")
+    if o.get("format") == "openpbr_h" and o["layout"] != "openpbr":
+        return ("format", f"'openpbr_h' writes OpenPBR's arrays: it needs layout = 'openpbr', not {o['layout']!r}")
+    return None
+
+
+def texel_count(o: dict) -> int:
+    """size x ior_size (the engine layouts: their fixed grids)"""
+    if o["layout"] in ("eevee_btdf", "eevee_bsdf"):
+        return int(np.prod(EEVEE_SIZE))
+    if o["layout"] == "openpbr":
+        return OPENPBR_SIZE**3
+    return o["size"][0] * o["size"][1] * o["ior_size"]
+
+
+def avg_texel_count(o: dict) -> int:
+    """roughness_size x ior_size"""
+    return OPENPBR_SIZE**2 if o["layout"] == "openpbr" else o["roughness_size"] * o["ior_size"]
+
+
+SAMPLES_DOC = (
+    "integrand evaluations per texel; omitted: the estimator's default (gauss_legendre 432 = order 12 per "
+    "panel, sobol_vndf 16384)"
+)
+ESTIMATION = Estimation(ESTIMATORS, "gauss_legendre", SAMPLES_DOC)
+
+
+DIELECTRIC = declare(
+    "dielectric",
+    "rough dielectric BSDF energies E_R, E_T, E_R + E_T: NoV x roughness x IOR slices "
+    "(eta < 1: seen from inside), or an engine's layout (EEVEE btdf/bsdf, OpenPBR)",
+    KEYS,
+    plan,
+    ESTIMATION,
+    aliases=("glass", "btdf"),
+    check=check_spec,
+    texels=texel_count,
+)
+DIELECTRIC_AVG = declare(
+    "dielectric_avg",
+    "hemispherical averages 2 ∫ E mu dmu of the dielectric energies: IOR (rows) x roughness (columns)",
+    AVG_KEYS,
+    plan_avg,
+    ESTIMATION,
+    aliases=("glass_avg",),
+    check=check_spec,
+    texels=avg_texel_count,
+)

@@ -1,0 +1,332 @@
+"""Kind ``ltc``: Linearly Transformed Cosine tables (Heitz et al. 2016) in selfshadow/ltc_code's layout.
+
+Two RGBA textures, stored as the two z slices of one table (slice 0 = ltc_code's ltc_1, slice 1 = ltc_2):
+    ltc_1 = (M^-1_00, M^-1_20, M^-1_02, M^-1_22) / M^-1_11   (the shader's mat3(vec3(x, 0, y), vec3(0, 1, 0),
+                                                              vec3(z, 0, w)), columns)
+    ltc_2 = (magnitude, fresnel, fit_error, sphere)
+magnitude = ∫ f (n.l) dω with F = 1 and fresnel = ∫ f (1 - v.h)^5 (n.l) dω, both from lutbake's Gauss-Legendre
+integrators (the ``albedo`` kind's kernel and the ``dfg`` multiscatter kernel: exact, not fitted); a shader
+forms the Schlick-weighted magnitude f0 * magnitude + (1 - f0) * fresnel (ltc_code ltc_quad.fs:
+spec *= scol * t2.x + (1 - scol) * t2.y). Lobes without Fresnel (charlie, lambert) store fresnel = magnitude,
+so that mix is the magnitude for every f0. fit_error is Heitz's L3 error of the texel's fit, relative
+(lutbake.ltc.fit; ltc_code leaves this channel 0 and no engine reads it; engine layouts write 0). sphere is
+the horizon-clipped sphere/disk integral table (lutbake.ltc.sphere; its own axes, see below).
+
+Axes (ltc_code fitLTC.cpp fitTab, read not guessed): x (columns) = roughness at endpoint texels a/(N - 1)
+(alpha = r^2 for GGX / Beckmann; alpha = the value for charlie, whose axis is sheenRoughness); y (rows) =
+t = sqrt(1 - cos theta_v) at endpoint texels t/(N - 1), theta_v <= 1.57 rad (NoV >= cos 1.57 = 7.96e-4).
+Shaders sample uv = vec2(roughness, sqrt(1 - NoV)) * (N - 1)/N + 0.5/N. Differences from ltc_code, all recorded
+in the metadata: alpha >= 1e-4 (lutbake.edge; ltc_code 1e-5), magnitude and fresnel integrated exactly
+(ltc_code: 32^2 samples), every texel fitted independently from a coarse pass (ltc_code: chained).
+The sphere channel's own axes: x = z * 0.5 + 0.5 (z = cos of the form-factor direction's elevation), y =
+len = |form factor|, both endpoint (ltc_code genSphereTab).
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+
+import numpy as np
+
+from ..axes import Axis
+from ..edge import ALPHA_MIN
+from ..integrands.specular import specular_integrand
+from ..ltc import fit, sphere
+from ..ltc.lobes import LOBES
+from ..sampling.hemisphere import estimator_for
+from ..sampling.plan import TexelPlan
+from .base import Estimation, Key, declare
+
+THETA_MAX = 1.57  # ltc_code fitTab: theta = min(1.57, acos(1 - x^2))
+NOV_LO = float(np.cos(np.float32(THETA_MAX)))
+MAGNITUDE_SAMPLES = {"ggx": 432, "beckmann": 432, "charlie": 3072, "lambert": 0}
+FORMATS = {
+    "exr": "OpenEXR, two parts (slice_0 = ltc_1, slice_1 = ltc_2), lutbake:* attributes (default)",
+    "npy": "NumPy (2, N, N, 4) + .json sidecar",
+    "ltc_dds": "ltc_code's two files <name>_1.dds, <name>_2.dds: RGBA16F (dtype half, as ltc_code) or RGBA32F",
+    "js": "three.js ES module: LTC_MAT_1 / LTC_MAT_2 Float32Arrays as RectAreaLightTexturesLib's, .z of LTC_MAT_2 = 0",
+    "c": "Blender EEVEE C arrays ltc_mat_<lobe>[N][N][4], ltc_mag_<lobe>[N][N][2], ltc_disk_integral[N][N][1]",
+    "cs": "Unity HDRP C# table s_LtcMatrixData_BRDF_<LOBE> (ushort FP16 bits, one RGBA16F slice of _LtcData): "
+    "(M^-1_00, M^-1_20, M^-1_11, M^-1_02) / M^-1_22",
+}
+ESTIMATORS = {
+    "gauss_legendre": "the fit (Heitz's L3 metric, Nelder-Mead per texel: lutbake.ltc.fit) with magnitude and fresnel "
+    "by Gauss-Legendre (default)",
+    "sobol_ndf": "the same fit with magnitude and fresnel by scrambled Sobol' points, NDF importance sampling (a "
+    "second, independent estimator of the integrals the fit depends on; ggx and beckmann)",
+}
+KEYS = {
+    "lobe": Key("lobe", "str", "ggx", "the lobe fitted", {k: v.description for k, v in LOBES.items()}),
+    "size": Key("size", "int_pair", [64, 64], "[view, roughness] texel counts (ltc_code: 64 x 64)", minimum=2),
+    "fit_samples": Key(
+        "fit_samples",
+        "int",
+        fit.DEFAULT_GRID,
+        "N: the error metric's N x N stratified grid per sampling technique (ltc_code Nsample = 32)",
+        minimum=4,
+        maximum=256,
+    ),
+    "alpha_min": Key(
+        "alpha_min",
+        "float",
+        ALPHA_MIN,
+        "smallest NDF alpha fitted (lutbake's edge policy: 1e-4; Unity HDRP's own fit: 1e-3)",
+        minimum=ALPHA_MIN,
+        maximum=0.1,
+    ),
+    "format": Key("format", "str", "exr", "output file format", FORMATS),
+}
+CHANNELS = {
+    "x": "slice 0 (ltc_1): M^-1_00 / M^-1_11; slice 1 (ltc_2): magnitude = ∫ f (n.l) dω_l with F = 1",
+    "y": "slice 0: M^-1_20 / M^-1_11 (glm invM[0][2]); slice 1: fresnel = ∫ f (1 - v.h)^5 (n.l) dω_l "
+    "(= magnitude for lobes without Fresnel)",
+    "z": "slice 0: M^-1_02 / M^-1_11 (glm invM[2][0]); slice 1: fit_error = (E / ∫ f^3 dω)^(1/3), E = Heitz's L3 "
+    "metric of the fit (0 in engine layouts)",
+    "w": "slice 0: M^-1_22 / M^-1_11; slice 1: sphere = horizon-clipped / unclipped form factor of a spherical cap, "
+    "at x = z * 0.5 + 0.5, y = len (own axes, endpoint texels)",
+}
+RECONSTRUCTION = (
+    "uv = vec2(roughness, sqrt(1 - NoV)) * (N - 1)/N + 0.5/N; t1 = texture(ltc_1, uv); t2 = texture(ltc_2, uv); "
+    "Minv = mat3(vec3(t1.x, 0, t1.y), vec3(0, 1, 0), vec3(t1.z, 0, t1.w)); in the frame (T1, T2, N), "
+    "T1 = normalize(V - N NoV): polygon integral I = 1/(2 pi) Σ edges acos(v_i.v_j) normalize(v_i x v_j).z of the "
+    "clipped, normalised vertices Minv p_i; specular = light * I * (f0 * t2.x + (1 - f0) * t2.y); "
+    "sphere/disk: I = len * texture(ltc_2, vec2(z * 0.5 + 0.5, len) * (N - 1)/N + 0.5/N).w for the vector "
+    "form factor F (len = |F|, z = F.z / len)"
+)
+
+
+def axes_for(o: dict) -> list[Axis]:
+    n_view, n_rough = o["size"]
+    lb = LOBES[o["lobe"]]
+    rname = "alpha" if lb.roughness == "alpha" else "perceptual_roughness"
+    return [
+        Axis("texture", "z", 2, 1.0, 2.0, texel="endpoint", mapping="listed", listed=(1.0, 2.0)),
+        Axis("NoV", "y", n_view, 0.0, 1.0, texel="endpoint", mapping="one_minus_t2", clamp=(NOV_LO, 1.0)),
+        Axis(rname, "x", n_rough, 0.0, 1.0, texel="endpoint"),
+    ]
+
+
+def texel_params(axes: list[Axis], alpha_min: float = ALPHA_MIN) -> tuple[np.ndarray, np.ndarray]:
+    """Per texel of one slice, row-major (y = view slowest): (NoV, alpha) as float32, alpha >= alpha_min (the
+    alpha fitted: an LTC of a Dirac lobe is not defined)."""
+    _, view, rough = axes
+    alpha = np.maximum(rough.alpha(), np.float32(alpha_min))
+    return np.repeat(view.values(), rough.count), np.tile(alpha, view.count)
+
+
+def magnitude_alpha(axes: list[Axis], alpha_min: float = ALPHA_MIN) -> np.ndarray:
+    """The alpha at which magnitude and fresnel are integrated: the axis alpha itself under lutbake's edge policy
+    (alpha -> 0: the exact mirror limit, as the ``albedo`` table), or alpha_min where a larger one is set."""
+    _, view, rough = axes
+    a = rough.alpha()
+    if alpha_min > ALPHA_MIN:
+        a = np.maximum(a, np.float32(alpha_min))
+    return np.tile(a, view.count)
+
+
+def magnitude_fresnel(
+    lobe_name: str,
+    nov: np.ndarray,
+    alpha: np.ndarray,
+    samples: int | None,
+    device: str = "cpu",
+    estimator: str = "gauss_legendre",
+    seed: int = 0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(magnitude, fresnel) per texel from lutbake's integrators (``estimator``, default Gauss-Legendre).
+    GGX / Beckmann: magnitude is the ``albedo`` kind's integrand (so it equals that table at the same texels),
+    fresnel the ``dfg`` multiscatter integrand's Fc channel; charlie: the ``dfg`` charlie layout's B channel (the
+    gltf-charlie table), fresnel = magnitude; lambert: 1. ``alpha`` goes through the integrands' edge policy
+    (mirror limit at alpha -> 0)."""
+    lb = LOBES[lobe_name]
+    if lb.magnitude == "lambert":
+        one = np.ones(len(nov))
+        return one, one.copy()
+    if estimator == "gauss_legendre":
+        samples = samples or MAGNITUDE_SAMPLES[lobe_name]
+    est = estimator_for(estimator, samples, seed)
+    nov = np.asarray(nov, np.float32)
+    zero = np.zeros(len(nov), np.float32)
+
+    def integrate(integrand):
+        inputs = {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": zero}
+        return est.evaluate(integrand, inputs, device)
+
+    _, which = lb.magnitude.split(":")
+    if which == "charlie":
+        m = integrate(specular_integrand("ggx", "smith_height_correlated", "charlie"))[:, 2]
+        return m, m.copy()
+    mag = integrate(specular_integrand(which, "smith_height_correlated", "albedo", "microfacet", 1))[:, 0]
+    fres = integrate(specular_integrand(which, "smith_height_correlated", "multiscatter"))[:, 0]
+    return mag, fres
+
+
+class LtcBake:
+    """The state one bake shares between its tiles: the problem (magnitudes, frames) and the coarse pass,
+    built once under a lock; fits are memoised per texel range (both slices' tiles of one range use one fit)."""
+
+    def __init__(self, o: dict, axes: list[Axis]):
+        self.o = o
+        self.axes = axes
+        self.nov, self.alpha = texel_params(axes, o["alpha_min"])
+        self.n_view, self.n_rough = axes[1].count, axes[2].count
+        self._lock = threading.Lock()
+        self._fits: dict[tuple[int, int], tuple[threading.Lock, list]] = {}
+        self.problem = None
+        self.coarse = None
+        self.sphere = sphere.sphere_table(self.n_rough) if self.n_view == self.n_rough else None
+
+    def prepare(self, device: str) -> None:
+        with self._lock:
+            if self.problem is None:
+                o = self.o
+                alpha = magnitude_alpha(self.axes, o["alpha_min"])
+                mag, fres = magnitude_fresnel(
+                    o["lobe"], self.nov, alpha, o["samples"], device, o["estimator"], o["seed"]
+                )
+                self.fresnel = fres
+                p = fit.Problem(self.o["lobe"], self.nov, self.alpha, mag, self.o["fit_samples"], device)
+                self.coarse = fit.coarse_pass(p, self.n_view, self.n_rough)
+                self.problem = p
+
+    def fitted(self, start: int, stop: int) -> list:
+        """[packed ltc_1 (k, 4), relative error (k,)] of texels [start, stop) of a slice (fitted once)."""
+        with self._lock:
+            lock, box = self._fits.setdefault((start, stop), (threading.Lock(), []))
+        with lock:
+            if not box:
+                texel = np.arange(start, stop)
+                m, err = fit.fit_texels(self.problem, texel, self.n_rough, self.coarse)
+                box += [fit.pack_inverse(m), self.problem.relative(texel, err)]
+        return box
+
+    def run_tile(self, start: int, stop: int, device: str) -> np.ndarray:
+        self.prepare(device)
+        n = self.n_view * self.n_rough
+        out = np.empty((stop - start, 4))
+        pos = start
+        while pos < stop:  # a tile may straddle the two slices
+            z, s = divmod(pos, n)
+            e = min(stop - z * n, n)
+            packed, rel = self.fitted(s, e)
+            rows = slice(pos - start, pos - start + e - s)
+            if z == 0:
+                out[rows] = packed
+            else:
+                sph = self.sphere.ravel()[s:e] if self.sphere is not None else np.zeros(e - s)
+                out[rows] = np.stack([self.problem.magnitude[s:e], self.fresnel[s:e], rel, sph], axis=1)
+            pos += e - s
+        return out
+
+
+def fit_error_stats(data: np.ndarray) -> dict[str, str]:
+    """The lutbake:fit_error_* attributes: statistics of slice 1's z channel (relative L3 error per texel)."""
+    e = np.asarray(data)[1, ..., 2].ravel()
+    return {
+        "fit_error_max": f"{e.max():.4g}",
+        "fit_error_median": f"{np.median(e):.4g}",
+        "fit_error_p95": f"{np.quantile(e, 0.95):.4g}",
+        "fit_error": json.dumps(
+            {
+                "metric": "(E / ∫ f^3 dω)^(1/3), E = ∫ |f (n.l) - magnitude D_ltc|^3 dω by MIS "
+                "over the lobe's and the LTC's N x N stratified samples (Heitz et al. 2016, "
+                "ltc_code computeError)",
+                "max": float(e.max()),
+                "median": float(np.median(e)),
+                "p95": float(np.quantile(e, 0.95)),
+                "mean": float(e.mean()),
+            }
+        ),
+    }
+
+
+def plan(spec) -> TexelPlan:
+    o = spec.options
+    axes = axes_for(o)
+    state = LtcBake(o, axes)
+    n = axes[1].count * axes[2].count
+    lb = LOBES[o["lobe"]]
+    m_samples = 0 if lb.magnitude == "lambert" else o["samples"]
+    if o["estimator"] == "gauss_legendre" and not m_samples:
+        m_samples = MAGNITUDE_SAMPLES[o["lobe"]]
+    terms = {
+        "lobe": o["lobe"],
+        "description": lb.description,
+        "fresnel": "schlick (1 - v.h)^5 channel"
+        if lb.magnitude.startswith("dfg:") and lb.name != "charlie"
+        else "none (fresnel channel = magnitude)",
+        "layout": "ltc_code (selfshadow/ltc_code fit/fitLTC.cpp packTab)",
+    }
+    extra = {
+        "ltc_fit": json.dumps(
+            {
+                "parametrisation": "M = [X Y Z] [[m11, 0, m13], [0, m22, 0], [0, 0, 1]], Z = lobe's average direction",
+                "metric": "Heitz et al. 2016 L3 distance, MIS over lobe and LTC samples (ltc_code computeError)",
+                "fit_samples": f"{o['fit_samples']} x {o['fit_samples']} per technique",
+                "optimiser": f"Nelder-Mead (ltc_code nelder_mead.h), tol {fit.NELDER_MEAD_TOL}, "
+                f"<= {fit.NELDER_MEAD_ITERS} iterations per restart, simplex sizes {list(fit.COARSE_STEPS)} "
+                f"(coarse pass), {list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11)",
+                "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses; each texel starts "
+                "from the best of the analytic guesses and the surrounding coarse fits (no chaining)",
+                "alpha_min": o["alpha_min"],
+                "theta_max": THETA_MAX,
+                "magnitude": f"{o['estimator']}, {m_samples or 'default'} samples (lutbake albedo / dfg integrands)",
+            }
+        ),
+        "ltc_texture_slices": "slice_0 = ltc_1 (inverse matrix), slice_1 = ltc_2 (magnitude, fresnel, fit_error, "
+        "sphere)",
+    }
+    return TexelPlan(
+        axes=axes,
+        channels=CHANNELS,
+        reconstruction=RECONSTRUCTION,
+        n_texels=2 * n,
+        n_channels=4,
+        run_tile=state.run_tile,
+        prepare=state.prepare,
+        samples=2 * o["fit_samples"] ** 2,
+        estimator=f"ltc_fit (magnitude: {o['estimator']})",
+        terms=terms,
+        cost=float(n) * 300 * 2 * o["fit_samples"] ** 2,
+        extra=extra,
+        attributes_after=fit_error_stats,
+    )
+
+
+def check_spec(spec):
+    o = spec.options
+    if o["estimator"] != "gauss_legendre" and LOBES[o["lobe"]].magnitude not in ("dfg:ggx", "dfg:beckmann"):
+        return (
+            "estimator",
+            f"estimator {o['estimator']!r} samples the GGX / Beckmann NDF: lobe {o['lobe']!r} needs 'gauss_legendre'",
+        )
+    if o["format"] == "ltc_dds" and o["dtype"] not in ("half", "float32"):
+        return ("dtype", "ltc_dds writes RGBA16F (half) or RGBA32F (float32)")
+    return None
+
+
+def texel_count(o: dict) -> int:
+    """2 x size (two texture slices)"""
+    return 2 * o["size"][0] * o["size"][1]
+
+
+ESTIMATION = Estimation(
+    ESTIMATORS,
+    "gauss_legendre",
+    "Gauss-Legendre budget of the magnitude / fresnel integrals per texel; "
+    "omitted: 432 (ggx, beckmann), 3072 (charlie)",
+    samples_min=12,
+    samples_max=1 << 20,
+)
+LTC = declare(
+    "ltc",
+    "Linearly Transformed Cosine fit (Heitz et al. 2016): ltc_code's two RGBA textures "
+    "(inverse matrix; magnitude, fresnel, fit error, sphere integral)",
+    KEYS,
+    plan,
+    ESTIMATION,
+    aliases=("ltc_fit",),
+    check=check_spec,
+    texels=texel_count,
+)

@@ -1,0 +1,113 @@
+"""Kind ``specular_aniso``: split-sum tables of anisotropic lobes, NoV x roughness x anisotropy.
+
+    E(NoV, r, a) = ∫ f(l, v) (n.l) dω_l,  f anisotropic: tangent T = +x, bitangent B = +y, n = +z,
+stored as z slices over the anisotropy a (a multi-part EXR, one part per a, as specular_3d stores f0), with the
+split-sum channels of ``dfg`` (Schlick F: scale/bias or multiscatter; the sheen and F82 layouts are not defined
+for these lobes). The lobes and the anisotropy -> (alpha_x, alpha_y) mapping: lutbake.integrands.anisotropic;
+the estimators (``sobol``, ``sobol_cosine``) and the view azimuth: lutbake.sampling.anisotropic.
+
+Key ``view_azimuth``: ``average`` (default) integrates the view azimuth out, E = (1/2 pi) ∫ E(phi_v) dphi_v, which
+is what a shader looking up a 3D table without the azimuth should use (at a = 0 it is the isotropic table);
+``tangent`` fixes phi_v = 0 (v in the T-n plane), ``bitangent`` phi_v = pi/2. Recorded in lutbake:view_azimuth.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..axes import Axis
+from ..edge import alpha_policy
+from ..integrands.anisotropic import ANISO_LAYOUTS, ANISO_MODELS, AXES_FORMULA, alpha_xy, aniso_integrand
+from ..sampling.anisotropic import ANISO_ESTIMATORS, AnisoSobol
+from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from . import dfg
+from .base import Estimation, Key, declare
+
+VIEW_AZIMUTHS = {
+    "average": "E averaged over the view azimuth phi_v in [0, 2 pi) (default)",
+    "tangent": "phi_v = 0: v in the plane of the tangent and the normal",
+    "bitangent": "phi_v = pi/2: v in the plane of the bitangent and the normal",
+}
+PHI_V = {"average": -1.0, "tangent": 0.0, "bitangent": 0.5 * np.pi}
+
+KEYS = {
+    "model": Key("model", "str", "microfacet", "the anisotropic lobe", ANISO_MODELS),
+    "layout": Key(
+        "layout", "str", "scale_bias", "channel layout (Schlick split sum)", {k: dfg.LAYOUTS[k] for k in ANISO_LAYOUTS}
+    ),
+    **{k: dfg.KEYS[k] for k in ("size", "roughness", "texel", "nov_range", "roughness_range")},
+    "anisotropy_size": Key("anisotropy_size", "int", 8, "anisotropy slice count (z)", minimum=1, maximum=1024),
+    "anisotropy_range": Key(
+        "anisotropy_range",
+        "float_range",
+        [0.0, 1.0],
+        "anisotropy at t = 0 and t = 1 (same texel convention); a < 0 stretches along B",
+        minimum=-1.0,
+        maximum=1.0,
+    ),
+    "view_azimuth": Key("view_azimuth", "str", "average", "the view azimuth about n, from the tangent", VIEW_AZIMUTHS),
+}
+RECONSTRUCTION = {
+    "scale_bias": "load part k as layer k of a 3D texture; t = texture(lut3d, vec3(NoV, roughness, anisotropy)).rg; "
+    "specular = prefiltered * (f0 * t.r + t.g) (texel centres on all three axes)",
+    "multiscatter": "t = texture(lut3d, vec3(NoV, roughness, anisotropy)).rg; E = mix(t.r, t.g, f0); "
+    "energy compensation = 1 + f0 (1 / t.g - 1)",
+}
+
+
+def axes_for(o: dict) -> list[Axis]:
+    return [Axis("anisotropy", "z", o["anisotropy_size"], *o["anisotropy_range"], texel=o["texel"])] + dfg.axes_for(o)
+
+
+def plan(spec) -> TexelPlan:
+    o = spec.options
+    axes = axes_for(o)
+    an_axis, rough, nov_axis = axes
+    nx, ny, nz = nov_axis.count, rough.count, an_axis.count
+    integrand = aniso_integrand(o["model"], o["layout"])
+    # texel t = (iz * ny + iy) * nx + ix: anisotropy slowest, then roughness, then NoV
+    nov = np.tile(nov_axis.values(), ny * nz)
+    alpha = np.tile(np.repeat(rough.alpha(), nx), nz)
+    ax, ay = alpha_xy(alpha, np.repeat(an_axis.values(), ny * nx), integrand.mirror)
+    grid = Grid(
+        axes,
+        {"nov": nov, "alpha_x": ax, "alpha_y": ay, "phi_v": np.full(len(nov), PHI_V[o["view_azimuth"]], np.float32)},
+        grazing=nov,
+    )
+    terms = {
+        "model": o["model"],
+        "ndf": "ggx_aniso" if o["model"] == "microfacet" else "ashikhmin_shirley",
+        "masking": "smith_height_correlated (anisotropic Lambda)"
+        if o["model"] == "microfacet"
+        else "none (implicit in the lobe)",
+        "fresnel": "schlick",
+        "layout": o["layout"],
+    }
+    return per_texel_plan(
+        integrand,
+        AnisoSobol(o["estimator"], o["samples"] or AnisoSobol.budget, o["seed"]),
+        grid,
+        channels=dfg.CHANNELS[o["layout"]],
+        reconstruction=RECONSTRUCTION[o["layout"]],
+        terms=terms,
+        extra={
+            "view_azimuth": f"{o['view_azimuth']}: {VIEW_AZIMUTHS[o['view_azimuth']]}",
+            "anisotropy_mapping": f"Burley 2012, Addenda B.2: {AXES_FORMULA}",
+            "tangent_frame": "T = +x (phi = 0), B = +y, n = +z",
+            "alpha_policy": alpha_policy(integrand.mirror),
+        },
+        error_estimate=False,
+    )
+
+
+def texel_count(o: dict) -> int:
+    """size x anisotropy_size"""
+    return o["size"][0] * o["size"][1] * o["anisotropy_size"]
+
+
+DESCRIPTION = (
+    "anisotropic split-sum: NoV x roughness x anisotropy slices (anisotropic GGX or Ashikhmin-Shirley), "
+    "scale/bias or multiscatter"
+)
+ESTIMATION = Estimation(ANISO_ESTIMATORS, "sobol", dfg.SAMPLES_DOC)
+SPECULAR_ANISO = declare("specular_aniso", DESCRIPTION, KEYS, plan, ESTIMATION, aliases=("aniso",), texels=texel_count)

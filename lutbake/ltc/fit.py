@@ -1,0 +1,408 @@
+"""Fitting Linearly Transformed Cosines (Heitz, Dupuy, Hill & Neubelt 2016, "Real-Time Polygonal-Light
+Shading with Linearly Transformed Cosines", SIGGRAPH) to a lobe f(v, l)(n.l), one texel at a time.
+
+The LTC distribution of a 3x3 matrix M is the clamped cosine D_o(w_o) = max(0, z_o)/pi pushed through
+w = M w_o / |M w_o|:
+    D(w) = D_o(w_o) |det M^-1| / |M^-1 w|^3,   w_o = M^-1 w / |M^-1 w|          (Heitz et al. 2016, Eq. 3)
+and the fitted lobe is magnitude x D, magnitude = ∫ f (n.l) dω (the directional albedo with F = 1).
+
+Parametrisation (ltc_code fit/LTC.h, fitLTC.cpp): M = [X Y Z] * [[m11, 0, m13], [0, m22, 0], [0, 0, 1]],
+the frame Z = the lobe's average direction (y cleared: the lobe is symmetric about the xz-plane), X = (Z.z, 0,
+-Z.x), Y = (0, 1, 0); at normal incidence (n.v = 1) the lobe is isotropic: m22 = m11, m13 = 0.
+The optimiser sees q = (log m11, log m22, m13 / m11): scale-free, so one simplex size fits every roughness.
+
+Error metric (ltc_code computeError, unchanged): the L3 distance between the lobe and the LTC,
+    E = ∫ |f(v, l)(n.l) - magnitude D(l)|^3 dω_l,
+estimated with multiple importance sampling by both distributions on the same N x N stratified grid
+u = ((i + 0.5)/N, (j + 0.5)/N): E ≈ 1/N^2 Σ_both |f - D|^3 / (p_ltc + p_brdf), p_ltc = D / magnitude.
+Kept as Heitz's so that the published table and lutbake's fits are compared on one metric. The table
+records the scale-free relative form e = (E / ∫ f^3 dω)^(1/3) (same ordering per texel; ∫ f^3 by the
+lobe's sampler on the same grid).
+
+Search: Nelder-Mead (ltc_code nelder_mead.h: reflection 1, expansion 2, contraction 1/2, shrink 1/2,
+Numerical Recipes' stopping test 2|f_lo - f_hi| <= tol (|f_lo| + |f_hi|)) vectorised with numpy over every
+texel at once, the objective a Warp kernel over (texel, candidate) pairs. Every texel is independent: the
+start is the best of (an analytic guess; the fits of a coarse pass at the surrounding coarse-grid texels),
+the coarse pass itself starting from analytic guesses only. No texel depends on its neighbours' order, and
+a texel's result is a function of its own inputs and the coarse pass alone, so the table is bit-identical
+for any tiling or worker count (ltc_code instead chains each texel off the previously fitted neighbour).
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import warp as wp
+
+from .lobes import lobe
+
+NELDER_MEAD_TOL = 1.0e-5  # ltc_code fit(): NelderMead(..., epsilon, 1e-5, 100, ...)
+NELDER_MEAD_ITERS = 100
+# successive restarts' simplex sizes in q = (log m11, log m22, m13/m11): the coarse pass starts far from the
+# optimum and restarts twice; a texel starts from the coarse fits and runs once (a second restart at 0.02 cost
+# 80 % more evaluations and changed the median error by 1e-9 relative on GGX 64^2)
+COARSE_STEPS = (0.5, 0.1, 0.02)
+FINE_STEPS = (0.1,)
+# absolute stop: simplex values within (1e-6)^3 ∫ f^3 (relative L3 errors within 1e-6): reached only by lobes an
+# LTC fits exactly (Lambert), whose E ~ 1e-22 would otherwise run every iteration on rounding noise
+ATOL_RELATIVE = 1.0e-6
+COARSE_NODES = 8  # coarse-pass texels per axis (including both ends)
+DEFAULT_GRID = 32  # ltc_code Nsample: the metric's grid is N x N per sampling technique
+M_MIN = 1.0e-7  # ltc_code FitLTC::update: m11, m22 >= 1e-7
+
+
+@wp.func
+def ltc_eval(m_inv: wp.mat33d, det_inv: wp.float64, l: wp.vec3d):
+    """D(l) = max(0, z_o)/pi |det M^-1| / |M^-1 l|^3, z_o = (M^-1 l).z / |M^-1 l| (Heitz et al. 2016, Eq. 3)."""
+    lo = m_inv * l
+    n = wp.length(lo)
+    z = lo[2] / n
+    if z <= wp.float64(0.0):
+        return wp.float64(0.0)
+    return z * wp.float64(0.3183098861837907) * det_inv / (n * n * n)
+
+
+@functools.lru_cache(maxsize=None)
+def kernels(lobe_name: str):
+    """(lobe_samples, heitz_error) Warp kernels for a lobe, compiled once per Warp cache."""
+    lb = lobe(lobe_name)
+    f_cos, sample, pdf, f_pdf = lb.f_cos, lb.sample, lb.pdf, lb.f_pdf
+
+    @wp.kernel(enable_backward=False)
+    def lobe_samples(
+        v: wp.array(dtype=wp.vec3),
+        alpha: wp.array(dtype=float),
+        grid: wp.array(dtype=wp.vec2),
+        dirs: wp.array2d(dtype=wp.vec3d),
+        f: wp.array2d(dtype=wp.float64),
+        p: wp.array2d(dtype=wp.float64),
+    ):
+        """The lobe-sampled half of the metric does not depend on M: its directions, f (n.l) and density, once."""
+        i, s = wp.tid()
+        vi = v[i]
+        a = alpha[i]
+        u = grid[s]
+        l = sample(vi, a, u[0], u[1])
+        dirs[i, s] = wp.vec3d(wp.float64(l[0]), wp.float64(l[1]), wp.float64(l[2]))
+        f[i, s] = wp.float64(f_cos(vi, l, a))
+        p[i, s] = wp.float64(pdf(vi, l, a))
+
+    @wp.kernel(enable_backward=False)
+    def heitz_error(
+        texel: wp.array(dtype=int),
+        m: wp.array(dtype=wp.mat33d),
+        v: wp.array(dtype=wp.vec3),
+        alpha: wp.array(dtype=float),
+        magnitude: wp.array(dtype=wp.float64),
+        cos_dirs: wp.array(dtype=wp.vec3d),
+        lobe_dirs: wp.array2d(dtype=wp.vec3d),
+        lobe_f: wp.array2d(dtype=wp.float64),
+        lobe_p: wp.array2d(dtype=wp.float64),
+        err: wp.array(dtype=wp.float64),
+    ):
+        """ltc_code computeError: 1/N^2 Σ over LTC samples and lobe samples of |f - mag D|^3 / (p_ltc + p_brdf)."""
+        i = wp.tid()
+        t = texel[i]
+        mi = m[i]
+        m_inv = wp.inverse(mi)
+        det_inv = wp.abs(wp.determinant(m_inv))
+        vi = v[t]
+        a = alpha[t]
+        mag = magnitude[t]
+        acc = wp.float64(0.0)
+        for s in range(cos_dirs.shape[0]):
+            # LTC sample: l = M w_o / |M w_o|, w_o cosine-distributed (p_ltc = D, the normalised LTC)
+            ld = wp.normalize(mi * cos_dirs[s])
+            l = wp.vec3(float(ld[0]), float(ld[1]), float(ld[2]))
+            d = ltc_eval(m_inv, det_inv, ld)
+            fp = f_pdf(vi, l, a)
+            e = wp.abs(wp.float64(fp[0]) - mag * d)
+            q = d + wp.float64(fp[1])
+            if q > wp.float64(0.0):
+                acc += e * e * e / q
+            # lobe sample (precomputed by lobe_samples)
+            d2 = ltc_eval(m_inv, det_inv, lobe_dirs[t, s])
+            e2 = wp.abs(lobe_f[t, s] - mag * d2)
+            q2 = d2 + lobe_p[t, s]
+            if q2 > wp.float64(0.0):
+                acc += e2 * e2 * e2 / q2
+        err[i] = acc / wp.float64(cos_dirs.shape[0])
+
+    return lobe_samples, heitz_error
+
+
+def stratified_grid(n: int) -> np.ndarray:
+    """ltc_code's N x N grid (U1 = (i + 0.5)/N fastest, U2 = (j + 0.5)/N), float32 (N^2, 2)."""
+    u = (np.arange(n) + 0.5) / n
+    u1, u2 = np.meshgrid(u, u)
+    return np.stack([u1.ravel(), u2.ravel()], axis=1).astype(np.float32)
+
+
+def cosine_dirs(grid: np.ndarray) -> np.ndarray:
+    """ltc_code LTC::sample's cosine-distributed directions: theta = acos(sqrt(U1)), phi = 2 pi U2 (float64)."""
+    u1, u2 = grid[:, 0].astype(np.float64), grid[:, 1].astype(np.float64)
+    s = np.sqrt(1.0 - u1)
+    return np.stack([s * np.cos(2 * np.pi * u2), s * np.sin(2 * np.pi * u2), np.sqrt(u1)], axis=1)
+
+
+class Problem:
+    """The per-texel data of a fit (views, alphas, magnitudes, frames) and its objective on Warp's CPU device."""
+
+    def __init__(
+        self,
+        lobe_name: str,
+        nov: np.ndarray,
+        alpha: np.ndarray,
+        magnitude: np.ndarray,
+        n_grid: int = DEFAULT_GRID,
+        device: str = "cpu",
+    ):
+        self.lobe = lobe_name
+        self.device = device
+        self.nov = np.asarray(nov, np.float32)
+        self.alpha = np.asarray(alpha, np.float32)
+        self.magnitude = np.asarray(magnitude, np.float64)
+        self.n = len(self.nov)
+        nv = self.nov.astype(np.float64)
+        self.v = np.stack([np.sqrt(np.maximum(1.0 - nv * nv, 0.0)), np.zeros_like(nv), nv], axis=1).astype(np.float32)
+        self.isotropic = self.nov >= np.float32(1.0)
+        grid = stratified_grid(n_grid)
+        lobe_samples, self._heitz = kernels(lobe_name)
+        d = device
+        self._grid = wp.array(grid, dtype=wp.vec2, device=d)
+        self._cos = wp.array(cosine_dirs(grid), dtype=wp.vec3d, device=d)
+        self._v = wp.array(self.v, dtype=wp.vec3, device=d)
+        self._alpha = wp.array(self.alpha, dtype=float, device=d)
+        self._mag = wp.array(self.magnitude, dtype=wp.float64, device=d)
+        s = len(grid)
+        self._ldir = wp.zeros((self.n, s), dtype=wp.vec3d, device=d)
+        self._lf = wp.zeros((self.n, s), dtype=wp.float64, device=d)
+        self._lp = wp.zeros((self.n, s), dtype=wp.float64, device=d)
+        wp.launch(
+            lobe_samples,
+            dim=(self.n, s),
+            inputs=[self._v, self._alpha, self._grid, self._ldir, self._lf, self._lp],
+            device=d,
+        )
+        # from the lobe's samples: its average direction Σ (f / p) l (ltc_code computeAvgTerms) and ∫ f^3 ≈ Σ f^3 / p
+        f, p = self._lf.numpy(), self._lp.numpy()
+        w = np.where(p > 0.0, f / np.where(p > 0.0, p, 1.0), 0.0)
+        self.f3 = np.sum(f * f * w, axis=1) / s
+        self.frame_z = self._frames(np.einsum("ts,tsk->tk", w, self._ldir.numpy()))
+        self.evaluations = 0
+
+    def _frames(self, avg: np.ndarray) -> np.ndarray:
+        """Z = normalize(average direction with y cleared); (0, 0, 1) at normal incidence (ltc_code fitTab)."""
+        z = avg.copy()
+        z[:, 1] = 0.0
+        nrm = np.linalg.norm(z, axis=1)
+        ok = nrm > 0.0
+        z[ok] /= nrm[ok, None]
+        z[~ok] = (0.0, 0.0, 1.0)
+        z[self.isotropic] = (0.0, 0.0, 1.0)
+        return z
+
+    def matrices(self, texel: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """M = [X Y Z] * [[m11, 0, m13], [0, m22, 0], [0, 0, 1]] for q = (log m11, log m22, m13 / m11)."""
+        m11 = np.maximum(np.exp(q[:, 0]), M_MIN)
+        m22 = np.maximum(np.exp(q[:, 1]), M_MIN)
+        m13 = q[:, 2] * m11
+        iso = self.isotropic[texel]
+        m22 = np.where(iso, m11, m22)
+        m13 = np.where(iso, 0.0, m13)
+        z = self.frame_z[texel]
+        k = len(texel)
+        R = np.zeros((k, 3, 3))
+        R[:, :, 2] = z
+        R[:, 0, 0], R[:, 2, 0] = z[:, 2], -z[:, 0]  # X = (Z.z, 0, -Z.x)
+        R[:, 1, 1] = 1.0
+        A = np.zeros((k, 3, 3))
+        A[:, 0, 0], A[:, 1, 1], A[:, 0, 2], A[:, 2, 2] = m11, m22, m13, 1.0
+        return R @ A
+
+    def error(self, texel: np.ndarray, m: np.ndarray) -> np.ndarray:
+        """Heitz's metric E for the matrices ``m`` (k, 3, 3) at texels ``texel`` (k,) (any scale of M)."""
+        k = len(texel)
+        if k == 0:
+            return np.zeros(0)
+        d = self.device
+        out = wp.zeros(k, dtype=wp.float64, device=d)
+        wp.launch(
+            self._heitz,
+            dim=k,
+            inputs=[
+                wp.array(np.asarray(texel, np.int32), dtype=int, device=d),
+                wp.array(np.ascontiguousarray(m, np.float64), dtype=wp.mat33d, device=d),
+                self._v,
+                self._alpha,
+                self._mag,
+                self._cos,
+                self._ldir,
+                self._lf,
+                self._lp,
+                out,
+            ],
+            device=d,
+        )
+        self.evaluations += k
+        return out.numpy()
+
+    def objective(self, texel: np.ndarray, q: np.ndarray) -> np.ndarray:
+        return self.error(texel, self.matrices(texel, q))
+
+    def relative(self, texel: np.ndarray, err: np.ndarray) -> np.ndarray:
+        """The scale-free fit error e = (E / ∫ f^3)^(1/3) recorded per texel. ∫ f^3 is the lobe sampler's estimate,
+        floored at Hölder's bound ∫ f^3 >= (∫ f)^3 / (2 pi)^2 = magnitude^3 / (4 pi^2): where a sampler misses a
+        lobe (charlie at alpha -> 0 and grazing view puts it all within 1e-2 rad of the horizon) the estimate
+        falls below that provable bound and the floor keeps e finite and meaningful (0 for a zero lobe)."""
+        f3 = np.maximum(self.f3[texel], self.magnitude[texel] ** 3 / (4.0 * np.pi**2))
+        return np.cbrt(np.where(f3 > 0.0, err / np.where(f3 > 0.0, f3, 1.0), 0.0))
+
+
+def nelder_mead(
+    fun,
+    texel: np.ndarray,
+    start: np.ndarray,
+    step: float,
+    tol: float = NELDER_MEAD_TOL,
+    iters: int = NELDER_MEAD_ITERS,
+    atol: np.ndarray | float = 0.0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """ltc_code's downhill simplex (nelder_mead.h) run on every texel at once: ``fun(texel_subset, q)`` -> values.
+    Each texel follows exactly the scalar algorithm (its own simplex, its own stopping test
+    2 |f_lo - f_hi| < tol (|f_lo| + |f_hi|) + atol); the vector form only batches the objective calls.
+    Returns (best q (n, 3), best value (n,))."""
+    n, dim = start.shape
+    s = np.repeat(start[:, None, :], dim + 1, axis=1)
+    for i in range(dim):
+        s[:, i + 1, i] += step
+    f = fun(np.repeat(texel, dim + 1), s.reshape(-1, dim)).reshape(n, dim + 1)
+    active = np.ones(n, bool)
+    rows = np.arange(n)
+    for _ in range(iters):
+        order = np.argsort(f, axis=1, kind="stable")
+        lo, nh, hi = order[:, 0], order[:, -2], order[:, -1]
+        flo, fhi, fnh = f[rows, lo], f[rows, hi], f[rows, nh]
+        a, b = np.abs(flo), np.abs(fhi)
+        active &= ~(2.0 * np.abs(a - b) < (a + b) * tol + atol)
+        idx = np.flatnonzero(active)
+        if len(idx) == 0:
+            break
+        sh = s[idx, hi[idx]]
+        o = (s[idx].sum(axis=1) - sh) / dim
+        r = o + (o - sh)
+        fr = fun(texel[idx], r)
+        better_nh = fr < fnh[idx]
+        expand = better_nh & (fr < flo[idx])
+        contract = ~better_nh
+        # expansion and contraction points are evaluated together (a texel needs one or the other)
+        trial = np.where(expand[:, None], o + 2.0 * (o - sh), o - 0.5 * (o - sh))
+        need = expand | contract
+        ft = np.full(len(idx), np.inf)
+        ft[need] = fun(texel[idx[need]], trial[need])
+        new = sh.copy()
+        fnew = fhi[idx].copy()
+        take_e = expand & (ft < fr)
+        take_r = better_nh & ~take_e
+        take_c = contract & (ft < fhi[idx])
+        new[take_e], fnew[take_e] = trial[take_e], ft[take_e]
+        new[take_r], fnew[take_r] = r[take_r], fr[take_r]
+        new[take_c], fnew[take_c] = trial[take_c], ft[take_c]
+        s[idx, hi[idx]] = new
+        f[idx, hi[idx]] = fnew
+        shrink = idx[contract & ~take_c]
+        if len(shrink):
+            slo = s[shrink, lo[shrink]][:, None, :]
+            s[shrink] = slo + 0.5 * (s[shrink] - slo)
+            keep = lo[shrink]
+            pts = s[shrink].reshape(-1, dim)
+            fs = fun(np.repeat(texel[shrink], dim + 1), pts).reshape(len(shrink), dim + 1)
+            fs[np.arange(len(shrink)), keep] = f[shrink, keep]
+            f[shrink] = fs
+    best = np.argmin(f, axis=1)
+    return s[rows, best], f[rows, best]
+
+
+def analytic_guesses(problem: Problem, texel: np.ndarray) -> np.ndarray:
+    """Starting points without any other texel: isotropic lobes of scale 2 alpha (a mirror lobe is twice as
+    wide as its NDF), alpha and 1, no skew; (k, 3, 3) candidates q."""
+    a = np.maximum(problem.alpha[texel].astype(np.float64), 1e-4)
+    cands = [np.log(2.0 * a), np.log(a), np.zeros_like(a)]
+    return np.stack([np.stack([c, c, np.zeros_like(c)], axis=1) for c in cands], axis=1)
+
+
+def best_of(problem: Problem, texel: np.ndarray, cands: np.ndarray) -> np.ndarray:
+    """The candidate (k, c, 3) of least error per texel (first on ties)."""
+    k, c, _ = cands.shape
+    f = problem.objective(np.repeat(texel, c), cands.reshape(-1, 3)).reshape(k, c)
+    return cands[np.arange(k), np.argmin(f, axis=1)]
+
+
+def refine(problem: Problem, texel: np.ndarray, start: np.ndarray, steps) -> tuple[np.ndarray, np.ndarray]:
+    """Nelder-Mead from ``start``, restarted from its result at each simplex size of ``steps``."""
+    q, f = start, None
+    atol = ATOL_RELATIVE**3 * problem.f3[texel]
+    for step in steps:
+        q, f = nelder_mead(problem.objective, texel, q, step, atol=atol)
+    return q, f
+
+
+def coarse_nodes(n: int) -> np.ndarray:
+    return np.unique(np.round(np.linspace(0, n - 1, min(COARSE_NODES, n))).astype(int))
+
+
+def coarse_pass(problem: Problem, ny: int, nx: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Fit the coarse-grid texels (rows ``iy``, columns ``ix``) from analytic guesses alone.
+    Returns (iy nodes, ix nodes, q of shape (len(iy), len(ix), 3))."""
+    iy, ix = coarse_nodes(ny), coarse_nodes(nx)
+    texel = (iy[:, None] * nx + ix[None, :]).ravel()
+    start = best_of(problem, texel, analytic_guesses(problem, texel))
+    q, _ = refine(problem, texel, start, COARSE_STEPS)
+    return iy, ix, q.reshape(len(iy), len(ix), 3)
+
+
+def seeds(problem: Problem, texel: np.ndarray, nx: int, coarse) -> np.ndarray:
+    """Per texel: the best of the analytic guesses, the coarse fits of the (up to 4) surrounding coarse texels
+    and their bilinear blend in q."""
+    iy, ix, qc = coarse
+    y, x = texel // nx, texel % nx
+    j = np.clip(np.searchsorted(iy, y, side="right") - 1, 0, len(iy) - 2) if len(iy) > 1 else np.zeros_like(y)
+    i = np.clip(np.searchsorted(ix, x, side="right") - 1, 0, len(ix) - 2) if len(ix) > 1 else np.zeros_like(x)
+    j1, i1 = np.minimum(j + 1, len(iy) - 1), np.minimum(i + 1, len(ix) - 1)
+    ty = np.where(iy[j1] > iy[j], (y - iy[j]) / np.maximum(iy[j1] - iy[j], 1), 0.0)[:, None]
+    tx = np.where(ix[i1] > ix[i], (x - ix[i]) / np.maximum(ix[i1] - ix[i], 1), 0.0)[:, None]
+    c00, c01, c10, c11 = qc[j, i], qc[j, i1], qc[j1, i], qc[j1, i1]
+    blend = (1 - ty) * ((1 - tx) * c00 + tx * c01) + ty * ((1 - tx) * c10 + tx * c11)
+    cands = np.concatenate([analytic_guesses(problem, texel), np.stack([c00, c01, c10, c11, blend], axis=1)], axis=1)
+    return best_of(problem, texel, cands)
+
+
+def fit_texels(problem: Problem, texel: np.ndarray, nx: int, coarse) -> tuple[np.ndarray, np.ndarray]:
+    """Fitted M (k, 3, 3) and Heitz's error E (k,) at ``texel``, seeded from the coarse pass."""
+    start = seeds(problem, texel, nx, coarse)
+    q, f = refine(problem, texel, start, FINE_STEPS)
+    return problem.matrices(texel, q), f
+
+
+def pack_inverse(m: np.ndarray) -> np.ndarray:
+    """ltc_code packTab: M^-1 / (M^-1)_11, stored (M^-1_00, M^-1_20, M^-1_02, M^-1_22) in the row-major maths
+    indexing used here (glm's invM[0][0], invM[0][2], invM[2][0], invM[2][2], glm being column-major); the
+    shader rebuilds mat3(vec3(t.x, 0, t.y), vec3(0, 1, 0), vec3(t.z, 0, t.w)) (columns)."""
+    inv = np.linalg.inv(m)
+    inv = inv / inv[:, 1, 1][:, None, None]
+    return np.stack([inv[:, 0, 0], inv[:, 2, 0], inv[:, 0, 2], inv[:, 2, 2]], axis=1)
+
+
+def unpack_inverse(t: np.ndarray) -> np.ndarray:
+    """(k, 4) packed coefficients -> M^-1 (k, 3, 3) (row-major maths indexing; the inverse of pack_inverse)."""
+    k = len(t)
+    inv = np.zeros((k, 3, 3))
+    inv[:, 0, 0], inv[:, 2, 0], inv[:, 0, 2], inv[:, 2, 2] = t[:, 0], t[:, 1], t[:, 2], t[:, 3]
+    inv[:, 1, 1] = 1.0
+    return inv
+
+
+def heitz_error_of_packed(problem: Problem, texel: np.ndarray, packed: np.ndarray) -> np.ndarray:
+    """Heitz's metric of a stored table (its packed inverse matrices), e.g. the published ltc_code table."""
+    return problem.error(texel, np.linalg.inv(unpack_inverse(packed)))

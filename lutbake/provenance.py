@@ -1,0 +1,82 @@
+"""Hashing and provenance: what makes an output current, and the ``lutbake:*`` record every output carries.
+
+- **Content hash.** Every output records ``lutbake:content_hash`` = sha256 of the table's canonical TOML
+  (``TableSpec.toml()``), the lutbake version and the source text of the modules that define what a table holds
+  (``HASH_SOURCES``: terms, integrands, sampling, kinds, axes, edge policy). An output with the same hash is up to
+  date (lutbake.batch skips it); anything else (no file, unreadable file, other hash) is baked again.
+- **Provenance.** ``attributes(spec, plan)``: terms, estimator, samples, seed, config text, versions, the plan's
+  own records and the content hash, written as ``lutbake:*`` (EXR header or the JSON sidecar).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+
+from . import __version__
+from .config import TableSpec
+from .io.integrity import verified_attributes
+
+PACKAGE = Path(__file__).parent
+# the modules whose source defines what a table holds (kernels, terms, estimators, kinds, axes, edge policy)
+HASH_SOURCES = ("terms/*.py", "integrands/*.py", "sampling/*.py", "kinds/*.py", "ltc/*.py", "axes.py", "edge.py")
+HASH_ATTRIBUTE = "content_hash"
+
+
+def source_files() -> list[Path]:
+    """The source files that enter every content hash, sorted by their path in the package."""
+    files = {f for pattern in HASH_SOURCES for f in PACKAGE.glob(pattern) if f.is_file()}
+    return sorted(files, key=lambda f: f.relative_to(PACKAGE).as_posix())
+
+
+def sources_digest() -> bytes:
+    """sha256 over (relative path, text) of every file in source_files()."""
+    h = hashlib.sha256()
+    for f in source_files():
+        data = f.read_bytes()
+        h.update(f.relative_to(PACKAGE).as_posix().encode() + b"\0" + str(len(data)).encode() + b"\0" + data)
+    return h.digest()
+
+
+def content_hash(spec: TableSpec, digest: bytes | None = None) -> str:
+    """The hex sha256 of (spec.toml(), lutbake version, source digest): what makes an output current."""
+    h = hashlib.sha256()
+    for part in (
+        b"lutbake-content-hash-v1",
+        spec.toml().encode(),
+        __version__.encode(),
+        digest if digest is not None else sources_digest(),
+    ):
+        h.update(str(len(part)).encode() + b"\0" + part)
+    return h.hexdigest()
+
+
+def read_header(path) -> dict[str, str] | None:
+    """The ``lutbake:*`` attributes of an existing output (prefix removed), only if the output passes its
+    integrity check (lutbake.io.integrity: the recorded sha256 of the stored bytes; for the non-EXR formats
+    the ``<file>.json`` sidecar written last); None if missing, corrupt or half-written (not up to date)."""
+    return verified_attributes(path)
+
+
+def warp_version() -> str:
+    import warp as wp
+
+    return wp.config.version
+
+
+def attributes(spec: TableSpec, plan, extra: dict[str, str] | None = None) -> dict[str, str]:
+    """The provenance of a table baked from ``spec`` by ``plan`` (lutbake.sampling.plan.TexelPlan)."""
+    return {
+        "terms": json.dumps(plan.terms),
+        "estimator": plan.estimator,
+        "samples": str(plan.samples),
+        "seed": str(spec.options.get("seed", 0)),
+        "config": spec.toml(),
+        "config_file": Path(spec.source).name,
+        "version": __version__,
+        "warp_version": warp_version(),
+        **plan.extra,
+        **(extra or {}),
+        HASH_ATTRIBUTE: content_hash(spec),  # what makes the file current
+    }

@@ -1,0 +1,271 @@
+"""Panelled Gauss-Legendre over the microfacet normal for the rough dielectric BSDF (reflection + refraction).
+
+The integrand (lutbake.integrands.dielectric) is a function of h = (theta_h, phi) that is analytic except on a few
+curves where a lobe's support ends or the Fresnel term has a square-root kink. As the ``dfg`` estimator splits at
+the reflection horizon (lutbake.sampling.hemisphere, docs/estimators.md), this one integrates every smooth piece over
+its exact domain. With v = (sin theta_v, 0, cos theta_v),
+c = v.h = cos(theta_v) cos(theta_h) + sin(theta_v) sin(theta_h)
+cos(phi) grows with cos(phi), and each curve is a breakpoint in phi at every theta_h, in closed form:
+    phi_l  n.l = 0 (reflection horizon):   cos(phi) = c* = -cos(theta_v) cos(2 theta_h) / (sin(theta_v) sin(2 theta_h))
+    phi_0  v.h = 0 (end of the visible normals): cos(phi) = -cot(theta_v) cot(theta_h)
+    phi_c  v.h = cos(theta_c) = sqrt(1 - eta^2), eta < 1 (TIR; F's sqrt kink):
+           cos(phi) = (cos theta_c - mu cos theta_h) / (sin theta_v sin theta_h)
+    phi_t  n.t = 0, eta < 1 (refraction horizon): t on the horizon at azimuth psi has h = (v + eta t) / |v + eta t|, so
+           cos(theta_h) = mu / sqrt(1 + eta^2 + 2 eta sin(theta_v) cos(psi)) gives psi, and phi_t = atan2(eta sin psi,
+           sin theta_v + eta cos psi) (a valid refraction pair needs v.t < -eta)
+Reflection lives on [0, phi_l], transmission on [0, phi_0] (eta >= 1) or [0, min(phi_c, phi_t)] (eta < 1); n.t < 0
+for every h when eta > 1 (t = (c/eta - cos theta_t) h - v/eta with c/eta < cos theta_t). By symmetry in phi,
+    I = (1/pi) ∫ du ∫_0^pi dphi g / p    (u = CDF of D(h)(n.h) in theta_h, p = D (n.h); theta_h itself past the peak)
+The outer variable theta_h is cut at the theta_h where a phi-breakpoint enters or leaves [0, pi] (there the breakpoint
+moves like a square root): theta_a = (pi/2 - theta_v)/2 and theta_b = pi/2 - theta_a (c* = -1, +1), 2 theta_a (phi_0),
+|theta_c - theta_v| and theta_v + theta_c (phi_c), acos(mu / sqrt(1 + eta^2 -+ 2 eta sin theta_v)) (phi_t), and
+acos(mu / cos theta_c) where phi_t meets phi_c (the transmission domain's end switches from one to the other), and
+acos(mu / (2 cos theta_c)) where phi_c meets phi_l (n.l = 2 (v.h)(n.h) - mu = 0 at v.h = cos theta_c); at the NDF
+peak scale atan(alpha) R^j; and geometrically from theta_a to pi/4 and from pi/4 to theta_b, as the dfg estimator,
+and from |theta_c - theta_v| to pi/4 (a view near the critical angle makes phi_c vary on every scale there).
+Every outer panel is smoothstep-mapped (removes the square-root ends). Inner panels run between consecutive
+phi-breakpoints: a panel ending at a horizon (phi_l or phi_t) uses the sinh map of the dfg estimator towards it
+(G2 has a pole at n.o = -alpha / (1 + 2 Lambda(v)) just past the cut), with x -> x^2 at its lower end when that end is a
+kink; the other panels are smoothstep-mapped.
+Per texel: (n.v, alpha, eta) (eta = the kernel's ``param``); GL (node, weight) rules on [0, 1] for the outer and
+inner variables. float64 accumulation, float32 terms. alpha = 0 takes the integrand's closed-form mirror limit.
+``DielectricGaussLegendre`` is this quadrature as an estimator of the lutbake.sampling.plan protocol; the QMC
+estimators of lutbake.sampling.hemisphere serve as the second estimator unchanged (the integrand lives in the same
+half-vector measure).
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import warp as wp
+
+from .arrays import Rows64, Rule
+from .hemisphere import (
+    PANEL_RATIO,
+    PI64,
+    GaussLegendre,
+    asinh64,
+    facet_weight_for,
+    next_geometric,
+    outer_variable_for,
+    store_row,
+    texel_view,
+)
+
+ZERO64 = wp.constant(wp.float64(0.0))
+ONE64 = wp.constant(wp.float64(1.0))
+TWO64 = wp.constant(wp.float64(2.0))
+HALF64 = wp.constant(wp.float64(0.5))
+MAX_PANELS = 96  # outer panels per texel (a guard; grazing texels at the smallest alpha use ~30)
+vec4d = wp.types.vector(length=4, dtype=wp.float64)
+vec7d = wp.types.vector(length=7, dtype=wp.float64)
+
+
+@wp.func
+def next_theta_dielectric(
+    t_lo: wp.float64, theta_a: wp.float64, theta_b: wp.float64, theta_peak: wp.float64, kinks: vec7d
+):
+    """Upper edge of the outer panel starting at t_lo: the smallest candidate above t_lo among the NDF-peak points
+    theta_peak R^j, the horizon grading (theta_a R^j below pi/4; pi/2 - (pi/2 - t_lo)/R up to theta_b) and the kinks."""
+    quarter = PI64 * wp.float64(0.25)
+    half = PI64 * wp.float64(0.5)
+    tiny = wp.float64(1.0e-12) * (wp.float64(1.0) + t_lo)
+    t = half
+    c = next_geometric(t_lo, theta_peak)
+    if c > t_lo + tiny:
+        t = wp.min(t, c)
+    if t_lo < quarter:
+        c = wp.min(next_geometric(t_lo, theta_a), quarter)
+    else:
+        c = wp.min(half - (half - t_lo) / wp.float64(PANEL_RATIO), theta_b)
+    if c > t_lo + tiny:
+        t = wp.min(t, c)
+    for k in range(7):
+        if kinks[k] > t_lo + tiny:
+            t = wp.min(t, kinks[k])
+    if kinks[1] > wp.float64(0.0) and t_lo < quarter:  # view near the critical angle: phi_c varies on every scale
+        c = wp.min(next_geometric(t_lo, kinks[1]), quarter)
+        if c > t_lo + tiny:
+            t = wp.min(t, c)
+    return t
+
+
+@wp.func
+def acos_clamped(x: wp.float64):
+    return wp.acos(wp.clamp(x, wp.float64(-1.0), wp.float64(1.0)))
+
+
+@wp.func
+def sort4(b: vec4d):
+    """Ascending sort of four values (insertion sort)."""
+    for i in range(1, 4):
+        j = i
+        while j > 0 and b[j - 1] > b[j]:
+            tmp = b[j - 1]
+            b[j - 1] = b[j]
+            b[j] = tmp
+            j = j - 1
+    return b
+
+
+@wp.func
+def phi_refraction_horizon(cos_v: wp.float64, sin_v: wp.float64, cos_h: wp.float64, eta: wp.float64):
+    """phi_t (module docstring) at this theta_h; -1 where the refraction horizon does not cross this theta_h."""
+    one = wp.float64(1.0)
+    if sin_v <= wp.float64(1.0e-12) or cos_h <= wp.float64(0.0):
+        return -one
+    cp = (cos_v * cos_v / (cos_h * cos_h) - one - eta * eta) / (wp.float64(2.0) * eta * sin_v)
+    if cp < -one or cp > one or sin_v * cp >= -eta:
+        return -one
+    sp = wp.sqrt(wp.max(one - cp * cp, wp.float64(0.0)))
+    return wp.atan2(eta * sp, sin_v + eta * cp)
+
+
+@wp.func
+def dnot_dphi(
+    cos_v: wp.float64, sin_v: wp.float64, cos_h: wp.float64, sin_h: wp.float64, phi: wp.float64, eta: wp.float64
+):
+    """|d(n.t)/dphi| at phi: n.t = (c/eta - cos theta_t) cos theta_h - mu/eta with c = v.h (module docstring)."""
+    c = cos_v * cos_h + sin_v * sin_h * wp.cos(phi)
+    ct = wp.sqrt(wp.max(wp.float64(1.0) - (wp.float64(1.0) - c * c) / (eta * eta), wp.float64(1.0e-300)))
+    dc = sin_v * sin_h * wp.sin(phi)
+    return wp.abs(dc * cos_h * (wp.float64(1.0) / eta - c / (eta * eta * ct)))
+
+
+def make_gauss_legendre_dielectric(spec):
+    """The kernel (module docstring) for an integrand record (lutbake.integrands.dielectric.dielectric_integrand).
+    Inputs as lutbake.sampling.hemisphere.make_gauss_legendre: texel (n.v, alpha, eta), rule_u, rule_p, out."""
+    acc_type, mirror = spec.acc, spec.mirror
+    d = spec.distribution
+    outer_range, outer_node = outer_variable_for(d.tan2_from_u, d.u_from_tan2)
+    facet_weight = facet_weight_for(spec.g, d.pdf_ndf)
+    nch = spec.vec._length_
+
+    @wp.kernel(enable_backward=False, module="unique")
+    def gauss_legendre_dielectric_kernel(texel: wp.array(dtype=wp.vec3), rule_u: Rule, rule_p: Rule, out: Rows64):
+        i = wp.tid()
+        v, a, eta_f, a64, cos_v, sin_v, eps_l, theta_a, theta_b, theta_peak = texel_view(texel[i])
+        eta = wp.float64(eta_f)
+        half = PI64 * HALF64
+        inside = eta < ONE64
+        theta_v = wp.atan2(sin_v, cos_v)
+        cos_c = ZERO64  # cos of the critical angle (eta < 1)
+        kinks = vec7d(TWO64 * theta_a, -ONE64, -ONE64, -ONE64, -ONE64, -ONE64, -ONE64)
+        if inside:
+            cos_c = wp.sqrt(ONE64 - eta * eta)
+            theta_c = wp.asin(eta)
+            kinks[1] = wp.abs(theta_c - theta_v)
+            kinks[2] = theta_v + theta_c
+            kinks[3] = acos_clamped(cos_v / wp.sqrt(ONE64 + eta * eta + TWO64 * eta * sin_v))
+            kinks[4] = acos_clamped(
+                cos_v / wp.sqrt(wp.max(ONE64 + eta * eta - TWO64 * eta * sin_v, wp.float64(1.0e-300)))
+            )
+            if cos_v < cos_c:  # phi_t meets phi_c: the horizon t with v.t = -eta
+                kinks[5] = wp.acos(cos_v / cos_c)
+            if cos_v < TWO64 * cos_c:  # phi_c meets phi_l: F's kink reaches the reflection horizon
+                kinks[6] = wp.acos(cos_v / (TWO64 * cos_c))
+        acc = acc_type()
+        t_lo = ZERO64
+        if a <= 0.0:  # alpha -> 0: the closed-form mirror limit below (lutbake.edge), no quadrature
+            t_lo = half
+        n_panels = wp.int32(0)  # a dynamic variable (a literal 0 is a constant to Warp)
+        while t_lo < half and n_panels < MAX_PANELS:
+            t_hi = next_theta_dielectric(t_lo, theta_a, theta_b, theta_peak, kinks)
+            n_panels += 1
+            in_u = t_hi <= theta_peak
+            x_lo, dx = outer_range(t_lo, t_hi, in_u, a64)
+            for k in range(rule_u.shape[0]):
+                s = rule_u[k][0]
+                x = x_lo + dx * s * s * (wp.float64(3.0) - TWO64 * s)  # smoothstep
+                cos_h, sin_h, wk = outer_node(x, rule_u[k][1] * dx * wp.float64(6.0) * s * (ONE64 - s), in_u, a64)
+                # phi-breakpoints at this theta_h (module docstring)
+                den = sin_v * sin_h
+                phi_l = PI64
+                phi_0 = PI64
+                phi_c = PI64
+                phi_t = -ONE64
+                if den > wp.float64(1.0e-300):
+                    c_star = -cos_v * (cos_h * cos_h - sin_h * sin_h) / (TWO64 * den * cos_h)
+                    phi_l = acos_clamped(c_star)
+                    phi_0 = acos_clamped(-cos_v * cos_h / den)
+                    if inside:
+                        phi_c = acos_clamped((cos_c - cos_v * cos_h) / den)
+                else:  # normal view: v.h = cos(theta_h), n.l > 0 iff theta_h < pi/4, for every phi
+                    if cos_h * cos_h - sin_h * sin_h <= ZERO64:
+                        phi_l = ZERO64
+                    if inside and cos_h <= cos_c:
+                        phi_c = ZERO64
+                if inside:
+                    phi_t = phi_refraction_horizon(cos_v, sin_v, cos_h, eta)
+                    if phi_t > phi_c:
+                        phi_t = -ONE64
+                phi_tr = phi_0
+                if inside:
+                    phi_tr = phi_c
+                    if phi_t >= ZERO64:
+                        phi_tr = phi_t
+                phi_end = wp.max(phi_l, phi_tr)
+                if phi_end <= ZERO64:
+                    continue
+                brk = sort4(vec4d(phi_l, phi_0, phi_c, phi_t))
+                p_lo = ZERO64
+                for m in range(5):
+                    p_hi = phi_end
+                    if m < 4:
+                        p_hi = wp.min(brk[m], phi_end)
+                    if p_hi <= p_lo + wp.float64(1.0e-14):
+                        continue
+                    dp = p_hi - p_lo
+                    horizon_end = (p_hi == phi_l and phi_l < PI64) or (p_hi == phi_t)
+                    kink_lo = p_lo > ZERO64
+                    eps = PI64
+                    if horizon_end:
+                        slope = TWO64 * cos_h * sin_v * sin_h * wp.max(wp.sin(p_hi), wp.float64(1.0e-12))
+                        if p_hi == phi_t:
+                            slope = wp.max(dnot_dphi(cos_v, sin_v, cos_h, sin_h, p_hi, eta), wp.float64(1.0e-12))
+                        eps = wp.max(eps_l / slope, wp.float64(1.0e-12))
+                    big_a = asinh64(dp / eps)
+                    for j in range(rule_p.shape[0]):
+                        y = rule_p[j][0]
+                        wy = rule_p[j][1]
+                        phi = p_lo
+                        w = wk
+                        if horizon_end:
+                            if kink_lo:
+                                wy = wy * TWO64 * y
+                                y = y * y
+                            # sinh map (Johnston & Elliott 2005) towards p_hi: phi = p_hi - eps sinh(A (1 - y))
+                            arg = big_a * (ONE64 - y)
+                            phi = p_hi - eps * wp.sinh(arg)
+                            w = wk * wy * eps * wp.cosh(arg) * big_a
+                        else:
+                            phi = p_lo + dp * y * y * (wp.float64(3.0) - TWO64 * y)
+                            w = wk * wy * dp * wp.float64(6.0) * y * (ONE64 - y)
+                        h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
+                        gw = facet_weight(v, h, a, eta_f, in_u)
+                        for c in range(wp.static(nch)):
+                            acc[c] = acc[c] + w * wp.float64(gw[c])
+                    p_lo = p_hi
+            t_lo = t_hi
+        for c in range(wp.static(nch)):
+            out[i, c] = acc[c] / PI64
+        if a <= 0.0:  # the mirror limit (lutbake.edge)
+            store_row(out, i, mirror(v, eta_f))
+
+    return gauss_legendre_dielectric_kernel
+
+
+@functools.lru_cache(maxsize=None)
+def gl_dielectric_kernel(spec):
+    return make_gauss_legendre_dielectric(spec)
+
+
+@dataclass(frozen=True)
+class DielectricGaussLegendre(GaussLegendre):
+    """The ``gauss_legendre`` estimator of the dielectric kinds (lutbake.sampling.hemisphere.GaussLegendre with this
+    module's kernel): order n = gl_order(budget) per panel in both variables; the panel count varies per texel."""
+
+    def _kernel(self, integrand):
+        return gl_dielectric_kernel(integrand)

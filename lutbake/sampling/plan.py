@@ -1,0 +1,162 @@
+"""One texel plan for every kind: ``per_texel_plan(integrand, estimator, grid)``.
+
+A *texel plan* (``TexelPlan``) is everything the executor needs: the axes, the channel meanings, the texel count
+and ``run_tile(start, stop, device)``, a pure function of (spec, tile bounds) that returns the float64 values of
+texels [start, stop) in row-major order (slowest axis first), so tiles can be handed to any worker, thread or
+cluster, and the result is bit-identical however they are cut.
+
+The three parts it composes stay apart, as in ``warp.fem.integrate(integrand, domain, quadrature)``:
+- the **integrand** (lutbake.integrands): what is integrated per texel, a record holding its ``@wp.func``s;
+- the **estimator** (this package): how, an object with ``name``, ``prepare(integrand, device)``,
+  ``evaluate(integrand, inputs, device) -> (n, nch) float64``, ``samples(inputs)`` (evaluations per texel) and
+  ``refined() -> (estimator, how)``: the same estimator at a higher budget (or another scrambling), for the
+  error estimate;
+- the **grid** (``Grid``): the axes and the per-texel inputs (lutbake.axes gives the values).
+The error estimate re-evaluates one set of probe texels (``probe_indices``) with ``refined()``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..axes import Axis
+
+PROBE_STRIDED = 256  # strided probe texels of the error estimate
+PROBE_EXTREME = 64  # ... plus at most this many of the most grazing and of the smallest-alpha texels
+
+
+@dataclass
+class TexelPlan:
+    axes: list[Axis]  # slowest first; image dims z, y, x
+    channels: dict[str, str]
+    reconstruction: str
+    n_texels: int
+    n_channels: int
+    run_tile: Callable[[int, int, str], np.ndarray]
+    prepare: Callable[[str], None]  # compile kernels before threads launch them
+    samples: int  # integrand evaluations per texel (nominal)
+    estimator: str
+    terms: dict[str, str]
+    cost: float  # integrand evaluations in total, for the progress bar
+    extra: dict[str, str] = field(default_factory=dict)
+    # (flat float64 data (n_texels, n_channels), device) -> (estimated max error, how it was estimated)
+    error_estimate: Callable[[np.ndarray, str], tuple[float, str]] | None = None
+    # (data of plan.shape) -> extra lutbake:* attributes known only after the bake (ltc: fit-error statistics)
+    attributes_after: Callable[[np.ndarray], dict[str, str]] | None = None
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        """(z,) y, x, C; a 1D table (one x axis) is one image row: (1, x, C). A ``y_block`` axis is
+        flattened into the rows: y = y_block count x y count (row = block * y count + y index)."""
+        counts = tuple(a.count for a in self.axes if a.dim != "y_block")
+        blocks = [a.count for a in self.axes if a.dim == "y_block"]
+        if blocks:
+            dims = [a.dim for a in self.axes if a.dim != "y_block"]
+            counts = tuple(c * blocks[0] if d == "y" else c for c, d in zip(counts, dims))
+        if len(counts) == 1:
+            counts = (1,) + counts
+        return counts + (self.n_channels,)
+
+
+@dataclass(frozen=True)
+class Grid:
+    """The texels of a table: ``axes`` and the per-texel ``inputs`` of the integrand (name -> array, row-major,
+    slowest axis first). ``grazing`` and ``alpha`` (optional, per texel) pick the probe texels of the error
+    estimate. ``nodes``: a texel is ``scale`` times the weighted sum over len(nodes) sub-texels (input row
+    texel * len + k) with these weights (albedo_avg: E_avg = 2 ∫ E mu dmu, weights w_k mu_k, scale 2)."""
+
+    axes: list[Axis]
+    inputs: dict[str, np.ndarray]
+    grazing: np.ndarray | None = None
+    alpha: np.ndarray | None = None
+    nodes: np.ndarray | None = None
+    scale: float = 1.0
+
+    @property
+    def n_texels(self) -> int:
+        n = len(next(iter(self.inputs.values())))
+        return n // (1 if self.nodes is None else len(self.nodes))
+
+    def rows(self, idx) -> dict[str, Any]:
+        """The inputs of texels ``idx`` (a slice or an index array), every sub-texel included."""
+        if self.nodes is None:
+            return {k: v[idx] for k, v in self.inputs.items()}
+        k = len(self.nodes)
+        t = np.arange(self.n_texels)[idx]
+        sub = (t[:, None] * k + np.arange(k)[None, :]).reshape(-1)
+        return {name: v[sub] for name, v in self.inputs.items()}
+
+    def reduce(self, values: np.ndarray) -> np.ndarray:
+        if self.nodes is None:
+            return values
+        k = len(self.nodes)
+        return np.stack([self.scale * values[:, c].reshape(-1, k) @ self.nodes for c in range(values.shape[1])], 1)
+
+
+def probe_indices(grid: Grid) -> np.ndarray:
+    """The probe texels of every error estimate: PROBE_STRIDED strided texels, plus (at most PROBE_EXTREME each)
+    the most grazing ones (``grid.grazing`` at its minimum) and the smallest alphas at grazing view, where
+    every quadrature converges slowest."""
+    n = grid.n_texels
+    parts = [np.arange(0, n, max(1, n // PROBE_STRIDED))]
+    if grid.grazing is not None:
+        grazing = np.flatnonzero(grid.grazing <= grid.grazing.min())
+        parts.append(grazing[:: max(1, len(grazing) // PROBE_EXTREME)])
+        if grid.alpha is not None:
+            parts.append(np.lexsort((grid.alpha, grid.grazing))[:PROBE_EXTREME])
+    return np.unique(np.concatenate(parts))
+
+
+def per_texel_plan(
+    integrand,
+    estimator,
+    grid: Grid,
+    *,
+    channels: dict[str, str],
+    reconstruction: str,
+    terms: dict[str, str],
+    extra: dict[str, str] | None = None,
+    relative_error: bool = False,
+    error_estimate: bool = True,
+) -> TexelPlan:
+    """The texel plan of ``grid``'s texels integrated by ``estimator``: texel i = estimator.evaluate(integrand,
+    grid inputs of i) (reduced over ``grid.nodes``), the first ``integrand.nch`` channels kept.
+    ``relative_error``: the error estimate is max |a - b| / |b| over probe texels with |b| > 1e-6."""
+
+    def run(idx, est, device):
+        return grid.reduce(est.evaluate(integrand, grid.rows(idx), device))[:, : integrand.nch]
+
+    def estimate(data: np.ndarray, device: str) -> tuple[float, str]:
+        idx = probe_indices(grid)
+        refined, how = estimator.refined()
+        ref = run(idx, refined, device)
+        got = data.reshape(grid.n_texels, -1)[idx]
+        err = np.abs(got - ref)
+        where = f"over {len(idx)} probe texels (strided + most grazing + smallest alpha)"
+        if not relative_error:
+            return float(np.max(err)), f"max |{how}| {where}"
+        ok = np.abs(ref) > 1e-6
+        rel = float(np.max(err[ok] / np.abs(ref[ok]))) if ok.any() else 0.0
+        return rel, f"max relative |{how}| {where} with |f| > 1e-6; max abs {float(np.max(err)):.3e}"
+
+    samples = estimator.samples(grid.inputs)  # evaluations per input row
+    k = 1 if grid.nodes is None else len(grid.nodes)
+    return TexelPlan(
+        axes=grid.axes,
+        channels=channels,
+        reconstruction=reconstruction,
+        n_texels=grid.n_texels,
+        n_channels=integrand.nch,
+        run_tile=lambda s, e, d: run(slice(s, e), estimator, d),
+        prepare=lambda d: estimator.prepare(integrand, d),
+        samples=int(round(np.mean(samples) * k)),
+        estimator=estimator.name,
+        terms=terms,
+        cost=float(np.sum(samples)),
+        extra=dict(extra or {}),
+        error_estimate=estimate if error_estimate else None,
+    )

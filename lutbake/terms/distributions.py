@@ -1,0 +1,166 @@
+"""One object per normal distribution: its ``@wp.func`` terms side by side, so a sampler and its pdf cannot drift
+apart (after pbrt-v4's ``TrowbridgeReitzDistribution``, src/pbrt/util/scattering.h, and mitsuba3's
+``MicrofacetDistribution``: D, Lambda, G1, G2, pdf and sample in one place).
+
+``Distribution`` (host-side record, cached ``@wp.func`` factories):
+- ``D(h, alpha)``, ``Lambda(NoX, alpha)`` (None where no closed-form Smith Lambda exists), ``G2(masking)``;
+- ``tan2_from_u`` / ``u_from_tan2``: the inverse and forward CDF of the polar angle under D(m)(n.m);
+- ``pdf_ndf`` / ``sample_ndf``: density D(h)(n.h) and its sampler (inverse CDF, phi = 2 pi u2);
+- ``pdf_vndf`` / ``sample_vndf``: the visible-normal density G1(v) max(0, v.h) D(h) / (n.v) and its sampler
+  (GGX only).
+Edge policy (lutbake.edge): alpha >= ALPHA_MIN here; the alpha -> 0 mirror limit is taken by the integrands that
+have it (lutbake.integrands.specular), not by a quadrature.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import warp as wp
+
+from ..edge import COS_EPS
+from . import masking, ndf
+
+MASKINGS = {
+    "smith_height_correlated": "Smith G2 = 1/(1 + Lambda(v) + Lambda(l)), height-correlated (Heitz 2014, Eq. 99)",
+    "smith_separable": "Smith G2 = G1(v) G1(l), separable (Heitz 2014, Eq. 98)",
+    "v_cavity": "Cook-Torrance V-cavity min(1, 2 NoH NoV / VoH, 2 NoH NoL / VoH) (lecture 003)",
+    "smith_joint_approx": "UE4's Vis_SmithJointApprox as G2 = 2 NoL NoV / (NoL (NoV (1-a) + a) + NoV (NoL (1-a) + a)), "
+    "a = alpha (an approximation of height-correlated Smith GGX; NDF-independent)",
+}
+
+
+@dataclass(frozen=True)
+class Distribution:
+    name: str
+    description: str
+    D: object
+    Lambda: object | None
+    tan2_from_u: object
+    u_from_tan2: object
+    sample_vndf: object | None = None  # visible-normal sampler, where one exists
+
+    def masking_allowed(self, masking_name: str) -> bool:
+        """Smith masking needs this NDF's Lambda; V-cavity goes with any NDF."""
+        return masking_name == "v_cavity" or self.Lambda is not None
+
+    def G2(self, masking_name: str):
+        return _G2(self, masking_name)
+
+    @property
+    def pdf_ndf(self):
+        return _pdf_ndf(self)
+
+    @property
+    def sample_ndf(self):
+        return _sample_ndf(self)
+
+    @property
+    def pdf_vndf(self):
+        return _pdf_vndf(self)
+
+
+@functools.lru_cache(maxsize=None)
+def _G2(d: Distribution, masking_name: str):
+    """The composed masking-shadowing ``G2(NoV, NoL, NoH, VoH, alpha)`` of ``d`` and a masking form."""
+    Lam = d.Lambda
+    if masking_name == "smith_height_correlated":
+
+        @wp.func
+        def G2(NoV: float, NoL: float, NoH: float, VoH: float, alpha: float):
+            return masking.G2_smith_height_correlated(Lam(NoV, alpha), Lam(NoL, alpha))
+    elif masking_name == "smith_separable":
+
+        @wp.func
+        def G2(NoV: float, NoL: float, NoH: float, VoH: float, alpha: float):
+            return masking.G2_smith_separable(Lam(NoV, alpha), Lam(NoL, alpha))
+    elif masking_name == "v_cavity":
+
+        @wp.func
+        def G2(NoV: float, NoL: float, NoH: float, VoH: float, alpha: float):
+            return masking.G2_v_cavity(NoH, NoV, NoL, VoH, VoH)
+    elif masking_name == "smith_joint_approx":
+
+        @wp.func
+        def G2(NoV: float, NoL: float, NoH: float, VoH: float, alpha: float):
+            return masking.G2_smith_joint_approx(NoV, NoL, alpha)
+    else:
+        raise KeyError(masking_name)
+    return G2
+
+
+@functools.lru_cache(maxsize=None)
+def _pdf_ndf(d: Distribution):
+    """Density of h under NDF sampling: p(h) = D(h) (n.h)."""
+    D = d.D
+
+    @wp.func
+    def pdf_ndf(v: wp.vec3, h: wp.vec3, alpha: float):
+        return D(h, alpha) * h[2]
+
+    return pdf_ndf
+
+
+@functools.lru_cache(maxsize=None)
+def _sample_ndf(d: Distribution):
+    """h from the NDF's inverse CDF: tan^2 theta = CDF^-1(u1) (float64), phi = 2 pi u2; density ``pdf_ndf``."""
+    t2u = d.tan2_from_u
+
+    @wp.func
+    def sample_ndf(v: wp.vec3, alpha: float, u1: float, u2: float):
+        tan2 = t2u(wp.float64(u1), wp.float64(alpha))
+        c = wp.float64(1.0) / wp.sqrt(wp.float64(1.0) + tan2)
+        s = float(wp.sqrt(tan2) * c)
+        phi = 2.0 * wp.pi * u2
+        return wp.vec3(s * wp.cos(phi), s * wp.sin(phi), float(c))
+
+    return sample_ndf
+
+
+@functools.lru_cache(maxsize=None)
+def _pdf_vndf(d: Distribution):
+    """Density of h under visible-normal sampling (``sample_vndf``): p(h) = G1(v) max(0, v.h) D(h) / (n.v)."""
+    D, Lam = d.D, d.Lambda
+
+    @wp.func
+    def pdf_vndf(v: wp.vec3, h: wp.vec3, alpha: float):
+        VoH = wp.dot(v, h)
+        if VoH <= COS_EPS or v[2] <= COS_EPS:
+            return 0.0
+        return masking.G1_smith(Lam(v[2], alpha)) * VoH * D(h, alpha) / v[2]
+
+    return pdf_vndf
+
+
+GGX = Distribution(
+    "ggx",
+    "GGX / Trowbridge-Reitz (Walter et al. 2007)",
+    ndf.D_ggx,
+    masking.Lambda_ggx,
+    ndf.tan2_from_u_ggx,
+    ndf.u_from_tan2_ggx,
+    ndf.sample_vndf_ggx,
+)
+BECKMANN = Distribution(
+    "beckmann",
+    "Beckmann, normalised with 1/pi (Walter et al. 2007, Eq. 25)",
+    ndf.D_beckmann,
+    masking.Lambda_beckmann,
+    ndf.tan2_from_u_beckmann,
+    ndf.u_from_tan2_beckmann,
+)
+# Blinn-Phong has no closed-form Smith Lambda. Walter et al. 2007 (Sec. 5.2) suggest Beckmann's at the same
+# alpha, but that is only close for small alpha: at alpha = 1 (s = 0, D = 1/pi) it gave E(F = 1) = 1.77 at
+# grazing view. So Blinn-Phong pairs with the V-cavity G only (Lambda = None; kinds.dfg checks it).
+BLINN_PHONG = Distribution(
+    "blinn_phong",
+    "normalized Blinn-Phong (s + 2)/(2 pi) (n.h)^s, s = 2/alpha^2 - 2 "
+    "(masking = v_cavity only: no closed-form Smith Lambda)",
+    ndf.D_blinn_phong,
+    None,
+    ndf.tan2_from_u_blinn_phong,
+    ndf.u_from_tan2_blinn_phong,
+)
+NDFS = {d.name: d for d in (GGX, BECKMANN, BLINN_PHONG)}
+SMITH_NDFS = tuple(n for n, d in NDFS.items() if d.Lambda is not None)

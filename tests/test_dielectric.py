@@ -1,0 +1,295 @@
+"""The rough dielectric BSDF (Walter et al. 2007) and its energy tables (kinds dielectric / dielectric_avg):
+terms against numpy, tables against the independent integral over the outgoing sphere (tests/dielectric_reference.py),
+the analytic limits, reciprocity, the second estimator, and the engine layouts' grids."""
+
+import dielectric_reference as ref
+import numpy as np
+import pytest
+
+from lutbake.config import validate_table
+from lutbake.edge import ALPHA_MIN, NOV_MIN
+from lutbake.kinds import dielectric as kd
+from lutbake.kinds import lookup_kind
+from lutbake.validate import dielectric as vd
+
+REFERENCE_ATOL = 1.0e-6  # |table - numpy reference| per channel, every texel below
+QMC_ATOL = 5.0e-5  # |GL - sobol_vndf 2^16|
+SMOOTH_ATOL = vd.SMOOTH_LIMIT_TOL
+TERM_RTOL = 2.0e-5  # Warp float32 f_r / f_t vs numpy float64, well-conditioned pairs
+
+# (NoV, alpha, eta): random texels and edges (grazing, TIR-dominated, at the critical angle, high roughness,
+# small alpha)
+RANDOM = [
+    tuple(x)
+    for x in np.column_stack(
+        [
+            np.random.default_rng(15).uniform(0.1, 1.0, 2),
+            np.random.default_rng(16).uniform(0.05, 0.8, 2),
+            np.random.default_rng(17).uniform(0.5, 2.2, 2),
+        ]
+    )
+]
+EDGES = [
+    (0.02, 0.2, 0.67),
+    (float(np.sqrt(1 - 0.75**2)), 0.1, 0.75),
+    (0.05, 1.0, 1.5),
+    (0.9, 0.03, 1.33),
+    (0.999, 0.5, 2.5),
+]
+
+
+def spec(**kw):
+    return validate_table({"name": "t", **kw}, "<test>", 0)
+
+
+def f32(*xs):
+    return (np.asarray(x, np.float32) for x in xs)
+
+
+@pytest.mark.parametrize("texel", RANDOM + EDGES)
+def test_energies_match_numpy_integral_over_the_outgoing_sphere(texel):
+    nov, alpha, eta = f32(*texel)
+    e = kd.integrate(
+        ("ggx", "smith_separable", "exact", "gauss_legendre"),
+        *(np.atleast_1d(x) for x in (nov, alpha, eta)),
+        kd.DEFAULT_SAMPLES["gauss_legendre"],
+        0,
+    )[0]
+    er, et = ref.energies(float(nov), float(alpha), float(eta))
+    np.testing.assert_allclose(e, [er, et, er + et], rtol=0, atol=REFERENCE_ATOL)
+
+
+@pytest.mark.parametrize(
+    "ndf,masking,texel",
+    [("ggx", "smith_height_correlated", (0.4, 0.3, 0.8)), ("beckmann", "smith_separable", (0.6, 0.2, 1.5))],
+)
+def test_other_terms_match_numpy_integral(ndf, masking, texel):
+    nov, alpha, eta = (np.atleast_1d(x) for x in f32(*texel))
+    e = kd.integrate(
+        (ndf, masking, "exact", "gauss_legendre"), nov, alpha, eta, kd.DEFAULT_SAMPLES["gauss_legendre"], 0
+    )[0]
+    er, et = ref.energies(float(nov[0]), float(alpha[0]), float(eta[0]), ndf, masking)
+    np.testing.assert_allclose(e[:2], [er, et], rtol=0, atol=REFERENCE_ATOL)
+
+
+@pytest.mark.parametrize("texel", [(0.5, 0.3, 1.5), (0.3, 0.2, 0.75)])
+def test_eevee_channels_match_numpy_integral(texel):
+    """EEVEE's Schlick split-sum channels (scale, bias, transmission factor) against the reference's own weights."""
+    nov, alpha, eta = (np.atleast_1d(x) for x in f32(*texel))
+    e = kd.integrate(
+        ("ggx", "smith_separable", "eevee", "gauss_legendre"), nov, alpha, eta, kd.DEFAULT_SAMPLES["gauss_legendre"], 0
+    )[0]
+    np.testing.assert_allclose(
+        e, ref.energies(float(nov[0]), float(alpha[0]), float(eta[0]), fresnel="eevee"), rtol=0, atol=REFERENCE_ATOL
+    )
+
+
+def test_bsdf_terms_match_numpy():
+    """f_r and f_t of the Warp terms (validate.dielectric.evaluate_bsdf) against the reference's numpy BSDF."""
+    rng = np.random.default_rng(3)
+    n = 512
+    i, o = vd.random_directions(rng, n), vd.random_directions(rng, n, upper=bool(0))
+    o[: n // 2] *= np.array([1.0, 1.0, -1.0])  # half reflection pairs
+    alpha, eta = rng.uniform(0.05, 1.0, n), rng.choice(np.array(vd.ETAS), n)
+    got = vd.evaluate_bsdf(i, o, alpha, eta)
+    want = np.array([sum(ref.bsdf(i[k], o[k], alpha[k], eta[k])) for k in range(n)])
+    ok = vd._well_conditioned(i, o, eta) & (want > 1e-6 * want.max())
+    np.testing.assert_allclose(got[ok], want[ok], rtol=TERM_RTOL, atol=0)
+    assert ok.sum() > n // 2
+
+
+def test_smooth_limit_is_fresnel_including_total_internal_reflection():
+    worst, where = vd.smooth_limit()
+    assert worst <= SMOOTH_ATOL, where
+    # the TIR branch explicitly: inside glass (eta = 1/1.5), views past the critical angle reflect everything
+    mu = np.array([0.1, 0.3, 0.6], np.float32)  # cos theta_c = 0.745
+    e = kd.integrate(
+        ("ggx", "smith_separable", "exact", "gauss_legendre"),
+        mu,
+        *f32([ALPHA_MIN] * 3, [1 / 1.5] * 3),
+        kd.DEFAULT_SAMPLES["gauss_legendre"],
+        0,
+    )
+    np.testing.assert_allclose(e[:, :2], np.tile([1.0, 0.0], (3, 1)), rtol=0, atol=SMOOTH_ATOL)
+    # alpha = 0 (lutbake.edge): the closed-form mirror limit, both estimators, exactly F and 1 - F
+    mu = np.array([0.1, 0.5, 0.9, 0.5], np.float32)
+    eta = np.array([1.5, 1.5, 1 / 1.5, 1 / 1.5], np.float32)
+    F = vd.fresnel_np(eta, mu)
+    for est in ("gauss_legendre", "sobol_vndf"):
+        e = kd.integrate(("ggx", "smith_separable", "exact", est), mu, np.zeros(4, np.float32), eta)
+        want_t = np.where(mu < np.sqrt(np.maximum(1 - eta**2.0, 0.0)), 0.0, 1 - F)
+        np.testing.assert_allclose(e, np.stack([F, want_t, F + want_t], 1), rtol=0, atol=1e-6, err_msg=est)
+
+
+def test_index_matched_interface_has_no_reflection_and_the_smith_transmittance():
+    """eta = 1: E_R = 0, E_T = G2(mu, mu)/G1(mu) (-> 1 as alpha -> 0), continuous from both sides. Below 1 the TIR
+    cone v.h < sqrt(1 - eta^2) opens like sqrt(1 - eta): E(1 - 1e-3) is 8e-3 off at mu = 0.2, E(1 - 1e-6)
+    within 4e-4."""
+    r = vd.dielectric_index_matched()
+    assert r.passed, str(r)
+    mu, alpha = f32([0.2, 0.5, 0.9], [0.3, 0.3, 0.3])
+    at = {}
+    for eta in (1.0 - 1e-6, 1.0, 1.0 + 1e-6):
+        at[eta] = kd.integrate(
+            ("ggx", "smith_separable", "exact", "gauss_legendre"),
+            mu,
+            alpha,
+            *f32([eta] * 3),
+            kd.DEFAULT_SAMPLES["gauss_legendre"],
+            0,
+        )
+    np.testing.assert_allclose(at[1.0 - 1e-6][:, 2], at[1.0][:, 2], atol=1e-3)
+    np.testing.assert_allclose(at[1.0 + 1e-6][:, 2], at[1.0][:, 2], atol=1e-3)
+    smooth = kd.integrate(
+        ("ggx", "smith_separable", "exact", "gauss_legendre"),
+        mu,
+        *f32([ALPHA_MIN] * 3, [1.0] * 3),
+        kd.DEFAULT_SAMPLES["gauss_legendre"],
+        0,
+    )
+    np.testing.assert_allclose(smooth[:, 1], 1.0, atol=1e-6)
+
+
+def test_reciprocity_of_f_r_and_generalised_reciprocity_of_f_t():
+    for m in ("smith_separable", "smith_height_correlated"):
+        r, t, _ = vd.reciprocity_errors(m)
+        assert r <= vd.RECIPROCITY_RTOL and t <= vd.RECIPROCITY_RTOL, (m, r, t)
+
+
+def test_energy_is_at_most_one_and_loss_is_largest_at_high_roughness_and_grazing():
+    """E_R + E_T <= 1; for every eta the largest loss is at alpha = 1, and at the most grazing views for eta >= 0.67.
+    Measured exception: inside a dense medium (eta = 0.5) grazing views are totally reflected with little loss, and the
+    largest loss is at normal view (0.676 at mu = 1, alpha = 1). The loss is not monotone in alpha everywhere (at
+    mu = 0.05, eta = 2.5 it dips by 0.006 from alpha = 0.05 to 0.2)."""
+    M, A, E = vd.energy_grid()
+    e = vd._integrate(M, A, E)
+    s = e[:, 0] + e[:, 1]
+    assert s.max() <= 1.0 + vd.ENERGY_TOL
+    mus, alphas = np.unique(M), np.unique(A)
+    loss = (1.0 - s).reshape(len(mus), len(alphas), len(vd.ETAS))
+    for k, eta in enumerate(vd.ETAS):
+        i, j = np.unravel_index(np.argmax(loss[:, :, k]), loss.shape[:2])
+        assert alphas[j] == alphas.max(), eta
+        assert mus[i] <= 0.05 or eta < 0.67, eta
+
+
+def test_estimators_agree():
+    r = vd.dielectric_estimators_agree()
+    assert r.measured <= QMC_ATOL, str(r)
+
+
+def test_eevee_grids_follow_the_generator():
+    """eevee_lut_comp.glsl main(): coordinate = gid / (extent - 1); btdf x: f0 = clamp(x^2), ior = (1 + f0)/(1 - f0);
+    bsdf x: ior = clamp(sqrt(x)); y centred on the critical angle; z = roughness, alpha = z^2."""
+    axes, nov, alpha, eta, _ = kd.texel_grid(spec(kind="dielectric", layout="eevee_btdf").options)
+    assert [a.count for a in axes] == [16, 64, 64]
+    x = np.arange(64) / 63
+    np.testing.assert_allclose(eta[:64], (1 + np.clip(x * x, 1e-4, 0.9999)) / (1 - np.clip(x * x, 1e-4, 0.9999)))
+    np.testing.assert_allclose(np.sqrt((eta[1:63] - 1) / (eta[1:63] + 1)), x[1:63], rtol=1e-12)
+    np.testing.assert_allclose(nov[::64][:64], np.clip(1 - x * x, 1e-4, 0.9999))
+    np.testing.assert_allclose(alpha[:: 64 * 64], (np.arange(16) / 15) ** 2, rtol=1e-6)  # 0: the mirror limit
+    axes, nov, alpha, eta, _ = kd.texel_grid(spec(kind="dielectric", layout="eevee_bsdf").options)
+    eta2, nov2 = eta[: 64 * 64].reshape(64, 64), nov[: 64 * 64].reshape(64, 64)
+    np.testing.assert_allclose(eta2[0], np.clip(np.sqrt(x), 1e-4, 0.9999))
+    c = np.sqrt(1 - eta2**2)
+    y = ((nov2 - c) / np.where(nov2 > c, 1 - c, c)) * 0.5 + 0.5  # EEVEE's lookup (bsdf_lut) inverts the generator
+    inside = (nov2 > 1e-4) & (nov2 < 0.9999)
+    np.testing.assert_allclose(y[inside], np.broadcast_to(x[:, None], (64, 64))[inside], atol=1e-12)
+
+
+def test_openpbr_grid_and_layout():
+    axes, nov, alpha, eta, _ = kd.texel_grid(spec(kind="dielectric", layout="openpbr").options)
+    assert [a.name for a in axes] == ["ior", "perceptual_roughness", "NoV"] and [a.count for a in axes] == [32] * 3
+    e = eta[:: 32 * 32]
+    i = np.arange(32)
+    # openpbr_ior_to_exact_index inverted
+    idx = np.where(e < 1, 15 - 15 * (1 / e - 1) / 1.5, 16 + 15 * (e - 1) / 1.5)
+    np.testing.assert_allclose(idx[:15], i[:15], atol=1e-9)
+    np.testing.assert_allclose(idx[16:], i[16:], atol=1e-9)
+    assert e[15] == e[16] == 1.0
+    np.testing.assert_allclose(np.sqrt(alpha[: 32 * 32 : 32]), i / 31, rtol=1e-6)
+    np.testing.assert_allclose(nov[:32], np.maximum(i / 31, NOV_MIN), rtol=1e-6)
+
+
+OPENPBR_ATOL = 3.0e-3  # its Monte Carlo noise (measured max 2.1e-3 over cos > 0, eta != 1) + UNORM16
+
+
+def test_openpbr_tables_match_shipped_arrays_within_their_monte_carlo_noise():
+    """A strided subset of the 32^3 tables against adobe/openpbr-bsdf's arrays (tests/data, UNORM16 / 65535)."""
+    shipped = np.load("tests/data/openpbr_energy_tables.npz")
+    plan = lookup_kind("dielectric").plan(spec(kind="dielectric", layout="openpbr"))
+    rows = [(z, y) for z in (2, 9, 20, 28) for y in (3, 12, 24, 31)]
+    for z, y in rows:
+        start = (z * 32 + y) * 32
+        got = plan.run_tile(start + 1, start + 32, "cpu")  # cos > 0 (cos = 0 is clamped to NOV_MIN here)
+        for c, name in enumerate(["ideal_dielectric_energy_complement", "opaque_dielectric_energy_complement"]):
+            np.testing.assert_allclose(got[:, c], shipped[name][z, y, 1:] / 65535.0, rtol=0, atol=OPENPBR_ATOL)
+        np.testing.assert_allclose(
+            got[:, 2], shipped["ideal_metal_energy_complement"][y, 1:] / 65535.0, rtol=0, atol=OPENPBR_ATOL
+        )
+
+
+def test_bake_energy_kind_and_average_consistency():
+    from lutbake.api import bake_table
+
+    t, _, _ = bake_table(spec(kind="dielectric", size=[6, 4], ior_size=3, ior_range=[0.7, 1.6]))
+    assert t.data.shape == (3, 4, 6, 3) and list(t.channels) == ["e_r", "e_t", "e_sum"]
+    np.testing.assert_allclose(t.data[..., 2], t.data[..., 0] + t.data[..., 1], atol=1e-6)
+    a, _, _ = bake_table(
+        spec(kind="dielectric_avg", roughness_size=4, ior_size=3, ior_range=[0.7, 1.6], mu_order=12),
+    )
+    assert a.data.shape == (3, 4, 3) and np.all(np.isfinite(a.data))
+    # E_avg of a smooth interface is the Fresnel average: 1 - F_avg transmitted, outside and inside (TIR) alike
+    s, _, _ = bake_table(
+        spec(
+            kind="dielectric_avg",
+            roughness="alpha",
+            roughness_size=1,
+            roughness_range=[0, 0],
+            ior_size=2,
+            ior_range=[1 / 1.5, 1.5],
+            texel="endpoint",
+        )
+    )
+    mu, w = np.polynomial.legendre.leggauss(400)
+    for k, eta in enumerate([1 / 1.5, 1.5]):
+        edges = np.unique([0, 0.2, np.sqrt(max(1 - eta * eta, 0)), 1])
+        f_avg = sum(
+            np.sum((b - a_) / 2 * w * 2 * m * vd.fresnel_np(eta, m))
+            for a_, b in zip(edges[:-1], edges[1:])
+            for m in [a_ + (b - a_) * (mu + 1) / 2]
+        )
+        np.testing.assert_allclose(s.data[k, 0, :2], [f_avg, 1 - f_avg], atol=5e-5)
+
+
+def test_bad_configs_name_the_key():
+    with pytest.raises(Exception, match="ior_mapping"):
+        spec(kind="dielectric", ior_mapping="symmetric", ior_size=5, ior_range=[0.5, 2.0])
+    with pytest.raises(Exception, match="layout"):
+        spec(kind="dielectric", layout="openpbr", masking="smith_height_correlated")
+    with pytest.raises(Exception, match="masking"):
+        spec(kind="dielectric", masking="v_cavity")
+
+
+def test_openpbr_header_writes_its_arrays_as_unorm16(tmp_path):
+    import re
+
+    from lutbake.io.formats import write_table
+    from lutbake.table import Table
+
+    rng = np.random.default_rng(5)
+    channels = kd.CHANNELS["openpbr"]
+    data = rng.uniform(0, 1, (32, 32, 32, 3)).astype(np.float32)
+    path = write_table(Table("opbr", "dielectric", data, [], channels, ""), tmp_path, "openpbr_h")
+    text = path.read_text()
+    for name, want in [
+        ("IdealDielectricEnergyComplement", data[..., 0]),
+        ("OpaqueDielectricEnergyComplement", data[..., 1]),
+        ("IdealMetalEnergyComplement", data[16, ..., 2]),
+    ]:
+        body = re.search(rf"OpenPBR_{name}_Array\[(\d+)\] = {{[^\n]*\n(.*?)}};", text, re.S)
+        codes = np.array([int(x) for x in re.findall(r"\d+", body.group(2))])
+        assert int(body.group(1)) == want.size == codes.size
+        np.testing.assert_array_equal(codes, np.rint(want.ravel().astype(np.float64) * 65535))
+    with pytest.raises(Exception, match="format"):
+        spec(kind="dielectric", format="openpbr_h")
