@@ -168,7 +168,7 @@ def sphere(E, roughness_value: float, perceptual: float, size: int = 128) -> np.
 
 def _ticks(ax, axis: Axis | None, n: int, which: str, label: bool = True) -> None:
     idx = np.unique(np.linspace(0, n - 1, min(n, 4)).round().astype(int))
-    vals = axis.values() if axis is not None else idx
+    vals = axis.values() if axis is not None else np.arange(n)
     setter = ax.set_xticks if which == "x" else ax.set_yticks
     setter(idx, [f"{vals[i]:.3g}" for i in idx], fontsize=7)
     if label:

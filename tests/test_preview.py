@@ -156,3 +156,15 @@ def test_titles_are_words_not_json(tmp_path):
     assert "ndf ggx" in title and "masking smith_height_correlated" in title and "samples 432 per texel" in title
     assert any(t.startswith("R = scale\nmultiplies f0") for t in titles(fig)), titles(fig)
     plt.close(fig)
+
+
+def test_a_table_without_lutbake_metadata_is_drawn_by_index(tmp_path):
+    from test_formats import table2d
+
+    from lutbake.io.integrity import sidecar_path
+
+    p = write_table(table2d(4, h=8, w=6), tmp_path, "dds")
+    sidecar_path(p).unlink()
+    fig = figure(p)
+    assert "no lutbake metadata" in fig.get_suptitle() and fig.axes[0].get_xlabel() == "x index"
+    plt.close(fig)

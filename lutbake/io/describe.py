@@ -34,6 +34,8 @@ def _container(loaded: LoadedFile) -> str:
         return f"dtype {f['dtype']}, shape {tuple(f['shape'])}"
     if loaded.format == "h":
         return f"array {f['array']} of {f['element_type']}"
+    if loaded.format == "engine":
+        return f"{f.get('format')}"
     if "data_file" in f:
         return f"describes {f['data_file']} ({f['data_format']})"
     if loaded.format == "report":

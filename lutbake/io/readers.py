@@ -41,7 +41,9 @@ MAX_FILE_BYTES = 4 << 30  # a table is at most 2^24 texels x 4 channels x 4 byte
 EXR_MAGIC = b"\x76\x2f\x31\x01"
 NPY_MAGIC = b"\x93NUMPY"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+GENERIC_FORMATS = ("exr", "npy", "png16", "dds", "ktx2", "h")  # sidecar "format"s whose pixels lutbake reads
 FORMAT_NAMES = {
+    "engine": "engine-specific file",
     "exr": "OpenEXR",
     "npy": "NumPy .npy",
     "png": "PNG",
@@ -126,6 +128,36 @@ def read(path) -> LoadedFile:
     size = path.stat().st_size
     if size > MAX_FILE_BYTES:
         raise ReadError(f"{path}: {size} bytes is larger than any table lutbake writes ({MAX_FILE_BYTES} bytes)")
+    try:
+        loaded = READERS[fmt](path)
+    except (ValueError, KeyError, TypeError, IndexError, OverflowError, UnicodeDecodeError, EOFError):
+        engine = _engine_sidecar(path)
+        if engine is None:
+            return _read_or_raise(path, fmt)
+        return engine
+    if loaded.facts.get("sidecar_format", "exr") not in GENERIC_FORMATS:
+        return _engine_sidecar(path) or loaded
+    return loaded
+
+
+def _engine_sidecar(path: Path) -> LoadedFile | None:
+    """A file in an engine's own layout (``format`` = ltc_dds, openpbr_h, a .cs/.js/.cc module ...): its
+    sidecar's metadata without pixels, or None when no sidecar names the file with such a format."""
+    for side in sidecar_candidates(path):
+        if side.is_file() and side != path:
+            doc = _load_json(side)
+            if isinstance(doc, dict) and doc.get("file") == path.name and doc.get("format") not in GENERIC_FORMATS:
+                doc = _load_sidecar(side, doc)
+                note = (
+                    f"engine-specific format {doc.get('format')!r}: lutbake reads its metadata (sidecar "
+                    f"{side.name}), not its pixels; bake the table as exr to look at them"
+                )
+                facts = {k: v for k, v in doc.items() if k != "lutbake"}
+                return LoadedFile(path, "engine", None, doc["lutbake"], f"sidecar {side.name}", facts, [note])
+    return None
+
+
+def _read_or_raise(path: Path, fmt: str) -> LoadedFile:
     try:
         return READERS[fmt](path)
     except (LutbakeError, MemoryError):
@@ -348,6 +380,7 @@ def _with_sidecar(loaded: LoadedFile) -> LoadedFile:
             loaded.notes.append(f"{side.name} describes {named}, not this file")
             continue
         loaded.attrs, loaded.meta_source = doc["lutbake"], f"sidecar {side.name}"
+        loaded.facts["sidecar_format"] = doc.get("format", "")
         return loaded
     if not loaded.notes:
         loaded.notes.append(f"no sidecar ({' or '.join(p.name for p in sidecar_candidates(loaded.path))})")
@@ -363,7 +396,8 @@ def read_sidecar(path: Path) -> LoadedFile:
     doc = _load_sidecar(path, doc)
     named = doc.get("file")
     facts = {k: v for k, v in doc.items() if k != "lutbake"}
-    if isinstance(named, str) and named and Path(named).name == named and (path.parent / named).is_file():
+    generic = doc.get("format", "exr") in GENERIC_FORMATS
+    if generic and isinstance(named, str) and named and Path(named).name == named and (path.parent / named).is_file():
         data_path = path.parent / named
         if sniff(data_path) == "sidecar":
             raise ReadError(f"{path}: names another sidecar ({named}) as its data file")
@@ -371,6 +405,8 @@ def read_sidecar(path: Path) -> LoadedFile:
         facts = {**facts, "data_file": named, "data_format": FORMAT_NAMES[inner.format], **inner.facts}
         return LoadedFile(path, "sidecar", inner.data, doc["lutbake"], f"sidecar {path.name}", facts)
     note = f"its data file {named!r} is not beside it" if named else "it names no data file"
+    if not generic:
+        note = f"it describes {named!r} in the engine-specific format {doc.get('format')!r} (metadata only)"
     return LoadedFile(path, "sidecar", None, doc["lutbake"], f"sidecar {path.name}", facts, [note])
 
 
