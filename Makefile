@@ -11,15 +11,13 @@ CONFIGS := $(wildcard configs/*.toml)
 PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-eevee unreal blender-eevee-btdf blender-eevee-bsdf \
            openpbr turquin ltc-ggx ltc-threejs ltc-eevee ltc-hdrp \
            unity-hdrp godot bevy threejs
-SOURCES := $(shell find lutbake -name '*.py' -o -name '*.toml' 2>/dev/null)
 WORKERS ?=
 FORCE   ?=
-LUTS_STAMP := $(OUT)/.luts.stamp
 
-.PHONY: lint luts test validate bench clean venv help force-luts figures bench-diffuse bench-ltc bench-cluster
+.PHONY: lint luts test validate bench clean venv help figures bench-diffuse bench-ltc bench-cluster
 
 help:
-	@echo "make luts | test | validate | clean"
+	@echo "make luts | test | validate | figures | bench | clean"
 
 venv: $(STAMP)
 
@@ -29,20 +27,18 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install -q -e '.[test,plot]'
 	touch $(STAMP)
 
-# `make luts` re-runs lutbake only when a config, a lutbake source or this Makefile changed; lutbake then
-# rebakes only the tables whose content hash changed (the others print "skipped ... (up to date)").
+# `make luts` always asks lutbake, which rebakes exactly the tables whose output is missing or whose content
+# hash (config, lutbake version, kernel sources) differs from the file's -- also a table another command
+# overwrote with other settings -- and prints "skipped ... (up to date)" for the others (about a second).
 # `make luts FORCE=1` rebakes every table.
-luts: $(LUTS_STAMP)
-
-$(LUTS_STAMP): $(STAMP) $(CONFIGS) $(SOURCES) Makefile $(if $(FORCE),force-luts)
+luts: $(STAMP)
 	$(BIN)/lutbake bake $(CONFIGS) $(foreach p,$(PRESETS),--preset $(p)) --out-dir $(OUT) --report $(OUT)/report.json \
 		$(if $(WORKERS),--workers $(WORKERS)) $(if $(FORCE),--force)
-	touch $@
 
-force-luts:
-
+# every figure lutbake draws, under $(OUT)/figures (the PNGs tracked in docs/figures are not rewritten)
 figures: $(STAMP)
 	$(BIN)/lutbake plot --out-dir $(OUT)/figures
+	$(BIN)/python docs/plot_fresnel.py $(OUT)/figures
 
 lint: $(STAMP)
 	$(BIN)/ruff check lutbake tests benchmarks

@@ -1,6 +1,8 @@
 """Reproduce the seed's Fresnel figures (Gotanda 2014 course notes, Figs. 1-3) from lutbake's @wp.func terms.
 
-    python docs/plot_fresnel.py [out_dir]      (default docs/figures)
+    make figures                                  (writes outputs/figures/fig*.png with the venv's Python)
+    .venv/bin/python docs/plot_fresnel.py [out_dir]   (default outputs/figures; the PNGs in docs/figures, which
+                                                       the docs show, are never rewritten by default)
 Fig. 1: Schlick vs exact Fresnel for aluminium at 610 nm (1.3 + 7.48i) and for eta = 1.5.
 Fig. 2: Eq. 2 with the real f0 of 1.3 + 7.48i vs the complex-index Fresnel (plus Lazanyi-Schlick).
 Fig. 3: improved spherical Gaussian (Eq. 3) vs Schlick vs exact Fresnel at eta = 1.5.
@@ -17,6 +19,7 @@ import numpy as np  # noqa: E402
 from lutbake.integrands.fresnel import evaluate  # noqa: E402
 from lutbake.terms.metals import fit_lazanyi_a  # noqa: E402
 
+DEFAULT_OUT = Path(__file__).resolve().parents[1] / "outputs" / "figures"  # never docs/figures (tracked)
 AL = (1.3, 7.48)
 ETA = 1.5
 
@@ -53,4 +56,4 @@ def main(out: Path) -> None:
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).parent / "figures")
+    main(Path(sys.argv[1]) if len(sys.argv) > 1 else DEFAULT_OUT)

@@ -32,6 +32,27 @@ class BakeResult:
     status: str = "baked"
 
 
+def samples_note(spec: TableSpec, effective: int | None) -> str:
+    """Why a table integrates ``effective`` samples per texel when its config asked for another number
+    ('' when they agree or none was asked): each quadrature rounds the budget to its own grid."""
+    asked = spec.options.get("samples")
+    if not asked or effective is None or asked == effective:
+        return ""
+    estimator = spec.options.get("estimator", "")
+    if estimator == "gauss_legendre":
+        from .sampling.hemisphere import gl_order
+
+        n = gl_order(asked)
+        if 3 * n * n == effective:
+            return (
+                f"samples = {asked} asked; gauss_legendre integrates 3 regions x n x n points with "
+                f"n = round(sqrt({asked} / 3)) = {n}: 3 x {n}^2 = {effective}"
+            )
+    if estimator.startswith("sobol") and effective == 1 << (asked - 1).bit_length():
+        return f"samples = {asked} asked; Sobol' points come in powers of two: {effective}"
+    return f"samples = {asked} asked; the {spec.kind} quadrature evaluates {effective} per texel (docs/config.md)"
+
+
 def bake(
     configs,
     out_dir="outputs",

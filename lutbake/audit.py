@@ -35,7 +35,7 @@ import numpy as np
 
 from .axes import Axis
 from .edge import NOV_MIN
-from .io.readers import LutFile, read_lut
+from .io.lut_files import LutFile, read_lut
 from .tolerance import Tolerance
 
 MAX_SIDE = 128  # default subset: at most this many rows and columns are re-integrated

@@ -13,15 +13,6 @@ from .io.formats import FORMATS
 EXIT_CONFIG = 2
 
 
-def _quiet_warp():
-    """Warp >= 1.10 logs its banner and module loads at INFO; keep the CLI's output to its own lines."""
-    import logging
-
-    import warp as wp
-
-    wp.config.log_level = logging.WARNING
-
-
 def out_dir_option(default: str, what: str):
     """The shared ``--out-dir`` option of the commands that write files."""
     return click.option(
@@ -35,19 +26,31 @@ def out_dir_option(default: str, what: str):
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
 @click.version_option(__version__, prog_name="lutbake")
-def main():
+@click.option(
+    "-v",
+    "--verbose",
+    is_flag=True,
+    help="Keep Warp's banner, CUDA-driver warning and module-load lines (same as LUTBAKE_VERBOSE=1).",
+)
+def main(verbose):
     """Bake pre-integrated BRDF lookup tables (split-sum DFG, ...) into EXR files.
 
     \b
     Examples:
       lutbake bake configs/dfg.toml                  # -> outputs/dfg.exr
       lutbake bake configs/*.toml --out-dir build/luts --workers 2
-      lutbake bake --preset default --set samples=2048 --set dtype=half
+      lutbake bake --preset default --set samples=2048 --set dtype=half --out-dir outputs/examples
       lutbake inspect outputs/dfg.exr
       lutbake preview outputs/dfg.exr                # -> outputs/dfg.preview.png
       lutbake list
       lutbake validate
     """
+    if verbose:
+        import os
+
+        from .warp_runtime import VERBOSE_ENV
+
+        os.environ[VERBOSE_ENV] = "1"
 
 
 @main.command()
@@ -113,11 +116,11 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     import contextlib
 
     from . import batch, cluster, preflight
+    from .api import samples_note
     from .config import load_configs, preset_path
     from .errors import ConfigError, LutbakeError
     from .textsafe import escape_controls
 
-    _quiet_warp()
     try:
         paths = [preset_path(p) for p in presets] + list(configs)
         if not paths:
@@ -129,9 +132,9 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
         if scheduler is not None:
             cluster.parse_scheduler(scheduler)
         elif device == "cuda":  # on a cluster the workers' GPUs count (lutbake.cluster checks them)
-            import warp as wp
+            from .warp_runtime import init_warp
 
-            if not wp.is_cuda_available():
+            if not init_warp().is_cuda_available():
                 raise ConfigError("--device", "device", "cuda", "cpu", "no CUDA device is available")
         jobs = batch.schedule(specs, out_dir, force=force)
         preflight.check_outputs(jobs)
@@ -148,8 +151,10 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
 
     def on_done(job):
         if job.status == "baked":
+            note = samples_note(job.spec, job.samples)
             click.echo(
                 f"{escape_controls(str(job.path))}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel"
+                + (f" ({note})" if note else "")
             )
         elif job.status == "failed":
             click.echo(f"FAILED {job.name}: {escape_controls(job.message)}", err=True)
@@ -280,19 +285,24 @@ def _first_comment(path: Path) -> str:
 @main.command()
 @click.argument("file", type=click.Path(path_type=Path))
 def inspect(file):
-    """Print a baked table's kind, axes, channels, reconstruction, provenance and statistics.
+    """Print what a table file holds: kind, axes, channels, reconstruction, provenance and statistics.
+
+    Reads every format lutbake writes, recognised by its first bytes (EXR, .npy, PNG, DDS, KTX2, C
+    header, and the .json sidecars, with the data file they name); a table without lutbake metadata
+    (as an engine ships it) gets its format, size, channels and value ranges.
 
     \b
-    Example:
+    Examples:
       lutbake inspect outputs/dfg.exr
+      lutbake inspect outputs/filament_dfg.dds      # metadata from its .json sidecar
     """
-    from .io.exr import describe_exr
+    from .errors import LutbakeError
+    from .io.describe import describe
 
-    _quiet_warp()
     try:
-        click.echo(describe_exr(file))
-    except (OSError, ValueError) as e:
-        click.echo(f"error: {file}: {e}", err=True)
+        click.echo(describe(file), nl=False)
+    except (LutbakeError, OSError) as e:
+        click.echo(f"error: {e}", err=True)
         sys.exit(EXIT_CONFIG)
 
 
@@ -314,7 +324,7 @@ def inspect(file):
 )
 @click.option("--no-png", is_flag=True, help="Only print the error table.")
 def plot(out_dir, sigma_to_alpha, order, no_png):
-    """Reproduce the seed's Figures 11-15 (settings of Figures 6-10): Oren-Nayar, Oren-Nayar with Fresnel,
+    """Reproduce Figures 11-15 of Gotanda 2014 (settings of its Figures 6-10): Oren-Nayar, Oren-Nayar with Fresnel,
     the integrated microfacet model and the fitted model; print the fitted model's error per figure.
 
     \b
@@ -323,7 +333,6 @@ def plot(out_dir, sigma_to_alpha, order, no_png):
     """
     from .figures import error_table, plot_all
 
-    _quiet_warp()
     if not no_png:
         for p in plot_all(out_dir, sigma_to_alpha, order):
             click.echo(str(p))
@@ -346,17 +355,22 @@ def plot(out_dir, sigma_to_alpha, order, no_png):
 def validate():
     """Run the analytic checks; print each measured error against its tolerance.
 
-    Exits with status 1 if any check fails.
+    Per check: PASS or FAIL and its name; "measured" (the one number compared) and what it is;
+    "tolerance"; then any secondary figure on its own labelled line (where the worst case is, other
+    limits that are checked separately). Ends with the total ("37 passed, 0 failed"); exits with
+    status 1 if any check fails.
     """
-    from .validate.checks import run_all
+    from .validate.checks import run_all, summary
 
-    _quiet_warp()
-    ok = True
+    results = []
     for r in run_all():
-        ok &= r.passed
-        status = click.style("PASS", fg="green") if r.passed else click.style("FAIL", fg="red")
-        click.echo(f"{status}  {r.name:<48} measured {r.measured:.3e}  tolerance {r.tolerance:.1e}  {r.detail}")
-    sys.exit(0 if ok else 1)
+        results.append(r)
+        head, *rest = r.lines()
+        click.echo(click.style(head[:4], fg="green" if r.passed else "red") + head[4:])
+        for line in rest:
+            click.echo(line)
+    click.echo(summary(results))
+    sys.exit(0 if all(r.passed for r in results) else 1)
 
 
 @main.command()
@@ -369,13 +383,16 @@ def validate():
     help="PNG to write (default: FILE's stem + .preview.png beside it).",
 )
 def preview(file, out):
-    """Render a PNG of a baked table: each channel colour-mapped with labelled axes, and (dfg) a row of
-    spheres lit with the split-sum through the table. Reads EXR, or .npy with its .json sidecar.
+    """Render a PNG of a table file (any format lutbake writes; see inspect): 1D tables as curves, 2D
+    tables as colour-mapped channels with labelled axes, 3D tables as labelled slice grids, btf tables as
+    light x view images per sigma and phi; and, where the table has a split-sum reconstruction, a row of
+    spheres shaded with it.
 
     \b
     Example:
       lutbake preview outputs/dfg.exr        # -> outputs/dfg.preview.png
     """
+    from .errors import LutbakeError
     from .preview import render
 
     try:
@@ -383,8 +400,8 @@ def preview(file, out):
     except ImportError as e:
         click.echo(f"error: preview needs matplotlib (pip install 'lutbake[plot]'): {e}", err=True)
         sys.exit(EXIT_CONFIG)
-    except (OSError, ValueError, KeyError) as e:
-        click.echo(f"error: {file}: {e}", err=True)
+    except (LutbakeError, OSError) as e:
+        click.echo(f"error: {e}", err=True)
         sys.exit(EXIT_CONFIG)
     click.echo(str(path))
 

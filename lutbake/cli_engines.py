@@ -11,9 +11,10 @@ EXIT_CONFIG = 2
 
 
 def _quiet():
-    from .cli import _quiet_warp
+    """Start Warp without its banner and CUDA-driver warning (lutbake.warp_runtime; --verbose brings them back)."""
+    from .warp_runtime import init_warp
 
-    _quiet_warp()
+    init_warp()
 
 
 def _shape(text: str | None):

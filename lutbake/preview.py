@@ -1,85 +1,151 @@
-"""``lutbake preview FILE``: one PNG to judge a table at a glance.
+"""``lutbake preview FILE``: one PNG to judge a table at a glance, for every kind and every format
+lutbake reads (lutbake.io.readers).
 
-Top row: every channel as a colour-mapped image with labelled axes (ticks show the axis values the
-file's metadata lists, so non-linear mappings and flipped rows read correctly; image row 0 is drawn at
-the bottom). Bottom row (``dfg`` tables): spheres of increasing roughness lit by a simple sky/ground
-environment with the split-sum, E = table(NoV, r) reconstructed per the file's layout, so a wrong axis,
-flip or channel order shows up as an implausible sphere.
+- a 1D table (``albedo_avg``): each channel as a curve over its axis;
+- a 2D table: each channel colour-mapped, ticks at the axis values the metadata lists (so non-linear
+  mappings and flipped rows read correctly; image row 0 is drawn at the bottom);
+- a 3D table (``specular_3d``, ``specular_aniso``, ``diffuse_3d``): a grid of slices, one row per channel,
+  each slice titled with its z value (f0, anisotropy ...), one colour scale per channel;
+- ``btf``: light x view images (theta_l across, theta_v up), one row per sigma, one column per phi;
+- a table without lutbake metadata: its channels (or slices) by index.
+A row of spheres follows where the table has a split-sum reconstruction (``dfg`` and ``specular_aniso``
+layouts, ``specular_3d``, the sheen ``charlie`` layout): orthographic spheres lit by a sky/ground
+environment with a sun, shaded with the file's own reconstruction, E looked up through the table's axes
+(``Axis.uv``), so a wrong axis, flip or channel order shows up as an implausible sphere. Kinds with no
+split-sum reconstruction (albedo, diffuse, btf, the sheen albedo-scaling layouts) get no sphere row.
 """
 
 from __future__ import annotations
 
-import json
+import textwrap
 from pathlib import Path
 
 import numpy as np
 
 from .axes import Axis
+from .io.readers import TableView, read_table
 
-SPHERE_ROUGHNESS = (0.05, 0.25, 0.45, 0.65, 0.85)
-SPHERE_F0 = np.array([1.0, 0.71, 0.29])  # gold-like conductor
-SKY, GROUND = np.array([0.45, 0.65, 1.1]), np.array([0.06, 0.05, 0.04])
+N_SPHERES = 5
+MAX_SLICES = 6  # columns of a 3D slice grid
+MAX_BTF_SIGMAS, MAX_BTF_PHIS = 4, 5
+SPHERE_F0 = np.array([1.0, 0.71, 0.29])  # a gold-like conductor's f0 (RGB)
+SHEEN_COLOR = np.array([1.0, 1.0, 1.0])
+SKY, GROUND = np.array([0.75, 0.82, 0.95]), np.array([0.06, 0.05, 0.04])  # a pale sky: gold reads as gold
 SUN_DIR = np.array([-0.45, 0.65, 0.6]) / np.linalg.norm([-0.45, 0.65, 0.6])
 SUN_POWER = 1.5  # integral of the sun's radiance over the sphere (its irradiance scale)
+UNITS = {"phi": "rad", "theta_l": "rad", "theta_v": "rad"}
+SYMBOLS = {
+    "sigma": "σ",
+    "phi": "φ",
+    "cos_phi": "cos φ",
+    "theta_l": "θ_l",
+    "theta_v": "θ_v",
+    "NoV": "n·v",
+    "NoL": "n·l",
+    "alpha": "α",
+    "perceptual_roughness": "perceptual roughness r",
+    "f0": "f0",
+}
+ROUGHNESS_AXES = ("perceptual_roughness", "alpha")
+MEANING_WIDTH, MEANING_LINES = 44, 4  # characters per line and lines of a channel's meaning under its name
+CLIP_PERCENTILE, CLIP_RATIO = 99.0, 3.0  # colour scale: see _color_range
+CHARS_PER_INCH = 13  # of 9-point text: where the figure title wraps
 
 
-def axis_from_meta(d: dict) -> Axis:
-    lo, hi = d.get("range", [0.0, 1.0])
-    clamp = d.get("clamp")
-    listed = tuple(d["values"]) if d.get("mapping") == "listed" else ()
-    return Axis(
-        d["name"],
-        d["dim"],
-        int(d["count"]),
-        float(lo),
-        float(hi),
-        texel=d.get("texel", "center"),
-        mapping=d.get("mapping", "linear"),
-        order=d.get("order", "lo_first"),
-        clamp=tuple(clamp) if clamp else None,
-        listed=listed,
-    )
+def _label(axis: Axis) -> str:
+    unit = UNITS.get(axis.name)
+    return SYMBOLS.get(axis.name, axis.name) + (f" [{unit}]" if unit else "")
 
 
-def read_table(path: Path) -> tuple[np.ndarray, dict]:
-    """(data, attrs) from an EXR, or from a .npy with its sidecar <name>.npy.json."""
-    if path.suffix == ".npy":
-        from .io.integrity import sidecar_path
-
-        side = sidecar_path(path)
-        if not side.is_file():
-            raise ValueError(f"{path}: no sidecar {side.name} with the table's conventions")
-        return np.load(path).astype(np.float32), json.loads(side.read_text())["lutbake"]
-    from .io.exr import read_exr
-
-    return read_exr(path)
+def _short(axis: Axis, value: float) -> str:
+    unit = UNITS.get(axis.name)
+    return f"{SYMBOLS.get(axis.name, axis.name)} = {value:.3g}" + (f" {unit}" if unit else "")
 
 
-def sample(data: np.ndarray, axes: list[Axis], nov: np.ndarray, rough: np.ndarray) -> np.ndarray:
-    """Bilinear (clamp-to-edge) lookup of a 2D dfg table at (NoV, roughness), via each axis' uv()."""
-    y_axis, x_axis = axes
-    by = {a.name: a for a in axes}
-    rname = next(n for n in by if n != "NoV")
-    u = {"NoV": by["NoV"].uv(nov), rname: by[rname].uv(rough if rname != "alpha" else rough**2)}
-    h, w = data.shape[:2]
-    x = np.clip(u[x_axis.name] * w - 0.5, 0, w - 1)
-    y = np.clip(u[y_axis.name] * h - 0.5, 0, h - 1)
-    x0 = np.clip(np.floor(x).astype(int), 0, max(w - 2, 0))
-    y0 = np.clip(np.floor(y).astype(int), 0, max(h - 2, 0))
-    x1, y1 = np.minimum(x0 + 1, w - 1), np.minimum(y0 + 1, h - 1)
-    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
-    return (1 - fy) * ((1 - fx) * data[y0, x0] + fx * data[y0, x1]) + fy * ((1 - fx) * data[y1, x0] + fx * data[y1, x1])
+# ------------------------------------------------------------------------------------- lookups
 
 
-def specular_E(t: np.ndarray, layout: str, f0: np.ndarray) -> np.ndarray:
-    r, g = t[..., 0:1], t[..., 1:2]
-    if layout.startswith("multiscatter"):
-        return (1 - f0) * r + f0 * g
-    return f0 * r + g
+def lookup(data: np.ndarray, axes: list[Axis], coords: dict[str, np.ndarray | float]) -> np.ndarray:
+    """n-linear, clamp-to-edge lookup of ``data`` (one axis per dimension, in order, channels last) at
+    the axis values ``coords[axis.name]``, through each axis' ``uv`` (its texel convention, mapping and
+    order): what a GPU's filtered fetch returns."""
+    grids = np.broadcast_arrays(*[np.asarray(coords[a.name], np.float64) for a in axes])
+    lo, frac = [], []
+    for axis, n, g in zip(axes, data.shape[:-1], grids):
+        x = np.clip(axis.uv(g) * n - 0.5, 0, n - 1)
+        i0 = np.clip(np.floor(x).astype(int), 0, max(n - 2, 0))
+        lo.append(i0)
+        frac.append(np.clip(x - i0, 0.0, 1.0)[..., None])
+    out = 0.0
+    for corner in range(1 << len(axes)):
+        w, idx = 1.0, []
+        for d, (i0, f) in enumerate(zip(lo, frac)):
+            up = corner >> d & 1
+            idx.append(np.minimum(i0 + up, data.shape[d] - 1))
+            w = w * (f if up else 1 - f)
+        out = out + w * data[tuple(idx)]
+    return out
 
 
-def sphere(data, axes, layout, roughness, size=128):
-    """An orthographic sphere, view along -z, lit by prefiltered sky/ground radiance times E."""
+def split_sum(view: TableView):
+    """(how the spheres are shaded, E(nov, roughness value) -> RGB, broad) from the file's own
+    reconstruction, or None where the kind has none. ``roughness value`` is in the units of the table's
+    roughness axis; ``broad``: the lobe is prefiltered as a near-uniform blur (sheen)."""
+    axes = [a for a in view.axes if a.dim != "y_block"]
+    names = [a.name for a in axes]
+    rough = next((n for n in names if n in ROUGHNESS_AXES), None)
+    if view.kind is None or "NoV" not in names or rough is None or view.data.ndim != 3 + (len(axes) == 3):
+        return None
+    layout = view.terms.get("layout", "scale_bias")
+    z = axes[0] if len(axes) == 3 else None
+    nch = view.data.shape[-1]
+
+    def at(nov, r, zval=None):
+        coords = {"NoV": nov, rough: r}
+        if z is not None:
+            coords[z.name] = zval
+        return lookup(view.data, axes, coords)
+
+    if view.kind in ("dfg", "specular_aniso") and nch >= 2:
+        zmid = float(z.values()[z.count // 2]) if z is not None else None
+        where = f", {_short(z, zmid)}" if z is not None else ""
+        if layout in ("scale_bias", "scale_bias_f82"):  # Karis 2013: E = f0 * scale + bias
+
+            def E_scale_bias(nov, r):
+                t = at(nov, r, zmid)
+                return SPHERE_F0 * t[..., 0:1] + t[..., 1:2]
+
+            return f"E = f0 R + G, f0 = gold{where}", E_scale_bias, False
+        if layout in ("multiscatter", "multiscatter_cloth"):  # Filament: E = mix(R, G, f0)
+
+            def E_multiscatter(nov, r):
+                t = at(nov, r, zmid)
+                return (1 - SPHERE_F0) * t[..., 0:1] + SPHERE_F0 * t[..., 1:2]
+
+            return f"E = (1 - f0) R + f0 G, f0 = gold{where}", E_multiscatter, False
+        if layout in ("charlie", "charlie_clamped") and nch >= 3:
+            # the sheen lobe is broad: its prefiltered (Charlie) environment is close to the mean radiance
+            return (
+                "sheen = prefiltered_charlie sheenColor B, sheenColor = white",
+                lambda nov, r: SHEEN_COLOR * at(nov, r)[..., 2:3],
+                True,
+            )
+        return None
+    if view.kind == "specular_3d":
+        if z is not None and z.name == "f0":
+            return (
+                "E = T(n·v, r, f0) per RGB f0 of gold",
+                lambda nov, r: np.concatenate([at(nov, r, f)[..., 0:1] for f in SPHERE_F0], axis=-1),
+                False,
+            )
+        if z is None and nch == 3:
+            return "E = T(n·v, r).rgb (the metal's own complex Fresnel)", lambda nov, r: at(nov, r), False
+    return None
+
+
+def sphere(E, roughness_value: float, perceptual: float, size: int = 128) -> np.ndarray:
+    """An orthographic sphere, view along -z, lit by a prefiltered sky/ground/sun environment times
+    E(n.v, roughness_value) (RGB); ``perceptual`` widens the prefilter."""
     s = (np.arange(size) + 0.5) / size * 2 - 1
     X, Y = np.meshgrid(s, -s)
     inside = X**2 + Y**2 < 1
@@ -88,64 +154,217 @@ def sphere(data, axes, layout, roughness, size=128):
     refl = np.stack([2 * nov * X, 2 * nov * Y, 2 * nov * Z - 1], -1)  # R = 2 (n.v) n - v, v = +z
     up = np.clip(0.5 + 0.5 * refl[..., 1], 0, 1)[..., None]
     radiance = GROUND + (SKY - GROUND) * (up**0.5)
-    avg = 0.5 * (SKY + GROUND)
-    blur = roughness**2  # the prefiltered sky tends to its average as roughness grows
-    # a sun prefiltered by a lobe of solid angle ~ 2 pi w: exp((cos - 1) / w) / (2 pi w)
-    w = max(2.0 * roughness**4, 2e-4)
+    blur = perceptual**2  # the prefiltered sky tends to its average as roughness grows
+    w = max(2.0 * perceptual**4, 2e-4)  # a sun prefiltered by a lobe of solid angle ~ 2 pi w
     sun = SUN_POWER * np.exp((refl @ SUN_DIR - 1) / w) / (2 * np.pi * w)
-    prefiltered = (1 - blur) * radiance + blur * avg + np.minimum(sun, 50.0)[..., None]
-    E = specular_E(sample(data, axes, nov, np.full_like(nov, roughness)), layout, SPHERE_F0)
-    rgb = prefiltered * E
+    prefiltered = (1 - blur) * radiance + blur * 0.5 * (SKY + GROUND) + np.minimum(sun, 50.0)[..., None]
+    rgb = prefiltered * E(nov, np.full_like(nov, roughness_value))
     rgb = np.where(inside[..., None], rgb, 0.08)
     return np.clip(rgb / (1 + 0.25 * rgb), 0, 1) ** (1 / 2.2)  # soft tone map + display gamma (a picture)
 
 
-def render(path, out=None) -> Path:
-    """Write the preview PNG of the table at ``path`` (default: <path stem>.preview.png)."""
+# ---------------------------------------------------------------------------------------- drawing
+
+
+def _ticks(ax, axis: Axis | None, n: int, which: str, label: bool = True) -> None:
+    idx = np.unique(np.linspace(0, n - 1, min(n, 4)).round().astype(int))
+    vals = axis.values() if axis is not None else np.arange(n)
+    setter = ax.set_xticks if which == "x" else ax.set_yticks
+    setter(idx, [f"{vals[i]:.3g}" for i in idx], fontsize=7)
+    if label:
+        text = f"{_label(axis)} ({axis.mapping}, {axis.texel})" if axis is not None else f"{which} index"
+        (ax.set_xlabel if which == "x" else ax.set_ylabel)(text, fontsize=8)
+
+
+def _image(fig, ax, img, y_axis, x_axis, vmin=None, vmax=None, labels=(True, True), bar=True):
+    im = ax.imshow(img, origin="lower", cmap="viridis", interpolation="nearest", aspect="auto", vmin=vmin, vmax=vmax)
+    _ticks(ax, x_axis, img.shape[1], "x", labels[0])
+    _ticks(ax, y_axis, img.shape[0], "y", labels[1])
+    if bar:
+        fig.colorbar(im, ax=ax, fraction=0.046, pad=0.04).ax.tick_params(labelsize=7)
+    return im
+
+
+def _color_range(values: np.ndarray) -> tuple[float, float, str]:
+    """(vmin, vmax, note): the full range, or up to the CLIP_PERCENTILE when a few texels (a grazing corner)
+    are far above the rest, so the rest stays readable; the note says so and gives the true maximum."""
+    lo, hi = float(values.min()), float(values.max())
+    top = float(np.percentile(values, CLIP_PERCENTILE))
+    if hi - lo > CLIP_RATIO * (top - lo) > 0:
+        return lo, top, f"\ncolours clipped at the {CLIP_PERCENTILE:g}th percentile {top:.3g} (max {hi:.3g})"
+    return lo, hi, ""
+
+
+def _channel_title(view: TableView, c: int) -> str:
+    name, meaning = view.channel_names[c], view.meanings[c]
+    meaning = meaning.split(": ", 1)[1] if meaning.startswith(name + ": ") else meaning
+    lines = textwrap.wrap(meaning, MEANING_WIDTH)
+    if len(lines) > MEANING_LINES:
+        lines = lines[: MEANING_LINES - 1] + [textwrap.shorten(" ".join(lines[MEANING_LINES - 1 :]), MEANING_WIDTH)]
+    col = view.data[..., c]
+    const = f"  (constant {float(col.flat[0]):.3g})" if col.size and col.min() == col.max() else ""
+    return "\n".join([f"{'RGBA'[c]} = {name}{const}"] + lines)
+
+
+def _suptitle(view: TableView, path: Path, width_chars: int) -> str:
+    head = f"{path.name}: {view.kind} table '{view.name}'" if view.kind else f"{path.name}: no lutbake metadata"
+    terms = ", ".join(f"{k} {v}" for k, v in view.terms.items())
+    attrs = view.attrs
+    extra = ", ".join(f"{k} {attrs[k]}" for k in ("estimator", "samples") if k in attrs)
+    body = "; ".join(x for x in (terms, extra + (" per texel" if "samples" in attrs else "")) if x)
+    return "\n".join([head] + textwrap.wrap(body, max(width_chars, 40)))
+
+
+def _fig_1d(plt, view):
+    axis = next(a for a in view.axes if a.dim == "x")
+    fig, ax = plt.subplots(figsize=(6.4, 4.2), dpi=100, layout="constrained")
+    for c in range(view.data.shape[-1]):
+        ax.plot(axis.values(), view.data[0, :, c], marker=".", label=view.channel_names[c])
+    ax.set_xlabel(f"{_label(axis)} ({axis.mapping}, {axis.texel})", fontsize=9)
+    ax.set_ylabel(", ".join(view.channel_names), fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    ax.set_title("\n".join(textwrap.wrap(view.meanings[0], 70)), fontsize=8)
+    return fig, 6.4
+
+
+def _pick(n: int, k: int) -> list[int]:
+    return sorted(set(np.linspace(0, n - 1, min(n, k)).round().astype(int).tolist()))
+
+
+def _axis_by_dim(view, dim):
+    return next((a for a in view.axes if a.dim == dim), None)
+
+
+SPHERE_ROW_INCHES = 3.2
+
+
+def _canvases(plt, width: float, grid_height: float, spheres):
+    """The figure, the canvas the table is drawn on and (with spheres) the canvas of the sphere row."""
+    fig = plt.figure(
+        figsize=(width, grid_height + (SPHERE_ROW_INCHES if spheres else 0) + 0.8), dpi=100, layout="constrained"
+    )
+    if not spheres:
+        return fig, fig, None
+    top, bottom = fig.subfigures(2, 1, height_ratios=[grid_height, SPHERE_ROW_INCHES])
+    return fig, top, bottom
+
+
+def _fig_2d(plt, view, spheres):
+    nch = view.data.shape[-1]
+    width = max(3.4 * nch, 2.9 * N_SPHERES if spheres else 0)
+    fig, canvas, row = _canvases(plt, width, 3.9, spheres)
+    y_axis, x_axis = _axis_by_dim(view, "y"), _axis_by_dim(view, "x")
+    for c in range(nch):
+        ax = canvas.add_subplot(1, max(nch, 2), c + 1)
+        vmin, vmax, clipped = _color_range(view.data[..., c])
+        _image(canvas, ax, view.data[..., c], y_axis, x_axis, vmin, vmax)
+        ax.set_title(_channel_title(view, c) + clipped, fontsize=8, loc="left")
+    if spheres:
+        _sphere_row(row, view, spheres)
+    return fig, width
+
+
+def _fig_3d(plt, view, spheres):
+    data = view.data
+    z_axis, y_axis, x_axis = (_axis_by_dim(view, d) for d in ("z", "y", "x"))
+    nch = data.shape[-1]
+    picks = _pick(data.shape[0], MAX_SLICES)
+    width = max(2.6 * len(picks) + 1.2, 2.9 * N_SPHERES if spheres else 0)
+    fig, canvas, row = _canvases(plt, width, 2.9 * nch + 0.4, spheres)
+    zvals = z_axis.values() if z_axis is not None else None
+    for c in range(nch):
+        vmin, vmax, clipped = _color_range(data[..., c])
+        axes = []
+        for j, k in enumerate(picks):
+            ax = canvas.add_subplot(nch, len(picks), c * len(picks) + j + 1)
+            im = _image(
+                canvas, ax, data[k, ..., c], y_axis, x_axis, vmin, vmax, labels=(c == nch - 1, j == 0), bar=False
+            )
+            where = _short(z_axis, zvals[k]) if z_axis is not None else f"slice {k}"
+            ax.set_title(
+                f"{where}  (slice {k})" if j else f"{_channel_title(view, c)}{clipped}\n{where}  (slice {k})",
+                fontsize=8,
+                loc="left",
+            )
+            axes.append(ax)
+        canvas.colorbar(im, ax=axes, fraction=0.02, pad=0.02).ax.tick_params(labelsize=7)
+    if spheres:
+        _sphere_row(row, view, spheres)
+    return fig, width
+
+
+def _fig_btf(plt, view):
+    """Light x view images, one row per sigma slice, one column per phi block (a y_block axis)."""
+    z_axis, block, y_axis, x_axis = (_axis_by_dim(view, d) for d in ("z", "y_block", "y", "x"))
+    data = view.data if view.data.ndim == 4 else view.data[None]
+    sig = _pick(data.shape[0], MAX_BTF_SIGMAS)
+    phis = _pick(block.count, MAX_BTF_PHIS)
+    ny = y_axis.count
+    vmin, vmax = float(data[..., 0].min()), float(data[..., 0].max())
+    fig = plt.figure(figsize=(2.6 * len(phis) + 1.4, 2.6 * len(sig) + 1.4), dpi=100, layout="constrained")
+    zvals, pvals = (z_axis.values() if z_axis is not None else None), block.values()
+    for i, k in enumerate(sig):
+        for j, p in enumerate(phis):
+            ax = fig.add_subplot(len(sig), len(phis), i * len(phis) + j + 1)
+            img = data[k, p * ny : (p + 1) * ny, :, 0]
+            im = _image(fig, ax, img, y_axis, x_axis, vmin, vmax, labels=(i == len(sig) - 1, j == 0), bar=False)
+            where = _short(z_axis, zvals[k]) + ", " if z_axis is not None else ""
+            ax.set_title(f"{where}{_short(block, pvals[p])}", fontsize=8)
+    fig.colorbar(im, ax=fig.axes, fraction=0.02, pad=0.02).ax.tick_params(labelsize=7)
+    fig.supxlabel(_channel_title(view, 0).replace("\n", " "), fontsize=8)
+    return fig, 2.6 * len(phis) + 1.4
+
+
+def _sphere_row(canvas, view, spheres):
+    how, E, broad = spheres
+    canvas.suptitle(f"spheres lit by a sky, ground and sun environment: {how}", fontsize=8)
+    rough = next(a for a in view.axes if a.name in ROUGHNESS_AXES)
+    vals = rough.values()
+    lo, hi = float(vals.min()), float(vals.max())
+    for k, v in enumerate(lo + (hi - lo) * np.linspace(0.05, 0.95, N_SPHERES)):
+        ax = canvas.add_subplot(1, N_SPHERES, k + 1)
+        perceptual = 1.0 if broad else float(np.sqrt(v)) if rough.name == "alpha" else float(v)
+        ax.imshow(sphere(E, float(v), perceptual))
+        ax.set_title(_short(rough, v), fontsize=8)
+        ax.axis("off")
+
+
+def figure(path):
+    """The preview of the table file at ``path`` as a matplotlib Figure (Agg; close it when done)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     path = Path(path)
-    data, attrs = read_table(path)
-    axes = [axis_from_meta(d) for d in json.loads(attrs["axes"])]
-    names = json.loads(attrs.get("channel_names", "{}"))
-    meanings = json.loads(attrs.get("channels", "{}"))
-    terms = json.loads(attrs.get("terms", "{}"))
-    if data.ndim == 4:
-        data = data[data.shape[0] // 2]  # the middle slice of a 3D table
-        axes = axes[1:]
-    nch = data.shape[-1]
-    spheres = attrs.get("kind") == "dfg" and nch >= 2
-    ncols = max(nch, len(SPHERE_ROUGHNESS) if spheres else 0)
-    fig = plt.figure(figsize=(3.2 * ncols, 6.4 if spheres else 3.4), dpi=100)
-    y_axis, x_axis = axes
-    for c in range(nch):
-        ax = fig.add_subplot(2 if spheres else 1, ncols, c + 1)
-        im = ax.imshow(data[..., c], origin="lower", cmap="viridis", interpolation="nearest", aspect="auto")
-        letter = "RGBA"[c]
-        ax.set_title(f"{letter} = {names.get(letter, '?')}", fontsize=9)
-        for axis, setter, ticker in ((x_axis, ax.set_xlabel, ax.set_xticks), (y_axis, ax.set_ylabel, ax.set_yticks)):
-            idx = np.unique(np.linspace(0, axis.count - 1, 5).round().astype(int))
-            vals = axis.values()
-            ticker(idx, [f"{vals[i]:.3g}" for i in idx], fontsize=7)
-            setter(f"{axis.name} ({axis.mapping}, {axis.texel}, {axis.order})", fontsize=8)
-        fig.colorbar(im, ax=ax, fraction=0.046, pad=0.04).ax.tick_params(labelsize=7)
-        ax.tick_params(labelsize=7)
-        ax.text(0.0, -0.32, meanings.get(letter, "")[:60], transform=ax.transAxes, fontsize=6)
-    if spheres:
-        layout = terms.get("layout", "scale_bias")
-        for k, r in enumerate(SPHERE_ROUGHNESS):
-            ax = fig.add_subplot(2, ncols, ncols + k + 1)
-            ax.imshow(sphere(data, axes, layout, r))
-            ax.set_title(f"r = {r:g}, f0 = gold", fontsize=8)
-            ax.axis("off")
-    fig.suptitle(f"{path.name}: {attrs.get('kind', '?')} {attrs.get('table', '')}  {json.dumps(terms)}", fontsize=9)
-    fig.tight_layout()
-    out = Path(out) if out else path.with_name(path.stem + ".preview.png")
+    view = read_table(path)
+    spheres = split_sum(view)
+    dims = {a.dim for a in view.axes}
+    if "y_block" in dims:
+        fig, inches = _fig_btf(plt, view)
+    elif view.axes and dims == {"x"}:
+        fig, inches = _fig_1d(plt, view)
+    elif view.data.ndim == 4:
+        fig, inches = _fig_3d(plt, view, spheres)
+    else:
+        fig, inches = _fig_2d(plt, view, spheres)
+    note = "" if spheres or not view.kind else f"\n(no sphere row: {view.kind} has no split-sum reconstruction)"
+    fig.suptitle(_suptitle(view, path, int(inches * CHARS_PER_INCH)) + note, fontsize=9)
+    return fig
+
+
+def render(path, out=None, dpi: int = 100) -> Path:
+    """Write the preview PNG of the table at ``path`` (default: <path stem>.preview.png beside it)."""
+    import matplotlib.pyplot as plt
+
     from .io.atomic import atomic_write
 
-    atomic_write(out, lambda tmp: fig.savefig(tmp, format="png"))
-    plt.close(fig)
+    path = Path(path)
+    fig = figure(path)
+    out = Path(out) if out else path.with_name(path.stem + ".preview.png")
+    try:
+        atomic_write(out, lambda tmp: fig.savefig(tmp, format="png", dpi=dpi))
+    finally:
+        plt.close(fig)
     return out

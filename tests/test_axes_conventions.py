@@ -83,7 +83,7 @@ def test_axis_metadata_round_trips_through_the_preview_reader():
     import numpy as np
 
     from lutbake.axes import Axis
-    from lutbake.preview import axis_from_meta
+    from lutbake.io.readers import axis_from_meta
 
     for a in (
         Axis("NoV", "y", 8, texel="endpoint", mapping="one_minus_t2", order="hi_first", clamp=(1e-4, 0.9999)),

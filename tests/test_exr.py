@@ -14,8 +14,10 @@ pytest.importorskip("OpenImageIO")
 
 from lutbake.axes import Axis  # noqa: E402
 from lutbake.io import atomic as atomic_mod  # noqa: E402
-from lutbake.io import describe_exr, read_exr, write_exr  # noqa: E402
 from lutbake.io import exr as exr_mod  # noqa: E402
+from lutbake.io import read_exr, write_exr  # noqa: E402
+from lutbake.io.describe import describe  # noqa: E402
+from lutbake.io.readers import ReadError  # noqa: E402
 from lutbake.table import Table  # noqa: E402
 
 PROVENANCE = {
@@ -192,7 +194,7 @@ def test_single_slice_3d_stays_3d(tmp_path):
 
 def test_describe_exr(tmp_path):
     out = write_exr(table_3d(), tmp_path / "spec3d.exr", dtype="half")
-    text = describe_exr(out)
+    text = describe(out)
     for needle in [
         "specular_3d",
         "f0",
@@ -223,15 +225,17 @@ def test_describe_exr(tmp_path):
 
 
 def test_describe_missing_and_foreign_files(tmp_path):
-    with pytest.raises(FileNotFoundError, match="nope.exr"):
-        describe_exr(tmp_path / "nope.exr")
+    with pytest.raises(ReadError, match="nope.exr: no such file"):
+        describe(tmp_path / "nope.exr")
     with pytest.raises(FileNotFoundError, match="nope.exr"):
         read_exr(tmp_path / "nope.exr")
     # an EXR that lutbake did not write
     foreign = tmp_path / "foreign.exr"
     OpenEXR.File({}, {"R": np.zeros((2, 2), np.float32)}).write(str(foreign))
     with pytest.raises(ValueError, match="foreign.exr.*not a lutbake EXR"):
-        describe_exr(foreign)
+        read_exr(foreign)
+    text = describe(foreign)  # inspect says what it can of a table lutbake did not write
+    assert "no lutbake metadata" in text and "2 x 2, 1 channel(s)" in text and "R: min 0  max 0" in text
     junk = tmp_path / "junk.exr"
     junk.write_bytes(b"not an image at all")
     with pytest.raises(ValueError, match="junk.exr"):

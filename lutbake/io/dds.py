@@ -67,18 +67,37 @@ def encode(pixels: np.ndarray) -> bytes:
 
 
 def decode(blob: bytes) -> tuple[np.ndarray, dict]:
-    """Read what ``encode`` writes (DX10 header, uncompressed float formats): (array, facts)."""
+    """Read an uncompressed float DDS with a DX10 header (what ``encode`` writes; OpenImageIO 3.x has no
+    float DDS reader): (array (y, x, C) or (z, y, x, C) as stored, facts). Every header field is checked
+    against the file length before any pixel is touched; a ValueError says what is wrong."""
     if blob[:4] != MAGIC:
         raise ValueError("not a DDS file (bad magic)")
+    if len(blob) < 148:
+        raise ValueError(f"DDS file of {len(blob)} bytes is shorter than its headers (148 bytes)")
     size, flags, height, width, pitch, depth, mips = struct.unpack_from("<IIIIIII", blob, 4)
     if size != 124:
         raise ValueError(f"DDS header size {size} != 124")
     fourcc = blob[84:88]  # magic (4) + 72 bytes of header before DDS_PIXELFORMAT, + dwSize, dwFlags
     if fourcc != b"DX10":
-        raise ValueError(f"DDS without a DX10 header (FourCC {fourcc!r})")
+        raise ValueError(f"DDS without a DX10 header (FourCC {fourcc!r}); lutbake reads uncompressed float DDS only")
     fmt, dim, _, array_size, _ = struct.unpack_from("<IIIII", blob, 128)
+    if fmt not in FROM_DXGI:
+        raise ValueError(f"DXGI format {fmt} is not one lutbake reads ({', '.join(DXGI_NAMES.values())})")
+    if dim not in (DIM_TEXTURE2D, DIM_TEXTURE3D):
+        raise ValueError(f"DDS resource dimension {dim} (lutbake reads TEXTURE2D = 3 and TEXTURE3D = 4)")
     dtype, nch = FROM_DXGI[fmt]
     npdt = np.dtype("<f2" if dtype == "half" else "<f4")
     shape = ((depth,) if dim == DIM_TEXTURE3D else ()) + (height, width, nch)
+    need = 148 + int(np.prod(shape, dtype=object)) * npdt.itemsize
+    if min(shape) < 1 or need > len(blob):
+        raise ValueError(
+            f"DDS header says {' x '.join(map(str, shape))} {DXGI_NAMES[fmt]} ({need} bytes) but the "
+            f"file holds {len(blob)} bytes"
+        )
     arr = np.frombuffer(blob, dtype=npdt, count=int(np.prod(shape)), offset=148).reshape(shape)
-    return arr, {"dxgi_format": DXGI_NAMES[fmt], "dimension": dim, "mips": mips, "array_size": array_size}
+    return arr, {
+        "dxgi_format": DXGI_NAMES[fmt],
+        "dimension": "TEXTURE3D" if dim == DIM_TEXTURE3D else "TEXTURE2D",
+        "mips": mips,
+        "array_size": array_size,
+    }

@@ -27,12 +27,11 @@ File layout (the contract engines and ``lutbake inspect`` rely on):
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 
-from ..table import CHANNEL_LETTERS, Table, attr_text, metadata
+from ..table import CHANNEL_LETTERS, Table, metadata
 from ..table import pixels as checked_pixels
 from .atomic import atomic_write
 from .integrity import HASH_KEY, PLACEHOLDER, seal_exr
@@ -124,70 +123,34 @@ def write_exr(table: Table, path, dtype: str = "float32") -> Path:
 # --------------------------------------------------------------------------------------- reading
 
 
-def _open(path: Path):
-    oiio = _oiio()
+def _read_parts(path) -> tuple[list[np.ndarray], list[dict[str, str]], list[dict]]:
+    """Every part's pixels (float32, (y, x, C), channels in R, G, B, A order), lutbake attributes,
+    and file facts (pixel type, compression, part name), of an EXR lutbake wrote."""
+    from .readers import EXR_MAGIC, exr_parts
+
+    path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"{path}: no such file")
     if not path.is_file():
         raise ValueError(f"{path}: not a file")
-    inp = oiio.ImageInput.open(str(path))
-    if inp is None:
-        raise ValueError(f"{path}: not a readable image ({oiio.geterror()})")
-    if inp.format_name() != "openexr":
-        inp.close()
-        raise ValueError(f"{path}: not an EXR file (OpenImageIO reads it as {inp.format_name()!r})")
-    return inp
-
-
-def _lutbake_attrs(spec) -> dict[str, str]:
-    return {
-        p.name[len(PREFIX) :]: p.value if isinstance(p.value, str) else attr_text(p.value)
-        for p in spec.extra_attribs
-        if p.name.startswith(PREFIX)
-    }
-
-
-def _read_parts(path) -> tuple[list[np.ndarray], list[dict[str, str]], list[dict]]:
-    """Every part's pixels (float32, (y, x, C), channels in R, G, B, A order), lutbake attributes,
-    and file facts (pixel type, compression, part name)."""
-    path = Path(path)
-    inp = _open(path)
-    pixels, attrs, facts = [], [], []
+    with open(path, "rb") as f:
+        if f.read(len(EXR_MAGIC)) != EXR_MAGIC:
+            raise ValueError(f"{path}: not an EXR file (no EXR magic number)")
     try:
-        k = 0
-        while inp.seek_subimage(k, 0):
-            spec = inp.spec()
-            a = _lutbake_attrs(spec)
-            if "kind" not in a:
-                raise ValueError(
-                    f"{path}: not a lutbake EXR (part {k} has no lutbake:kind attribute; was it written by lutbake?)"
-                )
-            names = list(spec.channelnames)
-            want = [c for c in CHANNEL_LETTERS if c in names]
-            if len(want) != len(names) or not names:
-                raise ValueError(f"{path}: part {k} has channels {names}; lutbake writes R, G, B, A only")
-            arr = inp.read_image(k, 0, 0, len(names), "float")
-            if arr is None:
-                raise ValueError(f"{path}: cannot read pixels of part {k}: {inp.geterror()}")
-            arr = np.asarray(arr, dtype=np.float32).reshape(spec.height, spec.width, len(names))
-            arr = arr[..., [names.index(c) for c in want]]
-            pixels.append(np.ascontiguousarray(arr))
-            attrs.append(a)
-            facts.append(
-                {
-                    "format": str(spec.format),
-                    "compression": spec.getattribute("compression"),
-                    "name": spec.getattribute("name") or spec.getattribute("oiio:subimagename"),
-                    "channels": want,
-                }
+        parts = exr_parts(path)
+    except ValueError as e:
+        raise ValueError(f"{path}: not a readable EXR ({e})") from None
+    for k, (_, attrs, facts) in enumerate(parts):
+        if "kind" not in attrs:
+            raise ValueError(
+                f"{path}: not a lutbake EXR (part {k} has no lutbake:kind attribute; was it written by lutbake?)"
             )
-            k += 1
-    finally:
-        inp.close()
-    shapes = {p.shape for p in pixels}
+        if not facts["channels"] or any(c not in CHANNEL_LETTERS for c in facts["channels"]):
+            raise ValueError(f"{path}: part {k} has channels {facts['channels']}; lutbake writes R, G, B, A only")
+    shapes = {p[0].shape for p in parts}
     if len(shapes) != 1:
         raise ValueError(f"{path}: parts have different shapes {sorted(shapes)}")
-    return pixels, attrs, facts
+    return [p[0] for p in parts], [p[1] for p in parts], [{**p[2], "format": p[2]["pixel_type"]} for p in parts]
 
 
 def read_exr(path) -> tuple[np.ndarray, dict[str, str]]:
@@ -204,90 +167,3 @@ def read_exr(path) -> tuple[np.ndarray, dict[str, str]]:
     data = np.stack([pixels[order.index(k)] for k in range(len(order))])
     common = {k: v for k, v in attrs[0].items() if k not in PER_PART}
     return data, common
-
-
-# ------------------------------------------------------------------------------------- describing
-
-_PROVENANCE = ("terms", "estimator", "samples", "seed", "error_estimate", "version", "warp_version")
-
-
-def _fmt(x: float) -> str:
-    return f"{x:.6g}"
-
-
-def _json(path: Path, attrs: dict[str, str], key: str):
-    try:
-        return json.loads(attrs[key])
-    except KeyError:
-        raise ValueError(f"{path}: lutbake EXR without lutbake:{key}") from None
-    except json.JSONDecodeError as e:
-        raise ValueError(f"{path}: lutbake:{key} is not valid JSON ({e})") from None
-
-
-def describe_exr(path) -> str:
-    """The human-readable report ``lutbake inspect FILE`` prints: kind, axes, channels,
-    reconstruction, provenance and per-channel statistics."""
-    path = Path(path)
-    pixels, part_attrs, facts = _read_parts(path)
-    attrs = {k: v for k, v in part_attrs[0].items() if k not in PER_PART}
-    axes = _json(path, attrs, "axes")
-    channels = _json(path, attrs, "channels")
-    data = np.stack(pixels) if len(pixels) > 1 or "slice_index" in part_attrs[0] else pixels[0]
-
-    lines = [f"{path}"]
-    h, w, nch = pixels[0].shape
-    layout = f"{len(pixels)} parts (one per z slice) of {w} x {h}" if data.ndim == 4 else f"{w} x {h}"
-    lines.append(f"  kind: {attrs['kind']}" + (f"   table: {attrs['table']}" if "table" in attrs else ""))
-    lines.append(
-        f"  image: {layout}, {nch} channel(s) {','.join(facts[0]['channels'])}, "
-        f"{facts[0]['format']}, {facts[0]['compression']} compression"
-    )
-    lines.append("  row 0 = y index 0, column 0 = x index 0 (no flip)")
-
-    lines.append("axes:")
-    for ax in axes:
-        values = ax.get("values") or []
-        rng = ax.get("range", ["?", "?"])
-        lines.append(
-            f"  {ax.get('name')}: {ax.get('dim')} ({ax.get('image')}), count {ax.get('count')}, "
-            f"range [{_fmt(rng[0])}, {_fmt(rng[1])}]"
-        )
-        lines.append(
-            f"    texel {ax.get('texel')} ({ax.get('texel_formula')}), "
-            f"mapping {ax.get('mapping')} ({ax.get('mapping_formula')})"
-        )
-        if values:
-            lines.append(f"    index 0 = {_fmt(values[0])}, index {len(values) - 1} = {_fmt(values[-1])}")
-        if ax.get("uv_formula"):
-            lines.append(f"    order {ax.get('order')}; sample at {ax.get('uv_formula')}")
-        alpha = ax.get("alpha")
-        if alpha:
-            lines.append(f"    alpha {_fmt(min(alpha))} .. {_fmt(max(alpha))} ({ax.get('alpha_formula')})")
-    if data.ndim == 4:
-        slices = ", ".join(f"{f['name']}={a.get('slice_value', '?')}" for f, a in zip(facts, part_attrs))
-        lines.append(f"  parts: {slices}")
-
-    lines.append("channels:")
-    for c in facts[0]["channels"]:
-        lines.append(f"  {c} = {channels.get(c, '(no meaning recorded)')}")
-    lines.append("reconstruction:")
-    lines.extend(f"  {line}" for line in attrs.get("reconstruction", "(none recorded)").splitlines())
-
-    lines.append("provenance:")
-    for key in _PROVENANCE:
-        if key in attrs:
-            lines.append(f"  {key}: {attrs[key]}")
-    if "config" in attrs:
-        n = len(attrs["config"].splitlines())
-        lines.append(f"  config: {n} line(s) of TOML in lutbake:config")
-    shown = {"kind", "table", "axes", "channels", "channel_names", "reconstruction", "config", *_PROVENANCE}
-    for key in sorted(set(attrs) - shown):
-        value = attrs[key]
-        lines.append(f"  {key}: {value if len(value) <= 200 else value[:200] + ' ...'}")
-
-    lines.append("statistics:")
-    flat = data.reshape(-1, data.shape[-1]).astype(np.float64)
-    for i, c in enumerate(facts[0]["channels"]):
-        col = flat[:, i]
-        lines.append(f"  {c}: min {_fmt(col.min())}  max {_fmt(col.max())}  mean {_fmt(col.mean())}")
-    return "\n".join(lines) + "\n"

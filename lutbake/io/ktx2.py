@@ -1,4 +1,4 @@
-"""KTX 2.0 writer, per the Khronos KTX File Format Specification 2.0 and the Khronos Data Format
+"""KTX 2.0 writer and reader, per the Khronos KTX File Format Specification 2.0 and the Khronos Data Format
 Specification 1.3 (basic data format descriptor). One mip level, uncompressed or, with
 ``supercompression="zstd"``, supercompressionScheme 2 (Zstandard, level ZSTD_LEVEL): the level's bytes are one
 zstd frame, ``byteLength`` the compressed and ``uncompressedByteLength`` the raw size (KTX 2.0 §3.12.2, §4.1;
@@ -112,32 +112,63 @@ def encode(
     return head + dfd + kvd + b"\0" * (level_off - end) + level
 
 
-def decode(blob: bytes) -> tuple[np.ndarray, dict[str, str]]:
-    """Read a one-level float KTX2 (what ``encode`` writes, uncompressed or zstd): (array, key/value data).
-    2D -> (y, x, C); 3D or array -> (z, y, x, C). Rows in file order (KTXorientation ``rd``: row 0 first)."""
+def _kv_pairs(blob: bytes, start: int, length: int) -> dict[str, str]:
+    """Key/value data: repeated (u32 keyAndValueByteLength, key NUL value NUL, padding to 4 bytes)."""
+    pairs, pos, end = {}, start, start + length
+    while pos + 4 <= end:
+        (n,) = struct.unpack_from("<I", blob, pos)
+        if n == 0 or pos + 4 + n > end:
+            raise ValueError(f"KTX2 key/value entry at byte {pos} runs past the key/value data")
+        key, sep, value = blob[pos + 4 : pos + 4 + n].partition(b"\0")
+        if not sep:
+            raise ValueError(f"KTX2 key/value entry at byte {pos} has no NUL after its key")
+        pairs[key.decode("utf-8", "replace")] = value.rstrip(b"\0").decode("utf-8", "replace")
+        pos += 4 + n + (-n % 4)
+    return pairs
+
+
+def decode(blob: bytes) -> tuple[np.ndarray, dict]:
+    """Read a one-level float KTX 2.0 file (what ``encode`` writes, uncompressed or zstd): (array (y, x, C), or
+    (z, y, x, C) for a 3D or array texture, as stored; facts incl. the key/value data). Only level 0 is read. Every
+    offset and size is checked against the file length first; a ValueError says what is wrong."""
     if blob[:12] != IDENTIFIER:
         raise ValueError("not a KTX 2.0 file (bad identifier)")
-    vk, _, width, height, depth, layers, faces, levels, scheme = struct.unpack_from("<9I", blob, 12)
+    if len(blob) < 104:
+        raise ValueError(f"KTX2 file of {len(blob)} bytes is shorter than its header (104 bytes)")
+    vk, type_size, width, height, depth, layers, faces, levels, scheme = struct.unpack_from("<9I", blob, 12)
+    _, _, kvd_off, kvd_len, _, _ = struct.unpack_from("<4I2Q", blob, 48)
+    level_off, level_len, raw_len = struct.unpack_from("<3Q", blob, 80)
     if vk not in FROM_VK_FORMAT:
-        raise ValueError(
-            f"KTX2 vkFormat {vk} is not a float format lutbake reads ({', '.join(VK_FORMAT_NAMES.values())})"
-        )
+        raise ValueError(f"vkFormat {vk} is not one lutbake reads ({', '.join(VK_FORMAT_NAMES.values())})")
     if scheme not in SUPERCOMPRESSION.values():
         raise ValueError(f"KTX2 supercompressionScheme {scheme}: only none (0) and Zstandard (2) are read")
-    dfd_off, dfd_len, kvd_off, kvd_len, _, _ = struct.unpack_from("<IIIIQQ", blob, 48)
-    level_off, level_len, raw_len = struct.unpack_from("<QQQ", blob, 80)
-    level = blob[level_off : level_off + level_len]
-    if scheme:
-        import zstandard
-
-        level = zstandard.ZstdDecompressor().decompress(level, max_output_size=raw_len)
-    pairs, pos = {}, kvd_off
-    while pos < kvd_off + kvd_len:
-        (n,) = struct.unpack_from("<I", blob, pos)
-        key, _, value = blob[pos + 4 : pos + 4 + n].partition(b"\0")
-        pairs[key.decode("utf-8")] = value.rstrip(b"\0").decode("utf-8")
-        pos += 4 + n + (-n % 4)
+    if faces != 1:
+        raise ValueError(f"KTX2 with {faces} faces (lutbake reads 2D, 3D and array textures)")
+    if kvd_off + kvd_len > len(blob):
+        raise ValueError(f"KTX2 key/value data [{kvd_off}, +{kvd_len}) runs past the file ({len(blob)} bytes)")
     dtype, nch = FROM_VK_FORMAT[vk]
     npdt = np.dtype("<f2" if dtype == "half" else "<f4")
-    shape = ((max(depth, layers),) if (depth or layers) else ()) + (height, width, nch)
-    return np.frombuffer(level, dtype=npdt, count=int(np.prod(shape))).reshape(shape), pairs
+    shape = ((depth,) if depth else (layers,) if layers else ()) + (height, width, nch)
+    need = int(np.prod(shape, dtype=object)) * npdt.itemsize
+    level = blob[level_off : level_off + level_len]
+    if scheme:  # one zstd frame of uncompressedByteLength bytes (KTX 2.0 §3.12.2)
+        import zstandard
+
+        if raw_len != need:
+            raise ValueError(f"KTX2 uncompressedByteLength {raw_len} != {need} bytes of its header's shape")
+        level = zstandard.ZstdDecompressor().decompress(level, max_output_size=raw_len)
+        level_off, level_len = 0, len(level)
+    if min(shape) < 1 or need > level_len or (not scheme and level_off + need > len(blob)):
+        raise ValueError(
+            f"KTX2 header says {' x '.join(map(str, shape))} {VK_FORMAT_NAMES[vk]} ({need} bytes) but "
+            f"level 0 holds {level_len} bytes at offset {level_off} of a {len(blob)}-byte file"
+        )
+    arr = np.frombuffer(level, dtype=npdt, count=int(np.prod(shape))).reshape(shape)
+    kv = _kv_pairs(blob, kvd_off, kvd_len)
+    return arr, {
+        "vk_format": VK_FORMAT_NAMES[vk],
+        "dimension": "3D" if depth else "2D array" if layers else "2D",
+        "levels": max(levels, 1),
+        "supercompression": {v: k for k, v in SUPERCOMPRESSION.items()}[scheme],
+        "key_value": kv,
+    }

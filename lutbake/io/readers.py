@@ -1,159 +1,558 @@
-"""Read any LUT file lutbake can audit into a float64 (rows, columns, channels) array.
+"""Read every file lutbake writes, and the tables engines ship: one reader per format, chosen by the
+file's first bytes (its magic number), never by its extension.
 
-``read_lut(path, shape=None, encoding=None) -> LutFile``. Formats, by extension:
-- ``.exr``: OpenImageIO, float; the ``lutbake:*`` attributes when present.
-- ``.png``: OpenImageIO, the raw UNORM codes (8 or 16 bit), value = code / (2^bits - 1), **no transfer function**.
-- ``.dds``: DX10 header, R16G16_FLOAT ... RGBA32F (lutbake.io.dds); ``.ktx2``: lutbake.io.ktx2.decode (plain or zstd).
-- ``.npy``, ``.npz``: an integer array is UNORM codes (value = code / dtype max), a float array values (npz: the
-  array named ``table``, else its only one).
-- ``.h .hpp .inc .js .ts .mjs .wgsl .rs``: the numbers of the first brace/bracket array: hex ``0x....`` literals
-  are IEEE half bits, decimal literals floats.
-``storage`` records how the file stores a value (unorm8/16, half, float32), which the audit's quantisation check uses.
-A text array's layout must be declared: ``#define *_HEIGHT/_WIDTH/_CHANNELS`` (lutbake's C header), the
-``lutbake:shape`` line of lutbake's JS/WGSL/Rust comment block, or ``shape=(rows, columns, channels)``.
-Row 0 of the result is the first row stored in the file (no flip). A JSON sidecar beside the file
-(lutbake's ``<file>.json``, or a ``<stem>.json`` provenance note) is returned in ``sidecar``.
+| format | magic | pixels | lutbake metadata |
+| --- | --- | --- | --- |
+| EXR | ``76 2f 31 01`` | OpenImageIO, any channels, every part (3D: a part per z) | ``lutbake:*`` attributes |
+| NumPy | ``\\x93NUMPY`` | ``np.load`` (no pickles), 2 to 4 dimensions | the ``.json`` sidecar |
+| PNG | ``\\x89PNG\\r\\n\\x1a\\n`` | OpenImageIO; codes / 65535 (8-bit: / 255), linear | the ``.json`` sidecar |
+| DDS | ``DDS `` | lutbake.io.dds.decode (DX10 float formats; OpenImageIO 3.x reads none) | the ``.json`` sidecar |
+| KTX2 | ``«KTX 20»\\r\\n\\x1a\\n`` | lutbake.io.ktx2.decode | ``lutbake:metadata`` key/value, else sidecar |
+| C header | text from ``/*``, ``//`` or ``#`` | its ``static const`` array and size macros | the ``.json`` sidecar |
+| sidecar | text from ``{`` | the data file it names (``"file"``) | its ``"lutbake"`` object |
+
+``read(path)`` returns a :class:`LoadedFile` (pixels as stored, including a GPU format's padding
+channel); ``table_view(loaded)`` checks the metadata against the pixels and returns a
+:class:`TableView` (axes rebuilt as :class:`lutbake.axes.Axis`, channels trimmed to the table's). A
+file lutbake cannot read, or metadata that does not fit its pixels, raises :class:`ReadError`: one line
+that names the file once and says what is wrong. A file without lutbake metadata still reads: format,
+size, channels and values.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-TEXT_EXTENSIONS = (".h", ".hpp", ".inc", ".js", ".mjs", ".ts", ".wgsl", ".rs")
-READABLE = (".exr", ".png", ".dds", ".ktx2", ".npy", ".npz") + TEXT_EXTENSIONS
+from ..axes import IMAGE_DIMS, MAPPINGS, ORDERS, TEXELS, Axis
+from ..errors import LutbakeError
+from ..warp_runtime import stderr_silenced
+from . import dds, ktx2
+
+PREFIX = "lutbake:"
+MAGIC_BYTES = 16  # enough to tell every format apart
+MAX_AXIS_COUNT = 1 << 20  # no lutbake axis is longer (the texel cap is 2^24 in all)
+MAX_FILE_BYTES = 4 << 30  # a table is at most 2^24 texels x 4 channels x 4 bytes = 256 MiB; headers are text
+EXR_MAGIC = b"\x76\x2f\x31\x01"
+NPY_MAGIC = b"\x93NUMPY"
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+GENERIC_FORMATS = ("exr", "npy", "png16", "dds", "ktx2", "h")  # sidecar "format"s whose pixels lutbake reads
+FORMAT_NAMES = {
+    "engine": "engine-specific file",
+    "exr": "OpenEXR",
+    "npy": "NumPy .npy",
+    "png": "PNG",
+    "dds": "DDS",
+    "ktx2": "KTX 2.0",
+    "h": "C header",
+    "sidecar": "lutbake .json sidecar",
+    "report": "lutbake bake report (--report)",
+}
+
+
+class ReadError(LutbakeError, ValueError):
+    """A file lutbake cannot read, or metadata that does not fit the file: one line that names the file."""
+
+    def __init__(self, message: str):
+        super().__init__("; ".join(line.strip() for line in str(message).splitlines() if line.strip()))
 
 
 @dataclass
-class LutFile:
+class LoadedFile:
     path: Path
-    data: np.ndarray  # float64 (rows, columns, channels), file row order
-    storage: str  # "unorm8", "unorm16", "half", "float32", ...: how the file stores a value
-    attrs: dict = field(default_factory=dict)  # lutbake:* attributes (without the prefix) when present
-    sidecar: dict = field(default_factory=dict)
+    format: str  # a key of FORMAT_NAMES
+    data: np.ndarray | None  # float32, (y, x, C) or (z, y, x, C), as stored; None: a sidecar whose data is missing
+    attrs: dict[str, str]  # lutbake attributes without the prefix; {} when the file carries none
+    meta_source: str | None  # where ``attrs`` came from ("EXR header", "sidecar dfg.json", ...)
+    facts: dict = field(default_factory=dict)  # what the container says: pixel type, texture format, parts ...
+    notes: list[str] = field(default_factory=list)  # why metadata is missing, and the like
+
+
+@dataclass
+class TableView:
+    """A read table with its metadata checked against its pixels (``kind`` None: no lutbake metadata)."""
+
+    loaded: LoadedFile
+    data: np.ndarray  # float32, (y, x, C) or (z, y, x, C), channels trimmed to the table's
+    axes: list[Axis]  # [] without metadata
+    channel_names: list[str]  # one per channel of ``data``
+    meanings: list[str]
+    kind: str | None
+    name: str
+    terms: dict
+    reconstruction: str
 
     @property
-    def unorm_bits(self) -> int | None:
-        return int(self.storage[5:]) if self.storage.startswith("unorm") else None
+    def attrs(self) -> dict[str, str]:
+        return self.loaded.attrs
 
 
-def _unorm(codes: np.ndarray) -> tuple[np.ndarray, str]:
-    bits = codes.dtype.itemsize * 8
-    return codes.astype(np.float64) / float((1 << bits) - 1), f"unorm{bits}"
-
-
-def _float_storage(arr: np.ndarray) -> str:
-    return "half" if arr.dtype == np.float16 else "float32" if arr.dtype == np.float32 else "float64"
-
-
-def _read_png(path: Path) -> tuple[np.ndarray, str]:
-    import OpenImageIO as oiio
-
-    inp = oiio.ImageInput.open(str(path))
-    if inp is None:
-        raise ValueError(f"{path}: cannot open PNG: {oiio.geterror()}")
-    try:
-        spec = inp.spec()
-        native = oiio.UINT16 if spec.format.size() == 2 else oiio.UINT8
-        codes = inp.read_image(native)  # raw codes: OIIO applies no transfer function on read
-    finally:
-        inp.close()
-    if codes is None:
-        raise ValueError(f"{path}: cannot read PNG pixels")
-    return _unorm(np.asarray(codes))
-
-
-def _text_shape(text: str, shape) -> tuple[int, ...]:
-    if shape is not None:
-        return tuple(int(s) for s in shape)
-    m = re.search(r"lutbake:shape\s*[=:]\s*\[?\s*(\d+)\s*,\s*(\d+)\s*,\s*(\d+)", text)
-    if m:
-        return tuple(int(g) for g in m.groups())
-    dims = {k: int(v) for k, v in re.findall(r"#define\s+\w+?_(HEIGHT|WIDTH|CHANNELS)\s+(\d+)", text)}
-    if len(dims) == 3:
-        return dims["HEIGHT"], dims["WIDTH"], dims["CHANNELS"]
-    raise ValueError(
-        "the array's layout is not declared in the file: give shape=(rows, columns, channels) "
-        "(CLI: --shape ROWSxCOLUMNSxCHANNELS)"
+def sniff(path: Path) -> str:
+    """The format of ``path`` from its first bytes (FORMAT_NAMES); ReadError for anything else."""
+    if not path.exists():
+        raise ReadError(f"{path}: no such file")
+    if not path.is_file():
+        raise ReadError(f"{path}: not a regular file")
+    with open(path, "rb") as f:
+        head = f.read(MAGIC_BYTES)
+    for magic, fmt in (
+        (EXR_MAGIC, "exr"),
+        (NPY_MAGIC, "npy"),
+        (PNG_MAGIC, "png"),
+        (dds.MAGIC, "dds"),
+        (ktx2.IDENTIFIER, "ktx2"),
+    ):
+        if head.startswith(magic):
+            return fmt
+    text = head.lstrip(b"\xef\xbb\xbf \t\r\n")
+    if text.startswith(b"{"):
+        return "sidecar"
+    if text.startswith((b"/*", b"//", b"#")):
+        return "h"
+    shown = head[:8].hex(" ") if head else "nothing (an empty file)"
+    raise ReadError(
+        f"{path}: not a format lutbake reads (EXR, npy, PNG, DDS, KTX2, C header, .json sidecar): "
+        f"it starts with {shown}"
     )
 
 
-def parse_text_array(text: str, shape=None) -> tuple[np.ndarray, str]:
-    """The values of the first ``{...}`` / ``[...]`` array literal after its declaration: hex literals
-    are IEEE 754 binary16 bit patterns, decimal literals floats; comments are skipped."""
-    body = re.sub(r"/\*.*?\*/", " ", text, flags=re.S)
-    body = re.sub(r"//[^\n]*", " ", body)
-    m = re.search(r"(?:=|\()\s*[^{\[;]*?[{\[]\s*((?:0x|[-+.\d])[^;]*)", body)
-    if not m:
-        raise ValueError("no array literal found")
-    payload = m.group(1)
-    hexes = re.findall(r"0x([0-9a-fA-F]{1,4})\b", payload)
-    shp = _text_shape(text, shape)
-    n = int(np.prod(shp))
-    if hexes:
-        bits = np.array([int(h, 16) for h in hexes[:n]], dtype=np.uint16)
-        arr, storage = bits.view(np.float16).astype(np.float64), "half"
-    else:
-        nums = re.findall(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?", payload)
-        arr, storage = np.array([float(x) for x in nums[:n]], dtype=np.float64), "float32"
-    if arr.size != n:
-        raise ValueError(f"the array holds {arr.size} values, the declared shape {shp} needs {n}")
-    return arr.reshape(shp), storage
-
-
-def read_lut(path, shape=None) -> LutFile:
-    """Read ``path`` (see the module docstring). ``shape``: (rows, columns, channels) of a text array
-    whose file does not declare it."""
-    from .dds import decode as dds_decode
-    from .exr import read_exr
-    from .ktx2 import decode as ktx2_decode
-
+def read(path) -> LoadedFile:
+    """Read any file lutbake writes (see the module docstring), dispatched by its magic bytes."""
     path = Path(path)
-    ext = path.suffix.lower()
-    if ext not in READABLE:
-        raise ValueError(f"{path}: cannot read '{ext}' files; readable: {', '.join(READABLE)}")
-    if not path.is_file():
-        raise ValueError(f"{path}: no such file")
-    attrs, sidecar = {}, {}
-    for side in (path.with_name(path.name + ".json"), path.with_suffix(".json")):  # lutbake's, then refs style
-        if side.is_file():
-            sidecar = json.loads(side.read_text())
-            attrs = sidecar.get("lutbake", {})
-            break
-    if ext == ".exr":
-        data, attrs = read_exr(path)
-        storage = "float32"
-    elif ext == ".png":
-        data, storage = _read_png(path)
-    elif ext == ".dds":
-        arr, _ = dds_decode(path.read_bytes())
-        data, storage = arr.astype(np.float64), _float_storage(arr)
-    elif ext == ".ktx2":
-        arr, kv = ktx2_decode(path.read_bytes())
-        data, storage = arr.astype(np.float64), _float_storage(arr)
-        if "lutbake:metadata" in kv:
-            attrs = json.loads(kv["lutbake:metadata"])
-    elif ext in (".npy", ".npz"):
-        arr = np.load(path, allow_pickle=False)
-        if ext == ".npz":  # one array: named "table" (tests/data), else the only one
-            names = list(arr.files)
-            arr = arr["table" if "table" in names else names[0]]
-        if np.issubdtype(arr.dtype, np.unsignedinteger):
-            data, storage = _unorm(arr)
-        else:
-            data, storage = arr.astype(np.float64), _float_storage(arr)
+    fmt = sniff(path)
+    size = path.stat().st_size
+    if size > MAX_FILE_BYTES:
+        raise ReadError(f"{path}: {size} bytes is larger than any table lutbake writes ({MAX_FILE_BYTES} bytes)")
+    try:
+        loaded = READERS[fmt](path)
+    except (ValueError, KeyError, TypeError, IndexError, OverflowError, UnicodeDecodeError, EOFError):
+        engine = _engine_sidecar(path)
+        if engine is None:
+            return _read_or_raise(path, fmt)
+        return engine
+    if loaded.facts.get("sidecar_format", "exr") not in GENERIC_FORMATS:
+        return _engine_sidecar(path) or loaded
+    return loaded
+
+
+def _engine_sidecar(path: Path) -> LoadedFile | None:
+    """A file in an engine's own layout (``format`` = ltc_dds, openpbr_h, a .cs/.js/.cc module ...): its
+    sidecar's metadata without pixels, or None when no sidecar names the file with such a format."""
+    for side in sidecar_candidates(path):
+        if side.is_file() and side != path:
+            doc = _load_json(side)
+            if isinstance(doc, dict) and doc.get("file") == path.name and doc.get("format") not in GENERIC_FORMATS:
+                doc = _load_sidecar(side, doc)
+                note = (
+                    f"engine-specific format {doc.get('format')!r}: lutbake reads its metadata (sidecar "
+                    f"{side.name}), not its pixels; bake the table as exr to look at them"
+                )
+                facts = {k: v for k, v in doc.items() if k != "lutbake"}
+                return LoadedFile(path, "engine", None, doc["lutbake"], f"sidecar {side.name}", facts, [note])
+    return None
+
+
+def _read_or_raise(path: Path, fmt: str) -> LoadedFile:
+    try:
+        return READERS[fmt](path)
+    except (LutbakeError, MemoryError):
+        raise
+    except OSError as e:
+        raise ReadError(f"{path}: cannot read: {e.strerror or e}") from None
+    except (ValueError, KeyError, TypeError, IndexError, OverflowError, UnicodeDecodeError, EOFError) as e:
+        raise ReadError(f"{path}: not a readable {FORMAT_NAMES[fmt]} file: {e}") from None
+
+
+# ------------------------------------------------------------------------------------------ readers
+
+
+def _as_table_array(arr: np.ndarray) -> np.ndarray:
+    """float32 (y, x, C) or (z, y, x, C): a 2D array gains a channel axis."""
+    if arr.dtype.kind not in "fiub":
+        raise ValueError(f"array of dtype {arr.dtype} holds no numbers")
+    if arr.ndim == 2:
+        arr = arr[..., None]
+    if arr.ndim not in (3, 4) or arr.shape[-1] > 4 or 0 in arr.shape:
+        raise ValueError(
+            f"array of shape {arr.shape} is not a table: lutbake reads (y, x), (y, x, C) or "
+            "(z, y, x, C) with 1 to 4 channels"
+        )
+    return np.ascontiguousarray(arr, dtype=np.float32)
+
+
+def _exr_attrs(spec) -> dict[str, str]:
+    return {
+        p.name[len(PREFIX) :]: p.value if isinstance(p.value, str) else json.dumps(p.value)
+        for p in spec.extra_attribs
+        if p.name.startswith(PREFIX)
+    }
+
+
+def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
+    """Every part of an EXR: (float32 pixels (y, x, C), lutbake attributes, facts). Channels R, G, B, A
+    come in that order; any other channel names are kept in file order."""
+    import OpenImageIO as oiio  # imported here: only EXR and PNG need it
+
+    with stderr_silenced():  # libpng / OpenEXR print their own complaints; the ReadError says it once
+        inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
+    parts = []
+    try:
+        k = 0
+        while inp.seek_subimage(k, 0):
+            spec = inp.spec()
+            names = list(spec.channelnames)
+            rgba = [c for c in "RGBA" if c in names]
+            order = rgba if len(rgba) == len(names) else names
+            with stderr_silenced():
+                arr = inp.read_image(k, 0, 0, len(names), "float")
+            if arr is None:
+                raise ValueError(f"cannot read the pixels of part {k}: {inp.geterror()}")
+            arr = np.asarray(arr, dtype=np.float32).reshape(spec.height, spec.width, len(names))
+            arr = np.ascontiguousarray(arr[..., [names.index(c) for c in order]])
+            facts = {
+                "pixel_type": str(spec.format),
+                "compression": spec.getattribute("compression"),
+                "part": spec.getattribute("name") or spec.getattribute("oiio:subimagename"),
+                "channels": order,
+            }
+            parts.append((arr, _exr_attrs(spec), facts))
+            k += 1
+    finally:
+        inp.close()
+    if not parts:
+        raise ValueError("no image part")
+    return parts
+
+
+def read_exr(path: Path) -> LoadedFile:
+    parts = exr_parts(path)
+    shapes = {p[0].shape for p in parts}
+    if len(shapes) != 1:
+        raise ValueError(f"its parts have different shapes {sorted(shapes)}")
+    attrs = {k: v for k, v in parts[0][1].items() if k not in ("slice_index", "slice_value")}
+    facts = {**parts[0][2], "parts": [(f["part"], a.get("slice_value")) for _, a, f in parts]}
+    if len(parts) == 1 and "slice_index" not in parts[0][1]:
+        data = parts[0][0]
     else:
+        order = [int(a.get("slice_index", k)) for k, (_, a, _) in enumerate(parts)]
+        if sorted(order) != list(range(len(order))):
+            raise ValueError(f"slice indices {order} are not 0..{len(order) - 1}")
+        data = np.stack([parts[order.index(k)][0] for k in range(len(order))])
+    return LoadedFile(path, "exr", data, attrs, "EXR header" if attrs else None, facts)
+
+
+def read_npy(path: Path) -> LoadedFile:
+    arr = np.load(path, mmap_mode="r", allow_pickle=False)
+    data = _as_table_array(np.asarray(arr))
+    return _with_sidecar(LoadedFile(path, "npy", data, {}, None, {"dtype": str(arr.dtype), "shape": list(arr.shape)}))
+
+
+def read_png(path: Path) -> LoadedFile:
+    import OpenImageIO as oiio
+
+    with stderr_silenced():
+        inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
+    try:
+        spec = inp.spec()
+        bits = 16 if str(spec.format) == "uint16" else 8
+        with stderr_silenced():
+            arr = inp.read_image("uint16" if bits == 16 else "uint8")
+        if arr is None:
+            raise ValueError(inp.geterror())
+        codes = np.asarray(arr).reshape(spec.height, spec.width, spec.nchannels)
+    finally:
+        inp.close()
+    data = _as_table_array(codes.astype(np.float64) / float((1 << bits) - 1))
+    facts = {"bit_depth": bits, "channels": list(spec.channelnames), "encoding": f"code / {(1 << bits) - 1}"}
+    return _with_sidecar(LoadedFile(path, "png", data, {}, None, facts))
+
+
+def read_dds(path: Path) -> LoadedFile:
+    arr, facts = dds.decode(path.read_bytes())
+    return _with_sidecar(LoadedFile(path, "dds", _as_table_array(arr), {}, None, facts))
+
+
+def read_ktx2(path: Path) -> LoadedFile:
+    arr, facts = ktx2.decode(path.read_bytes())
+    kv = facts.pop("key_value")
+    facts.update({k: v for k, v in kv.items() if k.startswith("KTX")})
+    loaded = LoadedFile(path, "ktx2", _as_table_array(arr), {}, None, facts)
+    if "lutbake:metadata" in kv:
         try:
-            data, storage = parse_text_array(path.read_text(errors="replace"), shape)
-        except ValueError as e:
-            raise ValueError(f"{path}: {e}") from None
-    data = np.asarray(data, dtype=np.float64)
-    if data.ndim == 2:
-        data = data[..., None]
-    if data.ndim != 3:
-        raise ValueError(f"{path}: a 2D table (rows, columns, channels) is needed, got shape {data.shape}")
-    return LutFile(path, data, storage, attrs, sidecar)
+            meta = json.loads(kv["lutbake:metadata"])
+        except json.JSONDecodeError as e:
+            raise ReadError(f"{path}: key/value lutbake:metadata is not valid JSON ({e})") from None
+        loaded.attrs = _string_attrs(meta, path, "key/value lutbake:metadata")
+        loaded.meta_source = "KTX2 key/value data"
+        return loaded
+    return _with_sidecar(loaded)
+
+
+_DEFINE = re.compile(r"^#define\s+(\w+?)_(DEPTH|HEIGHT|WIDTH|CHANNELS)\s+(\d+)\s*$", re.M)
+_ARRAY = re.compile(r"static\s+const\s+(uint16_t|float)\s+(\w+)\s*\[[^\]]*\]\s*=\s*\{([^}]*)\}", re.S)
+
+
+def read_header(path: Path) -> LoadedFile:
+    """A C header as lutbake writes it (lutbake.io.formats.header_text): size macros and one flat array
+    of floats or binary16 bit patterns."""
+    text = path.read_text(encoding="utf-8")
+    m = _ARRAY.search(text)
+    if m is None:
+        raise ValueError("no 'static const float|uint16_t NAME[...] = {...}' array")
+    ctype, ident, body = m.groups()
+    dims = {k: int(v) for macro, k, v in _DEFINE.findall(text) if macro == ident.upper()}
+    if not {"HEIGHT", "WIDTH", "CHANNELS"} <= set(dims):
+        raise ValueError(f"no {ident.upper()}_HEIGHT / _WIDTH / _CHANNELS macros for array {ident}")
+    shape = tuple(dims[k] for k in ("DEPTH", "HEIGHT", "WIDTH", "CHANNELS") if k in dims)
+    items = [s for s in (x.strip() for x in body.split(",")) if s]
+    if math.prod(shape) != len(items):
+        raise ValueError(f"array {ident} has {len(items)} values, its macros say {' x '.join(map(str, shape))}")
+    if ctype == "uint16_t":
+        data = np.array([int(s, 0) for s in items], dtype=np.uint16).view(np.float16)
+    else:
+        data = np.array([s.rstrip("fF") for s in items], dtype=np.float64)
+    loaded = LoadedFile(
+        path,
+        "h",
+        _as_table_array(data.reshape(shape)),
+        {},
+        None,
+        {"array": ident, "element_type": ctype + (" (binary16 bits)" if ctype == "uint16_t" else "")},
+    )
+    return _with_sidecar(loaded)
+
+
+def _is_report(doc) -> bool:
+    return isinstance(doc, dict) and "lutbake" not in doc and {"lutbake_version", "tables"} <= set(doc)
+
+
+def _load_json(path: Path):
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as e:
+        raise ReadError(f"{path}: sidecar is not valid JSON ({e})") from None
+
+
+def _load_sidecar(path: Path, doc=None) -> dict:
+    doc = _load_json(path) if doc is None else doc
+    if not isinstance(doc, dict):
+        raise ReadError(f"{path}: a sidecar is a JSON object with a 'lutbake' object, got {type(doc).__name__}")
+    if "lutbake" not in doc:
+        raise ReadError(f"{path}: JSON without a 'lutbake' object: not a lutbake sidecar")
+    doc["lutbake"] = _string_attrs(doc["lutbake"], path, "key 'lutbake'")
+    return doc
+
+
+def _string_attrs(meta, where: Path, what: str) -> dict[str, str]:
+    if not isinstance(meta, dict):
+        raise ReadError(
+            f"{where}: {what} must be a JSON object of lutbake attributes, got {type(meta).__name__} "
+            f"{json.dumps(meta)[:40]}"
+        )
+    bad = [k for k, v in meta.items() if not isinstance(v, str)]
+    if bad:
+        raise ReadError(f"{where}: {what}: attribute {bad[0]!r} must be a string, got {type(meta[bad[0]]).__name__}")
+    return dict(meta)
+
+
+def sidecar_candidates(path: Path) -> list[Path]:
+    """Where the sidecar of a data file may be: <name>.<ext>.json, then <name>.json."""
+    return [path.with_name(path.name + ".json"), path.with_suffix(".json")]
+
+
+def _with_sidecar(loaded: LoadedFile) -> LoadedFile:
+    """Attach the attributes of the sidecar that names this file (a sidecar naming another file is skipped)."""
+    for side in sidecar_candidates(loaded.path):
+        if not side.is_file() or side == loaded.path or _is_report(_load_json(side)):
+            continue
+        doc = _load_sidecar(side)
+        named = doc.get("file")
+        if named not in (None, loaded.path.name):
+            loaded.notes.append(f"{side.name} describes {named}, not this file")
+            continue
+        loaded.attrs, loaded.meta_source = doc["lutbake"], f"sidecar {side.name}"
+        loaded.facts["sidecar_format"] = doc.get("format", "")
+        return loaded
+    if not loaded.notes:
+        loaded.notes.append(f"no sidecar ({' or '.join(p.name for p in sidecar_candidates(loaded.path))})")
+    return loaded
+
+
+def read_sidecar(path: Path) -> LoadedFile:
+    """A sidecar: its attributes, with the pixels of the data file it names (beside it) when present.
+    A bake report (``lutbake bake --report``) reads as format "report": facts only, no pixels."""
+    doc = _load_json(path)
+    if _is_report(doc):
+        return LoadedFile(path, "report", None, {}, None, doc, ["a bake report: it lists tables and holds no pixels"])
+    doc = _load_sidecar(path, doc)
+    named = doc.get("file")
+    facts = {k: v for k, v in doc.items() if k != "lutbake"}
+    generic = doc.get("format", "exr") in GENERIC_FORMATS
+    if generic and isinstance(named, str) and named and Path(named).name == named and (path.parent / named).is_file():
+        data_path = path.parent / named
+        if sniff(data_path) == "sidecar":
+            raise ReadError(f"{path}: names another sidecar ({named}) as its data file")
+        inner = READERS[sniff(data_path)](data_path)
+        facts = {**facts, "data_file": named, "data_format": FORMAT_NAMES[inner.format], **inner.facts}
+        return LoadedFile(path, "sidecar", inner.data, doc["lutbake"], f"sidecar {path.name}", facts)
+    note = f"its data file {named!r} is not beside it" if named else "it names no data file"
+    if not generic:
+        note = f"it describes {named!r} in the engine-specific format {doc.get('format')!r} (metadata only)"
+    return LoadedFile(path, "sidecar", None, doc["lutbake"], f"sidecar {path.name}", facts, [note])
+
+
+READERS = {
+    "exr": read_exr,
+    "npy": read_npy,
+    "png": read_png,
+    "dds": read_dds,
+    "ktx2": read_ktx2,
+    "h": read_header,
+    "sidecar": read_sidecar,
+}
+
+
+# ------------------------------------------------------------------------------- metadata vs pixels
+
+
+def _json_attr(loaded: LoadedFile, key: str, kind: type, default):
+    where = f"{loaded.path}: {'lutbake:' if loaded.format == 'exr' else 'lutbake.'}{key}"
+    if key not in loaded.attrs:
+        if default is None:
+            raise ReadError(f"{where} is missing (every lutbake table records it)")
+        return default
+    try:
+        value = json.loads(loaded.attrs[key])
+    except json.JSONDecodeError as e:
+        raise ReadError(f"{where} is not valid JSON ({e})") from None
+    if not isinstance(value, kind):
+        raise ReadError(f"{where} must be a JSON {'list' if kind is list else 'object'}, got {loaded.attrs[key][:60]}")
+    return value
+
+
+def _number(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def axis_from_meta(d: dict, where: str = "axis") -> Axis:
+    """An Axis rebuilt from its ``lutbake:axes`` entry (Axis.describe()), every field checked."""
+
+    def bad(msg):
+        raise ReadError(f"{where}: {msg}")
+
+    if not isinstance(d, dict):
+        bad(f"each axis must be a JSON object, got {json.dumps(d)[:40]}")
+    name = d.get("name")
+    if not isinstance(name, str) or not name:
+        bad(f"an axis needs a 'name' string, got {json.dumps(d)[:60]}")
+    where = f"{where} {name!r}"
+    count = d.get("count")
+    if isinstance(count, float) and count.is_integer():
+        count = int(count)
+    if not isinstance(count, int) or isinstance(count, bool) or not 1 <= count <= MAX_AXIS_COUNT:
+        bad(f"count {count!r} is not an integer in [1, {MAX_AXIS_COUNT}]")
+    choices = {"dim": IMAGE_DIMS, "texel": TEXELS, "mapping": MAPPINGS, "order": ORDERS}
+    defaults = {"dim": None, "texel": "center", "mapping": "linear", "order": "lo_first"}
+    v = {}
+    for key, allowed in choices.items():
+        v[key] = d.get(key, defaults[key])
+        if v[key] not in allowed:
+            bad(f"{key} {v[key]!r} is not one of {', '.join(allowed)}")
+    rng = d.get("range", [0.0, 1.0])
+    if not (isinstance(rng, list) and len(rng) == 2 and all(map(_number, rng))):
+        bad(f"range {json.dumps(rng)[:40]} is not [lo, hi]")
+    clamp = d.get("clamp")
+    if clamp is not None and not (isinstance(clamp, list) and len(clamp) == 2 and all(map(_number, clamp))):
+        bad(f"clamp {json.dumps(clamp)[:40]} is not [lo, hi]")
+    listed = ()
+    if v["mapping"] == "listed":
+        vals = d.get("values")
+        if not (isinstance(vals, list) and len(vals) == count and all(map(_number, vals))):
+            bad(f"mapping 'listed' needs {count} numeric values")
+        listed = tuple(float(x) for x in vals)
+    return Axis(
+        name,
+        v["dim"],
+        count,
+        float(rng[0]),
+        float(rng[1]),
+        texel=v["texel"],
+        mapping=v["mapping"],
+        order=v["order"],
+        clamp=tuple(clamp) if clamp else None,
+        listed=listed,
+    )
+
+
+def _check_axes_fit(path: Path, axes: list[Axis], shape: tuple[int, ...]) -> None:
+    """Every axis' count matches the pixels along its image dimension (a y_block axis divides the rows)."""
+    sizes = {"z": shape[0] if len(shape) == 4 else 1, "y": shape[-3], "x": shape[-2]}
+    words = {"z": "slices", "y": "rows", "x": "columns", "y_block": "row blocks"}
+    dims = [a.dim for a in axes]
+    if len(set(dims)) != len(dims):
+        raise ReadError(f"{path}: lutbake axes: two axes share an image dimension: {dims}")
+    blocks = [a for a in axes if a.dim == "y_block"]
+    if blocks:
+        if sizes["y"] % blocks[0].count:
+            raise ReadError(f"{path}: lutbake axes: {sizes['y']} rows do not split into {blocks[0].count} row blocks")
+        sizes["y_block"], sizes["y"] = blocks[0].count, sizes["y"] // blocks[0].count
+    for a in axes:
+        if a.count != sizes[a.dim]:
+            raise ReadError(
+                f"{path}: lutbake axes: axis {a.name!r} ({a.dim}) has count {a.count} but the image "
+                f"has {sizes[a.dim]} {words[a.dim]} (shape {' x '.join(map(str, shape))})"
+            )
+    missing = [d for d in ("z", "y") if sizes[d] > 1 and d not in dims]
+    if "x" not in dims or missing:
+        raise ReadError(
+            f"{path}: lutbake axes {[a.name for a in axes]} do not cover the image's "
+            f"{', '.join(words[d] for d in ['x'] + missing)} (shape {' x '.join(map(str, shape))})"
+        )
+
+
+def table_view(loaded: LoadedFile) -> TableView:
+    """The table in a read file, its metadata checked against its pixels (ReadError if they disagree)."""
+    if loaded.data is None:
+        raise ReadError(f"{loaded.path}: {loaded.notes[0] if loaded.notes else 'no pixels'}")
+    data, path = loaded.data, loaded.path
+    if not loaded.attrs:
+        nch = data.shape[-1]
+        return TableView(loaded, data, [], [f"channel {c}" for c in "RGBA"[:nch]], [""] * nch, None, path.stem, {}, "")
+    if "kind" not in loaded.attrs:
+        raise ReadError(f"{path}: lutbake metadata ({loaded.meta_source}) without 'kind'")
+    axes_meta = _json_attr(loaded, "axes", list, None)
+    where = f"{path}: {'lutbake:' if loaded.format == 'exr' else 'lutbake.'}axes"
+    axes = [axis_from_meta(d, where) for d in axes_meta]
+    _check_axes_fit(path, axes, data.shape)
+    names = _json_attr(loaded, "channel_names", dict, {})
+    meanings = _json_attr(loaded, "channels", dict, {})
+    letters = [c for c in "RGBA" if c in names] or list("RGBA"[: data.shape[-1]])
+    if len(letters) > data.shape[-1]:
+        raise ReadError(f"{path}: lutbake channel_names lists {len(letters)} channels, the file holds {data.shape[-1]}")
+    data = data[..., : len(letters)]  # drop a GPU format's padding (PNG B = 0, DDS/KTX2 A = 1)
+    terms = _json_attr(loaded, "terms", dict, {})
+    return TableView(
+        loaded,
+        data,
+        axes,
+        [str(names.get(c, f"channel {c}")) for c in letters],
+        [str(meanings.get(c, "")) for c in letters],
+        loaded.attrs["kind"],
+        loaded.attrs.get("table", path.stem),
+        terms,
+        loaded.attrs.get("reconstruction", ""),
+    )
+
+
+def read_table(path) -> TableView:
+    """``table_view(read(path))``."""
+    return table_view(read(path))

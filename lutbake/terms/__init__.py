@@ -6,3 +6,9 @@ Naming follows the math: ``D_`` normal distributions, ``Lambda_``/``G1_``/``G2_`
 Host code picks terms by name: one ``Distribution`` object per NDF in :mod:`.distributions`
 (with the masking forms), composed into integrands by :mod:`lutbake.integrands`.
 """
+
+from ..warp_runtime import init_warp
+
+# Every lutbake kernel is composed of these terms, so any module that can launch one has imported this
+# package first: Warp starts here, quietly unless LUTBAKE_VERBOSE is set (lutbake.warp_runtime).
+init_warp()

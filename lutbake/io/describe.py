@@ -1,0 +1,147 @@
+"""``lutbake inspect FILE``: what a table file holds, in words, for every format lutbake reads
+(lutbake.io.readers). With lutbake metadata: kind, axes, channels, reconstruction, provenance and
+per-channel statistics; without (a LUT an engine ships): format, size, channels and value ranges."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from .readers import FORMAT_NAMES, LoadedFile, read, table_view
+
+PROVENANCE = ("terms", "estimator", "samples", "seed", "error_estimate", "version", "warp_version")
+SHOWN = {"kind", "table", "axes", "channels", "channel_names", "reconstruction", "config", *PROVENANCE}
+LONG_VALUE = 200  # characters of any other attribute shown
+
+
+def _fmt(x: float) -> str:
+    return f"{x:.6g}"
+
+
+def _container(loaded: LoadedFile) -> str:
+    f = loaded.facts
+    if loaded.format == "exr":
+        return f"{f.get('pixel_type')} pixels, {f.get('compression')} compression"
+    if loaded.format == "dds":
+        return f"DXGI {f['dxgi_format']}, {f['dimension']}, {f['mips']} mip level(s)"
+    if loaded.format == "ktx2":
+        return f"{f['vk_format']}, {f['dimension']} texture, orientation {f.get('KTXorientation', '?')}"
+    if loaded.format == "png":
+        return f"{f['bit_depth']}-bit, linear values = {f['encoding']}"
+    if loaded.format == "npy":
+        return f"dtype {f['dtype']}, shape {tuple(f['shape'])}"
+    if loaded.format == "h":
+        return f"array {f['array']} of {f['element_type']}"
+    if loaded.format == "engine":
+        return f"{f.get('format')}"
+    if "data_file" in f:
+        return f"describes {f['data_file']} ({f['data_format']})"
+    if loaded.format == "report":
+        return f"{len(f.get('tables') or [])} table(s)"
+    return "no data file"
+
+
+def _image_line(data: np.ndarray) -> str:
+    if data.ndim == 4:
+        z, h, w, nch = data.shape
+        return f"{z} slices of {w} x {h}, {nch} channel(s)"
+    h, w, nch = data.shape
+    return f"{w} x {h}, {nch} channel(s)"
+
+
+def _statistics(data: np.ndarray, names: list[str]) -> list[str]:
+    lines = ["statistics:"]
+    flat = data.reshape(-1, data.shape[-1]).astype(np.float64)
+    for i, name in enumerate(names):
+        col = flat[:, i]
+        lines.append(f"  {name}: min {_fmt(col.min())}  max {_fmt(col.max())}  mean {_fmt(col.mean())}")
+    return lines
+
+
+def _report_lines(doc: dict) -> list[str]:
+    counts = doc.get("counts") if isinstance(doc.get("counts"), dict) else {}
+    lines = [
+        f"  lutbake {doc.get('lutbake_version')}, exit status {doc.get('exit_status')}"
+        + (f", interrupted by {doc['interrupted_by']}" if doc.get("interrupted_by") else ""),
+        "  " + ", ".join(f"{v} {k}" for k, v in counts.items()),
+        "tables:",
+    ]
+    for t in doc.get("tables") if isinstance(doc.get("tables"), list) else []:
+        if isinstance(t, dict):
+            secs = t.get("seconds")
+            lines.append(
+                f"  {t.get('status', '?'):<11} {t.get('path') or t.get('name')}"
+                + (f"  {secs:.2f} s" if isinstance(secs, (int, float)) else "")
+                + (f"  error estimate {t['error_estimate']}" if t.get("error_estimate") else "")
+                + (f"  ({t['message']})" if t.get("message") else "")
+            )
+    return lines
+
+
+def describe(path) -> str:
+    """The report ``lutbake inspect FILE`` prints (raises readers.ReadError, naming the file once)."""
+    path = Path(path)
+    loaded = read(path)
+    lines = [str(path), f"  format: {FORMAT_NAMES[loaded.format]}, {_container(loaded)}"]
+    if loaded.format == "report":
+        return "\n".join(lines + _report_lines(loaded.facts)) + "\n"
+    if loaded.data is None:
+        lines.append(f"  metadata only: {loaded.notes[0]}")
+        lines += [f"  {k}: {v if len(v) <= LONG_VALUE else v[:LONG_VALUE] + ' ...'}" for k, v in loaded.attrs.items()]
+        return "\n".join(lines) + "\n"
+    view = table_view(loaded)
+    if view.kind is None:
+        lines.append(f"  image: {_image_line(view.data)}")
+        lines.append(
+            "  no lutbake metadata (" + "; ".join(loaded.notes or ["none in the file"]) + "): "
+            "axes, channel meanings and provenance unknown"
+        )
+        letters = loaded.facts.get("channels") or list("RGBA"[: view.data.shape[-1]])
+        return "\n".join(lines + _statistics(view.data, [str(c) for c in letters])) + "\n"
+
+    attrs = loaded.attrs
+    lines.append(f"  metadata: {loaded.meta_source}")
+    lines.append(f"  kind: {view.kind}   table: {view.name}")
+    lines.append(
+        f"  image: {_image_line(view.data)}"
+        + (
+            f" (+{loaded.data.shape[-1] - view.data.shape[-1]} padding channel(s) in the file)"
+            if loaded.data.shape[-1] > view.data.shape[-1]
+            else ""
+        )
+    )
+    lines.append("  row 0 = y index 0, column 0 = x index 0 (no flip)")
+    lines.append("axes:")
+    raw_axes = json.loads(attrs["axes"])
+    for ax, d in zip(view.axes, raw_axes):
+        values = ax.values()
+        lines.append(
+            f"  {ax.name}: {ax.dim} ({d.get('image', ax.dim)}), count {ax.count}, range [{_fmt(ax.lo)}, {_fmt(ax.hi)}]"
+        )
+        lines.append(
+            f"    texel {ax.texel} ({d.get('texel_formula', '')}), mapping {ax.mapping} "
+            f"({d.get('mapping_formula', '')})"
+        )
+        lines.append(f"    index 0 = {_fmt(values[0])}, index {ax.count - 1} = {_fmt(values[-1])}")
+        lines.append(f"    order {ax.order}; sample at {d.get('uv_formula') or 'u = ' + ax.uv_formula()}")
+        alpha = ax.alpha()
+        if alpha is not None:
+            lines.append(f"    alpha {_fmt(alpha.min())} .. {_fmt(alpha.max())} ({d.get('alpha_formula', '')})")
+    parts = loaded.facts.get("parts") or []
+    if len(parts) > 1:
+        lines.append("  parts: " + ", ".join(f"{name}={value}" for name, value in parts))
+    lines.append("channels:")
+    for letter, name, meaning in zip("RGBA", view.channel_names, view.meanings):
+        lines.append(f"  {letter} = {meaning or name}")
+    lines.append("reconstruction:")
+    lines.extend(f"  {line}" for line in (view.reconstruction or "(none recorded)").splitlines())
+    lines.append("provenance:")
+    lines += [f"  {key}: {attrs[key]}" for key in PROVENANCE if key in attrs]
+    if "config" in attrs:
+        lines.append(f"  config: {len(attrs['config'].splitlines())} line(s) of TOML")
+    for key in sorted(set(attrs) - SHOWN):
+        value = attrs[key]
+        lines.append(f"  {key}: {value if len(value) <= LONG_VALUE else value[:LONG_VALUE] + ' ...'}")
+    return "\n".join(lines + _statistics(view.data, view.channel_names)) + "\n"

@@ -1,0 +1,160 @@
+"""Read any LUT file lutbake can audit into a float64 (rows, columns, channels) array.
+
+``read_lut(path, shape=None, encoding=None) -> LutFile``. Formats, by extension:
+- ``.exr``: OpenImageIO, float; the ``lutbake:*`` attributes when present.
+- ``.png``: OpenImageIO, the raw UNORM codes (8 or 16 bit), value = code / (2^bits - 1), **no transfer function**.
+- ``.dds``: DX10 header, R16G16_FLOAT ... RGBA32F (lutbake.io.dds); ``.ktx2``: lutbake.io.ktx2.decode (plain or zstd).
+- ``.npy``, ``.npz``: an integer array is UNORM codes (value = code / dtype max), a float array values (npz: the
+  array named ``table``, else its only one).
+- ``.h .hpp .inc .js .ts .mjs .wgsl .rs``: the numbers of the first brace/bracket array: hex ``0x....`` literals
+  are IEEE half bits, decimal literals floats.
+``storage`` records how the file stores a value (unorm8/16, half, float32), which the audit's quantisation check uses.
+A text array's layout must be declared: ``#define *_HEIGHT/_WIDTH/_CHANNELS`` (lutbake's C header), the
+``lutbake:shape`` line of lutbake's JS/WGSL/Rust comment block, or ``shape=(rows, columns, channels)``.
+Row 0 of the result is the first row stored in the file (no flip). A JSON sidecar beside the file
+(lutbake's ``<file>.json``, or a ``<stem>.json`` provenance note) is returned in ``sidecar``.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+TEXT_EXTENSIONS = (".h", ".hpp", ".inc", ".js", ".mjs", ".ts", ".wgsl", ".rs")
+READABLE = (".exr", ".png", ".dds", ".ktx2", ".npy", ".npz") + TEXT_EXTENSIONS
+
+
+@dataclass
+class LutFile:
+    path: Path
+    data: np.ndarray  # float64 (rows, columns, channels), file row order
+    storage: str  # "unorm8", "unorm16", "half", "float32", ...: how the file stores a value
+    attrs: dict = field(default_factory=dict)  # lutbake:* attributes (without the prefix) when present
+    sidecar: dict = field(default_factory=dict)
+
+    @property
+    def unorm_bits(self) -> int | None:
+        return int(self.storage[5:]) if self.storage.startswith("unorm") else None
+
+
+def _unorm(codes: np.ndarray) -> tuple[np.ndarray, str]:
+    bits = codes.dtype.itemsize * 8
+    return codes.astype(np.float64) / float((1 << bits) - 1), f"unorm{bits}"
+
+
+def _float_storage(arr: np.ndarray) -> str:
+    return "half" if arr.dtype == np.float16 else "float32" if arr.dtype == np.float32 else "float64"
+
+
+def _read_png(path: Path) -> tuple[np.ndarray, str]:
+    import OpenImageIO as oiio
+
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise ValueError(f"{path}: cannot open PNG: {oiio.geterror()}")
+    try:
+        spec = inp.spec()
+        native = oiio.UINT16 if spec.format.size() == 2 else oiio.UINT8
+        codes = inp.read_image(native)  # raw codes: OIIO applies no transfer function on read
+    finally:
+        inp.close()
+    if codes is None:
+        raise ValueError(f"{path}: cannot read PNG pixels")
+    return _unorm(np.asarray(codes))
+
+
+def _text_shape(text: str, shape) -> tuple[int, ...]:
+    if shape is not None:
+        return tuple(int(s) for s in shape)
+    m = re.search(r"lutbake:shape\s*[=:]\s*\[?\s*(\d+)\s*,\s*(\d+)\s*,\s*(\d+)", text)
+    if m:
+        return tuple(int(g) for g in m.groups())
+    dims = {k: int(v) for k, v in re.findall(r"#define\s+\w+?_(HEIGHT|WIDTH|CHANNELS)\s+(\d+)", text)}
+    if len(dims) == 3:
+        return dims["HEIGHT"], dims["WIDTH"], dims["CHANNELS"]
+    raise ValueError(
+        "the array's layout is not declared in the file: give shape=(rows, columns, channels) "
+        "(CLI: --shape ROWSxCOLUMNSxCHANNELS)"
+    )
+
+
+def parse_text_array(text: str, shape=None) -> tuple[np.ndarray, str]:
+    """The values of the first ``{...}`` / ``[...]`` array literal after its declaration: hex literals
+    are IEEE 754 binary16 bit patterns, decimal literals floats; comments are skipped."""
+    body = re.sub(r"/\*.*?\*/", " ", text, flags=re.S)
+    body = re.sub(r"//[^\n]*", " ", body)
+    m = re.search(r"(?:=|\()\s*[^{\[;]*?[{\[]\s*((?:0x|[-+.\d])[^;]*)", body)
+    if not m:
+        raise ValueError("no array literal found")
+    payload = m.group(1)
+    hexes = re.findall(r"0x([0-9a-fA-F]{1,4})\b", payload)
+    shp = _text_shape(text, shape)
+    n = int(np.prod(shp))
+    if hexes:
+        bits = np.array([int(h, 16) for h in hexes[:n]], dtype=np.uint16)
+        arr, storage = bits.view(np.float16).astype(np.float64), "half"
+    else:
+        nums = re.findall(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?", payload)
+        arr, storage = np.array([float(x) for x in nums[:n]], dtype=np.float64), "float32"
+    if arr.size != n:
+        raise ValueError(f"the array holds {arr.size} values, the declared shape {shp} needs {n}")
+    return arr.reshape(shp), storage
+
+
+def read_lut(path, shape=None) -> LutFile:
+    """Read ``path`` (see the module docstring). ``shape``: (rows, columns, channels) of a text array
+    whose file does not declare it."""
+    from .dds import decode as dds_decode
+    from .exr import read_exr
+    from .ktx2 import decode as ktx2_decode
+
+    path = Path(path)
+    ext = path.suffix.lower()
+    if ext not in READABLE:
+        raise ValueError(f"{path}: cannot read '{ext}' files; readable: {', '.join(READABLE)}")
+    if not path.is_file():
+        raise ValueError(f"{path}: no such file")
+    attrs, sidecar = {}, {}
+    for side in (path.with_name(path.name + ".json"), path.with_suffix(".json")):  # lutbake's, then refs style
+        if side.is_file():
+            sidecar = json.loads(side.read_text())
+            attrs = sidecar.get("lutbake", {})
+            break
+    if ext == ".exr":
+        data, attrs = read_exr(path)
+        storage = "float32"
+    elif ext == ".png":
+        data, storage = _read_png(path)
+    elif ext == ".dds":
+        arr, _ = dds_decode(path.read_bytes())
+        data, storage = arr.astype(np.float64), _float_storage(arr)
+    elif ext == ".ktx2":
+        arr, facts = ktx2_decode(path.read_bytes())
+        kv = facts["key_value"]
+        data, storage = arr.astype(np.float64), _float_storage(arr)
+        if "lutbake:metadata" in kv:
+            attrs = json.loads(kv["lutbake:metadata"])
+    elif ext in (".npy", ".npz"):
+        arr = np.load(path, allow_pickle=False)
+        if ext == ".npz":  # one array: named "table" (tests/data), else the only one
+            names = list(arr.files)
+            arr = arr["table" if "table" in names else names[0]]
+        if np.issubdtype(arr.dtype, np.unsignedinteger):
+            data, storage = _unorm(arr)
+        else:
+            data, storage = arr.astype(np.float64), _float_storage(arr)
+    else:
+        try:
+            data, storage = parse_text_array(path.read_text(errors="replace"), shape)
+        except ValueError as e:
+            raise ValueError(f"{path}: {e}") from None
+    data = np.asarray(data, dtype=np.float64)
+    if data.ndim == 2:
+        data = data[..., None]
+    if data.ndim != 3:
+        raise ValueError(f"{path}: a 2D table (rows, columns, channels) is needed, got shape {data.shape}")
+    return LutFile(path, data, storage, attrs, sidecar)

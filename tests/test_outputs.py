@@ -1,0 +1,101 @@
+"""`lutbake inspect` and `lutbake preview` read every file `make luts` writes: every table of configs/*.toml and
+of the Makefile's PRESETS, baked here at small sizes (their kinds, layouts, formats and conventions unchanged),
+plus the formats `make luts` does not use (npy, ktx2); every data file and every .json sidecar."""
+
+import re
+import tomllib
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from lutbake.api import bake_table
+from lutbake.cli import main
+from lutbake.config import preset_path, validate_table
+from lutbake.io.formats import write_table
+from lutbake.kinds import lookup_kind
+
+ROOT = Path(__file__).resolve().parents[1]
+SMALL = {"size": [8, 6], "roughness_size": 8, "f0_size": 3, "anisotropy_size": 3, "phi_size": 3, "sigma_size": 3}
+PREVIEW_DPI = 40  # the layout is what is checked here, not the pixels
+
+
+def make_luts_sources() -> list[Path]:
+    """The configs and presets `make luts` bakes (the Makefile's CONFIGS and PRESETS)."""
+    makefile = (ROOT / "Makefile").read_text().replace("\\\n", " ")  # join continued lines
+    presets = re.search(r"^PRESETS \?=(.*)$", makefile, re.M).group(1).split()
+    return sorted((ROOT / "configs").glob("*.toml")) + [preset_path(p) for p in presets]
+
+
+@pytest.fixture(scope="module")
+def luts(tmp_path_factory) -> Path:
+    out = tmp_path_factory.mktemp("luts")
+    for src in make_luts_sources():
+        for i, raw in enumerate(tomllib.loads(src.read_text())["table"]):
+            keys = lookup_kind(raw["kind"]).keys
+            raw.update({k: v for k, v in SMALL.items() if k in keys})
+            spec = validate_table(raw, src, i)
+            table = bake_table(spec, workers=1)[0]
+            write_table(table, out, spec.options.get("format", "exr"), spec.options.get("dtype", "float32"))
+            if spec.name == "dfg":  # the formats make luts does not write, each in its own folder
+                for fmt in ("exr", "npy", "png16", "dds", "ktx2", "h"):
+                    write_table(table, out / fmt, fmt, "half")
+    return out
+
+
+def test_the_small_set_has_every_kind_and_format(luts):
+    from lutbake.io.readers import read
+
+    kinds = {read(p).attrs.get("kind") for p in luts.glob("*") if p.is_file() and not p.name.endswith(".json")}
+    assert {"dfg", "albedo", "albedo_avg", "specular_3d", "specular_aniso", "diffuse", "diffuse_3d", "btf"} <= kinds
+    formats = {read(p).format for p in luts.rglob("*.*")}
+    assert {"exr", "npy", "png", "dds", "ktx2", "h", "sidecar"} <= formats
+
+
+def test_inspect_reads_every_file_make_luts_writes(luts):
+    from lutbake.io.readers import read
+
+    files = sorted(p for p in luts.rglob("*.*") if not p.name.endswith(".preview.png"))
+    assert len(files) > 40
+    for p in files:
+        r = CliRunner().invoke(main, ["inspect", str(p)])
+        assert r.exit_code == 0, (p, r.output)
+        loaded = read(p)
+        if loaded.data is None:  # an engine's own layout (LTC modules, OpenPBR header): its metadata only
+            assert "metadata only" in r.output and "kind:" in r.output, (p, r.output)
+        elif not loaded.attrs:  # the second file of a two-file output (ltc_ggx_2.dds): its pixels only
+            assert "no lutbake metadata" in r.output and "statistics:" in r.output, (p, r.output)
+        else:
+            assert "kind:" in r.output and "axes:" in r.output and "statistics:" in r.output, (p, r.output)
+
+
+def test_preview_draws_every_file_make_luts_writes(luts, tmp_path):
+    """Every file with pixels gets its preview figure (the others a one-line error); one file per kind of
+    picture is drawn to a PNG as well."""
+    plt = pytest.importorskip("matplotlib.pyplot")
+    from lutbake.io.readers import ReadError, read
+    from lutbake.preview import figure, render
+
+    files = sorted(p for p in luts.rglob("*.*") if p.suffix != ".json") + [luts / "npy" / "dfg.npy.json"]
+    for p in files:
+        if read(p).data is None:
+            with pytest.raises(ReadError, match="metadata"):
+                figure(p)
+            continue
+        fig = figure(p)
+        titles = [t for ax in fig.axes for t in (ax.get_title(), ax.get_title(loc="left")) if t]
+        plt.close(fig)
+        assert p.name in fig.get_suptitle() and titles, p
+    for name in (
+        "dfg.exr",
+        "lut_charlie.exr",
+        "albedo_avg.exr",
+        "specular_3d_dielectric_f0.exr",
+        "btf_fitted.exr",
+        "filament_dfg.dds",
+        "eevee_brdf_ggx.h",
+        "lut_ggx.png",
+        "ktx2/dfg.ktx2",
+    ):
+        out = render(luts / name, tmp_path / f"{name.replace('/', '_')}.png", dpi=PREVIEW_DPI)
+        assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", name
