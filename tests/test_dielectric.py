@@ -229,6 +229,32 @@ def test_openpbr_tables_match_shipped_arrays_within_their_monte_carlo_noise():
         )
 
 
+UNORM16_STEP = 1.0 / 65535.0
+# x(1/eta) predicted from x(eta) through lutbake's averages: the shipped averages' Monte Carlo noise (max 4.2e-4)
+# divided by E_c,avg(1/eta) >= 0.03 at alpha index >= 16 (measured max 7.0e-4)
+OPENPBR_RATIO_ATOL = 2.0e-3
+
+
+def test_openpbr_reflection_ratio_is_tied_to_the_averages_by_the_lobes_reciprocity():
+    """OpenPBR's multiple-scattering lobe (impl/openpbr_microfacet_multiple_scattering_lobes.h) transmits
+    (1 - x(eta)) E_c(eta, mu_i) E_c(1/eta, mu_o) / (pi E_c,avg(1/eta)) from side i and (1 - x(1/eta)) E_c(1/eta, mu_o)
+    E_c(eta, mu_i) / (pi E_c,avg(eta)) back: it is symmetric iff (1 - x(eta)) E_c,avg(eta) = (1 - x(1/eta))
+    E_c,avg(1/eta). The shipped ratio obeys that to UNORM16 precision, so its eta < 1 half follows from its eta > 1
+    half and the averages (lutbake's included); the other half is not fixed by any single-scattering integral."""
+    shipped = np.load("tests/data/openpbr_energy_tables.npz")
+    x = shipped["ideal_dielectric_reflection_ratio"] / 65535.0
+    ec_shipped = shipped["ideal_dielectric_avg_energy_complement"] / 65535.0
+    k = np.arange(1, 16)
+    inside, outside = 15 - k, 16 + k  # eta_in = 1 / eta_out: OpenPBR's IOR axis is symmetric about 15.5
+    residual = (1 - x[outside]) * ec_shipped[outside] - (1 - x[inside]) * ec_shipped[inside]
+    np.testing.assert_allclose(residual, 0.0, rtol=0, atol=UNORM16_STEP)
+    plan = lookup_kind("dielectric_avg").plan(spec(kind="dielectric_avg", layout="openpbr"))
+    a0 = 16  # alpha index >= 16 (alpha >= 0.27): E_c,avg >= 0.03, the division is well conditioned
+    ec = np.stack([plan.run_tile(z * 32 + a0, z * 32 + 32, "cpu")[:, 0] for z in range(32)])
+    predicted = 1 - (1 - x[outside, a0:]) * ec[outside] / ec[inside]
+    np.testing.assert_allclose(predicted, x[inside, a0:], rtol=0, atol=OPENPBR_RATIO_ATOL)
+
+
 def test_bake_energy_kind_and_average_consistency():
     from lutbake.api import bake_table
 
