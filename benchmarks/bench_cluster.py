@@ -38,6 +38,7 @@ sys.path.insert(0, str(ROOT))
 
 from lutbake import batch, cluster  # noqa: E402
 from lutbake.config import load_configs, preset_path  # noqa: E402
+from lutbake.io.integrity import sidecar_path  # noqa: E402
 from lutbake.executor import default_workers  # noqa: E402
 from lutbake.io.exr import read_exr  # noqa: E402
 from lutbake.kinds import lookup_kind  # noqa: E402
@@ -134,7 +135,7 @@ def identical(a: list, b: list) -> bool:
             }
         else:  # npy / png16 / dds / ktx2 / h: the bytes (no timestamps), and the sidecar if any
             same &= ja.path.read_bytes() == jb.path.read_bytes()
-            side_a, side_b = ja.path.with_suffix(".json"), jb.path.with_suffix(".json")
+            side_a, side_b = sidecar_path(ja.path), sidecar_path(jb.path)
             if side_a.exists():
                 same &= side_a.read_bytes() == side_b.read_bytes()
     return same

@@ -315,7 +315,7 @@ class DaskRunner:
         label: str = "",
         cancel: threading.Event | None = None,
     ) -> np.ndarray:
-        """lutbake.executor.execute() on the cluster: float64 data of shape plan.shape (``progress``: an
+        """lutbake.executor.execute_tiles() on the cluster: float64 (n_texels, plan.tile_width) (``progress``: an
         executor.Progress factory, updated in the calling thread as tiles arrive)."""
         from .devices import plan_tile_texels
         from .executor import Cancelled, tiles
@@ -336,7 +336,7 @@ class DaskRunner:
                 self._submit(bake_tile, spec, s, e, device, self.token, key=f"{prefix}-{s}-{e}", priority=priority)
             ] = (s, e)
         sent = len(pickle.dumps((spec, 0, plan.n_texels, device, self.token), protocol=5))
-        out = np.empty((plan.n_texels, plan.n_channels), dtype=np.float64)
+        out = np.empty((plan.n_texels, plan.tile_width), dtype=np.float64)
         pending = set(futures)
         finished: queue.Queue = queue.Queue()
         for f in futures:
@@ -372,7 +372,7 @@ class DaskRunner:
                 self.client.cancel(list(pending))
                 with self.stats.lock:
                     self.stats.cancelled += len(pending)
-        return out.reshape(plan.shape)
+        return out
 
     def estimate_error(self, spec, data: np.ndarray, device: str) -> tuple[float, str]:
         key = f"lutbake-{spec.name}-{uuid.uuid4().hex[:8]}-{device}-error-estimate"

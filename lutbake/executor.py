@@ -36,7 +36,13 @@ def tiles(n: int, size: int = TILE_TEXELS) -> list[tuple[int, int]]:
     return [(s, min(s + size, n)) for s in range(0, n, size)]
 
 
-def execute(
+def execute(plan: TexelPlan, **options) -> np.ndarray:
+    """Evaluate every tile of ``plan``; returns float64 data of shape plan.shape: execute_tiles (same keyword
+    options) without the tiles' aux columns."""
+    return execute_tiles(plan, **options)[:, : plan.n_channels].reshape(plan.shape)
+
+
+def execute_tiles(
     plan: TexelPlan,
     workers: int | None = None,
     device: str = "cpu",
@@ -45,7 +51,8 @@ def execute(
     cancel: threading.Event | None = None,
     spec=None,
 ) -> np.ndarray:
-    """Evaluate every tile of ``plan``; returns float64 data of shape plan.shape.
+    """Evaluate every tile of ``plan``; returns float64 (n_texels, plan.tile_width): the values, then the aux
+    columns (lutbake.sampling.plan.TexelPlan.aux_channels).
 
     ``progress``: a ``Progress`` factory; its update is called in the calling thread after each tile.
     ``cancel``: when set (by another thread), no further tile starts and Cancelled is raised.
@@ -62,7 +69,7 @@ def execute(
     with _PREPARE_LOCK:
         plan.prepare(device)
     parts = tiles(plan.n_texels, plan_tile_texels(plan, device))
-    out = np.empty((plan.n_texels, plan.n_channels), dtype=np.float64)
+    out = np.empty((plan.n_texels, plan.tile_width), dtype=np.float64)
     update = progress(label, plan.n_texels, plan.cost) if progress is not None else None
 
     def work(bounds):
@@ -84,11 +91,11 @@ def execute(
     finally:
         if not (workers == 1 or device != "cpu"):
             pool.shutdown(wait=True)
-    return out.reshape(plan.shape)
+    return out
 
 
 def estimate_error(plan: TexelPlan, data: np.ndarray, device: str = "cpu", spec=None) -> tuple[float, str] | None:
-    """``plan.error_estimate`` of baked ``data`` (flat float64, (n_texels, n_channels)), None if the kind has
+    """``plan.error_estimate`` of baked ``data`` (flat float64, (n_texels, tile_width)), None if the kind has
     none; inside a lutbake.cluster session it runs on a worker, as the tiles did."""
     from . import cluster
 

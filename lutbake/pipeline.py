@@ -11,7 +11,7 @@ import numpy as np
 
 from .config import TableSpec
 from .errors import TableError
-from .executor import Progress, Timer, estimate_error, execute
+from .executor import Progress, Timer, estimate_error, execute_tiles
 from .kinds import lookup_kind
 from .provenance import attributes
 from .table import Table
@@ -24,14 +24,15 @@ def bake_table(
     value is not finite; executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
     plan = lookup_kind(spec.kind).plan(spec)
     with Timer() as t:
-        data = execute(
+        full = execute_tiles(
             plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel, spec=spec
         )
+    data = full[:, : plan.n_channels].reshape(plan.shape)
     if not np.all(np.isfinite(data)):
         bad = int(np.size(data) - np.count_nonzero(np.isfinite(data)))
         raise TableError(f"{spec.source}: table '{spec.name}': {bad} non-finite values; nothing written")
     extra = {}
-    estimate = estimate_error(plan, data.reshape(plan.n_texels, plan.n_channels), device, spec)
+    estimate = estimate_error(plan, full, device, spec)
     if estimate is not None:
         err, how = estimate
         extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)

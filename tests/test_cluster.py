@@ -27,6 +27,7 @@ from lutbake.api import bake_table  # noqa: E402
 from lutbake.cli import main  # noqa: E402
 from lutbake.config import load_configs, preset_path, validate_table  # noqa: E402
 from lutbake.io.exr import read_exr  # noqa: E402
+from lutbake.kinds import lookup_kind  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 pytestmark = pytest.mark.usefixtures("terminal_sigint")  # the interrupt tests and deadline() need SIGINT
@@ -36,6 +37,8 @@ TILE = 384  # cluster tiles in these tests: small tables are cut into several, a
 # several kinds, each cut into more than one TILE-texel tile
 SPECS = {
     "dfg_gl": {"kind": "dfg", "size": [40, 24], "samples": 48},
+    # adaptive Gauss-Legendre (no samples): its per-texel error estimates travel with the tiles (aux columns)
+    "dfg_adaptive": {"kind": "dfg", "size": [48, 32], "tolerance": 1e-5},
     "dfg_vndf": {"kind": "dfg", "size": [32, 20], "estimator": "sobol_vndf", "samples": 64, "seed": 3},
     "btf": {"kind": "btf", "size": [8, 8], "phi_size": 8, "sigma_size": 2, "samples": 2},
     "spec3d": {"kind": "specular_3d", "size": [16, 8], "f0_size": 6, "fresnel": "dielectric_f0", "samples": 48},
@@ -151,7 +154,9 @@ def test_cluster_bake_is_bit_identical_to_the_thread_executor(runner):
     texels = [t.data[..., 0].size for t in local.values()]
     assert min(texels) > TILE  # every table was cut into several tiles
     assert runner.stats.tiles == sum(-(-n // TILE) for n in texels)
-    assert runner.stats.bytes_from_workers == sum(t.data.size * 8 for t in local.values())  # float64 results
+    # float64 results: each tile's values and its aux columns (an adaptive estimator's per-texel error estimates)
+    width = {s.name: lookup_kind(s.kind).plan(s).tile_width for s in specs}
+    assert runner.stats.bytes_from_workers == sum(t.data[..., 0].size * width[n] * 8 for n, t in local.items())
     assert runner.stats.cancelled == 0
 
 

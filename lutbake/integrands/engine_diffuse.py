@@ -94,10 +94,13 @@ def disney_fgd(nov: np.ndarray, perceptual_roughness: np.ndarray, device: str = 
 def with_diffuse_channel(plan: TexelPlan, nov: np.ndarray, perceptual_roughness: np.ndarray) -> TexelPlan:
     """The plan of the base layout with channel B = disney_fgd - HDRP_DIFFUSE_OFFSET appended (same tiles)."""
     base_tile = plan.run_tile
+    nch = plan.n_channels
 
     def run_tile(start: int, stop: int, device: str) -> np.ndarray:
+        """The base channels, B, then the base tile's aux columns (TexelPlan.aux_channels)."""
         b = disney_fgd(nov[start:stop], perceptual_roughness[start:stop], device) - HDRP_DIFFUSE_OFFSET
-        return np.concatenate([base_tile(start, stop, device), b[:, None]], axis=1)
+        base = base_tile(start, stop, device)
+        return np.concatenate([base[:, :nch], b[:, None], base[:, nch:]], axis=1)
 
     base_prepare = plan.prepare
 
@@ -106,9 +109,8 @@ def with_diffuse_channel(plan: TexelPlan, nov: np.ndarray, perceptual_roughness:
         wp.load_module(diffuse_kernel().module, device=device)
 
     base_estimate = plan.error_estimate
-    nch = plan.n_channels
     if base_estimate is not None:  # the specular channels' estimate; B's quadrature is checked in the tests
-        plan.error_estimate = lambda data, device: base_estimate(np.ascontiguousarray(data[:, :nch]), device)
+        plan.error_estimate = lambda data, device: base_estimate(np.delete(data, nch, axis=1), device)
     plan.run_tile, plan.prepare, plan.n_channels = run_tile, prepare, nch + 1
     return plan
 

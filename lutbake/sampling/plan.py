@@ -43,10 +43,19 @@ class TexelPlan:
     terms: dict[str, str]
     cost: float  # integrand evaluations in total, for the progress bar
     extra: dict[str, str] = field(default_factory=dict)
-    # (flat float64 data (n_texels, n_channels), device) -> (estimated max error, how it was estimated)
+    # (flat float64 tile data (n_texels, tile_width), device) -> (estimated max error, how it was estimated)
     error_estimate: Callable[[np.ndarray, str], tuple[float, str]] | None = None
     # (data of plan.shape) -> extra lutbake:* attributes known only after the bake (ltc: fit-error statistics)
     attributes_after: Callable[[np.ndarray], dict[str, str]] | None = None
+    # columns run_tile returns after the table's channels (an adaptive estimator's per-texel error estimates):
+    # they travel with the tile, so the estimate is a pure function of the tiles wherever they ran, and are
+    # handed to error_estimate, never stored in the table
+    aux_channels: int = 0
+
+    @property
+    def tile_width(self) -> int:
+        """Columns of run_tile's result: n_channels values, then aux_channels."""
+        return self.n_channels + self.aux_channels
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -134,19 +143,18 @@ def per_texel_plan(
     tolerance_record = (
         {"tolerance": f"max({estimator.absolute:.3g}, {estimator.relative:.3g} |v|) per value"} if adaptive else {}
     )
-    texel_error = np.zeros((grid.n_texels, integrand.nch)) if adaptive else None
 
     def run_adaptive(s: int, e: int, device: str) -> np.ndarray:
-        """Values of texels [s, e), their error estimates kept in texel_error (a tile writes only its rows);
-        sub-texels' errors add up with |weights| (grid.reduce is linear, the GL weights positive)."""
+        """Values of texels [s, e), then their error estimates (aux columns); sub-texels' errors add up with
+        |weights| (grid.reduce is linear, the GL weights positive)."""
         values, err = estimator.evaluate_with_error(integrand, grid.rows(slice(s, e)), device)
-        texel_error[s:e] = grid.reduce(err)[:, : integrand.nch]
-        return grid.reduce(values)[:, : integrand.nch]
+        return np.concatenate([grid.reduce(values)[:, : integrand.nch], grid.reduce(err)[:, : integrand.nch]], 1)
 
     def adaptive_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
-        """The max over texels of the kernel's own per-texel estimate; the method names the worst ratio to the
-        tolerance (<= 1: every texel met it)."""
-        values = data.reshape(grid.n_texels, -1)
+        """The max over texels of the kernel's own per-texel estimate (the tiles' aux columns); the method names
+        the worst ratio to the tolerance (<= 1: every texel met it)."""
+        full = data.reshape(grid.n_texels, -1)
+        values, texel_error = full[:, : integrand.nch], full[:, integrand.nch :]
         target = np.maximum(estimator.absolute, estimator.relative * np.abs(values))
         ratio = float(np.max(texel_error / target))
         err = float(np.max(texel_error))
@@ -190,4 +198,5 @@ def per_texel_plan(
         cost=float(np.sum(samples)),
         extra={**(extra or {}), **tolerance_record},
         error_estimate=(adaptive_estimate if adaptive else estimate) if error_estimate else None,
+        aux_channels=integrand.nch if adaptive else 0,
     )
