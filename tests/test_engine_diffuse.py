@@ -4,6 +4,7 @@ unity-hdrp layout against scipy's adaptive quadrature (an independent method).""
 import numpy as np
 import pytest
 import warp as wp
+from hemisphere_reference import hemisphere_integral
 from scipy import integrate
 
 from lutbake.integrands.engine_diffuse import HDRP_DIFFUSE_OFFSET, disney_fgd
@@ -121,23 +122,13 @@ def charlie_dv_numpy(nov, nol, noh, alpha):
 def charlie_fgd_scipy(nov, alpha, f0=None):
     """(x, y) = (∫ D V (1 - v.h)^5 (n.l) dω, ∫ D V (n.l) dω) over l in spherical coordinates (mu = n.l, phi), or,
     with ``f0``, ∫ D V F_schlick(f0, v.h) (n.l) dω. Symmetric in phi: 2 ∫_0^pi."""
-    sv = np.sqrt(1.0 - nov * nov)
 
-    def g(phi, mu, which):
-        sl = np.sqrt(1.0 - mu * mu)
-        h = np.array([sv + sl * np.cos(phi), sl * np.sin(phi), nov + mu])
-        h /= np.linalg.norm(h)
-        voh = sv * h[0] + nov * h[2]
-        fc = (1.0 - voh) ** 5
-        w = {"fc": fc, "one": 1.0, "f": f0 + (1.0 - f0) * fc if f0 is not None else 0.0}[which]
-        return charlie_dv_numpy(nov, mu, h[2], alpha) * mu * w
-
-    def integral(which):
-        return 2.0 * integrate.dblquad(g, 0.0, 1.0, 0.0, np.pi, args=(which,), epsabs=1e-10, epsrel=1e-8)[0]
+    def integral(weight):
+        return hemisphere_integral(lambda mu, noh, voh: charlie_dv_numpy(nov, mu, noh, alpha) * mu * weight(voh), nov)
 
     if f0 is not None:
-        return integral("f")
-    return integral("fc"), integral("one")
+        return integral(lambda voh: f0 + (1.0 - f0) * (1.0 - voh) ** 5)
+    return integral(lambda voh: (1.0 - voh) ** 5), integral(lambda voh: 1.0)
 
 
 @pytest.fixture(scope="module")

@@ -4,6 +4,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hemisphere_reference import hemisphere_integral
 
 from lutbake.config import load_configs, presets
 
@@ -59,29 +60,20 @@ def godot_dfg_scipy(nov, r):
     """Godot integrate_dfg.glsl's integrand in numpy: GGX D (a = r²), geometry_smith = Schlick-GGX with k = r²/2 (its
     geometry_schlick_ggx squares the perceptual r it is given) on both directions; returns
     (∫ Fc f/F (n.l) dω, ∫ f/F (n.l) dω, ∫ D_charlie V_ashikhmin (n.l) dω)."""
-    from scipy import integrate
-
     a = r * r
     k = r * r / 2.0
-    sv = np.sqrt(1.0 - nov * nov)
 
-    def g(phi, mu, which):
-        sl = np.sqrt(1.0 - mu * mu)
-        h = np.array([sv + sl * np.cos(phi), sl * np.sin(phi), nov + mu])
-        h /= np.linalg.norm(h)
-        voh = sv * h[0] + nov * h[2]
-        if which == "cloth":
-            d = (2.0 + 1.0 / a) * (1.0 - h[2] ** 2) ** (0.5 / a) / (2.0 * np.pi)
-            return d / (4.0 * (mu + nov - mu * nov)) * mu
-        d = a * a / (np.pi * (h[2] ** 2 * (a * a - 1.0) + 1.0) ** 2)
+    def cloth(mu, noh, voh):
+        d = (2.0 + 1.0 / a) * (1.0 - noh**2) ** (0.5 / a) / (2.0 * np.pi)
+        return d / (4.0 * (mu + nov - mu * nov)) * mu
+
+    def specular(mu, noh, voh):
+        d = a * a / (np.pi * (noh**2 * (a * a - 1.0) + 1.0) ** 2)
         g2 = nov / (nov * (1.0 - k) + k) * mu / (mu * (1.0 - k) + k)
-        f = d * g2 / (4.0 * nov * mu) * mu
-        return f * (1.0 - voh) ** 5 if which == "fc" else f
+        return d * g2 / (4.0 * nov * mu) * mu
 
-    return [
-        2.0 * integrate.dblquad(g, 0.0, 1.0, 0.0, np.pi, args=(w,), epsabs=1e-10, epsrel=1e-8)[0]
-        for w in ("fc", "e", "cloth")
-    ]
+    fc = hemisphere_integral(lambda mu, noh, voh: specular(mu, noh, voh) * (1.0 - voh) ** 5, nov)
+    return [fc, hemisphere_integral(specular, nov), hemisphere_integral(cloth, nov)]
 
 
 @pytest.fixture(scope="module")
