@@ -10,7 +10,7 @@ OUT    ?= outputs
 CONFIGS := $(wildcard configs/*.toml)
 PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-eevee unreal blender-eevee-btdf blender-eevee-bsdf \
            openpbr turquin ltc-ggx ltc-threejs ltc-eevee ltc-hdrp \
-           unity-hdrp godot bevy threejs
+           unity-hdrp unity-hdrp-charlie godot bevy threejs
 WORKERS ?=
 FORCE   ?=
 

@@ -301,8 +301,7 @@ class Integrator:
             tol = Tolerance(REFERENCE_TOLERANCE, 0.0)
             out = self._run(self.base, "gauss_legendre", None, self.nch, nov, alpha, tol)
             if self.base != self.layout:
-                b = self.engine_diffuse.disney_fgd(nov, rough) - self.engine_diffuse.HDRP_DIFFUSE_OFFSET
-                out = np.concatenate([out, b[:, None]], axis=1)
+                out = self.engine_diffuse.engine_channels(self.layout, out, nov, rough)
             self._cache[key] = out
         return self._cache[key]
 

@@ -19,7 +19,9 @@ tests/test_value_bounds.py against bakes of every kind, layout and model:
 from __future__ import annotations
 
 # dfg layouts whose channels are weighted single-scattering albedos (each weight in [0, 1]), and the others
-UNIT_LAYOUTS = frozenset({"scale_bias", "multiscatter", "scale_bias_f82"})
+# charlie_fabric (Unity HDRP): R, G = the sheen albedo / 2 pi (Charlie's Smith-form visibility; measured <= 0.131),
+# B = lerp(1, 0.5, alpha) in [0.5, 1]
+UNIT_LAYOUTS = frozenset({"scale_bias", "multiscatter", "scale_bias_f82", "charlie_fabric"})
 # multiscatter_disney (Unity HDRP): B = Disney FGD - 0.5 spans [-0.028, 1.0036] on endpoint texels (NoV = 0 rows)
 ABOVE_ONE_LAYOUTS = frozenset(
     {"multiscatter_cloth", "charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped", "multiscatter_disney"}

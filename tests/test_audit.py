@@ -158,6 +158,25 @@ def test_threejs_shipped_table_is_height_correlated_not_separable():
     assert hc.hypotheses[0]["rms"] < 0.1 * sep.hypotheses[0]["rms"]
 
 
+BEVY_MARGIN = 5.0  # the nominal conventions' RMS must be this many times below every alternative's
+
+
+def test_bevy_shipped_ktx2_fits_the_bevy_preset():
+    """Bevy's own dfg.ktx2 (tests/data/bevy_dfg.json): the preset's axes, texel centres and row order are the best
+    hypothesis by more than BEVY_MARGIN (measured: 7.4x on this
+    32-per-side subset, 8.7x on the full 64²), half floats."""
+    r = run(DATA / "bevy_dfg.ktx2", preset="bevy")
+    assert r.extra["chosen"] == "nominal" and r.quantisation["kind"] == "half"
+    nominal = next(h for h in r.hypotheses if h["name"] == "nominal")
+    assert nominal["rms"] * BEVY_MARGIN < min(h["rms"] for h in r.hypotheses if h["name"] != "nominal")
+
+
+def test_bevy_shipped_table_is_height_correlated_not_separable():
+    hc = run(DATA / "bevy_dfg.ktx2", preset="bevy")
+    sep = audit(DATA / "bevy_dfg.ktx2", {"preset": "bevy", "overrides": ["masking=smith_separable"]}, max_side=MAX_SIDE)
+    assert hc.hypotheses[0]["rms"] < 0.1 * sep.hypotheses[0]["rms"]
+
+
 def test_unity_hdrp_table_audits_clean_and_its_sqrt_axis_flip_is_found(tmp_path):
     """A lutbake unity-hdrp table (Disney channel B, x = sqrt(NoV), endpoints) re-audited under its preset."""
     import lutbake

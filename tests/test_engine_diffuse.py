@@ -4,6 +4,7 @@ unity-hdrp layout against scipy's adaptive quadrature (an independent method).""
 import numpy as np
 import pytest
 import warp as wp
+from hemisphere_reference import hemisphere_integral
 from scipy import integrate
 
 from lutbake.integrands.engine_diffuse import HDRP_DIFFUSE_OFFSET, disney_fgd
@@ -89,3 +90,78 @@ def test_unity_hdrp_preset_layout_and_channel_b():
     r = np.repeat(y_axis.values(), 8)
     np.testing.assert_allclose(table.data[..., 2].ravel(), disney_fgd(nov, r) - HDRP_DIFFUSE_OFFSET, atol=1e-6)
     assert np.all(table.data[..., 1] <= 1.0 + 1e-5) and np.all(table.data[..., 0] <= table.data[..., 1] + 1e-6)
+
+
+# --- unity-hdrp-charlie: PreIntegratedFGD_CharlieFabricLambert -------------------------------------------------------
+CHARLIE_ATOL = 2e-6  # converged Gauss-Legendre (lutbake) vs scipy dblquad (epsabs 1e-10) on the stored (/ 2 pi) scale
+CHARLIE_TEXELS = [(2, 0), (2, 5), (4, 1), (5, 7), (7, 0), (7, 3)]  # (row = roughness, column = NoV) of an 8 x 8 bake
+
+
+def charlie_l_hdrp(x, alpha):
+    """HDRP core BSDF.hlsl CharlieL: the Estevez & Kulla 2017 fit, lerp in 1 - (1 - alpha)^2 (written as HDRP does)."""
+    s = 1.0 - (1.0 - alpha) ** 2
+    a, b, c = 25.3245 + (21.5473 - 25.3245) * s, 3.32435 + (3.82987 - 3.32435) * s, 0.16801 + (0.19823 - 0.16801) * s
+    d, e = -1.27393 + (-1.97760 + 1.27393) * s, -4.85967 + (-4.32054 + 4.85967) * s
+    return a / (1.0 + b * x**c) + d * x + e
+
+
+def charlie_dv_numpy(nov, nol, noh, alpha):
+    """HDRP D_Charlie(NdotH, alpha) * V_Charlie(NdotL, NdotV, alpha) (BSDF.hlsl), numpy."""
+    d = (2.0 + 1.0 / alpha) * (1.0 - noh * noh) ** (0.5 / alpha) / (2.0 * np.pi)
+
+    def lam(c):
+        return (
+            np.exp(charlie_l_hdrp(c, alpha))
+            if c < 0.5
+            else np.exp(2 * charlie_l_hdrp(0.5, alpha) - charlie_l_hdrp(1 - c, alpha))
+        )
+
+    return d / ((1.0 + lam(nov) + lam(nol)) * 4.0 * nov * nol)
+
+
+def charlie_fgd_scipy(nov, alpha, f0=None):
+    """(x, y) = (∫ D V (1 - v.h)^5 (n.l) dω, ∫ D V (n.l) dω) over l in spherical coordinates (mu = n.l, phi), or,
+    with ``f0``, ∫ D V F_schlick(f0, v.h) (n.l) dω. Symmetric in phi: 2 ∫_0^pi."""
+
+    def integral(weight):
+        return hemisphere_integral(lambda mu, noh, voh: charlie_dv_numpy(nov, mu, noh, alpha) * mu * weight(voh), nov)
+
+    if f0 is not None:
+        return integral(lambda voh: f0 + (1.0 - f0) * (1.0 - voh) ** 5)
+    return integral(lambda voh: (1.0 - voh) ** 5), integral(lambda voh: 1.0)
+
+
+@pytest.fixture(scope="module")
+def hdrp_charlie_table():
+    import lutbake
+    from lutbake.config import load_config, preset_path
+
+    spec = load_config(preset_path("unity-hdrp-charlie"), [(None, "size", [8, 8])])[0]
+    return lutbake.bake_table(spec)[0]
+
+
+def test_unity_hdrp_charlie_axes_and_fabric_lambert_channel(hdrp_charlie_table):
+    y_axis, x_axis = hdrp_charlie_table.axes
+    centres = (np.arange(8) + 0.5) / 8  # HDRP Frag: NdotV = texCoord.x, r = texCoord.y at pixel centres
+    assert (x_axis.name, x_axis.mapping, x_axis.texel) == ("NoV", "linear", "center")
+    assert (y_axis.name, y_axis.texel) == ("perceptual_roughness", "center")
+    np.testing.assert_allclose(x_axis.values(), centres, rtol=1e-6)
+    np.testing.assert_allclose(y_axis.values(), centres, rtol=1e-6)
+    fabric = np.broadcast_to((1.0 - 0.5 * centres**2)[:, None], (8, 8))  # FabricLambertNoPI(alpha = r^2)
+    np.testing.assert_allclose(hdrp_charlie_table.data[..., 2], fabric, rtol=TERM_RTOL)
+
+
+@pytest.mark.parametrize("row, col", CHARLIE_TEXELS)
+def test_unity_hdrp_charlie_rg_equal_scipy_over_2pi(hdrp_charlie_table, row, col):
+    nov, r = (col + 0.5) / 8, (row + 0.5) / 8
+    x, y = charlie_fgd_scipy(nov, r * r)
+    np.testing.assert_allclose(hdrp_charlie_table.data[row, col, :2], np.array([x, y]) / (2 * np.pi), atol=CHARLIE_ATOL)
+
+
+@pytest.mark.parametrize("row, col, f0", [(3, 2, 0.04), (6, 6, 0.5), (7, 1, 1.0)])
+def test_unity_hdrp_charlie_runtime_decode_reproduces_the_integral(hdrp_charlie_table, row, col, f0):
+    # PreIntegratedFGD.hlsl GetPreIntegratedFGDCharlieAndFabricLambert: specularFGD = lerp(x, y, F0) * 2 pi
+    nov, r = (col + 0.5) / 8, (row + 0.5) / 8
+    t = hdrp_charlie_table.data[row, col]
+    decoded = ((1.0 - f0) * t[0] + f0 * t[1]) * 2.0 * np.pi
+    np.testing.assert_allclose(decoded, charlie_fgd_scipy(nov, r * r, f0), atol=CHARLIE_ATOL * 2 * np.pi)

@@ -2,7 +2,9 @@
 
 from pathlib import Path
 
+import numpy as np
 import pytest
+from hemisphere_reference import hemisphere_integral
 
 from lutbake.config import load_configs, presets
 
@@ -27,7 +29,17 @@ def test_make_luts_batch_loads_with_unique_names():
             "unity-hdrp",
             {"size": [64, 64], "texel": "endpoint", "nov_mapping": "square", "layout": "multiscatter_disney"},
         ),
-        ("godot", {"size": [128, 128], "layout": "multiscatter_cloth", "dtype": "half"}),
+        (
+            "godot",
+            {
+                "size": [128, 128],
+                "layout": "multiscatter_cloth",
+                "dtype": "half",
+                "masking": "schlick_ggx_ibl",
+                "row_order": "hi_first",
+                "texel": "center",
+            },
+        ),
         ("bevy", {"layout": "scale_bias", "dtype": "half", "format": "ktx2zst"}),
         (
             "threejs",
@@ -38,3 +50,44 @@ def test_make_luts_batch_loads_with_unique_names():
 def test_engine_preset_conventions(preset, expected):
     (spec,) = load_configs([presets()[preset]])
     assert {k: spec.options[k] for k in expected} == expected
+
+
+GODOT_ATOL = 2e-6  # converged lutbake vs scipy dblquad (epsabs 1e-10), float32 storage of the 8 x 8 bake
+GODOT_TEXELS = [(0, 0), (1, 3), (3, 6), (5, 2), (7, 7)]  # (image row, column); row 0 = the roughest (hi_first)
+
+
+def godot_dfg_scipy(nov, r):
+    """Godot integrate_dfg.glsl's integrand in numpy: GGX D (a = r²), geometry_smith = Schlick-GGX with k = r²/2 (its
+    geometry_schlick_ggx squares the perceptual r it is given) on both directions; returns
+    (∫ Fc f/F (n.l) dω, ∫ f/F (n.l) dω, ∫ D_charlie V_ashikhmin (n.l) dω)."""
+    a = r * r
+    k = r * r / 2.0
+
+    def cloth(mu, noh, voh):
+        d = (2.0 + 1.0 / a) * (1.0 - noh**2) ** (0.5 / a) / (2.0 * np.pi)
+        return d / (4.0 * (mu + nov - mu * nov)) * mu
+
+    def specular(mu, noh, voh):
+        d = a * a / (np.pi * (noh**2 * (a * a - 1.0) + 1.0) ** 2)
+        g2 = nov / (nov * (1.0 - k) + k) * mu / (mu * (1.0 - k) + k)
+        return d * g2 / (4.0 * nov * mu) * mu
+
+    fc = hemisphere_integral(lambda mu, noh, voh: specular(mu, noh, voh) * (1.0 - voh) ** 5, nov)
+    return [fc, hemisphere_integral(specular, nov), hemisphere_integral(cloth, nov)]
+
+
+@pytest.fixture(scope="module")
+def godot_table():
+    import lutbake
+    from lutbake.config import load_config, preset_path
+
+    spec = load_config(preset_path("godot"), [(None, "size", [8, 8]), (None, "dtype", "float32")])[0]
+    return lutbake.bake_table(spec)[0]
+
+
+@pytest.mark.parametrize("row, col", GODOT_TEXELS)
+def test_godot_table_equals_its_shader_integrand(godot_table, row, col):
+    # integrate_dfg.glsl @ e8387d69: roughness = (pos.y + 0.5)/SIZE, NdotV = (pos.x + 0.5)/SIZE, stored at row
+    # SIZE - 1 - pos.y; so image row `row` holds r = (7 - row + 0.5)/8
+    nov, r = (col + 0.5) / 8, (7 - row + 0.5) / 8
+    np.testing.assert_allclose(godot_table.data[row, col], godot_dfg_scipy(nov, r), atol=GODOT_ATOL)

@@ -108,7 +108,15 @@ def ref_G2_smith_joint_approx(nov, nol, alpha):
     return 4.0 * nol * nov * vis
 
 
+def ref_G2_schlick_ggx_ibl(nov, nol, alpha):
+    """Godot integrate_dfg.glsl geometry_smith: Schlick G1 = n.x / (n.x (1 - k) + k), k = alpha / 2, product."""
+    k = f32(alpha) / 2.0
+    return nov / (nov * (1.0 - k) + k) * nol / (nol * (1.0 - k) + k)
+
+
 def ref_G2(ndf, masking, nov, nol, noh, voh, alpha):
+    if masking == "schlick_ggx_ibl":
+        return ref_G2_schlick_ggx_ibl(nov, nol, alpha)
     if masking == "v_cavity":
         return ref_G2_v_cavity(noh, nov, nol, voh, voh)
     if masking == "smith_joint_approx":

@@ -1,5 +1,13 @@
 """dfg layouts that add an engine's pre-integrated diffuse term as channel B (Unity HDRP PreIntegratedFGD).
 
+``charlie_fabric`` (HDRP PreIntegratedFGD_CharlieFabricLambert): the sheen lobe's multiscatter pair stored divided
+by 2 pi, B the Fabric Lambert term:
+    R = (1/2pi) ∫ D_charlie V_charlie (1 - v.h)^5 (n.l) dω_l,  G = (1/2pi) ∫ D_charlie V_charlie (n.l) dω_l,
+    B = FabricLambertNoPI(alpha) = lerp(1, 0.5, alpha)   (constant in l: its cosine-weighted mean is itself)
+HDRP's shader averages D V (n.l) over uniform hemisphere samples (pdf 1/(2 pi)) and leaves out the 2 pi "to keep the
+values in [0, 1]"; the runtime multiplies it back: specularFGD = lerp(R, G, F0) * 2 pi (PreIntegratedFGD.hlsl).
+D_charlie, V_charlie and the Lambda fit take alpha = r^2 (PerceptualRoughnessToRoughness), as lutbake's terms.
+
 ``multiscatter_disney``: R = ∫ f/F Fc (n.l), G = ∫ f/F (n.l) (the multiscatter layout, lutbake.kinds.dfg), and
     B = (1/pi) ∫ Fd_disney_hdrp(n.v, n.l, l.v, r) (n.l) dω_l - 0.5
 the Disney diffuse FGD that HDRP stores shifted by -0.5 (its shader adds 0.5 back: diffuseFGD = preFGD.z + 0.5;
@@ -20,13 +28,16 @@ import numpy as np
 import warp as wp
 
 from ..sampling.plan import TexelPlan
-from ..terms.engine_diffuse import Fd_disney_hdrp
+from ..terms.engine_diffuse import Fd_disney_hdrp, Fd_fabric_lambert_hdrp
 
 DIFFUSE_ORDER = 24  # Gauss-Legendre nodes per dimension (mu, phi)
 HDRP_DIFFUSE_OFFSET = 0.5  # HDRP stores the Disney FGD minus 0.5 (range [0.5, 1.5] -> [0, 1] for its UNORM target)
+HDRP_UNIFORM_SCALE = 2.0 * np.pi  # HDRP's Charlie R, G are the integrals / 2 pi (its runtime multiplies by 2 pi)
 LAYOUTS = {
     "multiscatter_disney": "multiscatter + B = (1/pi) ∫ Fd_disney (n.l) dω - 0.5: Unity HDRP "
     "PreIntegratedFGD_GGXDisneyDiffuse",
+    "charlie_fabric": "sheen lobe: R = ∫ D_charlie V_charlie Fc (n.l) / 2pi, G = ∫ D_charlie V_charlie (n.l) / 2pi, "
+    "B = FabricLambertNoPI(alpha): Unity HDRP PreIntegratedFGD_CharlieFabricLambert (gauss_legendre only)",
 }
 CHANNELS = {
     "multiscatter_disney": {
@@ -35,12 +46,25 @@ CHANNELS = {
         "disney_fgd_minus_half": "(1/pi) ∫ Fd_disney(n.v, n.l, l.v, r) (n.l) dω_l - 0.5, Burley diffuse without 1/pi "
         "normalised by 1.03571 as HDRP's DisneyDiffuseNoPI (preFGD.z; diffuseFGD = z + 0.5)",
     },
+    "charlie_fabric": {
+        "fc_over_2pi": "(1/2pi) ∫ D_charlie V_charlie (1 - v.h)^5 (n.l) dω_l, Estevez & Kulla 2017 NDF and Lambda fit "
+        "(HDRP preFGD.x)",
+        "e_over_2pi": "(1/2pi) ∫ D_charlie V_charlie (n.l) dω_l: the sheen albedo / 2pi (HDRP preFGD.y, its "
+        "'reflectivity' as stored)",
+        "fabric_lambert": "FabricLambertNoPI(alpha) = lerp(1, 0.5, alpha) (HDRP preFGD.z = diffuseFGD)",
+    },
 }
 RECONSTRUCTION = {
     "multiscatter_disney": "uv = Remap01ToHalfTexelCoord(vec2(sqrt(NoV), perceptualRoughness), 64); t = texture(lut, "
     "uv).rgb; specularFGD = mix(t.r, t.g, f0); diffuseFGD = t.b + 0.5; reflectivity = t.g",
+    "charlie_fabric": "uv = vec2(NoV, perceptualRoughness) (texel centres); t = texture(lut, uv).rgb; specularFGD = "
+    "mix(t.r, t.g, f0) * 2 pi; diffuseFGD = t.b; reflectivity = t.g (HDRP, as stored: the albedo / 2pi)",
 }
-BASE_LAYOUT = {"multiscatter_disney": "multiscatter"}
+BASE_LAYOUT = {"multiscatter_disney": "multiscatter", "charlie_fabric": "sheen_fgd"}
+DIFFUSE_TERMS = {
+    "multiscatter_disney": "disney (Burley 2012, HDRP DisneyDiffuseNoPI / 1.03571), minus 0.5",
+    "charlie_fabric": "fabric lambert (HDRP FabricLambertNoPI = lerp(1, 0.5, alpha)); R, G divided by 2 pi",
+}
 
 
 @functools.lru_cache(maxsize=None)
@@ -91,26 +115,62 @@ def disney_fgd(nov: np.ndarray, perceptual_roughness: np.ndarray, device: str = 
     return out.numpy()
 
 
-def with_diffuse_channel(plan: TexelPlan, nov: np.ndarray, perceptual_roughness: np.ndarray) -> TexelPlan:
-    """The plan of the base layout with channel B = disney_fgd - HDRP_DIFFUSE_OFFSET appended (same tiles)."""
+@functools.lru_cache(maxsize=None)
+def fabric_kernel():
+    @wp.kernel(enable_backward=False)
+    def fabric_lambert(r: wp.array(dtype=float), out: wp.array(dtype=wp.float64)):
+        i = wp.tid()
+        out[i] = wp.float64(Fd_fabric_lambert_hdrp(r[i] * r[i]))
+
+    return fabric_lambert
+
+
+def fabric_lambert(perceptual_roughness: np.ndarray, device: str = "cpu") -> np.ndarray:
+    """HDRP's FabricLambertNoPI(alpha = r^2) at every texel: its cosine-weighted hemisphere mean (a constant)."""
+    out = wp.zeros(len(perceptual_roughness), dtype=wp.float64, device=device)
+    r = wp.array(np.ascontiguousarray(perceptual_roughness, np.float32), dtype=float, device=device)
+    wp.launch(fabric_kernel(), dim=len(out), device=device, inputs=[r, out])
+    return out.numpy()
+
+
+def engine_channels(layout: str, base: np.ndarray, nov: np.ndarray, rough: np.ndarray, device: str = "cpu"):
+    """The layout's table from its base layout's channels (n, nch) at texels (nov, perceptual roughness)."""
+    if layout == "charlie_fabric":
+        b = fabric_lambert(rough, device)
+        return np.concatenate([base / HDRP_UNIFORM_SCALE, b[:, None]], axis=1)
+    b = disney_fgd(nov, rough, device) - HDRP_DIFFUSE_OFFSET
+    return np.concatenate([base, b[:, None]], axis=1)
+
+
+def with_diffuse_channel(
+    plan: TexelPlan, nov: np.ndarray, perceptual_roughness: np.ndarray, layout: str = "multiscatter_disney"
+) -> TexelPlan:
+    """The plan of the base layout turned into ``layout``'s (engine_channels: channel B appended, same tiles)."""
     base_tile = plan.run_tile
     nch = plan.n_channels
 
     def run_tile(start: int, stop: int, device: str) -> np.ndarray:
-        """The base channels, B, then the base tile's aux columns (TexelPlan.aux_channels)."""
-        b = disney_fgd(nov[start:stop], perceptual_roughness[start:stop], device) - HDRP_DIFFUSE_OFFSET
+        """The layout's channels from the base tile's, then the base tile's aux columns (TexelPlan.aux_channels)."""
+        s = slice(start, stop)
         base = base_tile(start, stop, device)
-        return np.concatenate([base[:, :nch], b[:, None], base[:, nch:]], axis=1)
+        table = engine_channels(layout, base[:, :nch], nov[s], perceptual_roughness[s], device)
+        return np.concatenate([table, base[:, nch:]], axis=1)
 
     base_prepare = plan.prepare
 
     def prepare(device: str) -> None:
         base_prepare(device)
-        wp.load_module(diffuse_kernel().module, device=device)
+        wp.load_module((fabric_kernel() if layout == "charlie_fabric" else diffuse_kernel()).module, device=device)
 
     base_estimate = plan.error_estimate
-    if base_estimate is not None:  # the specular channels' estimate; B's quadrature is checked in the tests
-        plan.error_estimate = lambda data, device: base_estimate(np.delete(data, nch, axis=1), device)
+    scale = HDRP_UNIFORM_SCALE if layout == "charlie_fabric" else 1.0
+
+    def base_data(data: np.ndarray) -> np.ndarray:
+        """The base layout's tile data: its channels (rescaled) and aux columns, without channel B."""
+        return np.concatenate([data[:, :nch] * scale, data[:, nch + 1 :]], axis=1)
+
+    if base_estimate is not None:  # the specular channels' estimate, on the base layout's values; B: the tests
+        plan.error_estimate = lambda data, device: base_estimate(base_data(data), device)
     plan.run_tile, plan.prepare, plan.n_channels = run_tile, prepare, nch + 1
     return plan
 

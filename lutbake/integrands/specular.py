@@ -86,9 +86,10 @@ N_CHANNELS = {
     "sheen_albedo": 2,
     "charlie_clamped": 3,
     "sheen_albedo_clamped": 2,
+    "sheen_fgd": 2,
 }
 # the sheen lobe alone: no GGX term (sheen_integrand_for); *_clamped: V clamped to [0, 1] (the viewer's shaders)
-SHEEN_LAYOUTS = ("charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped")
+SHEEN_LAYOUTS = ("charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped", "sheen_fgd")
 
 
 @functools.lru_cache(maxsize=None)
@@ -198,6 +199,8 @@ def sheen_integrand_for(layout: str):
         charlie       (0, 0, D_charlie V_ashikhmin (n.l) 4 (v.h))   the glTF Sample Viewer's lut_charlie (read .b)
         sheen_albedo  (D_charlie V_charlie (n.l) 4 (v.h), D_charlie V_ashikhmin (n.l) 4 (v.h))
                       R: E(mu) with the spec's Charlie visibility, G: with Ashikhmin's
+        sheen_fgd     (D_charlie V_charlie Fc (n.l) 4 (v.h), D_charlie V_charlie (n.l) 4 (v.h)), Fc = (1 - v.h)^5:
+                      the multiscatter pair of the sheen lobe (Unity HDRP PreIntegratedFGD_CharlieFabricLambert)
     0 where n.l, v.h or n.v <= COS_EPS (back-facing). alpha is the texel's alpha (roughness = "alpha": the
     sheenRoughness itself, as the KHR spec's D and Lambda fit use it). The ``*_clamped`` layouts clamp each V
     to [0, 1], as the glTF Sample Viewer's V_Ashikhmin (ibl_filtering.frag) and V_Sheen (brdf.glsl) do."""
@@ -213,6 +216,9 @@ def sheen_integrand_for(layout: str):
         ash = d * wp.min(masking.V_ashikhmin(NoV, NoL), wp.static(vmax))
         if wp.static(base == "charlie"):
             return wp.vec3(0.0, 0.0, ash)
+        if wp.static(base == "sheen_fgd"):
+            dc = d * masking.V_charlie(NoV, NoL, alpha)
+            return wp.vec3(dc * fresnel.Fc_schlick(VoH), dc, 0.0)
         return wp.vec3(d * wp.min(masking.V_charlie(NoV, NoL, alpha), wp.static(vmax)), ash, 0.0)
 
     return half_vector_integrand(lobe, wp.vec3, False)

@@ -177,7 +177,7 @@ def check_spec(spec) -> tuple[str, str] | None:
             "layout 'multiscatter_cloth' needs estimator 'gauss_legendre': the QMC estimators draw "
             "h from the GGX NDF and miss the Charlie NDF's grazing lobe of the cloth channel",
         )
-    if o.get("layout") in SHEEN_LAYOUTS:
+    if engine_diffuse.BASE_LAYOUT.get(o.get("layout"), o.get("layout")) in SHEEN_LAYOUTS:
         if o["estimator"] != "gauss_legendre":
             return (
                 "estimator",
@@ -292,9 +292,9 @@ def plan(spec) -> TexelPlan:
     integrand = specular_integrand(nd, mk, base, form, nch)
     cloth = {"cloth": "D_charlie + V_ashikhmin"} if o["layout"] == "multiscatter_cloth" else {}
     terms = {**terms_record(o, "schlick"), "layout": o["layout"], **cloth}
-    if o["layout"] in SHEEN_LAYOUTS:
-        vis = (
-            "ashikhmin" if o["layout"].startswith("charlie") else "R: charlie (Estevez-Kulla Lambda fit), G: ashikhmin"
+    if base in SHEEN_LAYOUTS:
+        vis = {"charlie": "ashikhmin", "sheen_fgd": "charlie (Estevez-Kulla Lambda fit), R and G"}.get(
+            base.removesuffix("_clamped"), "R: charlie (Estevez-Kulla Lambda fit), G: ashikhmin"
         )
         if o["layout"].endswith("_clamped"):
             vis += " (V clamped to [0, 1], as the glTF Sample Viewer)"
@@ -307,7 +307,7 @@ def plan(spec) -> TexelPlan:
             "gauss_legendre_panels": "the GGX CDF in theta_h (panelling only; the integrand is the sheen lobe)",
         }
     if base != o["layout"]:
-        terms["diffuse"] = "disney (Burley 2012, HDRP DisneyDiffuseNoPI / 1.03571), minus 0.5"
+        terms["diffuse"] = engine_diffuse.DIFFUSE_TERMS[o["layout"]]
     plan = per_texel_plan(
         integrand,
         estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
@@ -319,7 +319,8 @@ def plan(spec) -> TexelPlan:
     )
     if base != o["layout"]:
         nov = texel_grid(axes)[0]
-        plan = engine_diffuse.with_diffuse_channel(plan, nov, engine_diffuse.perceptual_roughness_grid(axes))
+        rough = engine_diffuse.perceptual_roughness_grid(axes)
+        plan = engine_diffuse.with_diffuse_channel(plan, nov, rough, o["layout"])
     return plan
 
 

@@ -28,6 +28,8 @@ MASKINGS = {
     "v_cavity": "Cook-Torrance V-cavity min(1, 2 NoH NoV / VoH, 2 NoH NoL / VoH) (lecture 003)",
     "smith_joint_approx": "UE4's Vis_SmithJointApprox as G2 = 2 NoL NoV / (NoL (NoV (1-a) + a) + NoV (NoL (1-a) + a)), "
     "a = alpha (an approximation of height-correlated Smith GGX; NDF-independent)",
+    "schlick_ggx_ibl": "separable Schlick-GGX G2 = G1(v) G1(l), G1 = NoX / (NoX (1 - k) + k), k = alpha / 2 "
+    "(Karis 2013 Eq. 4, its IBL k; Godot's integrate_dfg.glsl; NDF-independent)",
 }
 
 
@@ -85,6 +87,11 @@ def _G2(d: Distribution, masking_name: str):
         @wp.func
         def G2(NoV: float, NoL: float, NoH: float, VoH: float, alpha: float):
             return masking.G2_smith_joint_approx(NoV, NoL, alpha)
+    elif masking_name == "schlick_ggx_ibl":
+
+        @wp.func
+        def G2(NoV: float, NoL: float, NoH: float, VoH: float, alpha: float):
+            return masking.G2_schlick_ggx_ibl(NoV, NoL, alpha)
     else:
         raise KeyError(masking_name)
     return G2

@@ -125,6 +125,23 @@ def G2_smith_joint_approx(NoV: float, NoL: float, alpha: float):
 
 
 @wp.func
+def G1_schlick_ggx(NoX: float, k: float):
+    """Schlick's G1 approximation (Schlick 1994) as Karis writes it for GGX ("Real Shading in Unreal Engine 4", 2013,
+    Eq. 4): n.x / ((n.x)(1 - k) + k)."""
+    return NoX / (NoX * (1.0 - k) + k)
+
+
+@wp.func
+def G2_schlick_ggx_ibl(NoV: float, NoL: float, alpha: float):
+    """Separable Schlick-GGX G2 = G1(v) G1(l) with Karis 2013's IBL choice k = alpha / 2 (no (r + 1)/2 remap), as
+    Godot's integrate_dfg.glsl (geometry_smith) and LearnOpenGL's IBL code. 0 for a back-facing n.l or n.v."""
+    if NoV <= COS_EPS or NoL <= COS_EPS:
+        return 0.0
+    k = 0.5 * alpha
+    return G1_schlick_ggx(NoV, k) * G1_schlick_ggx(NoL, k)
+
+
+@wp.func
 def Lambda_ggx64(NoX: wp.float64, alpha: wp.float64):
     """Lambda_ggx in float64, for n.x > 0 (the swapped-integral albedo's nodes never reach the horizon)."""
     c2 = NoX * NoX
