@@ -2,6 +2,8 @@
 terms against numpy, tables against the independent integral over the outgoing sphere (tests/dielectric_reference.py),
 the analytic limits, reciprocity, the second estimator, and the engine layouts' grids."""
 
+import functools
+
 import dielectric_reference as ref
 import numpy as np
 import pytest
@@ -235,12 +237,25 @@ UNORM16_STEP = 1.0 / 65535.0
 OPENPBR_RATIO_ATOL = 2.0e-3
 
 
+OPENPBR_PAIRS_K = (1, 5, 10, 15)  # IOR rows 15 - k (eta < 1) and 16 + k (eta > 1) = 1 / each other
+RATIO_A0 = 16  # alpha index >= 16
+
+
+@functools.lru_cache(maxsize=1)
+def openpbr_avg_rows() -> dict:
+    """{IOR row z: (16, 4) dielectric_avg openpbr channels at alpha index >= RATIO_A0} for the rows of OPENPBR_PAIRS_K
+    (each tile computes its mirror row's averages itself: the ratio channel needs them)."""
+    plan = lookup_kind("dielectric_avg").plan(spec(kind="dielectric_avg", layout="openpbr"))
+    zs = [z for k in OPENPBR_PAIRS_K for z in (15 - k, 16 + k)]
+    return {z: plan.run_tile(z * 32 + RATIO_A0, z * 32 + 32, "cpu") for z in zs}
+
+
 def test_openpbr_reflection_ratio_is_tied_to_the_averages_by_the_lobes_reciprocity():
     """OpenPBR's multiple-scattering lobe (impl/openpbr_microfacet_multiple_scattering_lobes.h) transmits
     (1 - x(eta)) E_c(eta, mu_i) E_c(1/eta, mu_o) / (pi E_c,avg(1/eta)) from side i and (1 - x(1/eta)) E_c(1/eta, mu_o)
     E_c(eta, mu_i) / (pi E_c,avg(eta)) back: it is symmetric iff (1 - x(eta)) E_c,avg(eta) = (1 - x(1/eta))
     E_c,avg(1/eta). The shipped ratio obeys that to UNORM16 precision, so its eta < 1 half follows from its eta > 1
-    half and the averages (lutbake's included); the other half is not fixed by any single-scattering integral."""
+    half and the averages (lutbake's included); the closed form fixing the other half is tested below."""
     shipped = np.load("tests/data/openpbr_energy_tables.npz")
     x = shipped["ideal_dielectric_reflection_ratio"] / 65535.0
     ec_shipped = shipped["ideal_dielectric_avg_energy_complement"] / 65535.0
@@ -248,11 +263,66 @@ def test_openpbr_reflection_ratio_is_tied_to_the_averages_by_the_lobes_reciproci
     inside, outside = 15 - k, 16 + k  # eta_in = 1 / eta_out: OpenPBR's IOR axis is symmetric about 15.5
     residual = (1 - x[outside]) * ec_shipped[outside] - (1 - x[inside]) * ec_shipped[inside]
     np.testing.assert_allclose(residual, 0.0, rtol=0, atol=UNORM16_STEP)
+    rows = openpbr_avg_rows()  # alpha index >= 16 (alpha >= 0.27): E_c,avg >= 0.03, the division is well conditioned
+    for k in OPENPBR_PAIRS_K:
+        ec_out, ec_in = rows[16 + k][:, 0], rows[15 - k][:, 0]
+        predicted = 1 - (1 - x[16 + k, RATIO_A0:]) * ec_out / ec_in
+        np.testing.assert_allclose(predicted, x[15 - k, RATIO_A0:], rtol=0, atol=OPENPBR_RATIO_ATOL)
+
+
+# the closed form of lutbake.kinds.dielectric_ratio on the shipped averages vs the shipped ratio: both arrays are
+# UNORM16-rounded and the ratio divides by E_c,avg (measured max 6.5e-5 = 4.3 steps at alpha index >= 16, 3.5e-4
+# at >= 8)
+RATIO_FORM_ATOL = {16: 1.0e-4, 8: 5.0e-4}
+# lutbake's ratio channel vs the shipped one at alpha index >= 16: the shipped averages' Monte Carlo noise (max 4.2e-4)
+# divided by E_c,avg (measured max 6.9e-4 over every eta != 1 row)
+RATIO_BAKED_ATOL = 1.0e-3
+OPENPBR_ETA_ONE_ROWS = (15, 16)  # both eta = 1: the shipped rows are degenerate there (docs/transmission.md)
+
+
+def kulla_conty_ratio(ec, ec_mirror, eta):
+    """The reflection ratio transcribed independently (scalar, explicit branches) from docs/transmission.md."""
+
+    def f_avg(e):  # Kulla & Conty 2017, slide 18 (OpenPBR's openpbr_average_fresnel)
+        return (e - 1) / (4.08567 + 1.00071 * e) if e > 1 else 0.997118 + 0.1014 * e - 0.965241 * e**2 - 0.130607 * e**3
+
+    f, fm = f_avg(eta), f_avg(1 / eta)
+    if (1 - f) * ec <= (1 - fm) * ec_mirror:  # this side transmits less under an F_avg split: it splits first
+        return f * ec / (f * ec + (1 - fm) * ec_mirror)
+    xm = fm * ec_mirror / (fm * ec_mirror + (1 - f) * ec)
+    return 1 - (1 - xm) * ec_mirror / ec  # reciprocity: (1 - x) E_c,avg equal on both sides
+
+
+def test_openpbr_reflection_ratio_closed_form_reproduces_the_shipped_array():
+    """Fed OpenPBR's own (shipped) averages, the Kulla-Conty split reproduces OpenPBR_IdealDielectricReflectionRatio
+    to its UNORM16 rounding on every eta != 1 row, in the module and in an independent scalar transcription."""
+    from lutbake.kinds.dielectric_ratio import reflection_ratio
+
+    shipped = np.load("tests/data/openpbr_energy_tables.npz")
+    x = shipped["ideal_dielectric_reflection_ratio"] / 65535.0
+    ec = shipped["ideal_dielectric_avg_energy_complement"] / 65535.0
+    etas = kd.ior_values(32, 0.4, 2.5, "endpoint", "symmetric")
+    rows = [z for z in range(32) if z not in OPENPBR_ETA_ONE_ROWS]
+    got = reflection_ratio(ec[rows], ec[[31 - z for z in rows]], etas[rows, None])
+    scalar = np.array([[kulla_conty_ratio(ec[z, a], ec[31 - z, a], etas[z]) for a in range(8, 32)] for z in rows])
+    np.testing.assert_allclose(got[:, 8:], scalar, rtol=0, atol=1e-12)
+    for a0, tol in RATIO_FORM_ATOL.items():
+        np.testing.assert_allclose(got[:, a0:], x[rows, a0:], rtol=0, atol=tol)
+
+
+def test_openpbr_reflection_ratio_channel_matches_the_shipped_array_and_any_tiling():
+    """The dielectric_avg openpbr layout's 4th channel at the IOR rows of OPENPBR_PAIRS_K (eta = 1/1.1 ... 1/2.5 and
+    1.1 ... 2.5), alpha index >= 16, against the shipped array; a tile's texels do not depend on the tile (each tile
+    computes its mirror row itself)."""
+    shipped = np.load("tests/data/openpbr_energy_tables.npz")
+    x = shipped["ideal_dielectric_reflection_ratio"] / 65535.0
     plan = lookup_kind("dielectric_avg").plan(spec(kind="dielectric_avg", layout="openpbr"))
-    a0 = 16  # alpha index >= 16 (alpha >= 0.27): E_c,avg >= 0.03, the division is well conditioned
-    ec = np.stack([plan.run_tile(z * 32 + a0, z * 32 + 32, "cpu")[:, 0] for z in range(32)])
-    predicted = 1 - (1 - x[outside, a0:]) * ec[outside] / ec[inside]
-    np.testing.assert_allclose(predicted, x[inside, a0:], rtol=0, atol=OPENPBR_RATIO_ATOL)
+    assert list(plan.channels)[3] == "ideal_dielectric_reflection_ratio" and plan.n_channels == 4
+    rows = openpbr_avg_rows()
+    for z, got in rows.items():
+        np.testing.assert_allclose(got[:, 3], x[z, RATIO_A0:], rtol=0, atol=RATIO_BAKED_ATOL)
+    z = 16 + OPENPBR_PAIRS_K[1]
+    np.testing.assert_array_equal(plan.run_tile(z * 32 + 24, z * 32 + 32, "cpu"), rows[z][24 - RATIO_A0 :])
 
 
 def test_bake_energy_kind_and_average_consistency():
@@ -317,5 +387,19 @@ def test_openpbr_header_writes_its_arrays_as_unorm16(tmp_path):
         codes = np.array([int(x) for x in re.findall(r"\d+", body.group(2))])
         assert int(body.group(1)) == want.size == codes.size
         np.testing.assert_array_equal(codes, np.rint(want.ravel().astype(np.float64) * 65535))
+    avg = rng.uniform(0, 1, (32, 32, 4)).astype(np.float32)
+    text = write_table(
+        Table("opbr_avg", "dielectric_avg", avg, [], kd.AVG_CHANNELS["openpbr"], ""), tmp_path, "openpbr_h"
+    )
+    arrays = dict(re.findall(r"OpenPBR_(\w+)_Array\[(\d+)\]", text.read_text()))
+    assert arrays == {
+        "IdealDielectricAverageEnergyComplement": "1024",
+        "OpaqueDielectricAverageEnergyComplement": "1024",
+        "IdealMetalAverageEnergyComplement": "32",
+        "IdealDielectricReflectionRatio": "1024",  # the seventh array
+    }
+    body = re.search(r"OpenPBR_IdealDielectricReflectionRatio_Array\[1024\] = {[^\n]*\n(.*?)};", text.read_text(), re.S)
+    codes = np.array([int(x) for x in re.findall(r"\d+", body.group(1))])
+    np.testing.assert_array_equal(codes, np.rint(avg[..., 3].ravel().astype(np.float64) * 65535))
     with pytest.raises(Exception, match="format"):
         spec(kind="dielectric", format="openpbr_h")

@@ -7,10 +7,9 @@
                       OpenPBR_OpaqueDielectricEnergyComplement_Array
                       [32*32*32], OpenPBR_IdealMetalEnergyComplement_Array[32*32]
     dielectric_avg -> OpenPBR_IdealDielectricAverageEnergyComplement_Array[32*32], OpenPBR_OpaqueDielectric...[32*32],
-                      OpenPBR_IdealMetalAverageEnergyComplement_Array[32]
-OpenPBR_IdealDielectricReflectionRatio_Array (the split of the multiple-scattering energy) is not written: energy
-conservation leaves it free and reciprocity fixes only its eta < 1 half from the eta > 1 half; the rest is a random-walk
-quantity (docs/transmission.md, "The reflection ratio").
+                      OpenPBR_IdealMetalAverageEnergyComplement_Array[32],
+                      OpenPBR_IdealDielectricReflectionRatio_Array[32*32] (the seventh array:
+                      lutbake.kinds.dielectric_ratio; docs/transmission.md, "The reflection ratio")
 """
 
 from __future__ import annotations

@@ -23,7 +23,9 @@ Layouts (key ``layout``) fix the channels, and for the engine layouts the whole 
     openpbr     adobe/openpbr-bsdf's [ior][alpha][cos] 32^3 tables: z = IOR (indices 0-15: 1/eta = 1 + 1.5 (15 - i)/15,
                 16-31: eta = 1 + 1.5 (i - 16)/15), y = sqrt(alpha) = i/31, x = cos theta = i/31 (0 clamped to NOV_MIN);
                 R = 1 - (E_R + E_T) (IdealDielectricEnergyComplement), G = 1 - E_R (OpaqueDielectricEnergyComplement),
-                B = 1 - E(F = 1) (IdealMetalEnergyComplement, the same in every IOR slice)
+                B = 1 - E(F = 1) (IdealMetalEnergyComplement, the same in every IOR slice); kind dielectric_avg:
+                the three averages and A = OpenPBR's IdealDielectricReflectionRatio (lutbake.kinds.dielectric_ratio,
+                from the averages of both sides of the interface: row z and its mirror row 31 - z, eta -> 1/eta)
 """
 
 from __future__ import annotations
@@ -40,7 +42,7 @@ from ..sampling.hemisphere import ESTIMATORS, QuasiMonteCarlo
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan, probe_indices
 from ..terms.distributions import MASKINGS as ALL_MASKINGS
 from ..terms.distributions import NDFS
-from . import dfg
+from . import dfg, dielectric_ratio
 from .base import Estimation, Key, declare
 
 DEFAULT_SAMPLES = {"gauss_legendre": 3 * 12**2, "sobol_vndf": 1 << 14, "sobol_ndf": 1 << 16, "hammersley_ndf": 1 << 16}
@@ -83,6 +85,8 @@ AVG_CHANNELS = {
         "ideal_dielectric_average_energy_complement": "1 - 2 ∫ (E_R + E_T) mu dmu",
         "opaque_dielectric_average_energy_complement": "1 - 2 ∫ E_R mu dmu",
         "ideal_metal_average_energy_complement": "1 - 2 ∫ E(F = 1) mu dmu",
+        "ideal_dielectric_reflection_ratio": "x: the multiple-scattering lobe's reflected share, Kulla-Conty split of "
+        "the two sides' E_c,avg (lutbake.kinds.dielectric_ratio), symmetric transmission",
     },
 }
 RECONSTRUCTION = {
@@ -102,7 +106,8 @@ RECONSTRUCTION = {
 }
 AVG_RECONSTRUCTION = {
     "energy": "E_avg = texture(lut2d, vec2(u(roughness), u(eta))).rgb: rows = IOR, columns = roughness",
-    "openpbr": "openpbr_look_up_*_average_energy_complement(ior, alpha): bilinear over array[ior][alpha] (alpha "
+    "openpbr": "openpbr_look_up_*_average_energy_complement(ior, alpha) and "
+    "openpbr_look_up_ideal_dielectric_reflection_ratio(ior, alpha): bilinear over array[ior][alpha] (alpha "
     "fastest), indices as the 3D tables",
 }
 IOR_MAPPINGS = {
@@ -391,8 +396,9 @@ def plan_avg(spec) -> TexelPlan:
     counts = np.array([len(m) for m, _ in nodes])
     grid = Grid(axes, {"alpha": alpha}, alpha=np.asarray(alpha, np.float64))
 
-    def run(idx, est, device):
-        t = np.arange(len(alpha))[idx]
+    def averages(t, est, device):
+        """(len(t), 3) float64 averages 2 ∫ E mu dmu of (E_R, E_T, E(F = 1)) at texels t (each texel's own sums:
+        independent of which texels share the call)."""
         mu = np.concatenate([nodes[k][0] for k in t])
         inputs = {
             "nov": mu.astype(np.float32),
@@ -401,15 +407,27 @@ def plan_avg(spec) -> TexelPlan:
         }
         res = est.evaluate(integrand, inputs, device)
         starts = np.concatenate([[0], np.cumsum(counts[t])])
-        avg = np.array([2.0 * (nodes[k][1] * nodes[k][0]) @ res[starts[j] : starts[j + 1]] for j, k in enumerate(t)])
+        return np.array([2.0 * (nodes[k][1] * nodes[k][0]) @ res[starts[j] : starts[j + 1]] for j, k in enumerate(t)])
+
+    def run(idx, est, device):
+        t = np.arange(len(alpha))[idx]
         if layout == "openpbr":
-            return post_process("openpbr", avg)
+            # the reflection ratio at (eta, alpha) needs E_c,avg at (1/eta, alpha) too: row z mirrors row N - 1 - z
+            mirror = (OPENPBR_SIZE - 1 - t // OPENPBR_SIZE) * OPENPBR_SIZE + t % OPENPBR_SIZE
+            both = np.unique(np.concatenate([t, mirror]))
+            avg = averages(both, est, device)
+            ch, ch_m = (post_process("openpbr", avg[np.searchsorted(both, u)]) for u in (t, mirror))
+            ratio = dielectric_ratio.reflection_ratio(ch[:, 0], ch_m[:, 0], eta[t])
+            return np.concatenate([ch, ratio[:, None]], axis=1)
+        avg = averages(t, est, device)
         return np.stack([avg[:, 0], avg[:, 1], avg[:, 0] + avg[:, 1]], axis=1)
+
+    n_channels = len(AVG_CHANNELS[layout])
 
     def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
         idx = probe_indices(grid)
         refined, how = estimator.refined()
-        err = float(np.max(np.abs(data.reshape(len(alpha), 3)[idx] - run(idx, refined, device))))
+        err = float(np.max(np.abs(data.reshape(len(alpha), n_channels)[idx] - run(idx, refined, device))))
         return err, f"max |{how}| over {len(idx)} strided probe texels"
 
     per = int(estimator.samples({"nov": [0.0]})[0]) * int(counts.max())
@@ -418,7 +436,7 @@ def plan_avg(spec) -> TexelPlan:
         channels=AVG_CHANNELS[layout],
         reconstruction=AVG_RECONSTRUCTION[layout],
         n_texels=len(alpha),
-        n_channels=3,
+        n_channels=n_channels,
         run_tile=lambda s, e, d: run(slice(s, e), estimator, d),
         prepare=lambda d: estimator.prepare(integrand, d),
         samples=per,
@@ -428,6 +446,7 @@ def plan_avg(spec) -> TexelPlan:
         extra={
             "mu_quadrature": f"{order} Gauss-Legendre nodes per panel, panels split at mu = 0.2 and cos theta_c",
             "alpha_policy": alpha_policy(True),
+            **({"reflection_ratio": dielectric_ratio.METADATA} if layout == "openpbr" else {}),
         },
         error_estimate=error_estimate,
     )

@@ -13,6 +13,9 @@
   f_t(i -> o) / eta_o^2 = f_t(o -> i) / eta_i^2 (Walter et al. 2007, Sec. 3.2; Veach 1997), at random pairs.
 - ``dielectric_energy_le_one``: E_R + E_T <= 1 over a (mu, alpha, eta) grid; reports where the loss is largest.
 - ``dielectric_estimators_agree``: panelled Gauss-Legendre vs scrambled-Sobol' VNDF sampling.
+- ``openpbr_reflection_ratio_reciprocity``: the OpenPBR layout's reflection ratio x (kind dielectric_avg) keeps
+  OpenPBR's multiple-scattering transmission lobe symmetric: (1 - x(eta)) E_c,avg(eta) = (1 - x(1/eta)) E_c,avg(1/eta)
+  (lutbake.kinds.dielectric_ratio), on mirrored rows of the baked table, and 0 <= x <= 1.
 """
 
 from __future__ import annotations
@@ -276,10 +279,49 @@ def dielectric_estimators_agree():
     )
 
 
+RATIO_RECIPROCITY_TOL = 1.0e-7  # float32-stored channels; the relation holds exactly in float64
+RATIO_ROW_PAIRS = ((3, 28), (12, 19))  # OpenPBR IOR indices z and 31 - z: eta = 1/2.3 and 2.3, 1/1.3 and 1.3
+RATIO_ALPHAS = (20, 32)  # alpha index range (sqrt(alpha) = i/31) of the probed texels
+
+
+def openpbr_ratio_rows():
+    """{IOR index z: (n, 4) float64 rows of the openpbr dielectric_avg layout at RATIO_ALPHAS} for RATIO_ROW_PAIRS,
+    baked by the kind's own plan (each tile computes its mirror row's averages itself)."""
+    from ..config import validate_table
+    from ..kinds import lookup_kind
+
+    raw = {"name": "openpbr_ratio_check", "kind": "dielectric_avg", "layout": "openpbr"}
+    plan = lookup_kind("dielectric_avg").plan(validate_table(raw, "<openpbr_reflection_ratio_reciprocity>", 0))
+    lo, hi = RATIO_ALPHAS
+    rows = {}
+    for pair in RATIO_ROW_PAIRS:
+        for z in pair:
+            rows[z] = np.asarray(plan.run_tile(z * 32 + lo, z * 32 + hi, "cpu"), np.float32).astype(np.float64)
+    return rows
+
+
+def openpbr_reflection_ratio_reciprocity():
+    from ..kinds.dielectric_ratio import reciprocity_residual
+
+    rows = openpbr_ratio_rows()
+    res = [reciprocity_residual(rows[a][:, 3], rows[a][:, 0], rows[b][:, 3], rows[b][:, 0]) for a, b in RATIO_ROW_PAIRS]
+    x = np.concatenate([r[:, 3] for r in rows.values()])
+    out_of_range = float(max(0.0, -x.min(), x.max() - 1.0))
+    return _result(
+        "openpbr_reflection_ratio_reciprocity",
+        max(float(np.max(np.abs(res))), out_of_range),
+        RATIO_RECIPROCITY_TOL,
+        f"max |(1 - x(eta)) E_c,avg(eta) - (1 - x(1/eta)) E_c,avg(1/eta)| (and how far x leaves [0, 1]) over IOR "
+        f"index pairs {RATIO_ROW_PAIRS} x alpha indices {RATIO_ALPHAS[0]}..{RATIO_ALPHAS[1] - 1} of the openpbr "
+        f"dielectric_avg table; x ranges {x.min():.4f}..{x.max():.4f}",
+    )
+
+
 CHECKS = {
     "dielectric_smooth_limit": dielectric_smooth_limit,
     "dielectric_index_matched": dielectric_index_matched,
     "dielectric_reciprocity": dielectric_reciprocity,
     "dielectric_energy_le_one": dielectric_energy_le_one,
     "dielectric_estimators_agree": dielectric_estimators_agree,
+    "openpbr_reflection_ratio_reciprocity": openpbr_reflection_ratio_reciprocity,
 }
