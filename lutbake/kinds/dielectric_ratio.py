@@ -9,9 +9,10 @@ so energy conservation holds for any x and the transmission lobe is symmetric if
 
     (1 - x(eta)) E_c,avg(eta) = (1 - x(1/eta)) E_c,avg(1/eta)                              (reciprocity, no eta^2).
 
-The source ships x without its generator ("a custom Monte Carlo integration tool"). The shipped array is reproduced
-to its UNORM16 step (max 3.8e-5 / 6.5e-5 on the eta > 1 / eta < 1 halves at alpha index >= 16, with the shipped
-averages as input; docs/transmission.md) by this closed form in the two averages and the hemispherical Fresnel average
+The source ships x without its generator ("a custom Monte Carlo integration tool"). The shipped array is reproduced,
+with the shipped averages as input, within the worst-case effect of the arrays' UNORM16 rounding at every texel with
+alpha > 0 and eta != 1 (max 6.5e-5 at alpha index >= 16; docs/transmission.md) by this closed form in the two averages
+and the hemispherical Fresnel average
 F_avg of Kulla & Conty 2017 ("Revisiting physically based shading at Imageworks", SIGGRAPH course, slide 18; the fit
 OpenPBR's openpbr_average_fresnel implements): for the two sides s, s' of the interface (eta_s' = 1/eta_s) put
 
