@@ -64,6 +64,8 @@ def test_inspect_imports_only_what_the_format_needs(tmp_path):
     dds = write_table(table2d(2), tmp_path, "dds")
     exr = write_table(table2d(2), tmp_path / "e", "exr")
     assert loaded_after(["inspect", str(dds)]) == []
+    js = write_table(table2d(2), tmp_path / "j", "js")  # an engine layout: values read back with its sidecar
+    assert loaded_after(["inspect", str(js)]) == []
     assert loaded_after(["inspect", str(exr)]) == ["OpenImageIO"]
 
 
