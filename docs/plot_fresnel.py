@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from lutbake.integrands.fresnel import evaluate  # noqa: E402
-from lutbake.terms.metals import fit_lazanyi_a  # noqa: E402
+from lutbake.metals import fit_lazanyi_a  # noqa: E402
 
 DEFAULT_OUT = Path(__file__).resolve().parents[1] / "outputs" / "figures"  # never docs/figures (tracked)
 AL = (1.3, 7.48)

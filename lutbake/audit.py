@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from .axes import Axis
+from .catalog import SHEEN_LAYOUTS
 from .edge import NOV_MIN
 from .io.lut_files import LutFile, read_lut
 from .tolerance import Tolerance
@@ -254,13 +255,14 @@ class Integrator:
     def __init__(self, conv: Conventions, workers: int | None = None):
         from .integrands import engine_diffuse, specular
         from .kinds.dfg import terms_of
+        from .kinds.engine_layouts import BASE_LAYOUT
 
         self.specular = specular
         self.engine_diffuse = engine_diffuse
         o = conv.options
         self.form, self.ndf, self.masking = terms_of(o)
         self.layout = o["layout"]
-        self.base = engine_diffuse.BASE_LAYOUT.get(self.layout, self.layout)  # the specular integrand's layout
+        self.base = BASE_LAYOUT.get(self.layout, self.layout)  # the specular integrand's layout
         self.nch = specular.N_CHANNELS[self.base]
         self.workers = workers
         self._cache: dict[bytes, np.ndarray] = {}
@@ -307,7 +309,7 @@ class Integrator:
 
     def hammersley(self, nov, alpha, samples: int) -> np.ndarray | None:
         """The engines' usual estimator (R, G of the split-sum layout), or None for the sheen layouts."""
-        if self.base in self.specular.SHEEN_LAYOUTS or self.form != "microfacet":
+        if self.base in SHEEN_LAYOUTS or self.form != "microfacet":
             return None
         base = "multiscatter" if self.base.startswith("multiscatter") else "scale_bias"
         return self._run(base, "hammersley_ndf", samples, 2, nov, alpha)

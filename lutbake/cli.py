@@ -230,20 +230,23 @@ def progress_bars(label: str, n_texels: int, cost: float):
 def list_():
     """List table kinds, selectable terms, estimators and presets."""
     from .axes import TEXELS
+    from .catalog import (
+        ANISO_ESTIMATORS,
+        ANISO_MODELS,
+        DIFFUSE_MODELS,
+        FRESNELS,
+        HEMISPHERE_ESTIMATORS,
+        MASKINGS,
+        NDF_DESCRIPTIONS,
+        SPECULAR_MODELS,
+    )
     from .config import presets
-    from .integrands.anisotropic import ANISO_MODELS
-    from .integrands.diffuse import DIFFUSE_MODELS
-    from .integrands.fresnel import FRESNELS
-    from .integrands.specular import SPECULAR_MODELS
     from .io.formats import FORMATS
     from .kinds import KINDS
     from .kinds.dfg import LAYOUTS
     from .kinds.diffuse import DIFFUSE_ESTIMATORS
     from .kinds.specular_aniso import VIEW_AZIMUTHS
-    from .sampling.anisotropic import ANISO_ESTIMATORS
-    from .sampling.hemisphere import ESTIMATORS
-    from .terms.distributions import MASKINGS, NDFS
-    from .terms.metals import METALS
+    from .metals import METALS
 
     def section(title, items):
         click.echo(click.style(title, bold=True))
@@ -255,7 +258,7 @@ def list_():
         "Table kinds (kind = ...)",
         {k.name + (f" ({', '.join(k.aliases)})" if k.aliases else ""): k.description for k in KINDS.values()},
     )
-    section("NDFs (ndf = ...)", {k: v.description for k, v in NDFS.items()})
+    section("NDFs (ndf = ...)", NDF_DESCRIPTIONS)
     section("Masking-shadowing (masking = ...)", MASKINGS)
     section("Models (dfg, albedo, albedo_avg, specular_3d: model = ...)", SPECULAR_MODELS)
     section("Anisotropic models (specular_aniso: model = ...)", ANISO_MODELS)
@@ -266,7 +269,7 @@ def list_():
         "Metals (specular_3d: metal = ...)", {k: f"n+ik R,G,B = {m.n} + i{m.k}; {m.source}" for k, m in METALS.items()}
     )
     section("DFG layouts (layout = ...)", LAYOUTS)
-    section("Estimators (dfg, albedo, albedo_avg, specular_3d: estimator = ...)", ESTIMATORS)
+    section("Estimators (dfg, albedo, albedo_avg, specular_3d: estimator = ...)", HEMISPHERE_ESTIMATORS)
     section("Diffuse models (kind = diffuse, model = ...)", DIFFUSE_MODELS)
     section("Estimators (diffuse, diffuse_3d: estimator = ...)", DIFFUSE_ESTIMATORS)
     section("Estimators (specular_aniso: estimator = ...)", ANISO_ESTIMATORS)

@@ -7,6 +7,9 @@ lutbake reads (lutbake.io.readers).
 - a 3D table (``specular_3d``, ``specular_aniso``, ``diffuse_3d``): a grid of slices, one row per channel,
   each slice titled with its z value (f0, anisotropy ...), one colour scale per channel;
 - ``btf``: light x view images (theta_l across, theta_v up), one row per sigma, one column per phi;
+- ``ltc``, from its EXR or any engine layout (lutbake.io.engine_files): the textures ltc_1 (matrix coefficients)
+  and ltc_2 (magnitude, fresnel, sphere) as the two slices of a 3D table, per channel; HDRP's .cs holds one
+  texture, drawn as a 2D table of HDRP's own texel;
 - a table without lutbake metadata: its channels (or slices) by index.
 A row of spheres follows where the table has a split-sum reconstruction (``dfg`` and ``specular_aniso``
 layouts, ``specular_3d``, the sheen ``charlie`` layout): orthographic spheres lit by a sky/ground

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from lutbake.integrands.fresnel import evaluate, f_avg
-from lutbake.terms.metals import LAZANYI_ALPHA, METALS, fit_lazanyi_a, lookup_metal
+from lutbake.metals import LAZANYI_ALPHA, METALS, fit_lazanyi_a, lookup_metal
 
 F32_TOL = 2e-6  # float32 evaluation of an O(1) expression
 C = np.concatenate([np.linspace(0.0, 1.0, 401), [1e-6, 1e-3, 0.999999]])

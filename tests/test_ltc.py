@@ -275,3 +275,21 @@ def test_ltc_presets_load_with_their_engine_layouts():
         assert output_path("out", spec.name, fmt).name == file
     (hdrp,) = load_configs([preset_path("ltc-hdrp")])
     assert hdrp.options["alpha_min"] == 1e-3
+
+
+@pytest.mark.parametrize("fmt", ["exr", "c", "js"])
+def test_inspect_shows_the_fit_error_and_the_engine_layouts_hold_the_exr_values(small_ltc, tmp_path, fmt):
+    """issue 14: the fit error's max / median in `lutbake inspect`, for the EXR and the engine layouts alike (whose
+    values read back as the EXR's, ltc_2.z = 0: lutbake.io.engine_files)."""
+    from lutbake.io.describe import describe
+    from lutbake.io.formats import write_table
+    from lutbake.io.readers import read_table
+
+    path = write_table(small_ltc, tmp_path, fmt, "float32")
+    text = describe(path)
+    for key in ("fit_error_max", "fit_error_median"):
+        assert f"  {key}: {small_ltc.attributes[key]}\n" in text, text
+    expected = np.array(small_ltc.data, np.float32)
+    if fmt != "exr":
+        expected[1, ..., 2] = 0.0
+    np.testing.assert_array_equal(read_table(path).data, expected)

@@ -41,10 +41,31 @@ def test_help_and_version_import_nothing_heavy():
     assert loaded_after(["--version"]) == []
 
 
+def test_list_and_every_commands_help_import_nothing_heavy():
+    """`lutbake list` prints every kind, NDF, model and estimator from warp-free declarations (lutbake.catalog)."""
+    assert loaded_after(["list"]) == []
+    for command in ("validate", "audit", "inspect", "preview", "size", "fit", "plot"):
+        assert loaded_after([command, "--help"]) == [], command
+
+
+def test_the_kind_registry_and_config_checks_import_no_warp(tmp_path):
+    """Only planning a table imports its Warp modules (lutbake.kinds.*.plan); a config loads without them."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(CONFIG + 'layout = "multiscatter_disney"\nestimator = "sobol_vndf"\n')
+    code = (
+        f"import sys; from lutbake.config import load_configs; load_configs([{str(cfg)!r}])\n"
+        f"print([m for m in {HEAVY!r} if m in sys.modules])"
+    )
+    r = python(code)
+    assert r.returncode == 0 and r.stdout.strip() == "[]", r.stdout + r.stderr
+
+
 def test_inspect_imports_only_what_the_format_needs(tmp_path):
     dds = write_table(table2d(2), tmp_path, "dds")
     exr = write_table(table2d(2), tmp_path / "e", "exr")
     assert loaded_after(["inspect", str(dds)]) == []
+    js = write_table(table2d(2), tmp_path / "j", "js")  # an engine layout: values read back with its sidecar
+    assert loaded_after(["inspect", str(js)]) == []
     assert loaded_after(["inspect", str(exr)]) == ["OpenImageIO"]
 
 
@@ -70,7 +91,8 @@ def test_bake_and_the_python_api_print_no_warp_lines_unless_asked(tmp_path):
         assert r.returncode == 0, out
         assert "Warp" not in out and "Module" not in out and "CUDA" not in out, out
     assert python(api).stdout == "" and python(api).stderr == ""
-    for extra, code in (({"LUTBAKE_VERBOSE": "1"}, api), ({}, cli.replace("['bake'", "['--verbose', 'bake'"))):
+    fresh = api.replace(repr(str(tmp_path / "p")), repr(str(tmp_path / "v")))  # a skipped table starts no Warp
+    for extra, code in (({"LUTBAKE_VERBOSE": "1"}, fresh), ({}, cli.replace("['bake'", "['--verbose', 'bake'"))):
         r = python(code, extra)
         assert r.returncode == 0 and "Warp " in r.stdout + r.stderr and "initialized" in r.stdout, r.stdout
 

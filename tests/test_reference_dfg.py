@@ -175,7 +175,7 @@ def test_dfg_beckmann_separable_gauss_legendre_matches_reference(references):
 
 def test_dfg_cook_torrance_gauss_legendre_matches_reference(references, spec):
     """The lecture's Cook-Torrance (Beckmann D with 1/pi, V-cavity G, Schlick F): the table kernel of
-    model = "cook_torrance" (lutbake.integrands.specular.model_terms) against the reference with the V-cavity G
+    model = "cook_torrance" (lutbake.catalog.model_terms) against the reference with the V-cavity G
     written here."""
     from lutbake.kinds.dfg import terms_of
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from lutbake.integrands.fresnel import evaluate
-from lutbake.terms.metals import METALS
+from lutbake.metals import METALS
 
 SIZE = [20, 10]
 COLLAPSE_TOL = 1e-6

@@ -7,10 +7,9 @@ import pytest
 
 from lutbake import value_bounds as vb
 from lutbake.api import bake_table
+from lutbake.catalog import ANISO_MODELS, DIFFUSE_MODELS
+from lutbake.catalog import SPECULAR_MODELS as MODELS
 from lutbake.config import validate_table
-from lutbake.integrands.anisotropic import ANISO_MODELS
-from lutbake.integrands.diffuse import DIFFUSE_MODELS
-from lutbake.integrands.specular import SPECULAR_MODELS as MODELS
 from lutbake.io.formats import PNG_SLACK
 from lutbake.kinds import KINDS
 from lutbake.kinds.dfg import LAYOUTS

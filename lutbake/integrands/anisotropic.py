@@ -30,15 +30,6 @@ from ..edge import ALPHA_MIN
 from ..terms import masking, ndf
 from .specular import channels_for
 
-ANISO_MODELS = {
-    "microfacet": "anisotropic GGX, height-correlated Smith G2 with the anisotropic Lambda, Schlick F (Heitz 2014)",
-    "ashikhmin_shirley": "Ashikhmin & Shirley 2000, nu = 2/alpha_x^2 - 2 (tangent), nv = 2/alpha_y^2 - 2 (bitangent)",
-}
-ANISO_LAYOUTS = ("scale_bias", "multiscatter")
-AXES_FORMULA = (
-    "aspect = sqrt(1 - 0.9 |a|); alpha_x = alpha / aspect, alpha_y = alpha * aspect (a >= 0; swapped for a < 0)"
-)
-
 
 def alpha_xy(alpha: np.ndarray, aniso: np.ndarray, mirror: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Burley 2012 (Addenda B.2): (alpha_x, alpha_y) (float32) for NDF alpha and anisotropy a in [-1, 1], each

@@ -27,6 +27,7 @@ import functools
 
 import warp as wp
 
+from ..catalog import DIELECTRIC_MASKINGS
 from ..edge import COS_EPS
 from ..terms import fresnel
 from ..terms.dielectric import cos_transmitted, refract
@@ -39,7 +40,6 @@ FRESNEL_MODES = {
     "exact_metal": "(E_R, E_T, E with F = 1): OpenPBR's dielectric and metal tables from one integral",
     "eevee": "Blender EEVEE's Schlick split sum: (scale, bias, transmission_factor), s = (1 - |x.h|)^5",
 }
-MASKINGS = ("smith_separable", "smith_height_correlated")
 
 
 @functools.lru_cache(maxsize=None)
@@ -47,8 +47,10 @@ def integrand_for(ndf_name: str, masking_name: str, mode: str):
     """``g(v, h, alpha, eta) -> wp.vec3`` (module docstring); 0 for v.h, n.v <= COS_EPS or n.h <= 0."""
     if mode not in FRESNEL_MODES:
         raise KeyError(f"unknown Fresnel mode {mode!r}; valid: {', '.join(FRESNEL_MODES)}")
-    if masking_name not in MASKINGS:
-        raise KeyError(f"masking {masking_name!r} is not defined for transmission; valid: {', '.join(MASKINGS)}")
+    if masking_name not in DIELECTRIC_MASKINGS:
+        raise KeyError(
+            f"masking {masking_name!r} is not defined for transmission; valid: {', '.join(DIELECTRIC_MASKINGS)}"
+        )
     D = NDFS[ndf_name].D
     G2 = NDFS[ndf_name].G2(masking_name)
 

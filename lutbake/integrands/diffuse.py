@@ -22,41 +22,11 @@ from ..sampling.facets import fd_microfacet_for
 from ..sampling.swapped import integrate_swapped
 from ..terms import diffuse
 
-FACET_FRESNEL = {
-    "eq6": "Eq. 6 on each facet: 21/20 (1 - f0)(1 - (1 - m.l)^5)(1 - (1 - m.v)^5); E scales with (1 - f0)",
-    "schlick": "(1 - F(m.l))(1 - F(m.v)), F Schlick: (1 - f0)^2 (1 - (1 - m.l)^5)(1 - (1 - m.v)^5); "
-    "E scales with (1 - f0)^2",
-    "dielectric_f0": "(1 - F(m.l))(1 - F(m.v)), F the exact dielectric Fresnel of Eq. 2 written with f0: f0 does not "
-    "factor out (kind diffuse_3d bakes an f0 axis; kind diffuse bakes the given f0 only)",
-}
 FACET_FUNCS = {
     "eq6": diffuse.F_facet_eq6,
     "schlick": diffuse.F_facet_schlick,
     "dielectric_f0": diffuse.F_facet_dielectric_f0,
 }
-DIFFUSE_MODELS = {
-    "lambert": "Lambert, rho / pi",
-    "oren_nayar": "classic Oren-Nayar as taught in lecture 003 (A with 0.57)",
-    "oren_nayar_improved": "improved Oren-Nayar, Gotanda 2014 Eq. 5",
-    "oren_nayar_fresnel": "Oren-Nayar with Fresnel, Gotanda 2014 Eq. 7 ((1 - f0) counted once)",
-    "fitted": "Gotanda's fitted microfacet diffuse, Eq. 8 (course-notes reading)",
-    "fitted_slides": "Eq. 8 with the slides' reading of F_r's second factor",
-    "microfacet": "the microfacet diffuse model, Eq. 4, integrated over m (GGX, height-correlated Smith)",
-}
-
-
-F0_NONE = "none: f0 does not factor out; the table holds E at the baked f0 only (kind diffuse_3d has an f0 axis)"
-
-
-def f0_factor(model: str, facet_fresnel: str) -> str:
-    """How f0 enters a model: every model here is g(f0) times an f0-free function."""
-    if model in ("lambert", "oren_nayar", "oren_nayar_improved"):
-        return "1"
-    if model == "microfacet" and facet_fresnel == "schlick":
-        return "(1 - f0)^2"
-    if model == "microfacet" and facet_fresnel == "dielectric_f0":
-        return F0_NONE
-    return "(1 - f0)"
 
 
 # facet form -> (transmission T(c, f0), the f0 factor c(f0) as a Python function)

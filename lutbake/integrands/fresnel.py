@@ -14,18 +14,11 @@ import functools
 import numpy as np
 import warp as wp
 
+from ..catalog import FRESNELS
+from ..metals import LAZANYI_ALPHA
 from ..sampling.arrays import Floats
 from ..terms import fresnel as fr
-from ..terms.metals import LAZANYI_ALPHA
 
-FRESNELS = {
-    "schlick": "f0 + (1 - f0)(1 - c)^5 (Schlick 1994)",
-    "schlick_sg": "f0 + (1 - f0) 2^((-5.55473 c - 6.98316) c): spherical-Gaussian Schlick (Lagarde 2012)",
-    "improved_sg": "f0 + (1 - f0) 2^(-9.60232 c^8 - 8.58092 c): Gotanda 2014, Eq. 3",
-    "dielectric_f0": "exact dielectric Fresnel written with f0: Gotanda 2014, Eq. 2",
-    "conductor": "exact Fresnel of a complex index n + ik",
-    "lazanyi": "Lazanyi & Szirmay-Kalos 2005 metal approximation (n, k, fitted a)",
-}
 COLUMNS = tuple(FRESNELS)
 
 

@@ -21,8 +21,10 @@ from dataclasses import dataclass
 import numpy as np
 import warp as wp
 
+from .. import metals
+from ..catalog import SHEEN_LAYOUTS
 from ..edge import COS_EPS, effective_alpha
-from ..terms import fresnel, masking, metals, ndf
+from ..terms import fresnel, masking, ndf
 from ..terms.distributions import NDFS, Distribution
 from ..terms.frame import reflect
 
@@ -88,14 +90,12 @@ N_CHANNELS = {
     "sheen_albedo_clamped": 2,
     "sheen_fgd": 2,
 }
-# the sheen lobe alone: no GGX term (sheen_integrand_for); *_clamped: V clamped to [0, 1] (the viewer's shaders)
-SHEEN_LAYOUTS = ("charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped", "sheen_fgd")
 
 
 @functools.lru_cache(maxsize=None)
 def channels_for(channels_name: str):
     """(channel wp.func (VoH, param) -> vec, vec type): a name of CHANNEL_FUNCS, or "metal:<name>"
-    for RGB = F_conductor(n_c, k_c, v.h) of a metal of lutbake.terms.metals (constants closed over)."""
+    for RGB = F_conductor(n_c, k_c, v.h) of a metal of lutbake.metals (constants closed over)."""
     if channels_name in CHANNEL_FUNCS:
         return CHANNEL_FUNCS[channels_name], (wp.vec3 if channels_name in THREE_CHANNELS else wp.vec2)
     if channels_name.startswith("metal:"):
@@ -224,29 +224,7 @@ def sheen_integrand_for(layout: str):
     return half_vector_integrand(lobe, wp.vec3, False)
 
 
-# The lecture's models (003) as term sets of the dfg-like kinds (key ``model``). "microfacet" takes ``ndf`` and
 # ``masking`` from the config; the others fix them: (integrand form, NDF whose CDF the estimators sample, masking).
-SPECULAR_MODELS = {
-    "microfacet": "D G2 F / (4 (n.l)(n.v)) with the config's ndf and masking (default)",
-    "cook_torrance": "Cook & Torrance 1982 as in the lecture: Beckmann D (with 1/pi), V-cavity G, Schlick F; "
-    "the same as model = microfacet, ndf = beckmann, masking = v_cavity",
-    "blinn_phong": "the lecture's normalized Blinn-Phong lobe f = F (s + 8)/(8 pi) (n.h)^s, s = 2/alpha^2 - 2 "
-    "(no G; the lecture's (s + 8)/8 is this times pi, per unit irradiance)",
-    "ashikhmin_shirley": "Ashikhmin & Shirley 2000, isotropic (nu = nv = s = 2/alpha^2 - 2): "
-    "f = F sqrt((nu+1)(nv+1))/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v))",
-}
-
-
-def model_terms(model: str, ndf_name: str, masking_name: str) -> tuple[str, str, str]:
-    """(integrand form, ndf, masking) a model integrates: the form is "microfacet", "blinn_phong" or
-    "ashikhmin_shirley"; Cook-Torrance is the microfacet form with Beckmann and V-cavity."""
-    if model == "microfacet":
-        return "microfacet", ndf_name, masking_name
-    if model == "cook_torrance":
-        return "microfacet", "beckmann", "v_cavity"
-    if model in ("blinn_phong", "ashikhmin_shirley"):
-        return model, "blinn_phong", "none"
-    raise KeyError(model)
 
 
 @dataclass(frozen=True)

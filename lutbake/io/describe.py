@@ -35,7 +35,7 @@ def _container(loaded: LoadedFile) -> str:
     if loaded.format == "h":
         return f"array {f['array']} of {f['element_type']}"
     if loaded.format == "engine":
-        return f"{f.get('format')}"
+        return f"{f.get('format')}" + (f", values: {f['engine_values']}" if "engine_values" in f else "")
     if "data_file" in f:
         return f"describes {f['data_file']} ({f['data_format']})"
     if loaded.format == "report":
@@ -144,4 +144,9 @@ def describe(path) -> str:
     for key in sorted(set(attrs) - SHOWN):
         value = attrs[key]
         lines.append(f"  {key}: {value if len(value) <= LONG_VALUE else value[:LONG_VALUE] + ' ...'}")
+    if view.kind == "ltc" and view.data.ndim == 4:  # the two textures' channels mean different things
+        lines.append("statistics:")
+        for k, name in enumerate(("ltc_1 (slice 0)", "ltc_2 (slice 1)")[: len(view.data)]):
+            lines += [f"  {name}:"] + ["  " + x for x in _statistics(view.data[k], view.channel_names)[1:]]
+        return "\n".join(lines) + "\n"
     return "\n".join(lines + _statistics(view.data, view.channel_names)) + "\n"

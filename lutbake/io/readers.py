@@ -10,6 +10,7 @@ file's first bytes (its magic number), never by its extension.
 | KTX2 | ``«KTX 20»\\r\\n\\x1a\\n`` | lutbake.io.ktx2.decode | ``lutbake:metadata`` key/value, else sidecar |
 | C header | text from ``/*``, ``//`` or ``#`` | its ``static const`` array and size macros | the ``.json`` sidecar |
 | sidecar | text from ``{`` | the data file it names (``"file"``) | its ``"lutbake"`` object |
+| engine layout | DDS or text | lutbake.io.engine_files, by the sidecar's ``format`` (LTC, OpenPBR, JS) | the sidecar |
 
 ``read(path)`` returns a :class:`LoadedFile` (pixels as stored, including a GPU format's padding
 channel); ``table_view(loaded)`` checks the metadata against the pixels and returns a
@@ -41,7 +42,7 @@ MAX_FILE_BYTES = 4 << 30  # a table is at most 2^24 texels x 4 channels x 4 byte
 EXR_MAGIC = b"\x76\x2f\x31\x01"
 NPY_MAGIC = b"\x93NUMPY"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
-GENERIC_FORMATS = ("exr", "npy", "png16", "dds", "ktx2", "h")  # sidecar "format"s whose pixels lutbake reads
+GENERIC_FORMATS = ("exr", "npy", "png16", "dds", "ktx2", "ktx2zst", "h")  # sidecar "format"s whose pixels lutbake reads
 FORMAT_NAMES = {
     "engine": "engine-specific file",
     "exr": "OpenEXR",
@@ -141,20 +142,28 @@ def read(path) -> LoadedFile:
 
 
 def _engine_sidecar(path: Path) -> LoadedFile | None:
-    """A file in an engine's own layout (``format`` = ltc_dds, openpbr_h, a .cs/.js/.cc module ...): its
-    sidecar's metadata without pixels, or None when no sidecar names the file with such a format."""
+    """A file in an engine's own layout (``format`` = ltc_dds, openpbr_h, a .cs/.js/.cc module ...): its values
+    (lutbake.io.engine_files) with its sidecar's metadata, or None when no sidecar names the file with such a format."""
     for side in sidecar_candidates(path):
         if side.is_file() and side != path:
             doc = _load_json(side)
             if isinstance(doc, dict) and doc.get("file") == path.name and doc.get("format") not in GENERIC_FORMATS:
-                doc = _load_sidecar(side, doc)
-                note = (
-                    f"engine-specific format {doc.get('format')!r}: lutbake reads its metadata (sidecar "
-                    f"{side.name}), not its pixels; bake the table as exr to look at them"
-                )
-                facts = {k: v for k, v in doc.items() if k != "lutbake"}
-                return LoadedFile(path, "engine", None, doc["lutbake"], f"sidecar {side.name}", facts, [note])
+                return _engine_values(path, _load_sidecar(side, doc), f"sidecar {side.name}")
     return None
+
+
+def _engine_values(path: Path, doc: dict, source: str, fmt: str = "engine") -> LoadedFile:
+    """An engine-layout file's values and metadata (its sidecar ``doc``); the metadata alone, with the reason,
+    where its values cannot be read."""
+    from .engine_files import read_engine
+
+    facts = {k: v for k, v in doc.items() if k != "lutbake"}
+    try:
+        data, attrs, note = read_engine(path, doc)
+    except (ValueError, KeyError, TypeError, IndexError, OSError, UnicodeDecodeError) as e:
+        note = f"engine-specific format {doc.get('format')!r}: its values cannot be read ({e}); metadata only"
+        return LoadedFile(path, fmt, None, doc["lutbake"], source, facts, [note])
+    return LoadedFile(path, fmt, data, attrs, source, {**facts, "engine_values": note})
 
 
 def _read_or_raise(path: Path, fmt: str) -> LoadedFile:
@@ -405,8 +414,10 @@ def read_sidecar(path: Path) -> LoadedFile:
         facts = {**facts, "data_file": named, "data_format": FORMAT_NAMES[inner.format], **inner.facts}
         return LoadedFile(path, "sidecar", inner.data, doc["lutbake"], f"sidecar {path.name}", facts)
     note = f"its data file {named!r} is not beside it" if named else "it names no data file"
-    if not generic:
-        note = f"it describes {named!r} in the engine-specific format {doc.get('format')!r} (metadata only)"
+    if not generic and isinstance(named, str) and Path(named).name == named and (path.parent / named).is_file():
+        inner = _engine_values(path.parent / named, doc, f"sidecar {path.name}", "sidecar")
+        inner.path, inner.facts = path, {**inner.facts, "data_file": named, "data_format": FORMAT_NAMES["engine"]}
+        return inner
     return LoadedFile(path, "sidecar", None, doc["lutbake"], f"sidecar {path.name}", facts, [note])
 
 

@@ -18,9 +18,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import Axis
-from ..integrands.fresnel import mu_nodes
-from ..integrands.specular import specular_integrand
-from ..sampling.hemisphere import estimator_for
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from ..tolerance import tolerance_of
 from . import dfg
@@ -52,11 +49,15 @@ AVG_RECONSTRUCTION = "E_avg = texture(albedo_avg, vec2(roughness, 0.5)).r (one r
 
 
 def integrand_of(o: dict):
+    from ..integrands.specular import specular_integrand
+
     form, nd, mk = dfg.terms_of(o)
     return specular_integrand(nd, mk, "albedo", form, 1)
 
 
 def plan_albedo(spec) -> TexelPlan:
+    from ..sampling.hemisphere import estimator_for
+
     o = spec.options
     axes = dfg.axes_for(o)
     integrand = integrand_of(o)
@@ -78,6 +79,9 @@ def avg_roughness_axis(o: dict) -> Axis:
 
 def plan_albedo_avg(spec) -> TexelPlan:
     """E_avg(r) = sum_k (2 w_k mu_k) E(mu_k, r): a texel is the weighted sum over the mu nodes (Grid.nodes)."""
+    from ..integrands.fresnel import mu_nodes
+    from ..sampling.hemisphere import estimator_for
+
     o = spec.options
     rough = avg_roughness_axis(o)
     integrand = integrand_of(o)

@@ -21,10 +21,8 @@ import json
 import numpy as np
 
 from ..axes import TEXELS, Axis, sigma_alpha
+from ..catalog import DIFFUSE_MODELS, f0_factor
 from ..edge import effective_alpha
-from ..integrands.diffuse import DIFFUSE_MODELS, diffuse_integrand, f0_factor
-from ..sampling.diffuse import PointEvaluation, PointSobol
-from ..sampling.panels import n_tail_cuts_np
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from . import diffuse
 from .base import Estimation, Key, declare
@@ -154,6 +152,10 @@ BTF_ESTIMATORS = {
 
 
 def plan(spec) -> TexelPlan:
+    from ..integrands.diffuse import diffuse_integrand
+    from ..sampling.diffuse import PointEvaluation, PointSobol
+    from ..sampling.panels import n_tail_cuts_np
+
     o = spec.options
     axes = axes_for(o)
     l, v, sigma = directions(axes, o["parametrisation"])

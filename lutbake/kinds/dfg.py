@@ -24,14 +24,20 @@ import re
 import numpy as np
 
 from ..axes import MAPPINGS, ORDERS, ROUGHNESS_PARAMS, TEXELS, Axis
+from ..catalog import (
+    HEMISPHERE_ESTIMATORS,
+    MASKINGS,
+    NDF_DESCRIPTIONS,
+    SHEEN_LAYOUTS,
+    SPECULAR_MODELS,
+    VNDF_NDFS,
+    masking_allowed,
+    model_terms,
+)
 from ..edge import alpha_policy
-from ..integrands import engine_diffuse
-from ..integrands.specular import N_CHANNELS as SPECULAR_CHANNELS
-from ..integrands.specular import SHEEN_LAYOUTS, SPECULAR_MODELS, model_terms, specular_integrand
-from ..sampling.hemisphere import ESTIMATORS, estimator_for
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
-from ..terms.distributions import MASKINGS, NDFS
 from ..tolerance import tolerance_of
+from . import engine_layouts
 from .base import Estimation, Key, declare
 
 LAYOUTS = {
@@ -108,10 +114,9 @@ RECONSTRUCTION["sheen_albedo"] = (
 )
 RECONSTRUCTION["charlie_clamped"] = RECONSTRUCTION["charlie"]
 RECONSTRUCTION["sheen_albedo_clamped"] = RECONSTRUCTION["sheen_albedo"]
-N_CHANNELS = {**SPECULAR_CHANNELS, **{k: 3 for k in engine_diffuse.LAYOUTS}}
-LAYOUTS.update(engine_diffuse.LAYOUTS)
-CHANNELS.update(engine_diffuse.CHANNELS)
-RECONSTRUCTION.update(engine_diffuse.RECONSTRUCTION)
+LAYOUTS.update(engine_layouts.LAYOUTS)
+CHANNELS.update(engine_layouts.CHANNELS)
+RECONSTRUCTION.update(engine_layouts.RECONSTRUCTION)
 AXIS_ORDERS = {
     "nov_x": "columns (x) = NoV, rows (y) = roughness: sample at vec2(NoV, roughness) (Filament, glTF, UE4)",
     "roughness_x": "columns (x) = roughness, rows (y) = NoV: sample at vec2(roughness, NoV-coordinate) (Blender EEVEE)",
@@ -122,7 +127,7 @@ ROUGHNESS_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "texel_offset")}
 KEYS = {
     "size": Key("size", "int_pair", [128, 128], "[NoV, roughness] texel counts", minimum=1),
     "roughness": Key("roughness", "str", "perceptual", "what the roughness axis holds", ROUGHNESS_PARAMS),
-    "ndf": Key("ndf", "str", "ggx", "normal distribution function", {k: v.description for k, v in NDFS.items()}),
+    "ndf": Key("ndf", "str", "ggx", "normal distribution function", NDF_DESCRIPTIONS),
     "masking": Key("masking", "str", "smith_height_correlated", "masking-shadowing G2", MASKINGS),
     "model": Key(
         "model",
@@ -163,9 +168,9 @@ def check_spec(spec) -> tuple[str, str] | None:
             f"(got ndf = {o['ndf']!r}, masking = {o['masking']!r})",
         )
     form, nd, mk = terms_of(o)
-    if form == "microfacet" and not NDFS[nd].masking_allowed(mk):
+    if form == "microfacet" and not masking_allowed(nd, mk):
         return ("masking", f"ndf {nd!r} has no Smith Lambda: use masking = 'v_cavity' with it, not {mk!r}")
-    if o["estimator"] == "sobol_vndf" and NDFS[nd].sample_vndf is None:
+    if o["estimator"] == "sobol_vndf" and nd not in VNDF_NDFS:
         return (
             "estimator",
             f"'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not ndf = {nd!r}"
@@ -177,7 +182,7 @@ def check_spec(spec) -> tuple[str, str] | None:
             "layout 'multiscatter_cloth' needs estimator 'gauss_legendre': the QMC estimators draw "
             "h from the GGX NDF and miss the Charlie NDF's grazing lobe of the cloth channel",
         )
-    if engine_diffuse.BASE_LAYOUT.get(o.get("layout"), o.get("layout")) in SHEEN_LAYOUTS:
+    if engine_layouts.BASE_LAYOUT.get(o.get("layout"), o.get("layout")) in SHEEN_LAYOUTS:
         if o["estimator"] != "gauss_legendre":
             return (
                 "estimator",
@@ -196,7 +201,7 @@ def check_spec(spec) -> tuple[str, str] | None:
 
 
 def terms_of(o: dict) -> tuple[str, str, str]:
-    """(integrand form, ndf, masking) of a spec's options (lutbake.integrands.specular.model_terms)."""
+    """(integrand form, ndf, masking) of a spec's options (lutbake.catalog.model_terms)."""
     return model_terms(o.get("model", "microfacet"), o["ndf"], o["masking"])
 
 
@@ -284,12 +289,15 @@ def specular_extra(integrand) -> dict[str, str]:
 
 
 def plan(spec) -> TexelPlan:
+    from ..integrands import engine_diffuse
+    from ..integrands.specular import N_CHANNELS, specular_integrand
+    from ..sampling.hemisphere import estimator_for
+
     o = spec.options
     axes = axes_for(o)
     form, nd, mk = terms_of(o)
-    base = engine_diffuse.BASE_LAYOUT.get(o["layout"], o["layout"])  # the specular integrand's layout
-    nch = N_CHANNELS[base]
-    integrand = specular_integrand(nd, mk, base, form, nch)
+    base = engine_layouts.BASE_LAYOUT.get(o["layout"], o["layout"])  # the specular integrand's layout
+    integrand = specular_integrand(nd, mk, base, form, N_CHANNELS[base])
     cloth = {"cloth": "D_charlie + V_ashikhmin"} if o["layout"] == "multiscatter_cloth" else {}
     terms = {**terms_record(o, "schlick"), "layout": o["layout"], **cloth}
     if base in SHEEN_LAYOUTS:
@@ -307,7 +315,7 @@ def plan(spec) -> TexelPlan:
             "gauss_legendre_panels": "the GGX CDF in theta_h (panelling only; the integrand is the sheen lobe)",
         }
     if base != o["layout"]:
-        terms["diffuse"] = engine_diffuse.DIFFUSE_TERMS[o["layout"]]
+        terms["diffuse"] = engine_layouts.DIFFUSE_TERMS[o["layout"]]
     plan = per_texel_plan(
         integrand,
         estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
@@ -325,6 +333,6 @@ def plan(spec) -> TexelPlan:
 
 
 SAMPLES_DOC = "integrand evaluations per texel; omitted: the estimator's default quality"
-SPECULAR_ESTIMATION = Estimation(ESTIMATORS, "gauss_legendre", SAMPLES_DOC)
+SPECULAR_ESTIMATION = Estimation(HEMISPHERE_ESTIMATORS, "gauss_legendre", SAMPLES_DOC)
 DESCRIPTION = "split-sum specular DFG: NoV x roughness, scale/bias or multiscatter (Σ Fc·V, Σ V) channels"
 DFG = declare("dfg", DESCRIPTION, KEYS, plan, SPECULAR_ESTIMATION, aliases=("split_sum",), check=check_spec)

@@ -35,13 +35,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..axes import Axis
+from ..catalog import DIELECTRIC_MASKINGS, HEMISPHERE_ESTIMATORS, MASKINGS, NDF_DESCRIPTIONS, SMITH_NDFS, VNDF_NDFS
 from ..edge import alpha_policy
-from ..integrands.dielectric import MASKINGS, dielectric_integrand
-from ..sampling.dielectric import DielectricGaussLegendre
-from ..sampling.hemisphere import ESTIMATORS, QuasiMonteCarlo
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan, probe_indices
-from ..terms.distributions import MASKINGS as ALL_MASKINGS
-from ..terms.distributions import NDFS
 from . import dfg, dielectric_ratio
 from .base import Estimation, Key, declare
 
@@ -147,14 +143,14 @@ KEYS = {
         "str",
         "ggx",
         "normal distribution function",
-        {k: v.description for k, v in NDFS.items() if v.Lambda is not None},
+        {k: NDF_DESCRIPTIONS[k] for k in SMITH_NDFS},
     ),
     "masking": Key(
         "masking",
         "str",
         "smith_separable",
         "Smith G2, evaluated with |n.o| on both sides",
-        {k: ALL_MASKINGS[k] for k in MASKINGS},
+        {k: MASKINGS[k] for k in DIELECTRIC_MASKINGS},
     ),
     **GEOMETRY_KEYS,
 }
@@ -270,6 +266,9 @@ def terms_of(o: dict) -> tuple[str, str]:
 def estimator_for(name: str, samples: int | None = None, seed: int = 0):
     """The dielectric kinds' estimator ``name``: the panelled Gauss-Legendre of lutbake.sampling.dielectric, or a
     QMC estimator of lutbake.sampling.hemisphere (the same half-vector measure)."""
+    from ..sampling.dielectric import DielectricGaussLegendre
+    from ..sampling.hemisphere import QuasiMonteCarlo
+
     if name == "gauss_legendre":
         return DielectricGaussLegendre(samples or DEFAULT_SAMPLES[name])
     return QuasiMonteCarlo(name, samples or DEFAULT_SAMPLES[name], seed)
@@ -278,6 +277,8 @@ def estimator_for(name: str, samples: int | None = None, seed: int = 0):
 def integrate(key: tuple, nov, alpha, eta, samples: int | None = None, seed: int = 0, device: str = "cpu"):
     """Host helper (checks, tests, benchmarks): float64 (len, 3) integrals of the (ndf, masking, Fresnel mode)
     integrand by ``estimator`` at texels (nov, alpha, eta); alpha through the edge policy as in a table."""
+    from ..integrands.dielectric import dielectric_integrand
+
     ndf_name, masking_name, mode, estimator = key
     integrand = dielectric_integrand(ndf_name, masking_name, mode)
     inputs = {
@@ -332,6 +333,8 @@ def terms_record(key: tuple, layout: str) -> dict:
 
 
 def plan(spec) -> TexelPlan:
+    from ..integrands.dielectric import dielectric_integrand
+
     o = spec.options
     layout = o["layout"]
     axes, nov, alpha, eta, extra = texel_grid(o)
@@ -385,6 +388,8 @@ def avg_grid(o: dict) -> tuple[list[Axis], np.ndarray, np.ndarray]:
 def plan_avg(spec) -> TexelPlan:
     """E_avg per (eta, roughness) texel: the kernel at mu_panels(eta) nodes, reduced 2 sum w mu E per texel (the
     node set depends on eta, so the reduction is here rather than in lutbake.sampling.plan.Grid)."""
+    from ..integrands.dielectric import dielectric_integrand
+
     o = spec.options
     layout = o["layout"]
     axes, alpha, eta = avg_grid(o)
@@ -455,7 +460,7 @@ def plan_avg(spec) -> TexelPlan:
 def check_spec(spec) -> tuple[str, str] | None:
     o = spec.options
     nd, _ = terms_of(o)
-    if o["estimator"] == "sobol_vndf" and NDFS[nd].sample_vndf is None:
+    if o["estimator"] == "sobol_vndf" and nd not in VNDF_NDFS:
         return ("estimator", f"'sobol_vndf' needs ndf = 'ggx' (a visible-normal sampler), not {nd!r}")
     if o.get("ior_mapping") == "symmetric" and (o["ior_range"][1] <= 1.0 or o["ior_size"] % 2):
         return ("ior_mapping", "'symmetric' needs ior_range[1] > 1 (the largest eta) and an even ior_size")
@@ -487,7 +492,7 @@ SAMPLES_DOC = (
     "integrand evaluations per texel; omitted: the estimator's default (gauss_legendre 432 = order 12 per "
     "panel, sobol_vndf 16384)"
 )
-ESTIMATION = Estimation(ESTIMATORS, "gauss_legendre", SAMPLES_DOC)
+ESTIMATION = Estimation(HEMISPHERE_ESTIMATORS, "gauss_legendre", SAMPLES_DOC)
 
 
 DIELECTRIC = declare(

@@ -14,11 +14,9 @@ import json
 import numpy as np
 
 from ..axes import SIGMA_TO_ALPHA, TEXELS, Axis, sigma_alpha
+from ..catalog import DIFFUSE_MODELS, FACET_FRESNEL, f0_factor
 from ..edge import alpha_policy, effective_alpha
-from ..integrands.diffuse import DIFFUSE_MODELS, FACET_FRESNEL, diffuse_integrand, f0_factor
-from ..sampling.diffuse import CosineSobol, DiffuseGaussLegendre
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
-from ..sampling.swapped import SwappedGaussLegendre
 from .base import Estimation, Key, declare
 
 DEFAULT_ORDER = {"microfacet": 12}  # base GL order (lutbake.sampling.swapped); closed forms: CLOSED_ORDER
@@ -72,6 +70,9 @@ def order_for(o: dict) -> int:
 def estimator_of(o: dict):
     """gauss_legendre: the swapped integral for the microfacet model, the 2 x 2-panel rule over l otherwise;
     sobol_cosine: cosine-weighted Sobol' directions l (lutbake.sampling.diffuse)."""
+    from ..sampling.diffuse import CosineSobol, DiffuseGaussLegendre
+    from ..sampling.swapped import SwappedGaussLegendre
+
     order = order_for(o)
     if o["estimator"] == "sobol_cosine":
         return CosineSobol(o["samples"] or DEFAULT_COSINE_SAMPLES, o["seed"], inner_order=order)
@@ -109,6 +110,8 @@ def check_spec(spec) -> tuple[str, str] | None:
 
 
 def plan(spec) -> TexelPlan:
+    from ..integrands.diffuse import diffuse_integrand
+
     o = spec.options
     n_nov, n_sigma = o["size"]
     axes = [

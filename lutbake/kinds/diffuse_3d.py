@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import Axis
-from ..integrands.diffuse import FACET_FRESNEL, diffuse_integrand, f0_factor
+from ..catalog import FACET_FRESNEL, f0_factor
 from ..sampling.plan import TexelPlan, per_texel_plan
 from . import diffuse
 from .base import Key, declare
@@ -43,6 +43,8 @@ RECONSTRUCTION = (
 
 
 def plan(spec) -> TexelPlan:
+    from ..integrands.diffuse import diffuse_integrand
+
     o = spec.options
     n_nov, n_sigma = o["size"]
     f0_axis = Axis("f0", "z", o["f0_size"], *o["f0_range"], texel=o["texel"])

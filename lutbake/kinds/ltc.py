@@ -30,11 +30,8 @@ import threading
 import numpy as np
 
 from ..axes import Axis
+from ..catalog import LTC_FIT_GRID, LTC_LOBES
 from ..edge import ALPHA_MIN
-from ..integrands.specular import specular_integrand
-from ..ltc import fit, sphere
-from ..ltc.lobes import LOBES
-from ..sampling.hemisphere import estimator_for
 from ..sampling.plan import TexelPlan
 from .base import Estimation, Key, declare
 
@@ -57,12 +54,12 @@ ESTIMATORS = {
     "second, independent estimator of the integrals the fit depends on; ggx and beckmann)",
 }
 KEYS = {
-    "lobe": Key("lobe", "str", "ggx", "the lobe fitted", {k: v.description for k, v in LOBES.items()}),
+    "lobe": Key("lobe", "str", "ggx", "the lobe fitted", LTC_LOBES),
     "size": Key("size", "int_pair", [64, 64], "[view, roughness] texel counts (ltc_code: 64 x 64)", minimum=2),
     "fit_samples": Key(
         "fit_samples",
         "int",
-        fit.DEFAULT_GRID,
+        LTC_FIT_GRID,
         "N: the error metric's N x N stratified grid per sampling technique (ltc_code Nsample = 32)",
         minimum=4,
         maximum=256,
@@ -97,6 +94,8 @@ RECONSTRUCTION = (
 
 
 def axes_for(o: dict) -> list[Axis]:
+    from ..ltc.lobes import LOBES
+
     n_view, n_rough = o["size"]
     lb = LOBES[o["lobe"]]
     rname = "alpha" if lb.roughness == "alpha" else "perceptual_roughness"
@@ -139,6 +138,10 @@ def magnitude_fresnel(
     fresnel the ``dfg`` multiscatter integrand's Fc channel; charlie: the ``dfg`` charlie layout's B channel (the
     gltf-charlie table), fresnel = magnitude; lambert: 1. ``alpha`` goes through the integrands' edge policy
     (mirror limit at alpha -> 0)."""
+    from ..integrands.specular import specular_integrand
+    from ..ltc.lobes import LOBES
+    from ..sampling.hemisphere import estimator_for
+
     lb = LOBES[lobe_name]
     if lb.magnitude == "lambert":
         one = np.ones(len(nov))
@@ -171,6 +174,8 @@ class LtcBake:
         self.axes = axes
         self.nov, self.alpha = texel_params(axes, o["alpha_min"])
         self.n_view, self.n_rough = axes[1].count, axes[2].count
+        from ..ltc import sphere
+
         self._lock = threading.Lock()
         self._fits: dict[tuple[int, int], tuple[threading.Lock, list]] = {}
         self.problem = None
@@ -178,6 +183,8 @@ class LtcBake:
         self.sphere = sphere.sphere_table(self.n_rough) if self.n_view == self.n_rough else None
 
     def prepare(self, device: str) -> None:
+        from ..ltc import fit
+
         with self._lock:
             if self.problem is None:
                 o = self.o
@@ -192,6 +199,8 @@ class LtcBake:
 
     def fitted(self, start: int, stop: int) -> list:
         """[packed ltc_1 (k, 4), relative error (k,)] of texels [start, stop) of a slice (fitted once)."""
+        from ..ltc import fit
+
         with self._lock:
             lock, box = self._fits.setdefault((start, stop), (threading.Lock(), []))
         with lock:
@@ -242,6 +251,9 @@ def fit_error_stats(data: np.ndarray) -> dict[str, str]:
 
 
 def plan(spec) -> TexelPlan:
+    from ..ltc import fit
+    from ..ltc.lobes import LOBES
+
     o = spec.options
     axes = axes_for(o)
     state = LtcBake(o, axes)
@@ -295,6 +307,8 @@ def plan(spec) -> TexelPlan:
 
 
 def check_spec(spec):
+    from ..ltc.lobes import LOBES
+
     o = spec.options
     if o["estimator"] != "gauss_legendre" and LOBES[o["lobe"]].magnitude not in ("dfg:ggx", "dfg:beckmann"):
         return (

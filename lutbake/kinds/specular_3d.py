@@ -8,7 +8,7 @@ an f0 axis:
 stored as z slices over f0 (a multi-part EXR, one part per f0, slice values in lutbake:axes and each
 part's lutbake:slice_value). For Schlick it collapses to the dfg table: E = f0 scale + bias
 (tests/test_specular3d.py). With ``metal = "<name>"`` the table is 2D, NoV x roughness, and R, G, B hold
-E with F = F_conductor(n_c + i k_c, v.h) for the metal's three wavelengths (lutbake.terms.metals).
+E with F = F_conductor(n_c + i k_c, v.h) for the metal's three wavelengths (lutbake.metals).
 """
 
 from __future__ import annotations
@@ -16,10 +16,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import Axis
-from ..integrands.specular import specular_integrand
-from ..sampling.hemisphere import estimator_for
+from ..metals import METALS
 from ..sampling.plan import TexelPlan, per_texel_plan
-from ..terms.metals import METALS
 from ..tolerance import tolerance_of
 from . import dfg
 from .base import Key, declare
@@ -63,6 +61,9 @@ def axes_for(o: dict) -> list[Axis]:
 
 
 def plan(spec) -> TexelPlan:
+    from ..integrands.specular import specular_integrand
+    from ..sampling.hemisphere import estimator_for
+
     o = spec.options
     axes = axes_for(o)
     metal = o["metal"]

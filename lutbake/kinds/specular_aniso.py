@@ -16,9 +16,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import Axis
+from ..catalog import ANISO_ESTIMATORS, ANISO_LAYOUTS, ANISO_MODELS, AXES_FORMULA
 from ..edge import alpha_policy
-from ..integrands.anisotropic import ANISO_LAYOUTS, ANISO_MODELS, AXES_FORMULA, alpha_xy, aniso_integrand
-from ..sampling.anisotropic import ANISO_ESTIMATORS, AnisoSobol
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from . import dfg
 from .base import Estimation, Key, declare
@@ -60,6 +59,9 @@ def axes_for(o: dict) -> list[Axis]:
 
 
 def plan(spec) -> TexelPlan:
+    from ..integrands.anisotropic import alpha_xy, aniso_integrand
+    from ..sampling.anisotropic import AnisoSobol
+
     o = spec.options
     axes = axes_for(o)
     an_axis, rough, nov_axis = axes

@@ -35,6 +35,7 @@ import functools
 import numpy as np
 import warp as wp
 
+from ..catalog import LTC_FIT_GRID
 from .lobes import lobe
 
 NELDER_MEAD_TOL = 1.0e-5  # ltc_code fit(): NelderMead(..., epsilon, 1e-5, 100, ...)
@@ -48,7 +49,6 @@ FINE_STEPS = (0.1,)
 # LTC fits exactly (Lambert), whose E ~ 1e-22 would otherwise run every iteration on rounding noise
 ATOL_RELATIVE = 1.0e-6
 COARSE_NODES = 8  # coarse-pass texels per axis (including both ends)
-DEFAULT_GRID = 32  # ltc_code Nsample: the metric's grid is N x N per sampling technique
 M_MIN = 1.0e-7  # ltc_code FitLTC::update: m11, m22 >= 1e-7
 
 
@@ -155,7 +155,7 @@ class Problem:
         nov: np.ndarray,
         alpha: np.ndarray,
         magnitude: np.ndarray,
-        n_grid: int = DEFAULT_GRID,
+        n_grid: int = LTC_FIT_GRID,
         device: str = "cpu",
     ):
         self.lobe = lobe_name

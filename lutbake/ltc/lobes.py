@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import warp as wp
 
+from ..catalog import LTC_LOBES
 from ..edge import COS_EPS
 from ..terms import masking, ndf
 from ..terms.frame import reflect
@@ -172,21 +173,21 @@ class Lobe:
 LOBES = {
     "ggx": Lobe(
         "ggx",
-        "GGX, height-correlated Smith (ltc_code's BrdfGGX; the reference case)",
+        LTC_LOBES["ggx"],
         *GGX_FUNCS,
         "dfg:ggx",
         "perceptual",
     ),
     "beckmann": Lobe(
         "beckmann",
-        "Beckmann, height-correlated Smith with the exact Lambda",
+        LTC_LOBES["beckmann"],
         *BECKMANN_FUNCS,
         "dfg:beckmann",
         "perceptual",
     ),
     "charlie": Lobe(
         "charlie",
-        "KHR_materials_sheen: D_charlie V_ashikhmin, alpha = sheenRoughness (gltf-charlie)",
+        LTC_LOBES["charlie"],
         charlie_f_cos,
         cosine_sample,
         cosine_pdf,
@@ -196,7 +197,7 @@ LOBES = {
     ),
     "lambert": Lobe(
         "lambert",
-        "Lambert (n.l)/pi: its LTC is the identity (a check)",
+        LTC_LOBES["lambert"],
         lambert_f_cos,
         cosine_sample,
         cosine_pdf,

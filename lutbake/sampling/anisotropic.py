@@ -25,12 +25,6 @@ from . import points
 from .arrays import Points2, Rows64
 from .hemisphere import store_row
 
-ANISO_ESTIMATORS = {
-    "sobol": "scrambled 3D Sobol' points: h by anisotropic GGX VNDF sampling (microfacet) or the Ashikhmin-Shirley "
-    "h sampling; phi_v = 2 pi u3 when averaged",
-    "sobol_cosine": "scrambled 3D Sobol' points: l cosine-weighted (independent of the lobe's sampler); "
-    "phi_v = 2 pi u3 when averaged",
-}
 DEFAULT_SAMPLES = 16384
 
 

@@ -49,6 +49,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import warp as wp
 
+from ..catalog import HEMISPHERE_ESTIMATORS
 from ..terms.frame import view_dir
 from . import points
 from .arrays import Points2, Rows64, Rule, Values64
@@ -363,13 +364,6 @@ def make_qmc(spec, vndf: bool):
     return qmc_kernel
 
 
-ESTIMATORS = {
-    "gauss_legendre": "deterministic product Gauss-Legendre over panels in theta_h (or CDF(theta_h)) and phi, "
-    "split exactly at the horizon (default; converges exponentially)",
-    "sobol_vndf": "scrambled Sobol' points, GGX visible-normal sampling (Dupuy & Benyoub 2023)",
-    "sobol_ndf": "scrambled Sobol' points, NDF importance sampling of D(h)(n.h)",
-    "hammersley_ndf": "Hammersley points, NDF importance sampling (Filament cmgen's estimator)",
-}
 DEFAULT_SAMPLES = {"gauss_legendre": 432, "sobol_vndf": 4096, "sobol_ndf": 4096, "hammersley_ndf": 1024}
 
 
@@ -532,13 +526,14 @@ class QuasiMonteCarlo:
 
 
 def estimator_for(name: str, samples: int | None = None, seed: int = 0, tolerance=None):
-    """The hemisphere estimator ``name`` (ESTIMATORS) at ``samples`` per texel (None: its default). gauss_legendre
-    without ``samples`` but with a ``tolerance`` (lutbake.tolerance.Tolerance) adapts its order to it."""
+    """The hemisphere estimator ``name`` (lutbake.catalog.HEMISPHERE_ESTIMATORS) at ``samples`` per texel (None: its
+    default). gauss_legendre without ``samples`` but with a ``tolerance`` (lutbake.tolerance.Tolerance) adapts its
+    order to it."""
     budget = samples or DEFAULT_SAMPLES[name]
     if name == "gauss_legendre" and samples is None and tolerance is not None:
         return AdaptiveGaussLegendre(tolerance.absolute, tolerance.relative)
     if name == "gauss_legendre":
         return GaussLegendre(budget)
-    if name in ESTIMATORS:
+    if name in HEMISPHERE_ESTIMATORS:
         return QuasiMonteCarlo(name, budget, seed)
     raise KeyError(name)

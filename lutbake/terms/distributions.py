@@ -19,18 +19,9 @@ from dataclasses import dataclass
 
 import warp as wp
 
+from ..catalog import NDF_DESCRIPTIONS
 from ..edge import COS_EPS
 from . import masking, ndf
-
-MASKINGS = {
-    "smith_height_correlated": "Smith G2 = 1/(1 + Lambda(v) + Lambda(l)), height-correlated (Heitz 2014, Eq. 99)",
-    "smith_separable": "Smith G2 = G1(v) G1(l), separable (Heitz 2014, Eq. 98)",
-    "v_cavity": "Cook-Torrance V-cavity min(1, 2 NoH NoV / VoH, 2 NoH NoL / VoH) (lecture 003)",
-    "smith_joint_approx": "UE4's Vis_SmithJointApprox as G2 = 2 NoL NoV / (NoL (NoV (1-a) + a) + NoV (NoL (1-a) + a)), "
-    "a = alpha (an approximation of height-correlated Smith GGX; NDF-independent)",
-    "schlick_ggx_ibl": "separable Schlick-GGX G2 = G1(v) G1(l), G1 = NoX / (NoX (1 - k) + k), k = alpha / 2 "
-    "(Karis 2013 Eq. 4, its IBL k; Godot's integrate_dfg.glsl; NDF-independent)",
-}
 
 
 @dataclass(frozen=True)
@@ -142,7 +133,7 @@ def _pdf_vndf(d: Distribution):
 
 GGX = Distribution(
     "ggx",
-    "GGX / Trowbridge-Reitz (Walter et al. 2007)",
+    NDF_DESCRIPTIONS["ggx"],
     ndf.D_ggx,
     masking.Lambda_ggx,
     ndf.tan2_from_u_ggx,
@@ -151,7 +142,7 @@ GGX = Distribution(
 )
 BECKMANN = Distribution(
     "beckmann",
-    "Beckmann, normalised with 1/pi (Walter et al. 2007, Eq. 25)",
+    NDF_DESCRIPTIONS["beckmann"],
     ndf.D_beckmann,
     masking.Lambda_beckmann,
     ndf.tan2_from_u_beckmann,
@@ -162,12 +153,10 @@ BECKMANN = Distribution(
 # grazing view. So Blinn-Phong pairs with the V-cavity G only (Lambda = None; kinds.dfg checks it).
 BLINN_PHONG = Distribution(
     "blinn_phong",
-    "normalized Blinn-Phong (s + 2)/(2 pi) (n.h)^s, s = 2/alpha^2 - 2 "
-    "(masking = v_cavity only: no closed-form Smith Lambda)",
+    NDF_DESCRIPTIONS["blinn_phong"],
     ndf.D_blinn_phong,
     None,
     ndf.tan2_from_u_blinn_phong,
     ndf.u_from_tan2_blinn_phong,
 )
 NDFS = {d.name: d for d in (GGX, BECKMANN, BLINN_PHONG)}
-SMITH_NDFS = tuple(n for n, d in NDFS.items() if d.Lambda is not None)

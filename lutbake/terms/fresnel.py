@@ -115,7 +115,7 @@ def F_lazanyi(n: float, k: float, a: float, alpha: float, cos_theta: float):
         F = ((n-1)^2 + 4 n (1-c)^5 + k^2) / ((n+1)^2 + k^2) - a c (1-c)^alpha
     (the form as reproduced by Hoffman 2019, "Fresnel equations considered harmful", Sec. 3).
     The first term is Schlick with f0 = ((n-1)^2 + k^2)/((n+1)^2 + k^2) (since 1 - f0 = 4n/((n+1)^2+k^2));
-    ``a`` is fitted per wavelength against the exact curve (lutbake.terms.metals.fit_lazanyi_a), and
+    ``a`` is fitted per wavelength against the exact curve (lutbake.metals.fit_lazanyi_a), and
     ``alpha`` is a fixed exponent (LAZANYI_ALPHA = 6). Domain c in [0, 1] (clamped); returns 1 at c = 0
     and f0 at c = 1, as Schlick does."""
     c = wp.clamp(cos_theta, 0.0, 1.0)

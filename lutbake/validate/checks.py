@@ -19,10 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..catalog import SMITH_NDFS
 from ..edge import ALPHA_MIN, NOV_MIN
 from ..integrands.specular import hemisphere_integral
 from ..sampling import points
-from ..terms.distributions import NDFS, SMITH_NDFS
+from ..terms.distributions import NDFS
 from .probe import BRDF_PAIRS, evaluate_brdfs, evaluate_terms
 
 # Tolerances (absolute unless said otherwise). The terms run in float32: ~1e-7 is the floor.

@@ -34,9 +34,10 @@ import functools
 import numpy as np
 import warp as wp
 
+from ..catalog import MASKINGS
 from ..edge import COS_EPS
 from ..terms import fresnel, masking, ndf
-from ..terms.distributions import MASKINGS, NDFS
+from ..terms.distributions import NDFS
 
 wp.set_module_options({"enable_backward": False})
 
