@@ -464,6 +464,11 @@ def audit(
     """Audit the LUT at ``path`` against conventions(**conv_args) (see the module docstring)."""
     if metric not in METRICS:
         raise ValueError(f"metric {metric!r}: allowed {', '.join(METRICS)}")
+    from .audit_tables import dispatch  # LTC and OpenPBR conventions: lutbake.audit_tables
+
+    other = dispatch(path, conv_args, tolerance, metric, max_side)
+    if other is not None:
+        return other
     lut: LutFile = read_lut(path, shape=shape)
     rows, cols, fch = lut.data.shape
     bad = ~np.isfinite(lut.data)
