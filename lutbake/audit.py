@@ -466,7 +466,7 @@ def audit(
         raise ValueError(f"metric {metric!r}: allowed {', '.join(METRICS)}")
     from .audit_tables import dispatch  # LTC and OpenPBR conventions: lutbake.audit_tables
 
-    other = dispatch(path, conv_args, tolerance, metric, max_side)
+    other = dispatch(path, conv_args, tolerance, metric, max_side, error_map)
     if other is not None:
         return other
     lut: LutFile = read_lut(path, shape=shape)

@@ -255,18 +255,32 @@ def test_audit_runs_on_every_shipped_table(name):
         assert r.extra["chosen"] == "nominal", r.diagnosis
 
 
+def write_ltc_js(path, t1, t2):
+    path.write_text(
+        "var g_ltc_1 = [" + ", ".join(f"{v:.6g}" for v in t1.ravel()) + "];\n"
+        "var g_ltc_2 = [" + ", ".join(f"{v:.6g}" for v in t2.ravel()) + "];\n"
+    )
+    return path
+
+
 def test_ltc_audit_fails_a_table_whose_matrices_are_packed_in_the_wrong_order(tmp_path):
     """ltc_code's table with ltc_1's (y, z) coefficients exchanged (glm's column-major invM read row-major, a
     classic port mistake): the magnitudes are intact, so only the fit-quality check can catch it -- and does."""
     from lutbake.audit_tables import FIT_RATIO_MAX, read_ltc_pair
 
     t1, t2 = read_ltc_pair(DATA / "ltc_code_ltc.js.gz")
-    bad = t1[..., [0, 2, 1, 3]]
-    path = tmp_path / "ltc_swapped.js"
-    path.write_text(
-        "var g_ltc_1 = [" + ", ".join(f"{v:.6g}" for v in bad.ravel()) + "];\n"
-        "var g_ltc_2 = [" + ", ".join(f"{v:.6g}" for v in t2.ravel()) + "];\n"
-    )
+    path = write_ltc_js(tmp_path / "ltc_swapped.js", t1[..., [0, 2, 1, 3]], t2)
     r = audit(path, {"preset": "ltc-ggx"}, max_side=FAST_SIDE, tolerance=1.0)
+    assert r.extra["chosen"] == "nominal"
     assert r.extra["fit_ratio"] > FIT_RATIO_MAX
+    assert not r.passed
+
+
+def test_ltc_audit_names_flipped_view_rows(tmp_path):
+    """ltc_code's table with its view rows in reverse order (both textures): the magnitude hypotheses name it."""
+    from lutbake.audit_tables import read_ltc_pair
+
+    t1, t2 = read_ltc_pair(DATA / "ltc_code_ltc.js.gz")
+    r = audit(write_ltc_js(tmp_path / "ltc_flipped.js", t1[::-1], t2[::-1]), {"preset": "ltc-ggx"}, max_side=FAST_SIDE)
+    assert r.extra["chosen"] == "rows_flipped", r.findings
     assert not r.passed
