@@ -33,7 +33,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .audit import MISMATCH_RATIO, PERCENTILES, subset
+from .audit import MISMATCH_RATIO, PERCENTILES, _stats, subset
 
 FIT_RATIO_MAX = 2.0  # the file's median Heitz fit error may be at most this x lutbake's fit at the same texels
 AREA_TEXELS = 6  # texels (a spread of roughness and view) of the area-light comparison
@@ -49,11 +49,11 @@ OPENPBR_KEYS = (
 )
 
 
-def _stats(err: np.ndarray) -> dict:
-    a = np.abs(err)
-    d = {"max": float(a.max()), "mean": float(a.mean())}
-    d.update({f"p{p}": float(np.percentile(a, p)) for p in PERCENTILES})
-    return d
+def _metric(abs_err: np.ndarray, metric: str) -> float:
+    """The statistic of |error| held against --tolerance (lutbake.audit.METRICS)."""
+    return {"max": float(abs_err.max()), "p99": float(np.percentile(abs_err, 99)), "mean": float(abs_err.mean())}[
+        metric
+    ]
 
 
 @dataclass
@@ -266,7 +266,7 @@ def audit_ltc(
             f"fit {area['lutbake fit']['median']:.3g} (p90 {area['lutbake fit']['p90']:.3g})"
         )
     allerr = np.abs(np.concatenate([f_t2[:, 0] - mag, f_t2[:, 1] - fres]))
-    value = {"max": float(allerr.max()), "p99": float(np.percentile(allerr, 99)), "mean": float(allerr.mean())}[metric]
+    value = _metric(allerr, metric)
     passed = bool(value <= tolerance and fit_ratio <= FIT_RATIO_MAX and not mismatch)
     if error_map is not None:
         from .audit import write_error_map
@@ -356,7 +356,7 @@ def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> 
         f"storage UNORM16 (rounding RMS {rms_q:.2g}); residual RMS over cos > 0 {np.sqrt(np.mean(allerr**2)):.3g}: "
         "Monte Carlo noise of OpenPBR's generator above the rounding",
     )
-    value = {"max": float(allerr.max()), "p99": float(np.percentile(allerr, 99)), "mean": float(allerr.mean())}[metric]
+    value = _metric(allerr, metric)
     return TableAuditReport(
         file=str(path),
         conventions=f"preset openpbr ([ior][alpha][cos] {n}^3, separable Smith, exact Fresnel); {len(iz)} IOR slices "
