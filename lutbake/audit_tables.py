@@ -118,7 +118,11 @@ def read_ltc_pair(path: Path) -> tuple[np.ndarray, np.ndarray]:
         if len(arrays) == 2:
             break
     if len(arrays) != 2 or arrays[0].shape != arrays[1].shape:
-        raise ValueError(f"{path}: expected two arrays of N x N x 4 numbers (ltc_1, ltc_2), found {len(arrays)}")
+        raise ValueError(
+            f"{path}: expected two [...] arrays of N x N x 4 numbers (ltc_1, ltc_2: ltc_code's ltc.js, three.js' "
+            f"LTC_MAT_1/2, lutbake's ltc js output) or a lutbake _1.dds, found {len(arrays)}; Blender's and HDRP's "
+            "C/C# layouts (ltc_mag with 2 channels, HDRP's packing) are not read"
+        )
     return arrays[0], arrays[1]
 
 
