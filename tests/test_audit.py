@@ -284,3 +284,17 @@ def test_ltc_audit_names_flipped_view_rows(tmp_path):
     r = audit(write_ltc_js(tmp_path / "ltc_flipped.js", t1[::-1], t2[::-1]), {"preset": "ltc-ggx"}, max_side=FAST_SIDE)
     assert r.extra["chosen"] == "rows_flipped", r.findings
     assert not r.passed
+
+
+def test_ltc_audit_passes_lutbakes_own_table(tmp_path):
+    """A lutbake LTC table (ltc-threejs preset, JS floats, 8^2) audited under its own preset: magnitudes and Fresnel
+    within float rounding, the conventions fit, the matrices are lutbake's fit (per-texel ratio 1)."""
+    from lutbake import api
+    from lutbake.config import load_configs
+
+    spec = load_configs([Path("lutbake/presets/ltc-threejs.toml")], ["size=[8, 8]"])
+    path = api.bake(spec, out_dir=tmp_path, workers=2)[0].path
+    r = audit(path, {"preset": "ltc-threejs"}, max_side=8, tolerance=CLEAN_TOL)
+    assert r.passed, r.text()
+    assert r.extra["chosen"] == "nominal"
+    np.testing.assert_allclose(r.extra["fit_ratio"], 1.0, rtol=CLEAN_TOL)
