@@ -1,7 +1,8 @@
 """``lutbake audit FILE``: compare a shipped LUT with a converged re-bake under declared conventions, and
 diagnose the usual hand-over mistakes by testing each one against the data.
 
-The conventions are a ``dfg`` table spec (a preset or config, plus ``--set`` keys; the size is the file's).
+The conventions are a ``dfg`` table spec (a preset or config, plus ``--set`` keys; the size is the file's); a
+preset or config of kind ``ltc`` or layout ``openpbr`` is audited by lutbake.audit_tables instead.
 Every file texel (row y, column x) then has a declared (NoV, alpha) (lutbake.kinds.dfg.axes_for); the
 reference is lutbake's Gauss-Legendre integral at those points (error ~4e-7), on a strided subset of at most
 ``max_side`` x ``max_side`` texels (the last row and column always included).
@@ -466,6 +467,11 @@ def audit(
     """Audit the LUT at ``path`` against conventions(**conv_args) (see the module docstring)."""
     if metric not in METRICS:
         raise ValueError(f"metric {metric!r}: allowed {', '.join(METRICS)}")
+    from .audit_tables import dispatch  # LTC and OpenPBR conventions: lutbake.audit_tables
+
+    other = dispatch(path, conv_args, tolerance, metric, max_side, error_map)
+    if other is not None:
+        return other
     lut: LutFile = read_lut(path, shape=shape)
     rows, cols, fch = lut.data.shape
     bad = ~np.isfinite(lut.data)

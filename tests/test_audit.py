@@ -204,3 +204,97 @@ def test_cli_rejects_non_finite_values_and_undeclared_text_layouts(clean, tmp_pa
     js.write_text("const DATA = new Uint16Array( [ 0x3c00, 0x0000 ] );\n")
     res = CliRunner().invoke(main, ["audit", str(js)])
     assert res.exit_code == 2 and "--shape" in res.output
+
+
+# ------------------------------------------------------------------------- every shipped table in tests/data
+
+# file -> (preset, audit keyword arguments); every table file of tests/data must be listed (the test below checks)
+SHIPPED = {
+    "filament_dfg.npz": ("filament", {}),
+    "khronos_lut_ggx_u8.npz": ("gltf", {}),
+    "blender_eevee_next_brdf_ggx.npz": ("blender-eevee", {}),
+    "threejs_dfg_lut.js": ("threejs", {"shape": (16, 16, 2)}),
+    "bevy_dfg.ktx2": ("bevy", {}),
+    "openpbr_energy_tables.npz": ("openpbr", {}),
+    "ltc_code_ltc.js.gz": ("ltc-ggx", {}),
+}
+FAST_SIDE = 6  # the loop's subset (its own tests above use MAX_SIDE)
+OPENPBR_AVG_ATOL = 1e-3  # the averages: Monte Carlo noise of OpenPBR's generator (measured max 4.3e-4)
+LTC_SPHERE_ATOL = 2e-5  # ltc_code's float32 closed form printed with 6 digits (test_ltc PUBLISHED_SPHERE_ATOL)
+LTC_MAGNITUDE_P50 = 2e-3  # ltc_code's 32 x 32-sample magnitudes (measured median 6.3e-4; max 0.066 at NoV = 8e-4)
+
+
+def test_every_shipped_table_in_tests_data_is_audited():
+    tables = {p.name for p in DATA.iterdir() if p.suffix not in (".json", ".md")}
+    assert tables == set(SHIPPED), tables ^ set(SHIPPED)
+
+
+@pytest.mark.parametrize("name", sorted(SHIPPED))
+def test_audit_runs_on_every_shipped_table(name):
+    """Each shipped table audited under its engine's preset (fast subset): the preset's conventions fit the dfg-family
+    tables (Filament's cmgen offset is the 'filament' preset itself), OpenPBR's averages match lutbake's within their
+    Monte Carlo noise and its reflection ratio obeys the reciprocity identity, and ltc_code's unique LTC quantities
+    match (sphere to its printed digits, magnitude to its sampling noise) with matrices that fit the lobe within
+    FIT_RATIO_MAX of lutbake's own fit."""
+    from lutbake.audit_tables import FIT_RATIO_MAX, UNORM16_STEP
+
+    preset, kw = SHIPPED[name]
+    r = audit(DATA / name, {"preset": preset}, max_side=FAST_SIDE, **kw)
+    text = r.text()
+    assert text.startswith(f"audit {DATA / name}") and ("PASS" in text or "FAIL" in text)
+    if preset == "openpbr":
+        for key in ("ideal_dielectric", "opaque_dielectric", "ideal_metal"):
+            assert r.errors[f"{key}_avg_energy_complement"]["max"] < OPENPBR_AVG_ATOL
+        assert r.extra["reciprocity_residual_max"] <= UNORM16_STEP
+    elif preset == "ltc-ggx":
+        assert r.errors["sphere (t2.w)"]["max"] < LTC_SPHERE_ATOL
+        assert r.errors["magnitude (t2.x)"]["p50"] < LTC_MAGNITUDE_P50
+        assert r.extra["fit_ratio"] <= FIT_RATIO_MAX
+        assert r.extra["area"]["file"]["median"] < 2 * r.extra["area"]["lutbake fit"]["median"]
+    else:
+        assert r.extra["chosen"] == "nominal", r.diagnosis
+
+
+def write_ltc_js(path, t1, t2):
+    path.write_text(
+        "var g_ltc_1 = [" + ", ".join(f"{v:.6g}" for v in t1.ravel()) + "];\n"
+        "var g_ltc_2 = [" + ", ".join(f"{v:.6g}" for v in t2.ravel()) + "];\n"
+    )
+    return path
+
+
+def test_ltc_audit_fails_a_table_whose_matrices_are_packed_in_the_wrong_order(tmp_path):
+    """ltc_code's table with ltc_1's (y, z) coefficients exchanged (glm's column-major invM read row-major, a
+    classic port mistake): the magnitudes are intact, so only the fit-quality check can catch it -- and does."""
+    from lutbake.audit_tables import FIT_RATIO_MAX, read_ltc_pair
+
+    t1, t2 = read_ltc_pair(DATA / "ltc_code_ltc.js.gz")
+    path = write_ltc_js(tmp_path / "ltc_swapped.js", t1[..., [0, 2, 1, 3]], t2)
+    r = audit(path, {"preset": "ltc-ggx"}, max_side=FAST_SIDE, tolerance=1.0)
+    assert r.extra["chosen"] == "nominal"
+    assert r.extra["fit_ratio"] > FIT_RATIO_MAX
+    assert not r.passed
+
+
+def test_ltc_audit_names_flipped_view_rows(tmp_path):
+    """ltc_code's table with its view rows in reverse order (both textures): the magnitude hypotheses name it."""
+    from lutbake.audit_tables import read_ltc_pair
+
+    t1, t2 = read_ltc_pair(DATA / "ltc_code_ltc.js.gz")
+    r = audit(write_ltc_js(tmp_path / "ltc_flipped.js", t1[::-1], t2[::-1]), {"preset": "ltc-ggx"}, max_side=FAST_SIDE)
+    assert r.extra["chosen"] == "rows_flipped", r.findings
+    assert not r.passed
+
+
+def test_ltc_audit_passes_lutbakes_own_table(tmp_path):
+    """A lutbake LTC table (ltc-threejs preset, JS floats, 8^2) audited under its own preset: magnitudes and Fresnel
+    within float rounding, the conventions fit, the matrices are lutbake's fit (per-texel ratio 1)."""
+    from lutbake import api
+    from lutbake.config import load_configs
+
+    spec = load_configs([Path("lutbake/presets/ltc-threejs.toml")], ["size=[8, 8]"])
+    path = api.bake(spec, out_dir=tmp_path, workers=2)[0].path
+    r = audit(path, {"preset": "ltc-threejs"}, max_side=8, tolerance=CLEAN_TOL)
+    assert r.passed, r.text()
+    assert r.extra["chosen"] == "nominal"
+    np.testing.assert_allclose(r.extra["fit_ratio"], 1.0, rtol=CLEAN_TOL)

@@ -7,6 +7,7 @@ import re
 import shutil
 import struct
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -93,10 +94,52 @@ def test_ktx2_zstd_parsed_independently(table, tmp_path):
     blob = write_table(table, tmp_path, "ktx2zst", "half").read_bytes()
     assert blob[:12] == bytes([0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A])
     vk, type_size, w, h, depth, layers, faces, levels, scheme = struct.unpack_from("<9I", blob, 12)
-    assert (vk, type_size, w, h, scheme) == (83, 1, W, H, 2)  # R16G16_SFLOAT, typeSize 1 when supercompressed, zstd
+    assert (vk, w, h, scheme) == (83, W, H, 2)  # R16G16_SFLOAT, zstd
+    assert type_size == ktx2_spec_type_size(vk)
     off, size, raw = struct.unpack_from("<QQQ", blob, 80)
     assert raw == H * W * 2 * 2 and off + size == len(blob)
     level = zstandard.ZstdDecompressor().decompress(blob[off : off + size], max_output_size=raw)
     np.testing.assert_array_equal(np.frombuffer(level, "<f2").reshape(H, W, 2).astype(np.float32), half(table.data))
     kvd_off, kvd_len = struct.unpack_from("<II", blob, 56)
     assert b"lutbake:metadata" in blob[kvd_off : kvd_off + kvd_len]
+
+
+# KTX 2.0 §3.3 "typeSize": for an unpacked format, the bytes of one component ("derived from the format name", e.g.
+# 16 / 8 for R16G16B16_UNORM), with no exception for supercompressed files (1 only for VK_FORMAT_UNDEFINED and
+# *_BLOCK formats). The vkFormat values lutbake writes and their names' component widths (vulkan_core.h):
+VK_COMPONENT_BITS = {76: 16, 83: 16, 97: 16, 100: 32, 103: 32, 109: 32}  # R16, R16G16, R16G16B16A16, R32, ...
+
+
+def ktx2_spec_type_size(vk: int) -> int:
+    return VK_COMPONENT_BITS[vk] // 8
+
+
+@pytest.mark.parametrize("dtype", ["half", "float32"])
+@pytest.mark.parametrize("nch", [1, 2, 4])
+def test_ktx2_zstd_type_size_is_the_component_size(tmp_path, dtype, nch):
+    rng = np.random.default_rng(nch)
+    axes, chans = [Axis("a", "y", 3), Axis("b", "x", 4)], {f"c{i}": "test" for i in range(nch)}
+    t = Table("t", "dfg", rng.random((3, 4, nch)).astype(np.float32), axes, chans, "", {})
+    for fmt in ("ktx2", "ktx2zst"):
+        blob = write_table(t, tmp_path / fmt, fmt, dtype).read_bytes()
+        vk, type_size = struct.unpack_from("<2I", blob, 12)
+        assert type_size == ktx2_spec_type_size(vk) == (2 if dtype == "half" else 4), (fmt, vk, type_size)
+
+
+def test_ktx2_zstd_header_and_dfd_equal_bevys_shipped_dfg_ktx2(tmp_path):
+    """Bevy's dfg.ktx2 (tests/data/bevy_dfg.ktx2, written by `ktx create` v4.4.2) and lutbake's zstd KTX2 of an RG16F
+    table: the same vkFormat, typeSize, supercompressionScheme and byte-identical data format descriptors."""
+    bevy = (Path(__file__).parent / "data" / "bevy_dfg.ktx2").read_bytes()
+    axes, chans = [Axis("a", "y", 64), Axis("b", "x", 64)], {"scale": "", "bias": ""}
+    t = Table("t", "dfg", np.zeros((64, 64, 2), np.float32), axes, chans, "", {})
+    ours = write_table(t, tmp_path, "ktx2zst", "half").read_bytes()
+
+    def fields(blob):
+        vk, type_size, w, h, d, layers, faces, levels, scheme = struct.unpack_from("<9I", blob, 12)
+        dfd_off, dfd_len = struct.unpack_from("<2I", blob, 48)
+        return (vk, type_size, w, h, d, layers, faces, levels, scheme), blob[dfd_off : dfd_off + dfd_len]
+
+    (head_b, dfd_b), (head_o, dfd_o) = fields(bevy), fields(ours)
+    assert head_b == (83, 2, 64, 64, 0, 0, 1, 1, 2)
+    assert head_o == head_b
+    assert dfd_o == dfd_b

@@ -73,13 +73,14 @@ def read_dds_spec(blob):
 
 
 def read_ktx2_spec(blob):
-    """KTX 2.0 per the Khronos specification, sections 3.1-3.12, and the KDF 1.3 basic descriptor."""
+    """KTX 2.0 per the Khronos specification, sections 3.1-3.12, and the KDF 1.3 basic descriptor; level 0 plain
+    (supercompressionScheme 0) or one Zstandard frame (scheme 2, inflated with the ``zstandard`` package)."""
     assert blob[:12] == bytes([0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A])
     vk, type_size, w, h, d, layers, faces, levels, scheme = struct.unpack_from("<9I", blob, 12)
     dfd_off, dfd_len, kvd_off, kvd_len, sgd_off, sgd_len = struct.unpack_from("<4I2Q", blob, 48)
-    assert faces == 1 and levels == 1 and scheme == 0 and sgd_len == 0
+    assert faces == 1 and levels == 1 and scheme in (0, 2) and sgd_len == 0
     lvl_off, lvl_len, lvl_ulen = struct.unpack_from("<3Q", blob, 80)
-    assert lvl_len == lvl_ulen
+    assert lvl_len == lvl_ulen or scheme == 2
     # DFD: total size, then one basic block
     (total,) = struct.unpack_from("<I", blob, dfd_off)
     assert total == dfd_len
@@ -108,8 +109,15 @@ def read_ktx2_spec(blob):
         kv[key.decode()] = value.rstrip(b"\0").decode()
         p += 4 + n + (-n % 4)
     assert list(kv) == sorted(kv)
-    assert lvl_off % np.lcm(nch * type_size, 4) == 0
     shape = ((d,) if d else (layers,) if layers else ()) + (h, w, nch)
+    if scheme == 2:  # KTX 2.0 §3.12.2: a Zstandard frame inflating to uncompressedByteLength; no mipPadding
+        import zstandard
+
+        level = zstandard.ZstdDecompressor().decompress(blob[lvl_off : lvl_off + lvl_len], max_output_size=lvl_ulen)
+        assert len(level) == lvl_ulen == np.prod(shape) * type_size
+        blob, lvl_off = level, 0
+    else:
+        assert lvl_off % np.lcm(nch * type_size, 4) == 0
     arr = np.frombuffer(blob, dtype=dt, count=int(np.prod(shape)), offset=lvl_off).reshape(shape)
     return arr, vk, channels, kv, (d, layers)
 

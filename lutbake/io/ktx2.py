@@ -100,11 +100,13 @@ def encode(
 
         level = zstandard.ZstdCompressor(level=ZSTD_LEVEL).compress(raw)
         level_off = end  # supercompressed levels need no alignment (KTX 2.0 §3.9.7: mipPadding only if scheme 0)
-        vk_type_size = 1  # typeSize must be 1 when supercompressed (§3.6)
     else:
-        level, vk_type_size = raw, type_size
+        level = raw
+    # typeSize (KTX 2.0 §3.3 "typeSize"): the bytes of one component of an unpacked format (2 for *16_SFLOAT, 4 for
+    # *32_SFLOAT), whatever the supercompression; 1 only for VK_FORMAT_UNDEFINED and *_BLOCK formats. The DFD keeps
+    # the pre-deflation bytesPlane0 ("DFD for Supercompressed Data"). `ktx create` writes the same (Bevy's dfg.ktx2).
     head = IDENTIFIER + struct.pack(
-        "<9I", VK_FORMAT[(dtype, nch)], vk_type_size, width, height, depth, layers, 1, 1, scheme
+        "<9I", VK_FORMAT[(dtype, nch)], type_size, width, height, depth, layers, 1, 1, scheme
     )
     head += struct.pack("<IIIIQQ", dfd_off, len(dfd), kvd_off, len(kvd), 0, 0)
     head += struct.pack("<QQQ", level_off, len(level), len(raw))
@@ -170,5 +172,6 @@ def decode(blob: bytes) -> tuple[np.ndarray, dict]:
         "dimension": "3D" if depth else "2D array" if layers else "2D",
         "levels": max(levels, 1),
         "supercompression": {v: k for k, v in SUPERCOMPRESSION.items()}[scheme],
+        "type_size": type_size,
         "key_value": kv,
     }
