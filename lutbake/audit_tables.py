@@ -17,9 +17,10 @@ within the tolerance and ``fit_ratio`` <= FIT_RATIO_MAX.
 
 OpenPBR (adobe/openpbr-bsdf ``impl/data/openpbr_*_data.h``, UNORM16): each energy array against lutbake's bake
 under the ``openpbr`` preset's conventions (its [ior][alpha][cos] grid, separable Smith, exact Fresnel), at a
-strided subset of IOR slices and roughness rows; the reflection ratio, which no single-scattering integral fixes,
-against the reciprocity identity of OpenPBR's multiple-scattering lobe (1 - x(eta)) E_avg(eta) = (1 - x(1/eta))
-E_avg(1/eta) (tests/test_dielectric.py explains it). The cos = 0 column is reported apart: lutbake evaluates
+strided subset of IOR slices and roughness rows; the reflection ratio against lutbake's (its Kulla-Conty split of
+the two sides' averages, lutbake.kinds.dielectric_ratio) where OpenPBR reads it (alpha index >= 2, eta != 1; the rest
+reported apart), and against the reciprocity identity of OpenPBR's multiple-scattering lobe (1 - x(eta)) E_avg(eta) =
+(1 - x(1/eta)) E_avg(1/eta). The cos = 0 column is reported apart: lutbake evaluates
 NoV >= NOV_MIN there (lutbake.edge), a limit the shipped Monte Carlo estimator does not take.
 """
 
@@ -47,6 +48,7 @@ OPENPBR_KEYS = (
     ("opaque_dielectric_avg_energy_complement", "dielectric_avg", 1),
     ("ideal_metal_avg_energy_complement", "dielectric_avg", 2),
 )
+RATIO_CHANNEL = 3  # of the openpbr dielectric_avg layout: ideal_dielectric_reflection_ratio
 
 
 def _metric(abs_err: np.ndarray, metric: str) -> float:
@@ -342,14 +344,25 @@ def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> 
             s = _stats(got - ours)
             errors[key] = s
             judged.append((got - ours).ravel())
-    # the reflection ratio: OpenPBR's reciprocity identity, with the shipped averages and with lutbake's
+    # the reflection ratio (lutbake.kinds.dielectric_ratio): judged where OpenPBR reads it (alpha index >= 2, eta != 1);
+    # at alpha index 0-1 and on the eta = 1 row the averages are ~0 and their rounding decides the ratio
     x = shipped["ideal_dielectric_reflection_ratio"]
+    diff = x[iz] - ours_avg[..., RATIO_CHANNEL]
+    body = np.zeros(diff.shape, bool)
+    body[:, 2:] = True
+    body[np.isin(iz, (n // 2 - 1, n // 2)), :] = False  # the two eta = 1 slices (lutbake.kinds.dielectric, openpbr)
+    s = _stats(diff[body])
+    k = np.unravel_index(np.argmax(np.where(body, np.abs(diff), -1.0)), diff.shape)
+    s["where"] = f"ior index {iz[k[0]]}, alpha index {k[1]}"
+    errors["ideal_dielectric_reflection_ratio (alpha index >= 2, eta != 1)"] = s
+    errors["ideal_dielectric_reflection_ratio (alpha index < 2 or eta = 1)"] = _stats(diff[~body])
+    judged.append(diff[body].ravel())
     ec = shipped["ideal_dielectric_avg_energy_complement"]
     k = np.arange(1, n // 2)
     inside, outside = n // 2 - 1 - k, n // 2 + k
     res = (1 - x[outside]) * ec[outside] - (1 - x[inside]) * ec[inside]
     findings.append(
-        f"ideal_dielectric_reflection_ratio: not re-baked (no single-scattering integral fixes it); its reciprocity "
+        f"ideal_dielectric_reflection_ratio: re-baked from lutbake's averages (Kulla-Conty split); its reciprocity "
         f"identity (1 - x(eta)) E_avg(eta) = (1 - x(1/eta)) E_avg(1/eta) holds to max {np.abs(res).max():.3g} "
         f"(UNORM16 step {UNORM16_STEP:.3g})"
     )
