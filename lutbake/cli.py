@@ -152,6 +152,8 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     def on_done(job):
         if job.status == "baked":
             note = samples_note(job.spec, job.samples)
+            if job.values_from is not None:
+                note = "; ".join(filter(None, (note, f"values computed once with {job.values_from}")))
             click.echo(
                 f"{escape_controls(str(job.path))}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel"
                 + (f" ({note})" if note else "")
