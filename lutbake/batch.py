@@ -37,9 +37,11 @@ from .executor import Cancelled, Progress, default_workers
 from .io.atomic import atomic_write_bytes, remove_stale_temps
 from .io.formats import output_path, write_table
 from .io.oserror import os_error_text
-from .pipeline import assemble, compute
+from .kinds import lookup_kind
+from .pipeline import Computed, assemble, compute
 from .provenance import HASH_ATTRIBUTE, content_hash, read_header, sources_digest
 from .sharing import group_by, values_key
+from .values_cache import ValuesCache
 
 STATUSES = ("baked", "skipped", "failed", "interrupted")
 EXIT_OK, EXIT_FAILED, EXIT_SIGINT, EXIT_SIGTERM = 0, 1, 130, 143
@@ -138,15 +140,45 @@ def _record_failure(job: Job, e: Exception, needed: int = 0) -> None:
         job.message = f"{job.spec.source}: table '{job.name}': {type(e).__name__}: {e}; nothing written"
 
 
-def _bake_group(group: list[Job], workers: int, device: str, progress, cancel: threading.Event) -> list[Job]:
-    """Compute the values of ``group`` (pending jobs with one values key, lutbake.sharing) once, then assemble and
-    write each job's table in its own layout; any failure is recorded on the jobs it concerns, never raised."""
+def _cached(cache: ValuesCache | None, job: Job) -> Computed | None:
+    """``job``'s values from the cache (lutbake.values_cache), with its plan; None on a miss."""
+    entry = cache.load(job.values_key) if cache is not None else None
+    if entry is None:
+        return None
+    t0 = time.thread_time()
+    plan = lookup_kind(job.spec.kind).plan(job.spec)
+    if plan.shape != entry[0].shape:
+        return None
+    return Computed(plan, entry[0], entry[1], 0.0, time.thread_time() - t0)
+
+
+def _store(cache: ValuesCache | None, job: Job, computed: Computed) -> None:
+    """Write ``job``'s values into the cache; a cache that cannot be written only loses its use (said in the
+    job's message), never the table."""
+    if cache is None:
+        return
+    try:
+        cache.store(job.values_key, computed.data, computed.extra)
+    except OSError as e:
+        job.message = f"values cache not written: {os_error_text(e, cache.directory, computed.data.nbytes)}"
+
+
+def _bake_group(
+    group: list[Job], workers: int, device: str, progress, cancel: threading.Event, cache: ValuesCache | None = None
+) -> list[Job]:
+    """Compute the values of ``group`` (pending jobs with one values key, lutbake.sharing) once, or take them from
+    ``cache``, then assemble and write each job's table in its own layout; any failure is recorded on the jobs
+    it concerns, never raised."""
     lead = group[0]
     t0 = time.perf_counter()
     try:
         if cancel.is_set():
             raise Cancelled(lead.name)
-        computed = compute(lead.spec, workers, device, progress, cancel=cancel)
+        computed = _cached(cache, lead)
+        origin = "cache" if computed is not None else None
+        if computed is None:
+            computed = compute(lead.spec, workers, device, progress, cancel=cancel)
+            _store(cache, lead, computed)
     except Exception as e:  # every table of the group lacks its values
         for job in group:
             _record_failure(job, e)
@@ -155,12 +187,13 @@ def _bake_group(group: list[Job], workers: int, device: str, progress, cancel: t
             job.seconds = time.perf_counter() - t0
         return group
     for job in group:
-        _write_one(job, computed, lead, cancel)
+        _write_one(job, computed, lead.name if job is not lead else origin, cancel)
     return group
 
 
-def _write_one(job: Job, computed, lead: Job, cancel: threading.Event) -> None:
-    """Assemble ``job``'s table from ``computed`` (its group's values) and write it."""
+def _write_one(job: Job, computed: Computed, values_from: str | None, cancel: threading.Event) -> None:
+    """Assemble ``job``'s table from ``computed`` (its group's values: computed for this job, for the job named
+    ``values_from``, or taken from the cache: ``values_from`` = "cache") and write it."""
     t0 = time.perf_counter()
     needed = 0
     try:
@@ -182,11 +215,11 @@ def _write_one(job: Job, computed, lead: Job, cancel: threading.Event) -> None:
         _record_failure(job, e, needed)
         job.seconds = time.perf_counter() - t0
         return
-    shared = job is not lead
+    shared = values_from is not None and values_from != "cache"
     job.status, job.samples, job.table = "baked", computed.plan.samples, table
     job.seconds = 0.0 if shared else computed.seconds
     job.cpu_seconds = 0.0 if shared else computed.cpu_seconds
-    job.values_from = lead.name if shared else None
+    job.values_from = values_from
     job.error_estimate = _float_or_none(table.attributes.get("error_estimate"))
     job.shape = "x".join(str(a.count) for a in table.axes) + f"x{len(table.channels)}"
 
@@ -198,6 +231,7 @@ def run(
     progress: Progress | None = None,
     on_done: Callable[[Job], None] | None = None,
     poll: float = 0.2,
+    cache: ValuesCache | None = None,
 ) -> int | None:
     """Bake every ``pending`` job; ``on_done(job)`` is called in the calling thread as each finishes.
 
@@ -207,6 +241,7 @@ def run(
     several tables run; the result is bit-identical either way).
     Returns None, or the signal number if the run was interrupted (the unfinished jobs are then marked
     ``interrupted``; finished files are kept). ``progress``: lutbake.executor.Progress, per table.
+    ``cache``: lutbake.values_cache.ValuesCache, whose entries of other sources are pruned first.
     """
     workers = workers or default_workers()
     for d in sorted({j.path.parent for j in jobs}):
@@ -214,6 +249,8 @@ def run(
     pending = [j for j in jobs if j.status == "pending"]
     if not pending:
         return None
+    if cache is not None:
+        cache.prune()
     groups = group_by(pending, lambda j: j.values_key)
     threads = max(1, min(workers, len(groups)))
     per_table = workers
@@ -224,7 +261,7 @@ def run(
     reported: set = set()
     try:
         for g in groups:
-            futures[pool.submit(_bake_group, g, per_table, device, progress, cancel)] = g
+            futures[pool.submit(_bake_group, g, per_table, device, progress, cancel, cache)] = g
         remaining = set(futures)
         while remaining:
             done, remaining = wait(remaining, timeout=poll, return_when=FIRST_COMPLETED)

@@ -186,7 +186,7 @@ LAYERS = [
     {"kinds", "value_bounds"},
     {"config", "preflight"},
     # cluster: the executor's Dask counterpart
-    {"executor", "provenance", "sharing", "devices", "cluster", "cluster_probe"},
+    {"executor", "provenance", "sharing", "values_cache", "devices", "cluster", "cluster_probe"},
     {"pipeline"},
     {"batch"},
     {"api"},

@@ -16,8 +16,9 @@ from lutbake.io.exr import read_exr
 from lutbake.kinds import KINDS
 from lutbake.provenance import sources_digest
 from lutbake.sharing import layout_keys, values_key
+from lutbake.values_cache import open_cache
 
-SMALL_LTC = {"kind": "ltc", "lobe": "ggx", "size": [6, 6], "fit_samples": 8}
+SMALL_LTC = {"kind": "ltc", "lobe": "ggx", "size": [6, 6], "fit_samples": 4}
 SMALL_DIELECTRIC = {"kind": "dielectric", "size": [4, 3], "ior_size": 2}
 # one small valid table per kind that declares layout keys; every value each layout key allows is tried on it
 SMALL = {"ltc": SMALL_LTC, "dielectric": SMALL_DIELECTRIC, "dielectric_avg": {"kind": "dielectric_avg"}}
@@ -111,15 +112,75 @@ def test_shared_tables_are_computed_once_and_bit_identical_to_baking_each_alone(
 
     alone = tmp_path / "alone"
     for i, t in enumerate(tables):  # each table in its own batch, from a config of the same file name (recorded)
+        if t["name"] == "ltc_other":  # computed on its own in the batch too
+            continue
         (tmp_path / str(i)).mkdir()
         one = batch.schedule(load_configs([write_config(tmp_path / str(i) / "all.toml", [t])]), alone)
         assert batch.run(one, workers=1) is None and one[0].status == "baked"
     shared, single = output_files(together), output_files(alone)
-    assert sorted(shared) == sorted(single) and len(shared) >= len(tables)
-    for name, data in shared.items():
+    assert sorted(shared) == sorted([*single, "ltc_other.exr"]) and len(single) >= len(tables) - 1
+    for name, data in single.items():
         if name.endswith(".exr"):  # OpenEXR stamps capDate (the time of writing), and data_hash hashes the file
-            (pa, ha), (pb, hb) = read_exr(together / name), read_exr(alone / name)
+            (pa, ha), (pb, hb) = read_exr(alone / name), read_exr(together / name)
             ha.pop("data_hash"), hb.pop("data_hash")
             assert np.array_equal(pa, pb) and ha == hb, name
         else:
-            assert data == single[name], name
+            assert data == shared[name], name
+
+
+def test_the_values_cache_lays_out_known_values_without_computing_and_never_trusts_a_bad_entry(tmp_path, monkeypatch):
+    computed = []
+    real = batch.compute
+
+    def counting(spec, *a, **k):
+        computed.append(spec.name)
+        return real(spec, *a, **k)
+
+    monkeypatch.setattr(batch, "compute", counting)
+    cache_dir = tmp_path / "out" / ".cache"
+
+    def run(table: dict, out: Path, cache=True, force=False) -> batch.Job:
+        """Bake ``table`` into ``out`` after deleting its output (so that it is never up to date)."""
+        for p in out.glob(f"{table['name']}.*"):
+            p.unlink()
+        (job,) = batch.schedule(load_configs([write_config(tmp_path / "c.toml", [table])]), out, force=force)
+        assert batch.run([job], workers=2, cache=open_cache(cache_dir if cache else None, force)) is None
+        assert job.status == "baked", job.message
+        return job
+
+    first = run({"name": "diel", **SMALL_DIELECTRIC}, tmp_path / "out")
+    assert computed == ["diel"] and first.values_from is None
+    (entry,) = cache_dir.glob("*.npy")
+    assert entry.stem == first.values_key and (cache_dir / f"{entry.stem}.json").is_file()
+
+    # the output deleted: written again from the cache, the same pixels and attributes as the first bake
+    data0, attrs0 = read_exr(first.path)
+    again = run({"name": "diel", **SMALL_DIELECTRIC}, tmp_path / "out")
+    data1, attrs1 = read_exr(again.path)
+    attrs0.pop("data_hash"), attrs1.pop("data_hash")
+    assert computed == ["diel"] and again.values_from == "cache"
+    np.testing.assert_array_equal(data1, data0)
+    assert attrs1 == attrs0
+
+    # a layout-only change (another format and dtype): no computation, the file of a bake without the cache
+    npy = {"name": "diel", **SMALL_DIELECTRIC, "format": "npy", "dtype": "half"}
+    cached = run(npy, tmp_path / "out").path.read_bytes()
+    assert computed == ["diel"]
+    assert run(npy, tmp_path / "fresh", cache=False).path.read_bytes() == cached and computed == ["diel"] * 2
+
+    # a corrupt entry (one flipped byte) is a miss: computed again, the entry rewritten whole
+    blob = bytearray(entry.read_bytes())
+    blob[-1] ^= 1
+    entry.write_bytes(bytes(blob))
+    assert run(npy, tmp_path / "out").values_from is None and len(computed) == 3
+    assert run(npy, tmp_path / "out", force=True).values_from is None and len(computed) == 4  # --force reads none
+    assert run(npy, tmp_path / "out").values_from == "cache" and len(computed) == 4
+
+    # entries of other sources are removed at the start of a run; files the cache did not write stay
+    meta = json.loads((cache_dir / f"{entry.stem}.json").read_text())
+    old = "0" * 64
+    (cache_dir / f"{old}.json").write_text(json.dumps({**meta, "values_key": old, "sources": "other sources"}))
+    (cache_dir / f"{old}.npy").write_bytes(entry.read_bytes())
+    (cache_dir / "notes.json").write_text("{}")
+    assert {p.name for p in open_cache(cache_dir).prune()} == {f"{old}.json", f"{old}.npy"}
+    assert sorted(p.name for p in cache_dir.iterdir()) == sorted([entry.name, entry.stem + ".json", "notes.json"])
