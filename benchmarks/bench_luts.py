@@ -54,6 +54,7 @@ def main() -> None:
         out = Path(tmp) / "outputs"
         clean = make_luts(out)
         report = json.loads((out / "report.json").read_text())
+        cache_bytes = sum(p.stat().st_size for p in (out / ".cache").iterdir())
         rerun = make_luts(out)
     tables = report["tables"]
     assert all(t["status"] == "baked" for t in tables), [t["name"] for t in tables if t["status"] != "baked"]
@@ -68,6 +69,7 @@ def main() -> None:
         "tables": len(tables),
         "computations": len(tables) - len(shared),
         "shared": shared,
+        "cache_bytes": cache_bytes,
         "tables_cpu_s": table_cpu,
         "outside_tables_cpu_s": clean["cpu_s"] - table_cpu,
         "per_table": [
@@ -88,7 +90,10 @@ def main() -> None:
         f"{doc['outside_tables_cpu_s']:.1f} s CPU; shared: "
         + (", ".join(f"{k} <- {v}" for k, v in shared.items()) or "-")
     )
-    print(f"  up-to-date rerun: {rerun['wall_s']:.2f} s wall, {rerun['cpu_s']:.2f} s CPU")
+    print(
+        f"  up-to-date rerun: {rerun['wall_s']:.2f} s wall, {rerun['cpu_s']:.2f} s CPU; "
+        f"values cache {cache_bytes / 2**20:.1f} MiB"
+    )
     print(f"  top {TOP} tables by CPU:")
     for t in top:
         print(f"    {t['name']:<40} {t['cpu_seconds']:7.2f} s CPU  {t['seconds']:7.2f} s wall (tiles)")
