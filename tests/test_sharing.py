@@ -83,7 +83,21 @@ def output_files(out: Path) -> dict[str, bytes]:
     return {p.name: p.read_bytes() for p in sorted(out.iterdir()) if p.is_file()}
 
 
-def test_shared_tables_are_computed_once_and_bit_identical_to_baking_each_alone(tmp_path, monkeypatch):
+@pytest.fixture
+def computed(monkeypatch):
+    """The names of the specs the batch computes (lutbake.batch.compute calls), in order."""
+    names = []
+    real = batch.compute
+
+    def counting(spec, *a, **k):
+        names.append(spec.name)
+        return real(spec, *a, **k)
+
+    monkeypatch.setattr(batch, "compute", counting)
+    return names
+
+
+def test_shared_tables_are_computed_once_and_bit_identical_to_baking_each_alone(tmp_path, computed):
     tables = [
         {"name": "ltc_exr", **SMALL_LTC},
         {"name": "ltc_js", **SMALL_LTC, "format": "js"},
@@ -92,14 +106,6 @@ def test_shared_tables_are_computed_once_and_bit_identical_to_baking_each_alone(
         {"name": "diel_exr", **SMALL_DIELECTRIC},
         {"name": "diel_npy", **SMALL_DIELECTRIC, "format": "npy", "dtype": "half"},
     ]
-    computed = []
-    real = batch.compute
-
-    def counting(spec, *a, **k):
-        computed.append(spec.name)
-        return real(spec, *a, **k)
-
-    monkeypatch.setattr(batch, "compute", counting)
     together = tmp_path / "together"
     jobs = batch.schedule(load_configs([write_config(tmp_path / "all.toml", tables)]), together)
     assert batch.run(jobs, workers=2) is None
@@ -128,15 +134,7 @@ def test_shared_tables_are_computed_once_and_bit_identical_to_baking_each_alone(
             assert data == shared[name], name
 
 
-def test_the_values_cache_lays_out_known_values_without_computing_and_never_trusts_a_bad_entry(tmp_path, monkeypatch):
-    computed = []
-    real = batch.compute
-
-    def counting(spec, *a, **k):
-        computed.append(spec.name)
-        return real(spec, *a, **k)
-
-    monkeypatch.setattr(batch, "compute", counting)
+def test_the_values_cache_lays_out_known_values_without_computing_and_never_trusts_a_bad_entry(tmp_path, computed):
     cache_dir = tmp_path / "out" / ".cache"
 
     def run(table: dict, out: Path, cache=True, force=False) -> batch.Job:
