@@ -14,7 +14,7 @@ PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-ee
 WORKERS ?=
 FORCE   ?=
 
-.PHONY: lint luts test validate bench clean venv help figures bench-diffuse bench-ltc bench-cluster
+.PHONY: lint luts test validate bench clean venv help figures bench-diffuse bench-ltc bench-cluster bench-luts
 
 help:
 	@echo "make luts | test | validate | figures | bench | clean"
@@ -30,9 +30,12 @@ $(STAMP): pyproject.toml
 # `make luts` always asks lutbake, which rebakes exactly the tables whose output is missing or whose content
 # hash (config, lutbake version, kernel sources) differs from the file's -- also a table another command
 # overwrote with other settings -- and prints "skipped ... (up to date)" for the others (about a second).
-# `make luts FORCE=1` rebakes every table.
+# `make luts FORCE=1` rebakes every table. Tables that hold the same values (one LTC fit for three engines) are
+# computed once; $(OUT)/.cache keeps each computation's values, so a deleted output or a layout-only change
+# (format, dtype of an ltc or dielectric table) is written again without computing.
 luts: $(STAMP)
 	$(BIN)/lutbake bake $(CONFIGS) $(foreach p,$(PRESETS),--preset $(p)) --out-dir $(OUT) --report $(OUT)/report.json \
+		--cache $(OUT)/.cache \
 		$(if $(WORKERS),--workers $(WORKERS)) $(if $(FORCE),--force)
 
 # every figure lutbake draws, under $(OUT)/figures (the PNGs tracked in docs/figures are not rewritten)
@@ -61,8 +64,10 @@ clean:
 
 # every kind against converged references, C and numpy baselines: outputs/bench/report.json + accuracy_vs_time.png;
 # then the Dask executor (local:2) against the thread executor on the make-luts batch, and a scaling projection:
-# outputs/bench/cluster.json (docs/cluster.md)
+# outputs/bench/cluster.json (docs/cluster.md); first, `make luts` into an empty folder timed (wall, CPU, top ten
+# tables): outputs/bench/luts.json
 bench: $(STAMP)
+	$(BIN)/python benchmarks/bench_luts.py
 	$(BIN)/python benchmarks/bench.py
 	$(BIN)/python benchmarks/bench_dielectric.py
 	$(BIN)/python benchmarks/bench_ltc.py
@@ -71,6 +76,9 @@ bench: $(STAMP)
 # LTC fits (kind ltc): fit time per lobe at 64^2, the straight-port baseline, area-light errors: outputs/bench/ltc.json
 bench-ltc: $(STAMP)
 	$(BIN)/python benchmarks/bench_ltc.py
+
+bench-luts: $(STAMP)
+	$(BIN)/python benchmarks/bench_luts.py
 
 bench-cluster: $(STAMP)
 	$(BIN)/python benchmarks/bench_cluster.py

@@ -3,7 +3,8 @@
     python benchmarks/compare_outputs.py BASELINE_DIR NEW_DIR [--json report.json]
 
 Every file lutbake writes is decoded to a float64 array with readers independent of lutbake's writers
-(OpenImageIO for EXR/PNG, the DDS/KTX2 headers parsed here, numpy for .npy, the C array text for .h);
+(OpenImageIO for EXR/PNG, the DDS/KTX2 headers parsed here (KTX2 Zstandard levels decompressed), numpy for .npy,
+the C array text for .h, every number outside the comments of .js/.cc/.cs);
 metadata (content hash, versions, axes text) is ignored. For each table it prints ``identical`` or the number
 of differing texels, the largest absolute difference and where the differing texels lie (index ranges per
 array dimension).
@@ -20,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-SUFFIXES = (".exr", ".npy", ".png", ".dds", ".ktx2", ".h")
+SUFFIXES = (".exr", ".npy", ".png", ".dds", ".ktx2", ".h", ".js", ".cc", ".cs")
 
 
 def read_exr(path: Path) -> np.ndarray:
@@ -76,9 +77,15 @@ def read_ktx2(path: Path) -> np.ndarray:
     w, h, d = struct.unpack_from("<III", blob, 20)
     fmts = {76: ("<f2", 1), 83: ("<f2", 2), 97: ("<f2", 4), 100: ("<f4", 1), 103: ("<f4", 2), 109: ("<f4", 4)}
     dt, nch = fmts[vk]
-    off = struct.unpack_from("<Q", blob, 80)[0]  # level 0 byteOffset
+    scheme = struct.unpack_from("<I", blob, 44)[0]  # supercompressionScheme: 0 none, 2 Zstandard
+    off, length = struct.unpack_from("<QQ", blob, 80)  # level 0 byteOffset, byteLength
     n = max(d, 1) * max(h, 1) * w * nch
-    return np.frombuffer(blob, dtype=dt, offset=off, count=n).astype(np.float64).reshape(max(d, 1), max(h, 1), w, nch)
+    level = blob[off : off + length]
+    if scheme == 2:
+        import zstandard
+
+        level = zstandard.ZstdDecompressor().decompress(level, max_output_size=n * np.dtype(dt).itemsize)
+    return np.frombuffer(level, dtype=dt, count=n).astype(np.float64).reshape(max(d, 1), max(h, 1), w, nch)
 
 
 def read_h(path: Path) -> np.ndarray:
@@ -92,6 +99,17 @@ def read_h(path: Path) -> np.ndarray:
     return np.array([float(t) for t in tokens], np.float64)
 
 
+NUMBER = re.compile(r"0x[0-9a-fA-F]+|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def read_code(path: Path) -> np.ndarray:
+    """Every number of a source-code table (.js, .cc, .cs) outside its comments, declarations' sizes included (a
+    texel-by-texel comparison of two files of the same layout)."""
+    text = re.sub(r"/\*.*?\*/", "", path.read_text(), flags=re.S)
+    text = "\n".join(line.split("//")[0] for line in text.splitlines())
+    return np.array([int(t, 16) if t.startswith("0x") else float(t) for t in NUMBER.findall(text)], np.float64)
+
+
 def read(path: Path) -> np.ndarray:
     return {
         ".exr": read_exr,
@@ -99,6 +117,9 @@ def read(path: Path) -> np.ndarray:
         ".png": read_png,
         ".dds": read_dds,
         ".ktx2": read_ktx2,
+        ".js": read_code,
+        ".cc": read_code,
+        ".cs": read_code,
         ".h": read_h,
     }[path.suffix](path)
 

@@ -15,6 +15,7 @@ from .errors import TableError
 from .executor import Progress
 from .pipeline import bake_table
 from .table import Table
+from .values_cache import open_cache
 
 __all__ = ["BakeResult", "bake", "bake_table"]
 
@@ -63,6 +64,7 @@ def bake(
     progress: Progress | None = None,
     on_result=None,
     force: bool = False,
+    cache_dir=None,
 ) -> list[BakeResult]:
     """Validate every config, then bake each table and write ``out_dir/<name>.<ext>`` (key ``format``, default
     EXR) atomically; a table whose output is up to date (same content hash, lutbake.provenance) is skipped unless
@@ -70,6 +72,7 @@ def bake(
 
     ``configs``: paths to TOML files, or TableSpecs. Nothing runs unless every config is valid. A table that
     fails raises TableError (after the other tables finished). ``on_result(BakeResult)`` is called as each ends.
+    ``cache_dir``: the values cache of ``lutbake bake --cache`` (lutbake.values_cache; ``force`` reads no entry).
     """
     specs = [c for c in configs if isinstance(c, TableSpec)]
     paths = [c for c in configs if not isinstance(c, TableSpec)]
@@ -96,7 +99,7 @@ def bake(
     for job in jobs:
         if job.status == "skipped":
             done(job)
-    signum = batch.run(jobs, workers, device, progress, on_done=done)
+    signum = batch.run(jobs, workers, device, progress, on_done=done, cache=open_cache(cache_dir, force))
     if signum is not None:
         raise KeyboardInterrupt(batch.signal_name(signum))
     failed = [j for j in jobs if j.status == "failed"]

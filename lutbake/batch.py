@@ -7,7 +7,10 @@
 - **Run.** ``run()`` bakes the pending tables on a small thread pool (tables in parallel, each on the
   tile executor; the result is bit-identical for any worker count). One failing table (a NaN, an
   exception in a kernel, a MemoryError) is marked ``failed`` and does not stop the others. Each table goes
-  through lutbake.pipeline.bake_table, as in the Python API (lutbake.api.bake is schedule + run).
+  through lutbake.pipeline (compute, assemble), as in the Python API (lutbake.api.bake is schedule + run).
+- **Compute once, write many.** Pending tables with the same values key (lutbake.sharing: same kind and options
+  but for name and the kind's layout keys, e.g. one LTC fit written as DDS, JS and C) are computed once and
+  written each in its own layout; the files are those each table gets baked alone.
 - **Interrupts.** A KeyboardInterrupt (SIGINT) or ``Interrupted`` (raised by the SIGTERM handler of
   ``signal_handlers()``) while the main thread waits cancels every table that has not written its
   file: those are marked ``interrupted``; finished files stay. Writes are atomic (io.exr.write_exr),
@@ -34,8 +37,11 @@ from .executor import Cancelled, Progress, default_workers
 from .io.atomic import atomic_write_bytes, remove_stale_temps
 from .io.formats import output_path, write_table
 from .io.oserror import os_error_text
-from .pipeline import bake_table
+from .kinds import lookup_kind
+from .pipeline import Computed, assemble, compute
 from .provenance import HASH_ATTRIBUTE, content_hash, read_header, sources_digest
+from .sharing import group_by, values_key
+from .values_cache import ValuesCache
 
 STATUSES = ("baked", "skipped", "failed", "interrupted")
 EXIT_OK, EXIT_FAILED, EXIT_SIGINT, EXIT_SIGTERM = 0, 1, 130, 143
@@ -56,8 +62,11 @@ class Job:
     spec: TableSpec
     path: Path
     content_hash: str
+    values_key: str = ""  # lutbake.sharing.values_key: pending jobs with the same key are computed once
     status: str = "pending"  # then one of STATUSES
     seconds: float | None = None
+    cpu_seconds: float | None = None  # CPU of its computation (0 when its values came from ``values_from``)
+    values_from: str | None = None  # the table whose computation this one's values came from (same values key)
     samples: int | None = None
     error_estimate: float | None = None
     message: str = ""
@@ -75,6 +84,8 @@ class Job:
             "path": str(self.path),
             "content_hash": self.content_hash,
             "seconds": self.seconds,
+            "cpu_seconds": self.cpu_seconds,
+            "values_from": self.values_from,
             "samples": self.samples,
             "error_estimate": self.error_estimate,
             "message": self.message,
@@ -94,7 +105,8 @@ def schedule(specs: list[TableSpec], out_dir, force: bool = False) -> list[Job]:
     digest = sources_digest()
     jobs = []
     for spec in specs:
-        job = Job(spec, output_path(out_dir, spec.name, spec.options.get("format", "exr")), content_hash(spec, digest))
+        path = output_path(out_dir, spec.name, spec.options.get("format", "exr"))
+        job = Job(spec, path, content_hash(spec, digest), values_key(spec, digest))
         header = None if force else read_header(job.path)
         if header is not None and header.get(HASH_ATTRIBUTE) == job.content_hash:
             job.status = "skipped"
@@ -106,14 +118,88 @@ def schedule(specs: list[TableSpec], out_dir, force: bool = False) -> list[Job]:
     return jobs
 
 
-def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.Event) -> Job:
-    """Bake and write one table; any failure is recorded on the job, never raised."""
+def _record_failure(job: Job, e: Exception, needed: int = 0) -> None:
+    """Mark ``job`` interrupted (executor.Cancelled) or failed, with a message that says why."""
+    if isinstance(e, Cancelled):
+        job.status, job.message = "interrupted", "interrupted before its file was written; nothing written"
+    elif isinstance(e, MemoryError):
+        job.status = "failed"
+        job.message = (
+            f"{job.spec.source}: table '{job.name}': out of memory{': ' + str(e) if str(e) else ''}; nothing written"
+        )
+    elif isinstance(e, LutbakeError):
+        job.status, job.message = "failed", str(e)
+    elif isinstance(e, OSError):  # the output could not be written: say why (a full disk, a read-only mount ...)
+        job.status = "failed"
+        job.message = (
+            f"{job.spec.source}: table '{job.name}': cannot write {job.path}: "
+            f"{os_error_text(e, job.path.parent, needed)}; the next run bakes it again"
+        )
+    else:  # a kernel error, an I/O error, anything: this table fails, the others go on
+        job.status = "failed"
+        job.message = f"{job.spec.source}: table '{job.name}': {type(e).__name__}: {e}; nothing written"
+
+
+def _cached(cache: ValuesCache | None, job: Job) -> Computed | None:
+    """``job``'s values from the cache (lutbake.values_cache), with its plan; None on a miss."""
+    entry = cache.load(job.values_key) if cache is not None else None
+    if entry is None:
+        return None
+    t0 = time.thread_time()
+    plan = lookup_kind(job.spec.kind).plan(job.spec)
+    if plan.shape != entry[0].shape:
+        return None
+    return Computed(plan, entry[0], entry[1], 0.0, time.thread_time() - t0)
+
+
+def _store(cache: ValuesCache | None, job: Job, computed: Computed) -> None:
+    """Write ``job``'s values into the cache; a cache that cannot be written only loses its use (said in the
+    job's message), never the table."""
+    if cache is None:
+        return
+    try:
+        cache.store(job.values_key, computed.data, computed.extra)
+    except OSError as e:
+        job.message = f"values cache not written: {os_error_text(e, cache.directory, computed.data.nbytes)}"
+
+
+def _bake_group(
+    group: list[Job], workers: int, device: str, progress, cancel: threading.Event, cache: ValuesCache | None = None
+) -> list[Job]:
+    """Compute the values of ``group`` (pending jobs with one values key, lutbake.sharing) once, or take them from
+    ``cache``, then assemble and write each job's table in its own layout; any failure is recorded on the jobs
+    it concerns, never raised."""
+    lead = group[0]
+    t0 = time.perf_counter()
+    try:
+        if cancel.is_set():
+            raise Cancelled(lead.name)
+        computed = _cached(cache, lead)
+        origin = "cache" if computed is not None else None
+        if computed is None:
+            computed = compute(lead.spec, workers, device, progress, cancel=cancel)
+            _store(cache, lead, computed)
+    except Exception as e:  # every table of the group lacks its values
+        for job in group:
+            _record_failure(job, e)
+            if job is not lead and job.status == "failed":
+                job.message = f"its values are computed with table '{lead.name}', which failed: {job.message}"
+            job.seconds = time.perf_counter() - t0
+        return group
+    for job in group:
+        _write_one(job, computed, lead.name if job is not lead else origin, cancel)
+    return group
+
+
+def _write_one(job: Job, computed: Computed, values_from: str | None, cancel: threading.Event) -> None:
+    """Assemble ``job``'s table from ``computed`` (its group's values: computed for this job, for the job named
+    ``values_from``, or taken from the cache: ``values_from`` = "cache") and write it."""
     t0 = time.perf_counter()
     needed = 0
     try:
         if cancel.is_set():
             raise Cancelled(job.name)
-        table, seconds, samples = bake_table(job.spec, workers, device, progress, cancel=cancel)
+        table = assemble(job.spec, computed)
         needed = table.data.nbytes
         if table.attributes.get(HASH_ATTRIBUTE) != job.content_hash:  # sources changed under a running batch
             raise RuntimeError("the lutbake sources changed while the batch ran; run it again")
@@ -125,31 +211,17 @@ def _bake_one(job: Job, workers: int, device: str, progress, cancel: threading.E
             job.spec.options.get("format", "exr"),
             dtype=job.spec.options.get("dtype", "float32"),
         )
-    except Cancelled:
-        job.status, job.message = "interrupted", "interrupted before its file was written; nothing written"
-    except MemoryError as e:
-        job.status = "failed"
-        job.message = (
-            f"{job.spec.source}: table '{job.name}': out of memory{': ' + str(e) if str(e) else ''}; nothing written"
-        )
-    except LutbakeError as e:
-        job.status, job.message = "failed", str(e)
-    except OSError as e:  # the output could not be written: say why (a full disk, a read-only mount ...)
-        job.status = "failed"
-        job.message = (
-            f"{job.spec.source}: table '{job.name}': cannot write {job.path}: "
-            f"{os_error_text(e, job.path.parent, needed)}; the next run bakes it again"
-        )
-    except Exception as e:  # a kernel error, an I/O error, anything: this table fails, the others go on
-        job.status = "failed"
-        job.message = f"{job.spec.source}: table '{job.name}': {type(e).__name__}: {e}; nothing written"
-    else:
-        job.status, job.seconds, job.samples, job.table = "baked", seconds, samples, table
-        job.error_estimate = _float_or_none(table.attributes.get("error_estimate"))
-        job.shape = "x".join(str(a.count) for a in table.axes) + f"x{len(table.channels)}"
-        return job
-    job.seconds = time.perf_counter() - t0
-    return job
+    except Exception as e:
+        _record_failure(job, e, needed)
+        job.seconds = time.perf_counter() - t0
+        return
+    shared = values_from is not None and values_from != "cache"
+    job.status, job.samples, job.table = "baked", computed.plan.samples, table
+    job.seconds = 0.0 if shared else computed.seconds
+    job.cpu_seconds = 0.0 if shared else computed.cpu_seconds
+    job.values_from = values_from
+    job.error_estimate = _float_or_none(table.attributes.get("error_estimate"))
+    job.shape = "x".join(str(a.count) for a in table.axes) + f"x{len(table.channels)}"
 
 
 def run(
@@ -159,14 +231,17 @@ def run(
     progress: Progress | None = None,
     on_done: Callable[[Job], None] | None = None,
     poll: float = 0.2,
+    cache: ValuesCache | None = None,
 ) -> int | None:
     """Bake every ``pending`` job; ``on_done(job)`` is called in the calling thread as each finishes.
 
-    Tables run on min(workers, pending) threads, each on the tile executor with ``workers`` tile threads:
+    Pending jobs with one values key (lutbake.sharing) form a group, computed once and written per job.
+    Groups run on min(workers, groups) threads, each on the tile executor with ``workers`` tile threads:
     a big table keeps every core busy after the small ones are done (the OS shares the cores while
     several tables run; the result is bit-identical either way).
     Returns None, or the signal number if the run was interrupted (the unfinished jobs are then marked
     ``interrupted``; finished files are kept). ``progress``: lutbake.executor.Progress, per table.
+    ``cache``: lutbake.values_cache.ValuesCache, whose entries of other sources are pruned first.
     """
     workers = workers or default_workers()
     for d in sorted({j.path.parent for j in jobs}):
@@ -174,7 +249,10 @@ def run(
     pending = [j for j in jobs if j.status == "pending"]
     if not pending:
         return None
-    threads = max(1, min(workers, len(pending)))
+    if cache is not None:
+        cache.prune()
+    groups = group_by(pending, lambda j: j.values_key)
+    threads = max(1, min(workers, len(groups)))
     per_table = workers
     cancel = threading.Event()
     pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="lutbake-table")
@@ -182,15 +260,16 @@ def run(
     signum = None
     reported: set = set()
     try:
-        for j in pending:
-            futures[pool.submit(_bake_one, j, per_table, device, progress, cancel)] = j
+        for g in groups:
+            futures[pool.submit(_bake_group, g, per_table, device, progress, cancel, cache)] = g
         remaining = set(futures)
         while remaining:
             done, remaining = wait(remaining, timeout=poll, return_when=FIRST_COMPLETED)
             for f in done:
                 reported.add(f)
-                if on_done:
-                    on_done(f.result())
+                for j in f.result():
+                    if on_done:
+                        on_done(j)
     except (KeyboardInterrupt, Interrupted) as e:
         signum = getattr(e, "signum", int(signal.SIGINT))
         cancel.set()
@@ -202,9 +281,10 @@ def run(
         for j in pending:
             if j.status == "pending":  # cancelled before it started
                 j.status, j.message = "interrupted", "not started; nothing written"
-        for f, j in futures.items():
+        for f, g in futures.items():
             if f not in reported and on_done:
-                on_done(j)
+                for j in g:
+                    on_done(j)
     return signum
 
 

@@ -71,6 +71,15 @@ def main(verbose):
 @click.option("--progress/--no-progress", default=None, help="Progress bar (default: on a terminal, for long bakes).")
 @click.option("--force", is_flag=True, help="Rebake every table, even those whose output is up to date.")
 @click.option(
+    "--cache",
+    "cache_dir",
+    type=click.Path(path_type=Path, file_okay=False),
+    default=None,
+    metavar="DIR",
+    help="Keep each computation's values in DIR (content-addressed) and lay out again from there, without "
+    "computing, any table whose values are known (make luts: <out-dir>/.cache). --force reads no entry.",
+)
+@click.option(
     "--report",
     type=click.Path(path_type=Path, dir_okay=False),
     default=None,
@@ -91,7 +100,7 @@ def main(verbose):
     default=None,
     help="Output format of every table (same as --set format=...; default: each table's `format`, exr).",
 )
-def bake(configs, presets, out_dir, overrides, workers, device, progress, force, report, scheduler, fmt):
+def bake(configs, presets, out_dir, overrides, workers, device, progress, force, cache_dir, report, scheduler, fmt):
     """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.<ext> (EXR unless `format` / --format says otherwise).
 
     All configs are validated before any kernel runs; a bad config exits with status 2 and writes
@@ -120,6 +129,7 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     from .config import load_configs, preset_path
     from .errors import ConfigError, LutbakeError
     from .textsafe import escape_controls
+    from .values_cache import open_cache
 
     try:
         paths = [preset_path(p) for p in presets] + list(configs)
@@ -152,6 +162,8 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     def on_done(job):
         if job.status == "baked":
             note = samples_note(job.spec, job.samples)
+            if job.values_from is not None:
+                note = "; ".join(filter(None, (note, f"values computed once with {job.values_from}")))
             click.echo(
                 f"{escape_controls(str(job.path))}  {job.shape}  {job.seconds:.2f} s  {job.samples} samples/texel"
                 + (f" ({note})" if note else "")
@@ -174,7 +186,14 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
                     click.echo(f"error: {escape_controls(str(e))}", err=True)
                     sys.exit(EXIT_CONFIG)
                 workers = pending  # every table in flight: the client's threads only wait for tiles
-            signum = batch.run(jobs, workers, device, progress_bars if bars else None, on_done=on_done)
+            signum = batch.run(
+                jobs,
+                workers,
+                device,
+                progress_bars if bars else None,
+                on_done=on_done,
+                cache=open_cache(cache_dir, force),
+            )
     except (KeyboardInterrupt, batch.Interrupted) as e:  # a second Ctrl-C while tables wind down
         signum = getattr(e, "signum", 2)
         for job in jobs:

@@ -50,6 +50,7 @@ def execute_tiles(
     label: str = "",
     cancel: threading.Event | None = None,
     spec=None,
+    cpu: list[float] | None = None,
 ) -> np.ndarray:
     """Evaluate every tile of ``plan``; returns float64 (n_texels, plan.tile_width): the values, then the aux
     columns (lutbake.sampling.plan.TexelPlan.aux_channels).
@@ -58,7 +59,8 @@ def execute_tiles(
     ``cancel``: when set (by another thread), no further tile starts and Cancelled is raised.
     ``spec``: the TableSpec ``plan`` came from; inside a lutbake.cluster session the tiles run on the
     cluster's workers instead (as tasks of (spec, tile range)). Tiles are TILE_TEXELS on the CPU, device-sized
-    on CUDA (lutbake.devices)."""
+    on CUDA (lutbake.devices). ``cpu``: a list that receives the CPU seconds of the kernels' preparation and of
+    each tile, each measured in the thread that ran it (time.thread_time; not for tiles run on a cluster)."""
     from . import cluster
     from .devices import plan_tile_texels
 
@@ -66,8 +68,11 @@ def execute_tiles(
     if remote is not None:
         return remote.execute(spec, plan, device, progress=progress, label=label, cancel=cancel)
     workers = workers or default_workers()
+    cpu = cpu if cpu is not None else []
     with _PREPARE_LOCK:
+        t0 = time.thread_time()
         plan.prepare(device)
+        cpu.append(time.thread_time() - t0)
     parts = tiles(plan.n_texels, plan_tile_texels(plan, device))
     out = np.empty((plan.n_texels, plan.tile_width), dtype=np.float64)
     update = progress(label, plan.n_texels, plan.cost) if progress is not None else None
@@ -76,7 +81,9 @@ def execute_tiles(
         s, e = bounds
         if cancel is not None and cancel.is_set():
             raise Cancelled(label)
+        t0 = time.thread_time()
         out[s:e] = plan.run_tile(s, e, device)
+        cpu.append(time.thread_time() - t0)
         return e - s
 
     if workers == 1 or device != "cpu":

@@ -2,10 +2,16 @@
 
     spec (lutbake.config) -> lutbake.kinds.<kind>.plan = per_texel_plan(integrand, estimator, grid)
          -> lutbake.executor.execute -> finite check -> lutbake.table.Table (lutbake.provenance.attributes)
-The batch (lutbake.batch) and the Python API (lutbake.api) both bake through ``bake_table``; writing is theirs.
+``compute`` runs everything up to the values (plan, tiles, finite check, error estimate); ``assemble`` makes the
+Table of one spec from them (name, config, content hash). ``bake_table`` is both. The batch (lutbake.batch) computes
+once per distinct values key (lutbake.sharing) and assembles per table; the batch and the Python API (lutbake.api)
+write.
 """
 
 from __future__ import annotations
+
+import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -14,19 +20,37 @@ from .errors import TableError
 from .executor import Progress, Timer, estimate_error, execute_tiles
 from .kinds import lookup_kind
 from .provenance import attributes
+from .sampling.plan import TexelPlan
 from .table import Table
 
 
-def bake_table(
+@dataclass
+class Computed:
+    """What ``compute`` made of a spec: its plan, the float64 values (plan.shape), the attributes known only after
+    the bake (error estimate, plan.attributes_after), the tiles' wall seconds, and the CPU seconds of the whole
+    computation in this process, every thread's share (in a lutbake.cluster session the workers' are not counted)."""
+
+    plan: TexelPlan
+    data: np.ndarray
+    extra: dict[str, str]
+    seconds: float
+    cpu_seconds: float
+
+
+def compute(
     spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: Progress | None = None, cancel=None
-) -> tuple[Table, float, int]:
-    """Bake one spec into a Table (nothing written): (table, seconds, samples per texel). Raises TableError if a
-    value is not finite; executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
+) -> Computed:
+    """The values of ``spec``'s table (nothing written). Raises TableError if a value is not finite;
+    executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
+    cpu: list[float] = []  # CPU seconds of each part, measured in the thread that ran it (time.thread_time)
+    t0 = time.thread_time()
     plan = lookup_kind(spec.kind).plan(spec)
+    cpu.append(time.thread_time() - t0)
     with Timer() as t:
         full = execute_tiles(
-            plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel, spec=spec
+            plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel, spec=spec, cpu=cpu
         )
+    t0 = time.thread_time()
     data = full[:, : plan.n_channels].reshape(plan.shape)
     if not np.all(np.isfinite(data)):
         bad = int(np.size(data) - np.count_nonzero(np.isfinite(data)))
@@ -38,13 +62,29 @@ def bake_table(
         extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)
     if plan.attributes_after is not None:
         extra.update(plan.attributes_after(data))
-    table = Table(
+    cpu.append(time.thread_time() - t0)
+    return Computed(plan, data, extra, t.seconds, sum(cpu))
+
+
+def assemble(spec: TableSpec, computed: Computed) -> Table:
+    """The Table of ``spec`` from ``computed`` (``spec``'s own values, or those of a spec with the same
+    lutbake.sharing.values_key): the values with ``spec``'s name and provenance."""
+    plan = computed.plan
+    return Table(
         spec.name,
         spec.kind,
-        data.astype(np.float32),
+        computed.data.astype(np.float32),
         plan.axes,
         plan.channels,
         plan.reconstruction,
-        attributes(spec, plan, extra),
+        attributes(spec, plan, computed.extra),
     )
-    return table, t.seconds, plan.samples
+
+
+def bake_table(
+    spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: Progress | None = None, cancel=None
+) -> tuple[Table, float, int]:
+    """Bake one spec into a Table (nothing written): (table, seconds, samples per texel). Raises TableError if a
+    value is not finite; executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
+    c = compute(spec, workers, device, progress, cancel)
+    return assemble(spec, c), c.seconds, c.plan.samples

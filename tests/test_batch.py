@@ -158,7 +158,8 @@ def _sabotage(monkeypatch, how):
 
 
 def test_one_failing_table_does_not_stop_the_others(monkeypatch, tmp_path):
-    cfg = write_config(tmp_path, table("boom"), table("good"), table("nan"), table("oom"), table("fine"))
+    # distinct seeds: tables that differ only in name would share one computation (lutbake.sharing)
+    cfg = write_config(tmp_path, *[table(n, seed=i) for i, n in enumerate(("boom", "good", "nan", "oom", "fine"))])
     out = tmp_path / "out"
     _sabotage(monkeypatch, {"boom": "raise", "nan": "nan", "oom": "oom"})
     rep = tmp_path / "report.json"
@@ -189,19 +190,21 @@ def test_report_has_every_field(three):
     assert r.exit_code == 0
     doc = json.loads(rep.read_text())
     assert doc["counts"] == {"baked": 1, "skipped": 3, "failed": 0, "interrupted": 0}
-    keys = {"name", "status", "path", "content_hash", "seconds", "samples", "error_estimate", "message"}
+    keys = {"name", "status", "path", "content_hash", "seconds", "cpu_seconds", "values_from", "samples"}
+    keys |= {"error_estimate", "message"}
     for t in doc["tables"]:
         assert set(t) == keys
         assert Path(t["path"]).is_file() and len(t["content_hash"]) == 64
         assert t["samples"] in (48, 64) and t["error_estimate"] >= 0 and t["seconds"] >= 0
     assert [t["status"] for t in doc["tables"]] == ["skipped", "skipped", "skipped", "baked"]
+    assert doc["tables"][-1]["cpu_seconds"] > 0 and doc["tables"][-1]["values_from"] is None
 
 
 @pytest.mark.parametrize("signum, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
 def test_interrupt_keeps_finished_tables_and_writes_no_unfinished_one(
     monkeypatch, tmp_path, signum, code, terminal_sigint
 ):
-    cfg = write_config(tmp_path, table("first"), table("slow", size=[64, 32]), table("last"))
+    cfg = write_config(tmp_path, table("first"), table("slow", size=[64, 32]), table("last", seed=1))  # not shared
     out = tmp_path / "out"
     out.mkdir()
     stale = out / "slow.exr"

@@ -163,7 +163,8 @@ def test_cluster_bake_is_bit_identical_to_the_thread_executor(runner):
 def test_a_killed_worker_costs_only_its_tiles(client, tmp_path):
     """SIGKILL one worker process when the first tile arrives: Dask runs its tiles again on the other
     worker, every table is baked, the files equal an undisturbed thread-executor bake."""
-    specs = [spec(f"k{i}", kind="dfg", size=[64, 64], samples=768) for i in range(3)]
+    # distinct seeds: tables that differ only in name would share one computation (lutbake.sharing)
+    specs = [spec(f"k{i}", kind="dfg", size=[64, 64], samples=768, seed=i) for i in range(3)]
     per_table = -(-64 * 64 // TILE)
     ref = thread_bake(specs, tmp_path / "ref")
     r = cluster.DaskRunner(client, name="test cluster")

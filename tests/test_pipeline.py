@@ -185,7 +185,8 @@ LAYERS = [
     {"integrands", "ltc"},
     {"kinds", "value_bounds"},
     {"config", "preflight"},
-    {"executor", "provenance", "devices", "cluster", "cluster_probe"},  # cluster: the executor's Dask counterpart
+    # cluster: the executor's Dask counterpart
+    {"executor", "provenance", "sharing", "values_cache", "devices", "cluster", "cluster_probe"},
     {"pipeline"},
     {"batch"},
     {"api"},

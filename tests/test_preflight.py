@@ -40,7 +40,7 @@ def no_kernel(monkeypatch):
     def boom(*a, **k):
         raise AssertionError("a kernel ran before the error")
 
-    monkeypatch.setattr(batch, "bake_table", boom)
+    monkeypatch.setattr(batch, "compute", boom)
 
 
 def refused(r, *fragments):

@@ -43,6 +43,10 @@ class Kind:
     check: Callable[[Any], str | tuple[str, str] | None] | None = None
     texels: Callable[[Any], int] = lambda o: math.prod(o.get("size", [1]))  # texel count, for config.MAX_TEXELS
     texels_doc: str = "size"  # the keys whose product ``texels`` is, for the error message
+    # keys (besides ``name``) that choose only how a computed table is written, never its values: specs differing
+    # only in these share one computation in a batch (lutbake.sharing). Not format / dtype where the storage's
+    # default tolerance (lutbake.tolerance) steers the estimator.
+    layout_keys: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -106,9 +110,12 @@ def declare(
     aliases: tuple[str, ...] = (),
     check=None,
     texels=None,
+    layout_keys: tuple[str, ...] = (),
 ) -> Kind:
     """A Kind with the common keys (``common_keys``) followed by its own ``keys``. ``texels(options)``: the texel
-    count (default: the product of ``size``); its docstring names the keys it multiplies (for the error message)."""
+    count (default: the product of ``size``); its docstring names the keys it multiplies (for the error message).
+    ``layout_keys``: Kind.layout_keys."""
+    all_keys = {**common_keys(estimation), **keys}
     if texels is None:
-        return Kind(name, description, {**common_keys(estimation), **keys}, plan, aliases, check)
-    return Kind(name, description, {**common_keys(estimation), **keys}, plan, aliases, check, texels, texels.__doc__)
+        return Kind(name, description, all_keys, plan, aliases, check, layout_keys=layout_keys)
+    return Kind(name, description, all_keys, plan, aliases, check, texels, texels.__doc__, layout_keys)

@@ -46,6 +46,7 @@ EEVEE_SIZE = (16, 64, 64)  # UTIL_BTDF_LAYER_COUNT roughness layers x UTIL_TEX_S
 EEVEE_CLAMP = (1.0e-4, 0.9999)  # eevee_lut_comp.glsl: NoV, f0-like x^2 (btdf) and eta (bsdf) clamps
 OPENPBR_SIZE = 32  # OpenPBR_EnergyTableSize
 OPENPBR_IOR_MAX = 2.5  # OpenPBR_IorMax
+LAYOUT_KEYS = ("format", "dtype")  # fixed-order quadrature, no storage-derived tolerance: values never depend on them
 
 LAYOUTS = {
     "energy": "R = E_R, G = E_T, B = E_R + E_T over NoV x roughness x IOR (exact Fresnel)",
@@ -397,7 +398,8 @@ def plan_avg(spec) -> TexelPlan:
     integrand = dielectric_integrand(nd, mk, "exact_metal")
     estimator = estimator_for(o["estimator"], o["samples"], o["seed"])
     order = o["mu_order"]
-    nodes = [mu_panels(float(x), order) for x in eta]
+    per_eta = {e: mu_panels(e, order) for e in map(float, np.unique(eta))}  # one rule per IOR row, not per texel
+    nodes = [per_eta[float(x)] for x in eta]
     counts = np.array([len(m) for m, _ in nodes])
     grid = Grid(axes, {"alpha": alpha}, alpha=np.asarray(alpha, np.float64))
 
@@ -505,6 +507,7 @@ DIELECTRIC = declare(
     aliases=("glass", "btdf"),
     check=check_spec,
     texels=texel_count,
+    layout_keys=LAYOUT_KEYS,
 )
 DIELECTRIC_AVG = declare(
     "dielectric_avg",
@@ -515,4 +518,5 @@ DIELECTRIC_AVG = declare(
     aliases=("glass_avg",),
     check=check_spec,
     texels=avg_texel_count,
+    layout_keys=LAYOUT_KEYS,
 )

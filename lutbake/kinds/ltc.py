@@ -343,4 +343,5 @@ LTC = declare(
     aliases=("ltc_fit",),
     check=check_spec,
     texels=texel_count,
+    layout_keys=("format", "dtype"),  # the fit reads neither (no storage-derived tolerance): engine layouts share it
 )
