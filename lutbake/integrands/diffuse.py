@@ -42,6 +42,8 @@ DIFFUSE_MODELS = {
     "fitted": "Gotanda's fitted microfacet diffuse, Eq. 8 (course-notes reading)",
     "fitted_slides": "Eq. 8 with the slides' reading of F_r's second factor",
     "microfacet": "the microfacet diffuse model, Eq. 4, integrated over m (GGX, height-correlated Smith)",
+    "eon": "energy-preserving Oren-Nayar (Portsmouth et al. 2024, OpenPBR's diffuse), sigma = its roughness r; "
+    "E = 1 for rho = 1 (exact-albedo variant)",
 }
 
 
@@ -50,7 +52,7 @@ F0_NONE = "none: f0 does not factor out; the table holds E at the baked f0 only 
 
 def f0_factor(model: str, facet_fresnel: str) -> str:
     """How f0 enters a model: every model here is g(f0) times an f0-free function."""
-    if model in ("lambert", "oren_nayar", "oren_nayar_improved"):
+    if model in ("lambert", "oren_nayar", "oren_nayar_improved", "eon"):
         return "1"
     if model == "microfacet" and facet_fresnel == "schlick":
         return "(1 - f0)^2"
@@ -73,6 +75,7 @@ CLOSED_FORMS = {  # model -> (Fd_ term, whether it takes f0)
     "oren_nayar_fresnel": (diffuse.Fd_oren_nayar_fresnel, True),
     "fitted": (diffuse.Fd_gotanda_fitted, True),
     "fitted_slides": (diffuse.Fd_gotanda_fitted_slides, True),
+    "eon": (diffuse.Fd_eon, False),
 }
 
 
