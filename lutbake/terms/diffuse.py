@@ -173,7 +173,8 @@ EON_EPS = wp.constant(1.0e-7)  # the paper's floor on 1 - E in the multiple-scat
 
 @wp.func
 def A_fon(r: float):
-    """A_F = 1 / (1 + (1/2 - 2/(3 pi)) r): the Fujii Oren-Nayar (FON) constant term (EON paper's listing, f_EON); B_F = r A_F."""
+    """A_F = 1 / (1 + (1/2 - 2/(3 pi)) r): the Fujii Oren-Nayar (FON) constant term (EON paper's listing, f_EON);
+    B_F = r A_F."""
     return 1.0 / (1.0 + FON_C1 * r)
 
 
@@ -192,7 +193,8 @@ def E_fon(mu: float, r: float):
 
 @wp.func
 def E_fon_avg(r: float):
-    """Cosine-weighted average of E_fon over the hemisphere, A_F (1 + (2/3 - 28/(15 pi)) r) (EON paper's listing, avgEF in f_EON)."""
+    """Cosine-weighted average of E_fon over the hemisphere, A_F (1 + (2/3 - 28/(15 pi)) r) (EON paper's listing,
+    avgEF in f_EON)."""
     return A_fon(r) * (1.0 + FON_C2 * r)
 
 
@@ -211,7 +213,8 @@ def Fd_fon(rho: float, NoL: float, NoV: float, LoV: float, r: float):
 
 @wp.func
 def Fd_eon_multiple(rho: float, NoL: float, NoV: float, r: float):
-    """EON's multiple-scattering lobe (EON paper's listing, f_ms in f_EON): rho_ms/pi (1 - E_F(n.l))(1 - E_F(n.v)) / (1 - E_avg),
+    """EON's multiple-scattering lobe (EON paper's listing, f_ms in f_EON):
+    rho_ms/pi (1 - E_F(n.l))(1 - E_F(n.v)) / (1 - E_avg),
     rho_ms = rho^2 E_avg / (1 - rho (1 - E_avg)), each 1 - E floored at 1e-7 as the paper's listing.
     Its albedo is rho_ms (1 - E_F(n.v)), so E_EON = rho E_F + rho_ms (1 - E_F): 1 for rho = 1."""
     if NoL <= COS_EPS or NoV <= COS_EPS:
@@ -225,7 +228,8 @@ def Fd_eon_multiple(rho: float, NoL: float, NoV: float, r: float):
 
 @wp.func
 def Fd_eon(rho: float, NoL: float, NoV: float, LoV: float, r: float):
-    """Energy-preserving Oren-Nayar (EON paper's listing, f_EON with exact = true; OpenPBR's diffuse BRDF), the exact-albedo variant:
+    """Energy-preserving Oren-Nayar (EON paper's listing, f_EON with exact = true; OpenPBR's diffuse BRDF), the
+    exact-albedo variant:
     f = Fd_fon + Fd_eon_multiple. Reciprocal; r = 0: Lambert (plus 1e-7 / pi from the paper's floors);
     0 when NoL or NoV <= COS_EPS. (adobe/openpbr-bsdf evaluates E_F by the paper's polynomial fit, E_FON_approx.)"""
     return Fd_fon(rho, NoL, NoV, LoV, r) + Fd_eon_multiple(rho, NoL, NoV, r)
