@@ -248,6 +248,7 @@ class LtcBake:
         return out
 
 
+FREE_FRAME = " turned about y by a fitted angle d (4 parameters: every LTC of a lobe symmetric about the xz-plane)"
 ROUGHNESS_AXES = {
     "perceptual": "x = perceptual roughness r, NDF alpha = r^2 (ltc_code)",
     "alpha": "x = alpha (the lobe's own parameter: charlie's sheenRoughness)",
@@ -315,15 +316,17 @@ def plan(spec) -> TexelPlan:
         else "none (fresnel channel = magnitude)",
         "layout": "ltc_code (selfshadow/ltc_code fit/fitLTC.cpp packTab)",
     }
+    q_tail = ", d" if lb.free_frame else ""
     extra = {
         "ltc_fit": json.dumps(
             {
-                "parametrisation": "M = [X Y Z] [[m11, 0, m13], [0, m22, 0], [0, 0, 1]], Z = lobe's average direction",
+                "parametrisation": "M = [X Y Z] [[m11, 0, m13], [0, m22, 0], [0, 0, 1]], Z = lobe's average direction"
+                + (FREE_FRAME if lb.free_frame else " (ltc_code's 3 parameters)"),
                 "metric": "Heitz et al. 2016 L3 distance, MIS over lobe and LTC samples (ltc_code computeError)",
                 "fit_samples": f"{o['fit_samples']} x {o['fit_samples']} per technique",
                 "optimiser": f"Nelder-Mead (ltc_code nelder_mead.h), tol {fit.NELDER_MEAD_TOL}, "
                 f"<= {fit.NELDER_MEAD_ITERS} iterations per restart, simplex sizes {list(fit.COARSE_STEPS)} "
-                f"(coarse pass), {list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11)",
+                f"(coarse pass), {list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11{q_tail})",
                 "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses; each texel starts "
                 "from the best of the analytic guesses and the surrounding coarse fits (no chaining)",
                 "alpha_min": o["alpha_min"],

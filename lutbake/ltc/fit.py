@@ -228,6 +228,7 @@ class Problem:
         self.f3 = np.sum(f * f * w, axis=1) / s
         self.frame_z = self._frames(np.einsum("ts,tsk->tk", w, self._ldir.numpy()))
         self.evaluations = 0
+        self.dof = 4 if lb.free_frame else 3  # q's length (matrices)
 
     def _frames(self, avg: np.ndarray) -> np.ndarray:
         """Z = normalize(average direction with y cleared); (0, 0, 1) at normal incidence (ltc_code fitTab)."""
@@ -241,7 +242,9 @@ class Problem:
         return z
 
     def matrices(self, texel: np.ndarray, q: np.ndarray) -> np.ndarray:
-        """M = [X Y Z] * [[m11, 0, m13], [0, m22, 0], [0, 0, 1]] for q = (log m11, log m22, m13 / m11)."""
+        """M = [X Y Z] * [[m11, 0, m13], [0, m22, 0], [0, 0, 1]] for q = (log m11, log m22, m13 / m11) (``dof`` 3,
+        ltc_code's); with ``dof`` 4, q[:, 3] = d, the frame Z turned by d radians about y from the lobe's average
+        direction (every M of a lobe symmetric about the xz-plane, up to scale, is of this form)."""
         m11 = np.maximum(np.exp(q[:, 0]), M_MIN)
         m22 = np.maximum(np.exp(q[:, 1]), M_MIN)
         m13 = q[:, 2] * m11
@@ -249,6 +252,10 @@ class Problem:
         m22 = np.where(iso, m11, m22)
         m13 = np.where(iso, 0.0, m13)
         z = self.frame_z[texel]
+        if q.shape[1] > 3:
+            d = np.where(iso, 0.0, q[:, 3])
+            c, s = np.cos(d), np.sin(d)
+            z = np.stack([c * z[:, 0] + s * z[:, 2], z[:, 1], c * z[:, 2] - s * z[:, 0]], axis=1)
         k = len(texel)
         R = np.zeros((k, 3, 3))
         R[:, :, 2] = z
@@ -373,16 +380,17 @@ def nelder_mead(
 
 def analytic_guesses(problem: Problem, texel: np.ndarray) -> np.ndarray:
     """Starting points without any other texel: isotropic lobes of scale 2 alpha (a mirror lobe is twice as
-    wide as its NDF), alpha and 1, no skew; (k, 3, 3) candidates q."""
+    wide as its NDF), alpha and 1, no skew, the frame at the average direction; (k, 3, dof) candidates q."""
     a = np.maximum(problem.alpha[texel].astype(np.float64), 1e-4)
     cands = [np.log(2.0 * a), np.log(a), np.zeros_like(a)]
-    return np.stack([np.stack([c, c, np.zeros_like(c)], axis=1) for c in cands], axis=1)
+    z = np.zeros_like(a)
+    return np.stack([np.stack([c, c, *[z] * (problem.dof - 2)], axis=1) for c in cands], axis=1)
 
 
 def best_of(problem: Problem, texel: np.ndarray, cands: np.ndarray) -> np.ndarray:
-    """The candidate (k, c, 3) of least error per texel (first on ties)."""
-    k, c, _ = cands.shape
-    f = problem.objective(np.repeat(texel, c), cands.reshape(-1, 3)).reshape(k, c)
+    """The candidate (k, c, dof) of least error per texel (first on ties)."""
+    k, c, dof = cands.shape
+    f = problem.objective(np.repeat(texel, c), cands.reshape(-1, dof)).reshape(k, c)
     return cands[np.arange(k), np.argmin(f, axis=1)]
 
 
@@ -401,12 +409,12 @@ def coarse_nodes(n: int) -> np.ndarray:
 
 def coarse_pass(problem: Problem, ny: int, nx: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Fit the coarse-grid texels (rows ``iy``, columns ``ix``) from analytic guesses alone.
-    Returns (iy nodes, ix nodes, q of shape (len(iy), len(ix), 3))."""
+    Returns (iy nodes, ix nodes, q of shape (len(iy), len(ix), dof))."""
     iy, ix = coarse_nodes(ny), coarse_nodes(nx)
     texel = (iy[:, None] * nx + ix[None, :]).ravel()
     start = best_of(problem, texel, analytic_guesses(problem, texel))
     q, _ = refine(problem, texel, start, COARSE_STEPS)
-    return iy, ix, q.reshape(len(iy), len(ix), 3)
+    return iy, ix, q.reshape(len(iy), len(ix), problem.dof)
 
 
 def seeds(problem: Problem, texel: np.ndarray, nx: int, coarse) -> np.ndarray:

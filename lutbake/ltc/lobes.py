@@ -198,6 +198,8 @@ class Lobe:
     roughness: str  # "perceptual": x = r, alpha = r^2; "alpha": x = alpha; "sigma": x = sigma, GGX alpha = sigma;
     # "diffuse_roughness": x = the model's own roughness (EON's r), passed to the lobe as its parameter; "none"
     tabulate: object = None  # host (v (n, 3), alpha (n,), device, workers) -> per-texel table, or None (closed form)
+    free_frame: bool = False  # fit the frame angle too (4 parameters, lutbake.ltc.fit.Problem.matrices), not only
+    # ltc_code's 3 with Z = the lobe's average direction
 
 
 LOBES = {
@@ -224,6 +226,7 @@ LOBES = {
         charlie_f_pdf,
         "dfg:charlie",
         "alpha",
+        free_frame=True,
     ),
     "lambert": Lobe(
         "lambert",
