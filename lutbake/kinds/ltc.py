@@ -25,6 +25,7 @@ len = |form factor|, both endpoint (ltc_code genSphereTab).
 from __future__ import annotations
 
 import json
+import os
 import threading
 
 import numpy as np
@@ -214,7 +215,10 @@ class LtcBake:
                     o["lobe"], self.nov, alpha, o["samples"], device, o["estimator"], o["seed"]
                 )
                 self.fresnel = fres
-                p = fit.Problem(self.o["lobe"], self.nov, self.alpha, mag, self.o["fit_samples"], device)
+                # a tabulated lobe's table is built here on every available core (the executor's default; values do
+                # not depend on the thread count)
+                threads = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+                p = fit.Problem(self.o["lobe"], self.nov, self.alpha, mag, self.o["fit_samples"], device, threads)
                 self.coarse = fit.coarse_pass(p, self.n_view, self.n_rough)
                 self.problem = p
 

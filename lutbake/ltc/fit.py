@@ -35,7 +35,6 @@ import functools
 import numpy as np
 import warp as wp
 
-from ..executor import default_workers
 from .lobes import lobe
 
 NELDER_MEAD_TOL = 1.0e-5  # ltc_code fit(): NelderMead(..., epsilon, 1e-5, 100, ...)
@@ -190,6 +189,7 @@ class Problem:
         magnitude: np.ndarray,
         n_grid: int = DEFAULT_GRID,
         device: str = "cpu",
+        workers: int = 1,
     ):
         self.lobe = lobe_name
         self.device = device
@@ -204,8 +204,8 @@ class Problem:
         lobe_samples, self._heitz, self._values = kernels(lobe_name)
         d = device
         lb = lobe(lobe_name)
-        # a tabulated lobe's per-texel table (lutbake.ltc.tabulated), else a 1-element placeholder
-        tab = lb.tabulate(self.v, self.alpha, d, default_workers()) if lb.tabulate else np.zeros((1, 1, 1), np.float32)
+        # a tabulated lobe's per-texel table (lutbake.ltc.tabulated, ``workers`` threads), else a 1-element placeholder
+        tab = lb.tabulate(self.v, self.alpha, d, workers) if lb.tabulate else np.zeros((1, 1, 1), np.float32)
         self._tab = wp.array(tab, dtype=float, device=d)
         self._grid = wp.array(grid, dtype=wp.vec2, device=d)
         self._cos = wp.array(cosine_dirs(grid), dtype=wp.vec3d, device=d)
