@@ -8,6 +8,9 @@
 4. GGX against the published ltc_code table on Heitz's metric (per texel): fraction no worse, medians.
 5. Area lights (lutbake.validate.ltc_area): relative error of magnitude x polygon integral against the brute
    force, per lobe and roughness, for lutbake's tables and the published GGX table.
+6. Tabulated lobes (gotanda): the interpolated lobe the fit sees against Eq. 4 by direct quadrature (GL order 12),
+   relative L3 per texel, next to the fit error of the same texels.
+Sections 2-4 need ``ggx`` among ``--lobes``.
 """
 
 from __future__ import annotations
@@ -33,7 +36,8 @@ import warp as wp  # noqa: E402
 from lutbake.api import bake_table  # noqa: E402
 from lutbake.config import load_configs  # noqa: E402
 from lutbake.executor import default_workers  # noqa: E402
-from lutbake.kinds.ltc import axes_for, texel_params  # noqa: E402
+from lutbake.integrands.diffuse import eval_brdf  # noqa: E402
+from lutbake.kinds.ltc import axes_for, lobe_parameter, magnitude_alpha, magnitude_fresnel, texel_params  # noqa: E402
 from lutbake.ltc import fit  # noqa: E402
 from lutbake.validate import ltc_area  # noqa: E402
 
@@ -62,8 +66,12 @@ def bake(lobe: str, workers: int):
     return table, seconds, time.process_time() - cpu0
 
 
+AREA_SAMPLES = {"gotanda": 256}  # brute-force grid S (S x S); Eq. 4 per sample is costly; default 512
+
+
 def area(lobe: str, t1, t2, axes) -> dict:
-    rows = ltc_area.compare(lobe, t1, t2, axes[1].values(), axes[2].alpha(), AREA_TEXELS, s=512)
+    s = AREA_SAMPLES.get(lobe, 512)
+    rows = ltc_area.compare(lobe, t1, t2, axes[1].values(), lobe_parameter(axes[2]), AREA_TEXELS, s=s)
     by_rough = ltc_area.summarise(rows, "a")
     return {f"r={a / (N - 1):.3f}": v for a, v in by_rough.items()}
 
@@ -93,7 +101,14 @@ def main(argv=None):
             flush=True,
         )
 
+    for lobe, table in tables.items():
+        if fit.lobe(lobe).tabulate is not None:
+            report.setdefault("interpolation", {})[lobe] = interpolation_error(lobe, table)
+            print(f"interpolation {lobe}:", json.dumps(report["interpolation"][lobe]), flush=True)
     axes = axes_for({"lobe": "ggx", "size": [N, N]})
+    if "ggx" not in tables:
+        area_section(report, tables, axes, None, None, with_published=False)
+        return finish(report)
     nov, alpha = texel_params(axes)
     ggx = tables["ggx"]
     mag = ggx.data[1, ..., 0].reshape(-1).astype(np.float64)
@@ -149,20 +164,58 @@ def main(argv=None):
     }
     print("straight port:", report["baseline_straight_port"], flush=True)
 
-    # area lights
-    report["area_lights"] = {
-        "lights": [name for name, _ in ltc_area.light_set()],
-        "texels": AREA_TEXELS,
-        "published_ggx": area("ggx", t1p, t2p, axes),
-    }
+    area_section(report, tables, axes, t1p, t2p, with_published=True)
+    finish(report)
+
+
+def area_section(report, tables, axes, t1p, t2p, with_published: bool) -> None:
+    report["area_lights"] = {"lights": [name for name, _ in ltc_area.light_set()], "texels": AREA_TEXELS}
+    if with_published:
+        report["area_lights"]["published_ggx"] = area("ggx", t1p, t2p, axes)
+        print("area lights published ggx:", json.dumps(report["area_lights"]["published_ggx"]), flush=True)
     for lobe, table in tables.items():
         ax = axes_for({"lobe": lobe, "size": [N, N]})
         report["area_lights"][lobe] = area(lobe, table.data[0].astype(np.float64), table.data[1].astype(np.float64), ax)
         print(f"area lights {lobe}:", json.dumps(report["area_lights"][lobe]), flush=True)
-    print("area lights published ggx:", json.dumps(report["area_lights"]["published_ggx"]), flush=True)
+
+
+def finish(report) -> None:
     report["machine"]["load_average_at_end"] = list(os.getloadavg())
-    (OUT / "ltc.json").write_text(json.dumps(report, indent=1))
-    print(f"wrote {OUT / 'ltc.json'}")
+    name = "ltc.json" if "ggx" in report["lobes"] else "ltc_" + "_".join(report["lobes"]) + ".json"
+    (OUT / name).write_text(json.dumps(report, indent=1))
+    print(f"wrote {OUT / name}")
+
+
+INTERP_DIRS = 4096  # cosine-distributed light directions per texel (stratified 64 x 64)
+
+
+def interpolation_error(lobe: str, table) -> dict:
+    """Relative L3 distance (∫ |f_interp - f|^3 / ∫ f^3)^(1/3) between the tabulated lobe the fit sees and Eq. 4 by
+    direct GL quadrature at order 12 (cosine-sampled estimate), at AREA_TEXELS, beside those texels' fit error."""
+    axes = axes_for({"lobe": lobe, "size": [N, N]})
+    nov_all, alpha_all = texel_params(axes)
+    idx = np.array([t * N + a for t, a in AREA_TEXELS])
+    mag, _ = magnitude_fresnel(lobe, nov_all[idx], magnitude_alpha(axes)[idx], None)
+    prob = fit.Problem(lobe, nov_all[idx], alpha_all[idx], mag)
+    k = int(np.sqrt(INTERP_DIRS))
+    u1, u2 = (x.ravel() for x in np.meshgrid((np.arange(k) + 0.5) / k, (np.arange(k) + 0.5) / k))
+    l = np.stack([np.sqrt(1 - u1) * np.cos(2 * np.pi * u2), np.sqrt(1 - u1) * np.sin(2 * np.pi * u2), np.sqrt(u1)], 1)
+    rel = []
+    for j in range(len(idx)):
+        got = prob.f_cos(np.full(len(l), j), l)
+        v = np.broadcast_to(prob.v[j], l.shape)
+        ref = eval_brdf(ltc_area.DIFFUSE_MODELS[lobe], l, v, float(alpha_all[idx[j]]), order=12) * l[:, 2]
+        pdf = l[:, 2] / np.pi
+        rel.append(float(np.cbrt(np.sum(np.abs(got - ref) ** 3 / pdf) / np.sum(ref**3 / pdf))))
+    fit_err = table.data[1, ..., 2].reshape(-1)[idx]
+    return {
+        "texels": AREA_TEXELS,
+        "interp_rel_l3": rel,
+        "interp_rel_l3_max": max(rel),
+        "interp_rel_l3_median": float(np.median(rel)),
+        "fit_error_same_texels": [float(x) for x in fit_err],
+        "ratio_fit_to_interp_min": float(np.min(fit_err / np.maximum(rel, 1e-30))),
+    }
 
 
 if __name__ == "__main__":

@@ -89,6 +89,8 @@ DIFFUSE_MODELS = {
     "fitted": "Gotanda's fitted microfacet diffuse, Eq. 8 (course-notes reading)",
     "fitted_slides": "Eq. 8 with the slides' reading of F_r's second factor",
     "microfacet": "the microfacet diffuse model, Eq. 4, integrated over m (GGX, height-correlated Smith)",
+    "eon": "energy-preserving Oren-Nayar (Portsmouth et al. 2024, OpenPBR's diffuse), sigma = its roughness r; "
+    "E = 1 for rho = 1 (exact-albedo variant)",
 }
 
 
@@ -97,7 +99,7 @@ F0_NONE = "none: f0 does not factor out; the table holds E at the baked f0 only 
 
 def f0_factor(model: str, facet_fresnel: str) -> str:
     """How f0 enters a model: every model here is g(f0) times an f0-free function."""
-    if model in ("lambert", "oren_nayar", "oren_nayar_improved"):
+    if model in ("lambert", "oren_nayar", "oren_nayar_improved", "eon"):
         return "1"
     if model == "microfacet" and facet_fresnel == "schlick":
         return "(1 - f0)^2"
@@ -137,5 +139,9 @@ LTC_LOBES = {
     "beckmann": "Beckmann, height-correlated Smith with the exact Lambda",
     "charlie": "KHR_materials_sheen: D_charlie V_ashikhmin, alpha = sheenRoughness (gltf-charlie)",
     "lambert": "Lambert (n.l)/pi: its LTC is the identity (a check)",
+    "gotanda": "Gotanda 2014 microfacet diffuse (Eq. 4: Lambertian GGX facets, Eq. 6 facet Fresnel, f0 = 0), "
+    "GGX alpha = sigma; f tabulated per texel by lutbake's quadrature and interpolated",
+    "eon": "energy-preserving Oren-Nayar (Portsmouth et al. 2024; OpenPBR's diffuse), rho = 1, exact albedo "
+    "(E = 1); x = base_diffuse_roughness",
 }
 LTC_FIT_GRID = 32  # ltc_code Nsample: the metric's grid is N x N per sampling technique

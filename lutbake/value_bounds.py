@@ -29,9 +29,10 @@ ABOVE_ONE_LAYOUTS = frozenset(
 # specular models whose directional albedo is at most 1 (energy conserving), and the others
 UNIT_SPECULAR_MODELS = frozenset({"microfacet", "cook_torrance", "ashikhmin_shirley"})
 ABOVE_ONE_SPECULAR_MODELS = frozenset({"blinn_phong"})
-# diffuse models whose tabulated albedo ratio is at most 1, and the others
+# diffuse models whose tabulated albedo ratio is at most 1, and the others (eon: exactly 1 for rho = 1, its GL
+# estimate within 1e-7 of it)
 UNIT_DIFFUSE_MODELS = frozenset(
-    {"lambert", "oren_nayar_improved", "oren_nayar_fresnel", "fitted", "fitted_slides", "microfacet"}
+    {"lambert", "oren_nayar_improved", "oren_nayar_fresnel", "fitted", "fitted_slides", "microfacet", "eon"}
 )
 ABOVE_ONE_DIFFUSE_MODELS = frozenset({"oren_nayar"})
 # rough dielectrics: E_R, E_T, E_R + E_T <= 1 (single-scattering energy conservation), the OpenPBR complements

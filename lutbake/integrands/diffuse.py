@@ -43,6 +43,7 @@ CLOSED_FORMS = {  # model -> (Fd_ term, whether it takes f0)
     "oren_nayar_fresnel": (diffuse.Fd_oren_nayar_fresnel, True),
     "fitted": (diffuse.Fd_gotanda_fitted, True),
     "fitted_slides": (diffuse.Fd_gotanda_fitted_slides, True),
+    "eon": (diffuse.Fd_eon, False),
 }
 
 

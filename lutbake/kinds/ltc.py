@@ -25,6 +25,7 @@ len = |form factor|, both endpoint (ltc_code genSphereTab).
 from __future__ import annotations
 
 import json
+import os
 import threading
 
 import numpy as np
@@ -37,7 +38,7 @@ from .base import Estimation, Key, declare
 
 THETA_MAX = 1.57  # ltc_code fitTab: theta = min(1.57, acos(1 - x^2))
 NOV_LO = float(np.cos(np.float32(THETA_MAX)))
-MAGNITUDE_SAMPLES = {"ggx": 432, "beckmann": 432, "charlie": 3072, "lambert": 0}
+MAGNITUDE_SAMPLES = {"ggx": 432, "beckmann": 432, "charlie": 3072, "lambert": 0}  # diffuse lobes: the diffuse kind's
 FORMATS = {
     "exr": "OpenEXR, two parts (slice_0 = ltc_1, slice_1 = ltc_2), lutbake:* attributes (default)",
     "npy": "NumPy (2, N, N, 4) + .json sidecar",
@@ -98,19 +99,28 @@ def axes_for(o: dict) -> list[Axis]:
 
     n_view, n_rough = o["size"]
     lb = LOBES[o["lobe"]]
-    rname = "alpha" if lb.roughness == "alpha" else "perceptual_roughness"
+    rname = {"alpha": "alpha", "sigma": "sigma", "diffuse_roughness": "diffuse_roughness"}.get(
+        lb.roughness, "perceptual_roughness"
+    )
+    amap = "sigma" if lb.roughness == "sigma" else None  # Gotanda's sigma: GGX alpha = sigma (docs/diffuse.md)
     return [
         Axis("texture", "z", 2, 1.0, 2.0, texel="endpoint", mapping="listed", listed=(1.0, 2.0)),
         Axis("NoV", "y", n_view, 0.0, 1.0, texel="endpoint", mapping="one_minus_t2", clamp=(NOV_LO, 1.0)),
-        Axis(rname, "x", n_rough, 0.0, 1.0, texel="endpoint"),
+        Axis(rname, "x", n_rough, 0.0, 1.0, texel="endpoint", alpha_map=amap),
     ]
+
+
+def lobe_parameter(rough: Axis) -> np.ndarray:
+    """The lobe's parameter per roughness index: the NDF alpha of the axis, or (EON) the axis value itself."""
+    a = rough.alpha()
+    return rough.values() if a is None else a
 
 
 def texel_params(axes: list[Axis], alpha_min: float = ALPHA_MIN) -> tuple[np.ndarray, np.ndarray]:
     """Per texel of one slice, row-major (y = view slowest): (NoV, alpha) as float32, alpha >= alpha_min (the
     alpha fitted: an LTC of a Dirac lobe is not defined)."""
     _, view, rough = axes
-    alpha = np.maximum(rough.alpha(), np.float32(alpha_min))
+    alpha = np.maximum(lobe_parameter(rough), np.float32(alpha_min))
     return np.repeat(view.values(), rough.count), np.tile(alpha, view.count)
 
 
@@ -118,7 +128,7 @@ def magnitude_alpha(axes: list[Axis], alpha_min: float = ALPHA_MIN) -> np.ndarra
     """The alpha at which magnitude and fresnel are integrated: the axis alpha itself under lutbake's edge policy
     (alpha -> 0: the exact mirror limit, as the ``albedo`` table), or alpha_min where a larger one is set."""
     _, view, rough = axes
-    a = rough.alpha()
+    a = lobe_parameter(rough)
     if alpha_min > ALPHA_MIN:
         a = np.maximum(a, np.float32(alpha_min))
     return np.tile(a, view.count)
@@ -136,8 +146,9 @@ def magnitude_fresnel(
     """(magnitude, fresnel) per texel from lutbake's integrators (``estimator``, default Gauss-Legendre).
     GGX / Beckmann: magnitude is the ``albedo`` kind's integrand (so it equals that table at the same texels),
     fresnel the ``dfg`` multiscatter integrand's Fc channel; charlie: the ``dfg`` charlie layout's B channel (the
-    gltf-charlie table), fresnel = magnitude; lambert: 1. ``alpha`` goes through the integrands' edge policy
-    (mirror limit at alpha -> 0)."""
+    gltf-charlie table), fresnel = magnitude; lambert: 1; gotanda, eon: the ``diffuse`` kind's integrator and
+    integrand (its default GL order unless ``samples``; ``alpha`` = sigma resp. EON's r), fresnel = magnitude.
+    ``alpha`` goes through the integrands' edge policy (mirror limit at alpha -> 0)."""
     from ..integrands.specular import specular_integrand
     from ..ltc.lobes import LOBES
     from ..sampling.hemisphere import estimator_for
@@ -146,6 +157,9 @@ def magnitude_fresnel(
     if lb.magnitude == "lambert":
         one = np.ones(len(nov))
         return one, one.copy()
+    if lb.magnitude.startswith("diffuse:"):
+        m = diffuse_magnitude(lb.magnitude.split(":")[1], nov, alpha, samples, device)
+        return m, m.copy()
     if estimator == "gauss_legendre":
         samples = samples or MAGNITUDE_SAMPLES[lobe_name]
     est = estimator_for(estimator, samples, seed)
@@ -163,6 +177,21 @@ def magnitude_fresnel(
     mag = integrate(specular_integrand(which, "smith_height_correlated", "albedo", "microfacet", 1))[:, 0]
     fres = integrate(specular_integrand(which, "smith_height_correlated", "multiscatter"))[:, 0]
     return mag, fres
+
+
+def diffuse_magnitude(model: str, nov, sigma, samples: int | None, device: str = "cpu") -> np.ndarray:
+    """E(n.v) = ∫ f (n.l) dω_l (rho = 1, f0 = 0) exactly as the ``diffuse`` kind integrates ``model`` at these
+    texels (its grid inputs, its Gauss-Legendre estimator and default order), so the magnitude equals that table."""
+    from ..integrands.diffuse import diffuse_integrand
+    from . import diffuse as kind_diffuse  # the diffuse kind declares its estimator; imported where needed
+
+    o = {"estimator": "gauss_legendre", "samples": samples, "model": model, "seed": 0}
+    nov = np.asarray(nov, np.float32)
+    grid = kind_diffuse.diffuse_grid([], nov, np.asarray(sigma, np.float32), np.zeros(len(nov)), "sigma")
+    est = kind_diffuse.estimator_of(o)
+    integrand = diffuse_integrand(model)
+    est.prepare(integrand, device)
+    return est.evaluate(integrand, grid.inputs, device)[:, 0]
 
 
 class LtcBake:
@@ -193,7 +222,10 @@ class LtcBake:
                     o["lobe"], self.nov, alpha, o["samples"], device, o["estimator"], o["seed"]
                 )
                 self.fresnel = fres
-                p = fit.Problem(self.o["lobe"], self.nov, self.alpha, mag, self.o["fit_samples"], device)
+                # a tabulated lobe's table is built here on every available core (the executor's default; values do
+                # not depend on the thread count)
+                threads = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+                p = fit.Problem(self.o["lobe"], self.nov, self.alpha, mag, self.o["fit_samples"], device, threads)
                 self.coarse = fit.coarse_pass(p, self.n_view, self.n_rough)
                 self.problem = p
 
@@ -229,6 +261,38 @@ class LtcBake:
         return out
 
 
+FREE_FRAME = " turned about y by a fitted angle d (4 parameters: every LTC of a lobe symmetric about the xz-plane)"
+ROUGHNESS_AXES = {
+    "perceptual": "x = perceptual roughness r, NDF alpha = r^2 (ltc_code)",
+    "alpha": "x = alpha (the lobe's own parameter: charlie's sheenRoughness)",
+    "sigma": "x = Gotanda's sigma, GGX alpha = sigma (the diffuse kind's default sigma_to_alpha, docs/diffuse.md)",
+    "diffuse_roughness": "x = EON's roughness r (OpenPBR base_diffuse_roughness), linear in [0, 1]",
+    "none": "x unused (lambert)",
+}
+
+
+def magnitude_record(lb, estimator: str, samples) -> str:
+    if lb.magnitude.startswith("diffuse:"):
+        model = lb.magnitude.split(":")[1]
+        return (
+            f"the diffuse kind's gauss_legendre estimator, model {model!r}, order {samples or 'default'} (rho = 1, "
+            "f0 = 0): equal to that table at the same texels; fresnel channel = magnitude"
+        )
+    return f"{estimator}, {samples or 'default'} samples (lutbake albedo / dfg integrands)"
+
+
+def tabulation_record(lb) -> dict:
+    if lb.tabulate is None:
+        return {}
+    from ..ltc import tabulated
+
+    return {
+        "tabulated_lobe": f"f (n.l) = G2 J, J tabulated per texel on {tabulated.TAB_THETA} theta_l (cell centres) x "
+        f"{tabulated.TAB_PHI} phi_l (endpoints, [0, pi]) by Eq. 4's GL quadrature at order {tabulated.TAB_ORDER}, "
+        "Catmull-Rom interpolated (lutbake.ltc.tabulated)"
+    }
+
+
 def fit_error_stats(data: np.ndarray) -> dict[str, str]:
     """The lutbake:fit_error_* attributes: statistics of slice 1's z channel (relative L3 error per texel)."""
     e = np.asarray(data)[1, ..., 2].ravel()
@@ -261,7 +325,7 @@ def plan(spec) -> TexelPlan:
     lb = LOBES[o["lobe"]]
     m_samples = 0 if lb.magnitude == "lambert" else o["samples"]
     if o["estimator"] == "gauss_legendre" and not m_samples:
-        m_samples = MAGNITUDE_SAMPLES[o["lobe"]]
+        m_samples = MAGNITUDE_SAMPLES.get(o["lobe"])
     terms = {
         "lobe": o["lobe"],
         "description": lb.description,
@@ -270,20 +334,24 @@ def plan(spec) -> TexelPlan:
         else "none (fresnel channel = magnitude)",
         "layout": "ltc_code (selfshadow/ltc_code fit/fitLTC.cpp packTab)",
     }
+    q_tail = ", d" if lb.free_frame else ""
     extra = {
         "ltc_fit": json.dumps(
             {
-                "parametrisation": "M = [X Y Z] [[m11, 0, m13], [0, m22, 0], [0, 0, 1]], Z = lobe's average direction",
+                "parametrisation": "M = [X Y Z] [[m11, 0, m13], [0, m22, 0], [0, 0, 1]], Z = lobe's average direction"
+                + (FREE_FRAME if lb.free_frame else " (ltc_code's 3 parameters)"),
                 "metric": "Heitz et al. 2016 L3 distance, MIS over lobe and LTC samples (ltc_code computeError)",
                 "fit_samples": f"{o['fit_samples']} x {o['fit_samples']} per technique",
                 "optimiser": f"Nelder-Mead (ltc_code nelder_mead.h), tol {fit.NELDER_MEAD_TOL}, "
                 f"<= {fit.NELDER_MEAD_ITERS} iterations per restart, simplex sizes {list(fit.COARSE_STEPS)} "
-                f"(coarse pass), {list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11)",
+                f"(coarse pass), {list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11{q_tail})",
                 "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses; each texel starts "
                 "from the best of the analytic guesses and the surrounding coarse fits (no chaining)",
                 "alpha_min": o["alpha_min"],
                 "theta_max": THETA_MAX,
-                "magnitude": f"{o['estimator']}, {m_samples or 'default'} samples (lutbake albedo / dfg integrands)",
+                "magnitude": magnitude_record(lb, o["estimator"], m_samples),
+                "roughness_axis": ROUGHNESS_AXES[lb.roughness],
+                **tabulation_record(lb),
             }
         ),
         "ltc_texture_slices": "slice_0 = ltc_1 (inverse matrix), slice_1 = ltc_2 (magnitude, fresnel, fit_error, "
@@ -315,6 +383,8 @@ def check_spec(spec):
             "estimator",
             f"estimator {o['estimator']!r} samples the GGX / Beckmann NDF: lobe {o['lobe']!r} needs 'gauss_legendre'",
         )
+    if LOBES[o["lobe"]].magnitude.startswith("diffuse:") and o["samples"] is not None and o["samples"] > 64:
+        return ("samples", f"lobe {o['lobe']!r}: samples is the diffuse kind's Gauss-Legendre order, at most 64")
     if o["format"] == "ltc_dds" and o["dtype"] not in ("half", "float32"):
         return ("dtype", "ltc_dds writes RGBA16F (half) or RGBA32F (float32)")
     return None
@@ -329,7 +399,7 @@ ESTIMATION = Estimation(
     ESTIMATORS,
     "gauss_legendre",
     "Gauss-Legendre budget of the magnitude / fresnel integrals per texel; "
-    "omitted: 432 (ggx, beckmann), 3072 (charlie)",
+    "omitted: 432 (ggx, beckmann), 3072 (charlie); gotanda, eon: the diffuse kind's GL order (omitted: its default)",
     samples_min=12,
     samples_max=1 << 20,
 )

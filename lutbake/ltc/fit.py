@@ -65,15 +65,32 @@ def ltc_eval(m_inv: wp.mat33d, det_inv: wp.float64, l: wp.vec3d):
 
 @functools.lru_cache(maxsize=None)
 def kernels(lobe_name: str):
-    """(lobe_samples, heitz_error) Warp kernels for a lobe, compiled once per Warp cache."""
+    """(lobe_samples, heitz_error, lobe_values) Warp kernels for a lobe, compiled once per Warp cache."""
     lb = lobe(lobe_name)
-    f_cos, sample, pdf, f_pdf = lb.f_cos, lb.sample, lb.pdf, lb.f_pdf
+    sample = lb.sample
+    if lb.tabulate is not None:  # f takes the texel's table and index (lutbake.ltc.tabulated)
+        f_cos, pdf, f_pdf = lb.f_cos, lb.pdf, lb.f_pdf
+    else:
+        f_cos0, pdf0, f_pdf0 = lb.f_cos, lb.pdf, lb.f_pdf
+
+        @wp.func
+        def f_cos(v: wp.vec3, l: wp.vec3, a: float, tab: wp.array3d(dtype=float), t: int):
+            return f_cos0(v, l, a)
+
+        @wp.func
+        def pdf(v: wp.vec3, l: wp.vec3, a: float, tab: wp.array3d(dtype=float), t: int):
+            return pdf0(v, l, a)
+
+        @wp.func
+        def f_pdf(v: wp.vec3, l: wp.vec3, a: float, tab: wp.array3d(dtype=float), t: int):
+            return f_pdf0(v, l, a)
 
     @wp.kernel(enable_backward=False)
     def lobe_samples(
         v: wp.array(dtype=wp.vec3),
         alpha: wp.array(dtype=float),
         grid: wp.array(dtype=wp.vec2),
+        tab: wp.array3d(dtype=float),
         dirs: wp.array2d(dtype=wp.vec3d),
         f: wp.array2d(dtype=wp.float64),
         p: wp.array2d(dtype=wp.float64),
@@ -85,8 +102,8 @@ def kernels(lobe_name: str):
         u = grid[s]
         l = sample(vi, a, u[0], u[1])
         dirs[i, s] = wp.vec3d(wp.float64(l[0]), wp.float64(l[1]), wp.float64(l[2]))
-        f[i, s] = wp.float64(f_cos(vi, l, a))
-        p[i, s] = wp.float64(pdf(vi, l, a))
+        f[i, s] = wp.float64(f_cos(vi, l, a, tab, i))
+        p[i, s] = wp.float64(pdf(vi, l, a, tab, i))
 
     @wp.kernel(enable_backward=False)
     def heitz_error(
@@ -95,6 +112,7 @@ def kernels(lobe_name: str):
         v: wp.array(dtype=wp.vec3),
         alpha: wp.array(dtype=float),
         magnitude: wp.array(dtype=wp.float64),
+        tab: wp.array3d(dtype=float),
         cos_dirs: wp.array(dtype=wp.vec3d),
         lobe_dirs: wp.array2d(dtype=wp.vec3d),
         lobe_f: wp.array2d(dtype=wp.float64),
@@ -116,7 +134,7 @@ def kernels(lobe_name: str):
             ld = wp.normalize(mi * cos_dirs[s])
             l = wp.vec3(float(ld[0]), float(ld[1]), float(ld[2]))
             d = ltc_eval(m_inv, det_inv, ld)
-            fp = f_pdf(vi, l, a)
+            fp = f_pdf(vi, l, a, tab, t)
             e = wp.abs(wp.float64(fp[0]) - mag * d)
             q = d + wp.float64(fp[1])
             if q > wp.float64(0.0):
@@ -129,7 +147,21 @@ def kernels(lobe_name: str):
                 acc += e2 * e2 * e2 / q2
         err[i] = acc / wp.float64(cos_dirs.shape[0])
 
-    return lobe_samples, heitz_error
+    @wp.kernel(enable_backward=False)
+    def lobe_values(
+        texel: wp.array(dtype=int),
+        l: wp.array(dtype=wp.vec3),
+        v: wp.array(dtype=wp.vec3),
+        alpha: wp.array(dtype=float),
+        tab: wp.array3d(dtype=float),
+        out: wp.array(dtype=wp.float64),
+    ):
+        """f (n.l) of texel[i] at direction l[i], as the fit sees it (a tabulated lobe: interpolated)."""
+        i = wp.tid()
+        t = texel[i]
+        out[i] = wp.float64(f_cos(v[t], l[i], alpha[t], tab, t))
+
+    return lobe_samples, heitz_error, lobe_values
 
 
 def stratified_grid(n: int) -> np.ndarray:
@@ -157,6 +189,7 @@ class Problem:
         magnitude: np.ndarray,
         n_grid: int = LTC_FIT_GRID,
         device: str = "cpu",
+        workers: int = 1,
     ):
         self.lobe = lobe_name
         self.device = device
@@ -168,8 +201,12 @@ class Problem:
         self.v = np.stack([np.sqrt(np.maximum(1.0 - nv * nv, 0.0)), np.zeros_like(nv), nv], axis=1).astype(np.float32)
         self.isotropic = self.nov >= np.float32(1.0)
         grid = stratified_grid(n_grid)
-        lobe_samples, self._heitz = kernels(lobe_name)
+        lobe_samples, self._heitz, self._values = kernels(lobe_name)
         d = device
+        lb = lobe(lobe_name)
+        # a tabulated lobe's per-texel table (lutbake.ltc.tabulated, ``workers`` threads), else a 1-element placeholder
+        tab = lb.tabulate(self.v, self.alpha, d, workers) if lb.tabulate else np.zeros((1, 1, 1), np.float32)
+        self._tab = wp.array(tab, dtype=float, device=d)
         self._grid = wp.array(grid, dtype=wp.vec2, device=d)
         self._cos = wp.array(cosine_dirs(grid), dtype=wp.vec3d, device=d)
         self._v = wp.array(self.v, dtype=wp.vec3, device=d)
@@ -182,7 +219,7 @@ class Problem:
         wp.launch(
             lobe_samples,
             dim=(self.n, s),
-            inputs=[self._v, self._alpha, self._grid, self._ldir, self._lf, self._lp],
+            inputs=[self._v, self._alpha, self._grid, self._tab, self._ldir, self._lf, self._lp],
             device=d,
         )
         # from the lobe's samples: its average direction Σ (f / p) l (ltc_code computeAvgTerms) and ∫ f^3 ≈ Σ f^3 / p
@@ -191,6 +228,7 @@ class Problem:
         self.f3 = np.sum(f * f * w, axis=1) / s
         self.frame_z = self._frames(np.einsum("ts,tsk->tk", w, self._ldir.numpy()))
         self.evaluations = 0
+        self.dof = 4 if lb.free_frame else 3  # q's length (matrices)
 
     def _frames(self, avg: np.ndarray) -> np.ndarray:
         """Z = normalize(average direction with y cleared); (0, 0, 1) at normal incidence (ltc_code fitTab)."""
@@ -204,7 +242,9 @@ class Problem:
         return z
 
     def matrices(self, texel: np.ndarray, q: np.ndarray) -> np.ndarray:
-        """M = [X Y Z] * [[m11, 0, m13], [0, m22, 0], [0, 0, 1]] for q = (log m11, log m22, m13 / m11)."""
+        """M = [X Y Z] * [[m11, 0, m13], [0, m22, 0], [0, 0, 1]] for q = (log m11, log m22, m13 / m11) (``dof`` 3,
+        ltc_code's); with ``dof`` 4, q[:, 3] = d, the frame Z turned by d radians about y from the lobe's average
+        direction (every M of a lobe symmetric about the xz-plane, up to scale, is of this form)."""
         m11 = np.maximum(np.exp(q[:, 0]), M_MIN)
         m22 = np.maximum(np.exp(q[:, 1]), M_MIN)
         m13 = q[:, 2] * m11
@@ -212,6 +252,10 @@ class Problem:
         m22 = np.where(iso, m11, m22)
         m13 = np.where(iso, 0.0, m13)
         z = self.frame_z[texel]
+        if q.shape[1] > 3:
+            d = np.where(iso, 0.0, q[:, 3])
+            c, s = np.cos(d), np.sin(d)
+            z = np.stack([c * z[:, 0] + s * z[:, 2], z[:, 1], c * z[:, 2] - s * z[:, 0]], axis=1)
         k = len(texel)
         R = np.zeros((k, 3, 3))
         R[:, :, 2] = z
@@ -237,6 +281,7 @@ class Problem:
                 self._v,
                 self._alpha,
                 self._mag,
+                self._tab,
                 self._cos,
                 self._ldir,
                 self._lf,
@@ -246,6 +291,15 @@ class Problem:
             device=d,
         )
         self.evaluations += k
+        return out.numpy()
+
+    def f_cos(self, texel: np.ndarray, l: np.ndarray) -> np.ndarray:
+        """The lobe f (n.l) the fit uses at texels ``texel`` (k,) and unit directions ``l`` (k, 3), float64."""
+        d = self.device
+        out = wp.zeros(len(texel), dtype=wp.float64, device=d)
+        inputs = [wp.array(np.asarray(texel, np.int32), dtype=int, device=d)]
+        inputs += [wp.array(np.asarray(l, np.float32), dtype=wp.vec3, device=d), self._v, self._alpha, self._tab, out]
+        wp.launch(self._values, dim=len(texel), inputs=inputs, device=d)
         return out.numpy()
 
     def objective(self, texel: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -326,16 +380,17 @@ def nelder_mead(
 
 def analytic_guesses(problem: Problem, texel: np.ndarray) -> np.ndarray:
     """Starting points without any other texel: isotropic lobes of scale 2 alpha (a mirror lobe is twice as
-    wide as its NDF), alpha and 1, no skew; (k, 3, 3) candidates q."""
+    wide as its NDF), alpha and 1, no skew, the frame at the average direction; (k, 3, dof) candidates q."""
     a = np.maximum(problem.alpha[texel].astype(np.float64), 1e-4)
     cands = [np.log(2.0 * a), np.log(a), np.zeros_like(a)]
-    return np.stack([np.stack([c, c, np.zeros_like(c)], axis=1) for c in cands], axis=1)
+    z = np.zeros_like(a)
+    return np.stack([np.stack([c, c, *[z] * (problem.dof - 2)], axis=1) for c in cands], axis=1)
 
 
 def best_of(problem: Problem, texel: np.ndarray, cands: np.ndarray) -> np.ndarray:
-    """The candidate (k, c, 3) of least error per texel (first on ties)."""
-    k, c, _ = cands.shape
-    f = problem.objective(np.repeat(texel, c), cands.reshape(-1, 3)).reshape(k, c)
+    """The candidate (k, c, dof) of least error per texel (first on ties)."""
+    k, c, dof = cands.shape
+    f = problem.objective(np.repeat(texel, c), cands.reshape(-1, dof)).reshape(k, c)
     return cands[np.arange(k), np.argmin(f, axis=1)]
 
 
@@ -354,12 +409,12 @@ def coarse_nodes(n: int) -> np.ndarray:
 
 def coarse_pass(problem: Problem, ny: int, nx: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Fit the coarse-grid texels (rows ``iy``, columns ``ix``) from analytic guesses alone.
-    Returns (iy nodes, ix nodes, q of shape (len(iy), len(ix), 3))."""
+    Returns (iy nodes, ix nodes, q of shape (len(iy), len(ix), dof))."""
     iy, ix = coarse_nodes(ny), coarse_nodes(nx)
     texel = (iy[:, None] * nx + ix[None, :]).ravel()
     start = best_of(problem, texel, analytic_guesses(problem, texel))
     q, _ = refine(problem, texel, start, COARSE_STEPS)
-    return iy, ix, q.reshape(len(iy), len(ix), 3)
+    return iy, ix, q.reshape(len(iy), len(ix), problem.dof)
 
 
 def seeds(problem: Problem, texel: np.ndarray, nx: int, coarse) -> np.ndarray:

@@ -13,6 +13,11 @@ ltc_code's agree sample for sample on GGX.
 | beckmann | D_beckmann G2 / (4 n.v), height-correlated Smith, exact Lambda (ltc_code: Walter's fit) | NDF, log |
 | charlie | D_charlie V_ashikhmin (n.l) (the gltf-charlie preset's lobe, alpha = sheenRoughness) | cosine |
 | lambert | (n.l) / pi (the identity LTC: a check) | cosine |
+| gotanda | Gotanda 2014 Eq. 4 (GGX alpha = sigma, Eq. 6 facets, f0 = 0), tabulated per texel | cosine |
+| eon | energy-preserving Oren-Nayar (Portsmouth et al. 2024; OpenPBR), rho = 1, exact albedo | cosine |
+
+A tabulated lobe (``Lobe.tabulate``: gotanda) takes two more arguments, its per-texel table and the texel index:
+f_cos(v, l, alpha, tab, t) (lutbake.ltc.tabulated); lutbake.ltc.fit adapts the others.
 """
 
 from __future__ import annotations
@@ -24,8 +29,9 @@ import warp as wp
 
 from ..catalog import LTC_LOBES
 from ..edge import COS_EPS
-from ..terms import masking, ndf
+from ..terms import diffuse, masking, ndf
 from ..terms.frame import reflect
+from .tabulated import gotanda_f_cos, tabulate_gotanda
 
 INV_PI = 0.31830988618379067
 
@@ -158,6 +164,29 @@ def lambert_f_pdf(v: wp.vec3, l: wp.vec3, alpha: float):
     return wp.vec2(lambert_f_cos(v, l, alpha), cosine_pdf(v, l, alpha))
 
 
+@wp.func
+def eon_f_cos(v: wp.vec3, l: wp.vec3, r: float):
+    """EON (lutbake.terms.diffuse.Fd_eon) for rho = 1 times (n.l); r = OpenPBR's base_diffuse_roughness."""
+    if l[2] <= COS_EPS or v[2] <= COS_EPS:
+        return 0.0
+    return diffuse.Fd_eon(1.0, l[2], v[2], wp.dot(l, v), r) * l[2]
+
+
+@wp.func
+def eon_f_pdf(v: wp.vec3, l: wp.vec3, r: float):
+    return wp.vec2(eon_f_cos(v, l, r), cosine_pdf(v, l, r))
+
+
+@wp.func
+def gotanda_pdf(v: wp.vec3, l: wp.vec3, alpha: float, tab: wp.array3d(dtype=float), t: int):
+    return cosine_pdf(v, l, alpha)
+
+
+@wp.func
+def gotanda_f_pdf(v: wp.vec3, l: wp.vec3, alpha: float, tab: wp.array3d(dtype=float), t: int):
+    return wp.vec2(gotanda_f_cos(v, l, alpha, tab, t), cosine_pdf(v, l, alpha))
+
+
 @dataclass(frozen=True)
 class Lobe:
     name: str
@@ -167,7 +196,11 @@ class Lobe:
     pdf: object
     f_pdf: object  # (f_cos, pdf) at once, sharing the terms both need
     magnitude: str  # how the magnitude / Fresnel channels are integrated (lutbake.kinds.ltc)
-    roughness: str  # "perceptual": the x axis is r, alpha = r^2; "alpha": the x axis is alpha; "none"
+    roughness: str  # "perceptual": x = r, alpha = r^2; "alpha": x = alpha; "sigma": x = sigma, GGX alpha = sigma;
+    # "diffuse_roughness": x = the model's own roughness (EON's r), passed to the lobe as its parameter; "none"
+    tabulate: object = None  # host (v (n, 3), alpha (n,), device, workers) -> per-texel table, or None (closed form)
+    free_frame: bool = False  # fit the frame angle too (4 parameters, lutbake.ltc.fit.Problem.matrices), not only
+    # ltc_code's 3 with Z = the lobe's average direction
 
 
 LOBES = {
@@ -194,6 +227,7 @@ LOBES = {
         charlie_f_pdf,
         "dfg:charlie",
         "alpha",
+        free_frame=True,
     ),
     "lambert": Lobe(
         "lambert",
@@ -204,6 +238,27 @@ LOBES = {
         lambert_f_pdf,
         "lambert",
         "none",
+    ),
+    "gotanda": Lobe(
+        "gotanda",
+        LTC_LOBES["gotanda"],
+        gotanda_f_cos,
+        cosine_sample,
+        gotanda_pdf,
+        gotanda_f_pdf,
+        "diffuse:microfacet",
+        "sigma",
+        tabulate_gotanda,
+    ),
+    "eon": Lobe(
+        "eon",
+        LTC_LOBES["eon"],
+        eon_f_cos,
+        cosine_sample,
+        cosine_pdf,
+        eon_f_pdf,
+        "diffuse:eon",
+        "diffuse_roughness",
     ),
 }
 

@@ -162,6 +162,79 @@ def Fd_gotanda_fitted_slides(rho: float, NoL: float, NoV: float, LoV: float, sig
     return rho * 1.05 * INV_PI * (1.0 - f0) * gotanda_fitted_radiance(NoL, NoV, LoV, sigma, 1) / NoL
 
 
+# --- energy-preserving Oren-Nayar (EON; Portsmouth, Kutz & Hill 2024, "EON: A practical energy-preserving rough
+# diffuse BRDF", JCGT 14(1) 2025; the OpenPBR diffuse lobe, adobe/openpbr-bsdf impl/openpbr_diffuse_lobe.h).
+# r in [0, 1] is OpenPBR's base_diffuse_roughness (the Fujii Oren-Nayar sigma); r = 0 is Lambert.
+
+FON_C1 = wp.constant(0.5 - 2.0 / (3.0 * 3.141592653589793))  # 1/2 - 2/(3 pi): A_F = 1 / (1 + FON_C1 r)
+FON_C2 = wp.constant(2.0 / 3.0 - 28.0 / (15.0 * 3.141592653589793))  # 2/3 - 28/(15 pi): E_avg = A_F (1 + FON_C2 r)
+EON_EPS = wp.constant(1.0e-7)  # the paper's floor on 1 - E in the multiple-scattering lobe
+
+
+@wp.func
+def A_fon(r: float):
+    """A_F = 1 / (1 + (1/2 - 2/(3 pi)) r): the Fujii Oren-Nayar (FON) constant term (EON paper's listing, f_EON);
+    B_F = r A_F."""
+    return 1.0 / (1.0 + FON_C1 * r)
+
+
+@wp.func
+def E_fon(mu: float, r: float):
+    """Directional albedo of the FON single-scattering lobe for rho = 1 (EON paper's listing, E_FON_exact):
+    A_F + B_F / pi G(mu), G = S (acos(mu) - S mu) + 2/3 (S / mu (1 - S^3) - S), S = sqrt(1 - mu^2).
+    (S / mu)(1 - S^3) is written S mu (1 + S + S^2) / (1 + S) (1 - S = mu^2 / (1 + S)), exact and free of the
+    float32 cancellation at mu -> 0, where it tends to 0 (G(0) = pi/2 - 2/3, G(1) = 0). mu in (0, 1]."""
+    m = wp.clamp(mu, 0.0, 1.0)
+    S = wp.sqrt(wp.max(1.0 - m * m, 0.0))
+    G = S * (wp.acos(m) - S * m) + (2.0 / 3.0) * (S * m * (1.0 + S + S * S) / (1.0 + S) - S)
+    A = A_fon(r)
+    return A + r * A * INV_PI * G
+
+
+@wp.func
+def E_fon_avg(r: float):
+    """Cosine-weighted average of E_fon over the hemisphere, A_F (1 + (2/3 - 28/(15 pi)) r) (EON paper's listing,
+    avgEF in f_EON)."""
+    return A_fon(r) * (1.0 + FON_C2 * r)
+
+
+@wp.func
+def Fd_fon(rho: float, NoL: float, NoV: float, LoV: float, r: float):
+    """Fujii Oren-Nayar single scattering (EON paper's listing, f_ss in f_EON): f = rho/pi A_F (1 + r s / t),
+    s = l.v - (n.l)(n.v), t = max(n.l, n.v) if s > 0 else 1. 0 when NoL or NoV <= COS_EPS; r = 0: Lambert."""
+    if NoL <= COS_EPS or NoV <= COS_EPS:
+        return 0.0
+    s = LoV - NoL * NoV
+    s_over_t = s
+    if s > 0.0:
+        s_over_t = s / wp.max(NoL, NoV)
+    return rho * INV_PI * A_fon(r) * (1.0 + r * s_over_t)
+
+
+@wp.func
+def Fd_eon_multiple(rho: float, NoL: float, NoV: float, r: float):
+    """EON's multiple-scattering lobe (EON paper's listing, f_ms in f_EON):
+    rho_ms/pi (1 - E_F(n.l))(1 - E_F(n.v)) / (1 - E_avg),
+    rho_ms = rho^2 E_avg / (1 - rho (1 - E_avg)), each 1 - E floored at 1e-7 as the paper's listing.
+    Its albedo is rho_ms (1 - E_F(n.v)), so E_EON = rho E_F + rho_ms (1 - E_F): 1 for rho = 1."""
+    if NoL <= COS_EPS or NoV <= COS_EPS:
+        return 0.0
+    e_avg = E_fon_avg(r)
+    rho_ms = rho * rho * e_avg / (1.0 - rho * (1.0 - e_avg))
+    one_l = wp.max(EON_EPS, 1.0 - E_fon(NoL, r))
+    one_v = wp.max(EON_EPS, 1.0 - E_fon(NoV, r))
+    return rho_ms * INV_PI * one_l * one_v / wp.max(EON_EPS, 1.0 - e_avg)
+
+
+@wp.func
+def Fd_eon(rho: float, NoL: float, NoV: float, LoV: float, r: float):
+    """Energy-preserving Oren-Nayar (EON paper's listing, f_EON with exact = true; OpenPBR's diffuse BRDF), the
+    exact-albedo variant:
+    f = Fd_fon + Fd_eon_multiple. Reciprocal; r = 0: Lambert (plus 1e-7 / pi from the paper's floors);
+    0 when NoL or NoV <= COS_EPS. (adobe/openpbr-bsdf evaluates E_F by the paper's polynomial fit, E_FON_approx.)"""
+    return Fd_fon(rho, NoL, NoV, LoV, r) + Fd_eon_multiple(rho, NoL, NoV, r)
+
+
 @wp.func
 def F_facet_eq6(MoL: float, MoV: float, f0: float):
     """Per-facet transmission of the microfacet diffuse model, Eq. 6 with m in place of n:

@@ -611,6 +611,36 @@ def ltc_sphere_table_is_snyder() -> CheckResult:
     return _result("ltc_sphere_table_is_snyder", err, LTC_SPHERE_TOL, "max |integrated - closed form| / (pi sin^2)")
 
 
+EON_ALBEDO_TOL = 1.0e-6  # EON (rho = 1) albedo by GL vs 1: measured 1.0e-7
+LTC_IDENTITY_TOL = 1.0e-3  # packed M^-1 of a Lambert-like lobe vs (1, 0, 0, 1)
+
+
+def eon_albedo_is_one() -> CheckResult:
+    """The energy-preserving Oren-Nayar (Portsmouth et al. 2024) preserves energy: its directional albedo for rho = 1
+    is 1 at every view and roughness (the diffuse kind's GL integrator, order 24, model ``eon``)."""
+    from ..integrands.diffuse import albedo_gl
+
+    nov, r = np.meshgrid([0.01, 0.1, 0.3, 0.6, 0.9, 1.0], [0.0, 0.25, 0.5, 0.75, 1.0])
+    err = np.max(np.abs(albedo_gl("eon", nov.ravel(), r.ravel(), order=24) - 1.0))
+    return _result("eon_albedo_is_one", err, EON_ALBEDO_TOL, "max |E_EON - 1| over 6 NoV x 5 r, rho = 1")
+
+
+def ltc_eon_r0_is_identity() -> CheckResult:
+    """EON at r = 0 is Lambert: its LTC fit (lutbake.ltc.fit, the kind's seeding) is the identity at every view."""
+    from ..kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
+    from ..ltc import fit
+
+    axes = axes_for({"lobe": "eon", "size": [6, 6]})
+    nov, r = texel_params(axes)
+    col0 = np.arange(0, 36, 6)
+    mag, _ = magnitude_fresnel("eon", nov[col0], magnitude_alpha(axes)[col0], None)
+    p = fit.Problem("eon", nov[col0], r[col0], mag)
+    texels = np.arange(len(col0))
+    m, _ = fit.fit_texels(p, texels, 1, fit.coarse_pass(p, len(col0), 1))
+    err = np.max(np.abs(fit.pack_inverse(m) - np.array([1.0, 0.0, 0.0, 1.0])))
+    return _result("ltc_eon_r0_is_identity", err, LTC_IDENTITY_TOL, "max |packed M^-1 - (1, 0, 0, 1)| over 6 views")
+
+
 # --- registry ------------------------------------------------------------------------------------------
 
 
@@ -642,6 +672,8 @@ def _registry() -> dict:
 
     checks.update(dielectric.CHECKS)
     checks["ltc_sphere_table_is_snyder"] = ltc_sphere_table_is_snyder
+    checks["eon_albedo_is_one"] = eon_albedo_is_one
+    checks["ltc_eon_r0_is_identity"] = ltc_eon_r0_is_identity
     return checks
 
 

@@ -4,7 +4,10 @@ brute-force integral of f(v, l)(n.l) over the polygon's solid angle, per lobe an
 The brute force is independent of the fit: numpy lobes written from the papers here (not the Warp terms), the
 integral ∫_P f(v, l)(n.l) dω_l estimated with the lobe's own importance sampler on a stratified S x S grid
 (GGX / Beckmann: h ~ D(h)(n.h), l = reflect(v, h), weight f (n.l) / p(l) = G2 (v.h) / ((n.v)(n.h)); charlie,
-lambert: cosine sampling), each sample tested against the polygon (ray from the shading point). The LTC side is
+lambert: cosine sampling), each sample tested against the polygon (ray from the shading point); the diffuse lobes
+gotanda and eon: cosine sampling with f from lutbake's diffuse integrands at each sample (Eq. 4 by its GL quadrature
+at order ``DIFFUSE_ORDER``, not the LTC fit's tabulated and interpolated lobe; EON's closed form, itself tested
+against a numpy port of the paper's listing in tests/test_eon.py). The LTC side is
 lutbake.ltc.polygon.shade at the texel's own (NoV, roughness) (no interpolation: the error measured is the
 fit's, plus the tabulated magnitude's).
 
@@ -36,6 +39,8 @@ LIGHTS = (
     ("triangle", 30, 135, 2.0, 1.0, 40, 0),
     ("triangle", 10, 270, 1.0, 2.0, 0, 0),  # crosses the horizon
 )
+DIFFUSE_MODELS = {"gotanda": "microfacet", "eon": "eon"}  # LTC lobe -> lutbake.integrands.diffuse model
+DIFFUSE_ORDER = 12  # GL order of Eq. 4's m-integral in the brute force (the fit's table uses 8)
 GT_FLOOR = 1.0e-3  # relative errors are taken where the ground truth exceeds this fraction of the magnitude
 
 
@@ -134,12 +139,21 @@ def hits(l: np.ndarray, poly: np.ndarray) -> np.ndarray:
 
 
 def brute_force(lobe: str, nov: float, alpha: float, polys: list[np.ndarray], s: int = 512) -> np.ndarray:
-    """∫_P f(v, l)(n.l) dω_l per polygon (F = 1), the stratified estimator above."""
+    """∫_P f(v, l)(n.l) dω_l per polygon (F = 1), the stratified estimator above (``alpha``: the lobe's parameter,
+    sigma for gotanda, r for eon)."""
     v = np.array([np.sqrt(max(1.0 - nov * nov, 0.0)), 0.0, nov])
-    l, w = sample_lobe(lobe, v, alpha, s)
+    l, w = sample_lobe("lambert" if lobe in DIFFUSE_MODELS else lobe, v, alpha, s)
     above = l[:, 2] > 0
     l, w = l[above], w[above]
-    return np.array([np.sum(w[hits(l, p)]) for p in polys]) / (s * s)
+    inside = [hits(l, p) for p in polys]
+    if lobe in DIFFUSE_MODELS:  # weight f (n.l) / (n.l / pi) at the samples some light covers
+        from ..integrands.diffuse import eval_brdf
+
+        need = np.flatnonzero(np.any(inside, axis=0))
+        w = np.zeros(len(l))
+        vv = np.broadcast_to(v, (len(need), 3))
+        w[need] = np.pi * eval_brdf(DIFFUSE_MODELS[lobe], l[need], vv, alpha, order=DIFFUSE_ORDER)
+    return np.array([np.sum(w[h]) for h in inside]) / (s * s)
 
 
 def ltc_value(t1: np.ndarray, t2: np.ndarray, nov: float, poly: np.ndarray) -> float:
