@@ -80,7 +80,7 @@ def bench_btf() -> dict:
     rng = np.random.default_rng(5)
     both = np.flatnonzero((l[:, 2] <= l[:, 2].min()) & (v[:, 2] <= v[:, 2].min()))
     t = np.arange(len(l)).reshape(16, 32, 32, 32)
-    near = t[:, 0][np.abs(np.subtract.outer(np.arange(32), np.arange(32))) == 1].reshape(-1)  # l ~ v, phi block 0
+    near = t[:, 0][:, np.abs(np.subtract.outer(np.arange(32), np.arange(32))) == 1].reshape(-1)  # l ~ v, phi block 0
     idx = np.unique(np.concatenate([rng.integers(0, len(l), 4000), both, near]))
     ref = D.eval_brdf("microfacet", l[idx], v[idx], sig[idx], order=40)
     ok = np.abs(ref) > 1e-6
