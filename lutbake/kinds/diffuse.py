@@ -18,8 +18,7 @@ from ..edge import alpha_policy, effective_alpha
 from ..integrands.diffuse import DIFFUSE_MODELS, FACET_FRESNEL, diffuse_integrand, f0_factor
 from ..sampling.diffuse import CosineSobol, DiffuseGaussLegendre
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
-from ..sampling.swapped import SwappedAdaptive, SwappedGaussLegendre
-from ..tolerance import tolerance_of
+from ..sampling.swapped import SwappedGaussLegendre
 from .base import Estimation, Key, declare
 
 DEFAULT_ORDER = {"microfacet": 12}  # base GL order (lutbake.sampling.swapped); closed forms: CLOSED_ORDER
@@ -71,15 +70,11 @@ def order_for(o: dict) -> int:
 
 
 def estimator_of(o: dict):
-    """gauss_legendre: the swapped integral for the microfacet model (to the tolerance, or at the fixed order
-    ``samples``), the 2 x 2-panel rule over l otherwise; sobol_cosine: cosine-weighted Sobol' directions l
-    (lutbake.sampling.diffuse)."""
+    """gauss_legendre: the swapped integral for the microfacet model, the 2 x 2-panel rule over l otherwise;
+    sobol_cosine: cosine-weighted Sobol' directions l (lutbake.sampling.diffuse)."""
     order = order_for(o)
     if o["estimator"] == "sobol_cosine":
         return CosineSobol(o["samples"] or DEFAULT_COSINE_SAMPLES, o["seed"], inner_order=order)
-    if o["model"] == "microfacet" and o["samples"] is None:  # to the tolerance (lutbake.tolerance)
-        tol = tolerance_of(o)
-        return SwappedAdaptive(tol.absolute, tol.relative)
     if o["model"] == "microfacet":
         return SwappedGaussLegendre(order)
     return DiffuseGaussLegendre(order)

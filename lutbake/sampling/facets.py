@@ -321,7 +321,7 @@ def fd_microfacet_adaptive_for(F_facet):
         G2 = masking.G2_smith_height_correlated(masking.Lambda_ggx(v[2], alpha), masking.Lambda_ggx(l[2], alpha))
         scale = wp.float64(G2) / (TWO_PI64 * PI64 * p.cl * p.cv)  # f = scale * (sum over panels)
         qe = integrate(
-            p, 3 * (p.n_geo + 1), rules, levels, 0, QUADRATURE_SHARE * tol[0] / scale, QUADRATURE_SHARE * tol[1]
+            p, 3 * (p.n_geo + 1), rules, levels, QUADRATURE_SHARE * tol[0] / scale, QUADRATURE_SHARE * tol[1]
         )
         f = scale * qe[0]
         return wp.vec2d(f, scale * qe[1] + FACET_ROUNDING * wp.abs(f))

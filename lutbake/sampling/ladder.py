@@ -25,9 +25,9 @@ from .arrays import Levels, Rule
 
 @functools.lru_cache(maxsize=None)
 def greedy_ladder_for(panel_sum, max_panels: int):
-    """``integrate(ctx, n_panels, rules, levels, first, target_abs, target_rel) -> vec2d(sum_p Q_p, sum_p d_p)``:
-    every panel at levels ``first`` and ``first`` + 1, then refined until sum_p d_p <= max(target_abs,
-    target_rel |sum_p Q_p|) or every panel is at the last order (module docstring); n_panels <= max_panels."""
+    """``integrate(ctx, n_panels, rules, levels, target_abs, target_rel) -> vec2d(sum_p Q_p, sum_p d_p)``: every
+    panel at the first two levels, then refined until sum_p d_p <= max(target_abs, target_rel |sum_p Q_p|) or every
+    panel is at the last order (module docstring); n_panels <= max_panels."""
     Values = wp.types.vector(length=max_panels, dtype=wp.float64)
     Orders = wp.types.vector(length=max_panels, dtype=wp.int32)  # a panel's level
 
@@ -37,7 +37,6 @@ def greedy_ladder_for(panel_sum, max_panels: int):
         n_panels: int,
         rules: Rule,
         levels: Levels,
-        first: int,
         target_abs: wp.float64,
         target_rel: wp.float64,
     ):
@@ -47,13 +46,12 @@ def greedy_ladder_for(panel_sum, max_panels: int):
         total = wp.float64(0.0)
         err = wp.float64(0.0)
         last = levels.shape[0] - 1
-        bottom = wp.min(first, last)
-        top = wp.min(bottom + 1, last)
+        top = wp.min(1, last)
         for j in range(n_panels):
             fine = panel_sum(ctx, j, rules, levels[top][0], levels[top][1])
             coarse = fine  # one order: the fixed rule, no estimate
-            if top > bottom:
-                coarse = panel_sum(ctx, j, rules, levels[bottom][0], levels[bottom][1])
+            if top > 0:
+                coarse = panel_sum(ctx, j, rules, levels[0][0], levels[0][1])
             q[j] = fine
             d[j] = wp.abs(fine - coarse)
             lev[j] = top

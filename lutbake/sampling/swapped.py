@@ -32,15 +32,13 @@ view), and the error estimate re-integrates probe texels with every order + 8.
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import warp as wp
 
 from ..terms.masking import Lambda_ggx64
-from .arrays import Levels, Rule
-from .hemisphere import ADAPTIVE_ORDERS, QUADRATURE_SHARE, TERMS_ROUNDING, gl_levels
-from .ladder import greedy_ladder_for
+from . import points
 from .panels import (
     MAX_TAIL_CUTS,
     PI64,
@@ -54,144 +52,42 @@ from .panels import (
     sort4,
 )
 
-MAX_ORDER = 96
-GRAZING_NOV = 0.1
-GRAZING_NOV64 = wp.constant(wp.float64(GRAZING_NOV))
-
-
-@wp.struct
-class SwappedTexel:
-    """A texel of the swapped integral: n.v, sin theta_v, alpha, f0, Lambda(n.v), u_v and 1 - u_v (without
-    cancellation), and K (n_tail_cuts)."""
-
-    cv: wp.float64
-    sv: wp.float64
-    a: wp.float64
-    f0: wp.float64
-    lam_v: wp.float64
-    u_v: wp.float64
-    om_v: wp.float64
-    n_geo: int
-
-
-@wp.func
-def swapped_texel(cv: wp.float64, a: wp.float64, f0: wp.float64):
-    t = SwappedTexel()
-    one = wp.float64(1.0)
-    t.cv = cv
-    t.sv = wp.sqrt(wp.max(one - cv * cv, wp.float64(0.0)))
-    t.a = a
-    t.f0 = f0
-    t.lam_v = Lambda_ggx64(cv, a)
-    den_v = a * a * (one - cv * cv) + cv * cv
-    t.u_v = cv * cv / den_v
-    t.om_v = a * a * (one - cv * cv) / den_v  # 1 - u_v without cancellation
-    t.n_geo = n_tail_cuts(a)
-    return t
-
-
-@wp.func
-def smooth(lo: wp.float64, hi: wp.float64, s: wp.float64):
-    return lo + (hi - lo) * s * s * (wp.float64(3.0) - wp.float64(2.0) * s)
-
-
-@wp.func
-def smooth_w(lo: wp.float64, hi: wp.float64, s: wp.float64):
-    return (hi - lo) * wp.float64(6.0) * s * (wp.float64(1.0) - s)
-
 
 @functools.lru_cache(maxsize=None)
-def swapped_panel_for(T):
-    """``swapped_panel(texel, j, rules, ru, nu, rm, nm, rp, npp) -> float64``: u panel j (0 .. 2 (K + 1) - 1: geometric
-    panel j // 2, its part below (j even) or above u_v where u_v cuts it) of E(v) (2 pi^2 (n.v)) / c(f0), with the GL
-    rules of orders nu (u), nm (mu = n.l) and npp (the arcs) at offsets ru, rm, rp into ``rules``; 0 for an empty
-    panel. ``T(c, f0)``: the facet transmission (float64; lutbake.terms.diffuse.T_*)."""
+def swapped_kernel(T):
+    """Kernel: E(nov[i]) / c(f0) for alpha[i], f0[i] and the facet transmission ``T(c, f0)`` (float64;
+    lutbake.terms.diffuse.T_*). rule[i] = (n_u, n_μ, n_φ), the texel's GL orders for u, μ = n.l and the arcs:
+    row n of xs, ws (``rules``) is the n-point rule on [0, 1], ns[n] = n."""
 
     @wp.func
     def arc_integral(
-        cm: wp.float64, sm: wp.float64, cx: wp.float64, sx: wp.float64, f0: wp.float64, rules: Rule, rp: int, n: int
+        cm: wp.float64,
+        sm: wp.float64,
+        cx: wp.float64,
+        sx: wp.float64,
+        f0: wp.float64,
+        xp: wp.array2d(dtype=wp.float64),
+        wpp: wp.array2d(dtype=wp.float64),
+        rp: int,
+        n: int,
     ):
         """∫ (m.x)+ T(m.x) dφ over the arc where m.x > 0 (2 ∫_0^w, the arc being symmetric)."""
         w = arc_half_width(cm, sm, cx, sx)
         acc = wp.float64(0.0)
         if w > wp.float64(0.0):
             for j in range(n):
-                c = cm * cx + sm * sx * wp.cos(w * rules[rp + j][0])
+                c = cm * cx + sm * sx * wp.cos(w * xp[rp, j])
                 if c > wp.float64(0.0):
-                    acc = acc + rules[rp + j][1] * c * T(c, f0)
+                    acc = acc + wpp[rp, j] * c * T(c, f0)
         return wp.float64(2.0) * w * acc
 
     @wp.func
-    def swapped_panel(t: SwappedTexel, j: int, rules: Rule, ru: int, nu: int, rm: int, nm: int, rp: int, npp: int):
-        one = wp.float64(1.0)
-        zero = wp.float64(0.0)
-        k = j // 2
-        h = j % 2
-        a = t.a
-        prev = zero
-        om_prev = one
-        if k > 0:
-            r2p = wp.pow(TAIL_RATIO64, wp.float64(2 * k))
-            om_prev = one / (one + r2p)
-            prev = r2p / (one + r2p)
-        cut = one
-        om_cut = zero
-        if k < t.n_geo:
-            r2 = wp.pow(TAIL_RATIO64, wp.float64(2 * (k + 1)))
-            om_cut = one / (one + r2)
-            cut = r2 / (one + r2)
-        split = t.u_v > prev and t.u_v < cut
-        lo = prev
-        om_lo = om_prev
-        om_hi = om_cut
-        if split and h == 0:
-            om_hi = t.om_v
-        if split and h == 1:
-            lo = t.u_v
-            om_lo = t.om_v
-        du = om_lo - om_hi
-        acc = zero
-        if (h == 0 or split) and du > zero:
-            for q in range(nu):
-                s = rules[ru + q][0]
-                wu = rules[ru + q][1] * du * wp.float64(6.0) * s * (one - s)
-                csm = facet_cos_sin(lo, du, om_hi, s, a)
-                cm = csm[0]
-                sm = csm[1]
-                V = arc_integral(cm, sm, t.cv, t.sv, t.f0, rules, rp, npp)
-                if V > zero:
-                    # H(theta_m): mu = n.l on four panels cut at sin(theta_m), 2 alpha and 16 alpha (sorted)
-                    cuts = sort4(
-                        zero,
-                        wp.min(sm, one),
-                        wp.min(wp.float64(2.0) * a, one),
-                        wp.min(wp.float64(16.0) * a, one),
-                    )
-                    H = zero
-                    for pm in range(4):
-                        ends = interval(pm, cuts, one)
-                        mlo = ends[0]
-                        mhi = ends[1]
-                        if mhi > mlo:
-                            for r in range(nm):
-                                x = rules[rm + r][0]
-                                mu = smooth(mlo, mhi, x)
-                                wmu = rules[rm + r][1] * smooth_w(mlo, mhi, x)
-                                sl = wp.sqrt(wp.max(one - mu * mu, zero))
-                                g2 = one / (one + t.lam_v + Lambda_ggx64(mu, a))
-                                H = H + wmu * g2 * arc_integral(cm, sm, mu, sl, t.f0, rules, rp, npp)
-                    acc = acc + wu * V * H / cm
-        return acc
+    def smooth(lo: wp.float64, hi: wp.float64, s: wp.float64):
+        return lo + (hi - lo) * s * s * (wp.float64(3.0) - wp.float64(2.0) * s)
 
-    return swapped_panel
-
-
-@functools.lru_cache(maxsize=None)
-def swapped_kernel(T):
-    """Kernel: E(nov[i]) / c(f0) for alpha[i], f0[i] and the facet transmission ``T(c, f0)`` (float64;
-    lutbake.terms.diffuse.T_*). rule[i] = (n_u, n_μ, n_φ), the texel's GL orders for u, μ = n.l and the arcs:
-    rules[offsets[n] : offsets[n] + n] is the n-point rule on [0, 1] (``rules``)."""
-    panel = swapped_panel_for(T)
+    @wp.func
+    def smooth_w(lo: wp.float64, hi: wp.float64, s: wp.float64):
+        return (hi - lo) * wp.float64(6.0) * s * (wp.float64(1.0) - s)
 
     @wp.kernel(enable_backward=False, module="unique")
     def albedo_kernel(
@@ -199,69 +95,105 @@ def swapped_kernel(T):
         alpha: wp.array(dtype=wp.float64),
         f0: wp.array(dtype=wp.float64),
         rule: wp.array2d(dtype=int),
-        rules: Rule,
-        offsets: wp.array(dtype=int),
+        xs: wp.array2d(dtype=wp.float64),
+        ws: wp.array2d(dtype=wp.float64),
+        ns: wp.array(dtype=int),
         out: wp.array2d(dtype=wp.float64),
     ):
         i = wp.tid()
-        t = swapped_texel(nov[i], alpha[i], f0[i])
-        nu = rule[i, 0]
-        nm = rule[i, 1]
-        npp = rule[i, 2]
-        acc = wp.float64(0.0)
-        for j in range(2 * (t.n_geo + 1)):
-            acc = acc + panel(t, j, rules, offsets[nu], nu, offsets[nm], nm, offsets[npp], npp)
-        out[i, 0] = acc / (wp.float64(2.0) * PI64 * PI64 * t.cv)
+        one = wp.float64(1.0)
+        zero = wp.float64(0.0)
+        cv = nov[i]
+        a = alpha[i]
+        ff = f0[i]
+        ru = rule[i, 0]
+        rm = rule[i, 1]
+        rp = rule[i, 2]
+        nu = ns[ru]
+        nm = ns[rm]
+        npp = ns[rp]
+        sv = wp.sqrt(wp.max(one - cv * cv, zero))
+        lam_v = Lambda_ggx64(cv, a)
+        den_v = a * a * (one - cv * cv) + cv * cv
+        u_v = cv * cv / den_v
+        om_v = a * a * (one - cv * cv) / den_v  # 1 - u_v without cancellation
+        n_geo = n_tail_cuts(a)
+        acc = zero
+        prev = zero
+        om_prev = one
+        for k in range(n_geo + 1):
+            cut = one
+            om_cut = zero
+            if k < n_geo:
+                r2 = wp.pow(TAIL_RATIO64, wp.float64(2 * (k + 1)))
+                om_cut = one / (one + r2)
+                cut = r2 / (one + r2)
+            split = u_v > prev and u_v < cut
+            for h in range(2):
+                lo = prev
+                om_lo = om_prev
+                om_hi = om_cut
+                if split and h == 0:
+                    om_hi = om_v
+                if split and h == 1:
+                    lo = u_v
+                    om_lo = om_v
+                du = om_lo - om_hi
+                if (h == 0 or split) and du > zero:
+                    for q in range(nu):
+                        s = xs[ru, q]
+                        wu = ws[ru, q] * du * wp.float64(6.0) * s * (one - s)
+                        csm = facet_cos_sin(lo, du, om_hi, s, a)
+                        cm = csm[0]
+                        sm = csm[1]
+                        V = arc_integral(cm, sm, cv, sv, ff, xs, ws, rp, npp)
+                        if V > zero:
+                            # H(theta_m): mu = n.l on four panels cut at sin(theta_m), 2 alpha and 16 alpha (sorted)
+                            cuts = sort4(
+                                zero,
+                                wp.min(sm, one),
+                                wp.min(wp.float64(2.0) * a, one),
+                                wp.min(wp.float64(16.0) * a, one),
+                            )
+                            H = zero
+                            for pm in range(4):
+                                ends = interval(pm, cuts, one)
+                                mlo = ends[0]
+                                mhi = ends[1]
+                                if mhi > mlo:
+                                    for q in range(nm):
+                                        t = xs[rm, q]
+                                        mu = smooth(mlo, mhi, t)
+                                        wmu = ws[rm, q] * smooth_w(mlo, mhi, t)
+                                        sl = wp.sqrt(wp.max(one - mu * mu, zero))
+                                        g2 = one / (one + lam_v + Lambda_ggx64(mu, a))
+                                        H = H + wmu * g2 * arc_integral(cm, sm, mu, sl, ff, xs, ws, rp, npp)
+                            acc = acc + wu * V * H / cm
+            prev = cut
+            om_prev = om_cut
+        out[i, 0] = acc / (wp.float64(2.0) * PI64 * PI64 * cv)
 
     return albedo_kernel
 
 
-@functools.lru_cache(maxsize=None)
-def swapped_adaptive_kernel(T):
-    """Kernel: out[i] = (E / c(f0), its error estimate / c(f0)) for texel[i] = (n.v, alpha, f0, absolute tolerance
-    on E / c(f0)) and the relative tolerance ``tol_rel``: every u panel at the orders ``levels`` (the same order for
-    u, mu and the arcs), refined greedily (lutbake.sampling.ladder); the estimate adds TERMS_ROUNDING |E|."""
-    panel = swapped_panel_for(T)
-
-    @wp.func
-    def ladder_panel(t: SwappedTexel, j: int, rules: Rule, off: int, n: int):
-        return panel(t, j, rules, off, n, off, n, off, n)
-
-    integrate = greedy_ladder_for(ladder_panel, 2 * (MAX_TAIL_CUTS + 1))
-
-    @wp.kernel(enable_backward=False, module="unique")
-    def albedo_adaptive_kernel(
-        texel: wp.array(dtype=wp.vec4d),
-        tol_rel: wp.float64,
-        rules: Rule,
-        levels: Levels,
-        levels_grazing: Levels,
-        out: wp.array2d(dtype=wp.float64),
-    ):
-        i = wp.tid()
-        x = texel[i]  # n.v, alpha, f0, the absolute tolerance on E / c(f0)
-        t = swapped_texel(x[0], x[1], x[2])
-        scale = wp.float64(1.0) / (wp.float64(2.0) * PI64 * PI64 * t.cv)
-        share = QUADRATURE_SHARE
-        n_panels = 2 * (t.n_geo + 1)
-        if t.cv < GRAZING_NOV64:  # the 1 / (n.v) and the steep Lambda(n.v) amplify the error: the orders x 1.5
-            qe = integrate(t, n_panels, rules, levels_grazing, 0, share * x[3] / scale, share * tol_rel)
-        else:
-            qe = integrate(t, n_panels, rules, levels, 0, share * x[3] / scale, share * tol_rel)
-        e = scale * qe[0]
-        out[i, 0] = e
-        out[i, 1] = scale * qe[1] + TERMS_ROUNDING * wp.abs(e)
-
-    return albedo_adaptive_kernel
+MAX_ORDER = 96
+GRAZING_NOV = 0.1
 
 
 @functools.lru_cache(maxsize=None)
 def rules(device: str):
-    """The GL rules of orders 1..MAX_ORDER on [0, 1], concatenated ((node, weight) rows), and the offset of order n
-    (offsets[n]; offsets[0] unused), as Warp arrays."""
-    allr, offsets = gl_levels(tuple(range(1, MAX_ORDER + 1)))
-    offs = np.concatenate([[0], offsets[:, 0]]).astype(np.int32)
-    return wp.array(allr, dtype=wp.vec2d, device=device), wp.array(offs, dtype=int, device=device)
+    """GL rules of orders 0..MAX_ORDER as rows of (MAX_ORDER + 1, MAX_ORDER) arrays (row n = order n)."""
+    xs = np.zeros((MAX_ORDER + 1, MAX_ORDER))
+    ws = np.zeros_like(xs)
+    for n in range(1, MAX_ORDER + 1):
+        x, w = points.gauss_legendre(n)
+        xs[n, :n], ws[n, :n] = x, w
+    ns = np.arange(MAX_ORDER + 1, dtype=np.int32)
+    return (
+        wp.array(xs, dtype=wp.float64, device=device),
+        wp.array(ws, dtype=wp.float64, device=device),
+        wp.array(ns, dtype=int, device=device),
+    )
 
 
 def orders_for(nov: np.ndarray, alpha: np.ndarray, base: int) -> np.ndarray:
@@ -302,34 +234,6 @@ def integrate_swapped(
     )
     c = integrand.f0_scale
     return out.numpy()[:, 0] * np.array([c(x) for x in f0a]) if n else np.zeros(0)
-
-
-def integrate_swapped_adaptive(
-    integrand, nov, alpha, f0, tol: tuple[float, float], orders=ADAPTIVE_ORDERS, device: str = "cpu"
-) -> tuple[np.ndarray, np.ndarray]:
-    """E(nov_i) for GGX alpha_i and f0_i (rho = 1) of the microfacet diffuse ``integrand`` to the tolerance ``tol``
-    (absolute, relative) on E, and each texel's error estimate: float64 (N,) each (``swapped_adaptive_kernel``)."""
-    nov = np.asarray(nov, dtype=np.float64).reshape(-1)
-    n = len(nov)
-    c = np.array([integrand.f0_scale(x) for x in np.broadcast_to(np.asarray(f0, np.float64), (n,))])
-    texel = np.stack([nov, *(np.broadcast_to(np.asarray(x, np.float64), (n,)) for x in (alpha, f0)), tol[0] / c], 1)
-    grazing = tuple(min(n + n // 2, MAX_ORDER) for n in orders)
-    all_orders = tuple(sorted(set(orders) | set(grazing)))
-    all_rules, offsets = gl_levels(all_orders)
-    at = dict(zip(all_orders, offsets[:, 0]))
-    levels, levels_grazing = (np.array([[at[n], n] for n in o], np.int32) for o in (orders, grazing))
-    out = wp.zeros((n, 2), dtype=wp.float64, device=device)
-    arrays = [
-        wp.array(np.ascontiguousarray(texel), dtype=wp.vec4d, device=device),
-        wp.float64(tol[1]),
-        wp.array(all_rules, dtype=wp.vec2d, device=device),
-        wp.array(levels, dtype=wp.vec2i, device=device),
-        wp.array(levels_grazing, dtype=wp.vec2i, device=device),
-        out,
-    ]
-    wp.launch(swapped_adaptive_kernel(integrand.transmission), dim=n, inputs=arrays, device=device)
-    e = out.numpy()
-    return e[:, 0] * c, e[:, 1] * c
 
 
 def u_panels(nov: np.ndarray, alpha: np.ndarray) -> np.ndarray:
@@ -383,36 +287,3 @@ class SwappedGaussLegendre:
     def refined(self):
         e = self.extra + ESTIMATE_EXTRA_ORDER
         return SwappedGaussLegendre(self.order, e), f"orders (n_u, n_mu, n_phi) - orders + {e}"
-
-
-@dataclass(frozen=True)
-class SwappedAdaptive:
-    """The microfacet diffuse albedo by the swapped integral to a tolerance (``absolute``, ``relative`` on E): every u
-    panel up the orders ``orders`` (u, mu and the arcs at the same order) until the sum of the panels'
-    |Q_(k) - Q_(k-1)| is within the tolerance (``swapped_adaptive_kernel``); ``evaluate_with_error`` also returns
-    each texel's estimate. Inputs: nov, alpha, f0."""
-
-    absolute: float
-    relative: float
-    orders: tuple[int, ...] = ADAPTIVE_ORDERS
-    name: str = "gauss_legendre_swapped"
-
-    def samples(self, inputs: dict) -> np.ndarray:  # nominal: every panel at the first two orders (the work adapts)
-        nov, alpha = (np.asarray(inputs[k], np.float64) for k in ("nov", "alpha"))
-        return sum(evaluations(np.full((len(nov), 3), n), nov, alpha) for n in self.orders[:2])
-
-    def prepare(self, integrand, device: str) -> None:
-        wp.load_module(swapped_adaptive_kernel(integrand.transmission).module, device=device)
-
-    def evaluate_with_error(self, integrand, inputs: dict, device: str) -> tuple[np.ndarray, np.ndarray]:
-        nov, alpha, f0 = (np.asarray(inputs[k], np.float64) for k in ("nov", "alpha", "f0"))
-        e, err = integrate_swapped_adaptive(
-            integrand, nov, alpha, f0, (self.absolute, self.relative), self.orders, device
-        )
-        return e[:, None], err[:, None]
-
-    def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
-        return self.evaluate_with_error(integrand, inputs, device)[0]
-
-    def refined(self):
-        return replace(self, absolute=self.absolute / 100, relative=self.relative / 100), "tolerance / 100"
