@@ -45,19 +45,20 @@ class Tolerance:
         return f"max({self.absolute:.3g}, {self.relative:.3g} |v|) per value"
 
 
-def default_tolerance(options) -> Tolerance:
-    """The storage-derived default (module docstring) for a spec's ``format`` and ``dtype``."""
+def default_tolerance(options, float32: Tolerance | None = None) -> Tolerance:
+    """The storage-derived default (module docstring) for a spec's ``format`` and ``dtype``; ``float32``: a kind's
+    own float32 default (kind btf: 1e-5 relative, its values spanning five decades), else FLOAT32_ABSOLUTE."""
     if options.get("format") == "png16":
         return Tolerance(QUARTER * UNORM16_QUANTUM, 0.0)
     if options.get("dtype") == "half":
         return Tolerance(QUARTER * HALF_SUBNORMAL_STEP, QUARTER * HALF_REL_STEP)
-    return Tolerance(FLOAT32_ABSOLUTE, FLOAT32_RELATIVE)
+    return float32 or Tolerance(FLOAT32_ABSOLUTE, FLOAT32_RELATIVE)
 
 
-def tolerance_of(options) -> Tolerance:
+def tolerance_of(options, float32: Tolerance | None = None) -> Tolerance:
     """The spec's tolerance: its ``tolerance`` / ``relative_tolerance`` keys where set, the default otherwise.
     Setting only ``tolerance`` drops the default relative part (and vice versa): the keys say the whole target."""
     tol, rel = options.get("tolerance"), options.get("relative_tolerance")
     if tol is None and rel is None:
-        return default_tolerance(options)
+        return default_tolerance(options, float32)
     return Tolerance(float(tol or 0.0), float(rel or 0.0))

@@ -24,6 +24,7 @@ from ..axes import TEXELS, Axis, sigma_alpha
 from ..catalog import DIFFUSE_MODELS, f0_factor
 from ..edge import effective_alpha
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..tolerance import Tolerance, tolerance_of
 from . import diffuse
 from .base import Estimation, Key, declare
 
@@ -31,9 +32,12 @@ PARAMETRISATIONS = {
     "cosines": "x = NoL in [0, 1], y = NoV in [0, 1], row blocks = cos(phi) in [-1, 1]",
     "angles": "x = theta_l in [0, pi/2], y = theta_v in [0, pi/2], row blocks = phi in [0, pi] (radians)",
 }
-DEFAULT_ORDER = 12  # GL order of the m-integral (docs/diffuse.md: measured relative errors on the 16 x 32^3 grid)
-GRAZING_COS = 0.15  # texels with n.l and n.v both below it get order + GRAZING_EXTRA
+DEFAULT_ORDER = 12  # GL order of the m-integral with ``samples`` unset and estimator sobol_ndf's nominal record
+GRAZING_COS = 0.15  # fixed order (``samples`` set): texels with n.l and n.v both below it get order + GRAZING_EXTRA
 GRAZING_EXTRA = 8
+# the float32 default tolerance of the microfacet btf: relative, as its values span five decades (f ~ 1e-5 in grazing
+# back-scatter to 0.8); half and png16 keep the storage-derived defaults of lutbake.tolerance
+FLOAT32_TOLERANCE = Tolerance(0.0, 1.0e-5)
 
 KEYS = {
     "size": Key("size", "int_pair", [32, 32], "[light, view] texel counts (columns, rows per phi block)", minimum=1),
@@ -151,9 +155,28 @@ BTF_ESTIMATORS = {
 }
 
 
+def reciprocal_inputs(l: np.ndarray, v: np.ndarray, o: dict) -> tuple[np.ndarray, np.ndarray]:
+    """l, v with every texel whose light index exceeds its view index given the directions of its reciprocal
+    (light and view indices swapped, same phi and sigma): f(l, v) = f(v, l), and rotating by -phi about n and
+    mirroring y maps (v, l) onto that texel's (l, v). Then a texel and its reciprocal are one integral
+    (PointAdaptive integrates equal rows once) and every (phi, sigma) block is exactly symmetric. Only where the
+    light and view axes are the same grid (equal counts): otherwise l, v unchanged."""
+    nl, nv = o["size"]
+    if nl != nv:
+        return l, v
+    t = np.arange(len(l)).reshape(-1, nv, nl)  # (sigma x phi blocks, view, light)
+    src = t.transpose(0, 2, 1).reshape(-1)  # texel (b, i, j) -> (b, j, i)
+    iv, il = np.meshgrid(np.arange(nv), np.arange(nl), indexing="ij")
+    swap = np.broadcast_to(il > iv, t.shape).reshape(-1)
+    l, v = l.copy(), v.copy()
+    l[swap], v[swap] = l[src[swap]], v[src[swap]]
+    return l, v
+
+
 def plan(spec) -> TexelPlan:
     from ..integrands.diffuse import diffuse_integrand
-    from ..sampling.diffuse import PointEvaluation, PointSobol
+    from ..sampling.diffuse import PointAdaptive, PointEvaluation, PointSobol
+    from ..sampling.facets import FACET_ORDERS
     from ..sampling.panels import n_tail_cuts_np
 
     o = spec.options
@@ -162,6 +185,9 @@ def plan(spec) -> TexelPlan:
     model, ff = o["model"], o["facet_fresnel"]
     order = (o["samples"] if o["estimator"] == "gauss_legendre" else None) or DEFAULT_ORDER
     integrated = model == "microfacet"
+    adaptive = integrated and o["estimator"] == "gauss_legendre" and o["samples"] is None
+    if adaptive:
+        l, v = reciprocal_inputs(l, v, o)
     # texels with light and view both grazing hold the smallest values (f ~ 1e-5 in back-scattering): their
     # relative error converges last, so they get order + GRAZING_EXTRA (about 1 % of the texels)
     orders = np.where((l[:, 2] < GRAZING_COS) & (v[:, 2] < GRAZING_COS), order + GRAZING_EXTRA, order)
@@ -194,9 +220,15 @@ def plan(spec) -> TexelPlan:
     if integrated:  # at most (K + 3) u panels (K + 1 geometric ones, cut at u_l and u_v) x 4 arcs x n^2
         a = effective_alpha(sigma_alpha(sig_axis.values(), o["sigma_to_alpha"]), False)
         per = int(round(float(np.mean(n_tail_cuts_np(a) + 3)) * 4 * order * order))
+        if adaptive:  # nominal: every panel at the first two orders, on at most two phi pieces (the work adapts)
+            per = int(round(float(np.mean(n_tail_cuts_np(a) + 3)) * 2 * sum(n * n for n in FACET_ORDERS[:2])))
     estimator = PointEvaluation(o["f0"], name="gauss_legendre" if integrated else "closed_form", evaluations=per)
+    if adaptive:
+        tol = tolerance_of(o, FLOAT32_TOLERANCE)
+        estimator = PointAdaptive(tol.absolute, tol.relative, o["f0"], evaluations=per)
     if o["estimator"] == "sobol_ndf":
         estimator = PointSobol(o["samples"] or DEFAULT_SOBOL, o["seed"], f0=o["f0"])
+    block = o["size"][0] * o["size"][1]
     return per_texel_plan(
         diffuse_integrand(model, ff),
         estimator,
@@ -207,6 +239,7 @@ def plan(spec) -> TexelPlan:
         extra=extra,
         relative_error=True,
         error_estimate=integrated,
+        tile_texels=block * -(-512 // block) if adaptive else None,  # whole blocks (reciprocal_inputs)
     )
 
 

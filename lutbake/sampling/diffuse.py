@@ -26,8 +26,9 @@ import warp as wp
 
 from ..terms.frame import view_dir
 from . import points
-from .arrays import Floats, Points2, Rows64, Rule, Values64
-from .facets import fd_microfacet_sobol_for
+from .arrays import Floats, Levels, Points2, Rows64, Rule, Values64
+from .facets import FACET_ORDERS, fd_microfacet_adaptive_for, fd_microfacet_sobol_for
+from .hemisphere import gl_levels
 
 PI64 = wp.constant(wp.float64(math.pi))
 REFINE_ORDER = 8  # the error estimates re-evaluate probe texels with every GL order + 8
@@ -266,3 +267,77 @@ class PointSobol(ScrambledSobol):
             sobol_points(self.budget, self.seed, device),
         ]
         return launch_rows(sobol_point_kernel(integrand.facet), arrays, len(lv), device, (len(lv),))[:, None]
+
+
+@functools.lru_cache(maxsize=None)
+def adaptive_point_kernel(facet):
+    """Kernel: the microfacet f(l, v) at lv[i] = (l, v) to the tolerance ``tol`` (absolute, relative), and its error
+    estimate (lutbake.sampling.facets.fd_microfacet_adaptive_for)."""
+    f = fd_microfacet_adaptive_for(facet)
+
+    @wp.kernel(enable_backward=False, module="unique")
+    def brdf_adaptive_kernel(
+        lv: wp.array2d(dtype=wp.vec3), alpha: Floats, f0: float, tol: wp.vec2d, rules: Rule, levels: Levels, out: Rows64
+    ):
+        i = wp.tid()
+        fe = f(lv[i, 0], lv[i, 1], alpha[i], f0, rules, levels, tol)
+        out[i, 0] = fe[0]  # f
+        out[i, 1] = fe[1]  # its error estimate
+
+    return brdf_adaptive_kernel
+
+
+def eval_points_adaptive(integrand, l, v, alpha, f0: float, tol, orders=FACET_ORDERS, device: str = "cpu"):
+    """The microfacet f(l_i, v_i) to the tolerance ``tol`` (absolute, relative): (values, error estimates), float64
+    (N, 1) each."""
+    lv = np.ascontiguousarray(np.stack([np.asarray(l, np.float32), np.asarray(v, np.float32)], axis=1))
+    n = len(lv)
+    rules, levels = gl_levels(tuple(orders))
+    arrays = [
+        wp.array(lv, dtype=wp.vec3, device=device),
+        wp.array(np.asarray(alpha, np.float32), dtype=float, device=device),
+        float(f0),
+        wp.vec2d(*tol),
+        wp.array(rules, dtype=wp.vec2d, device=device),
+        wp.array(levels, dtype=wp.vec2i, device=device),
+    ]
+    out = launch_rows(adaptive_point_kernel(integrand.facet), arrays, n, device, (n, 2))
+    return out[:, :1], out[:, 1:]
+
+
+@dataclass(frozen=True)
+class PointAdaptive:
+    """The microfacet model's f(l_i, v_i) (kind btf) to a tolerance: the u panels of the m-integral up the orders
+    FACET_ORDERS (lutbake.sampling.facets.fd_microfacet_adaptive_for); ``evaluate_with_error`` also returns each
+    texel's error estimate. Inputs: l, v (N, 3), alpha. Rows with equal inputs (kind btf gives a texel and its
+    reciprocal the same ones) are integrated once: the value of a row never depends on the others."""
+
+    absolute: float
+    relative: float
+    f0: float = 0.0
+    orders: tuple[int, ...] = FACET_ORDERS
+    evaluations: float = 1.0  # nominal evaluations per texel, for the record
+    name: str = "gauss_legendre"
+
+    def samples(self, inputs: dict) -> np.ndarray:
+        return np.full(len(inputs["alpha"]), self.evaluations)
+
+    def prepare(self, integrand, device: str) -> None:
+        wp.load_module(adaptive_point_kernel(integrand.facet).module, device=device)
+
+    def evaluate_with_error(self, integrand, inputs: dict, device: str) -> tuple[np.ndarray, np.ndarray]:
+        n = len(inputs["alpha"])
+        rows = np.concatenate([np.asarray(inputs[k], np.float32).reshape(n, -1) for k in ("l", "v", "alpha")], 1)
+        uniq, back = np.unique(rows, axis=0, return_inverse=True)
+        tol = (self.absolute, self.relative)
+        values, err = eval_points_adaptive(
+            integrand, uniq[:, :3], uniq[:, 3:6], uniq[:, 6], self.f0, tol, self.orders, device
+        )
+        back = back.reshape(-1)
+        return values[back], err[back]
+
+    def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
+        return self.evaluate_with_error(integrand, inputs, device)[0]
+
+    def refined(self):
+        return replace(self, absolute=self.absolute / 100, relative=self.relative / 100), "tolerance / 100"

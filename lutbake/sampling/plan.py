@@ -51,6 +51,9 @@ class TexelPlan:
     # they travel with the tile, so the estimate is a pure function of the tiles wherever they ran, and are
     # handed to error_estimate, never stored in the table
     aux_channels: int = 0
+    # texels per CPU tile where the plan wants other than lutbake.executor.TILE_TEXELS (kind btf: whole (sigma, phi)
+    # blocks, so that a tile holds a texel and its reciprocal); any cut still gives the same values
+    tile_texels: int | None = None
 
     @property
     def tile_width(self) -> int:
@@ -131,6 +134,7 @@ def per_texel_plan(
     extra: dict[str, str] | None = None,
     relative_error: bool = False,
     error_estimate: bool = True,
+    tile_texels: int | None = None,
 ) -> TexelPlan:
     """The texel plan of ``grid``'s texels integrated by ``estimator``: texel i = estimator.evaluate(integrand,
     grid inputs of i) (reduced over ``grid.nodes``), the first ``integrand.nch`` channels kept.
@@ -199,4 +203,5 @@ def per_texel_plan(
         extra={**(extra or {}), **tolerance_record},
         error_estimate=(adaptive_estimate if adaptive else estimate) if error_estimate else None,
         aux_channels=integrand.nch if adaptive else 0,
+        tile_texels=tile_texels,
     )

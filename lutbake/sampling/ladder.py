@@ -1,0 +1,82 @@
+"""A texel's integral over panels, each up a ladder of Gauss-Legendre orders, refined greedily to a tolerance.
+
+The orders are ``levels`` (offset, order) into ``rules`` (the concatenated GL rules of
+lutbake.sampling.hemisphere.gl_levels). Every panel is integrated at the first two orders; a panel's value is its
+finer one, Q_(k), and its error estimate d = |Q_(k) - Q_(k-1)| is the error of the coarser one: with exponential
+convergence a bound of Q_(k)'s (the argument of lutbake.sampling.hemisphere.make_gauss_legendre). Then, while the
+texel's estimate sum_p d_p exceeds its target, the panel with the largest d goes one order up (a panel at the last
+order stays). Against a fixed per-panel share of the tolerance (make_gauss_legendre), the texel's error budget goes
+where the error is: panels far below the tolerance stop at the second order.
+
+``greedy_ladder_for(panel_sum, max_panels)`` closes over the panel rule ``panel_sum(ctx, j, rules, offset, order)
+-> float64`` (``ctx``: the texel's constants, a Warp struct; ``j``: the panel's index, 0 .. n_panels - 1; an empty
+panel returns 0 at every order).
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Any
+
+import warp as wp
+
+from .arrays import Levels, Rule
+
+
+@functools.lru_cache(maxsize=None)
+def greedy_ladder_for(panel_sum, max_panels: int):
+    """``integrate(ctx, n_panels, rules, levels, target_abs, target_rel) -> vec2d(sum_p Q_p, sum_p d_p)``: every
+    panel at the first two levels, then refined until sum_p d_p <= max(target_abs, target_rel |sum_p Q_p|) or every
+    panel is at the last order (module docstring); n_panels <= max_panels."""
+    Values = wp.types.vector(length=max_panels, dtype=wp.float64)
+    Orders = wp.types.vector(length=max_panels, dtype=wp.int32)  # a panel's level
+
+    @wp.func
+    def integrate(
+        ctx: Any,
+        n_panels: int,
+        rules: Rule,
+        levels: Levels,
+        target_abs: wp.float64,
+        target_rel: wp.float64,
+    ):
+        q = Values()
+        d = Values()
+        lev = Orders()
+        total = wp.float64(0.0)
+        err = wp.float64(0.0)
+        last = levels.shape[0] - 1
+        top = wp.min(1, last)
+        for j in range(n_panels):
+            fine = panel_sum(ctx, j, rules, levels[top][0], levels[top][1])
+            coarse = fine  # one order: the fixed rule, no estimate
+            if top > 0:
+                coarse = panel_sum(ctx, j, rules, levels[0][0], levels[0][1])
+            q[j] = fine
+            d[j] = wp.abs(fine - coarse)
+            lev[j] = top
+            total = total + fine
+            err = err + d[j]
+        while err > wp.max(target_abs, target_rel * wp.abs(total)):
+            worst = wp.int32(-1)  # the panel with the largest d that can still go up
+            for j in range(n_panels):
+                if lev[j] < last:
+                    if worst < 0:
+                        worst = j
+                    elif d[j] > d[worst]:
+                        worst = j
+            if worst < 0:
+                break
+            k = lev[worst] + 1
+            fine = panel_sum(ctx, worst, rules, levels[k][0], levels[k][1])
+            d[worst] = wp.abs(fine - q[worst])
+            q[worst] = fine
+            lev[worst] = k
+            total = wp.float64(0.0)
+            err = wp.float64(0.0)
+            for j in range(n_panels):
+                total = total + q[j]
+                err = err + d[j]
+        return wp.vec2d(total, err)
+
+    return integrate
