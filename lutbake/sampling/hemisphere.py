@@ -51,7 +51,7 @@ import warp as wp
 
 from ..terms.frame import view_dir
 from . import points
-from .arrays import Points2, Rows64, Rule, Values64
+from .arrays import PhiRule, Points2, Rows64, Rule, Values64
 
 PI64 = wp.constant(wp.float64(math.pi))
 
@@ -61,6 +61,7 @@ PI64 = wp.constant(wp.float64(math.pi))
 TERMS_ROUNDING = wp.constant(wp.float64(1.0e-7))
 QUADRATURE_SHARE = wp.constant(wp.float64(0.9))  # of the tolerance; the rest is left to TERMS_ROUNDING
 PANEL_RATIO = 4.0  # panels grow geometrically in theta_h (and in pi/2 - theta_h) by this factor
+PANEL_MERGE = 2.0  # ... and no NDF-peak breakpoint lies within this factor of a horizon breakpoint (next_theta)
 
 
 @wp.func
@@ -92,12 +93,20 @@ def next_theta(t_lo: wp.float64, theta_a: wp.float64, theta_peak: wp.float64):
     - the NDF-peak breakpoints theta_peak R^j (below pi/4): the tail of D decays like a power of theta;
     - the horizon breakpoints: theta_a (c* = -1), then geometric from theta_a up to pi/4 and from
       theta_b = pi/2 - theta_a down to pi/4 (c* ~ -cot(theta_v) / (2 theta_h) varies on every scale
-      between theta_a and pi/4 at grazing view)."""
+      between theta_a and pi/4 at grazing view).
+    A peak breakpoint beyond the first (theta_peak, the end of the u panel) within a factor PANEL_MERGE of a horizon
+    breakpoint is skipped: it would cut a sliver that costs a whole panel's nodes."""
     quarter = PI64 * wp.float64(0.25)
     half = PI64 * wp.float64(0.5)
+    merge = wp.float64(PANEL_MERGE)
     if t_lo < quarter:
-        t = wp.min(next_geometric(t_lo, theta_a), quarter)
-        return wp.min(t, next_geometric(t_lo, theta_peak))
+        t_h = wp.min(next_geometric(t_lo, theta_a), quarter)
+        t_p = next_geometric(t_lo, theta_peak)
+        if t_p > theta_peak and t_p < t_lo * merge:  # t_lo is a horizon breakpoint just below t_p
+            t_p = t_p * wp.float64(PANEL_RATIO)
+        if t_p > theta_peak and t_h < t_p * merge:  # a horizon breakpoint just above t_p
+            t_p = t_h
+        return wp.min(t_h, t_p)
     d = wp.max((half - t_lo) / wp.float64(PANEL_RATIO), theta_a)
     return half - d
 
@@ -209,12 +218,15 @@ def make_gauss_legendre(spec):
         theta_peak: wp.float64,
         eps_l: wp.float64,
         rules: Rule,
+        phi_a: PhiRule,
         off: int,
         n: int,
     ):
-        """The n x n product rule (rules[off : off + n]) over the panel [t_lo, t_hi]: the sum of w g / p."""
+        """The n x n product rule (rules[off : off + n]) over the panel [t_lo, t_hi]: the sum of w g / p. Region A's
+        inner nodes are the same for every texel: ``phi_a[off + j]`` holds them (phi_rule_a)."""
         one = wp.float64(1.0)
         two = wp.float64(2.0)
+        half = wp.float64(0.5)
         a64 = wp.float64(a)
         cos_v = wp.float64(v[2])
         sin_v = wp.float64(v[0])
@@ -230,33 +242,51 @@ def make_gauss_legendre(spec):
                 x = x_lo + dx * s * s * (wp.float64(3.0) - two * s)
                 wk = rules[off + k][1] * dx * wp.float64(6.0) * s * (one - s)
             cos_h, sin_h, wk = outer_node(x, wk, in_u, a64)
-            phimax = PI64
-            eps = PI64  # sinh-map scale; >= phimax makes the map nearly linear
             if in_b:
-                # c* = -cos(theta_v) cos(2 theta_h) / (sin(theta_v) sin(2 theta_h))
-                c_star = -cos_v * (cos_h * cos_h - sin_h * sin_h) / (sin_v * two * sin_h * cos_h)
-                phimax = wp.acos(wp.clamp(c_star, -one, one))
+                # c* = -cos(theta_v) cos(2 theta_h) / (sin(theta_v) sin(2 theta_h)) = cos(phimax)
+                c_star = wp.clamp(-cos_v * (cos_h * cos_h - sin_h * sin_h) / (sin_v * two * sin_h * cos_h), -one, one)
+                s_star = wp.sqrt(one - c_star * c_star)  # sin(phimax)
+                phimax = wp.acos(c_star)
                 # n.l = 2 (n.h) sin(theta_v) sin(theta_h) (cos(phi) - c*): G2's pole at n.l = -eps_l
                 # lies eps_l / slope beyond phimax
-                slope = two * cos_h * sin_v * sin_h * wp.max(wp.sin(phimax), wp.float64(1.0e-12))
+                slope = two * cos_h * sin_v * sin_h * wp.max(s_star, wp.float64(1.0e-12))
                 eps = wp.max(eps_l / slope, wp.float64(1.0e-12))
-            big_a = asinh64(phimax / eps)
-            for j in range(n):
-                # sinh map (Johnston & Elliott 2005): phi = phimax - eps sinh(big_a (1 - x))
-                # sinh and cosh from one exp (Warp has no sincos; cos and sin of phi stay float64)
-                ex = wp.exp(big_a * (one - rules[off + j][0]))
-                phi = phimax - eps * wp.float64(0.5) * (ex - one / ex)
-                w = wk * rules[off + j][1] * eps * wp.float64(0.5) * (ex + one / ex) * big_a
-                h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
-                gw = facet_weight(v, h, a, prm, in_u)
-                for c in range(wp.static(nch)):
-                    acc[c] = acc[c] + w * wp.float64(gw[c])
+                big_a = asinh64(phimax / eps)
+                for j in range(n):
+                    # sinh map (Johnston & Elliott 2005): phi = phimax - delta, delta = eps sinh(big_a (1 - x));
+                    # sinh and cosh from one exp (Warp has no sincos)
+                    ex = wp.exp(big_a * (one - rules[off + j][0]))
+                    delta = eps * half * (ex - one / ex)
+                    w = wk * rules[off + j][1] * eps * half * (ex + one / ex) * big_a
+                    # cos and sin of phi from those of phimax (c*, s*, float64) and of delta / 2 (float32: relative
+                    # errors ~1e-7 in sin(delta) and 1 - cos(delta) = 2 sin^2(delta / 2), so cos(phi) - c*, which
+                    # sets n.l at the cut, keeps ~1e-7 relative accuracy, as h itself in float32)
+                    hd = float(half * delta)
+                    sd = wp.float64(wp.sin(hd))
+                    cd = wp.float64(wp.cos(hd))
+                    sin_d = two * sd * cd
+                    omc = two * sd * sd
+                    cos_phi = c_star - c_star * omc + s_star * sin_d
+                    sin_phi = s_star - s_star * omc - c_star * sin_d
+                    h = wp.vec3(float(sin_h * cos_phi), float(sin_h * sin_phi), float(cos_h))
+                    gw = facet_weight(v, h, a, prm, in_u)
+                    for c in range(wp.static(nch)):
+                        acc[c] = acc[c] + w * wp.float64(gw[c])
+            else:
+                for j in range(n):
+                    r = phi_a[off + j]  # (cos phi, sin phi, weight): phi over [0, pi], the same for every texel
+                    h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
+                    gw = facet_weight(v, h, a, prm, in_u)
+                    w = wk * r[2]
+                    for c in range(wp.static(nch)):
+                        acc[c] = acc[c] + w * wp.float64(gw[c])
         return acc
 
     @wp.kernel(enable_backward=False, module="unique")
     def gauss_legendre_kernel(
         texel: wp.array(dtype=wp.vec3),
         rules: Rule,
+        phi_a: PhiRule,
         levels: wp.array(dtype=wp.vec2i),
         tol: wp.vec2d,
         out: Rows64,
@@ -282,7 +312,9 @@ def make_gauss_legendre(spec):
             t_lo = t_start
             while t_lo < theta_b:
                 t_hi = next_theta(t_lo, theta_a, theta_peak)
-                q0 = panel_sum(v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, levels[0][0], levels[0][1])
+                q0 = panel_sum(
+                    v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, phi_a, levels[0][0], levels[0][1]
+                )
                 for c in range(wp.static(nch)):
                     mag[c] = mag[c] + q0[c]
                 t_lo = t_hi
@@ -296,12 +328,12 @@ def make_gauss_legendre(spec):
         t_lo = t_start
         while t_lo < theta_b:
             t_hi = next_theta(t_lo, theta_a, theta_peak)
-            q = panel_sum(v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, levels[0][0], levels[0][1])
+            q = panel_sum(v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, phi_a, levels[0][0], levels[0][1])
             d = acc_type()  # |Q_(k) - Q_(k-1)|: the error of Q_(k-1), an estimate (and with exponential
             lev = wp.int32(1)  # convergence a bound) of Q_(k)'s
             while lev < n_levels:
                 fine = panel_sum(
-                    v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, levels[lev][0], levels[lev][1]
+                    v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, phi_a, levels[lev][0], levels[lev][1]
                 )
                 ok = wp.int32(1)
                 for c in range(wp.static(nch)):
@@ -415,23 +447,36 @@ ADAPTIVE_ORDERS = (6, 9, 12, 16, 24, 32, 48, 64)
 
 
 @functools.lru_cache(maxsize=None)
-def gl_levels(orders: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
-    """The GL rules of ``orders`` on [0, 1], concatenated ((node, weight) rows), and (offset, order) per order."""
-    rules = [np.stack(points.gauss_legendre(n), axis=1) for n in orders]
-    offsets = np.cumsum([0] + [len(r) for r in rules[:-1]])
-    return np.concatenate(rules), np.stack([offsets, orders], axis=1).astype(np.int32)
+def gl_levels(orders: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The GL rules of ``orders`` on [0, 1], concatenated ((node, weight) rows), their region-A inner rows
+    (phi_rule_a) and (offset, order) per order."""
+    rules = np.concatenate([np.stack(points.gauss_legendre(n), axis=1) for n in orders])
+    offsets = np.cumsum([0] + list(orders[:-1]))
+    return rules, phi_rule_a(rules), np.stack([offsets, orders], axis=1).astype(np.int32)
+
+
+def phi_rule_a(rules: np.ndarray) -> np.ndarray:
+    """Region A's inner rule: phimax = pi and the sinh map's scale eps = pi (make_gauss_legendre) for every texel, so
+    its nodes phi_j = pi - pi sinh(A (1 - x_j)), A = asinh(1), and weights w_j pi A cosh(A (1 - x_j)) are computed
+    once, here: rows (cos phi_j, sin phi_j, weight), float64."""
+    x, w = rules[:, 0], rules[:, 1]
+    big_a = np.arcsinh(1.0)
+    ex = np.exp(big_a * (1.0 - x))
+    phi = np.pi - np.pi * 0.5 * (ex - 1.0 / ex)
+    return np.stack([np.cos(phi), np.sin(phi), w * np.pi * 0.5 * (ex + 1.0 / ex) * big_a], axis=1)
 
 
 def gl_launch(integrand, inputs: dict, orders: tuple[int, ...], tol: tuple[float, float], device: str):
     """The gauss_legendre kernel over texels ``inputs`` at ``orders`` (one: fixed order) and tolerance
     (absolute, relative): (values, error estimates), float64 (n, kernel_channels) each."""
     n, texel = _texels(inputs, device)
-    rules, levels = gl_levels(tuple(orders))
+    rules, phi_a, levels = gl_levels(tuple(orders))
     out = wp.zeros((n, integrand.kernel_channels), dtype=wp.float64, device=device)
     err = wp.zeros((n, integrand.kernel_channels), dtype=wp.float64, device=device)
     args = [
         texel,
         wp.array(rules, dtype=wp.vec2d, device=device),
+        wp.array(phi_a, dtype=wp.vec3d, device=device),
         wp.array(levels, dtype=wp.vec2i, device=device),
         wp.vec2d(*tol),
         out,
