@@ -61,7 +61,6 @@ PI64 = wp.constant(wp.float64(math.pi))
 TERMS_ROUNDING = wp.constant(wp.float64(1.0e-7))
 QUADRATURE_SHARE = wp.constant(wp.float64(0.9))  # of the tolerance; the rest is left to TERMS_ROUNDING
 PANEL_RATIO = 4.0  # panels grow geometrically in theta_h (and in pi/2 - theta_h) by this factor
-PANEL_MERGE = 2.0  # ... and no NDF-peak breakpoint lies within this factor of a horizon breakpoint (next_theta)
 
 
 @wp.func
@@ -93,20 +92,12 @@ def next_theta(t_lo: wp.float64, theta_a: wp.float64, theta_peak: wp.float64):
     - the NDF-peak breakpoints theta_peak R^j (below pi/4): the tail of D decays like a power of theta;
     - the horizon breakpoints: theta_a (c* = -1), then geometric from theta_a up to pi/4 and from
       theta_b = pi/2 - theta_a down to pi/4 (c* ~ -cot(theta_v) / (2 theta_h) varies on every scale
-      between theta_a and pi/4 at grazing view).
-    A peak breakpoint beyond the first (theta_peak, the end of the u panel) within a factor PANEL_MERGE of a horizon
-    breakpoint is skipped: it would cut a sliver that costs a whole panel's nodes."""
+      between theta_a and pi/4 at grazing view)."""
     quarter = PI64 * wp.float64(0.25)
     half = PI64 * wp.float64(0.5)
-    merge = wp.float64(PANEL_MERGE)
     if t_lo < quarter:
-        t_h = wp.min(next_geometric(t_lo, theta_a), quarter)
-        t_p = next_geometric(t_lo, theta_peak)
-        if t_p > theta_peak and t_p < t_lo * merge:  # t_lo is a horizon breakpoint just below t_p
-            t_p = t_p * wp.float64(PANEL_RATIO)
-        if t_p > theta_peak and t_h < t_p * merge:  # a horizon breakpoint just above t_p
-            t_p = t_h
-        return wp.min(t_h, t_p)
+        t = wp.min(next_geometric(t_lo, theta_a), quarter)
+        return wp.min(t, next_geometric(t_lo, theta_peak))
     d = wp.max((half - t_lo) / wp.float64(PANEL_RATIO), theta_a)
     return half - d
 
