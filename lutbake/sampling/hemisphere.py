@@ -35,7 +35,11 @@ lutbake.integrands.specular):
     p_v(h) = G1(v) max(0, v.h) D(h) / (n.v) (Distribution.pdf_vndf).
 
 All accumulate in float64; per-sample terms run in float32; the domain maps run in float64 because
-1 - u underflows float32 for small alpha.
+1 - u underflows float32 for small alpha. Per gauss_legendre node the costly part was the float64 exp, cos and sin of
+the inner map (two thirds of the time, measured on the 128^2 dfg): region A's inner rule is the same for every texel
+(phimax = eps = pi) and is tabulated once on the host (phi_rule_a); region B's cos(phi), sin(phi) come from
+cos(phimax) = c*, sin(phimax) in float64 and sin, cos of (phimax - phi) / 2 in float32, which keeps cos(phi) - c*
+(the distance to the horizon cut) accurate relatively (orders 32: <= 1.5e-8 from the float64 trig on the 128^2 dfg).
 Edge: a texel with alpha = 0 (the integrand has a ``mirror`` and alpha < ALPHA_MIN: lutbake.edge) takes the
 closed-form mirror limit ``mirror(v, param)`` instead of a quadrature.
 """
