@@ -259,6 +259,12 @@ def make_gauss_legendre(spec):
                     hd = float(half * delta)
                     sd = wp.float64(wp.sin(hd))
                     cd = wp.float64(wp.cos(hd))
+                    # back onto the unit circle (one Newton step of 1/sqrt(sd^2 + cd^2) from 1): cos^2 + sin^2 of
+                    # phi stays 1 to ~1e-15, as with float64 trig (sin^2 theta_h = h.x^2 + h.y^2 feeds D_charlie's
+                    # sin^(1/alpha), 1/alpha up to 1e4)
+                    nrm = wp.float64(1.5) - half * (sd * sd + cd * cd)
+                    sd = sd * nrm
+                    cd = cd * nrm
                     sin_d = two * sd * cd
                     omc = two * sd * sd
                     cos_phi = c_star - c_star * omc + s_star * sin_d
