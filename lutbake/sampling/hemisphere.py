@@ -39,7 +39,7 @@ All accumulate in float64; per-sample terms run in float32; the domain maps run 
 the inner map (two thirds of the time, measured on the 128^2 dfg): region A's inner rule is the same for every texel
 (phimax = eps = pi) and is tabulated once on the host (phi_rule_a); region B's cos(phi), sin(phi) come from
 cos(phimax) = c*, sin(phimax) in float64 and sin, cos of (phimax - phi) / 2 in float32, which keeps cos(phi) - c*
-(the distance to the horizon cut) accurate relatively (orders 32: <= 1.5e-8 from the float64 trig on the 128^2 dfg).
+(the distance to the horizon cut) accurate relatively (order 32: <= 1.2e-8 from the float64 trig on the 128^2 dfg).
 Edge: a texel with alpha = 0 (the integrand has a ``mirror`` and alpha < ALPHA_MIN: lutbake.edge) takes the
 closed-form mirror limit ``mirror(v, param)`` instead of a quadrature.
 """
