@@ -135,6 +135,34 @@ def texel_view(t: wp.vec3):
     return v, t[1], t[2], a64, cos_v, sin_v, horizon_scale(cos_v, a64), theta_a, theta_b, wp.atan(a64)
 
 
+@wp.func
+def phi_b(
+    ex: wp.float64, inv_ex: wp.float64, eps: wp.float64, big_a: wp.float64, c_star: wp.float64, s_star: wp.float64
+):
+    """Region B's inner node at e^(big_a (1 - x)) = ex (1 / ex = inv_ex) of the sinh map phi = phimax - delta,
+    delta = eps sinh(big_a (1 - x)): (cos phi, sin phi, d delta / dx). cos and sin of phi come from those of phimax
+    (c*, s*, float64) and of delta / 2 (float32: relative errors ~1e-7 in sin(delta) and in 1 - cos(delta) =
+    2 sin^2(delta / 2), so cos(phi) - c*, which sets n.l at the cut, keeps ~1e-7 relative accuracy, as h itself in
+    float32), put back on the unit circle (one Newton step of 1/sqrt(sd^2 + cd^2) from 1): cos^2 + sin^2 of phi is 1
+    to ~1e-15, as with float64 trig (sin^2 theta_h = h.x^2 + h.y^2 feeds D_charlie's sin^(1/alpha), 1/alpha up to
+    1e4)."""
+    half = wp.float64(0.5)
+    two = wp.float64(2.0)
+    hd = float(half * eps * half * (ex - inv_ex))
+    sd = wp.float64(wp.sin(hd))
+    cd = wp.float64(wp.cos(hd))
+    nrm = wp.float64(1.5) - half * (sd * sd + cd * cd)
+    sd = sd * nrm
+    cd = cd * nrm
+    sin_d = two * sd * cd
+    omc = two * sd * sd
+    return wp.vec3d(
+        c_star - c_star * omc + s_star * sin_d,
+        s_star - s_star * omc - c_star * sin_d,
+        eps * half * (ex + inv_ex) * big_a,
+    )
+
+
 @functools.lru_cache(maxsize=None)
 def outer_variable_for(tan2_from_u, u_from_tan2):
     """The outer variable of the Gauss-Legendre kernels: u = CDF(theta_h) on panels inside the NDF peak (``in_u``),
@@ -221,7 +249,6 @@ def make_gauss_legendre(spec):
         inner nodes are the same for every texel: ``phi_a[off + j]`` holds them (phi_rule_a)."""
         one = wp.float64(1.0)
         two = wp.float64(2.0)
-        half = wp.float64(0.5)
         a64 = wp.float64(a)
         cos_v = wp.float64(v[2])
         sin_v = wp.float64(v[0])
@@ -247,32 +274,26 @@ def make_gauss_legendre(spec):
                 slope = two * cos_h * sin_v * sin_h * wp.max(s_star, wp.float64(1.0e-12))
                 eps = wp.max(eps_l / slope, wp.float64(1.0e-12))
                 big_a = asinh64(phimax / eps)
-                for j in range(n):
-                    # sinh map (Johnston & Elliott 2005): phi = phimax - delta, delta = eps sinh(big_a (1 - x));
-                    # sinh and cosh from one exp (Warp has no sincos)
+                # sinh map (Johnston & Elliott 2005): phi = phimax - eps sinh(big_a (1 - x)); the GL nodes pair up,
+                # x_(n-1-j) = 1 - x_j, so the pair's e^(big_a (1 - x)) are ex and e^big_a / ex: one exp per pair
+                e_a = wp.exp(big_a)
+                inv_e_a = one / e_a
+                for j in range((n + 1) // 2):
                     ex = wp.exp(big_a * (one - rules[off + j][0]))
-                    delta = eps * half * (ex - one / ex)
-                    w = wk * rules[off + j][1] * eps * half * (ex + one / ex) * big_a
-                    # cos and sin of phi from those of phimax (c*, s*, float64) and of delta / 2 (float32: relative
-                    # errors ~1e-7 in sin(delta) and 1 - cos(delta) = 2 sin^2(delta / 2), so cos(phi) - c*, which
-                    # sets n.l at the cut, keeps ~1e-7 relative accuracy, as h itself in float32)
-                    hd = float(half * delta)
-                    sd = wp.float64(wp.sin(hd))
-                    cd = wp.float64(wp.cos(hd))
-                    # back onto the unit circle (one Newton step of 1/sqrt(sd^2 + cd^2) from 1): cos^2 + sin^2 of
-                    # phi stays 1 to ~1e-15, as with float64 trig (sin^2 theta_h = h.x^2 + h.y^2 feeds D_charlie's
-                    # sin^(1/alpha), 1/alpha up to 1e4)
-                    nrm = wp.float64(1.5) - half * (sd * sd + cd * cd)
-                    sd = sd * nrm
-                    cd = cd * nrm
-                    sin_d = two * sd * cd
-                    omc = two * sd * sd
-                    cos_phi = c_star - c_star * omc + s_star * sin_d
-                    sin_phi = s_star - s_star * omc - c_star * sin_d
-                    h = wp.vec3(float(sin_h * cos_phi), float(sin_h * sin_phi), float(cos_h))
+                    inv_ex = one / ex
+                    r = phi_b(ex, inv_ex, eps, big_a, c_star, s_star)
+                    h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
                     gw = facet_weight(v, h, a, prm, in_u)
+                    w = wk * rules[off + j][1] * r[2]
                     for c in range(wp.static(nch)):
                         acc[c] = acc[c] + w * wp.float64(gw[c])
+                    if n - 1 - j > j:
+                        r = phi_b(e_a * inv_ex, ex * inv_e_a, eps, big_a, c_star, s_star)
+                        h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
+                        gw = facet_weight(v, h, a, prm, in_u)
+                        w = wk * rules[off + n - 1 - j][1] * r[2]
+                        for c in range(wp.static(nch)):
+                            acc[c] = acc[c] + w * wp.float64(gw[c])
             else:
                 for j in range(n):
                     r = phi_a[off + j]  # (cos phi, sin phi, weight): phi over [0, pi], the same for every texel
