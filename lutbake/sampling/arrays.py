@@ -7,5 +7,6 @@ Vec3s = wp.array(dtype=wp.vec3)  # one direction per texel
 Points2 = wp.array2d(dtype=float)  # QMC points, one row each (float32)
 Rule = wp.array(dtype=wp.vec2d)  # a Gauss-Legendre rule on [0, 1]: (node, weight) pairs, float64
 Levels = wp.array(dtype=wp.vec2i)  # a ladder of rules: (offset, order) into concatenated Rules (hemisphere.gl_levels)
+PhiRule = wp.array(dtype=wp.vec3d)  # an inner rule in phi: (cos phi, sin phi, weight) rows, float64
 Rows64 = wp.array2d(dtype=wp.float64)  # the float64 output, one row per texel
 Values64 = wp.array(dtype=wp.float64)  # the float64 output, one value per texel

@@ -35,7 +35,11 @@ lutbake.integrands.specular):
     p_v(h) = G1(v) max(0, v.h) D(h) / (n.v) (Distribution.pdf_vndf).
 
 All accumulate in float64; per-sample terms run in float32; the domain maps run in float64 because
-1 - u underflows float32 for small alpha.
+1 - u underflows float32 for small alpha. Per gauss_legendre node the costly part was the float64 exp, cos and sin of
+the inner map (two thirds of the time, measured on the 128^2 dfg): region A's inner rule is the same for every texel
+(phimax = eps = pi) and is tabulated once on the host (phi_rule_a); region B's cos(phi), sin(phi) come from
+cos(phimax) = c*, sin(phimax) in float64 and sin, cos of (phimax - phi) / 2 in float32, which keeps cos(phi) - c*
+(the distance to the horizon cut) accurate relatively (order 32: <= 1.2e-8 from the float64 trig on the 128^2 dfg).
 Edge: a texel with alpha = 0 (the integrand has a ``mirror`` and alpha < ALPHA_MIN: lutbake.edge) takes the
 closed-form mirror limit ``mirror(v, param)`` instead of a quadrature.
 """
@@ -52,7 +56,7 @@ import warp as wp
 from ..catalog import HEMISPHERE_ESTIMATORS
 from ..terms.frame import view_dir
 from . import points
-from .arrays import Points2, Rows64, Rule, Values64
+from .arrays import PhiRule, Points2, Rows64, Rule, Values64
 
 PI64 = wp.constant(wp.float64(math.pi))
 
@@ -130,6 +134,34 @@ def texel_view(t: wp.vec3):
     theta_a = wp.float64(0.5) * wp.atan2(cos_v, sin_v)
     theta_b = PI64 * wp.float64(0.5) - theta_a
     return v, t[1], t[2], a64, cos_v, sin_v, horizon_scale(cos_v, a64), theta_a, theta_b, wp.atan(a64)
+
+
+@wp.func
+def phi_b(
+    ex: wp.float64, inv_ex: wp.float64, eps: wp.float64, big_a: wp.float64, c_star: wp.float64, s_star: wp.float64
+):
+    """Region B's inner node at e^(big_a (1 - x)) = ex (1 / ex = inv_ex) of the sinh map phi = phimax - delta,
+    delta = eps sinh(big_a (1 - x)): (cos phi, sin phi, d delta / dx). cos and sin of phi come from those of phimax
+    (c*, s*, float64) and of delta / 2 (float32: relative errors ~1e-7 in sin(delta) and in 1 - cos(delta) =
+    2 sin^2(delta / 2), so cos(phi) - c*, which sets n.l at the cut, keeps ~1e-7 relative accuracy, as h itself in
+    float32), put back on the unit circle (one Newton step of 1/sqrt(sd^2 + cd^2) from 1): cos^2 + sin^2 of phi is 1
+    to ~1e-15, as with float64 trig (sin^2 theta_h = h.x^2 + h.y^2 feeds D_charlie's sin^(1/alpha), 1/alpha up to
+    1e4)."""
+    half = wp.float64(0.5)
+    two = wp.float64(2.0)
+    hd = float(half * eps * half * (ex - inv_ex))
+    sd = wp.float64(wp.sin(hd))
+    cd = wp.float64(wp.cos(hd))
+    nrm = wp.float64(1.5) - half * (sd * sd + cd * cd)
+    sd = sd * nrm
+    cd = cd * nrm
+    sin_d = two * sd * cd
+    omc = two * sd * sd
+    return wp.vec3d(
+        c_star - c_star * omc + s_star * sin_d,
+        s_star - s_star * omc - c_star * sin_d,
+        eps * half * (ex + inv_ex) * big_a,
+    )
 
 
 @functools.lru_cache(maxsize=None)
@@ -210,10 +242,12 @@ def make_gauss_legendre(spec):
         theta_peak: wp.float64,
         eps_l: wp.float64,
         rules: Rule,
+        phi_a: PhiRule,
         off: int,
         n: int,
     ):
-        """The n x n product rule (rules[off : off + n]) over the panel [t_lo, t_hi]: the sum of w g / p."""
+        """The n x n product rule (rules[off : off + n]) over the panel [t_lo, t_hi]: the sum of w g / p. Region A's
+        inner nodes are the same for every texel: ``phi_a[off + j]`` holds them (phi_rule_a)."""
         one = wp.float64(1.0)
         two = wp.float64(2.0)
         a64 = wp.float64(a)
@@ -231,33 +265,51 @@ def make_gauss_legendre(spec):
                 x = x_lo + dx * s * s * (wp.float64(3.0) - two * s)
                 wk = rules[off + k][1] * dx * wp.float64(6.0) * s * (one - s)
             cos_h, sin_h, wk = outer_node(x, wk, in_u, a64)
-            phimax = PI64
-            eps = PI64  # sinh-map scale; >= phimax makes the map nearly linear
             if in_b:
-                # c* = -cos(theta_v) cos(2 theta_h) / (sin(theta_v) sin(2 theta_h))
-                c_star = -cos_v * (cos_h * cos_h - sin_h * sin_h) / (sin_v * two * sin_h * cos_h)
-                phimax = wp.acos(wp.clamp(c_star, -one, one))
+                # c* = -cos(theta_v) cos(2 theta_h) / (sin(theta_v) sin(2 theta_h)) = cos(phimax)
+                c_star = wp.clamp(-cos_v * (cos_h * cos_h - sin_h * sin_h) / (sin_v * two * sin_h * cos_h), -one, one)
+                s_star = wp.sqrt(one - c_star * c_star)  # sin(phimax)
+                phimax = wp.acos(c_star)
                 # n.l = 2 (n.h) sin(theta_v) sin(theta_h) (cos(phi) - c*): G2's pole at n.l = -eps_l
                 # lies eps_l / slope beyond phimax
-                slope = two * cos_h * sin_v * sin_h * wp.max(wp.sin(phimax), wp.float64(1.0e-12))
+                slope = two * cos_h * sin_v * sin_h * wp.max(s_star, wp.float64(1.0e-12))
                 eps = wp.max(eps_l / slope, wp.float64(1.0e-12))
-            big_a = asinh64(phimax / eps)
-            for j in range(n):
-                # sinh map (Johnston & Elliott 2005): phi = phimax - eps sinh(big_a (1 - x))
-                # sinh and cosh from one exp (Warp has no sincos; cos and sin of phi stay float64)
-                ex = wp.exp(big_a * (one - rules[off + j][0]))
-                phi = phimax - eps * wp.float64(0.5) * (ex - one / ex)
-                w = wk * rules[off + j][1] * eps * wp.float64(0.5) * (ex + one / ex) * big_a
-                h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
-                gw = facet_weight(v, h, a, prm, in_u)
-                for c in range(wp.static(nch)):
-                    acc[c] = acc[c] + w * wp.float64(gw[c])
+                big_a = asinh64(phimax / eps)
+                # sinh map (Johnston & Elliott 2005): phi = phimax - eps sinh(big_a (1 - x)); the GL nodes pair up,
+                # x_(n-1-j) = 1 - x_j, so the pair's e^(big_a (1 - x)) are ex and e^big_a / ex: one exp per pair
+                e_a = wp.exp(big_a)
+                inv_e_a = one / e_a
+                for j in range((n + 1) // 2):
+                    ex = wp.exp(big_a * (one - rules[off + j][0]))
+                    inv_ex = one / ex
+                    r = phi_b(ex, inv_ex, eps, big_a, c_star, s_star)
+                    h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
+                    gw = facet_weight(v, h, a, prm, in_u)
+                    w = wk * rules[off + j][1] * r[2]
+                    for c in range(wp.static(nch)):
+                        acc[c] = acc[c] + w * wp.float64(gw[c])
+                    if n - 1 - j > j:
+                        r = phi_b(e_a * inv_ex, ex * inv_e_a, eps, big_a, c_star, s_star)
+                        h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
+                        gw = facet_weight(v, h, a, prm, in_u)
+                        w = wk * rules[off + n - 1 - j][1] * r[2]
+                        for c in range(wp.static(nch)):
+                            acc[c] = acc[c] + w * wp.float64(gw[c])
+            else:
+                for j in range(n):
+                    r = phi_a[off + j]  # (cos phi, sin phi, weight): phi over [0, pi], the same for every texel
+                    h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
+                    gw = facet_weight(v, h, a, prm, in_u)
+                    w = wk * r[2]
+                    for c in range(wp.static(nch)):
+                        acc[c] = acc[c] + w * wp.float64(gw[c])
         return acc
 
     @wp.kernel(enable_backward=False, module="unique")
     def gauss_legendre_kernel(
         texel: wp.array(dtype=wp.vec3),
         rules: Rule,
+        phi_a: PhiRule,
         levels: wp.array(dtype=wp.vec2i),
         tol: wp.vec2d,
         out: Rows64,
@@ -283,7 +335,9 @@ def make_gauss_legendre(spec):
             t_lo = t_start
             while t_lo < theta_b:
                 t_hi = next_theta(t_lo, theta_a, theta_peak)
-                q0 = panel_sum(v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, levels[0][0], levels[0][1])
+                q0 = panel_sum(
+                    v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, phi_a, levels[0][0], levels[0][1]
+                )
                 for c in range(wp.static(nch)):
                     mag[c] = mag[c] + q0[c]
                 t_lo = t_hi
@@ -297,12 +351,12 @@ def make_gauss_legendre(spec):
         t_lo = t_start
         while t_lo < theta_b:
             t_hi = next_theta(t_lo, theta_a, theta_peak)
-            q = panel_sum(v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, levels[0][0], levels[0][1])
+            q = panel_sum(v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, phi_a, levels[0][0], levels[0][1])
             d = acc_type()  # |Q_(k) - Q_(k-1)|: the error of Q_(k-1), an estimate (and with exponential
             lev = wp.int32(1)  # convergence a bound) of Q_(k)'s
             while lev < n_levels:
                 fine = panel_sum(
-                    v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, levels[lev][0], levels[lev][1]
+                    v, a, prm, t_lo, t_hi, theta_a, theta_peak, eps_l, rules, phi_a, levels[lev][0], levels[lev][1]
                 )
                 ok = wp.int32(1)
                 for c in range(wp.static(nch)):
@@ -411,9 +465,20 @@ ADAPTIVE_ORDERS = (6, 9, 12, 16, 24, 32, 48, 64)
 @functools.lru_cache(maxsize=None)
 def gl_levels(orders: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
     """The GL rules of ``orders`` on [0, 1], concatenated ((node, weight) rows), and (offset, order) per order."""
-    rules = [np.stack(points.gauss_legendre(n), axis=1) for n in orders]
-    offsets = np.cumsum([0] + [len(r) for r in rules[:-1]])
-    return np.concatenate(rules), np.stack([offsets, orders], axis=1).astype(np.int32)
+    rules = np.concatenate([np.stack(points.gauss_legendre(n), axis=1) for n in orders])
+    offsets = np.cumsum([0] + list(orders[:-1]))
+    return rules, np.stack([offsets, orders], axis=1).astype(np.int32)
+
+
+def phi_rule_a(rules: np.ndarray) -> np.ndarray:
+    """Region A's inner rule: phimax = pi and the sinh map's scale eps = pi (make_gauss_legendre) for every texel, so
+    its nodes phi_j = pi - pi sinh(A (1 - x_j)), A = asinh(1), and weights w_j pi A cosh(A (1 - x_j)) are computed
+    once, here: rows (cos phi_j, sin phi_j, weight), float64."""
+    x, w = rules[:, 0], rules[:, 1]
+    big_a = np.arcsinh(1.0)
+    ex = np.exp(big_a * (1.0 - x))
+    phi = np.pi - np.pi * 0.5 * (ex - 1.0 / ex)
+    return np.stack([np.cos(phi), np.sin(phi), w * np.pi * 0.5 * (ex + 1.0 / ex) * big_a], axis=1)
 
 
 def gl_launch(integrand, inputs: dict, orders: tuple[int, ...], tol: tuple[float, float], device: str):
@@ -421,11 +486,13 @@ def gl_launch(integrand, inputs: dict, orders: tuple[int, ...], tol: tuple[float
     (absolute, relative): (values, error estimates), float64 (n, kernel_channels) each."""
     n, texel = _texels(inputs, device)
     rules, levels = gl_levels(tuple(orders))
+    phi_a = phi_rule_a(rules)
     out = wp.zeros((n, integrand.kernel_channels), dtype=wp.float64, device=device)
     err = wp.zeros((n, integrand.kernel_channels), dtype=wp.float64, device=device)
     args = [
         texel,
         wp.array(rules, dtype=wp.vec2d, device=device),
+        wp.array(phi_a, dtype=wp.vec3d, device=device),
         wp.array(levels, dtype=wp.vec2i, device=device),
         wp.vec2d(*tol),
         out,
