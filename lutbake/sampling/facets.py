@@ -34,7 +34,7 @@ import warp as wp
 from ..edge import COS_EPS
 from ..terms import masking
 from ..terms.distributions import GGX
-from .arrays import Levels, Rule
+from .arrays import Floats, Levels, Rows64, Rule, Values64
 from .hemisphere import QUADRATURE_SHARE
 from .ladder import greedy_ladder_for
 from .panels import (
@@ -234,54 +234,119 @@ def on_arc(phi: wp.float64, phx: wp.float64, w: wp.float64):
     return d <= w or d >= TWO_PI64 - w
 
 
+UNode = wp.types.vector(length=5, dtype=wp.float64)  # a u node's (weight, cos theta_m, sin theta_m, w_l, w_v)
+
+
+@wp.func
+def u_node(p: FacetPair, panel: wp.vec3d, rules: Rule, off: int, k: int):
+    """Node k of the smoothstep-mapped u panel ``panel`` (u_panel) under the GL rule rules[off :]: its weight
+    w_k du 6 s (1 - s), the facet's cos / sin theta_m and the half-widths of the arcs where m.l, m.v >= 0. None of
+    them depends on the azimuths of l and v."""
+    one = wp.float64(1.0)
+    s = rules[off + k][0]
+    csm = facet_cos_sin(panel[0], panel[1], panel[2], s, p.alpha)
+    return UNode(
+        rules[off + k][1] * panel[1] * wp.float64(6.0) * s * (one - s),
+        csm[0],
+        csm[1],
+        arc_half_width(csm[0], csm[1], p.cl, p.sl),
+        arc_half_width(csm[0], csm[1], p.cv, p.sv),
+    )
+
+
+@functools.lru_cache(maxsize=None)
+def phi_row_for(F_facet):
+    """``phi_row(l, v, phl, phv, node, f0, rules, off, n)``: the n-point rule in phi_m at the u node ``node``
+    (u_node): the sum of w (m.l)+ (m.v)+ F_facet over the pieces between the arcs' ends that lie on both arcs (on
+    the others the integrand is 0); the nodes' cos / sin are those of the piece's start rotated by the offset."""
+    Ff = F_facet
+
+    @wp.func
+    def phi_row(
+        l: wp.vec3, v: wp.vec3, phl: wp.float64, phv: wp.float64, node: UNode, f0: float, rules: Rule, off: int, n: int
+    ):
+        sm = node[2]
+        wl = node[3]
+        wv = node[4]
+        row = wp.float64(0.0)
+        bs = sort4(wrap_2pi(phl - wl), wrap_2pi(phl + wl), wrap_2pi(phv - wv), wrap_2pi(phv + wv))
+        for q in range(4):
+            ab = interval(q, bs, bs[0] + TWO_PI64)
+            a = ab[0]
+            dphi = ab[1] - a
+            mid = a + wp.float64(0.5) * dphi
+            if dphi > wp.float64(0.0) and on_arc(mid, phl, wl) and on_arc(mid, phv, wv):
+                ca = wp.cos(a)
+                sa = wp.sin(a)
+                for i in range(n):
+                    dl = float(dphi * rules[off + i][0])
+                    cd = wp.float64(wp.cos(dl))
+                    sd = wp.float64(wp.sin(dl))
+                    m = wp.vec3(float(sm * (ca * cd - sa * sd)), float(sm * (sa * cd + ca * sd)), float(node[1]))
+                    MoL = wp.dot(m, l)
+                    MoV = wp.dot(m, v)
+                    if MoL > 0.0 and MoV > 0.0:
+                        row = row + rules[off + i][1] * dphi * wp.float64(MoL * MoV * Ff(MoL, MoV, f0))
+        return row
+
+    return phi_row
+
+
 @functools.lru_cache(maxsize=None)
 def facet_panel_for(F_facet):
     """``facet_panel(pair, j, rules, off, n)``: the n x n product rule (rules[off : off + n]) over u panel j
     (``u_panel``): the sum of w (m.l)+ (m.v)+ F_facet / (n.m) over its nodes (times G2 / (2 pi^2 (n.l)(n.v)) it is
     the panel's share of f); 0 for an empty panel. In phi_m only the pieces between the arcs' ends that lie on both
-    arcs are integrated (on the others the integrand is 0)."""
-    Ff = F_facet
+    arcs are integrated (phi_row_for)."""
+    phi_row = phi_row_for(F_facet)
 
     @wp.func
     def facet_panel(p: FacetPair, j: int, rules: Rule, off: int, n: int):
-        one = wp.float64(1.0)
         panel = u_panel(j, p.n_geo, p.om1, p.om2)
-        lo = panel[0]
-        du = panel[1]
         acc = wp.float64(0.0)
-        if du <= wp.float64(0.0):
+        if panel[1] <= wp.float64(0.0):
             return acc
         for k in range(n):
-            s = rules[off + k][0]
-            wu = rules[off + k][1] * du * wp.float64(6.0) * s * (one - s)
-            csm = facet_cos_sin(lo, du, panel[2], s, p.alpha)
-            cm = csm[0]
-            sm = csm[1]
-            wl = arc_half_width(cm, sm, p.cl, p.sl)
-            wv = arc_half_width(cm, sm, p.cv, p.sv)
-            bs = sort4(wrap_2pi(p.phl - wl), wrap_2pi(p.phl + wl), wrap_2pi(p.phv - wv), wrap_2pi(p.phv + wv))
-            row = wp.float64(0.0)
-            for q in range(4):
-                ab = interval(q, bs, bs[0] + TWO_PI64)
-                a = ab[0]
-                dphi = ab[1] - a
-                mid = a + wp.float64(0.5) * dphi
-                if dphi > wp.float64(0.0) and on_arc(mid, p.phl, wl) and on_arc(mid, p.phv, wv):
-                    ca = wp.cos(a)
-                    sa = wp.sin(a)
-                    for i in range(n):
-                        dl = float(dphi * rules[off + i][0])
-                        cd = wp.float64(wp.cos(dl))
-                        sd = wp.float64(wp.sin(dl))
-                        m = wp.vec3(float(sm * (ca * cd - sa * sd)), float(sm * (sa * cd + ca * sd)), float(cm))
-                        MoL = wp.dot(m, p.l)
-                        MoV = wp.dot(m, p.v)
-                        if MoL > 0.0 and MoV > 0.0:
-                            row = row + rules[off + i][1] * dphi * wp.float64(MoL * MoV * Ff(MoL, MoV, p.f0))
-            acc = acc + wu * row / cm
+            node = u_node(p, panel, rules, off, k)
+            acc = acc + node[0] * phi_row(p.l, p.v, p.phl, p.phv, node, p.f0, rules, off, n) / node[1]
         return acc
 
     return facet_panel
+
+
+@functools.lru_cache(maxsize=None)
+def facet_panel_azimuths_for(F_facet):
+    """``facet_panel_azimuths(pair, lv, phl, first, end, j, rules, off, n, out, col)``: ``facet_panel`` for every
+    texel first .. end - 1 of lv (l, v): texels that differ from ``pair``'s only in the azimuth of l (phl[t]), so
+    each u node (u_node) is computed once for all of them; panel j's sum of texel t is written to out[col, t]
+    (the same float operations per texel as facet_panel, so the same values)."""
+    phi_row = phi_row_for(F_facet)
+
+    @wp.func
+    def facet_panel_azimuths(
+        p: FacetPair,
+        lv: wp.array2d(dtype=wp.vec3),
+        phl: Values64,
+        first: int,
+        end: int,
+        j: int,
+        rules: Rule,
+        off: int,
+        n: int,
+        out: Rows64,
+        col: int,
+    ):
+        panel = u_panel(j, p.n_geo, p.om1, p.om2)
+        for t in range(first, end):
+            out[col, t] = wp.float64(0.0)
+        if panel[1] > wp.float64(0.0):
+            for k in range(n):
+                node = u_node(p, panel, rules, off, k)
+                for t in range(first, end):
+                    row = phi_row(lv[t, 0], p.v, phl[t], p.phv, node, p.f0, rules, off, n)
+                    out[col, t] = out[col, t] + node[0] * row / node[1]
+
+    return facet_panel_azimuths
 
 
 MAX_U_PANELS = 3 * (MAX_TAIL_CUTS + 1)  # slots of u_panel: geometric panels x 3 (the cuts at u_l, u_v)
@@ -296,13 +361,27 @@ FACET_ROUNDING = wp.constant(wp.float64(5.0e-7))
 FACET_ORDERS = (8, 12, 16, 24, 32, 48, 64)
 
 
+@wp.func
+def facet_scale(p: FacetPair, alpha: float):
+    """G2 / (2 pi^2 (n.l)(n.v)): f = scale * (the sum of the panels' facet_panel)."""
+    G2 = masking.G2_smith_height_correlated(masking.Lambda_ggx(p.v[2], alpha), masking.Lambda_ggx(p.l[2], alpha))
+    return wp.float64(G2) / (TWO_PI64 * PI64 * p.cl * p.cv)
+
+
+@wp.func
+def facet_estimate(scale: wp.float64, qe: wp.vec2d):
+    """(f, error estimate) from the ladder's (sum of panels, sum of |Q_(k) - Q_(k-1)|): plus the float32 rounding."""
+    f = scale * qe[0]
+    return wp.vec2d(f, scale * qe[1] + FACET_ROUNDING * wp.abs(f))
+
+
 @functools.lru_cache(maxsize=None)
 def fd_microfacet_adaptive_for(F_facet):
     """``fd_microfacet_adaptive(l, v, alpha, f0, rules, levels, tol) -> vec2d(f, error estimate)``: Eq. 4 on the
     panels of ``fd_microfacet_for``, each u panel (with its phi pieces) at GL orders ``levels``, refined greedily
     (lutbake.sampling.ladder) until the sum of the panels' |Q_(k) - Q_(k-1)| is within QUADRATURE_SHARE of the
     texel's tolerance max(tol[0], tol[1] |f|). The estimate is that sum plus FACET_ROUNDING |f| (float32 terms)."""
-    integrate = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)
+    integrate = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)[0]
 
     @wp.func
     def fd_microfacet_adaptive(
@@ -318,12 +397,68 @@ def fd_microfacet_adaptive_for(F_facet):
         if l[2] <= COS_EPS or v[2] <= COS_EPS:
             return wp.vec2d(zero, zero)
         p = facet_pair(l, v, alpha, f0)
-        G2 = masking.G2_smith_height_correlated(masking.Lambda_ggx(v[2], alpha), masking.Lambda_ggx(l[2], alpha))
-        scale = wp.float64(G2) / (TWO_PI64 * PI64 * p.cl * p.cv)  # f = scale * (sum over panels)
+        scale = facet_scale(p, alpha)  # f = scale * (sum over panels)
         qe = integrate(
             p, 3 * (p.n_geo + 1), rules, levels, QUADRATURE_SHARE * tol[0] / scale, QUADRATURE_SHARE * tol[1]
         )
-        f = scale * qe[0]
-        return wp.vec2d(f, scale * qe[1] + FACET_ROUNDING * wp.abs(f))
+        return facet_estimate(scale, qe)
 
     return fd_microfacet_adaptive
+
+
+@functools.lru_cache(maxsize=None)
+def fd_microfacet_adaptive_azimuths_for(F_facet):
+    """``fd_microfacet_adaptive_azimuths(lv, alpha, f0, rules, levels, tol, first, end, phl, panels, out)``:
+    ``fd_microfacet_adaptive`` of the texels first .. end - 1 of lv (l, v), which differ only in the azimuth of l
+    (equal n.l, v and alpha): every panel's first two levels by facet_panel_azimuths (the u nodes computed once for
+    all of them), then each texel's greedy refinement on its own (the ladder's climb). The same float operations
+    per texel as fd_microfacet_adaptive, so the same values. Scratch: phl (the azimuths), panels (2 MAX_U_PANELS rows:
+    panel j at levels[1], then at levels[0], one column per texel); out[t] = (f, error estimate)."""
+    _, climb, Values = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)
+    panel_azimuths = facet_panel_azimuths_for(F_facet)
+
+    @wp.func
+    def fd_microfacet_adaptive_azimuths(
+        lv: wp.array2d(dtype=wp.vec3),
+        alpha: Floats,
+        f0: float,
+        rules: Rule,
+        levels: Levels,
+        tol: wp.vec2d,
+        first: int,
+        end: int,
+        phl: Values64,
+        panels: Rows64,
+        out: Rows64,
+    ):
+        zero = wp.float64(0.0)
+        if lv[first, 0][2] <= COS_EPS or lv[first, 1][2] <= COS_EPS:
+            for t in range(first, end):
+                out[t, 0] = zero
+                out[t, 1] = zero
+            return
+        for t in range(first, end):
+            phl[t] = wp.atan2(wp.float64(lv[t, 0][1]), wp.float64(lv[t, 0][0]))
+        p = facet_pair(lv[first, 0], lv[first, 1], alpha[first], f0)
+        n_panels = 3 * (p.n_geo + 1)
+        top = wp.min(1, levels.shape[0] - 1)
+        for j in range(n_panels):
+            panel_azimuths(p, lv, phl, first, end, j, rules, levels[top][0], levels[top][1], panels, j)
+            panel_azimuths(p, lv, phl, first, end, j, rules, levels[0][0], levels[0][1], panels, MAX_U_PANELS + j)
+        for t in range(first, end):
+            pt = facet_pair(lv[t, 0], lv[t, 1], alpha[t], f0)
+            scale = facet_scale(pt, alpha[t])
+            fine0 = Values()
+            coarse0 = Values()
+            for j in range(n_panels):
+                fine0[j] = panels[j, t]
+                coarse0[j] = panels[MAX_U_PANELS + j, t]
+            targets = wp.vec2d(
+                QUADRATURE_SHARE * tol[0] / scale, QUADRATURE_SHARE * tol[1]
+            )  # as fd_microfacet_adaptive
+            qe = climb(pt, n_panels, rules, levels, targets, fine0, coarse0)
+            fe = facet_estimate(scale, qe)
+            out[t, 0] = fe[0]
+            out[t, 1] = fe[1]
+
+    return fd_microfacet_adaptive_azimuths
