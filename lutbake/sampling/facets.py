@@ -258,14 +258,26 @@ def u_node(p: FacetPair, panel: wp.vec3d, rules: Rule, off: int, k: int):
 def phi_row_for(F_facet):
     """``phi_row(l, v, phl, phv, node, f0, rules, off, n)``: the n-point rule in phi_m at the u node ``node``
     (u_node): the sum of w (m.l)+ (m.v)+ F_facet over the pieces between the arcs' ends that lie on both arcs (on
-    the others the integrand is 0); the nodes' cos / sin are those of the piece's start rotated by the offset."""
+    the others the integrand is 0). The GL nodes are symmetric (x_(n-1-i) = 1 - x_i): node i's cos / sin are the
+    piece's start rotated by the offset dphi x_i, node n - 1 - i's its end rotated back by the same offset (float64
+    ends, float32 offset: one float32 cos / sin pair per two nodes)."""
     Ff = F_facet
+
+    @wp.func
+    def facet_term(l: wp.vec3, v: wp.vec3, node: UNode, c: wp.float64, s: wp.float64, f0: float):
+        # (m.l)+ (m.v)+ F_facet at the facet (theta_m of node, azimuth of cos c and sin s)
+        m = wp.vec3(float(node[2] * c), float(node[2] * s), float(node[1]))
+        MoL = wp.dot(m, l)
+        MoV = wp.dot(m, v)
+        t = wp.float64(0.0)
+        if MoL > 0.0 and MoV > 0.0:
+            t = wp.float64(MoL * MoV * Ff(MoL, MoV, f0))
+        return t
 
     @wp.func
     def phi_row(
         l: wp.vec3, v: wp.vec3, phl: wp.float64, phv: wp.float64, node: UNode, f0: float, rules: Rule, off: int, n: int
     ):
-        sm = node[2]
         wl = node[3]
         wv = node[4]
         row = wp.float64(0.0)
@@ -278,15 +290,18 @@ def phi_row_for(F_facet):
             if dphi > wp.float64(0.0) and on_arc(mid, phl, wl) and on_arc(mid, phv, wv):
                 ca = wp.cos(a)
                 sa = wp.sin(a)
-                for i in range(n):
+                cb = wp.cos(ab[1])
+                sb = wp.sin(ab[1])
+                h = n // 2
+                for i in range(n - h):  # node i from the start; for i < h also node n - 1 - i from the end
                     dl = float(dphi * rules[off + i][0])
                     cd = wp.float64(wp.cos(dl))
                     sd = wp.float64(wp.sin(dl))
-                    m = wp.vec3(float(sm * (ca * cd - sa * sd)), float(sm * (sa * cd + ca * sd)), float(node[1]))
-                    MoL = wp.dot(m, l)
-                    MoV = wp.dot(m, v)
-                    if MoL > 0.0 and MoV > 0.0:
-                        row = row + rules[off + i][1] * dphi * wp.float64(MoL * MoV * Ff(MoL, MoV, f0))
+                    w = rules[off + i][1] * dphi
+                    row = row + w * facet_term(l, v, node, ca * cd - sa * sd, sa * cd + ca * sd, f0)
+                    if i < h:
+                        w = rules[off + n - 1 - i][1] * dphi
+                        row = row + w * facet_term(l, v, node, cb * cd + sb * sd, sb * cd - cb * sd, f0)
         return row
 
     return phi_row
