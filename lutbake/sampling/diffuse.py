@@ -309,12 +309,12 @@ def adaptive_azimuths_kernel(facet):
         rules: Rule,
         levels: Levels,
         start: wp.array(dtype=int),
-        phl: Values64,
+        azl: wp.array(dtype=wp.vec3d),
         panels: Rows64,
         out: Rows64,
     ):
         g = wp.tid()
-        f(lv, alpha, f0, rules, levels, tol, start[g], start[g + 1], phl, panels, out)
+        f(lv, alpha, f0, rules, levels, tol, start[g], start[g + 1], azl, panels, out)
 
     return brdf_adaptive_azimuths_kernel
 
@@ -346,7 +346,7 @@ def eval_points_adaptive(integrand, l, v, alpha, f0: float, tol, orders=FACET_OR
         wp.array(rules, dtype=wp.vec2d, device=device),
         wp.array(levels, dtype=wp.vec2i, device=device),
         wp.array(start, dtype=int, device=device),
-        wp.zeros(n, dtype=wp.float64, device=device),
+        wp.zeros(n, dtype=wp.vec3d, device=device),
         wp.zeros((2 * MAX_U_PANELS, n), dtype=wp.float64, device=device),
     ]
     out = wp.zeros((n, 2), dtype=wp.float64, device=device)
