@@ -22,7 +22,9 @@ FACET_ORDERS refined greedily (lutbake.sampling.ladder) until the sum of the pan
 texel's tolerance; the per-texel estimate is that sum plus the float32 rounding (FACET_ROUNDING). In phi_m only the
 pieces on both visible arcs are integrated (the integrand is 0 on the others: 1 of the 4 where the arcs overlap
 partly, 2 where both are whole), and the nodes' cos / sin are those of the piece's start (float64) rotated by the
-node's offset (float32).
+node's offset (float32), the mirror node's (GL nodes are symmetric) the piece's end rotated back by the same offset;
+the ends' cos / sin by angle addition (phi_x +- w_x). Texels that differ only in the azimuth of l share each u
+node's theta_m and arc half-widths (fd_microfacet_adaptive_azimuths_for, the same values as per texel).
 """
 
 from __future__ import annotations
