@@ -126,6 +126,7 @@ def texel_count(o: dict) -> int:
 
 
 DEFAULT_SOBOL = 4096
+TILE_PHI_BLOCKS = 8  # phi blocks per tile of the adaptive microfacet btf
 MAX_GL_ORDER = 64
 
 
@@ -239,7 +240,9 @@ def plan(spec) -> TexelPlan:
         extra=extra,
         relative_error=True,
         error_estimate=integrated,
-        tile_texels=block * -(-512 // block) if adaptive else None,  # whole blocks (reciprocal_inputs)
+        # whole blocks (reciprocal_inputs), at least 512 texels and TILE_PHI_BLOCKS azimuths (texels that differ
+        # only in phi share the u nodes of their m-integral: lutbake.sampling.diffuse.adaptive_azimuths_kernel)
+        tile_texels=block * max(-(-512 // block), min(o["phi_size"], TILE_PHI_BLOCKS)) if adaptive else None,
     )
 
 

@@ -27,7 +27,13 @@ import warp as wp
 from ..terms.frame import view_dir
 from . import points
 from .arrays import Floats, Levels, Points2, Rows64, Rule, Values64
-from .facets import FACET_ORDERS, fd_microfacet_adaptive_for, fd_microfacet_sobol_for
+from .facets import (
+    FACET_ORDERS,
+    MAX_U_PANELS,
+    fd_microfacet_adaptive_azimuths_for,
+    fd_microfacet_adaptive_for,
+    fd_microfacet_sobol_for,
+)
 from .hemisphere import gl_levels
 
 PI64 = wp.constant(wp.float64(math.pi))
@@ -287,22 +293,67 @@ def adaptive_point_kernel(facet):
     return brdf_adaptive_kernel
 
 
+@functools.lru_cache(maxsize=None)
+def adaptive_azimuths_kernel(facet):
+    """Kernel: ``adaptive_point_kernel`` for groups of texels that differ only in the azimuth of l, one thread per
+    group (texels start[g] .. start[g + 1] - 1): the u nodes are computed once per group
+    (lutbake.sampling.facets.fd_microfacet_adaptive_azimuths_for); the same values as adaptive_point_kernel."""
+    f = fd_microfacet_adaptive_azimuths_for(facet)
+
+    @wp.kernel(enable_backward=False, module="unique")
+    def brdf_adaptive_azimuths_kernel(
+        lv: wp.array2d(dtype=wp.vec3),
+        alpha: Floats,
+        f0: float,
+        tol: wp.vec2d,
+        rules: Rule,
+        levels: Levels,
+        start: wp.array(dtype=int),
+        azl: wp.array(dtype=wp.vec3d),
+        panels: Rows64,
+        out: Rows64,
+    ):
+        g = wp.tid()
+        f(lv, alpha, f0, rules, levels, tol, start[g], start[g + 1], azl, panels, out)
+
+    return brdf_adaptive_azimuths_kernel
+
+
+def azimuth_groups(l: np.ndarray, v: np.ndarray, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(order, start): a permutation of the rows grouping those with equal v, n.l and alpha (they differ only in
+    the azimuth of l), and each group's first position in that order (plus the row count at the end)."""
+    key = np.concatenate([v, l[:, 2:], alpha[:, None]], axis=1)
+    order = np.lexsort(key.T[::-1])
+    k = key[order]
+    new = np.ones(len(k), dtype=bool)
+    new[1:] = np.any(k[1:] != k[:-1], axis=1)
+    return order, np.append(np.flatnonzero(new), len(k)).astype(np.int32)
+
+
 def eval_points_adaptive(integrand, l, v, alpha, f0: float, tol, orders=FACET_ORDERS, device: str = "cpu"):
     """The microfacet f(l_i, v_i) to the tolerance ``tol`` (absolute, relative): (values, error estimates), float64
-    (N, 1) each."""
-    lv = np.ascontiguousarray(np.stack([np.asarray(l, np.float32), np.asarray(v, np.float32)], axis=1))
+    (N, 1) each. Rows that differ only in the azimuth of l share their u nodes (adaptive_azimuths_kernel)."""
+    l, v, alpha = (np.asarray(x, np.float32) for x in (l, v, alpha))
+    order, start = azimuth_groups(l, v, alpha)
+    lv = np.ascontiguousarray(np.stack([l[order], v[order]], axis=1))
     n = len(lv)
     rules, levels = gl_levels(tuple(orders))
     arrays = [
         wp.array(lv, dtype=wp.vec3, device=device),
-        wp.array(np.asarray(alpha, np.float32), dtype=float, device=device),
+        wp.array(alpha[order], dtype=float, device=device),
         float(f0),
         wp.vec2d(*tol),
         wp.array(rules, dtype=wp.vec2d, device=device),
         wp.array(levels, dtype=wp.vec2i, device=device),
+        wp.array(start, dtype=int, device=device),
+        wp.zeros(n, dtype=wp.vec3d, device=device),
+        wp.zeros((2 * MAX_U_PANELS, n), dtype=wp.float64, device=device),
     ]
-    out = launch_rows(adaptive_point_kernel(integrand.facet), arrays, n, device, (n, 2))
-    return out[:, :1], out[:, 1:]
+    out = wp.zeros((n, 2), dtype=wp.float64, device=device)
+    wp.launch(adaptive_azimuths_kernel(integrand.facet), dim=len(start) - 1, inputs=[*arrays, out], device=device)
+    res = np.empty((n, 2))
+    res[order] = out.numpy()
+    return res[:, :1], res[:, 1:]
 
 
 @dataclass(frozen=True)
@@ -323,7 +374,7 @@ class PointAdaptive:
         return np.full(len(inputs["alpha"]), self.evaluations)
 
     def prepare(self, integrand, device: str) -> None:
-        wp.load_module(adaptive_point_kernel(integrand.facet).module, device=device)
+        wp.load_module(adaptive_azimuths_kernel(integrand.facet).module, device=device)
 
     def evaluate_with_error(self, integrand, inputs: dict, device: str) -> tuple[np.ndarray, np.ndarray]:
         n = len(inputs["alpha"])

@@ -25,21 +25,19 @@ from .arrays import Levels, Rule
 
 @functools.lru_cache(maxsize=None)
 def greedy_ladder_for(panel_sum, max_panels: int):
-    """``integrate(ctx, n_panels, rules, levels, target_abs, target_rel) -> vec2d(sum_p Q_p, sum_p d_p)``: every
-    panel at the first two levels, then refined until sum_p d_p <= max(target_abs, target_rel |sum_p Q_p|) or every
-    panel is at the last order (module docstring); n_panels <= max_panels."""
+    """``(integrate, climb, Values)``: ``integrate(ctx, n_panels, rules, levels, target_abs, target_rel) ->
+    vec2d(sum_p Q_p, sum_p d_p)``: every panel at the first two levels, then refined until
+    sum_p d_p <= max(target_abs, target_rel |sum_p Q_p|) or every panel is at the last order (module docstring);
+    n_panels <= max_panels. ``climb(ctx, n_panels, rules, levels, vec2d(target_abs, target_rel), fine0, coarse0)``:
+    the same from the first two levels' panel values given (``Values``: float64 vectors of max_panels; fine0 at
+    levels[1], coarse0 at levels[0]), e.g. computed for several texels that share per-node work: the same float
+    operations, so the same result."""
     Values = wp.types.vector(length=max_panels, dtype=wp.float64)
     Orders = wp.types.vector(length=max_panels, dtype=wp.int32)  # a panel's level
 
     @wp.func
-    def integrate(
-        ctx: Any,
-        n_panels: int,
-        rules: Rule,
-        levels: Levels,
-        target_abs: wp.float64,
-        target_rel: wp.float64,
-    ):
+    def climb(ctx: Any, n_panels: int, rules: Rule, levels: Levels, targets: wp.vec2d, fine0: Values, coarse0: Values):
+        # every panel at the first two levels: fine0 (levels[top]), coarse0 (levels[0]); targets: (abs, rel)
         q = Values()
         d = Values()
         lev = Orders()
@@ -48,16 +46,12 @@ def greedy_ladder_for(panel_sum, max_panels: int):
         last = levels.shape[0] - 1
         top = wp.min(1, last)
         for j in range(n_panels):
-            fine = panel_sum(ctx, j, rules, levels[top][0], levels[top][1])
-            coarse = fine  # one order: the fixed rule, no estimate
-            if top > 0:
-                coarse = panel_sum(ctx, j, rules, levels[0][0], levels[0][1])
-            q[j] = fine
-            d[j] = wp.abs(fine - coarse)
+            q[j] = fine0[j]
+            d[j] = wp.abs(fine0[j] - coarse0[j])
             lev[j] = top
-            total = total + fine
+            total = total + q[j]
             err = err + d[j]
-        while err > wp.max(target_abs, target_rel * wp.abs(total)):
+        while err > wp.max(targets[0], targets[1] * wp.abs(total)):
             worst = wp.int32(-1)  # the panel with the largest d that can still go up
             for j in range(n_panels):
                 if lev[j] < last:
@@ -79,4 +73,23 @@ def greedy_ladder_for(panel_sum, max_panels: int):
                 err = err + d[j]
         return wp.vec2d(total, err)
 
-    return integrate
+    @wp.func
+    def integrate(
+        ctx: Any,
+        n_panels: int,
+        rules: Rule,
+        levels: Levels,
+        target_abs: wp.float64,
+        target_rel: wp.float64,
+    ):
+        fine0 = Values()
+        coarse0 = Values()
+        top = wp.min(1, levels.shape[0] - 1)
+        for j in range(n_panels):
+            fine0[j] = panel_sum(ctx, j, rules, levels[top][0], levels[top][1])
+            coarse0[j] = fine0[j]  # one order: the fixed rule, no estimate
+            if top > 0:
+                coarse0[j] = panel_sum(ctx, j, rules, levels[0][0], levels[0][1])
+        return climb(ctx, n_panels, rules, levels, wp.vec2d(target_abs, target_rel), fine0, coarse0)
+
+    return integrate, climb, Values
