@@ -25,7 +25,7 @@ table cancels its futures and writes nothing).
   table's tiles all run on one kind of device: its bits never depend on which worker took which tile.
 - **Local clusters** (``local:N``): a distributed.LocalCluster of N single-threaded worker processes on
   this machine; they ignore SIGINT (Ctrl-C in a terminal reaches the whole process group: the client
-  cancels, then closes them) and initialise Warp without printing.
+  cancels, then closes them), initialise Warp without printing and log nothing of Dask's below CRITICAL.
 
 Python API::
 
@@ -219,9 +219,14 @@ def estimate_error_task(spec, data: np.ndarray, device: str, token: str) -> tupl
 
 
 def setup_local_worker() -> None:
-    """Registered on LocalCluster workers (now and after a restart): ignore SIGINT, initialise Warp."""
+    """Registered on LocalCluster workers (now and after a restart): ignore SIGINT, initialise Warp, and keep
+    Dask's own log lines out of the user's terminal: a local worker shares it, the client reports every failed tile
+    itself, and closing the cluster can race a worker's heartbeat into an ERROR traceback (seen once in four CI
+    runs: "Failed to communicate with scheduler during heartbeat")."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
+    for name in [n for n in logging.root.manager.loggerDict if n.startswith("distributed.")] + ["distributed"]:
+        logging.getLogger(name).setLevel(logging.CRITICAL)
     init_warp_quietly()
 
 
