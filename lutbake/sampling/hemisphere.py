@@ -490,23 +490,25 @@ def phi_rule_a(rules: np.ndarray) -> np.ndarray:
     return np.stack([np.cos(phi), np.sin(phi), w * np.pi * 0.5 * (ex + 1.0 / ex) * big_a], axis=1)
 
 
+@functools.lru_cache(maxsize=None)
+def gl_rule_arrays(orders: tuple[int, ...], device: str) -> tuple:
+    """(rules, phi_rule_a, levels) of ``orders`` as the kernel's device arrays: made once per (orders, device), not
+    per tile (read-only, shared by every launch)."""
+    rules, levels = gl_levels(orders)
+    return (
+        wp.array(rules, dtype=wp.vec2d, device=device),
+        wp.array(phi_rule_a(rules), dtype=wp.vec3d, device=device),
+        wp.array(levels, dtype=wp.vec2i, device=device),
+    )
+
+
 def gl_launch(integrand, inputs: dict, orders: tuple[int, ...], tol: tuple[float, float], device: str):
     """The gauss_legendre kernel over texels ``inputs`` at ``orders`` (one: fixed order) and tolerance
     (absolute, relative): (values, error estimates), float64 (n, kernel_channels) each."""
     n, texel = _texels(inputs, device)
-    rules, levels = gl_levels(tuple(orders))
-    phi_a = phi_rule_a(rules)
     out = wp.zeros((n, integrand.kernel_channels), dtype=wp.float64, device=device)
     err = wp.zeros((n, integrand.kernel_channels), dtype=wp.float64, device=device)
-    args = [
-        texel,
-        wp.array(rules, dtype=wp.vec2d, device=device),
-        wp.array(phi_a, dtype=wp.vec3d, device=device),
-        wp.array(levels, dtype=wp.vec2i, device=device),
-        wp.vec2d(*tol),
-        out,
-        err,
-    ]
+    args = [texel, *gl_rule_arrays(tuple(orders), device), wp.vec2d(*tol), out, err]
     wp.launch(gl_kernel(integrand), dim=n, inputs=args, device=device)
     return out.numpy(), err.numpy()
 
