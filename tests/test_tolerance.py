@@ -3,7 +3,7 @@
 The estimate of a texel (lutbake.sampling.hemisphere.make_gauss_legendre) is the sum over its panels of
 |Q(order k) - Q(order k-1)|; the tests hold it against (1) the independent numpy integrator over the light
 direction of test_reference_dfg (own terms, own coordinates), at its texels (grazing corners included), and
-(2) the same kernel at a fixed order 64 on every texel of a 32^2 grid.
+(2) the same kernel at a fixed order 64 on every texel of a 64^2 grid.
 """
 
 import numpy as np
@@ -49,7 +49,7 @@ def test_error_estimate_bounds_error_against_numpy_reference(integrand, numpy_re
 
 @pytest.mark.parametrize("tol", [(QUARTER * UNORM16_QUANTUM, 0.0), (1.0e-8, 1.0e-6)])
 def test_error_estimate_bounds_error_on_every_texel_of_a_grid(integrand, spec, tol):
-    grid = grid_for(axes_for(spec(kind="dfg", size=[32, 32]).options), integrand)
+    grid = grid_for(axes_for(spec(kind="dfg", size=[64, 64]).options), integrand)
     ref, _ = gl_launch(integrand, grid.inputs, (CONVERGED_ORDER,), (0.0, 0.0), "cpu")
     got, est = gl_launch(integrand, grid.inputs, ADAPTIVE_ORDERS, tol, "cpu")
     err = np.abs(got - ref)[:, :2]

@@ -37,7 +37,6 @@ from ..edge import COS_EPS
 from ..terms import masking
 from ..terms.distributions import GGX
 from .arrays import Floats, Levels, Rows64, Rule
-from .hemisphere import QUADRATURE_SHARE
 from .ladder import greedy_ladder_for
 from .panels import (
     MAX_TAIL_CUTS,
@@ -422,6 +421,7 @@ MAX_U_PANELS = 3 * (MAX_TAIL_CUTS + 1)  # slots of u_panel: geometric panels x 3
 # (tests/test_btf_tolerance.py), max 2.4e-7 relative (median 5e-8) over 198 texels of the 16 x 32^3 grid; the
 # estimate adds twice that
 FACET_ROUNDING = wp.constant(wp.float64(5.0e-7))
+QUADRATURE_SHARE = wp.constant(wp.float64(0.9))  # of the tolerance; the rest is left to FACET_ROUNDING
 # the orders of the ladder: from 6 (6 -> 8 or 6 -> 9, as lutbake.sampling.hemisphere.ADAPTIVE_ORDERS) two coarse rules
 # agreed by coincidence on 1 % of the 16 x 32^3 btf's texels (measured: error 4.3e-5 at an estimate 8e-6); from 8
 # every estimate bounds the error against the numpy reference (tests/test_btf_tolerance.py)
@@ -465,10 +465,9 @@ def fd_microfacet_adaptive_for(F_facet):
             return wp.vec2d(zero, zero)
         p = facet_pair(l, v, alpha, f0)
         scale = facet_scale(p, alpha)  # f = scale * (sum over panels)
-        qe = integrate(
-            p, 3 * (p.n_geo + 1), rules, levels, QUADRATURE_SHARE * tol[0] / scale, QUADRATURE_SHARE * tol[1]
-        )
-        return facet_estimate(scale, qe)
+        targets = wp.vec3d(QUADRATURE_SHARE * tol[0] / scale, QUADRATURE_SHARE * tol[1], wp.float64(0.0))
+        total, err = integrate(p, 3 * (p.n_geo + 1), rules, levels, targets)
+        return facet_estimate(scale, wp.vec2d(total[0], err[0]))
 
     return fd_microfacet_adaptive
 
@@ -482,7 +481,7 @@ def fd_microfacet_adaptive_azimuths_for(F_facet):
     per texel as fd_microfacet_adaptive, so the same values. Scratch: azl (the azimuths of l), panels (2
     MAX_U_PANELS rows: panel j at levels[1], then at levels[0], one column per texel); out[t] = (f, error
     estimate)."""
-    _, climb, Values = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)
+    _, climb, Panels, _ = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)
     panel_azimuths = facet_panel_azimuths_for(F_facet)
 
     @wp.func
@@ -516,16 +515,16 @@ def fd_microfacet_adaptive_azimuths_for(F_facet):
         for t in range(first, end):
             pt = facet_pair(lv[t, 0], lv[t, 1], alpha[t], f0)
             scale = facet_scale(pt, alpha[t])
-            fine0 = Values()
-            coarse0 = Values()
+            fine0 = Panels()
+            coarse0 = Panels()
             for j in range(n_panels):
-                fine0[j] = panels[j, t]
-                coarse0[j] = panels[MAX_U_PANELS + j, t]
-            targets = wp.vec2d(
-                QUADRATURE_SHARE * tol[0] / scale, QUADRATURE_SHARE * tol[1]
+                fine0[j, 0] = panels[j, t]
+                coarse0[j, 0] = panels[MAX_U_PANELS + j, t]
+            targets = wp.vec3d(
+                QUADRATURE_SHARE * tol[0] / scale, QUADRATURE_SHARE * tol[1], wp.float64(0.0)
             )  # as fd_microfacet_adaptive
-            qe = climb(pt, n_panels, rules, levels, targets, fine0, coarse0)
-            fe = facet_estimate(scale, qe)
+            total, err = climb(pt, n_panels, rules, levels, targets, fine0, coarse0)
+            fe = facet_estimate(scale, wp.vec2d(total[0], err[0]))
             out[t, 0] = fe[0]
             out[t, 1] = fe[1]
 

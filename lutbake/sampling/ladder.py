@@ -3,14 +3,16 @@
 The orders are ``levels`` (offset, order) into ``rules`` (the concatenated GL rules of
 lutbake.sampling.hemisphere.gl_levels). Every panel is integrated at the first two orders; a panel's value is its
 finer one, Q_(k), and its error estimate d = |Q_(k) - Q_(k-1)| is the error of the coarser one: with exponential
-convergence a bound of Q_(k)'s (the argument of lutbake.sampling.hemisphere.make_gauss_legendre). Then, while the
-texel's estimate sum_p d_p exceeds its target, the panel with the largest d goes one order up (a panel at the last
-order stays). Against a fixed per-panel share of the tolerance (make_gauss_legendre), the texel's error budget goes
-where the error is: panels far below the tolerance stop at the second order.
+convergence a bound of Q_(k)'s (the argument of lutbake.sampling.hemisphere.make_gauss_legendre). Then, while a
+channel's estimate sum_p d_p exceeds its target, that channel's panel with the largest d goes one order up (a panel at
+the last order stays; of several channels over their targets, the one furthest over). Against a fixed per-panel share
+of the tolerance, the texel's error budget goes where the error is: panels far below the tolerance stop at the second
+order.
 
-``greedy_ladder_for(panel_sum, max_panels)`` closes over the panel rule ``panel_sum(ctx, j, rules, offset, order)
--> float64`` (``ctx``: the texel's constants, a Warp struct; ``j``: the panel's index, 0 .. n_panels - 1; an empty
-panel returns 0 at every order).
+``greedy_ladder_for(panel_sum, max_panels, nch)`` closes over the panel rule ``panel_sum(ctx, j, rules, offset, order)
+-> value`` (``ctx``: the texel's constants, a Warp struct; ``j``: the panel's index, 0 .. n_panels - 1; an empty
+panel returns 0 at every order); the value is a float64 (nch = 1) or a float64 vector of nch channels (vec2d, vec3d),
+every channel refined to its own target.
 """
 
 from __future__ import annotations
@@ -23,73 +25,97 @@ import warp as wp
 from .arrays import Levels, Rule
 
 
+@wp.func
+def channel(x: wp.float64, c: int):
+    """Channel c of a panel value: the value itself for a scalar."""
+    return x
+
+
+@wp.func
+def channel(x: wp.vec2d, c: int):  # noqa: F811 (a Warp overload)
+    return x[c]
+
+
+@wp.func
+def channel(x: wp.vec3d, c: int):  # noqa: F811 (a Warp overload)
+    return x[c]
+
+
 @functools.lru_cache(maxsize=None)
-def greedy_ladder_for(panel_sum, max_panels: int):
-    """``(integrate, climb, Values)``: ``integrate(ctx, n_panels, rules, levels, target_abs, target_rel) ->
-    vec2d(sum_p Q_p, sum_p d_p)``: every panel at the first two levels, then refined until
-    sum_p d_p <= max(target_abs, target_rel |sum_p Q_p|) or every panel is at the last order (module docstring);
-    n_panels <= max_panels. ``climb(ctx, n_panels, rules, levels, vec2d(target_abs, target_rel), fine0, coarse0)``:
-    the same from the first two levels' panel values given (``Values``: float64 vectors of max_panels; fine0 at
+def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1):
+    """``(integrate, climb, Panels, Sums)``: ``integrate(ctx, n_panels, rules, levels, targets) -> (total, err)``
+    (``Sums``: float64 vectors of nch; ``targets``: vec3d(abs, rel, floor)): every panel at the first two levels,
+    then refined until err_c = sum_p d_(p,c) <= max(abs, rel |total_c|) - floor |total_c| for every channel c (floor:
+    a relative error the caller adds to the estimate, e.g. the terms' rounding) or every panel is at the last order
+    (module docstring); n_panels <= max_panels. ``climb(ctx, n_panels, rules, levels, targets, fine0, coarse0)``:
+    the same from the first two levels' panel values given (``Panels``: float64 matrices max_panels x nch; fine0 at
     levels[1], coarse0 at levels[0]), e.g. computed for several texels that share per-node work: the same float
     operations, so the same result."""
-    Values = wp.types.vector(length=max_panels, dtype=wp.float64)
+    Panels = wp.types.matrix(shape=(max_panels, nch), dtype=wp.float64)
+    Sums = wp.types.vector(length=nch, dtype=wp.float64)
     Orders = wp.types.vector(length=max_panels, dtype=wp.int32)  # a panel's level
 
     @wp.func
-    def climb(ctx: Any, n_panels: int, rules: Rule, levels: Levels, targets: wp.vec2d, fine0: Values, coarse0: Values):
-        # every panel at the first two levels: fine0 (levels[top]), coarse0 (levels[0]); targets: (abs, rel)
-        q = Values()
-        d = Values()
+    def climb(ctx: Any, n_panels: int, rules: Rule, levels: Levels, targets: wp.vec3d, fine0: Panels, coarse0: Panels):
+        q = Panels()
+        d = Panels()
         lev = Orders()
-        total = wp.float64(0.0)
-        err = wp.float64(0.0)
         last = levels.shape[0] - 1
         top = wp.min(1, last)
         for j in range(n_panels):
-            q[j] = fine0[j]
-            d[j] = wp.abs(fine0[j] - coarse0[j])
+            for c in range(wp.static(nch)):
+                q[j, c] = fine0[j, c]
+                d[j, c] = wp.abs(fine0[j, c] - coarse0[j, c])
             lev[j] = top
-            total = total + q[j]
-            err = err + d[j]
-        while err > wp.max(targets[0], targets[1] * wp.abs(total)):
-            worst = wp.int32(-1)  # the panel with the largest d that can still go up
+        total = Sums()
+        err = Sums()
+        climbing = wp.bool(True)  # a dynamic variable (Warp: a bare literal is a constant)
+        while climbing:
+            total = Sums()
+            err = Sums()
             for j in range(n_panels):
-                if lev[j] < last:
-                    if worst < 0:
-                        worst = j
-                    elif d[j] > d[worst]:
-                        worst = j
+                for c in range(wp.static(nch)):
+                    total[c] = total[c] + q[j, c]
+                    err[c] = err[c] + d[j, c]
+            worst_c = wp.int32(-1)  # the channel furthest over its target
+            over = wp.float64(1.0)
+            for c in range(wp.static(nch)):
+                target = wp.max(targets[0], targets[1] * wp.abs(total[c])) - targets[2] * wp.abs(total[c])
+                if err[c] > target * over:
+                    worst_c = c
+                    over = err[c] / wp.max(target, wp.float64(1.0e-300))
+            worst = wp.int32(-1)  # its panel with the largest d that can still go up
+            if worst_c >= 0:
+                for j in range(n_panels):
+                    if lev[j] < last:
+                        if worst < 0:
+                            worst = j
+                        elif d[j, worst_c] > d[worst, worst_c]:
+                            worst = j
             if worst < 0:
-                break
-            k = lev[worst] + 1
-            fine = panel_sum(ctx, worst, rules, levels[k][0], levels[k][1])
-            d[worst] = wp.abs(fine - q[worst])
-            q[worst] = fine
-            lev[worst] = k
-            total = wp.float64(0.0)
-            err = wp.float64(0.0)
-            for j in range(n_panels):
-                total = total + q[j]
-                err = err + d[j]
-        return wp.vec2d(total, err)
+                climbing = False
+            else:
+                k = lev[worst] + 1
+                fine = panel_sum(ctx, worst, rules, levels[k][0], levels[k][1])
+                for c in range(wp.static(nch)):
+                    d[worst, c] = wp.abs(channel(fine, c) - q[worst, c])
+                    q[worst, c] = channel(fine, c)
+                lev[worst] = k
+        return total, err
 
     @wp.func
-    def integrate(
-        ctx: Any,
-        n_panels: int,
-        rules: Rule,
-        levels: Levels,
-        target_abs: wp.float64,
-        target_rel: wp.float64,
-    ):
-        fine0 = Values()
-        coarse0 = Values()
+    def integrate(ctx: Any, n_panels: int, rules: Rule, levels: Levels, targets: wp.vec3d):
+        fine0 = Panels()
+        coarse0 = Panels()
         top = wp.min(1, levels.shape[0] - 1)
         for j in range(n_panels):
-            fine0[j] = panel_sum(ctx, j, rules, levels[top][0], levels[top][1])
-            coarse0[j] = fine0[j]  # one order: the fixed rule, no estimate
+            coarse = panel_sum(ctx, j, rules, levels[0][0], levels[0][1])
+            fine = coarse  # one order: the fixed rule, no estimate
             if top > 0:
-                coarse0[j] = panel_sum(ctx, j, rules, levels[0][0], levels[0][1])
-        return climb(ctx, n_panels, rules, levels, wp.vec2d(target_abs, target_rel), fine0, coarse0)
+                fine = panel_sum(ctx, j, rules, levels[top][0], levels[top][1])
+            for c in range(wp.static(nch)):
+                fine0[j, c] = channel(fine, c)
+                coarse0[j, c] = channel(coarse, c)
+        return climb(ctx, n_panels, rules, levels, targets, fine0, coarse0)
 
-    return integrate, climb, Values
+    return integrate, climb, Panels, Sums
