@@ -32,8 +32,9 @@ def _exit(status: int) -> None:
     if threading.active_count() == 1:
         atexit._run_exitfuncs()  # runs each hook once, reporting any that fails, as the teardown does
         try:
-            sys.stdout.flush()
-            sys.stderr.flush()
+            for stream in (sys.stdout, sys.stderr):
+                if stream is not None:  # None: the descriptor was closed when Python started
+                    stream.flush()
         except (OSError, ValueError):  # a closed pipe, a closed stream
             sys.exit(status)
         os._exit(status)
