@@ -27,9 +27,11 @@ def _exit(status: int) -> None:
     it), this is sys.exit itself."""
     import atexit
     import os
+    import signal
     import threading
 
     if threading.active_count() == 1:
+        signal.signal(signal.SIGINT, signal.SIG_DFL)  # as the teardown does: a Ctrl-C now ends it, no traceback
         atexit._run_exitfuncs()  # runs each hook once, reporting any that fails, as the teardown does
         try:
             for stream in (sys.stdout, sys.stderr):
