@@ -314,3 +314,33 @@ def test_entry_point_keeps_exit_codes_and_usage_errors():
     assert r.returncode == 2 and "Usage:" in r.stderr and "Traceback" not in r.stderr
     r = run("nosuchcommand")
     assert r.returncode == 2 and "No such command" in r.stderr
+
+
+def test_entry_point_ends_with_the_atexit_hooks_the_flushes_and_the_threads_of_a_normal_exit(cfg, tmp_path):
+    """lutbake._entry skips the interpreter's teardown (issue 13) but nothing a user sees of it: atexit hooks run,
+    buffered output reaches a pipe, a bake's lines and status stay, a thread still running is waited for, and a
+    closed stdout is no error."""
+    code = (
+        "import atexit, sys, threading, time\n"
+        "atexit.register(lambda: print('hook ran'))\n"
+        "if sys.argv[1] == 'thread':\n"
+        "    threading.Thread(target=lambda: (time.sleep(0.5), print('thread finished'))).start()\n"
+        "sys.argv = ['lutbake'] + sys.argv[2:]\n"
+        "from lutbake._entry import main\n"
+        "main()\n"
+    )
+
+    def run(*a, **kw):
+        env = {**os.environ, "PYTHONPATH": str(ROOT)}
+        kw = {"capture_output": True, **kw}
+        return subprocess.run([sys.executable, "-c", code, *a], text=True, timeout=300, env=env, **kw)
+
+    r = run("-", "bake", str(cfg), "--out-dir", str(tmp_path / "o"))
+    assert r.returncode == 0 and r.stdout.splitlines()[-1] == "hook ran", (r.stdout, r.stderr)
+    assert "t.exr" in r.stdout and r.stderr == "" and (tmp_path / "o" / "t.exr").is_file()
+    r = run("-", "bake", str(tmp_path / "missing.toml"))
+    assert r.returncode == 2 and "no such config file" in r.stderr and r.stdout == "hook ran\n"
+    r = run("thread", "--version")
+    assert r.returncode == 0 and r.stdout.splitlines()[-2:] == ["thread finished", "hook ran"], r.stdout
+    r = run("-", "--version", capture_output=False, stderr=subprocess.PIPE, preexec_fn=lambda: os.close(1))
+    assert r.returncode == 0 and r.stderr == "", r.stderr  # no stdout at all (sys.stdout is None)
