@@ -477,11 +477,13 @@ class FitMemo:
 MEMO = FitMemo()  # the ltc kind's (lutbake.kinds.ltc.LtcBake): shared by every table a process bakes
 
 
-def texel_keys(problem: Problem, texel: np.ndarray, cands: np.ndarray, steps) -> list[bytes]:
-    """The memo keys of ``texel``: everything its fit from ``cands`` reads (fit options, the texel's inputs)."""
-    head = repr((problem.lobe, problem.device, problem.grid_n, problem.dof, tuple(steps)))
+def texel_keys(problem: Problem, texel: np.ndarray, points: np.ndarray, what: str) -> list[bytes]:
+    """The memo keys of ``texel``: everything its fit from ``points`` (k, c, dof) reads (``what``: the fit options,
+    the texel's inputs)."""
+    head = repr((what, problem.lobe, problem.device, problem.grid_n, problem.dof))
     head = (head + repr((NELDER_MEAD_TOL, NELDER_MEAD_ITERS, ATOL_RELATIVE, M_MIN))).encode()
-    rows = zip(problem.nov[texel], problem.alpha[texel], problem.magnitude[texel], cands)
+    points = np.ascontiguousarray(points, np.float64)
+    rows = zip(problem.nov[texel], problem.alpha[texel], problem.magnitude[texel], points)
     return [head + n.tobytes() + a.tobytes() + m.tobytes() + c.tobytes() for n, a, m, c in rows]
 
 
@@ -489,14 +491,17 @@ def fit_from(
     problem: Problem, texel: np.ndarray, cands: np.ndarray, steps, memo: FitMemo | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Nelder-Mead (``refine`` at ``steps``) from the best of the candidates (k, c, dof) per texel; (q, f).
-    With ``memo``, texels fitted before with equal inputs and candidates are taken from it (same bits)."""
-
-    def compute(i):
-        return refine(problem, texel[i], best_of(problem, texel[i], cands[i]), steps)
-
+    With ``memo``, a texel fitted before with equal inputs and candidates is taken from it, and one whose best
+    candidate equals the start of an earlier fit takes that fit's result (refine reads nothing else): same bits."""
     if memo is None or len(texel) == 0:
-        return compute(np.arange(len(texel)))
-    return memo.run(texel_keys(problem, texel, np.ascontiguousarray(cands, np.float64), steps), compute)
+        return refine(problem, texel, best_of(problem, texel, cands), steps)
+
+    def from_cands(i):
+        start = best_of(problem, texel[i], cands[i])
+        keys = texel_keys(problem, texel[i], start[:, None, :], f"start {steps}")
+        return memo.run(keys, lambda j: refine(problem, texel[i][j], start[j], steps))
+
+    return memo.run(texel_keys(problem, texel, cands, f"candidates {steps}"), from_cands)
 
 
 def coarse_nodes(n: int) -> np.ndarray:
