@@ -372,10 +372,11 @@ def nelder_mead(
         if len(shrink):
             slo = s[shrink, lo[shrink]][:, None, :]
             s[shrink] = slo + 0.5 * (s[shrink] - slo)
-            keep = lo[shrink]
-            pts = s[shrink].reshape(-1, dim)
-            fs = fun(np.repeat(texel[shrink], dim + 1), pts).reshape(len(shrink), dim + 1)
-            fs[np.arange(len(shrink)), keep] = f[shrink, keep]
+            # the best vertex stays (slo + 0.5 * 0) and keeps its value: only the other dim vertices are evaluated
+            moved = np.ones((len(shrink), dim + 1), bool)
+            moved[np.arange(len(shrink)), lo[shrink]] = False
+            fs = f[shrink]
+            fs[moved] = fun(np.repeat(texel[shrink], dim), s[shrink][moved])
             f[shrink] = fs
     best = np.argmin(f, axis=1)
     return s[rows, best], f[rows, best]
