@@ -325,16 +325,23 @@ def nelder_mead(
     tol: float = NELDER_MEAD_TOL,
     iters: int = NELDER_MEAD_ITERS,
     atol: np.ndarray | float = 0.0,
+    f_start: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """ltc_code's downhill simplex (nelder_mead.h) run on every texel at once: ``fun(texel_subset, q)`` -> values.
     Each texel follows exactly the scalar algorithm (its own simplex, its own stopping test
     2 |f_lo - f_hi| < tol (|f_lo| + |f_hi|) + atol); the vector form only batches the objective calls.
-    Returns (best q (n, 3), best value (n,))."""
+    ``f_start``: fun at ``start`` where the caller has it (not evaluated again). Returns (best q (n, 3), best
+    value (n,))."""
     n, dim = start.shape
     s = np.repeat(start[:, None, :], dim + 1, axis=1)
     for i in range(dim):
         s[:, i + 1, i] += step
-    f = fun(np.repeat(texel, dim + 1), s.reshape(-1, dim)).reshape(n, dim + 1)
+    if f_start is None:
+        f = fun(np.repeat(texel, dim + 1), s.reshape(-1, dim)).reshape(n, dim + 1)
+    else:
+        f = np.empty((n, dim + 1))
+        f[:, 0] = f_start
+        f[:, 1:] = fun(np.repeat(texel, dim), s[:, 1:].reshape(-1, dim)).reshape(n, dim)
     active = np.ones(n, bool)
     rows = np.arange(n)
     for _ in range(iters):
@@ -391,19 +398,23 @@ def analytic_guesses(problem: Problem, texel: np.ndarray) -> np.ndarray:
     return np.stack([np.stack([c, c, *[z] * (problem.dof - 2)], axis=1) for c in cands], axis=1)
 
 
-def best_of(problem: Problem, texel: np.ndarray, cands: np.ndarray) -> np.ndarray:
-    """The candidate (k, c, dof) of least error per texel (first on ties)."""
+def best_of(problem: Problem, texel: np.ndarray, cands: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The candidate (k, c, dof) of least error per texel (first on ties) and that error."""
     k, c, dof = cands.shape
     f = problem.objective(np.repeat(texel, c), cands.reshape(-1, dof)).reshape(k, c)
-    return cands[np.arange(k), np.argmin(f, axis=1)]
+    best = np.argmin(f, axis=1)
+    return cands[np.arange(k), best], f[np.arange(k), best]
 
 
-def refine(problem: Problem, texel: np.ndarray, start: np.ndarray, steps) -> tuple[np.ndarray, np.ndarray]:
-    """Nelder-Mead from ``start``, restarted from its result at each simplex size of ``steps``."""
-    q, f = start, None
+def refine(
+    problem: Problem, texel: np.ndarray, start: np.ndarray, steps, f_start: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Nelder-Mead from ``start`` (of error ``f_start`` if known), restarted from its result at each simplex size of
+    ``steps`` (each restart's first vertex keeps the value the previous run found)."""
+    q, f = start, f_start
     atol = ATOL_RELATIVE**3 * problem.f3[texel]
     for step in steps:
-        q, f = nelder_mead(problem.objective, texel, q, step, atol=atol)
+        q, f = nelder_mead(problem.objective, texel, q, step, atol=atol, f_start=f)
     return q, f
 
 
@@ -495,12 +506,13 @@ def fit_from(
     With ``memo``, a texel fitted before with equal inputs and candidates is taken from it, and one whose best
     candidate equals the start of an earlier fit takes that fit's result (refine reads nothing else): same bits."""
     if memo is None or len(texel) == 0:
-        return refine(problem, texel, best_of(problem, texel, cands), steps)
+        start, f_start = best_of(problem, texel, cands)
+        return refine(problem, texel, start, steps, f_start)
 
     def from_cands(i):
-        start = best_of(problem, texel[i], cands[i])
+        start, f_start = best_of(problem, texel[i], cands[i])
         keys = texel_keys(problem, texel[i], start[:, None, :], f"start {steps}")
-        return memo.run(keys, lambda j: refine(problem, texel[i][j], start[j], steps))
+        return memo.run(keys, lambda j: refine(problem, texel[i][j], start[j], steps, f_start[j]))
 
     return memo.run(texel_keys(problem, texel, cands, f"candidates {steps}"), from_cands)
 
