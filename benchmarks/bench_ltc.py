@@ -10,7 +10,10 @@
    force, per lobe and roughness, for lutbake's tables and the published GGX table.
 6. Tabulated lobes (gotanda): the interpolated lobe the fit sees against Eq. 4 by direct quadrature (GL order 12),
    relative L3 per texel, next to the fit error of the same texels.
-Sections 2-4 need ``ggx`` among ``--lobes``.
+7. Sharing: the ltc-hdrp preset (alpha_min 1e-3) baked after GGX in the same process (lutbake.ltc.fit.MEMO: texels
+   with equal inputs and seeds take GGX's fits), CPU seconds and the ratio to GGX's; and baked alone (memo
+   cleared), to check the bits are the same.
+Sections 2-4 and 7 need ``ggx`` among ``--lobes``.
 """
 
 from __future__ import annotations
@@ -56,9 +59,9 @@ def published():
     )
 
 
-def bake(lobe: str, workers: int):
+def bake(lobe: str, workers: int, preset: str = "ltc-ggx"):
     spec = load_configs(
-        [ROOT / "lutbake" / "presets" / "ltc-ggx.toml"],
+        [ROOT / "lutbake" / "presets" / f"{preset}.toml"],
         [f'lobe="{lobe}"', f'name="ltc_{lobe}"', 'format="exr"', 'dtype="float32"'],
     )[0]
     cpu0 = time.process_time()
@@ -101,6 +104,9 @@ def main(argv=None):
             flush=True,
         )
 
+    if "ggx" in tables:
+        report["hdrp_after_ggx"] = sharing_section(report["lobes"]["ggx"]["cpu_seconds"], workers)
+        print("ltc-hdrp after ggx:", report["hdrp_after_ggx"], flush=True)
     for lobe, table in tables.items():
         if fit.lobe(lobe).tabulate is not None:
             report.setdefault("interpolation", {})[lobe] = interpolation_error(lobe, table)
@@ -166,6 +172,23 @@ def main(argv=None):
 
     area_section(report, tables, axes, t1p, t2p, with_published=True)
     finish(report)
+
+
+def sharing_section(ggx_cpu: float, workers: int) -> dict:
+    hits, misses = fit.MEMO.hits, fit.MEMO.misses
+    shared, seconds, cpu = bake("ggx", workers, "ltc-hdrp")
+    row = {
+        "seconds": round(seconds, 2),
+        "cpu_seconds": round(cpu, 2),
+        "cpu_ratio_to_ggx": round(cpu / ggx_cpu, 3),
+        "memo_hits": fit.MEMO.hits - hits,
+        "memo_misses": fit.MEMO.misses - misses,
+    }
+    fit.MEMO.clear()
+    alone, seconds, cpu = bake("ggx", workers, "ltc-hdrp")
+    row |= {"alone_seconds": round(seconds, 2), "alone_cpu_seconds": round(cpu, 2)}
+    row["identical_to_alone"] = bool(np.array_equal(shared.data, alone.data))
+    return row
 
 
 def area_section(report, tables, axes, t1p, t2p, with_published: bool) -> None:

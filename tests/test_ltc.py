@@ -316,3 +316,58 @@ def test_charlie_free_frame_fit_beats_ltc_codes_three_parameters():
         rel[dof] = p.relative(texels, err)
     assert np.all(rel[4] <= rel[3] * (1 + 1e-3) + 1e-6), np.max(rel[4] - rel[3])
     assert np.median(rel[4]) < CHARLIE_GAIN * np.median(rel[3]), (np.median(rel[4]), np.median(rel[3]))
+
+
+def test_hdrp_shares_the_ggx_texels_it_would_fit_alike_and_gets_the_same_bits():
+    """The fit memo (lutbake.ltc.fit.MEMO): ltc-hdrp (alpha_min 1e-3) baked after ltc-ggx takes ltc-ggx's fits
+    where a texel's inputs and seeds are equal, and its table is bit for bit the one it bakes alone (any workers)."""
+    n = 12  # coarse nodes 0, 2, 3, ...: only columns 0 (alpha clamped) and 1 (seeded from column 0) differ
+    over = [f"size=[{n},{n}]", "fit_samples=8", 'format="exr"', 'dtype="float32"']
+    (ggx,) = load_configs([Path("lutbake/presets/ltc-ggx.toml")], over)
+    (hdrp,) = load_configs([Path("lutbake/presets/ltc-hdrp.toml")], over)
+    fit.MEMO.clear()
+    alone = api.bake_table(hdrp, workers=1)[0].data
+    fit.MEMO.clear()
+    api.bake_table(ggx, workers=2)
+    hits, misses = fit.MEMO.hits, fit.MEMO.misses
+    shared = api.bake_table(hdrp, workers=2)[0].data
+    # shared by candidates: columns >= 2 and the coarse nodes off column 0; fitted at most: columns 0, 1 and the 8
+    # coarse nodes of column 0 (each a candidates entry and, where its start is new, a start entry)
+    assert fit.MEMO.hits - hits >= n * n - 2 * n + 8 * 8 - 8
+    assert fit.MEMO.misses - misses <= 2 * (2 * n + 8)
+    np.testing.assert_array_equal(shared, alone)
+    assert not np.array_equal(shared[0, :, :2], api.bake_table(ggx, workers=1)[0].data[0, :, :2])
+
+
+def test_fit_memo_waits_for_another_thread_and_refits_what_a_failed_one_released():
+    import threading
+
+    memo = fit.FitMemo()
+    started, go, calls = threading.Event(), threading.Event(), []
+
+    def slow(i):
+        calls.append(("slow", list(i)))
+        started.set()
+        go.wait()
+        return np.stack([np.full(2, float(k)) for k in i]), np.asarray(i, float)
+
+    worker = threading.Thread(target=memo.run, args=([b"a", b"b"], slow))
+    worker.start()
+    started.wait()
+    result = {}
+    waiter = threading.Thread(target=lambda: result.setdefault("r", memo.run([b"b", b"c"], slow)))
+    waiter.start()  # claims c (computes it once go is set), waits for b
+    go.set()
+    worker.join()
+    waiter.join()
+    q, f = result["r"]
+    np.testing.assert_array_equal(f, [1.0, 1.0])  # b from the first thread (its index 1), c computed as index 1
+    assert sorted(c for _, c in calls) == [[0, 1], [1]] and memo.hits == 1 and memo.misses == 3
+
+    def fail(i):
+        raise RuntimeError("cancelled")
+
+    with pytest.raises(RuntimeError):
+        memo.run([b"d"], fail)
+    q, f = memo.run([b"d"], lambda i: (np.zeros((1, 2)), np.array([7.0])))
+    assert f[0] == 7.0 and memo.misses == 4

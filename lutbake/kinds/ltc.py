@@ -196,7 +196,9 @@ def diffuse_magnitude(model: str, nov, sigma, samples: int | None, device: str =
 
 class LtcBake:
     """The state one bake shares between its tiles: the problem (magnitudes, frames) and the coarse pass,
-    built once under a lock; fits are memoised per texel range (both slices' tiles of one range use one fit)."""
+    built once under a lock; fits are memoised per texel range (both slices' tiles of one range use one fit) and
+    per texel across tables (lutbake.ltc.fit.MEMO: a texel with the same inputs and seeds as one another table
+    of the process fitted, e.g. ltc-hdrp's beside ltc-ggx's, is that fit)."""
 
     def __init__(self, o: dict, axes: list[Axis]):
         self.o = o
@@ -226,7 +228,7 @@ class LtcBake:
                 # not depend on the thread count)
                 threads = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
                 p = fit.Problem(self.o["lobe"], self.nov, self.alpha, mag, self.o["fit_samples"], device, threads)
-                self.coarse = fit.coarse_pass(p, self.n_view, self.n_rough)
+                self.coarse = fit.coarse_pass(p, self.n_view, self.n_rough, fit.MEMO)
                 self.problem = p
 
     def fitted(self, start: int, stop: int) -> list:
@@ -238,7 +240,7 @@ class LtcBake:
         with lock:
             if not box:
                 texel = np.arange(start, stop)
-                m, err = fit.fit_texels(self.problem, texel, self.n_rough, self.coarse)
+                m, err = fit.fit_texels(self.problem, texel, self.n_rough, self.coarse, fit.MEMO)
                 box += [fit.pack_inverse(m), self.problem.relative(texel, err)]
         return box
 

@@ -31,6 +31,8 @@ for any tiling or worker count (ltc_code instead chains each texel off the previ
 from __future__ import annotations
 
 import functools
+import threading
+from collections import OrderedDict
 
 import numpy as np
 import warp as wp
@@ -200,6 +202,7 @@ class Problem:
         nv = self.nov.astype(np.float64)
         self.v = np.stack([np.sqrt(np.maximum(1.0 - nv * nv, 0.0)), np.zeros_like(nv), nv], axis=1).astype(np.float32)
         self.isotropic = self.nov >= np.float32(1.0)
+        self.grid_n = n_grid
         grid = stratified_grid(n_grid)
         lobe_samples, self._heitz, self._values = kernels(lobe_name)
         d = device
@@ -322,16 +325,23 @@ def nelder_mead(
     tol: float = NELDER_MEAD_TOL,
     iters: int = NELDER_MEAD_ITERS,
     atol: np.ndarray | float = 0.0,
+    f_start: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """ltc_code's downhill simplex (nelder_mead.h) run on every texel at once: ``fun(texel_subset, q)`` -> values.
     Each texel follows exactly the scalar algorithm (its own simplex, its own stopping test
     2 |f_lo - f_hi| < tol (|f_lo| + |f_hi|) + atol); the vector form only batches the objective calls.
-    Returns (best q (n, 3), best value (n,))."""
+    ``f_start``: fun at ``start`` where the caller has it (not evaluated again). Returns (best q (n, 3), best
+    value (n,))."""
     n, dim = start.shape
     s = np.repeat(start[:, None, :], dim + 1, axis=1)
     for i in range(dim):
         s[:, i + 1, i] += step
-    f = fun(np.repeat(texel, dim + 1), s.reshape(-1, dim)).reshape(n, dim + 1)
+    if f_start is None:
+        f = fun(np.repeat(texel, dim + 1), s.reshape(-1, dim)).reshape(n, dim + 1)
+    else:
+        f = np.empty((n, dim + 1))
+        f[:, 0] = f_start
+        f[:, 1:] = fun(np.repeat(texel, dim), s[:, 1:].reshape(-1, dim)).reshape(n, dim)
     active = np.ones(n, bool)
     rows = np.arange(n)
     for _ in range(iters):
@@ -369,10 +379,11 @@ def nelder_mead(
         if len(shrink):
             slo = s[shrink, lo[shrink]][:, None, :]
             s[shrink] = slo + 0.5 * (s[shrink] - slo)
-            keep = lo[shrink]
-            pts = s[shrink].reshape(-1, dim)
-            fs = fun(np.repeat(texel[shrink], dim + 1), pts).reshape(len(shrink), dim + 1)
-            fs[np.arange(len(shrink)), keep] = f[shrink, keep]
+            # the best vertex stays (slo + 0.5 * 0) and keeps its value: only the other dim vertices are evaluated
+            moved = np.ones((len(shrink), dim + 1), bool)
+            moved[np.arange(len(shrink)), lo[shrink]] = False
+            fs = f[shrink]
+            fs[moved] = fun(np.repeat(texel[shrink], dim), s[shrink][moved])
             f[shrink] = fs
     best = np.argmin(f, axis=1)
     return s[rows, best], f[rows, best]
@@ -387,39 +398,143 @@ def analytic_guesses(problem: Problem, texel: np.ndarray) -> np.ndarray:
     return np.stack([np.stack([c, c, *[z] * (problem.dof - 2)], axis=1) for c in cands], axis=1)
 
 
-def best_of(problem: Problem, texel: np.ndarray, cands: np.ndarray) -> np.ndarray:
-    """The candidate (k, c, dof) of least error per texel (first on ties)."""
+def best_of(problem: Problem, texel: np.ndarray, cands: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The candidate (k, c, dof) of least error per texel (first on ties) and that error."""
     k, c, dof = cands.shape
     f = problem.objective(np.repeat(texel, c), cands.reshape(-1, dof)).reshape(k, c)
-    return cands[np.arange(k), np.argmin(f, axis=1)]
+    best = np.argmin(f, axis=1)
+    return cands[np.arange(k), best], f[np.arange(k), best]
 
 
-def refine(problem: Problem, texel: np.ndarray, start: np.ndarray, steps) -> tuple[np.ndarray, np.ndarray]:
-    """Nelder-Mead from ``start``, restarted from its result at each simplex size of ``steps``."""
-    q, f = start, None
+def refine(
+    problem: Problem, texel: np.ndarray, start: np.ndarray, steps, f_start: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Nelder-Mead from ``start`` (of error ``f_start`` if known), restarted from its result at each simplex size of
+    ``steps`` (each restart's first vertex keeps the value the previous run found)."""
+    q, f = start, f_start
     atol = ATOL_RELATIVE**3 * problem.f3[texel]
     for step in steps:
-        q, f = nelder_mead(problem.objective, texel, q, step, atol=atol)
+        q, f = nelder_mead(problem.objective, texel, q, step, atol=atol, f_start=f)
     return q, f
+
+
+class FitMemo:
+    """Per-texel fits shared between the bakes of one process (lutbake.kinds.ltc): a texel's fit is a pure function
+    of its own inputs (lobe, metric grid, device, n.v, alpha, magnitude) and its candidate starts, so two tables
+    that fit a texel with equal inputs and candidates get the same bits; the memo fits it once. The ltc-hdrp preset
+    (alpha_min 1e-3) differs from ltc-ggx only in the columns whose clamped alpha or coarse seeds differ.
+    Thread-safe: a texel another thread is fitting is waited for, not refitted. Least recently stored entries are
+    dropped beyond ``capacity``."""
+
+    def __init__(self, capacity: int = 1 << 16):
+        self.capacity = capacity
+        self._lock = threading.Lock()
+        self._done: OrderedDict[bytes, tuple[np.ndarray, float]] = OrderedDict()
+        self._pending: dict[bytes, threading.Event] = {}
+        self.hits = 0
+        self.misses = 0
+
+    def clear(self) -> None:
+        with self._lock:
+            self._done.clear()
+            self.hits = self.misses = 0
+
+    def run(self, keys: list[bytes], compute) -> tuple[np.ndarray, np.ndarray]:
+        """(q, f) per key: stored ones, ``compute(indices)`` -> (q, f) for those no thread has, waiting for those
+        another thread is computing (recomputed here if that thread failed)."""
+        n = len(keys)
+        q, f = [None] * n, np.empty(n)
+        todo = list(range(n))
+        while todo:
+            mine, theirs = [], []
+            with self._lock:
+                for i in todo:
+                    k = keys[i]
+                    if k in self._done:
+                        q[i], f[i] = self._done[k]
+                        self.hits += 1
+                    elif k in self._pending:
+                        theirs.append((i, self._pending[k]))
+                    else:
+                        self._pending[k] = threading.Event()
+                        mine.append(i)
+            if mine:
+                self._compute(keys, mine, compute, q, f)
+            for _, event in theirs:
+                event.wait()
+            todo = [i for i, _ in theirs]  # now stored (or released by a failed thread: claimed again)
+        return np.stack(q), f
+
+    def _compute(self, keys, mine, compute, q, f) -> None:
+        try:
+            qm, fm = compute(np.array(mine))
+        except BaseException:
+            self._release(keys, mine)
+            raise
+        with self._lock:
+            for j, i in enumerate(mine):
+                q[i], f[i] = qm[j], fm[j]
+                self._done[keys[i]] = (qm[j].copy(), float(fm[j]))
+            self.misses += len(mine)
+            while len(self._done) > self.capacity:
+                self._done.popitem(last=False)
+        self._release(keys, mine)
+
+    def _release(self, keys, mine) -> None:
+        with self._lock:
+            for i in mine:
+                self._pending.pop(keys[i]).set()
+
+
+MEMO = FitMemo()  # the ltc kind's (lutbake.kinds.ltc.LtcBake): shared by every table a process bakes
+
+
+def texel_keys(problem: Problem, texel: np.ndarray, points: np.ndarray, what: str) -> list[bytes]:
+    """The memo keys of ``texel``: everything its fit from ``points`` (k, c, dof) reads (``what``: the fit options,
+    the texel's inputs)."""
+    head = repr((what, problem.lobe, problem.device, problem.grid_n, problem.dof))
+    head = (head + repr((NELDER_MEAD_TOL, NELDER_MEAD_ITERS, ATOL_RELATIVE, M_MIN))).encode()
+    points = np.ascontiguousarray(points, np.float64)
+    rows = zip(problem.nov[texel], problem.alpha[texel], problem.magnitude[texel], points)
+    return [head + n.tobytes() + a.tobytes() + m.tobytes() + c.tobytes() for n, a, m, c in rows]
+
+
+def fit_from(
+    problem: Problem, texel: np.ndarray, cands: np.ndarray, steps, memo: FitMemo | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Nelder-Mead (``refine`` at ``steps``) from the best of the candidates (k, c, dof) per texel; (q, f).
+    With ``memo``, a texel fitted before with equal inputs and candidates is taken from it, and one whose best
+    candidate equals the start of an earlier fit takes that fit's result (refine reads nothing else): same bits."""
+    if memo is None or len(texel) == 0:
+        start, f_start = best_of(problem, texel, cands)
+        return refine(problem, texel, start, steps, f_start)
+
+    def from_cands(i):
+        start, f_start = best_of(problem, texel[i], cands[i])
+        keys = texel_keys(problem, texel[i], start[:, None, :], f"start {steps}")
+        return memo.run(keys, lambda j: refine(problem, texel[i][j], start[j], steps, f_start[j]))
+
+    return memo.run(texel_keys(problem, texel, cands, f"candidates {steps}"), from_cands)
 
 
 def coarse_nodes(n: int) -> np.ndarray:
     return np.unique(np.round(np.linspace(0, n - 1, min(COARSE_NODES, n))).astype(int))
 
 
-def coarse_pass(problem: Problem, ny: int, nx: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def coarse_pass(
+    problem: Problem, ny: int, nx: int, memo: FitMemo | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Fit the coarse-grid texels (rows ``iy``, columns ``ix``) from analytic guesses alone.
     Returns (iy nodes, ix nodes, q of shape (len(iy), len(ix), dof))."""
     iy, ix = coarse_nodes(ny), coarse_nodes(nx)
     texel = (iy[:, None] * nx + ix[None, :]).ravel()
-    start = best_of(problem, texel, analytic_guesses(problem, texel))
-    q, _ = refine(problem, texel, start, COARSE_STEPS)
+    q, _ = fit_from(problem, texel, analytic_guesses(problem, texel), COARSE_STEPS, memo)
     return iy, ix, q.reshape(len(iy), len(ix), problem.dof)
 
 
-def seeds(problem: Problem, texel: np.ndarray, nx: int, coarse) -> np.ndarray:
-    """Per texel: the best of the analytic guesses, the coarse fits of the (up to 4) surrounding coarse texels
-    and their bilinear blend in q."""
+def seed_candidates(problem: Problem, texel: np.ndarray, nx: int, coarse) -> np.ndarray:
+    """Per texel (k, 8, dof): the analytic guesses, the coarse fits of the (up to 4) surrounding coarse texels and
+    their bilinear blend in q."""
     iy, ix, qc = coarse
     y, x = texel // nx, texel % nx
     j = np.clip(np.searchsorted(iy, y, side="right") - 1, 0, len(iy) - 2) if len(iy) > 1 else np.zeros_like(y)
@@ -429,14 +544,14 @@ def seeds(problem: Problem, texel: np.ndarray, nx: int, coarse) -> np.ndarray:
     tx = np.where(ix[i1] > ix[i], (x - ix[i]) / np.maximum(ix[i1] - ix[i], 1), 0.0)[:, None]
     c00, c01, c10, c11 = qc[j, i], qc[j, i1], qc[j1, i], qc[j1, i1]
     blend = (1 - ty) * ((1 - tx) * c00 + tx * c01) + ty * ((1 - tx) * c10 + tx * c11)
-    cands = np.concatenate([analytic_guesses(problem, texel), np.stack([c00, c01, c10, c11, blend], axis=1)], axis=1)
-    return best_of(problem, texel, cands)
+    return np.concatenate([analytic_guesses(problem, texel), np.stack([c00, c01, c10, c11, blend], axis=1)], axis=1)
 
 
-def fit_texels(problem: Problem, texel: np.ndarray, nx: int, coarse) -> tuple[np.ndarray, np.ndarray]:
-    """Fitted M (k, 3, 3) and Heitz's error E (k,) at ``texel``, seeded from the coarse pass."""
-    start = seeds(problem, texel, nx, coarse)
-    q, f = refine(problem, texel, start, FINE_STEPS)
+def fit_texels(
+    problem: Problem, texel: np.ndarray, nx: int, coarse, memo: FitMemo | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Fitted M (k, 3, 3) and Heitz's error E (k,) at ``texel``, started from the best of its seed candidates."""
+    q, f = fit_from(problem, texel, seed_candidates(problem, texel, nx, coarse), FINE_STEPS, memo)
     return problem.matrices(texel, q), f
 
 
