@@ -93,3 +93,69 @@ def greedy_ladder_for(panel_sum, max_panels: int):
         return climb(ctx, n_panels, rules, levels, wp.vec2d(target_abs, target_rel), fine0, coarse0)
 
     return integrate, climb, Values
+
+
+@functools.lru_cache(maxsize=None)
+def greedy_ladder_channels_for(panel_sum, max_panels: int, nch: int):
+    """``integrate(ctx, n_panels, rules, levels, target_abs, target_rel) -> (sum_p Q_p, sum_p d_p)``: the greedy
+    ladder of ``greedy_ladder_for`` for a ``panel_sum`` that returns ``nch`` channels (a float64 vector), per channel
+    c until sum_p d_pc <= max(target_abs[c], target_rel[c] |sum_p Q_pc|) (targets: float64 vectors of nch; a channel
+    with an unreachable target, e.g. 1e300, never refines). Each step takes the channel furthest over its target
+    (largest sum_p d_pc / target_c) and raises its panel with the largest d_pc."""
+    Vec = wp.types.vector(length=nch, dtype=wp.float64)
+    Table = wp.types.matrix(shape=(max_panels, nch), dtype=wp.float64)
+    Orders = wp.types.vector(length=max_panels, dtype=wp.int32)  # a panel's level
+
+    @wp.func
+    def integrate(ctx: Any, n_panels: int, rules: Rule, levels: Levels, target_abs: Vec, target_rel: Vec):
+        q = Table()
+        d = Table()
+        lev = Orders()
+        last = levels.shape[0] - 1
+        top = wp.min(1, last)
+        for j in range(n_panels):
+            fine = panel_sum(ctx, j, rules, levels[top][0], levels[top][1])
+            coarse = fine  # one order: the fixed rule, no estimate
+            if top > 0:
+                coarse = panel_sum(ctx, j, rules, levels[0][0], levels[0][1])
+            for c in range(nch):
+                q[j, c] = fine[c]
+                d[j, c] = wp.abs(fine[c] - coarse[c])
+            lev[j] = top
+        total = Vec()
+        err = Vec()
+        going = wp.int32(1)
+        while going == 1:
+            total = Vec()
+            err = Vec()
+            for j in range(n_panels):
+                for c in range(nch):
+                    total[c] = total[c] + q[j, c]
+                    err[c] = err[c] + d[j, c]
+            worst_c = wp.int32(-1)  # the channel furthest over its target
+            over = wp.float64(1.0)
+            for c in range(nch):
+                r = err[c] / wp.max(wp.max(target_abs[c], target_rel[c] * wp.abs(total[c])), wp.float64(1.0e-300))
+                if r > over:
+                    over = r
+                    worst_c = c
+            worst = wp.int32(-1)  # its panel with the largest d that can still go up
+            if worst_c >= 0:
+                for j in range(n_panels):
+                    if lev[j] < last:
+                        if worst < 0:
+                            worst = j
+                        elif d[j, worst_c] > d[worst, worst_c]:
+                            worst = j
+            if worst < 0:
+                going = 0
+            else:
+                k = lev[worst] + 1
+                fine = panel_sum(ctx, worst, rules, levels[k][0], levels[k][1])
+                for c in range(nch):
+                    d[worst, c] = wp.abs(fine[c] - q[worst, c])
+                    q[worst, c] = fine[c]
+                lev[worst] = k
+        return total, err
+
+    return integrate, Vec
