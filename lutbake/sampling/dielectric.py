@@ -392,8 +392,11 @@ class DielectricGaussLegendre(GaussLegendre):
         return _launch(self._kernel(integrand), inputs, [rule], integrand.kernel_channels, device)
 
 
-# the ladder's orders: TODO measured
-DIELECTRIC_ORDERS = (6, 8, 12, 16, 24, 32, 48, 64)
+# the ladder's orders: a first step of 2x (6 -> 12), then ~1.4x. Successive close orders (6, 8 or 8, 12 first) agreed by
+# coincidence where the convergence stagnates (measured, 3005 random + edge texels against order 64: order 8 off by
+# 9e-7, order 12 by 6e-7 at (n.v, alpha, eta) = (0.24, 0.042, 0.49); error / estimate up to 10.6 from (8, 10), 2.2 from
+# (8, 12)); from (6, 12) every estimate bounds the error (worst 0.87; tests/test_dielectric.py)
+DIELECTRIC_ORDERS = (6, 12, 18, 24, 36, 48, 64)
 
 
 @dataclass(frozen=True)
