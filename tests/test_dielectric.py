@@ -426,8 +426,11 @@ HONESTY_TEXELS = (
         (float(np.sqrt(1 - 0.6**2)) + 0.01, 0.05, 0.6),  # just outside the critical angle
         (float(np.sqrt(1 - 0.6**2)) - 0.01, 0.05, 0.6),  # just inside (total internal reflection)
         (0.3, 0.6, 2.5),
+        (1.0e-4, 0.07111, 1.0629),  # EEVEE's clamped grazing row (not honest from orders (6, 12), see below)
     ]
 )
+# EEVEE btdf's grazing row with only its transmission channel driving the ladder (kinds.dielectric.kernel_tolerance)
+EEVEE_GRAZING = [(1.0e-4, a, e) for a in (0.0044, 0.07111, 0.16, 0.36, 1.0) for e in (1.0629, 1.25, 1.7563, 2.1438)]
 HONESTY_TOLERANCES = (1.0e-5, 1.0e-6, 1.0e-7)
 HIGH_ORDER = 64  # the converged reference (a): orders 48, 64 and 96 agree to ~5e-9 on such texels
 NUMPY_TOLERANCES = (1.0e-5, 1.0e-6)  # (b): the numpy integral is good to ~1e-7, too coarse for 1e-7
@@ -472,3 +475,22 @@ def test_adaptive_estimate_bounds_the_error_against_the_numpy_integral(tol):
     values, est = adaptive_at(tol)
     np.testing.assert_array_less(np.abs(values - want), est + NUMPY_ACCURACY)
     print(f"tol {tol:.0e}: worst error / estimate vs numpy {honesty_ratio(np.abs(values - want), est):.3f}")
+
+
+def test_adaptive_estimate_of_eevee_btdf_grazing_row_bounds_the_error():
+    from lutbake.integrands.dielectric import dielectric_integrand
+    from lutbake.sampling.dielectric import DielectricAdaptive
+    from lutbake.tolerance import Tolerance
+
+    nov, alpha, eta = (np.asarray(c, np.float32) for c in zip(*EEVEE_GRAZING))
+    integrand = dielectric_integrand("ggx", "smith_separable", "eevee", 1)
+    inputs = {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": eta}
+    tol = 1.0e-6
+    values, est = DielectricAdaptive(*kd.kernel_tolerance("eevee_btdf", Tolerance(tol, 0.0))).evaluate_with_error(
+        integrand, inputs, "cpu"
+    )
+    high = kd.integrate(("ggx", "smith_separable", "eevee", "gauss_legendre"), nov, alpha, eta, 3 * HIGH_ORDER**2)
+    err = np.abs(values[:, 2] - high[:, 2])
+    np.testing.assert_array_less(err, est[:, 2])
+    np.testing.assert_array_less(est[:, 2], tol + TERMS_FLOOR * np.abs(values[:, 2]))
+    print(f"eevee_btdf grazing: worst error / estimate {honesty_ratio(err, est[:, 2]):.3f}")
