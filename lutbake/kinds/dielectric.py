@@ -6,7 +6,8 @@ Torrance 2007, "Microfacet models for refraction through rough surfaces") over t
                                              mu = 0.2 and at cos theta_c for eta < 1)
 eta = eta_o / eta_i is the relative IOR seen from the view's side: eta > 1 outside a denser medium, eta < 1 inside it
 (total internal reflection past the critical angle). The integrands are lutbake.integrands.dielectric, the default
-quadrature lutbake.sampling.dielectric (panelled Gauss-Legendre split at every kink); docs/transmission.md has the
+quadrature lutbake.sampling.dielectric (panelled Gauss-Legendre split at every kink; kind dielectric to the
+tolerance, kind dielectric_avg at a fixed order); docs/transmission.md has the
 derivation, every engine's conventions and the measured accuracy.
 
 Layouts (key ``layout``) fix the channels, and for the engine layouts the whole grid:
@@ -545,8 +546,8 @@ def avg_texel_count(o: dict) -> int:
 
 
 SAMPLES_DOC = (
-    "integrand evaluations per texel; omitted: the estimator's default (gauss_legendre 432 = order 12 per "
-    "panel, sobol_vndf 16384)"
+    "integrand evaluations per texel; omitted: gauss_legendre adapts to the tolerance (kind dielectric; "
+    "dielectric_avg: 432 = order 12 per panel), sobol_vndf 16384"
 )
 ESTIMATION = Estimation(HEMISPHERE_ESTIMATORS, "gauss_legendre", SAMPLES_DOC)
 

@@ -29,9 +29,10 @@ phi-breakpoints: a panel ending at a horizon (phi_l or phi_t) uses the sinh map 
 kink; the other panels are smoothstep-mapped.
 Per texel: (n.v, alpha, eta) (eta = the kernel's ``param``); GL (node, weight) rules on [0, 1] for the outer and
 inner variables. float64 accumulation, float32 terms. alpha = 0 takes the integrand's closed-form mirror limit.
-``DielectricGaussLegendre`` is this quadrature as an estimator of the lutbake.sampling.plan protocol; the QMC
-estimators of lutbake.sampling.hemisphere serve as the second estimator unchanged (the integrand lives in the same
-half-vector measure).
+``DielectricGaussLegendre`` is this quadrature at a fixed order, ``DielectricAdaptive`` to a tolerance (each panel up
+DIELECTRIC_ORDERS, the worst panel first: make_adaptive_dielectric), estimators of the lutbake.sampling.plan
+protocol; the QMC estimators of lutbake.sampling.hemisphere serve as the second estimator unchanged (the integrand
+lives in the same half-vector measure).
 """
 
 from __future__ import annotations
