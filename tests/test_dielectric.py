@@ -408,3 +408,89 @@ def test_openpbr_header_writes_its_arrays_as_unorm16(tmp_path):
     np.testing.assert_array_equal(codes, np.rint(avg[..., 3].ravel().astype(np.float64) * 65535))
     with pytest.raises(Exception, match="format"):
         spec(kind="dielectric", format="openpbr_h")
+
+
+# the adaptive quadrature (kind dielectric's default, lutbake.sampling.dielectric.DielectricAdaptive): every per-texel
+# error estimate bounds the error against (a) the same kernel at a fixed high order and (b) the numpy integral over the
+# outgoing sphere, on texels where quadratures struggle: grazing n.v, small alpha, eta near 1, eta < 1 near the
+# critical angle, eta > 1, random
+HONESTY_TEXELS = (
+    EDGES
+    + RANDOM
+    + [
+        (0.002, 0.3, 1.5),  # grazing
+        (0.7, 0.002, 1.33),  # small alpha
+        (0.5, 0.04, 0.49),  # stagnating convergence (orders 8 and 12 agree, both off by 6e-7)
+        (0.6, 0.25, 1.02),  # eta near 1 (above)
+        (0.8, 0.4, 0.98),  # eta near 1 (below)
+        (float(np.sqrt(1 - 0.6**2)) + 0.01, 0.05, 0.6),  # just outside the critical angle
+        (float(np.sqrt(1 - 0.6**2)) - 0.01, 0.05, 0.6),  # just inside (total internal reflection)
+        (0.3, 0.6, 2.5),
+        (1.0e-4, 0.07111, 1.0629),  # EEVEE's clamped grazing row (not honest from orders (6, 12), see below)
+    ]
+)
+# EEVEE btdf's grazing row with only its transmission channel driving the ladder (kinds.dielectric.kernel_tolerance)
+EEVEE_GRAZING = [(1.0e-4, a, e) for a in (0.0044, 0.07111, 0.16, 0.36, 1.0) for e in (1.0629, 1.25, 1.7563, 2.1438)]
+HONESTY_TOLERANCES = (1.0e-5, 1.0e-6, 1.0e-7)
+HIGH_ORDER = 64  # the converged reference (a): orders 48, 64 and 96 agree to ~5e-9 on such texels
+NUMPY_TOLERANCES = (1.0e-5, 1.0e-6)  # (b): the numpy integral is good to ~1e-7, too coarse for 1e-7
+NUMPY_ACCURACY = 1.0e-7  # its own error, allowed on top of the estimate (measured: |numpy - order 96| <= 8.2e-8)
+TERMS_FLOOR = 1.0e-7  # the estimate's float32 rounding part, relative (lutbake.sampling.hemisphere.TERMS_ROUNDING)
+
+
+@functools.lru_cache(maxsize=None)
+def adaptive_at(tol: float):
+    from lutbake.integrands.dielectric import dielectric_integrand
+    from lutbake.sampling.dielectric import DielectricAdaptive
+
+    nov, alpha, eta = (np.asarray(c, np.float32) for c in zip(*HONESTY_TEXELS))
+    integrand = dielectric_integrand("ggx", "smith_separable", "exact")
+    inputs = {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": eta}
+    return DielectricAdaptive((tol,) * 3, (0.0,) * 3).evaluate_with_error(integrand, inputs, "cpu")
+
+
+def honesty_ratio(err: np.ndarray, est: np.ndarray) -> float:
+    return float(np.max(err / est))
+
+
+@pytest.mark.parametrize("tol", HONESTY_TOLERANCES)
+def test_adaptive_estimate_bounds_the_error_against_a_high_order(tol):
+    nov, alpha, eta = (np.asarray(c, np.float32) for c in zip(*HONESTY_TEXELS))
+    high = kd.integrate(("ggx", "smith_separable", "exact", "gauss_legendre"), nov, alpha, eta, 3 * HIGH_ORDER**2)
+    values, est = adaptive_at(tol)
+    np.testing.assert_array_less(np.abs(values - high), est)  # every estimate bounds its error
+    np.testing.assert_array_less(est, tol + TERMS_FLOOR * np.abs(values))  # and reached the tolerance (+ the floor)
+    print(f"tol {tol:.0e}: worst error / estimate {honesty_ratio(np.abs(values - high), est):.3f}")
+
+
+@functools.lru_cache(maxsize=None)
+def numpy_energies():
+    return np.array([ref.energies(*map(float, t)) for t in HONESTY_TEXELS])
+
+
+@pytest.mark.parametrize("tol", NUMPY_TOLERANCES)
+def test_adaptive_estimate_bounds_the_error_against_the_numpy_integral(tol):
+    er_et = numpy_energies()
+    want = np.column_stack([er_et, er_et.sum(axis=1)])
+    values, est = adaptive_at(tol)
+    np.testing.assert_array_less(np.abs(values - want), est + NUMPY_ACCURACY)
+    print(f"tol {tol:.0e}: worst error / estimate vs numpy {honesty_ratio(np.abs(values - want), est):.3f}")
+
+
+def test_adaptive_estimate_of_eevee_btdf_grazing_row_bounds_the_error():
+    from lutbake.integrands.dielectric import dielectric_integrand
+    from lutbake.sampling.dielectric import DielectricAdaptive
+    from lutbake.tolerance import Tolerance
+
+    nov, alpha, eta = (np.asarray(c, np.float32) for c in zip(*EEVEE_GRAZING))
+    integrand = dielectric_integrand("ggx", "smith_separable", "eevee", 1)
+    inputs = {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": eta}
+    tol = 1.0e-6
+    values, est = DielectricAdaptive(*kd.kernel_tolerance("eevee_btdf", Tolerance(tol, 0.0))).evaluate_with_error(
+        integrand, inputs, "cpu"
+    )
+    high = kd.integrate(("ggx", "smith_separable", "eevee", "gauss_legendre"), nov, alpha, eta, 3 * HIGH_ORDER**2)
+    err = np.abs(values[:, 2] - high[:, 2])
+    np.testing.assert_array_less(err, est[:, 2])
+    np.testing.assert_array_less(est[:, 2], tol + TERMS_FLOOR * np.abs(values[:, 2]))
+    print(f"eevee_btdf grazing: worst error / estimate {honesty_ratio(err, est[:, 2]):.3f}")

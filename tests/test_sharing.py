@@ -19,11 +19,11 @@ from lutbake.sharing import layout_keys, values_key
 from lutbake.values_cache import open_cache
 
 SMALL_LTC = {"kind": "ltc", "lobe": "ggx", "size": [6, 6], "fit_samples": 4}
-SMALL_DIELECTRIC = {"kind": "dielectric", "size": [4, 3], "ior_size": 2}
+SMALL_DIELECTRIC = {"kind": "dielectric_avg", "roughness_size": 4, "ior_size": 2}  # fixed order: format is layout
 # one small valid table per kind that declares layout keys; every value each layout key allows is tried on it
-SMALL = {"ltc": SMALL_LTC, "dielectric": SMALL_DIELECTRIC, "dielectric_avg": {"kind": "dielectric_avg"}}
+SMALL = {"ltc": SMALL_LTC, "dielectric_avg": SMALL_DIELECTRIC}
 # layout values a kind's own cross-key check refuses with these small specs (they pair with other keys)
-REFUSED = {("dielectric", "format", "openpbr_h"), ("dielectric_avg", "format", "openpbr_h")}
+REFUSED = {("dielectric_avg", "format", "openpbr_h")}
 
 
 def plan_records(plan) -> dict:
@@ -72,6 +72,10 @@ def test_values_key_follows_the_values_not_the_file(spec):
     assert "format" not in layout_keys("dfg")
     assert values_key(spec(dfg, format="png16"), digest) != values_key(spec(dfg), digest)
     assert values_key(spec(dfg, name="y"), digest) == values_key(spec(dfg), digest)
+    # so is kind dielectric's (adaptive since issue 13): dtype half sets a relative tolerance
+    diel = {"kind": "dielectric", "size": [4, 3], "ior_size": 2}
+    assert "dtype" not in layout_keys("dielectric")
+    assert values_key(spec(diel, dtype="half"), digest) != values_key(spec(diel), digest)
 
 
 def write_config(path: Path, tables: list[dict]) -> Path:

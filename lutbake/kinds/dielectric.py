@@ -6,7 +6,8 @@ Torrance 2007, "Microfacet models for refraction through rough surfaces") over t
                                              mu = 0.2 and at cos theta_c for eta < 1)
 eta = eta_o / eta_i is the relative IOR seen from the view's side: eta > 1 outside a denser medium, eta < 1 inside it
 (total internal reflection past the critical angle). The integrands are lutbake.integrands.dielectric, the default
-quadrature lutbake.sampling.dielectric (panelled Gauss-Legendre split at every kink); docs/transmission.md has the
+quadrature lutbake.sampling.dielectric (panelled Gauss-Legendre split at every kink; kind dielectric to the
+tolerance, kind dielectric_avg at a fixed order); docs/transmission.md has the
 derivation, every engine's conventions and the measured accuracy.
 
 Layouts (key ``layout``) fix the channels, and for the engine layouts the whole grid:
@@ -30,7 +31,7 @@ Layouts (key ``layout``) fix the channels, and for the engine layouts the whole 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -38,6 +39,7 @@ from ..axes import Axis
 from ..catalog import DIELECTRIC_MASKINGS, HEMISPHERE_ESTIMATORS, MASKINGS, NDF_DESCRIPTIONS, SMITH_NDFS, VNDF_NDFS
 from ..edge import alpha_policy
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan, probe_indices
+from ..tolerance import tolerance_of
 from . import dfg, dielectric_ratio
 from .base import Estimation, Key, declare
 
@@ -46,7 +48,10 @@ EEVEE_SIZE = (16, 64, 64)  # UTIL_BTDF_LAYER_COUNT roughness layers x UTIL_TEX_S
 EEVEE_CLAMP = (1.0e-4, 0.9999)  # eevee_lut_comp.glsl: NoV, f0-like x^2 (btdf) and eta (bsdf) clamps
 OPENPBR_SIZE = 32  # OpenPBR_EnergyTableSize
 OPENPBR_IOR_MAX = 2.5  # OpenPBR_IorMax
-LAYOUT_KEYS = ("format", "dtype")  # fixed-order quadrature, no storage-derived tolerance: values never depend on them
+# kind dielectric_avg: fixed-order quadrature, no storage-derived tolerance, so its values never depend on format /
+# dtype; kind dielectric adapts to the tolerance they set (lutbake.tolerance): no layout keys
+AVG_LAYOUT_KEYS = ("format", "dtype")
+NO_TARGET = 1.0e300  # the tolerance of a kernel channel a layout drops (it never refines)
 
 LAYOUTS = {
     "energy": "R = E_R, G = E_T, B = E_R + E_T over NoV x roughness x IOR (exact Fresnel)",
@@ -290,6 +295,26 @@ def integrate(key: tuple, nov, alpha, eta, samples: int | None = None, seed: int
     return estimator_for(estimator, samples, seed).evaluate(integrand, inputs, device)
 
 
+def kernel_tolerance(layout: str, tol) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(absolute, relative) per kernel channel such that every channel of ``layout`` meets ``tol``
+    (lutbake.tolerance.Tolerance) through post_process: openpbr's 1 - (E_R + E_T) adds two channels' errors
+    (half the absolute tolerance each; a complement's relative tolerance does not carry over: 0), eevee_btdf keeps
+    channel 2 only."""
+    a, r = tol.absolute, tol.relative
+    if layout == "openpbr":
+        return (a / 2, a / 2, a), (0.0, 0.0, 0.0)
+    if layout == "eevee_btdf":
+        return (NO_TARGET, NO_TARGET, a), (0.0, 0.0, r)
+    return (a, a, a), (r, r, r)
+
+
+def error_post_process(layout: str, err: np.ndarray) -> np.ndarray:
+    """Per-texel error bounds of post_process(layout, e) from those of e (the triangle inequality)."""
+    if layout == "openpbr":
+        return np.stack([err[:, 0] + err[:, 1], err[:, 0], err[:, 2]], axis=1)
+    return err[:, 2:] if layout == "eevee_btdf" else err
+
+
 def post_process(layout: str, e: np.ndarray) -> np.ndarray:
     """The integrals (n, 3) -> the layout's channels: complements for openpbr, the transmission factor (channel 2)
     for eevee_btdf."""
@@ -323,6 +348,36 @@ class LayoutChannels:
         return LayoutChannels(inner, self.layout), how
 
 
+@dataclass(frozen=True)
+class LayoutChannelsAdaptive(LayoutChannels):
+    """LayoutChannels of lutbake.sampling.dielectric.DielectricAdaptive: ``absolute`` / ``relative``, the table's
+    tolerance (its channels); the inner estimator holds kernel_tolerance's per kernel channel."""
+
+    absolute: float = 0.0
+    relative: float = 0.0
+
+    def evaluate_with_error(self, integrand, inputs: dict, device: str) -> tuple[np.ndarray, np.ndarray]:
+        values, err = self.inner.evaluate_with_error(integrand, inputs, device)
+        return post_process(self.layout, values), error_post_process(self.layout, err)
+
+    def refined(self):
+        inner, how = self.inner.refined()
+        return replace(self, inner=inner, absolute=self.absolute / 100, relative=self.relative / 100), how
+
+
+def layout_estimator(o: dict):
+    """The estimator of a ``dielectric`` spec: to its tolerance (lutbake.tolerance) when ``samples`` is unset and the
+    estimator is gauss_legendre, else estimator_for at ``samples``, through the layout's channels."""
+    layout = o["layout"]
+    if o["estimator"] == "gauss_legendre" and o["samples"] is None:
+        from ..sampling.dielectric import DielectricAdaptive
+
+        tol = tolerance_of(o)
+        inner = DielectricAdaptive(*kernel_tolerance(layout, tol))
+        return LayoutChannelsAdaptive(inner, layout, tol.absolute, tol.relative)
+    return LayoutChannels(estimator_for(o["estimator"], o["samples"], o["seed"]), layout)
+
+
 def terms_record(key: tuple, layout: str) -> dict:
     return {
         "model": "rough dielectric BSDF (Walter et al. 2007)",
@@ -348,7 +403,7 @@ def plan(spec) -> TexelPlan:
         "param": np.asarray(eta, np.float32),
     }
     grid = Grid(axes, inputs, grazing=inputs["nov"], alpha=np.asarray(alpha, np.float64))
-    est = LayoutChannels(estimator_for(o["estimator"], o["samples"], o["seed"]), layout)
+    est = layout_estimator(o)
     return per_texel_plan(
         integrand,
         est,
@@ -491,8 +546,8 @@ def avg_texel_count(o: dict) -> int:
 
 
 SAMPLES_DOC = (
-    "integrand evaluations per texel; omitted: the estimator's default (gauss_legendre 432 = order 12 per "
-    "panel, sobol_vndf 16384)"
+    "integrand evaluations per texel; omitted: gauss_legendre adapts to the tolerance (kind dielectric; "
+    "dielectric_avg: 432 = order 12 per panel), sobol_vndf 16384"
 )
 ESTIMATION = Estimation(HEMISPHERE_ESTIMATORS, "gauss_legendre", SAMPLES_DOC)
 
@@ -507,7 +562,6 @@ DIELECTRIC = declare(
     aliases=("glass", "btdf"),
     check=check_spec,
     texels=texel_count,
-    layout_keys=LAYOUT_KEYS,
 )
 DIELECTRIC_AVG = declare(
     "dielectric_avg",
@@ -518,5 +572,5 @@ DIELECTRIC_AVG = declare(
     aliases=("glass_avg",),
     check=check_spec,
     texels=avg_texel_count,
-    layout_keys=LAYOUT_KEYS,
+    layout_keys=AVG_LAYOUT_KEYS,
 )

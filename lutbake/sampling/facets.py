@@ -448,7 +448,7 @@ def fd_microfacet_adaptive_for(F_facet):
     panels of ``fd_microfacet_for``, each u panel (with its phi pieces) at GL orders ``levels``, refined greedily
     (lutbake.sampling.ladder) until the sum of the panels' |Q_(k) - Q_(k-1)| is within QUADRATURE_SHARE of the
     texel's tolerance max(tol[0], tol[1] |f|). The estimate is that sum plus FACET_ROUNDING |f| (float32 terms)."""
-    integrate = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)[0]
+    integrate, _, _, Sums = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)
 
     @wp.func
     def fd_microfacet_adaptive(
@@ -465,8 +465,9 @@ def fd_microfacet_adaptive_for(F_facet):
             return wp.vec2d(zero, zero)
         p = facet_pair(l, v, alpha, f0)
         scale = facet_scale(p, alpha)  # f = scale * (sum over panels)
-        targets = wp.vec3d(QUADRATURE_SHARE * tol[0] / scale, QUADRATURE_SHARE * tol[1], wp.float64(0.0))
-        total, err = integrate(p, 3 * (p.n_geo + 1), rules, levels, targets)
+        t_abs = Sums(QUADRATURE_SHARE * tol[0] / scale)
+        t_rel = Sums(QUADRATURE_SHARE * tol[1])
+        total, err = integrate(p, 3 * (p.n_geo + 1), rules, levels, t_abs, t_rel, wp.float64(0.0))
         return facet_estimate(scale, wp.vec2d(total[0], err[0]))
 
     return fd_microfacet_adaptive
@@ -481,7 +482,7 @@ def fd_microfacet_adaptive_azimuths_for(F_facet):
     per texel as fd_microfacet_adaptive, so the same values. Scratch: azl (the azimuths of l), panels (2
     MAX_U_PANELS rows: panel j at levels[1], then at levels[0], one column per texel); out[t] = (f, error
     estimate)."""
-    _, climb, Panels, _ = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)
+    _, climb, Panels, Sums = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)
     panel_azimuths = facet_panel_azimuths_for(F_facet)
 
     @wp.func
@@ -520,10 +521,9 @@ def fd_microfacet_adaptive_azimuths_for(F_facet):
             for j in range(n_panels):
                 fine0[j, 0] = panels[j, t]
                 coarse0[j, 0] = panels[MAX_U_PANELS + j, t]
-            targets = wp.vec3d(
-                QUADRATURE_SHARE * tol[0] / scale, QUADRATURE_SHARE * tol[1], wp.float64(0.0)
-            )  # as fd_microfacet_adaptive
-            total, err = climb(pt, n_panels, rules, levels, targets, fine0, coarse0)
+            t_abs = Sums(QUADRATURE_SHARE * tol[0] / scale)  # as fd_microfacet_adaptive
+            t_rel = Sums(QUADRATURE_SHARE * tol[1])
+            total, err = climb(pt, n_panels, rules, levels, t_abs, t_rel, wp.float64(0.0), fine0, coarse0)
             fe = facet_estimate(scale, wp.vec2d(total[0], err[0]))
             out[t, 0] = fe[0]
             out[t, 1] = fe[1]

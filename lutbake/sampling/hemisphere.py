@@ -340,7 +340,7 @@ def make_gauss_legendre(spec):
             t.v, t.a, t.prm, t.edges[j], t.edges[j + 1], t.theta_a, t.theta_peak, t.eps_l, rules, t.phi_a, off, n
         )
 
-    integrate = greedy_ladder_for(panel_of, MAX_PANELS, nch)[0]
+    integrate, _, _, Sums = greedy_ladder_for(panel_of, MAX_PANELS, nch)
 
     @wp.kernel(enable_backward=False, module="unique")
     def gauss_legendre_kernel(
@@ -378,8 +378,7 @@ def make_gauss_legendre(spec):
         t.phi_a = phi_a
         # the texel's target, in units of the panel sums (I = sum / pi): the estimate, TERMS_ROUNDING included, within
         # the tolerance
-        targets = wp.vec3d(tol[0] * PI64, tol[1], TERMS_ROUNDING)
-        total, e = integrate(t, n_panels, rules, levels, targets)
+        total, e = integrate(t, n_panels, rules, levels, Sums(tol[0] * PI64), Sums(tol[1]), TERMS_ROUNDING)
         for c in range(wp.static(nch)):
             out[i, c] = total[c] / PI64
             err[i, c] = e[c] / PI64 + TERMS_ROUNDING * wp.abs(total[c] / PI64)

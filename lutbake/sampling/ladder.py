@@ -12,10 +12,9 @@ order.
 ``greedy_ladder_for(panel_sum, max_panels, nch)`` closes over the panel rule ``panel_sum(ctx, j, rules, offset, order)
 -> value`` (``ctx``: the texel's constants, a Warp struct; ``j``: the panel's index, 0 .. n_panels - 1; an empty
 panel returns 0 at every order); the value is a float64 (nch = 1) or a float64 vector of nch channels (vec2d, vec3d),
-every channel refined to its own target.
+every channel refined to its own target. (No ``from __future__ import annotations``: Warp reads the kernels' argument
+types, local to the factory, from the annotations.)
 """
-
-from __future__ import annotations
 
 import functools
 from typing import Any
@@ -43,11 +42,12 @@ def channel(x: wp.vec3d, c: int):  # noqa: F811 (a Warp overload)
 
 @functools.lru_cache(maxsize=None)
 def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1):
-    """``(integrate, climb, Panels, Sums)``: ``integrate(ctx, n_panels, rules, levels, targets) -> (total, err)``
-    (``Sums``: float64 vectors of nch; ``targets``: vec3d(abs, rel, floor)): every panel at the first two levels,
-    then refined until err_c = sum_p d_(p,c) <= max(abs, rel |total_c|) - floor |total_c| for every channel c (floor:
-    a relative error the caller adds to the estimate, e.g. the terms' rounding) or every panel is at the last order
-    (module docstring); n_panels <= max_panels. ``climb(ctx, n_panels, rules, levels, targets, fine0, coarse0)``:
+    """``(integrate, climb, Panels, Sums)``: ``integrate(ctx, n_panels, rules, levels, target_abs, target_rel,
+    floor) -> (total, err)`` (``Sums``: float64 vectors of nch, the targets per channel too): every panel at the first
+    two levels, then refined until err_c = sum_p d_(p,c) <= max(target_abs_c, target_rel_c |total_c|) - floor
+    |total_c| for every channel c (floor: a relative error the caller adds to the estimate, e.g. the terms' rounding;
+    an unreachable target, e.g. 1e300, never refines) or every panel is at the last order (module docstring);
+    n_panels <= max_panels. ``climb(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0)``:
     the same from the first two levels' panel values given (``Panels``: float64 matrices max_panels x nch; fine0 at
     levels[1], coarse0 at levels[0]), e.g. computed for several texels that share per-node work: the same float
     operations, so the same result."""
@@ -56,7 +56,17 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1):
     Orders = wp.types.vector(length=max_panels, dtype=wp.int32)  # a panel's level
 
     @wp.func
-    def climb(ctx: Any, n_panels: int, rules: Rule, levels: Levels, targets: wp.vec3d, fine0: Panels, coarse0: Panels):
+    def climb(
+        ctx: Any,
+        n_panels: int,
+        rules: Rule,
+        levels: Levels,
+        target_abs: Sums,
+        target_rel: Sums,
+        floor: wp.float64,
+        fine0: Panels,
+        coarse0: Panels,
+    ):
         q = Panels()
         d = Panels()
         lev = Orders()
@@ -80,7 +90,7 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1):
             worst_c = wp.int32(-1)  # the channel furthest over its target
             over = wp.float64(1.0)
             for c in range(wp.static(nch)):
-                target = wp.max(targets[0], targets[1] * wp.abs(total[c])) - targets[2] * wp.abs(total[c])
+                target = wp.max(target_abs[c], target_rel[c] * wp.abs(total[c])) - floor * wp.abs(total[c])
                 if err[c] > target * over:
                     worst_c = c
                     over = err[c] / wp.max(target, wp.float64(1.0e-300))
@@ -104,7 +114,9 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1):
         return total, err
 
     @wp.func
-    def integrate(ctx: Any, n_panels: int, rules: Rule, levels: Levels, targets: wp.vec3d):
+    def integrate(
+        ctx: Any, n_panels: int, rules: Rule, levels: Levels, target_abs: Sums, target_rel: Sums, floor: wp.float64
+    ):
         fine0 = Panels()
         coarse0 = Panels()
         top = wp.min(1, levels.shape[0] - 1)
@@ -116,6 +128,6 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1):
             for c in range(wp.static(nch)):
                 fine0[j, c] = channel(fine, c)
                 coarse0[j, c] = channel(coarse, c)
-        return climb(ctx, n_panels, rules, levels, targets, fine0, coarse0)
+        return climb(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0)
 
     return integrate, climb, Panels, Sums
