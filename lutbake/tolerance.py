@@ -9,7 +9,7 @@ stored value can resolve, so the quadrature error never moves a stored code by m
 
 | storage | tolerance (absolute) | relative_tolerance |
 | --- | --- | --- |
-| ``format = "png16"`` (16-bit UNORM) | 1 / (4 * 65535) = 3.8e-6 | 0 |
+| ``format = "png16"``, ``"openpbr_h"`` (16-bit UNORM) | 1 / (4 * 65535) = 3.8e-6 | 0 |
 | ``dtype = "half"`` | 2^-26 = 1.5e-8 (1/4 of the subnormal step) | 2^-13 = 1.2e-4 (1/4 of the relative step 2^-11) |
 | ``dtype = "float32"`` | 1e-6 | 0 |
 
@@ -27,6 +27,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 UNORM16_QUANTUM = 1.0 / 65535.0
+UNORM16_FORMATS = ("png16", "openpbr_h")  # formats that store codes round(v * 65535)
 HALF_REL_STEP = 2.0**-11  # half: 10 stored mantissa bits, relative spacing between 2^-11 and 2^-10
 HALF_SUBNORMAL_STEP = 2.0**-24
 FLOAT32_ABSOLUTE = 1.0e-6  # the project's float32 accuracy bar (module docstring)
@@ -48,7 +49,7 @@ class Tolerance:
 def default_tolerance(options, float32: Tolerance | None = None) -> Tolerance:
     """The storage-derived default (module docstring) for a spec's ``format`` and ``dtype``; ``float32``: a kind's
     own float32 default (kind btf: 1e-5 relative, its values spanning five decades), else FLOAT32_ABSOLUTE."""
-    if options.get("format") == "png16":
+    if options.get("format") in UNORM16_FORMATS:
         return Tolerance(QUARTER * UNORM16_QUANTUM, 0.0)
     if options.get("dtype") == "half":
         return Tolerance(QUARTER * HALF_SUBNORMAL_STEP, QUARTER * HALF_REL_STEP)

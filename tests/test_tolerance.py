@@ -61,6 +61,8 @@ def test_error_estimate_bounds_error_on_every_texel_of_a_grid(integrand, spec, t
 
 def test_default_tolerance_follows_the_storage(spec):
     assert default_tolerance(spec(kind="dfg", format="png16").options) == Tolerance(0.25 / 65535, 0.0)
+    openpbr = spec(kind="dielectric", layout="openpbr", format="openpbr_h").options  # UNORM16 arrays
+    assert default_tolerance(openpbr) == Tolerance(0.25 / 65535, 0.0)
     assert default_tolerance(spec(kind="dfg", dtype="half").options).relative == 2.0**-13
     assert default_tolerance(spec(kind="dfg").options) == Tolerance(1.0e-6, 0.0)
     assert tolerance_of(spec(kind="dfg", tolerance=1e-5).options) == Tolerance(1e-5, 0.0)
