@@ -47,10 +47,16 @@ def test_error_estimate_bounds_error_against_numpy_reference(integrand, numpy_re
     assert np.all(est[:, :2] <= tol)  # every texel met the tolerance (no texel ran out of orders)
 
 
-@pytest.mark.parametrize("tol", [(QUARTER * UNORM16_QUANTUM, 0.0), (1.0e-8, 1.0e-6)])
-def test_error_estimate_bounds_error_on_every_texel_of_a_grid(integrand, spec, tol):
+@pytest.fixture(scope="module")
+def converged_grid(integrand, spec):
+    """The texels of a 64^2 dfg table and their values at fixed order 64 (computed once for the module)."""
     grid = grid_for(axes_for(spec(kind="dfg", size=[64, 64]).options), integrand)
-    ref, _ = gl_launch(integrand, grid.inputs, (CONVERGED_ORDER,), (0.0, 0.0), "cpu")
+    return grid, gl_launch(integrand, grid.inputs, (CONVERGED_ORDER,), (0.0, 0.0), "cpu")[0]
+
+
+@pytest.mark.parametrize("tol", [(QUARTER * UNORM16_QUANTUM, 0.0), (1.0e-8, 1.0e-6)])
+def test_error_estimate_bounds_error_on_every_texel_of_a_grid(integrand, converged_grid, tol):
+    grid, ref = converged_grid
     got, est = gl_launch(integrand, grid.inputs, ADAPTIVE_ORDERS, tol, "cpu")
     err = np.abs(got - ref)[:, :2]
     print(f"tol {tol}: max error {err.max():.3e}, max estimate {est[:, :2].max():.3e}")

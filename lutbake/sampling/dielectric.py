@@ -190,8 +190,10 @@ def dielectric_texel(t: wp.vec3):
         t_lo = half
     n_panels = wp.int32(0)  # a dynamic variable (a literal 0 is a constant to Warp)
     edges[0] = t_lo
-    while t_lo < half and n_panels < MAX_PANELS:
+    while t_lo < half:
         t_lo = next_theta_dielectric(t_lo, theta_a, theta_b, theta_peak, kinks)
+        if n_panels == MAX_PANELS - 1:  # never reached (MAX_PANELS): the last panel takes the rest, none is dropped
+            t_lo = half
         n_panels += 1
         edges[n_panels] = t_lo
     x = DielectricTexel()
