@@ -69,7 +69,8 @@ MAX_PANELS = 32  # a texel's panels (next_theta): at most 22 for n.v >= NOV_MIN,
 # an NDF-peak breakpoint within this factor of a horizon breakpoint (or of the panel's start) is dropped: a sliver
 # panel costs a whole product rule at two orders (measured, 256^2 glTF grid: 5.9 -> 4.9 panels per texel; every
 # estimate still bounds its error against order 64 there and on the 128^2 dfg, worst error / estimate unchanged;
-# 2.0 raised it to 0.98, 2.5 past 1)
+# 2.0 raised it to 0.98, 2.5 past 1). To a tolerance only: at a fixed order fewer panels are fewer nodes (the
+# kink-limited Cook-Torrance tables lost accuracy: 3.4e-5 -> 4.1e-5)
 PEAK_MERGE = 1.6
 PANEL_RATIO = 4.0  # panels grow geometrically in theta_h (and in pi/2 - theta_h) by this factor
 
@@ -116,10 +117,11 @@ def next_geometric(t_lo: wp.float64, t0: wp.float64):
 
 
 @wp.func
-def next_theta(t_lo: wp.float64, theta_a: wp.float64, theta_peak: wp.float64):
+def next_theta(t_lo: wp.float64, theta_a: wp.float64, theta_peak: wp.float64, merge: wp.float64):
     """Upper edge of the panel starting at t_lo: the next of
     - the NDF-peak breakpoints theta_peak R^j (below pi/4): the tail of D decays like a power of theta; one within
-      PEAK_MERGE of the next horizon breakpoint or of t_lo is skipped (D is analytic there, a scale, not a kink);
+      a factor ``merge`` (> 1: PEAK_MERGE, to a tolerance; 1: none, the fixed orders) of the next horizon breakpoint
+      or of t_lo is skipped (D is analytic there, a scale, not a kink);
     - the horizon breakpoints: theta_a (c* = -1), then geometric from theta_a up to pi/4 and from
       theta_b = pi/2 - theta_a down to pi/4 (c* ~ -cot(theta_v) / (2 theta_h) varies on every scale
       between theta_a and pi/4 at grazing view)."""
@@ -128,7 +130,6 @@ def next_theta(t_lo: wp.float64, theta_a: wp.float64, theta_peak: wp.float64):
     if t_lo < quarter:
         t = wp.min(next_geometric(t_lo, theta_a), quarter)
         tp = next_geometric(t_lo, theta_peak)
-        merge = wp.float64(PEAK_MERGE)
         if tp < t and tp * merge <= t and (t_lo <= wp.float64(0.0) or t_lo * merge <= tp):
             return tp
         return t
@@ -360,9 +361,12 @@ def make_gauss_legendre(spec):
             if a <= 0.0:  # alpha -> 0: the closed-form mirror limit below (lutbake.edge), no quadrature
                 edges[0] = theta_b
         n_panels = wp.int32(0)  # a dynamic variable (Warp: a bare literal is a constant)
+        merge = wp.float64(1.0)  # the fixed orders keep every breakpoint (their pixels as before PEAK_MERGE)
+        if levels.shape[0] > 1:
+            merge = wp.float64(PEAK_MERGE)
         t_lo = edges[0]
         while t_lo < theta_b:
-            t_lo = next_theta(t_lo, theta_a, theta_peak)
+            t_lo = next_theta(t_lo, theta_a, theta_peak, merge)
             if n_panels == MAX_PANELS - 1:  # never reached (MAX_PANELS): the last panel would take the rest
                 t_lo = theta_b
             n_panels += 1
