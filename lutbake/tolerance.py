@@ -31,7 +31,7 @@ UNORM16_FORMATS = ("png16", "openpbr_h")  # formats that store codes round(v * 6
 HALF_REL_STEP = 2.0**-11  # half: 10 stored mantissa bits, relative spacing between 2^-11 and 2^-10
 HALF_SUBNORMAL_STEP = 2.0**-24
 FLOAT32_ABSOLUTE = 1.0e-6  # the project's float32 accuracy bar (module docstring)
-FLOAT32_RELATIVE = 0.0  # absolute only: no first pass at the coarsest order to find |v| (lutbake.sampling.hemisphere)
+FLOAT32_RELATIVE = 0.0  # absolute only (the module docstring: 1e-6 is the float32 bar for values up to ~1)
 QUARTER = 0.25
 
 

@@ -547,9 +547,10 @@ class GaussLegendre:
 
 @dataclass(frozen=True)
 class AdaptiveGaussLegendre:
-    """``gauss_legendre`` to a tolerance: each panel at orders ADAPTIVE_ORDERS in turn until two agree within its
-    share of max(absolute, relative |I|) (make_gauss_legendre). ``evaluate_with_error`` also returns each texel's
-    error estimate (the sum over panels of |Q_(k) - Q_(k-1)|), recorded as the table's lutbake:error_estimate."""
+    """``gauss_legendre`` to a tolerance: every panel at the first two orders of ADAPTIVE_ORDERS, then the worst panel
+    one order up until the texel's estimate is within max(absolute, relative |I|) (make_gauss_legendre, the greedy
+    ladder of lutbake.sampling.ladder). ``evaluate_with_error`` also returns each texel's error estimate (the sum over
+    panels of |Q_(k) - Q_(k-1)| plus TERMS_ROUNDING |I|), recorded as the table's lutbake:error_estimate."""
 
     absolute: float
     relative: float
