@@ -294,9 +294,10 @@ def panel_rule_for(spec):
                             wy = wy * TWO64 * y
                             y = y * y
                         # sinh map (Johnston & Elliott 2005) towards p_hi: phi = p_hi - eps sinh(A (1 - y))
-                        arg = big_a * (ONE64 - y)
-                        phi = p_hi - eps * wp.sinh(arg)
-                        w = wk * wy * eps * wp.cosh(arg) * big_a
+                        ex = wp.exp(big_a * (ONE64 - y))  # sinh and cosh from one exp
+                        inv_ex = ONE64 / ex
+                        phi = p_hi - eps * HALF64 * (ex - inv_ex)
+                        w = wk * wy * eps * HALF64 * (ex + inv_ex) * big_a
                     else:
                         phi = p_lo + dp * y * y * (wp.float64(3.0) - TWO64 * y)
                         w = wk * wy * dp * wp.float64(6.0) * y * (ONE64 - y)
