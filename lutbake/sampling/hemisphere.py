@@ -341,7 +341,15 @@ def make_gauss_legendre(spec):
             t.v, t.a, t.prm, t.edges[j], t.edges[j + 1], t.theta_a, t.theta_peak, t.eps_l, rules, t.phi_a, off, n
         )
 
-    integrate, _, _, Sums = greedy_ladder_for(panel_of, MAX_PANELS, nch)
+    @wp.func
+    def first_level(t: PanelTexel, j: int):
+        """A panel's coarse level in ADAPTIVE_ORDERS: region A's NDF-peak panel (u = CDF(theta_h), every phi visible)
+        starts at (4, 6), the others at (6, 9)."""
+        if t.edges[j] < t.theta_a and t.edges[j + 1] <= t.theta_peak:
+            return 0
+        return 1
+
+    integrate, _, _, Sums = greedy_ladder_for(panel_of, MAX_PANELS, nch, first_level)
 
     @wp.kernel(enable_backward=False, module="unique")
     def gauss_legendre_kernel(
@@ -474,8 +482,10 @@ def _launch(kernel, inputs: dict, point_arrays: list, kernel_channels: int, devi
 # their estimates), the climbs are gentler (9 -> 11 -> 14 -> 20): most climbing panels need one step, and 11 costs
 # 0.84x of 12 (measured by replaying the ladder offline on every panel's orders 4..64, 96^2 grids: integrand
 # evaluations per texel 903 -> 852 on the dfg at 1e-6, 1080 -> 1005 at 3e-7, 760 -> 731 on glTF's at PNG16, worst
-# error / estimate unchanged)
-ADAPTIVE_ORDERS = (6, 9, 11, 14, 20, 32, 48, 64)
+# error / estimate unchanged). Region A's NDF-peak panel (u = CDF(theta_h), every phi visible: the smoothest) starts
+# one level lower, at (4, 6) (first_level in make_gauss_legendre; replayed: 731 -> 703 evaluations per texel on
+# glTF's grid, every estimate still bounding its error)
+ADAPTIVE_ORDERS = (4, 6, 9, 11, 14, 20, 32, 48, 64)
 
 
 @functools.lru_cache(maxsize=None)

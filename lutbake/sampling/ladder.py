@@ -41,7 +41,7 @@ def channel(x: wp.vec3d, c: int):  # noqa: F811 (a Warp overload)
 
 
 @functools.lru_cache(maxsize=None)
-def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1):
+def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None):
     """``(integrate, climb, Panels, Sums)``: ``integrate(ctx, n_panels, rules, levels, target_abs, target_rel,
     floor) -> (total, err)`` (``Sums``: float64 vectors of nch, the targets per channel too): every panel at the first
     two levels, then refined until err_c = sum_p d_(p,c) <= max(target_abs_c, target_rel_c |total_c|) - floor
@@ -50,13 +50,14 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1):
     n_panels <= max_panels. ``climb(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0)``:
     the same from the first two levels' panel values given (``Panels``: float64 matrices max_panels x nch; fine0 at
     levels[1], coarse0 at levels[0]), e.g. computed for several texels that share per-node work: the same float
-    operations, so the same result."""
+    operations, so the same result. ``first_level(ctx, j) -> k`` (optional): panel j starts at levels k and k + 1
+    instead of the first two (a panel class known to converge fast; clamped to the ladder)."""
     Panels = wp.types.matrix(shape=(max_panels, nch), dtype=wp.float64)
     Sums = wp.types.vector(length=nch, dtype=wp.float64)
     Orders = wp.types.vector(length=max_panels, dtype=wp.int32)  # a panel's level
 
     @wp.func
-    def climb(
+    def climb_from(
         ctx: Any,
         n_panels: int,
         rules: Rule,
@@ -66,17 +67,16 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1):
         floor: wp.float64,
         fine0: Panels,
         coarse0: Panels,
+        lev: Orders,
     ):
+        """climb, each panel's fine value at its level lev[j]."""
         q = Panels()
         d = Panels()
-        lev = Orders()
         last = levels.shape[0] - 1
-        top = wp.min(1, last)
         for j in range(n_panels):
             for c in range(wp.static(nch)):
                 q[j, c] = fine0[j, c]
                 d[j, c] = wp.abs(fine0[j, c] - coarse0[j, c])
-            lev[j] = top
         total = Sums()
         err = Sums()
         climbing = wp.bool(True)  # a dynamic variable (Warp: a bare literal is a constant)
@@ -114,20 +114,44 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1):
         return total, err
 
     @wp.func
+    def climb(
+        ctx: Any,
+        n_panels: int,
+        rules: Rule,
+        levels: Levels,
+        target_abs: Sums,
+        target_rel: Sums,
+        floor: wp.float64,
+        fine0: Panels,
+        coarse0: Panels,
+    ):
+        lev = Orders()
+        top = wp.min(1, levels.shape[0] - 1)
+        for j in range(n_panels):
+            lev[j] = top
+        return climb_from(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0, lev)
+
+    @wp.func
     def integrate(
         ctx: Any, n_panels: int, rules: Rule, levels: Levels, target_abs: Sums, target_rel: Sums, floor: wp.float64
     ):
         fine0 = Panels()
         coarse0 = Panels()
-        top = wp.min(1, levels.shape[0] - 1)
+        lev = Orders()
+        last = levels.shape[0] - 1
         for j in range(n_panels):
-            coarse = panel_sum(ctx, j, rules, levels[0][0], levels[0][1])
+            k = wp.int32(0)  # the panel's coarse level
+            if wp.static(first_level is not None):
+                k = wp.clamp(first_level(ctx, j), 0, wp.max(last - 1, 0))
+            top = wp.min(k + 1, last)
+            coarse = panel_sum(ctx, j, rules, levels[k][0], levels[k][1])
             fine = coarse  # one order: the fixed rule, no estimate
-            if top > 0:
+            if top > k:
                 fine = panel_sum(ctx, j, rules, levels[top][0], levels[top][1])
             for c in range(wp.static(nch)):
                 fine0[j, c] = channel(fine, c)
                 coarse0[j, c] = channel(coarse, c)
-        return climb(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0)
+            lev[j] = top
+        return climb_from(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0, lev)
 
     return integrate, climb, Panels, Sums
