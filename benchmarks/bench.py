@@ -293,11 +293,20 @@ def cpu_seconds(who=resource.RUSAGE_SELF) -> float:
     return r.ru_utime + r.ru_stime
 
 
-def timed_bake(s, workers):
-    """(float64 data, table attributes, wall s, CPU s (user + sys, every thread)) of one spec baked in-process."""
-    c0 = cpu_seconds()
-    table, seconds, _ = bake_table(s, workers=workers, progress=None)
-    return table.data.astype(np.float64), table.attributes, seconds, cpu_seconds() - c0
+# timed bakes are the best of REPEAT runs: this VM's speed varies by +-15 % between identical runs minutes apart
+REPEAT = 3
+
+
+def timed_bake(s, workers, repeat=REPEAT):
+    """(float64 data, table attributes, wall s, CPU s (user + sys, every thread)) of one spec baked in-process: the
+    fastest of ``repeat`` bakes (the same values each time)."""
+    best = None
+    for _ in range(repeat):
+        c0 = cpu_seconds()
+        table, seconds, _ = bake_table(s, workers=workers, progress=None)
+        row = (seconds, cpu_seconds() - c0)
+        best = row if best is None or row[0] < best[0] else best
+    return table.data.astype(np.float64), table.attributes, best[0], best[1]
 
 
 def timed_process(cmd, repeat=3, env=None):
@@ -381,7 +390,7 @@ def tolerance_cases(report, workers, quick):
     report["cases"]["dfg_128_tolerance"] = rows
 
     (gltf,) = load_config(preset_path("gltf"), [])
-    new, attrs, secs, cpu = timed_bake(gltf, workers)
+    new, attrs, secs, cpu = timed_bake(gltf, workers, repeat=2)
     g = {
         "seconds": secs,
         "cpu_seconds": cpu,
@@ -393,6 +402,7 @@ def tolerance_cases(report, workers, quick):
         old, _, osecs, ocpu = timed_bake(
             validate_table({**{k: v for k, v in gltf.options.items() if v is not None}, "samples": 432}, "<bench>", 0),
             workers,
+            repeat=2,
         )
         g.update(previous_seconds=osecs, previous_cpu_seconds=ocpu, speedup=osecs / secs)
         g["max_abs_difference_vs_previous"] = float(np.abs(new - old).max())

@@ -65,6 +65,9 @@ def bench_diffuse() -> dict:
     }
 
 
+REPEAT = 2
+
+
 def _cpu() -> float:
     r = resource.getrusage(resource.RUSAGE_SELF)
     return r.ru_utime + r.ru_stime
@@ -90,9 +93,13 @@ def bench_btf() -> dict:
             s = validate_table(
                 {**{k: x for k, x in spec.options.items() if x is not None}, "samples": 12}, "<bench>", 0
             )
-        c0 = _cpu()
-        table, seconds, samples = bake_table(s, workers=2)
-        cpu = _cpu() - c0
+        best = None
+        for _ in range(REPEAT):  # the fastest of REPEAT bakes: this VM's speed varies by +-15 % between runs
+            c0 = _cpu()
+            table, seconds, samples = bake_table(s, workers=2)
+            row = (seconds, _cpu() - c0)
+            best = row if best is None or row[0] < best[0] else best
+        seconds, cpu = best
         flat = table.data.reshape(-1).astype(np.float64)
         rel = np.abs(flat[idx] - ref)[ok] / np.abs(ref[ok])
         rows[label] = {
