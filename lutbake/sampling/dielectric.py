@@ -400,10 +400,10 @@ class DielectricGaussLegendre(GaussLegendre):
 # is off by 9e-7, order 12 by 6e-7; error / estimate up to 10.6 from (8, 10), 2.2 from (8, 12), 1.3 from (6, 8)), and
 # (6, 12) on EEVEE's btdf grazing row (n.v = 1e-4, alpha = 0.071, eta = 1.063: error 1.12e-6 under an estimate of
 # 8.4e-7, its transmission channel alone driving the ladder); from (8, 16) every estimate bounds the error there
-# (tests/test_dielectric.py), at ~10 % more work than from (6, 12). The first climb is 16 -> 20 (was 24): replayed offline
-# on every panel's orders 6..64 (2500 random texels and the grazing row of each of EEVEE's btdf and bsdf, Turquin's and
-# OpenPBR's tables) 7-9 % fewer evaluations, worst error / estimate 0.90 (from 16 -> 24: 0.43); 8 -> 14 saved 14-22 %
-# but reached 0.97, and 8 -> 12 passed errors over their estimates (2.2)
+# (tests/test_dielectric.py), at ~10 % more work than from (6, 12). The first climb is 16 -> 20 (was 24): replayed
+# offline on every panel's orders 6..64 (benchmarks/replay_ladder.py: 2500 random texels and the grazing row of each of
+# EEVEE's btdf and bsdf, Turquin's and OpenPBR's tables) 7-9 % fewer evaluations, worst error / estimate 0.90 (from
+# 16 -> 24: 0.43); 8 -> 14 saved 14-22 % but reached 0.97, and 8 -> 12 passed errors over their estimates (2.2)
 DIELECTRIC_ORDERS = (8, 16, 20, 24, 32, 48, 64)
 
 

@@ -167,6 +167,35 @@ def texel_view(t: wp.vec3):
 
 
 @wp.func
+def panel_texel(tx: wp.vec3, phi_a: PhiRule, merge: wp.float64, mirror_limit: bool):
+    """A texel (n.v, alpha, param) with its panels in theta_h (next_theta; ``merge``: PEAK_MERGE to a tolerance, 1 at
+    a fixed order): (PanelTexel, n_panels). No panel where ``mirror_limit`` and alpha = 0 (the closed-form mirror
+    limit takes the texel: lutbake.edge)."""
+    v, a, prm, a64, cos_v, sin_v, eps_l, theta_a, theta_b, theta_peak = texel_view(tx)
+    edges = Edges()
+    if mirror_limit and a <= 0.0:
+        edges[0] = theta_b
+    n_panels = wp.int32(0)  # a dynamic variable (Warp: a bare literal is a constant)
+    t_lo = edges[0]
+    while t_lo < theta_b:  # theta_b: c* = +1, nothing beyond reflects above the horizon
+        t_lo = next_theta(t_lo, theta_a, theta_peak, merge)
+        if n_panels == MAX_PANELS - 1:  # never reached (MAX_PANELS): the last panel would take the rest
+            t_lo = theta_b
+        n_panels += 1
+        edges[n_panels] = t_lo
+    t = PanelTexel()
+    t.v = v
+    t.a = a
+    t.prm = prm
+    t.theta_a = theta_a
+    t.theta_peak = theta_peak
+    t.eps_l = eps_l
+    t.edges = edges
+    t.phi_a = phi_a
+    return t, n_panels
+
+
+@wp.func
 def phi_b(
     ex: wp.float64, inv_ex: wp.float64, eps: wp.float64, big_a: wp.float64, c_star: wp.float64, s_star: wp.float64
 ):
@@ -238,27 +267,16 @@ def facet_weight_for(integrand, pdf):
     return facet_weight
 
 
-def make_gauss_legendre(spec):
-    """Product Gauss-Legendre over panels in theta_h (module docstring), adaptive per panel. Per panel [t_lo, t_hi]:
-    - the outer variable is u = CDF(theta_h) on the NDF-peak panel [0, atan(alpha)] (the weight is
-      g / p, D cancels), and theta_h itself beyond it (the weight is 2 pi sin(theta_h) g, because
-      du = 2 pi D cos sin dtheta); a panel in region B has its outer variable smoothstep-mapped;
-    - the inner variable phi runs over [0, pi] in region A and [0, acos c*] in region B, through a
-      sinh map that resolves G2's pole at n.l = -horizon_scale next to the cut.
-    Adaptivity (lutbake.sampling.ladder, greedy): every panel is integrated by the n_0 x n_0 and the n_1 x n_1
-    product rules (``levels``: the orders, their rules concatenated in ``rules``); a panel keeps Q_(k), the finer,
-    and d = |Q_(k) - Q_(k-1)|, the error of the coarser one: a bound, with exponential convergence, of Q_(k)'s
-    error. While a channel's estimate, sum_p d_p / pi + TERMS_ROUNDING |I_c| (float32 terms), exceeds
-    max(tol_abs, tol_rel |I_c|), its panel with the largest d goes one order up. The estimate is the texel's ``err``.
-    One level: the fixed-order rule, err = 0.
-    Kernel inputs: per-texel (n.v, alpha, param); ``levels`` (offset, order) into ``rules``, GL (node, weight)
-    pairs on [0, 1]; ``tol`` (tol_abs, tol_rel). ``spec``: an integrand record (g, vec, acc, distribution,
-    mirror)."""
-    vec_type, acc_type, mirror = spec.vec, spec.acc, spec.mirror
+@functools.lru_cache(maxsize=None)
+def panel_rule_for(spec):
+    """``(panel_of, first_level)`` of make_gauss_legendre's ladder for an integrand record: ``panel_of(t, j, rules,
+    off, n)``, the n x n product rule over panel j of texel t (a PanelTexel of panel_texel), and ``first_level(t,
+    j)``, the panel's first level in ADAPTIVE_ORDERS (also used by benchmarks/replay_ladder.py, which integrates
+    every panel at every order)."""
+    acc_type = spec.acc
     outer_range, outer_node = outer_variable_for(spec.distribution.tan2_from_u, spec.distribution.u_from_tan2)
     facet_weight = facet_weight_for(spec.g, spec.distribution.pdf_ndf)
-    nch = vec_type._length_
-    smooth = mirror is not None
+    nch = spec.vec._length_
 
     @wp.func
     def panel_sum(
@@ -349,6 +367,29 @@ def make_gauss_legendre(spec):
             return 0
         return 1
 
+    return panel_of, first_level
+
+
+def make_gauss_legendre(spec):
+    """Product Gauss-Legendre over panels in theta_h (module docstring), adaptive per panel. Per panel [t_lo, t_hi]:
+    - the outer variable is u = CDF(theta_h) on the NDF-peak panel [0, atan(alpha)] (the weight is
+      g / p, D cancels), and theta_h itself beyond it (the weight is 2 pi sin(theta_h) g, because
+      du = 2 pi D cos sin dtheta); a panel in region B has its outer variable smoothstep-mapped;
+    - the inner variable phi runs over [0, pi] in region A and [0, acos c*] in region B, through a
+      sinh map that resolves G2's pole at n.l = -horizon_scale next to the cut.
+    Adaptivity (lutbake.sampling.ladder, greedy): every panel is integrated by the n_0 x n_0 and the n_1 x n_1
+    product rules (``levels``: the orders, their rules concatenated in ``rules``); a panel keeps Q_(k), the finer,
+    and d = |Q_(k) - Q_(k-1)|, the error of the coarser one: a bound, with exponential convergence, of Q_(k)'s
+    error. While a channel's estimate, sum_p d_p / pi + TERMS_ROUNDING |I_c| (float32 terms), exceeds
+    max(tol_abs, tol_rel |I_c|), its panel with the largest d goes one order up. The estimate is the texel's ``err``.
+    One level: the fixed-order rule, err = 0.
+    Kernel inputs: per-texel (n.v, alpha, param); ``levels`` (offset, order) into ``rules``, GL (node, weight)
+    pairs on [0, 1]; ``tol`` (tol_abs, tol_rel). ``spec``: an integrand record (g, vec, acc, distribution,
+    mirror)."""
+    mirror = spec.mirror
+    nch = spec.vec._length_
+    smooth = mirror is not None
+    panel_of, first_level = panel_rule_for(spec)
     integrate, _, _, Sums = greedy_ladder_for(panel_of, MAX_PANELS, nch, first_level)
 
     @wp.kernel(enable_backward=False, module="unique")
@@ -362,32 +403,10 @@ def make_gauss_legendre(spec):
         err: Rows64,
     ):
         i = wp.tid()
-        # theta_b: c* = +1, nothing beyond reflects above the horizon
-        v, a, prm, a64, cos_v, sin_v, eps_l, theta_a, theta_b, theta_peak = texel_view(texel[i])
-        edges = Edges()
-        if wp.static(smooth):
-            if a <= 0.0:  # alpha -> 0: the closed-form mirror limit below (lutbake.edge), no quadrature
-                edges[0] = theta_b
-        n_panels = wp.int32(0)  # a dynamic variable (Warp: a bare literal is a constant)
         merge = wp.float64(1.0)  # the fixed orders keep every breakpoint (their pixels as before PEAK_MERGE)
         if levels.shape[0] > 1:
             merge = wp.float64(PEAK_MERGE)
-        t_lo = edges[0]
-        while t_lo < theta_b:
-            t_lo = next_theta(t_lo, theta_a, theta_peak, merge)
-            if n_panels == MAX_PANELS - 1:  # never reached (MAX_PANELS): the last panel would take the rest
-                t_lo = theta_b
-            n_panels += 1
-            edges[n_panels] = t_lo
-        t = PanelTexel()
-        t.v = v
-        t.a = a
-        t.prm = prm
-        t.theta_a = theta_a
-        t.theta_peak = theta_peak
-        t.eps_l = eps_l
-        t.edges = edges
-        t.phi_a = phi_a
+        t, n_panels = panel_texel(texel[i], phi_a, merge, wp.static(smooth))
         # the texel's target, in units of the panel sums (I = sum / pi): the estimate, TERMS_ROUNDING included, within
         # the tolerance
         total, e = integrate(t, n_panels, rules, levels, Sums(tol[0] * PI64), Sums(tol[1]), TERMS_ROUNDING)
@@ -395,8 +414,8 @@ def make_gauss_legendre(spec):
             out[i, c] = total[c] / PI64
             err[i, c] = e[c] / PI64 + TERMS_ROUNDING * wp.abs(total[c] / PI64)
         if wp.static(smooth):
-            if a <= 0.0:  # the mirror limit (lutbake.edge)
-                store_row(out, i, mirror(v, prm))
+            if t.a <= 0.0:  # the mirror limit (lutbake.edge)
+                store_row(out, i, mirror(t.v, t.prm))
 
     return gauss_legendre_kernel
 
