@@ -1,0 +1,272 @@
+"""Replay the greedy ladder offline: how many evaluations a ladder of GL orders costs and whether its estimates bound
+the errors, for candidate ladders, without a kernel per candidate.
+
+Every panel of every texel is integrated once at every order of ORDERS by the kernels' own panel rules
+(lutbake.sampling.hemisphere.panel_rule_for / panel_texel for the dfg family, lutbake.sampling.dielectric for the glass
+tables). ``replay`` then runs the ladder of lutbake.sampling.ladder on those values in numpy, operation for operation:
+every panel at its first two levels, then while a channel's estimate (sum of |Q_k - Q_(k-1)| plus TERMS_ROUNDING |I|)
+exceeds max(tol_abs, tol_rel |I|), that channel's worst panel one level up. It reports the cost (sum of n^2 per
+panel rule evaluated: integrand evaluations for the dfg family, where every inner interval has n nodes), the number
+of texels whose error against order 64 exceeds their estimate by more than 5e-8 (the allowance of
+tests/test_tolerance.py: the reference's own float32 rounding), and the worst error / estimate where the error
+exceeds 5e-8.
+
+Cases: the default dfg 96^2 at 1e-6 and 3e-7, glTF's lut_ggx grid at 96^2 (PNG16: 3.8e-6), and 1500 random texels
+plus the grazing row of each dielectric preset (EEVEE btdf / bsdf, Turquin, OpenPBR).
+Writes outputs/bench/ladder_replay.json.
+Run: PYTHONPATH=. python benchmarks/replay_ladder.py  (~4 min on 2 cores)
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import warp as wp
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from lutbake.api import bake_table  # noqa: E402
+from lutbake.config import load_config, preset_path, validate_table  # noqa: E402
+from lutbake.sampling import dielectric as DL  # noqa: E402
+from lutbake.sampling import hemisphere as H  # noqa: E402
+
+OUT = ROOT / "outputs" / "bench"
+ORDERS = (4, 5, 6, 7, 8, 9, 10, 11, 12, 14, 16, 20, 24, 32, 40, 48, 64)
+ALLOWANCE = 5.0e-8  # the order-64 reference's own float32 rounding (tests/test_tolerance.py)
+FLOOR = 1.0e-7  # TERMS_ROUNDING
+MAX_SLOTS = 40  # panels stored per texel (the dfg family reaches 22, the glass tables ~30)
+
+DFG_CANDIDATES = [
+    ("6,9,12,16,24,32,48,64", None),  # the previous default
+    ("6,9,11,14,20,32,48,64", None),
+    ("4,6,9,11,14,20,32,48,64", "dfg"),  # the default (ADAPTIVE_ORDERS, region A's NDF-peak panel from (4, 6))
+    ("6,8,11,16,24,32,48,64", None),
+    ("7,9,12,16,24,32,48,64", None),
+    ("5,8,12,16,24,32,48,64", None),
+    ("6,9,10,12,14,16,20,24,32,48,64", None),
+]
+GLASS_CANDIDATES = [
+    ("8,16,24,32,48,64", None),  # the previous default
+    ("8,16,20,24,32,48,64", None),  # the default (DIELECTRIC_ORDERS)
+    ("8,14,20,24,32,48,64", None),
+    ("8,12,16,20,24,32,48,64", None),
+    ("6,12,16,20,24,32,48,64", None),
+]
+
+
+def captured_inputs(spec, estimator_class):
+    """(integrand, inputs, estimator) of a table: its bake, recording what the adaptive estimator is handed."""
+    seen = []
+    orig = estimator_class.evaluate_with_error
+
+    def record(self, integrand, inputs, device):
+        seen.append((self, integrand, {k: np.asarray(v) for k, v in inputs.items()}))
+        return orig(self, integrand, inputs, device)
+
+    estimator_class.evaluate_with_error = record
+    try:
+        bake_table(spec, workers=2, progress=None)
+    finally:
+        estimator_class.evaluate_with_error = orig
+    inputs = {k: np.concatenate([s[2][k] for s in seen]) for k in seen[0][2]}
+    return seen[0][1], inputs, seen[0][0]
+
+
+def dfg_panels(integrand):
+    """Kernel: every panel of a texel at every level (PEAK_MERGE as to a tolerance), divided by pi."""
+    panel_of = H.panel_rule_for(integrand)[0]
+    first_level = H.panel_rule_for(integrand)[1]
+    nch = integrand.acc._length_
+
+    @wp.kernel(enable_backward=False, module="unique")
+    def replay_dfg(
+        texel: wp.array(dtype=wp.vec3),
+        rules: wp.array(dtype=wp.vec2d),
+        phi_a: wp.array(dtype=wp.vec3d),
+        levels: wp.array(dtype=wp.vec2i),
+        out: wp.array3d(dtype=wp.float64),
+        npan: wp.array2d(dtype=wp.int32),
+    ):
+        i = wp.tid()
+        t, n_panels = H.panel_texel(texel[i], phi_a, wp.float64(H.PEAK_MERGE), True)
+        npan[i, 0] = n_panels
+        nl = levels.shape[0]
+        for j in range(n_panels):
+            npan[i, 1 + j] = first_level(t, j)
+            for k in range(nl):
+                v = panel_of(t, j, rules, levels[k][0], levels[k][1])
+                for c in range(wp.static(nch)):
+                    out[i, j * nl + k, c] = v[c] / H.PI64
+
+    return replay_dfg
+
+
+def glass_panels(integrand):
+    panel_sum = DL.panel_rule_for(integrand)[1]
+    nch = integrand.acc._length_
+
+    @wp.kernel(enable_backward=False, module="unique")
+    def replay_glass(
+        texel: wp.array(dtype=wp.vec3),
+        rules: wp.array(dtype=wp.vec2d),
+        levels: wp.array(dtype=wp.vec2i),
+        out: wp.array3d(dtype=wp.float64),
+        npan: wp.array2d(dtype=wp.int32),
+    ):
+        i = wp.tid()
+        x = DL.dielectric_texel(texel[i])
+        npan[i, 0] = x.n_panels
+        nl = levels.shape[0]
+        for j in range(x.n_panels):
+            for k in range(nl):
+                v = panel_sum(x, j, rules, levels[k][0], levels[k][1])
+                for c in range(wp.static(nch)):
+                    out[i, j * nl + k, c] = v[c] / DL.PI64
+
+    return replay_glass
+
+
+def panel_values(kernel, inputs, nch, with_phi_a):
+    """(values (texels, MAX_SLOTS, len(ORDERS), nch), panel counts, first levels (texels, MAX_SLOTS))."""
+    n, texel = H._texels(inputs, "cpu")
+    rules, levels = H.gl_levels(ORDERS)
+    out = wp.zeros((n, MAX_SLOTS * len(ORDERS), nch), dtype=wp.float64)
+    npan = wp.zeros((n, MAX_SLOTS + 1), dtype=wp.int32)
+    args = [texel, wp.array(rules, dtype=wp.vec2d)]
+    if with_phi_a:
+        args.append(wp.array(H.phi_rule_a(rules), dtype=wp.vec3d))
+    wp.launch(kernel, dim=n, inputs=[*args, wp.array(levels, dtype=wp.vec2i), out, npan])
+    npan = npan.numpy()
+    assert npan[:, 0].max() <= MAX_SLOTS
+    return out.numpy().reshape(n, MAX_SLOTS, len(ORDERS), nch), npan[:, 0], npan[:, 1:]
+
+
+def replay(values, n_panels, first, ladder, tol_abs, tol_rel):
+    """The greedy ladder (lutbake.sampling.ladder) on precomputed panel values: (cost per texel, violations, worst
+    error / estimate where the error exceeds ALLOWANCE, max error)."""
+    idx = [ORDERS.index(o) for o in ladder]
+    last = len(ladder) - 1
+    ref = values[:, :, ORDERS.index(64)].sum(1)
+    live = np.asarray(tol_abs) < 1e200  # channels with a target (EEVEE's btdf refines one)
+    cost, violations, worst, emax = 0.0, 0, 0.0, 0.0
+    for i in range(len(n_panels)):
+        m = n_panels[i]
+        if m == 0:
+            continue
+        q_all = values[i, :m][:, idx]
+        lev = np.clip(first[i, :m] if first is not None else np.zeros(m, int), 0, max(last - 1, 0)) + 1
+        rows = np.arange(m)
+        q = q_all[rows, lev].copy()
+        d = np.abs(q - q_all[rows, lev - 1])
+        cost += sum(ladder[k] ** 2 + ladder[k - 1] ** 2 for k in lev)
+        while True:
+            total, err = q.sum(0), d.sum(0)
+            target = np.maximum(tol_abs, tol_rel * np.abs(total)) - FLOOR * np.abs(total)
+            over = np.where(err > target, err / np.maximum(target, 1e-300), 0.0)
+            c = int(np.argmax(over))
+            up = np.flatnonzero(lev < last)
+            if over[c] <= 0.0 or len(up) == 0:
+                break
+            j = up[np.argmax(d[up, c])]
+            lev[j] += 1
+            fine = q_all[j, lev[j]]
+            d[j], q[j] = np.abs(fine - q[j]), fine
+            cost += ladder[lev[j]] ** 2
+        total = q.sum(0)
+        est = (d.sum(0) + FLOOR * np.abs(total))[live]
+        e = np.abs(total - ref[i])[live]
+        emax = max(emax, float(e.max()))
+        violations += int(np.any(e > est + ALLOWANCE))
+        big = e > ALLOWANCE
+        if big.any():
+            worst = max(worst, float((e[big] / est[big]).max()))
+    return cost / len(n_panels), violations, worst, emax
+
+
+def dfg_case(label, options, tolerances):
+    spec = validate_table({"name": "replay", **options}, "<replay>", 0)
+    integrand, inputs, _ = captured_inputs(spec, H.AdaptiveGaussLegendre)
+    values, n_panels, first = panel_values(dfg_panels(integrand), inputs, integrand.acc._length_, True)
+    rows = []
+    for tol in tolerances:
+        tabs = np.full(values.shape[-1], tol)
+        for ladder, firsts in DFG_CANDIDATES:
+            orders = tuple(int(x) for x in ladder.split(","))
+            # first levels: the kernel's (ADAPTIVE_ORDERS: 0 for region A's NDF-peak panel, 1 otherwise); a ladder
+            # without that choice starts every panel at its first two orders
+            f = first if firsts == "dfg" else None
+            cost, viol, worst, emax = replay(values, n_panels, f, orders, tabs, np.zeros_like(tabs))
+            rows.append(
+                {
+                    "case": label,
+                    "tolerance": tol,
+                    "ladder": ladder,
+                    "first_levels": firsts or "all 0",
+                    "cost": cost,
+                    "violations": viol,
+                    "worst_error_over_estimate": worst,
+                    "max_error": emax,
+                }
+            )
+    return rows
+
+
+def glass_case(preset, n_random=1500):
+    (spec, *_) = load_config(preset_path(preset), [])
+    integrand, inputs, est = captured_inputs(spec, DL.DielectricAdaptive)
+    rng = np.random.default_rng(0)
+    n = len(inputs["nov"])
+    pick = np.unique(
+        np.concatenate([rng.choice(n, n_random, replace=False), np.flatnonzero(inputs["nov"] <= inputs["nov"].min())])
+    )
+    inputs = {k: v[pick] for k, v in inputs.items()}
+    values, n_panels, _ = panel_values(glass_panels(integrand), inputs, integrand.acc._length_, False)
+    rows = []
+    for ladder, _ in GLASS_CANDIDATES:
+        orders = tuple(int(x) for x in ladder.split(","))
+        cost, viol, worst, emax = replay(values, n_panels, None, orders, np.array(est.absolute), np.array(est.relative))
+        rows.append(
+            {
+                "case": f"{preset} ({len(pick)} texels)",
+                "tolerance": list(est.absolute),
+                "ladder": ladder,
+                "first_levels": "all 0",
+                "cost": cost,
+                "violations": viol,
+                "worst_error_over_estimate": worst,
+                "max_error": emax,
+            }
+        )
+    return rows
+
+
+def main() -> None:
+    wp.config.quiet = True
+    assert H.ADAPTIVE_ORDERS == (4, 6, 9, 11, 14, 20, 32, 48, 64)  # the defaults in the candidate lists
+    assert DL.DIELECTRIC_ORDERS == (8, 16, 20, 24, 32, 48, 64)
+    rows = dfg_case("dfg 96^2", {"kind": "dfg", "size": [96, 96]}, (1e-6, 3e-7))
+    (gltf,) = load_config(preset_path("gltf"), [])
+    opts = {**{k: v for k, v in gltf.options.items() if v is not None}, "size": [96, 96]}
+    rows += dfg_case("glTF lut_ggx grid 96^2", opts, (0.25 / 65535,))
+    for preset in ("blender-eevee-btdf", "blender-eevee-bsdf", "turquin", "openpbr"):
+        rows += glass_case(preset)
+    OUT.mkdir(parents=True, exist_ok=True)
+    (OUT / "ladder_replay.json").write_text(json.dumps(rows, indent=1) + "\n")
+    base = {}
+    for r in rows:
+        key = (r["case"], str(r["tolerance"]))
+        base.setdefault(key, r["cost"])
+        print(
+            f"{r['case']:<34} tol {str(r['tolerance'])[:24]:<24} {r['ladder']:<32} first {r['first_levels']:<5} "
+            f"cost {r['cost']:8.0f} ({r['cost'] / base[key]:.3f}x)  violations {r['violations']}  "
+            f"worst err/est {r['worst_error_over_estimate']:.2f}"
+        )
+    print(f"wrote {OUT / 'ladder_replay.json'}")
+
+
+if __name__ == "__main__":
+    main()
