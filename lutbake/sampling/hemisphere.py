@@ -359,12 +359,17 @@ def panel_rule_for(spec):
             t.v, t.a, t.prm, t.edges[j], t.edges[j + 1], t.theta_a, t.theta_peak, t.eps_l, rules, t.phi_a, off, n
         )
 
+    # the GGX microfacet lobes (a mirror limit: not the Charlie cloth / sheen lobes sampled by GGX's CDF), where (4, 6)
+    # was replayed honest (benchmarks/replay_ladder.py)
+    smooth_peak = spec.distribution.name == "ggx" and spec.mirror is not None
+
     @wp.func
     def first_level(t: PanelTexel, j: int):
-        """A panel's coarse level in ADAPTIVE_ORDERS: region A's NDF-peak panel (u = CDF(theta_h), every phi visible)
-        starts at (4, 6), the others at (6, 9)."""
-        if t.edges[j] < t.theta_a and t.edges[j + 1] <= t.theta_peak:
-            return 0
+        """A panel's coarse level in ADAPTIVE_ORDERS: GGX's region-A NDF-peak panel (u = CDF(theta_h), every phi
+        visible) starts at (4, 6), every other panel at (6, 9)."""
+        if wp.static(smooth_peak):
+            if t.edges[j] < t.theta_a and t.edges[j + 1] <= t.theta_peak:
+                return 0
         return 1
 
     return panel_of, first_level
@@ -495,16 +500,14 @@ def _launch(kernel, inputs: dict, point_arrays: list, kernel_channels: int, devi
     return out.numpy()
 
 
-# the successive product-rule orders of a panel. Starting lower (4, 6, ...) let coincidental agreements of two coarse
-# rules pass (measured: error 1.9e-6 at an estimate 8e-7 on the 128^2 dfg); from 6 every estimate bounds the error
-# against order 64 (tests/test_tolerance.py). The first step is 6 -> 9 (6 -> 8, 7 -> 9 and 5 -> 8 let errors pass
-# their estimates), the climbs are gentler (9 -> 11 -> 14 -> 20): most climbing panels need one step, and 11 costs
-# 0.84x of 12 (measured by replaying the ladder offline on every panel's orders 4..64, 96^2 grids: integrand
-# evaluations per texel 903 -> 852 on the dfg at 1e-6, 1080 -> 1005 at 3e-7, 760 -> 731 on glTF's at PNG16, worst
-# error / estimate unchanged). Region A's NDF-peak panel (u = CDF(theta_h), every phi visible: the smoothest) starts
-# one level lower, at (4, 6) (first_level in make_gauss_legendre; replayed: 731 -> 703 evaluations per texel on
-# glTF's grid, every estimate still bounding its error)
-ADAPTIVE_ORDERS = (4, 6, 9, 11, 14, 20, 32, 48, 64)
+# the successive product-rule orders of a panel: a ratio of ~1.5 (each level costs ~2.25x the last). Starting lower
+# (4, 6, ...) let coincidental agreements of two coarse rules pass (measured: error 1.9e-6 at an estimate 8e-7 on
+# the 128^2 dfg); from 6 every estimate bounds the error against order 64 (tests/test_tolerance.py). Only GGX's
+# region-A NDF-peak panel (u = CDF(theta_h), every phi visible: the smoothest) starts at (4, 6) (first_level in
+# panel_rule_for; replayed offline, benchmarks/replay_ladder.py: 760 -> 733 evaluations per texel on glTF's grid,
+# every estimate still bounding its error). Gentler climbs (9 -> 11 -> 14 -> 20) replayed 4-7 % cheaper on GGX but
+# let Blinn-Phong's 64^2 table pass an error of 2.7e-6 under an estimate of 2.2e-7: orders 9 and 11 agree by chance
+ADAPTIVE_ORDERS = (4, 6, 9, 12, 16, 24, 32, 48, 64)
 
 
 @functools.lru_cache(maxsize=None)
