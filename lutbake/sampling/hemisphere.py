@@ -594,7 +594,7 @@ class AdaptiveGaussLegendre:
     name: str = "gauss_legendre"
 
     def samples(self, inputs: dict) -> np.ndarray:  # nominal: 3 panels at the middle order (the work adapts)
-        return np.full(len(inputs["nov"]), 3 * self.orders[len(self.orders) // 2] ** 2)
+        return np.full(len(inputs["nov"]), 3 * self.orders[(len(self.orders) + 1) // 2] ** 2)  # 24: 1728, as before
 
     def prepare(self, integrand, device: str) -> None:
         load(gl_kernel(integrand), device)
