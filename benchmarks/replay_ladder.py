@@ -23,6 +23,7 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import warp as wp
@@ -78,14 +79,31 @@ def captured_inputs(spec, estimator_class):
     return seen[0][1], inputs, seen[0][0]
 
 
-def dfg_panels(integrand):
-    """Kernel: every panel of a texel at every level (PEAK_MERGE as to a tolerance), divided by pi."""
-    panel_of = H.panel_rule_for(integrand)[0]
-    first_level = H.panel_rule_for(integrand)[1]
-    nch = integrand.acc._length_
+@wp.func
+def dfg_texel(tx: wp.vec3, phi_a: wp.array(dtype=wp.vec3d)):
+    """The dfg family's texel and panels, the merge of a tolerance-driven bake (PEAK_MERGE)."""
+    return H.panel_texel(tx, phi_a, wp.float64(H.PEAK_MERGE), True)
+
+
+@wp.func
+def glass_texel(tx: wp.vec3, phi_a: wp.array(dtype=wp.vec3d)):
+    """The glass kinds' texel and outer panels (phi_a unused)."""
+    x = DL.dielectric_texel(tx)
+    return x, x.n_panels
+
+
+@wp.func
+def from_first(x: Any, j: int):
+    """Every panel from the ladder's first two levels."""
+    return 0
+
+
+def panels_kernel(texel_panels, panel, first_level, nch):
+    """Kernel: every panel of a texel (``texel_panels``) at every level (``panel``), divided by pi, and each panel's
+    first level (``first_level``)."""
 
     @wp.kernel(enable_backward=False, module="unique")
-    def replay_dfg(
+    def replay_panels(
         texel: wp.array(dtype=wp.vec3),
         rules: wp.array(dtype=wp.vec2d),
         phi_a: wp.array(dtype=wp.vec3d),
@@ -94,53 +112,35 @@ def dfg_panels(integrand):
         npan: wp.array2d(dtype=wp.int32),
     ):
         i = wp.tid()
-        t, n_panels = H.panel_texel(texel[i], phi_a, wp.float64(H.PEAK_MERGE), True)
+        t, n_panels = texel_panels(texel[i], phi_a)
         npan[i, 0] = n_panels
         nl = levels.shape[0]
         for j in range(n_panels):
             npan[i, 1 + j] = first_level(t, j)
             for k in range(nl):
-                v = panel_of(t, j, rules, levels[k][0], levels[k][1])
+                v = panel(t, j, rules, levels[k][0], levels[k][1])
                 for c in range(wp.static(nch)):
                     out[i, j * nl + k, c] = v[c] / H.PI64
 
-    return replay_dfg
+    return replay_panels
+
+
+def dfg_panels(integrand):
+    panel_of, first_level = H.panel_rule_for(integrand)
+    return panels_kernel(dfg_texel, panel_of, first_level, integrand.acc._length_)
 
 
 def glass_panels(integrand):
-    panel_sum = DL.panel_rule_for(integrand)[1]
-    nch = integrand.acc._length_
-
-    @wp.kernel(enable_backward=False, module="unique")
-    def replay_glass(
-        texel: wp.array(dtype=wp.vec3),
-        rules: wp.array(dtype=wp.vec2d),
-        levels: wp.array(dtype=wp.vec2i),
-        out: wp.array3d(dtype=wp.float64),
-        npan: wp.array2d(dtype=wp.int32),
-    ):
-        i = wp.tid()
-        x = DL.dielectric_texel(texel[i])
-        npan[i, 0] = x.n_panels
-        nl = levels.shape[0]
-        for j in range(x.n_panels):
-            for k in range(nl):
-                v = panel_sum(x, j, rules, levels[k][0], levels[k][1])
-                for c in range(wp.static(nch)):
-                    out[i, j * nl + k, c] = v[c] / DL.PI64
-
-    return replay_glass
+    return panels_kernel(glass_texel, DL.panel_rule_for(integrand)[1], from_first, integrand.acc._length_)
 
 
-def panel_values(kernel, inputs, nch, with_phi_a):
+def panel_values(kernel, inputs, nch):
     """(values (texels, MAX_SLOTS, len(ORDERS), nch), panel counts, first levels (texels, MAX_SLOTS))."""
     n, texel = H._texels(inputs, "cpu")
     rules, levels = H.gl_levels(ORDERS)
     out = wp.zeros((n, MAX_SLOTS * len(ORDERS), nch), dtype=wp.float64)
     npan = wp.zeros((n, MAX_SLOTS + 1), dtype=wp.int32)
-    args = [texel, wp.array(rules, dtype=wp.vec2d)]
-    if with_phi_a:
-        args.append(wp.array(H.phi_rule_a(rules), dtype=wp.vec3d))
+    args = [texel, wp.array(rules, dtype=wp.vec2d), wp.array(H.phi_rule_a(rules), dtype=wp.vec3d)]
     wp.launch(kernel, dim=n, inputs=[*args, wp.array(levels, dtype=wp.vec2i), out, npan])
     npan = npan.numpy()
     assert npan[:, 0].max() <= MAX_SLOTS
@@ -192,7 +192,7 @@ def replay(values, n_panels, first, ladder, tol_abs, tol_rel):
 def dfg_case(label, options, tolerances):
     spec = validate_table({"name": "replay", **options}, "<replay>", 0)
     integrand, inputs, _ = captured_inputs(spec, H.AdaptiveGaussLegendre)
-    values, n_panels, first = panel_values(dfg_panels(integrand), inputs, integrand.acc._length_, True)
+    values, n_panels, first = panel_values(dfg_panels(integrand), inputs, integrand.acc._length_)
     rows = []
     for tol in tolerances:
         tabs = np.full(values.shape[-1], tol)
@@ -226,7 +226,7 @@ def glass_case(preset, n_random=1500):
         np.concatenate([rng.choice(n, n_random, replace=False), np.flatnonzero(inputs["nov"] <= inputs["nov"].min())])
     )
     inputs = {k: v[pick] for k, v in inputs.items()}
-    values, n_panels, _ = panel_values(glass_panels(integrand), inputs, integrand.acc._length_, False)
+    values, n_panels, _ = panel_values(glass_panels(integrand), inputs, integrand.acc._length_)
     rows = []
     for ladder, _ in GLASS_CANDIDATES:
         orders = tuple(int(x) for x in ladder.split(","))

@@ -448,7 +448,7 @@ def fd_microfacet_adaptive_for(F_facet):
     panels of ``fd_microfacet_for``, each u panel (with its phi pieces) at GL orders ``levels``, refined greedily
     (lutbake.sampling.ladder) until the sum of the panels' |Q_(k) - Q_(k-1)| is within QUADRATURE_SHARE of the
     texel's tolerance max(tol[0], tol[1] |f|). The estimate is that sum plus FACET_ROUNDING |f| (float32 terms)."""
-    integrate, _, _, Sums = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)
+    integrate, _, _, Sums, _ = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)
 
     @wp.func
     def fd_microfacet_adaptive(
@@ -482,7 +482,7 @@ def fd_microfacet_adaptive_azimuths_for(F_facet):
     per texel as fd_microfacet_adaptive, so the same values. Scratch: azl (the azimuths of l), panels (2
     MAX_U_PANELS rows: panel j at levels[1], then at levels[0], one column per texel); out[t] = (f, error
     estimate)."""
-    _, climb, Panels, Sums = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)
+    _, climb, Panels, Sums, Orders = greedy_ladder_for(facet_panel_for(F_facet), MAX_U_PANELS)
     panel_azimuths = facet_panel_azimuths_for(F_facet)
 
     @wp.func
@@ -518,12 +518,14 @@ def fd_microfacet_adaptive_azimuths_for(F_facet):
             scale = facet_scale(pt, alpha[t])
             fine0 = Panels()
             coarse0 = Panels()
+            lev = Orders()
             for j in range(n_panels):
                 fine0[j, 0] = panels[j, t]
                 coarse0[j, 0] = panels[MAX_U_PANELS + j, t]
+                lev[j] = top
             t_abs = Sums(QUADRATURE_SHARE * tol[0] / scale)  # as fd_microfacet_adaptive
             t_rel = Sums(QUADRATURE_SHARE * tol[1])
-            total, err = climb(pt, n_panels, rules, levels, t_abs, t_rel, wp.float64(0.0), fine0, coarse0)
+            total, err = climb(pt, n_panels, rules, levels, t_abs, t_rel, wp.float64(0.0), fine0, coarse0, lev)
             fe = facet_estimate(scale, wp.vec2d(total[0], err[0]))
             out[t, 0] = fe[0]
             out[t, 1] = fe[1]

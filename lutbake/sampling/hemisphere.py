@@ -395,7 +395,7 @@ def make_gauss_legendre(spec):
     nch = spec.vec._length_
     smooth = mirror is not None
     panel_of, first_level = panel_rule_for(spec)
-    integrate, _, _, Sums = greedy_ladder_for(panel_of, MAX_PANELS, nch, first_level)
+    integrate, _, _, Sums, _ = greedy_ladder_for(panel_of, MAX_PANELS, nch, first_level)
 
     @wp.kernel(enable_backward=False, module="unique")
     def gauss_legendre_kernel(

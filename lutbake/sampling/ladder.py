@@ -42,22 +42,23 @@ def channel(x: wp.vec3d, c: int):  # noqa: F811 (a Warp overload)
 
 @functools.lru_cache(maxsize=None)
 def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None):
-    """``(integrate, climb, Panels, Sums)``: ``integrate(ctx, n_panels, rules, levels, target_abs, target_rel,
+    """``(integrate, climb, Panels, Sums, Orders)``: ``integrate(ctx, n_panels, rules, levels, target_abs, target_rel,
     floor) -> (total, err)`` (``Sums``: float64 vectors of nch, the targets per channel too): every panel at the first
     two levels, then refined until err_c = sum_p d_(p,c) <= max(target_abs_c, target_rel_c |total_c|) - floor
     |total_c| for every channel c (floor: a relative error the caller adds to the estimate, e.g. the terms' rounding;
     an unreachable target, e.g. 1e300, never refines) or every panel is at the last order (module docstring);
-    n_panels <= max_panels. ``climb(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0)``:
-    the same from the first two levels' panel values given (``Panels``: float64 matrices max_panels x nch; fine0 at
-    levels[1], coarse0 at levels[0]), e.g. computed for several texels that share per-node work: the same float
-    operations, so the same result. ``first_level(ctx, j) -> k`` (optional): panel j starts at levels k and k + 1
-    instead of the first two (a panel class known to converge fast; clamped to the ladder)."""
+    n_panels <= max_panels. ``climb(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0,
+    lev)``: the same from each panel's first two levels' values given (``Panels``: float64 matrices max_panels x nch;
+    fine0 at levels[lev[j]], coarse0 at levels[lev[j] - 1]; ``Orders``: int32 vectors of max_panels), e.g. computed
+    for several texels that share per-node work: the same float operations, so the same result.
+    ``first_level(ctx, j) -> k`` (optional): panel j starts at levels k and k + 1 instead of the first two (a panel
+    class known to converge fast; clamped to the ladder)."""
     Panels = wp.types.matrix(shape=(max_panels, nch), dtype=wp.float64)
     Sums = wp.types.vector(length=nch, dtype=wp.float64)
     Orders = wp.types.vector(length=max_panels, dtype=wp.int32)  # a panel's level
 
     @wp.func
-    def climb_from(
+    def climb(
         ctx: Any,
         n_panels: int,
         rules: Rule,
@@ -69,7 +70,6 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None
         coarse0: Panels,
         lev: Orders,
     ):
-        """climb, each panel's fine value at its level lev[j]."""
         q = Panels()
         d = Panels()
         last = levels.shape[0] - 1
@@ -114,24 +114,6 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None
         return total, err
 
     @wp.func
-    def climb(
-        ctx: Any,
-        n_panels: int,
-        rules: Rule,
-        levels: Levels,
-        target_abs: Sums,
-        target_rel: Sums,
-        floor: wp.float64,
-        fine0: Panels,
-        coarse0: Panels,
-    ):
-        lev = Orders()
-        top = wp.min(1, levels.shape[0] - 1)
-        for j in range(n_panels):
-            lev[j] = top
-        return climb_from(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0, lev)
-
-    @wp.func
     def integrate(
         ctx: Any, n_panels: int, rules: Rule, levels: Levels, target_abs: Sums, target_rel: Sums, floor: wp.float64
     ):
@@ -152,6 +134,6 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None
                 fine0[j, c] = channel(fine, c)
                 coarse0[j, c] = channel(coarse, c)
             lev[j] = top
-        return climb_from(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0, lev)
+        return climb(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0, lev)
 
-    return integrate, climb, Panels, Sums
+    return integrate, climb, Panels, Sums, Orders
