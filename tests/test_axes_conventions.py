@@ -72,9 +72,12 @@ def test_three_channel_layouts_extend_the_two_channel_ones(default, bake):
     np.testing.assert_allclose(f82.data[..., :2], default.data, atol=1e-6)
     assert list(f82.channels) == ["scale", "bias", "f82"]
     assert np.all(f82.data[..., 2] >= 0) and np.all(f82.data[..., 2] < 0.1)
-    cloth = bake(BASE, layout="multiscatter_cloth")
-    ms = bake(BASE, layout="multiscatter")
-    np.testing.assert_allclose(cloth.data[..., :2], ms.data, atol=1e-6)
+    # to the default tolerance (1e-6 each): the cloth layout's Charlie channel adds panels graded towards theta_h = pi/2
+    # (lutbake.sampling.hemisphere.next_toward), so at a fixed low order its GGX channels sit on other nodes
+    adaptive = {k: v for k, v in BASE.items() if k != "samples"}
+    cloth = bake(adaptive, layout="multiscatter_cloth")
+    ms = bake(adaptive, layout="multiscatter")
+    np.testing.assert_allclose(cloth.data[..., :2], ms.data, atol=2e-6)
     assert np.all(cloth.data[..., 2] > 0)  # the Charlie cloth integral (bake_table already rejects NaN/Inf)
 
 

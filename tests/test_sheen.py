@@ -111,3 +111,22 @@ def test_clamped_layouts_are_the_viewers_integrand(bake_preset, charlie_referenc
             e_clamped.data[y, x, 0], charlie_reference(a, c, "charlie", clamp=True), rtol=CLAMPED_RTOL
         )
     assert e_clamped.data[..., 0].max() <= 1.0  # the clamp also removes the corner's E > 1 (measured max below)
+
+
+def test_charlie_visibility_estimates_bound_their_errors(charlie_reference):
+    """To a tolerance, the sheen lobe with Charlie's V (HDRP's CharlieFabricLambert FGD, the spec's E): every texel's
+    error estimate bounds its error against the independent reference. Estevez & Kulla's Lambda switches formula at
+    n.l = 0.5 (C1 only) and has a cusp at l = n; before the panels split there (lutbake.sampling.hemisphere.kink_band),
+    452 of the 64² HDRP table's 12288 values exceeded their estimates, by up to 1.1e-5 (estimates ~1e-6)."""
+    from lutbake.integrands.specular import specular_integrand
+    from lutbake.sampling.hemisphere import AdaptiveGaussLegendre
+
+    nov, r = (g.ravel() for g in np.meshgrid(np.linspace(0.1, 0.95, 7), np.linspace(0.15, 0.99, 7)))
+    alpha = (r * r).astype(np.float32)  # HDRP's alpha = r², the range where the unsplit panels failed
+    integrand = specular_integrand("ggx", "none", "sheen_albedo")
+    inputs = {"nov": nov.astype(np.float32), "alpha": integrand.alpha_input(alpha), "param": np.zeros_like(alpha)}
+    value, estimate = AdaptiveGaussLegendre(1e-6, 0.0).evaluate_with_error(integrand, inputs, "cpu")
+    ref = np.array([charlie_reference(float(a), float(n), "charlie") for a, n in zip(alpha, inputs["nov"])])
+    err = np.abs(value[:, 0] - ref)
+    assert estimate[:, 0].max() <= 1e-6  # the tolerance is reached
+    np.testing.assert_array_less(err, estimate[:, 0] + 5e-8)  # 5e-8: the float32 terms' noise beyond TERMS_ROUNDING

@@ -234,7 +234,10 @@ class SpecularIntegrand:
     ``distribution``: the NDF whose CDF / pdf / sampler the estimators use; ``kernel_channels``: the length of
     ``vec``, of which the first ``nch`` are kept; ``mirror(v, param) -> vec``: the exact alpha -> 0 limit where one
     exists (the microfacet form: D -> delta about n, G2 -> 1 for n.v > 0, so E = channels(n.v, param); lutbake.edge),
-    else None and alpha is clamped to ALPHA_MIN."""
+    else None and alpha is clamped to ALPHA_MIN. ``nol_kink``: a cosine n.l where g is only C1 (Estevez & Kulla's
+    Lambda fit switches formula at cos = 0.5: its second derivative jumps), which the gauss_legendre panels split at
+    (lutbake.sampling.hemisphere), else None. ``grazing_peak``: g has a Charlie lobe, whose NDF peaks at theta_h = pi/2
+    (the gauss_legendre panels grade towards the end of the half-vector domain)."""
 
     key: tuple
     g: object
@@ -244,6 +247,8 @@ class SpecularIntegrand:
     nch: int
     distribution: Distribution
     mirror: object | None
+    nol_kink: float | None = None
+    grazing_peak: bool = False
 
     def alpha_input(self, alpha) -> np.ndarray:
         """The per-texel alpha the kernels receive (float32): lutbake.edge.effective_alpha."""
@@ -286,6 +291,10 @@ def specular_integrand(
         nch or k,
         NDFS[ndf_name],
         mirror,
+        masking.LAMBDA_SHEEN_SWITCH
+        if channels_name.removesuffix("_clamped") in ("sheen_albedo", "sheen_fgd")
+        else None,
+        charlie,
     )
 
 

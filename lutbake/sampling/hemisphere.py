@@ -28,7 +28,9 @@ lutbake.integrands.specular):
     are removed by u = u0 + du smoothstep(s).
     By symmetry in phi,
         I = (1/pi) ∫_0^1 du ∫_0^phimax(u) dphi  g(h) / p(h).
-    The integrand is then analytic in both variables and GL converges exponentially.
+    The integrand is then analytic in both variables and GL converges exponentially. An integrand only C1 along
+    n.l = kink (SpecularIntegrand.nol_kink: Charlie's Lambda) gets the same treatment for that level line
+    (kink_band, kink_cos_phi); a Charlie lobe's panels also grade towards theta_b (next_toward).
 ``sobol_ndf`` / ``hammersley_ndf``  h from the NDF's inverse CDF (Distribution.sample_ndf) at scrambled Sobol'
     (or Hammersley) points, weight g / p / N with p = D(h)(n.h) (Distribution.pdf_ndf).
 ``sobol_vndf`` (GGX) h from the visible-normal distribution (Distribution.sample_vndf),
@@ -49,6 +51,7 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 import warp as wp
@@ -65,7 +68,7 @@ PI64 = wp.constant(wp.float64(math.pi))
 # the BRDF terms run in float32: a texel value carries their rounding, ~1e-7 relative (measured: orders 48 and 64
 # differ by 3e-8 on the 128^2 dfg), which no difference of two orders sees; the error estimate adds it
 TERMS_ROUNDING = wp.constant(wp.float64(1.0e-7))
-MAX_PANELS = 32  # a texel's panels (next_theta): at most 22 for n.v >= NOV_MIN, alpha >= ALPHA_MIN (lutbake.edge)
+MAX_PANELS = 32  # a texel's panels: at most 22 for n.v >= NOV_MIN, alpha >= ALPHA_MIN (lutbake.edge), 25 with a Charlie lobe
 # an NDF-peak breakpoint within this factor of a horizon breakpoint (or of the panel's start) is dropped: a sliver
 # panel costs a whole product rule at two orders (measured, 256^2 glTF grid: 5.9 -> 4.9 panels per texel; every
 # estimate still bounds its error against order 64 there and on the 128^2 dfg, worst error / estimate unchanged;
@@ -95,7 +98,8 @@ Edges = wp.types.vector(length=MAX_PANELS + 1, dtype=wp.float64)  # a texel's pa
 @wp.struct
 class PanelTexel:
     """What a texel's panels share (make_gauss_legendre): its view, alpha, param, the panel anchors (texel_view), the
-    sinh map's distance eps_l to G2's pole (horizon_scale), the panel ends and region A's inner rule (phi_rule_a)."""
+    sinh map's distance eps_l to G2's pole (horizon_scale), the panel ends, region A's inner rule (phi_rule_a) and
+    the integrand's kink along n.l = kink (kink_band)."""
 
     v: wp.vec3
     a: float
@@ -105,6 +109,9 @@ class PanelTexel:
     eps_l: wp.float64
     edges: Edges
     phi_a: PhiRule
+    kink: wp.float64  # the n.l of the integrand's kink (SpecularIntegrand.nol_kink), 0: none
+    theta_klo: wp.float64  # theta_h where the kink enters the inner domain (cos phi_k = 1 or -1), -1: no kink
+    theta_khi: wp.float64  # ... and where it leaves it
 
 
 @wp.func
@@ -167,18 +174,69 @@ def texel_view(t: wp.vec3):
 
 
 @wp.func
-def panel_texel(tx: wp.vec3, phi_a: PhiRule, merge: wp.float64, mirror_limit: bool):
+def kink_cos_phi(kink: wp.float64, cos_v: wp.float64, sin_v: wp.float64, cos_h: wp.float64, sin_h: wp.float64):
+    """cos(phi_k), where n.l = kink at this theta_h: n.l = cos(theta_v) cos(2 theta_h) + sin(theta_v) sin(2 theta_h)
+    cos(phi) (l = reflect(v, h)), decreasing in phi over [0, pi]; outside (-1, 1) where the kink misses this
+    theta_h (the horizon's c* is the case kink = 0)."""
+    return (kink - cos_v * (cos_h * cos_h - sin_h * sin_h)) / wp.max(
+        sin_v * wp.float64(2.0) * sin_h * cos_h, wp.float64(1.0e-300)
+    )
+
+
+@wp.func
+def kink_band(kink: wp.float64, cos_v: wp.float64, sin_v: wp.float64):
+    """The theta_h interval where the level line n.l = kink (0 < kink < 1) crosses the inner domain: n.l spans
+    [cos(2 theta_h + theta_v), cos(2 theta_h - theta_v)] over phi, so (|acos(kink) - theta_v| / 2, (acos(kink) +
+    theta_v) / 2), as the horizon's (theta_a, theta_b) at kink = 0; and theta_v / 2, where l = n (h bisects v and n:
+    Estevez & Kulla's Lambda fit has a cusp there, (1 - n.l)^0.2); (-1, -1, -1) for no kink."""
+    if kink <= wp.float64(0.0):
+        return wp.vec3d(wp.float64(-1.0), wp.float64(-1.0), wp.float64(-1.0))
+    theta_v = wp.atan2(sin_v, cos_v)
+    t_k = wp.acos(kink)
+    half = wp.float64(0.5)
+    return wp.vec3d(half * wp.abs(t_k - theta_v), half * (t_k + theta_v), half * theta_v)
+
+
+@wp.func
+def next_toward(t_lo: wp.float64, t_end: wp.float64, scale: wp.float64, reach: wp.float64):
+    """Smallest t_end - scale R^j (j >= 0) above t_lo with scale R^j < reach, else t_end: breakpoints graded
+    geometrically towards t_end."""
+    if scale <= wp.float64(0.0) or t_end - t_lo <= scale:
+        return t_end
+    r = wp.float64(PANEL_RATIO)
+    d = scale * wp.pow(r, wp.floor(wp.log((t_end - t_lo) / scale) / wp.log(r)))
+    if t_end - d <= t_lo:
+        d = d / r
+    if d >= reach:
+        return t_end
+    return t_end - d
+
+
+@wp.func
+def panel_texel(tx: wp.vec3, phi_a: PhiRule, merge: wp.float64, mirror_limit: bool, kink: wp.float64, grazing: bool):
     """A texel (n.v, alpha, param) with its panels in theta_h (next_theta; ``merge``: PEAK_MERGE to a tolerance, 1 at
-    a fixed order): (PanelTexel, n_panels). No panel where ``mirror_limit`` and alpha = 0 (the closed-form mirror
-    limit takes the texel: lutbake.edge)."""
+    a fixed order), split where an integrand's kink along n.l = ``kink`` (0: none) enters and leaves the inner
+    domain (kink_band): (PanelTexel, n_panels). No panel where ``mirror_limit`` and alpha = 0 (the closed-form
+    mirror limit takes the texel: lutbake.edge). A ``grazing`` NDF (Charlie's sin(theta_h)^(1/alpha), peaking at
+    theta_h = pi/2) adds breakpoints graded towards theta_b on its scale there, alpha / (theta_a + sqrt(alpha)):
+    sin^(1/alpha) ~ exp(-(pi/2 - theta_h)^2 / (2 alpha)) and pi/2 - theta_b = theta_a."""
     v, a, prm, a64, cos_v, sin_v, eps_l, theta_a, theta_b, theta_peak = texel_view(tx)
+    band = kink_band(kink, cos_v, sin_v)
+    peak_scale = wp.float64(0.0)
+    if grazing:
+        peak_scale = a64 / (theta_a + wp.sqrt(a64))
     edges = Edges()
     if mirror_limit and a <= 0.0:
         edges[0] = theta_b
     n_panels = wp.int32(0)  # a dynamic variable (Warp: a bare literal is a constant)
     t_lo = edges[0]
     while t_lo < theta_b:  # theta_b: c* = +1, nothing beyond reflects above the horizon
-        t_lo = next_theta(t_lo, theta_a, theta_peak, merge)
+        t_next = next_theta(t_lo, theta_a, theta_peak, merge)
+        for k in range(3):
+            if t_lo < band[k] and band[k] < t_next:
+                t_next = band[k]
+        t_next = wp.min(t_next, next_toward(t_lo, theta_b, peak_scale, theta_a))
+        t_lo = t_next
         if n_panels == MAX_PANELS - 1:  # never reached (MAX_PANELS): the last panel would take the rest
             t_lo = theta_b
         n_panels += 1
@@ -192,6 +250,9 @@ def panel_texel(tx: wp.vec3, phi_a: PhiRule, merge: wp.float64, mirror_limit: bo
     t.eps_l = eps_l
     t.edges = edges
     t.phi_a = phi_a
+    t.kink = kink
+    t.theta_klo = band[0]
+    t.theta_khi = band[1]
     return t, n_panels
 
 
@@ -278,40 +339,111 @@ def panel_rule_for(spec):
     facet_weight = facet_weight_for(spec.g, spec.distribution.pdf_ndf)
     nch = spec.vec._length_
 
+    kinked = spec.nol_kink is not None
+
     @wp.func
-    def panel_sum(
+    def sinh_piece(
+        acc: Any,
         v: wp.vec3,
         a: float,
         prm: float,
-        t_lo: wp.float64,
-        t_hi: wp.float64,
-        theta_a: wp.float64,
-        theta_peak: wp.float64,
-        eps_l: wp.float64,
+        in_u: bool,
+        cos_h: wp.float64,
+        sin_h: wp.float64,
+        wk: wp.float64,
+        c_star: wp.float64,
+        s_star: wp.float64,
+        eps: wp.float64,
+        width: wp.float64,
         rules: Rule,
-        phi_a: PhiRule,
         off: int,
         n: int,
     ):
-        """The n x n product rule (rules[off : off + n]) over the panel [t_lo, t_hi]: the sum of w g / p. Region A's
-        inner nodes are the same for every texel: ``phi_a[off + j]`` holds them (phi_rule_a)."""
+        """acc plus the inner rule over phi in [phimax - width, phimax] (cos, sin of phimax: c_star, s_star) by the
+        sinh map (Johnston & Elliott 2005) phi = phimax - eps sinh(A (1 - x)), A = asinh(width / eps), which
+        clusters the nodes at phimax on the scale eps; wk: the outer node's weight."""
+        one = wp.float64(1.0)
+        big_a = asinh64(width / eps)
+        # the GL nodes pair up, x_(n-1-j) = 1 - x_j, so the pair's e^(big_a (1 - x)) are ex and e^big_a / ex: one exp
+        # per pair
+        e_a = wp.exp(big_a)
+        inv_e_a = one / e_a
+        for j in range((n + 1) // 2):
+            ex = wp.exp(big_a * (one - rules[off + j][0]))
+            inv_ex = one / ex
+            r = phi_b(ex, inv_ex, eps, big_a, c_star, s_star)
+            h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
+            gw = facet_weight(v, h, a, prm, in_u)
+            w = wk * rules[off + j][1] * r[2]
+            for c in range(wp.static(nch)):
+                acc[c] = acc[c] + w * wp.float64(gw[c])
+            if n - 1 - j > j:
+                r = phi_b(e_a * inv_ex, ex * inv_e_a, eps, big_a, c_star, s_star)
+                h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
+                gw = facet_weight(v, h, a, prm, in_u)
+                w = wk * rules[off + n - 1 - j][1] * r[2]
+                for c in range(wp.static(nch)):
+                    acc[c] = acc[c] + w * wp.float64(gw[c])
+        return acc
+
+    @wp.func
+    def plain_piece(
+        acc: Any,
+        v: wp.vec3,
+        a: float,
+        prm: float,
+        in_u: bool,
+        cos_h: wp.float64,
+        sin_h: wp.float64,
+        wk: wp.float64,
+        width: wp.float64,
+        rules: Rule,
+        off: int,
+        n: int,
+    ):
+        """acc plus the plain inner rule over phi in [0, width] (the side of a kink away from the horizon)."""
+        for j in range(n):
+            phi = width * rules[off + j][0]
+            h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
+            gw = facet_weight(v, h, a, prm, in_u)
+            w = wk * rules[off + j][1] * width
+            for c in range(wp.static(nch)):
+                acc[c] = acc[c] + w * wp.float64(gw[c])
+        return acc
+
+    @wp.func
+    def panel_sum(t: PanelTexel, t_lo: wp.float64, t_hi: wp.float64, rules: Rule, off: int, n: int):
+        """The n x n product rule (rules[off : off + n]) over the panel [t_lo, t_hi] of texel t: the sum of w g / p.
+        Region A's inner nodes are the same for every texel: ``t.phi_a[off + j]`` holds them (phi_rule_a). Inside
+        the kink band (kink_band) the inner domain splits at phi_k (n.l = kink): a plain rule over [0, phi_k], the
+        sinh map over [phi_k, phimax]; the band's ends are panel ends, where phi_k has sqrt-like ends as phimax."""
         one = wp.float64(1.0)
         two = wp.float64(2.0)
+        v = t.v
+        a = t.a
+        prm = t.prm
         a64 = wp.float64(a)
         cos_v = wp.float64(v[2])
         sin_v = wp.float64(v[0])
         acc = acc_type()
-        in_b = t_lo >= theta_a
-        in_u = t_hi <= theta_peak
+        in_b = t_lo >= t.theta_a
+        in_u = t_hi <= t.theta_peak
+        in_k = False
+        if wp.static(kinked):
+            in_k = t_lo >= t.theta_klo and t_hi <= t.theta_khi and t.theta_klo >= wp.float64(0.0)
         x_lo, dx = outer_range(t_lo, t_hi, in_u, a64)
         for k in range(n):
             s = rules[off + k][0]
             x = x_lo + dx * s
             wk = rules[off + k][1] * dx
-            if in_b:  # smoothstep: removes the sqrt-like ends of acos(c*) at c* = +-1
+            if in_b or in_k:  # smoothstep: removes the sqrt-like ends of acos(c*) at c* = +-1 (and of phi_k)
                 x = x_lo + dx * s * s * (wp.float64(3.0) - two * s)
                 wk = rules[off + k][1] * dx * wp.float64(6.0) * s * (one - s)
             cos_h, sin_h, wk = outer_node(x, wk, in_u, a64)
+            phi_k = wp.float64(0.0)
+            if wp.static(kinked):
+                if in_k:
+                    phi_k = wp.acos(wp.clamp(kink_cos_phi(t.kink, cos_v, sin_v, cos_h, sin_h), -one, one))
             if in_b:
                 # c* = -cos(theta_v) cos(2 theta_h) / (sin(theta_v) sin(2 theta_h)) = cos(phimax)
                 c_star = wp.clamp(-cos_v * (cos_h * cos_h - sin_h * sin_h) / (sin_v * two * sin_h * cos_h), -one, one)
@@ -320,31 +452,21 @@ def panel_rule_for(spec):
                 # n.l = 2 (n.h) sin(theta_v) sin(theta_h) (cos(phi) - c*): G2's pole at n.l = -eps_l
                 # lies eps_l / slope beyond phimax
                 slope = two * cos_h * sin_v * sin_h * wp.max(s_star, wp.float64(1.0e-12))
-                eps = wp.max(eps_l / slope, wp.float64(1.0e-12))
-                big_a = asinh64(phimax / eps)
-                # sinh map (Johnston & Elliott 2005): phi = phimax - eps sinh(big_a (1 - x)); the GL nodes pair up,
-                # x_(n-1-j) = 1 - x_j, so the pair's e^(big_a (1 - x)) are ex and e^big_a / ex: one exp per pair
-                e_a = wp.exp(big_a)
-                inv_e_a = one / e_a
-                for j in range((n + 1) // 2):
-                    ex = wp.exp(big_a * (one - rules[off + j][0]))
-                    inv_ex = one / ex
-                    r = phi_b(ex, inv_ex, eps, big_a, c_star, s_star)
-                    h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
-                    gw = facet_weight(v, h, a, prm, in_u)
-                    w = wk * rules[off + j][1] * r[2]
-                    for c in range(wp.static(nch)):
-                        acc[c] = acc[c] + w * wp.float64(gw[c])
-                    if n - 1 - j > j:
-                        r = phi_b(e_a * inv_ex, ex * inv_e_a, eps, big_a, c_star, s_star)
-                        h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
-                        gw = facet_weight(v, h, a, prm, in_u)
-                        w = wk * rules[off + n - 1 - j][1] * r[2]
-                        for c in range(wp.static(nch)):
-                            acc[c] = acc[c] + w * wp.float64(gw[c])
+                eps = wp.max(t.eps_l / slope, wp.float64(1.0e-12))
+                acc = sinh_piece(
+                    acc, v, a, prm, in_u, cos_h, sin_h, wk, c_star, s_star, eps, phimax - phi_k, rules, off, n
+                )
+                if wp.static(kinked):
+                    if in_k:
+                        acc = plain_piece(acc, v, a, prm, in_u, cos_h, sin_h, wk, phi_k, rules, off, n)
+            elif in_k:  # region A with the kink: phi_a's map (phimax = eps = pi) over [phi_k, pi], plain below
+                acc = sinh_piece(
+                    acc, v, a, prm, in_u, cos_h, sin_h, wk, -one, wp.float64(0.0), PI64, PI64 - phi_k, rules, off, n
+                )
+                acc = plain_piece(acc, v, a, prm, in_u, cos_h, sin_h, wk, phi_k, rules, off, n)
             else:
                 for j in range(n):
-                    r = phi_a[off + j]  # (cos phi, sin phi, weight): phi over [0, pi], the same for every texel
+                    r = t.phi_a[off + j]  # (cos phi, sin phi, weight): phi over [0, pi], the same for every texel
                     h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
                     gw = facet_weight(v, h, a, prm, in_u)
                     w = wk * r[2]
@@ -355,9 +477,7 @@ def panel_rule_for(spec):
     @wp.func
     def panel_of(t: PanelTexel, j: int, rules: Rule, off: int, n: int):
         """Panel j of texel t at the n x n rule rules[off : off + n] (the ladder's panel rule)."""
-        return panel_sum(
-            t.v, t.a, t.prm, t.edges[j], t.edges[j + 1], t.theta_a, t.theta_peak, t.eps_l, rules, t.phi_a, off, n
-        )
+        return panel_sum(t, t.edges[j], t.edges[j + 1], rules, off, n)
 
     # the GGX microfacet lobes (a mirror limit: not the Charlie cloth / sheen lobes sampled by GGX's CDF), where (4, 6)
     # was replayed honest (benchmarks/replay_ladder.py)
@@ -394,6 +514,7 @@ def make_gauss_legendre(spec):
     mirror = spec.mirror
     nch = spec.vec._length_
     smooth = mirror is not None
+    kink = spec.nol_kink or 0.0
     panel_of, first_level = panel_rule_for(spec)
     integrate, _, _, Sums, _ = greedy_ladder_for(panel_of, MAX_PANELS, nch, first_level)
 
@@ -411,7 +532,9 @@ def make_gauss_legendre(spec):
         merge = wp.float64(1.0)  # the fixed orders keep every breakpoint (their pixels as before PEAK_MERGE)
         if levels.shape[0] > 1:
             merge = wp.float64(PEAK_MERGE)
-        t, n_panels = panel_texel(texel[i], phi_a, merge, wp.static(smooth))
+        t, n_panels = panel_texel(
+            texel[i], phi_a, merge, wp.static(smooth), wp.float64(wp.static(kink)), wp.static(spec.grazing_peak)
+        )
         # the texel's target, in units of the panel sums (I = sum / pi): the estimate, TERMS_ROUNDING included, within
         # the tolerance
         total, e = integrate(t, n_panels, rules, levels, Sums(tol[0] * PI64), Sums(tol[1]), TERMS_ROUNDING)

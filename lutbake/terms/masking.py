@@ -95,12 +95,17 @@ def sheen_l(x: float, alpha: float):
     return a / (1.0 + b * wp.pow(wp.max(x, 0.0), c)) + d * x + e
 
 
+# where lambda_sheen switches formula: Lambda is C1 there, its second derivative jumps (the quadratures that integrate
+# V_charlie split their panels along n.l = LAMBDA_SHEEN_SWITCH: lutbake.integrands.specular, SpecularIntegrand.nol_kink)
+LAMBDA_SHEEN_SWITCH = 0.5
+
+
 @wp.func
 def lambda_sheen(cos_theta: float, alpha: float):
     """Charlie sheen Lambda: exp(l(cos)) below cos = 0.5, exp(2 l(0.5) - l(1 - cos)) above (Estevez & Kulla 2017)."""
-    if wp.abs(cos_theta) < 0.5:
+    if wp.abs(cos_theta) < wp.static(LAMBDA_SHEEN_SWITCH):
         return wp.exp(sheen_l(cos_theta, alpha))
-    return wp.exp(2.0 * sheen_l(0.5, alpha) - sheen_l(1.0 - cos_theta, alpha))
+    return wp.exp(2.0 * sheen_l(wp.static(LAMBDA_SHEEN_SWITCH), alpha) - sheen_l(1.0 - cos_theta, alpha))
 
 
 @wp.func
