@@ -82,7 +82,7 @@ def captured_inputs(spec, estimator_class):
 @wp.func
 def dfg_texel(tx: wp.vec3, phi_a: wp.array(dtype=wp.vec3d)):
     """The dfg family's texel and panels, the merge of a tolerance-driven bake (PEAK_MERGE)."""
-    return H.panel_texel(tx, phi_a, wp.float64(H.PEAK_MERGE), True, wp.float64(0.0), False)
+    return H.panel_texel(tx, phi_a, wp.float64(H.PEAK_MERGE), True, wp.float64(0.0), False, True)
 
 
 @wp.func

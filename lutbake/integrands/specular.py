@@ -237,7 +237,9 @@ class SpecularIntegrand:
     else None and alpha is clamped to ALPHA_MIN. ``nol_kink``: a cosine n.l where g is only C1 (Estevez & Kulla's
     Lambda fit switches formula at cos = 0.5: its second derivative jumps), which the gauss_legendre panels split at
     (lutbake.sampling.hemisphere), else None. ``grazing_peak``: g has a Charlie lobe, whose NDF peaks at theta_h = pi/2
-    (the gauss_legendre panels grade towards the end of the half-vector domain)."""
+    (the gauss_legendre panels grade towards the end of the half-vector domain). ``ndf_peak``: g has the lobe of
+    ``distribution`` (False for the sheen layouts, whose GGX distribution only panels: no u = CDF(theta_h) variable).
+    """
 
     key: tuple
     g: object
@@ -249,6 +251,7 @@ class SpecularIntegrand:
     mirror: object | None
     nol_kink: float | None = None
     grazing_peak: bool = False
+    ndf_peak: bool = True
 
     def alpha_input(self, alpha) -> np.ndarray:
         """The per-texel alpha the kernels receive (float32): lutbake.edge.effective_alpha."""
@@ -295,6 +298,7 @@ def specular_integrand(
         if channels_name.removesuffix("_clamped") in ("sheen_albedo", "sheen_fgd")
         else None,
         charlie,
+        channels_name not in SHEEN_LAYOUTS,
     )
 
 

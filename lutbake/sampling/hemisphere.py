@@ -213,18 +213,23 @@ def next_toward(t_lo: wp.float64, t_end: wp.float64, scale: wp.float64, reach: w
 
 
 @wp.func
-def panel_texel(tx: wp.vec3, phi_a: PhiRule, merge: wp.float64, mirror_limit: bool, kink: wp.float64, grazing: bool):
+def panel_texel(
+    tx: wp.vec3, phi_a: PhiRule, merge: wp.float64, mirror_limit: bool, kink: wp.float64, grazing: bool, ndf_peak: bool
+):
     """A texel (n.v, alpha, param) with its panels in theta_h (next_theta; ``merge``: PEAK_MERGE to a tolerance, 1 at
     a fixed order), split where an integrand's kink along n.l = ``kink`` (0: none) enters and leaves the inner
     domain (kink_band): (PanelTexel, n_panels). No panel where ``mirror_limit`` and alpha = 0 (the closed-form
     mirror limit takes the texel: lutbake.edge). A ``grazing`` NDF (Charlie's sin(theta_h)^(1/alpha), peaking at
     theta_h = pi/2) adds breakpoints graded towards theta_b on its scale there, alpha / (theta_a + sqrt(alpha)):
-    sin^(1/alpha) ~ exp(-(pi/2 - theta_h)^2 / (2 alpha)) and pi/2 - theta_b = theta_a."""
+    sin^(1/alpha) ~ exp(-(pi/2 - theta_h)^2 / (2 alpha)) and pi/2 - theta_b = theta_a. Without ``ndf_peak`` (a
+    sampling NDF that only panels: the sheen layouts) no breakpoints at its peak atan(alpha) R^j."""
     v, a, prm, a64, cos_v, sin_v, eps_l, theta_a, theta_b, theta_peak = texel_view(tx)
     band = kink_band(kink, cos_v, sin_v)
     peak_scale = wp.float64(0.0)
     if grazing:
         peak_scale = a64 / (theta_a + wp.sqrt(a64))
+    if not ndf_peak:
+        theta_peak = PI64 * wp.float64(0.25)  # no NDF-peak breakpoints: D_charlie has no peak at atan(alpha)
     edges = Edges()
     if mirror_limit and a <= 0.0:
         edges[0] = theta_b
@@ -235,7 +240,7 @@ def panel_texel(tx: wp.vec3, phi_a: PhiRule, merge: wp.float64, mirror_limit: bo
         for k in range(3):
             if t_lo < band[k] and band[k] < t_next:
                 t_next = band[k]
-        t_next = wp.min(t_next, next_toward(t_lo, theta_b, peak_scale, theta_a))
+        t_next = wp.min(t_next, next_toward(t_lo, theta_b, peak_scale, theta_b - PI64 * wp.float64(0.25)))
         t_lo = t_next
         if n_panels == MAX_PANELS - 1:  # never reached (MAX_PANELS): the last panel would take the rest
             t_lo = theta_b
@@ -427,7 +432,10 @@ def panel_rule_for(spec):
         sin_v = wp.float64(v[0])
         acc = acc_type()
         in_b = t_lo >= t.theta_a
-        in_u = t_hi <= t.theta_peak
+        in_u = t_hi <= t.theta_peak and wp.static(spec.ndf_peak)
+        ends = in_b  # smoothstep the outer variable
+        if wp.static(not spec.ndf_peak):  # sin(theta_h)^(1/alpha) at the pole: theta^(1/alpha), graded by smoothstep
+            ends = in_b or t_lo <= wp.float64(0.0)
         in_k = False
         if wp.static(kinked):
             in_k = t_lo >= t.theta_klo and t_hi <= t.theta_khi and t.theta_klo >= wp.float64(0.0)
@@ -436,7 +444,7 @@ def panel_rule_for(spec):
             s = rules[off + k][0]
             x = x_lo + dx * s
             wk = rules[off + k][1] * dx
-            if in_b or in_k:  # smoothstep: removes the sqrt-like ends of acos(c*) at c* = +-1 (and of phi_k)
+            if ends or in_k:  # smoothstep: removes the sqrt-like ends of acos(c*) at c* = +-1 (and of phi_k)
                 x = x_lo + dx * s * s * (wp.float64(3.0) - two * s)
                 wk = rules[off + k][1] * dx * wp.float64(6.0) * s * (one - s)
             cos_h, sin_h, wk = outer_node(x, wk, in_u, a64)
@@ -533,14 +541,25 @@ def make_gauss_legendre(spec):
         if levels.shape[0] > 1:
             merge = wp.float64(PEAK_MERGE)
         t, n_panels = panel_texel(
-            texel[i], phi_a, merge, wp.static(smooth), wp.float64(wp.static(kink)), wp.static(spec.grazing_peak)
+            texel[i],
+            phi_a,
+            merge,
+            wp.static(smooth),
+            wp.float64(wp.static(kink)),
+            wp.static(spec.grazing_peak),
+            wp.static(spec.ndf_peak),
         )
         # the texel's target, in units of the panel sums (I = sum / pi): the estimate, TERMS_ROUNDING included, within
         # the tolerance
-        total, e = integrate(t, n_panels, rules, levels, Sums(tol[0] * PI64), Sums(tol[1]), TERMS_ROUNDING)
+        rounding = TERMS_ROUNDING
+        if wp.static(spec.grazing_peak):
+            # D_charlie = sin(theta_h)^(1/alpha) of a float32 h: pow multiplies sin^2's rounding by 1 / (2 alpha)
+            # (measured: 9.5e-7 relative at alpha = 0.023, n.v = 1/128, at every order)
+            rounding = TERMS_ROUNDING * (wp.float64(1.0) + wp.float64(0.5) / wp.float64(t.a))
+        total, e = integrate(t, n_panels, rules, levels, Sums(tol[0] * PI64), Sums(tol[1]), rounding)
         for c in range(wp.static(nch)):
             out[i, c] = total[c] / PI64
-            err[i, c] = e[c] / PI64 + TERMS_ROUNDING * wp.abs(total[c] / PI64)
+            err[i, c] = e[c] / PI64 + rounding * wp.abs(total[c] / PI64)
         if wp.static(smooth):
             if t.a <= 0.0:  # the mirror limit (lutbake.edge)
                 store_row(out, i, mirror(t.v, t.prm))

@@ -45,7 +45,8 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None
     """``(integrate, climb, Panels, Sums, Orders)``: ``integrate(ctx, n_panels, rules, levels, target_abs, target_rel,
     floor) -> (total, err)`` (``Sums``: float64 vectors of nch, the targets per channel too): every panel at the first
     two levels, then refined until err_c = sum_p d_(p,c) <= max(target_abs_c, target_rel_c |total_c|) - floor
-    |total_c| for every channel c (floor: a relative error the caller adds to the estimate, e.g. the terms' rounding;
+    |total_c| (but at least floor |total_c| / 2) for every channel c (floor: a relative error the caller adds to the
+    estimate, e.g. the terms' rounding;
     an unreachable target, e.g. 1e300, never refines) or every panel is at the last order (module docstring);
     n_panels <= max_panels. ``climb(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0,
     lev)``: the same from each panel's first two levels' values given (``Panels``: float64 matrices max_panels x nch;
@@ -90,7 +91,11 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None
             worst_c = wp.int32(-1)  # the channel furthest over its target
             over = wp.float64(1.0)
             for c in range(wp.static(nch)):
-                target = wp.max(target_abs[c], target_rel[c] * wp.abs(total[c])) - floor * wp.abs(total[c])
+                # a floor over the tolerance (float32 noise) leaves the quadrature half of it: beyond, no order helps
+                target = wp.max(
+                    wp.max(target_abs[c], target_rel[c] * wp.abs(total[c])) - floor * wp.abs(total[c]),
+                    wp.float64(0.5) * floor * wp.abs(total[c]),
+                )
                 if err[c] > target * over:
                     worst_c = c
                     over = err[c] / wp.max(target, wp.float64(1.0e-300))
