@@ -117,7 +117,7 @@ def _check_value(key: Key, value, file, table) -> Any:
         ):
             fail("must be a list of two integers, e.g. [128, 128]")
         if any(x < (key.minimum or 1) for x in value):
-            fail("sizes must be >= 1")
+            fail(f"sizes must be >= {_num(key.minimum or 1)}")
         return list(value)
     if key.type == "float":
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):

@@ -452,7 +452,7 @@ def test_every_size_key_is_under_the_one_texel_cap(data, kind):
             [MAX_TEXELS + 1, 1]
             if data is None
             else data.draw(
-                st.tuples(st.integers(1, 10**12), st.integers(1, 10**12))
+                st.tuples(*[st.integers(int(k.minimum or 1), 10**12)] * 2)  # ltc's sizes start at 2
                 .filter(lambda s: s[0] * s[1] > MAX_TEXELS)
                 .map(list),
                 label="value",
