@@ -494,3 +494,20 @@ def test_adaptive_estimate_of_eevee_btdf_grazing_row_bounds_the_error():
     np.testing.assert_array_less(err, est[:, 2])
     np.testing.assert_array_less(est[:, 2], tol + TERMS_FLOOR * np.abs(values[:, 2]))
     print(f"eevee_btdf grazing: worst error / estimate {honesty_ratio(err, est[:, 2]):.3f}")
+
+
+def test_avg_estimate_includes_the_mu_rule():
+    """kind dielectric_avg's probe estimate refines the mu rule too (mu_order + MU_PROBE_STEP nodes per panel), not only
+    the inner one: inside the glass at a small roughness E(mu) has the total-internal-reflection transition, ~alpha
+    wide, which the mu rule resolves slowly (OpenPBR's table: 2.0e-4 at order 16 where the inner probe said 1.3e-5).
+    The table is small enough that every texel is a probe texel: the estimate is at least the mu refinement's change."""
+    from lutbake.api import bake_table
+
+    small = dict(kind="dielectric_avg", roughness_size=3, roughness_range=[0.06, 0.2], ior_size=2, ior_range=[0.4, 0.8])
+    base, _, _ = bake_table(spec(**small, samples=432))
+    finer, _, _ = bake_table(spec(**small, samples=432, mu_order=16 + kd.MU_PROBE_STEP))
+    attrs = base.attributes
+    change = float(np.max(np.abs(finer.data.astype(np.float64) - base.data)))
+    assert change > 1e-5  # the region where the mu rule, not the inner one, limits
+    assert float(attrs["error_estimate"]) >= change * (1 - 1e-3), attrs["error_estimate_method"]
+    assert "mu order 16 - 24" in attrs["error_estimate_method"]

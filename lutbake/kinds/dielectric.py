@@ -51,6 +51,10 @@ OPENPBR_IOR_MAX = 2.5  # OpenPBR_IorMax
 # kind dielectric_avg: fixed-order quadrature, no storage-derived tolerance, so its values never depend on format /
 # dtype; kind dielectric adapts to the tolerance they set (lutbake.tolerance): no layout keys
 AVG_LAYOUT_KEYS = ("format", "dtype")
+# the mu rule's share of kind dielectric_avg's probe estimate: its values against mu_order + MU_PROBE_STEP nodes per
+# panel (the inner rule's probe alone missed it: OpenPBR's eta < 1 rows at alpha = 0.004 are 2.0e-4 off at order 16,
+# where the inner probe said 1.3e-5; E(mu) has the total-internal-reflection transition there, ~alpha wide)
+MU_PROBE_STEP = 8
 NO_TARGET = 1.0e300  # the tolerance of a kernel channel a layout drops (it never refines)
 
 LAYOUTS = {
@@ -453,44 +457,56 @@ def plan_avg(spec) -> TexelPlan:
     integrand = dielectric_integrand(nd, mk, "exact_metal")
     estimator = estimator_for(o["estimator"], o["samples"], o["seed"])
     order = o["mu_order"]
-    per_eta = {e: mu_panels(e, order) for e in map(float, np.unique(eta))}  # one rule per IOR row, not per texel
-    nodes = [per_eta[float(x)] for x in eta]
+
+    def rule_of(n: int) -> list:
+        """Each texel's mu rule at n nodes per panel (one rule per IOR row, not per texel)."""
+        per_eta = {e: mu_panels(e, n) for e in map(float, np.unique(eta))}
+        return [per_eta[float(x)] for x in eta]
+
+    nodes = rule_of(order)
     counts = np.array([len(m) for m, _ in nodes])
     grid = Grid(axes, {"alpha": alpha}, alpha=np.asarray(alpha, np.float64))
 
-    def averages(t, est, device):
+    def averages(t, est, device, rule=nodes):
         """(len(t), 3) float64 averages 2 ∫ E mu dmu of (E_R, E_T, E(F = 1)) at texels t (each texel's own sums:
         independent of which texels share the call)."""
-        mu = np.concatenate([nodes[k][0] for k in t])
+        n = np.array([len(rule[k][0]) for k in t])
         inputs = {
-            "nov": mu.astype(np.float32),
-            "alpha": integrand.alpha_input(np.repeat(alpha[t], counts[t])),
-            "param": np.repeat(eta[t], counts[t]).astype(np.float32),
+            "nov": np.concatenate([rule[k][0] for k in t]).astype(np.float32),
+            "alpha": integrand.alpha_input(np.repeat(alpha[t], n)),
+            "param": np.repeat(eta[t], n).astype(np.float32),
         }
         res = est.evaluate(integrand, inputs, device)
-        starts = np.concatenate([[0], np.cumsum(counts[t])])
-        return np.array([2.0 * (nodes[k][1] * nodes[k][0]) @ res[starts[j] : starts[j + 1]] for j, k in enumerate(t)])
+        starts = np.concatenate([[0], np.cumsum(n)])
+        return np.array([2.0 * (rule[k][1] * rule[k][0]) @ res[starts[j] : starts[j + 1]] for j, k in enumerate(t)])
 
-    def run(idx, est, device):
+    def run(idx, est, device, rule=nodes):
         t = np.arange(len(alpha))[idx]
         if layout == "openpbr":
             # the reflection ratio at (eta, alpha) needs E_c,avg at (1/eta, alpha) too: row z mirrors row N - 1 - z
             mirror = (OPENPBR_SIZE - 1 - t // OPENPBR_SIZE) * OPENPBR_SIZE + t % OPENPBR_SIZE
             both = np.unique(np.concatenate([t, mirror]))
-            avg = averages(both, est, device)
+            avg = averages(both, est, device, rule)
             ch, ch_m = (post_process("openpbr", avg[np.searchsorted(both, u)]) for u in (t, mirror))
             ratio = dielectric_ratio.reflection_ratio(ch[:, 0], ch_m[:, 0], eta[t])
             return np.concatenate([ch, ratio[:, None]], axis=1)
-        avg = averages(t, est, device)
+        avg = averages(t, est, device, rule)
         return np.stack([avg[:, 0], avg[:, 1], avg[:, 0] + avg[:, 1]], axis=1)
 
     n_channels = len(AVG_CHANNELS[layout])
 
     def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
+        """Both rules refined in turn at the probe texels: the inner one (estimator.refined) and the mu rule (order
+        + MU_PROBE_STEP nodes per panel), the larger difference recorded."""
         idx = probe_indices(grid)
+        got = data.reshape(len(alpha), n_channels)[idx]
         refined, how = estimator.refined()
-        err = float(np.max(np.abs(data.reshape(len(alpha), n_channels)[idx] - run(idx, refined, device))))
-        return err, f"max |{how}| over {len(idx)} strided probe texels"
+        inner = float(np.max(np.abs(got - run(idx, refined, device))))
+        mu = float(np.max(np.abs(got - run(idx, estimator, device, rule_of(order + MU_PROBE_STEP)))))
+        return max(inner, mu), (
+            f"max over {len(idx)} strided probe texels of |{how}| ({inner:.3g}) and |mu order {order} - "
+            f"{order + MU_PROBE_STEP}| ({mu:.3g})"
+        )
 
     per = int(estimator.samples({"nov": [0.0]})[0]) * int(counts.max())
     return TexelPlan(
