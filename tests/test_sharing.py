@@ -19,11 +19,11 @@ from lutbake.sharing import layout_keys, values_key
 from lutbake.values_cache import open_cache
 
 SMALL_LTC = {"kind": "ltc", "lobe": "ggx", "size": [6, 6], "fit_samples": 4}
-SMALL_DIELECTRIC = {"kind": "dielectric_avg", "roughness_size": 4, "ior_size": 2}  # fixed order: format is layout
 # one small valid table per kind that declares layout keys; every value each layout key allows is tried on it
-SMALL = {"ltc": SMALL_LTC, "dielectric_avg": SMALL_DIELECTRIC}
+# (dielectric_avg declares none since its mu rule reaches the tolerance that format / dtype set)
+SMALL = {"ltc": SMALL_LTC}
 # layout values a kind's own cross-key check refuses with these small specs (they pair with other keys)
-REFUSED = {("dielectric_avg", "format", "openpbr_h")}
+REFUSED: set = set()
 
 
 def plan_records(plan) -> dict:
@@ -107,17 +107,16 @@ def test_shared_tables_are_computed_once_and_bit_identical_to_baking_each_alone(
         {"name": "ltc_js", **SMALL_LTC, "format": "js"},
         {"name": "ltc_dds", **SMALL_LTC, "format": "ltc_dds", "dtype": "half"},
         {"name": "ltc_other", **SMALL_LTC, "alpha_min": 1e-3},  # other values: its own computation
-        {"name": "diel_exr", **SMALL_DIELECTRIC},
-        {"name": "diel_npy", **SMALL_DIELECTRIC, "format": "npy", "dtype": "half"},
+        {"name": "ltc_npy", **SMALL_LTC, "format": "npy", "dtype": "half"},
     ]
     together = tmp_path / "together"
     jobs = batch.schedule(load_configs([write_config(tmp_path / "all.toml", tables)]), together)
     assert batch.run(jobs, workers=2) is None
-    assert sorted(computed) == ["diel_exr", "ltc_exr", "ltc_other"]
+    assert sorted(computed) == ["ltc_exr", "ltc_other"]
     by_name = {j.name: j for j in jobs}
     assert all(j.status == "baked" for j in jobs)
     assert by_name["ltc_js"].values_from == by_name["ltc_dds"].values_from == "ltc_exr"
-    assert by_name["diel_npy"].values_from == "diel_exr" and by_name["ltc_other"].values_from is None
+    assert by_name["ltc_npy"].values_from == "ltc_exr" and by_name["ltc_other"].values_from is None
     assert by_name["ltc_js"].cpu_seconds == 0.0 and by_name["ltc_exr"].cpu_seconds > 0.0
 
     alone = tmp_path / "alone"
@@ -150,25 +149,25 @@ def test_the_values_cache_lays_out_known_values_without_computing_and_never_trus
         assert job.status == "baked", job.message
         return job
 
-    first = run({"name": "diel", **SMALL_DIELECTRIC}, tmp_path / "out")
-    assert computed == ["diel"] and first.values_from is None
+    first = run({"name": "lut", **SMALL_LTC}, tmp_path / "out")
+    assert computed == ["lut"] and first.values_from is None
     (entry,) = cache_dir.glob("*.npy")
     assert entry.stem == first.values_key and (cache_dir / f"{entry.stem}.json").is_file()
 
     # the output deleted: written again from the cache, the same pixels and attributes as the first bake
     data0, attrs0 = read_exr(first.path)
-    again = run({"name": "diel", **SMALL_DIELECTRIC}, tmp_path / "out")
+    again = run({"name": "lut", **SMALL_LTC}, tmp_path / "out")
     data1, attrs1 = read_exr(again.path)
     attrs0.pop("data_hash"), attrs1.pop("data_hash")
-    assert computed == ["diel"] and again.values_from == "cache"
+    assert computed == ["lut"] and again.values_from == "cache"
     np.testing.assert_array_equal(data1, data0)
     assert attrs1 == attrs0
 
     # a layout-only change (another format and dtype): no computation, the file of a bake without the cache
-    npy = {"name": "diel", **SMALL_DIELECTRIC, "format": "npy", "dtype": "half"}
+    npy = {"name": "lut", **SMALL_LTC, "format": "npy", "dtype": "half"}
     cached = run(npy, tmp_path / "out").path.read_bytes()
-    assert computed == ["diel"]
-    assert run(npy, tmp_path / "fresh", cache=False).path.read_bytes() == cached and computed == ["diel"] * 2
+    assert computed == ["lut"]
+    assert run(npy, tmp_path / "fresh", cache=False).path.read_bytes() == cached and computed == ["lut"] * 2
 
     # a corrupt entry (one flipped byte) is a miss: computed again, the entry rewritten whole
     blob = bytearray(entry.read_bytes())

@@ -48,13 +48,16 @@ EEVEE_SIZE = (16, 64, 64)  # UTIL_BTDF_LAYER_COUNT roughness layers x UTIL_TEX_S
 EEVEE_CLAMP = (1.0e-4, 0.9999)  # eevee_lut_comp.glsl: NoV, f0-like x^2 (btdf) and eta (bsdf) clamps
 OPENPBR_SIZE = 32  # OpenPBR_EnergyTableSize
 OPENPBR_IOR_MAX = 2.5  # OpenPBR_IorMax
-# kind dielectric_avg: fixed-order quadrature, no storage-derived tolerance, so its values never depend on format /
-# dtype; kind dielectric adapts to the tolerance they set (lutbake.tolerance): no layout keys
-AVG_LAYOUT_KEYS = ("format", "dtype")
-# the mu rule's share of kind dielectric_avg's probe estimate: its values against mu_order + MU_PROBE_STEP nodes per
-# panel (the inner rule's probe alone missed it: OpenPBR's eta < 1 rows at alpha = 0.004 are 2.0e-4 off at order 16,
-# where the inner probe said 1.3e-5; E(mu) has the total-internal-reflection transition there, ~alpha wide)
-MU_PROBE_STEP = 8
+OPENPBR_MS_ALPHA_MIN = 0.0016  # below it OpenPBR's multiple-scattering lobe is off (lutbake.kinds.dielectric_ratio)
+# both kinds reach the tolerance that format / dtype set (lutbake.tolerance; kind dielectric_avg through its mu rule):
+# no layout keys
+AVG_LAYOUT_KEYS = ()
+# kind dielectric_avg: while a texel's mu estimate (its panels' differences between mu_order and 2/3 as many nodes)
+# exceeds a quarter of its target, its worst panel is bisected, up to MU_MAX_PANELS panels. Inside the glass at small
+# roughness E(mu) crosses the total-internal-reflection transition, ~alpha wide at cos theta_c, and E_T is not analytic
+# at further points inside the glass: the fixed 16 nodes per panel of before were off by up to 2.0e-4 on OpenPBR's
+# eta < 1 rows (alpha = 0.004)
+MU_MAX_PANELS = 40
 NO_TARGET = 1.0e300  # the tolerance of a kernel channel a layout drops (it never refines)
 
 LAYOUTS = {
@@ -175,8 +178,9 @@ AVG_KEYS = {
     "mu_order": Key(
         "mu_order",
         "int",
-        16,
-        "Gauss-Legendre nodes in mu per panel (panels split at 0.2 and cos theta_c)",
+        12,
+        "Gauss-Legendre nodes in mu per panel (panels from 0.2 and cos theta_c, bisected to the tolerance against "
+        "2/3 as many)",
         minimum=2,
         maximum=256,
     ),
@@ -419,14 +423,19 @@ def plan(spec) -> TexelPlan:
     )
 
 
-def mu_panels(eta: float, order: int) -> tuple[np.ndarray, np.ndarray]:
-    """GL nodes/weights on [0, 1] in mu, panels split at 0.2 and, for eta < 1, at cos theta_c = sqrt(1 - eta^2)
+def mu_starts(eta: float) -> np.ndarray:
+    """The first mu panel ends of kind dielectric_avg: 0, 0.2, 1 and, for eta < 1, cos theta_c = sqrt(1 - eta^2)
     (where E(mu) has its total-internal-reflection kink in the smooth limit)."""
     cuts = [0.0, 0.2, 1.0] + ([float(np.sqrt(1.0 - eta * eta))] if eta < 1.0 else [])
-    edges = np.unique(np.clip(cuts, 0.0, 1.0))
-    x, w = np.polynomial.legendre.leggauss(order)
-    lo, hi = edges[:-1, None], edges[1:, None]
-    return ((lo + (hi - lo) * (x + 1) / 2).ravel(), ((hi - lo) * w / 2).ravel())
+    return np.unique(np.clip(cuts, 0.0, 1.0))
+
+
+def ratio_error(ec, ec_m, err, err_m, eta) -> np.ndarray:
+    """A bound on OpenPBR's reflection ratio's error from its two averages' (|x(corner) - x| over the four corners
+    ec +- err, ec_m +- err_m: x is monotone in each average on each branch)."""
+    x = dielectric_ratio.reflection_ratio(ec, ec_m, eta)
+    corners = [dielectric_ratio.reflection_ratio(ec + a * err, ec_m + b * err_m, eta) for a in (-1, 1) for b in (-1, 1)]
+    return np.max(np.abs(np.array(corners) - x), axis=0)
 
 
 def avg_grid(o: dict) -> tuple[list[Axis], np.ndarray, np.ndarray]:
@@ -446,7 +455,7 @@ def avg_grid(o: dict) -> tuple[list[Axis], np.ndarray, np.ndarray]:
 
 
 def plan_avg(spec) -> TexelPlan:
-    """E_avg per (eta, roughness) texel: the kernel at mu_panels(eta) nodes, reduced 2 sum w mu E per texel (the
+    """E_avg per (eta, roughness) texel: the kernel at the nodes of its mu panels, reduced 2 sum w mu E per texel (the
     node set depends on eta, so the reduction is here rather than in lutbake.sampling.plan.Grid)."""
     from ..integrands.dielectric import dielectric_integrand
 
@@ -456,59 +465,111 @@ def plan_avg(spec) -> TexelPlan:
     nd, mk = terms_of(o)
     integrand = dielectric_integrand(nd, mk, "exact_metal")
     estimator = estimator_for(o["estimator"], o["samples"], o["seed"])
-    order = o["mu_order"]
-
-    def rule_of(n: int) -> list:
-        """Each texel's mu rule at n nodes per panel (one rule per IOR row, not per texel)."""
-        per_eta = {e: mu_panels(e, n) for e in map(float, np.unique(eta))}
-        return [per_eta[float(x)] for x in eta]
-
-    nodes = rule_of(order)
-    counts = np.array([len(m) for m, _ in nodes])
+    order, coarse = o["mu_order"], max(2, (2 * o["mu_order"]) // 3)
+    tol = tolerance_of(o)
+    starts = {e: mu_starts(e) for e in map(float, np.unique(eta))}
     grid = Grid(axes, {"alpha": alpha}, alpha=np.asarray(alpha, np.float64))
+    n_channels = len(AVG_CHANNELS[layout])
 
-    def averages(t, est, device, rule=nodes):
-        """(len(t), 3) float64 averages 2 ∫ E mu dmu of (E_R, E_T, E(F = 1)) at texels t (each texel's own sums:
-        independent of which texels share the call)."""
-        n = np.array([len(rule[k][0]) for k in t])
-        inputs = {
-            "nov": np.concatenate([rule[k][0] for k in t]).astype(np.float32),
-            "alpha": integrand.alpha_input(np.repeat(alpha[t], n)),
-            "param": np.repeat(eta[t], n).astype(np.float32),
-        }
-        res = est.evaluate(integrand, inputs, device)
-        starts = np.concatenate([[0], np.cumsum(n)])
-        return np.array([2.0 * (rule[k][1] * rule[k][0]) @ res[starts[j] : starts[j + 1]] for j, k in enumerate(t)])
+    def panel_sums(t, lo, hi, est, device):
+        """2 ∫ E mu dmu over the panels [lo, hi] of texels t by the order- and coarse-point rules: (fine, coarse),
+        (len(t), 3) each, one launch."""
+        out = []
+        for n in (order, coarse):
+            x, w = np.polynomial.legendre.leggauss(n)
+            mu = (lo[:, None] + (hi - lo)[:, None] * (x + 1) / 2).ravel()
+            wt = ((hi - lo)[:, None] * w / 2).ravel()
+            inputs = {
+                "nov": mu.astype(np.float32),
+                "alpha": integrand.alpha_input(np.repeat(alpha[t], n)),
+                "param": np.repeat(eta[t], n).astype(np.float32),
+            }
+            res = est.evaluate(integrand, inputs, device) * (2.0 * wt * mu)[:, None]
+            out.append(res.reshape(len(t), n, -1).sum(axis=1))
+        return out
 
-    def run(idx, est, device, rule=nodes):
+    def averages(t, est, device):
+        """(values, mu-rule estimates), (len(t), 3) float64 each: 2 ∫ E mu dmu of (E_R, E_T, E(F = 1)) at texels t.
+        Every panel (from mu_starts) takes the order- and the coarse-point rule, d = |Q_order - Q_coarse| its
+        estimate; while a texel's sum of d exceeds a quarter of its target (max(tolerance, relative_tolerance |v|) at
+        the first pass's v, the worst channel: a layout's sum of two channels gets half), its panel with the largest
+        d is bisected (greedy, as lutbake.sampling.ladder), up to MU_MAX_PANELS panels. Each texel's own panels:
+        independent of which texels share the call."""
+        panels = [[(a, b) for a, b in zip(starts[float(eta[i])][:-1], starts[float(eta[i])][1:])] for i in t]
+        owner = np.concatenate([[j] * len(p) for j, p in enumerate(panels)]).astype(int)
+        lo, hi = (np.array([x[c] for p in panels for x in p]) for c in (0, 1))
+        q, d = panel_sums(t[owner], lo, hi, est, device)
+        d = np.abs(q - d)
+        fine = [list(q[owner == j]) for j in range(len(t))]
+        diff = [list(d[owner == j]) for j in range(len(t))]
+        total0 = np.array([np.sum(f, axis=0) for f in fine])
+        target = 0.25 * np.maximum(tol.absolute, tol.relative * np.min(np.abs(total0), axis=1))
+        while True:
+            pick = [
+                j
+                for j in range(len(t))
+                if np.max(np.sum(diff[j], axis=0)) > target[j] and len(panels[j]) < MU_MAX_PANELS
+            ]
+            if not pick:
+                break
+            worst = [int(np.argmax(np.max(diff[j], axis=1))) for j in pick]
+            a_, b_ = (
+                np.array([panels[j][w][0] for j, w in zip(pick, worst)]),
+                np.array([panels[j][w][1] for j, w in zip(pick, worst)]),
+            )
+            m_ = 0.5 * (a_ + b_)
+            q, c = panel_sums(
+                np.concatenate([t[pick], t[pick]]), np.concatenate([a_, m_]), np.concatenate([m_, b_]), est, device
+            )
+            c = np.abs(q - c)
+            n = len(pick)
+            for i, (j, w) in enumerate(zip(pick, worst)):
+                panels[j][w : w + 1] = [(a_[i], m_[i]), (m_[i], b_[i])]
+                fine[j][w : w + 1] = [q[i], q[n + i]]
+                diff[j][w : w + 1] = [c[i], c[n + i]]
+        return np.array([np.sum(f, axis=0) for f in fine]), np.array([np.sum(e, axis=0) for e in diff])
+
+    def run(idx, est, device):
+        """The channels of texels idx, then their mu-rule estimates (aux columns; OpenPBR's ratio: the bound of
+        ratio_error)."""
         t = np.arange(len(alpha))[idx]
         if layout == "openpbr":
             # the reflection ratio at (eta, alpha) needs E_c,avg at (1/eta, alpha) too: row z mirrors row N - 1 - z
             mirror = (OPENPBR_SIZE - 1 - t // OPENPBR_SIZE) * OPENPBR_SIZE + t % OPENPBR_SIZE
             both = np.unique(np.concatenate([t, mirror]))
-            avg = averages(both, est, device, rule)
-            ch, ch_m = (post_process("openpbr", avg[np.searchsorted(both, u)]) for u in (t, mirror))
+            avg, err = averages(both, est, device)
+            at, at_m = np.searchsorted(both, t), np.searchsorted(both, mirror)
+            ch, ch_m = post_process("openpbr", avg[at]), post_process("openpbr", avg[at_m])
+            ce, ce_m = error_post_process("openpbr", err[at]), error_post_process("openpbr", err[at_m])
             ratio = dielectric_ratio.reflection_ratio(ch[:, 0], ch_m[:, 0], eta[t])
-            return np.concatenate([ch, ratio[:, None]], axis=1)
-        avg = averages(t, est, device, rule)
-        return np.stack([avg[:, 0], avg[:, 1], avg[:, 0] + avg[:, 1]], axis=1)
-
-    n_channels = len(AVG_CHANNELS[layout])
+            r_err = ratio_error(ch[:, 0], ch_m[:, 0], ce[:, 0], ce_m[:, 0], eta[t])
+            return np.concatenate([ch, ratio[:, None], ce, r_err[:, None]], axis=1)
+        avg, err = averages(t, est, device)
+        energy = np.stack([avg[:, 0], avg[:, 1], avg[:, 0] + avg[:, 1]], axis=1)
+        return np.concatenate([energy, np.stack([err[:, 0], err[:, 1], err[:, 0] + err[:, 1]], axis=1)], axis=1)
 
     def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
-        """Both rules refined in turn at the probe texels: the inner one (estimator.refined) and the mu rule (order
-        + MU_PROBE_STEP nodes per panel), the larger difference recorded."""
+        """The inner rule refined at the probe texels (estimator.refined) plus the largest per-texel mu-rule estimate
+        (the aux columns); OpenPBR's ratio (channel A) is reported apart (0/0-like where E_c,avg -> 0)."""
+        full = data.reshape(len(alpha), -1)
+        energy = 3
         idx = probe_indices(grid)
-        got = data.reshape(len(alpha), n_channels)[idx]
         refined, how = estimator.refined()
-        inner = float(np.max(np.abs(got - run(idx, refined, device))))
-        mu = float(np.max(np.abs(got - run(idx, estimator, device, rule_of(order + MU_PROBE_STEP)))))
-        return max(inner, mu), (
-            f"max over {len(idx)} strided probe texels of |{how}| ({inner:.3g}) and |mu order {order} - "
-            f"{order + MU_PROBE_STEP}| ({mu:.3g})"
+        inner = float(np.max(np.abs(full[idx, :energy] - run(idx, refined, device)[:, :energy])))
+        mu = float(np.max(full[:, n_channels : n_channels + energy]))
+        text = (
+            f"|{how}| over {len(idx)} strided probe texels ({inner:.3g}) + the largest per-texel mu-rule estimate, "
+            f"sum over bisected panels of |Q({order}) - Q({coarse})| ({mu:.3g})"
         )
+        if layout == "openpbr":
+            used = alpha >= OPENPBR_MS_ALPHA_MIN
+            text += (
+                f"; reflection ratio (A): mu-rule bound {float(np.max(full[used, n_channels + energy])):.3g} where "
+                f"alpha >= {OPENPBR_MS_ALPHA_MIN:g} (OpenPBR's multiple-scattering lobe)"
+            )
+        return inner + mu, text
 
-    per = int(estimator.samples({"nov": [0.0]})[0]) * int(counts.max())
+    per = int(estimator.samples({"nov": [0.0]})[0]) * 4 * (order + coarse)  # nominal: 4 panels
     return TexelPlan(
         axes=axes,
         channels=AVG_CHANNELS[layout],
@@ -518,11 +579,14 @@ def plan_avg(spec) -> TexelPlan:
         run_tile=lambda s, e, d: run(slice(s, e), estimator, d),
         prepare=lambda d: estimator.prepare(integrand, d),
         samples=per,
+        aux_channels=n_channels,
         estimator=estimator.name,
         terms=terms_record((nd, mk, "exact_metal"), layout),
         cost=float(len(alpha)) * per,
         extra={
-            "mu_quadrature": f"{order} Gauss-Legendre nodes per panel, panels split at mu = 0.2 and cos theta_c",
+            "mu_quadrature": f"Gauss-Legendre {order} and {coarse} nodes per panel from mu = 0, 0.2, cos theta_c, 1, "
+            f"the worst panel bisected until the sum of differences is within tol / 4 (at most {MU_MAX_PANELS} panels)",
+            "tolerance": tol.text(),
             "alpha_policy": alpha_policy(True),
             **({"reflection_ratio": dielectric_ratio.METADATA} if layout == "openpbr" else {}),
         },
