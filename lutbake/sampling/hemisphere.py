@@ -114,6 +114,20 @@ class PanelTexel:
     theta_khi: wp.float64  # ... and where it leaves it
 
 
+@wp.struct
+class OuterNode:
+    """An outer node of a panel's product rule (panel_rule_for): the texel's view, alpha, param, whether the outer
+    variable is the NDF's CDF (the weight is g / p), theta_h and the node's weight."""
+
+    v: wp.vec3
+    a: float
+    prm: float
+    in_u: wp.bool
+    cos_h: wp.float64
+    sin_h: wp.float64
+    wk: wp.float64
+
+
 @wp.func
 def next_geometric(t_lo: wp.float64, t0: wp.float64):
     """Smallest t0 * R^j (j >= 0) above t_lo, for t0 > 0."""
@@ -347,15 +361,18 @@ def panel_rule_for(spec):
     kinked = spec.nol_kink is not None
 
     @wp.func
+    def add_facet(acc: Any, f: OuterNode, cos_phi: wp.float64, sin_phi: wp.float64, w: wp.float64):
+        """acc plus w g / p at the facet (theta_h of the outer node f, phi)."""
+        h = wp.vec3(float(f.sin_h * cos_phi), float(f.sin_h * sin_phi), float(f.cos_h))
+        gw = facet_weight(f.v, h, f.a, f.prm, f.in_u)
+        for c in range(wp.static(nch)):
+            acc[c] = acc[c] + w * wp.float64(gw[c])
+        return acc
+
+    @wp.func
     def sinh_piece(
         acc: Any,
-        v: wp.vec3,
-        a: float,
-        prm: float,
-        in_u: bool,
-        cos_h: wp.float64,
-        sin_h: wp.float64,
-        wk: wp.float64,
+        f: OuterNode,
         c_star: wp.float64,
         s_star: wp.float64,
         eps: wp.float64,
@@ -366,7 +383,7 @@ def panel_rule_for(spec):
     ):
         """acc plus the inner rule over phi in [phimax - width, phimax] (cos, sin of phimax: c_star, s_star) by the
         sinh map (Johnston & Elliott 2005) phi = phimax - eps sinh(A (1 - x)), A = asinh(width / eps), which
-        clusters the nodes at phimax on the scale eps; wk: the outer node's weight."""
+        clusters the nodes at phimax on the scale eps."""
         one = wp.float64(1.0)
         big_a = asinh64(width / eps)
         # the GL nodes pair up, x_(n-1-j) = 1 - x_j, so the pair's e^(big_a (1 - x)) are ex and e^big_a / ex: one exp
@@ -377,43 +394,18 @@ def panel_rule_for(spec):
             ex = wp.exp(big_a * (one - rules[off + j][0]))
             inv_ex = one / ex
             r = phi_b(ex, inv_ex, eps, big_a, c_star, s_star)
-            h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
-            gw = facet_weight(v, h, a, prm, in_u)
-            w = wk * rules[off + j][1] * r[2]
-            for c in range(wp.static(nch)):
-                acc[c] = acc[c] + w * wp.float64(gw[c])
+            acc = add_facet(acc, f, r[0], r[1], f.wk * rules[off + j][1] * r[2])
             if n - 1 - j > j:
                 r = phi_b(e_a * inv_ex, ex * inv_e_a, eps, big_a, c_star, s_star)
-                h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
-                gw = facet_weight(v, h, a, prm, in_u)
-                w = wk * rules[off + n - 1 - j][1] * r[2]
-                for c in range(wp.static(nch)):
-                    acc[c] = acc[c] + w * wp.float64(gw[c])
+                acc = add_facet(acc, f, r[0], r[1], f.wk * rules[off + n - 1 - j][1] * r[2])
         return acc
 
     @wp.func
-    def plain_piece(
-        acc: Any,
-        v: wp.vec3,
-        a: float,
-        prm: float,
-        in_u: bool,
-        cos_h: wp.float64,
-        sin_h: wp.float64,
-        wk: wp.float64,
-        width: wp.float64,
-        rules: Rule,
-        off: int,
-        n: int,
-    ):
+    def plain_piece(acc: Any, f: OuterNode, width: wp.float64, rules: Rule, off: int, n: int):
         """acc plus the plain inner rule over phi in [0, width] (the side of a kink away from the horizon)."""
         for j in range(n):
             phi = width * rules[off + j][0]
-            h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
-            gw = facet_weight(v, h, a, prm, in_u)
-            w = wk * rules[off + j][1] * width
-            for c in range(wp.static(nch)):
-                acc[c] = acc[c] + w * wp.float64(gw[c])
+            acc = add_facet(acc, f, wp.float64(wp.cos(phi)), wp.float64(wp.sin(phi)), f.wk * rules[off + j][1] * width)
         return acc
 
     @wp.func
@@ -448,6 +440,7 @@ def panel_rule_for(spec):
                 x = x_lo + dx * s * s * (wp.float64(3.0) - two * s)
                 wk = rules[off + k][1] * dx * wp.float64(6.0) * s * (one - s)
             cos_h, sin_h, wk = outer_node(x, wk, in_u, a64)
+            f = OuterNode(v, a, prm, in_u, cos_h, sin_h, wk)
             phi_k = wp.float64(0.0)
             if wp.static(kinked):
                 if in_k:
@@ -461,25 +454,17 @@ def panel_rule_for(spec):
                 # lies eps_l / slope beyond phimax
                 slope = two * cos_h * sin_v * sin_h * wp.max(s_star, wp.float64(1.0e-12))
                 eps = wp.max(t.eps_l / slope, wp.float64(1.0e-12))
-                acc = sinh_piece(
-                    acc, v, a, prm, in_u, cos_h, sin_h, wk, c_star, s_star, eps, phimax - phi_k, rules, off, n
-                )
+                acc = sinh_piece(acc, f, c_star, s_star, eps, phimax - phi_k, rules, off, n)
                 if wp.static(kinked):
                     if in_k:
-                        acc = plain_piece(acc, v, a, prm, in_u, cos_h, sin_h, wk, phi_k, rules, off, n)
+                        acc = plain_piece(acc, f, phi_k, rules, off, n)
             elif in_k:  # region A with the kink: phi_a's map (phimax = eps = pi) over [phi_k, pi], plain below
-                acc = sinh_piece(
-                    acc, v, a, prm, in_u, cos_h, sin_h, wk, -one, wp.float64(0.0), PI64, PI64 - phi_k, rules, off, n
-                )
-                acc = plain_piece(acc, v, a, prm, in_u, cos_h, sin_h, wk, phi_k, rules, off, n)
+                acc = sinh_piece(acc, f, -one, wp.float64(0.0), PI64, PI64 - phi_k, rules, off, n)
+                acc = plain_piece(acc, f, phi_k, rules, off, n)
             else:
                 for j in range(n):
                     r = t.phi_a[off + j]  # (cos phi, sin phi, weight): phi over [0, pi], the same for every texel
-                    h = wp.vec3(float(sin_h * r[0]), float(sin_h * r[1]), float(cos_h))
-                    gw = facet_weight(v, h, a, prm, in_u)
-                    w = wk * r[2]
-                    for c in range(wp.static(nch)):
-                        acc[c] = acc[c] + w * wp.float64(gw[c])
+                    acc = add_facet(acc, f, r[0], r[1], wk * r[2])
         return acc
 
     @wp.func
