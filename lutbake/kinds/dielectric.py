@@ -31,6 +31,7 @@ Layouts (key ``layout``) fix the channels, and for the engine layouts the whole 
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -529,6 +530,24 @@ def plan_avg(spec) -> TexelPlan:
                 diff[j][w : w + 1] = [c[i], c[n + i]]
         return np.array([np.sum(f, axis=0) for f in fine]), np.array([np.sum(e, axis=0) for e in diff])
 
+    memo: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+    memo_lock = threading.Lock()
+
+    def averages_once(t, est, device):
+        """averages(t), each texel computed once per plan for the plan's own estimator: OpenPBR's tiles also need
+        their mirror rows, another tile's texels (a texel's values do not depend on who computes them)."""
+        if est is not estimator:
+            return averages(t, est, device)
+        with memo_lock:
+            missing = np.array([k for k in t if int(k) not in memo], dtype=int)
+        if len(missing):
+            v, e = averages(missing, est, device)
+            with memo_lock:
+                memo.update({int(k): (v[i], e[i]) for i, k in enumerate(missing)})
+        with memo_lock:
+            got = [memo[int(k)] for k in t]
+        return np.array([g[0] for g in got]), np.array([g[1] for g in got])
+
     def run(idx, est, device):
         """The channels of texels idx, then their mu-rule estimates (aux columns; OpenPBR's ratio: the bound of
         ratio_error)."""
@@ -536,11 +555,10 @@ def plan_avg(spec) -> TexelPlan:
         if layout == "openpbr":
             # the reflection ratio at (eta, alpha) needs E_c,avg at (1/eta, alpha) too: row z mirrors row N - 1 - z
             mirror = (OPENPBR_SIZE - 1 - t // OPENPBR_SIZE) * OPENPBR_SIZE + t % OPENPBR_SIZE
-            both = np.unique(np.concatenate([t, mirror]))
-            avg, err = averages(both, est, device)
-            at, at_m = np.searchsorted(both, t), np.searchsorted(both, mirror)
-            ch, ch_m = post_process("openpbr", avg[at]), post_process("openpbr", avg[at_m])
-            ce, ce_m = error_post_process("openpbr", err[at]), error_post_process("openpbr", err[at_m])
+            avg, err = averages_once(t, est, device)  # its own texels first: another tile may need them
+            avg_m, err_m = averages_once(mirror, est, device)
+            ch, ch_m = post_process("openpbr", avg), post_process("openpbr", avg_m)
+            ce, ce_m = error_post_process("openpbr", err), error_post_process("openpbr", err_m)
             ratio = dielectric_ratio.reflection_ratio(ch[:, 0], ch_m[:, 0], eta[t])
             r_err = ratio_error(ch[:, 0], ch_m[:, 0], ce[:, 0], ce_m[:, 0], eta[t])
             return np.concatenate([ch, ratio[:, None], ce, r_err[:, None]], axis=1)
