@@ -41,3 +41,39 @@ def test_gl_levels_offsets_address_each_order():
         assert n == order
         np.testing.assert_array_equal(rules[off : off + n, 0], x)
         np.testing.assert_array_equal(rules[off : off + n, 1], w)
+
+
+# QUADPACK dqk15 (Piessens, de Doncker-Kapenga, Ueberhuber, Kahaner 1983), on [-1, 1], x >= 0 half: the independent
+# reference of points.gauss_kronrod(7)
+QK15_XGK = [0.0, 0.207784955007898467600689403773245, 0.405845151377397166906606412076961,
+            0.586087235467691130294144845693013, 0.741531185599394439863864773280788,
+            0.864864423359769072789712788640926, 0.949107912342758524526189684047851,
+            0.991455371120812639206854697526329]  # fmt: skip
+QK15_WGK = [0.209482141084727828012999174891714, 0.204432940075298892414161999234649,
+            0.190350578064785409913256402421014, 0.169004726639267902826583426598550,
+            0.140653259715525918745189590510238, 0.104790010322250183839876322541518,
+            0.063092092629978553290700663189204, 0.022935322010529224963732008058970]  # fmt: skip
+QK15_WG = [0.417959183673469387755102040816327, 0.381830050505118944950369775488975,
+           0.279705391489276667901467771423780, 0.129484966168869693270611432679082]  # fmt: skip
+
+
+def test_gauss_kronrod_is_quadpacks_qk15():
+    x, wk, wg = points.gauss_kronrod(7)
+    np.testing.assert_allclose(2 * x[7:] - 1, QK15_XGK, atol=1e-15)
+    np.testing.assert_allclose(2 * wk[7:], QK15_WGK, rtol=1e-13)
+    np.testing.assert_allclose(2 * wg[7::2], QK15_WG, rtol=1e-13)  # the Gauss nodes: every other one from the middle
+    assert np.all(wg[8::2] == 0) and np.all(wk > 0)
+
+
+@pytest.mark.parametrize("n", [5, 7, 10, 12])
+def test_gauss_kronrod_degrees(n):
+    """The Kronrod weights integrate x^d exactly on [0, 1] for d <= 3n + 1, the Gauss weights for d <= 2n - 1, and the
+    Gauss subset is numpy's leggauss(n)."""
+    x, wk, wg = points.gauss_kronrod(n)
+    for d in range(3 * n + 2):
+        assert abs(wk @ x**d - 1 / (d + 1)) < RULE_TOLERANCE, d
+    for d in range(2 * n):
+        assert abs(wg @ x**d - 1 / (d + 1)) < RULE_TOLERANCE, d
+    xg, w = points.gauss_legendre(n)
+    np.testing.assert_allclose(x[wg > 0], xg, atol=1e-15)
+    np.testing.assert_allclose(wg[wg > 0], w, rtol=1e-13)

@@ -39,6 +39,7 @@ import numpy as np
 from ..axes import Axis
 from ..catalog import DIELECTRIC_MASKINGS, HEMISPHERE_ESTIMATORS, MASKINGS, NDF_DESCRIPTIONS, SMITH_NDFS, VNDF_NDFS
 from ..edge import alpha_policy
+from ..sampling import points
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan, probe_indices
 from ..tolerance import tolerance_of
 from . import dfg, dielectric_ratio
@@ -53,11 +54,11 @@ OPENPBR_MS_ALPHA_MIN = 0.0016  # below it OpenPBR's multiple-scattering lobe is 
 # both kinds reach the tolerance that format / dtype set (lutbake.tolerance; kind dielectric_avg through its mu rule):
 # no layout keys
 AVG_LAYOUT_KEYS = ()
-# kind dielectric_avg: while a texel's mu estimate (its panels' differences between mu_order and 2/3 as many nodes)
-# exceeds a quarter of its target, its worst panel is bisected, up to MU_MAX_PANELS panels. Inside the glass at small
-# roughness E(mu) crosses the total-internal-reflection transition, ~alpha wide at cos theta_c, and E_T is not analytic
-# at further points inside the glass: the fixed 16 nodes per panel of before were off by up to 2.0e-4 on OpenPBR's
-# eta < 1 rows (alpha = 0.004)
+# kind dielectric_avg: while a texel's mu estimate (its panels' differences between the Kronrod and the Gauss rule of
+# the mu_order pair) exceeds a quarter of its target, its worst panel is bisected, up to MU_MAX_PANELS panels. Inside
+# the glass at small roughness E(mu) crosses the total-internal-reflection transition, ~alpha wide at cos theta_c, and
+# E_T is not analytic at further points inside the glass (mu = eta among them: mu_starts): the fixed 16 nodes per panel
+# of before were off by up to 2.0e-4 on OpenPBR's eta < 1 rows (alpha = 0.004)
 MU_MAX_PANELS = 40
 NO_TARGET = 1.0e300  # the tolerance of a kernel channel a layout drops (it never refines)
 
@@ -179,11 +180,11 @@ AVG_KEYS = {
     "mu_order": Key(
         "mu_order",
         "int",
-        12,
-        "Gauss-Legendre nodes in mu per panel (panels from 0.2 and cos theta_c, bisected to the tolerance against "
-        "2/3 as many)",
+        7,
+        "Gauss points n in mu per panel of the (n, 2n + 1) Gauss-Kronrod pair (panels from 0.2, eta and cos theta_c, "
+        "bisected to the tolerance)",
         minimum=2,
-        maximum=256,
+        maximum=64,
     ),
 }
 
@@ -426,8 +427,11 @@ def plan(spec) -> TexelPlan:
 
 def mu_starts(eta: float) -> np.ndarray:
     """The first mu panel ends of kind dielectric_avg: 0, 0.2, 1 and, for eta < 1, cos theta_c = sqrt(1 - eta^2)
-    (where E(mu) has its total-internal-reflection kink in the smooth limit)."""
-    cuts = [0.0, 0.2, 1.0] + ([float(np.sqrt(1.0 - eta * eta))] if eta < 1.0 else [])
+    (where E(mu) has its total-internal-reflection kink in the smooth limit) and mu = eta = sin theta_c, where
+    theta_v + theta_c = pi/2: the outer cut theta_h = theta_v + theta_c of the dielectric estimator (phi_c,
+    lutbake.sampling.dielectric) enters the hemisphere there and E(mu) is not analytic (rough texels bisected
+    around it: 11 % of turquin_dielectric_e_avg's mu nodes)."""
+    cuts = [0.0, 0.2, 1.0] + ([float(np.sqrt(1.0 - eta * eta)), float(eta)] if eta < 1.0 else [])
     return np.unique(np.clip(cuts, 0.0, 1.0))
 
 
@@ -466,40 +470,42 @@ def plan_avg(spec) -> TexelPlan:
     nd, mk = terms_of(o)
     integrand = dielectric_integrand(nd, mk, "exact_metal")
     estimator = estimator_for(o["estimator"], o["samples"], o["seed"])
-    order, coarse = o["mu_order"], max(2, (2 * o["mu_order"]) // 3)
+    order = o["mu_order"]
+    x_mu, w_kronrod, w_gauss = points.gauss_kronrod(order)
     tol = tolerance_of(o)
     starts = {e: mu_starts(e) for e in map(float, np.unique(eta))}
     grid = Grid(axes, {"alpha": alpha}, alpha=np.asarray(alpha, np.float64))
     n_channels = len(AVG_CHANNELS[layout])
 
-    def panel_sums(t, lo, hi, est, device):
-        """2 ∫ E mu dmu over the panels [lo, hi] of texels t by the order- and coarse-point rules: (fine, coarse),
-        (len(t), 3) each, one launch."""
-        out = []
-        for n in (order, coarse):
-            x, w = np.polynomial.legendre.leggauss(n)
-            mu = (lo[:, None] + (hi - lo)[:, None] * (x + 1) / 2).ravel()
-            wt = ((hi - lo)[:, None] * w / 2).ravel()
-            inputs = {
-                "nov": mu.astype(np.float32),
-                "alpha": integrand.alpha_input(np.repeat(alpha[t], n)),
-                "param": np.repeat(eta[t], n).astype(np.float32),
-            }
-            res = est.evaluate(integrand, inputs, device) * (2.0 * wt * mu)[:, None]
-            out.append(res.reshape(len(t), n, -1).sum(axis=1))
-        return out
+    def e_at(t, mu, est, device):
+        """E(mu) (len(mu), 3) of texels t (one per mu), one launch."""
+        inputs = {
+            "nov": mu.astype(np.float32),
+            "alpha": integrand.alpha_input(alpha[t]),
+            "param": eta[t].astype(np.float32),
+        }
+        return est.evaluate(integrand, inputs, device)
 
-    def averages(t, est, device):
+    def panel_sums(t, lo, hi, device):
+        """2 ∫ E mu dmu over the panels [lo, hi] of texels t by the Kronrod and the Gauss rule of the pair (the
+        Gauss nodes are Kronrod nodes: 2 order + 1 evaluations a panel): (kronrod, gauss), (len(t), 3) each."""
+        mu = lo[:, None] + (hi - lo)[:, None] * x_mu
+        e = e_at(np.repeat(t, len(x_mu)), mu.ravel(), estimator, device).reshape(len(t), len(x_mu), -1)
+        e *= (2.0 * (hi - lo)[:, None] * mu)[:, :, None]
+        return np.einsum("tkc,k->tc", e, w_kronrod), np.einsum("tkc,k->tc", e, w_gauss)
+
+    def averages(t, device):
         """(values, mu-rule estimates), (len(t), 3) float64 each: 2 ∫ E mu dmu of (E_R, E_T, E(F = 1)) at texels t.
-        Every panel (from mu_starts) takes the order- and the coarse-point rule, d = |Q_order - Q_coarse| its
-        estimate; while a texel's sum of d exceeds a quarter of its target (max(tolerance, relative_tolerance |v|) at
-        the first pass's v, the worst channel: a layout's sum of two channels gets half), its panel with the largest
-        d is bisected (greedy, as lutbake.sampling.ladder), up to MU_MAX_PANELS panels. Each texel's own panels:
-        independent of which texels share the call."""
+        Every panel (from mu_starts) takes the Gauss-Kronrod pair, d = |Q_kronrod - Q_gauss| its estimate (the Gauss
+        rule's error: pessimistic for the Kronrod value, which has 3 order + 1 degrees against 2 order - 1); while a
+        texel's sum of d exceeds a quarter of its target (max(tolerance, relative_tolerance |v|) at the first pass's
+        v, the worst channel: a layout's sum of two channels gets half), its panel with the largest d is bisected
+        (greedy, as lutbake.sampling.ladder), up to MU_MAX_PANELS panels. Each texel's own panels: independent of
+        which texels share the call."""
         panels = [[(a, b) for a, b in zip(starts[float(eta[i])][:-1], starts[float(eta[i])][1:])] for i in t]
         owner = np.concatenate([[j] * len(p) for j, p in enumerate(panels)]).astype(int)
         lo, hi = (np.array([x[c] for p in panels for x in p]) for c in (0, 1))
-        q, d = panel_sums(t[owner], lo, hi, est, device)
+        q, d = panel_sums(t[owner], lo, hi, device)
         d = np.abs(q - d)
         fine = [list(q[owner == j]) for j in range(len(t))]
         diff = [list(d[owner == j]) for j in range(len(t))]
@@ -520,7 +526,7 @@ def plan_avg(spec) -> TexelPlan:
             )
             m_ = 0.5 * (a_ + b_)
             q, c = panel_sums(
-                np.concatenate([t[pick], t[pick]]), np.concatenate([a_, m_]), np.concatenate([m_, b_]), est, device
+                np.concatenate([t[pick], t[pick]]), np.concatenate([a_, m_]), np.concatenate([m_, b_]), device
             )
             c = np.abs(q - c)
             n = len(pick)
@@ -533,51 +539,72 @@ def plan_avg(spec) -> TexelPlan:
     memo: dict[int, tuple[np.ndarray, np.ndarray]] = {}
     memo_lock = threading.Lock()
 
-    def averages_once(t, est, device):
-        """averages(t), each texel computed once per plan for the plan's own estimator: OpenPBR's tiles also need
-        their mirror rows, another tile's texels (a texel's values do not depend on who computes them)."""
-        if est is not estimator:
-            return averages(t, est, device)
+    def averages_once(t, device):
+        """averages(t), each texel computed once per plan: OpenPBR's tiles also need their mirror rows, another
+        tile's texels (a texel's values do not depend on who computes them)."""
         with memo_lock:
             missing = np.array([k for k in t if int(k) not in memo], dtype=int)
         if len(missing):
-            v, e = averages(missing, est, device)
+            v, e = averages(missing, device)
             with memo_lock:
                 memo.update({int(k): (v[i], e[i]) for i, k in enumerate(missing)})
         with memo_lock:
             got = [memo[int(k)] for k in t]
         return np.array([g[0] for g in got]), np.array([g[1] for g in got])
 
-    def run(idx, est, device):
+    def run(idx, device):
         """The channels of texels idx, then their mu-rule estimates (aux columns; OpenPBR's ratio: the bound of
         ratio_error)."""
         t = np.arange(len(alpha))[idx]
         if layout == "openpbr":
             # the reflection ratio at (eta, alpha) needs E_c,avg at (1/eta, alpha) too: row z mirrors row N - 1 - z
             mirror = (OPENPBR_SIZE - 1 - t // OPENPBR_SIZE) * OPENPBR_SIZE + t % OPENPBR_SIZE
-            avg, err = averages_once(t, est, device)  # its own texels first: another tile may need them
-            avg_m, err_m = averages_once(mirror, est, device)
+            avg, err = averages_once(t, device)  # its own texels first: another tile may need them
+            avg_m, err_m = averages_once(mirror, device)
             ch, ch_m = post_process("openpbr", avg), post_process("openpbr", avg_m)
-            ce, ce_m = error_post_process("openpbr", err), error_post_process("openpbr", err_m)
+            ce, ce_m = energy_errors(err), energy_errors(err_m)
             ratio = dielectric_ratio.reflection_ratio(ch[:, 0], ch_m[:, 0], eta[t])
             r_err = ratio_error(ch[:, 0], ch_m[:, 0], ce[:, 0], ce_m[:, 0], eta[t])
             return np.concatenate([ch, ratio[:, None], ce, r_err[:, None]], axis=1)
-        avg, err = averages(t, est, device)
+        avg, err = averages(t, device)
         energy = np.stack([avg[:, 0], avg[:, 1], avg[:, 0] + avg[:, 1]], axis=1)
-        return np.concatenate([energy, np.stack([err[:, 0], err[:, 1], err[:, 0] + err[:, 1]], axis=1)], axis=1)
+        return np.concatenate([energy, energy_errors(err)], axis=1)
+
+    def energy_errors(err):
+        """Bounds on the layout's energy channels from those on (E_R, E_T, E(F = 1)) (the triangle inequality)."""
+        if layout == "openpbr":
+            return error_post_process("openpbr", err)
+        return np.stack([err[:, 0], err[:, 1], err[:, 0] + err[:, 1]], axis=1)
+
+    def inner_error(idx, device) -> tuple[float, str]:
+        """The inner rule's share: at the probe texels idx, 2 Σ W mu |E - E_refined| over the Kronrod nodes of the
+        texel's first panels (mu_starts). It bounds |2 ∫ mu (E - E_refined) dmu| whatever nodes the mu rule ends on
+        (2 ∫ mu dmu = 1: an error of E at every mu moves the average by at most its mu-weighted mean), so the
+        probe needs neither the bisection nor the refined rule's own panels."""
+        refined, how = estimator.refined()
+        lo = np.concatenate([starts[float(eta[i])][:-1] for i in idx])
+        hi = np.concatenate([starts[float(eta[i])][1:] for i in idx])
+        owner = np.concatenate([[i] * (len(starts[float(eta[i])]) - 1) for i in idx]).astype(int)
+        mu = (lo[:, None] + (hi - lo)[:, None] * x_mu).ravel()
+        tt = np.repeat(owner, len(x_mu))
+        d = np.abs(e_at(tt, mu, estimator, device) - e_at(tt, mu, refined, device))
+        d *= (2.0 * np.repeat(hi - lo, len(x_mu)) * mu * np.tile(w_kronrod, len(lo)))[:, None]
+        per_texel = np.zeros((len(alpha), 3))
+        np.add.at(per_texel, tt, d)
+        return float(np.max(energy_errors(per_texel[idx]))), how
 
     def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
-        """The inner rule refined at the probe texels (estimator.refined) plus the largest per-texel mu-rule estimate
-        (the aux columns); OpenPBR's ratio (channel A) is reported apart (0/0-like where E_c,avg -> 0)."""
+        """The inner rule's share at the probe texels (inner_error) plus the largest per-texel mu-rule estimate (the
+        aux columns); OpenPBR's ratio (channel A) is reported apart (0/0-like where E_c,avg -> 0)."""
         full = data.reshape(len(alpha), -1)
         energy = 3
         idx = probe_indices(grid)
-        refined, how = estimator.refined()
-        inner = float(np.max(np.abs(full[idx, :energy] - run(idx, refined, device)[:, :energy])))
+        inner, how = inner_error(idx, device)
         mu = float(np.max(full[:, n_channels : n_channels + energy]))
         text = (
-            f"|{how}| over {len(idx)} strided probe texels ({inner:.3g}) + the largest per-texel mu-rule estimate, "
-            f"sum over bisected panels of |Q({order}) - Q({coarse})| ({mu:.3g})"
+            f"2 sum W mu |{how}| at the Kronrod nodes of the first mu panels of {len(idx)} strided probe texels "
+            f"({inner:.3g}) + the largest per-texel mu-rule estimate, sum over bisected panels of "
+            f"|Q(Kronrod {2 * order + 1}) - Q(Gauss {order})| ({mu:.3g})"
         )
         if layout == "openpbr":
             used = alpha >= OPENPBR_MS_ALPHA_MIN
@@ -587,14 +614,14 @@ def plan_avg(spec) -> TexelPlan:
             )
         return inner + mu, text
 
-    per = int(estimator.samples({"nov": [0.0]})[0]) * 4 * (order + coarse)  # nominal: 4 panels
+    per = int(estimator.samples({"nov": [0.0]})[0]) * 5 * (2 * order + 1)  # nominal: 5 panels
     return TexelPlan(
         axes=axes,
         channels=AVG_CHANNELS[layout],
         reconstruction=AVG_RECONSTRUCTION[layout],
         n_texels=len(alpha),
         n_channels=n_channels,
-        run_tile=lambda s, e, d: run(slice(s, e), estimator, d),
+        run_tile=lambda s, e, d: run(slice(s, e), d),
         prepare=lambda d: estimator.prepare(integrand, d),
         samples=per,
         aux_channels=n_channels,
@@ -602,8 +629,9 @@ def plan_avg(spec) -> TexelPlan:
         terms=terms_record((nd, mk, "exact_metal"), layout),
         cost=float(len(alpha)) * per,
         extra={
-            "mu_quadrature": f"Gauss-Legendre {order} and {coarse} nodes per panel from mu = 0, 0.2, cos theta_c, 1, "
-            f"the worst panel bisected until the sum of differences is within tol / 4 (at most {MU_MAX_PANELS} panels)",
+            "mu_quadrature": f"Gauss-Kronrod ({order}, {2 * order + 1}) per panel from mu = 0, 0.2, 1 and, for "
+            f"eta < 1, eta and cos theta_c; the worst panel bisected until the sum of |Kronrod - Gauss| is within "
+            f"tol / 4 (at most {MU_MAX_PANELS} panels)",
             "tolerance": tol.text(),
             "alpha_policy": alpha_policy(True),
             **({"reflection_ratio": dielectric_ratio.METADATA} if layout == "openpbr" else {}),

@@ -15,6 +15,30 @@ def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
     return 0.5 * (x + 1.0), 0.5 * w
 
 
+@functools.lru_cache(maxsize=16)
+def gauss_kronrod(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The (n, 2n + 1) Gauss-Kronrod pair mapped to [0, 1]: the 2n + 1 nodes x_i (ascending), the Kronrod weights
+    (exact to degree 3n + 1) and the n-point Gauss-Legendre weights at its own nodes (0 at the n + 1 Kronrod
+    nodes): Kronrod, "Nodes and weights of quadrature formulas" (1965). The added nodes are the roots of the
+    Stieltjes polynomial E_(n+1), orthogonal to every polynomial of degree <= n under the weight P_n (its Legendre
+    coefficients from those n + 1 conditions, integrated exactly by leggauss(2n + 4)); the weights solve the
+    moment equations in the Legendre basis. n = 7 and 10 reproduce QUADPACK's dqk15 and dqk21 (Piessens et al.
+    1983) to rounding (tests/test_points.py)."""
+    leg = np.polynomial.legendre
+    xg, wg = leg.leggauss(n)
+    xq, wq = leg.leggauss(2 * n + 4)
+    v = leg.legvander(xq, n + 1)
+    a = (v[:, : n + 1] * (wq * leg.legval(xq, [0.0] * n + [1.0]))[:, None]).T @ v  # a[j, k] = ∫ P_j P_n P_k
+    e = np.append(np.linalg.solve(a[:, : n + 1], -a[:, n + 1]), 1.0)
+    x = np.sort(np.concatenate([xg, leg.legroots(e).real]))
+    moments = np.zeros(2 * n + 1)
+    moments[0] = 2.0
+    wk = np.linalg.solve(leg.legvander(x, 2 * n).T, moments)
+    g = np.zeros(2 * n + 1)
+    g[np.searchsorted(x, xg - 1e-12)] = wg
+    return 0.5 * (x + 1.0), 0.5 * wk, 0.5 * g
+
+
 @functools.lru_cache(maxsize=64)
 def sobol(n: int, seed: int) -> np.ndarray:
     """n points of the 2D Sobol' sequence with Owen scrambling (scipy.stats.qmc), seeded:
