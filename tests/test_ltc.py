@@ -342,7 +342,9 @@ def test_hdrp_shares_the_ggx_texels_it_would_fit_alike_and_gets_the_same_bits():
 def test_fit_memo_waits_for_another_thread_and_refits_what_a_failed_one_released():
     import threading
 
-    memo = fit.FitMemo()
+    from lutbake.memo import RowMemo
+
+    memo = RowMemo()
     started, go, calls = threading.Event(), threading.Event(), []
 
     def slow(i):

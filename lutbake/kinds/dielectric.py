@@ -31,7 +31,6 @@ Layouts (key ``layout``) fix the channels, and for the engine layouts the whole 
 
 from __future__ import annotations
 
-import threading
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -39,6 +38,7 @@ import numpy as np
 from ..axes import Axis
 from ..catalog import DIELECTRIC_MASKINGS, HEMISPHERE_ESTIMATORS, MASKINGS, NDF_DESCRIPTIONS, SMITH_NDFS, VNDF_NDFS
 from ..edge import alpha_policy
+from ..memo import RowMemo
 from ..sampling import points
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan, probe_indices
 from ..tolerance import tolerance_of
@@ -536,21 +536,13 @@ def plan_avg(spec) -> TexelPlan:
                 diff[j][w : w + 1] = [c[i], c[n + i]]
         return np.array([np.sum(f, axis=0) for f in fine]), np.array([np.sum(e, axis=0) for e in diff])
 
-    memo: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-    memo_lock = threading.Lock()
+    memo = RowMemo(capacity=len(alpha))
 
     def averages_once(t, device):
-        """averages(t), each texel computed once per plan: OpenPBR's tiles also need their mirror rows, another
-        tile's texels (a texel's values do not depend on who computes them)."""
-        with memo_lock:
-            missing = np.array([k for k in t if int(k) not in memo], dtype=int)
-        if len(missing):
-            v, e = averages(missing, device)
-            with memo_lock:
-                memo.update({int(k): (v[i], e[i]) for i, k in enumerate(missing)})
-        with memo_lock:
-            got = [memo[int(k)] for k in t]
-        return np.array([g[0] for g in got]), np.array([g[1] for g in got])
+        """averages(t), each texel computed once per plan, by one thread (a texel another thread is computing is
+        waited for): OpenPBR's tiles also need their mirror rows, another tile's texels (a texel's values do not
+        depend on who computes them)."""
+        return memo.run([int(k).to_bytes(8, "little") for k in t], lambda i: averages(t[i], device))
 
     def run(idx, device):
         """The channels of texels idx, then their mu-rule estimates (aux columns; OpenPBR's ratio: the bound of

@@ -31,13 +31,12 @@ for any tiling or worker count (ltc_code instead chains each texel off the previ
 from __future__ import annotations
 
 import functools
-import threading
-from collections import OrderedDict
 
 import numpy as np
 import warp as wp
 
 from ..catalog import LTC_FIT_GRID
+from ..memo import RowMemo
 from .lobes import lobe
 
 NELDER_MEAD_TOL = 1.0e-5  # ltc_code fit(): NelderMead(..., epsilon, 1e-5, 100, ...)
@@ -418,75 +417,12 @@ def refine(
     return q, f
 
 
-class FitMemo:
-    """Per-texel fits shared between the bakes of one process (lutbake.kinds.ltc): a texel's fit is a pure function
-    of its own inputs (lobe, metric grid, device, n.v, alpha, magnitude) and its candidate starts, so two tables
-    that fit a texel with equal inputs and candidates get the same bits; the memo fits it once. The ltc-hdrp preset
-    (alpha_min 1e-3) differs from ltc-ggx only in the columns whose clamped alpha or coarse seeds differ.
-    Thread-safe: a texel another thread is fitting is waited for, not refitted. Least recently stored entries are
-    dropped beyond ``capacity``."""
-
-    def __init__(self, capacity: int = 1 << 16):
-        self.capacity = capacity
-        self._lock = threading.Lock()
-        self._done: OrderedDict[bytes, tuple[np.ndarray, float]] = OrderedDict()
-        self._pending: dict[bytes, threading.Event] = {}
-        self.hits = 0
-        self.misses = 0
-
-    def clear(self) -> None:
-        with self._lock:
-            self._done.clear()
-            self.hits = self.misses = 0
-
-    def run(self, keys: list[bytes], compute) -> tuple[np.ndarray, np.ndarray]:
-        """(q, f) per key: stored ones, ``compute(indices)`` -> (q, f) for those no thread has, waiting for those
-        another thread is computing (recomputed here if that thread failed)."""
-        n = len(keys)
-        q, f = [None] * n, np.empty(n)
-        todo = list(range(n))
-        while todo:
-            mine, theirs = [], []
-            with self._lock:
-                for i in todo:
-                    k = keys[i]
-                    if k in self._done:
-                        q[i], f[i] = self._done[k]
-                        self.hits += 1
-                    elif k in self._pending:
-                        theirs.append((i, self._pending[k]))
-                    else:
-                        self._pending[k] = threading.Event()
-                        mine.append(i)
-            if mine:
-                self._compute(keys, mine, compute, q, f)
-            for _, event in theirs:
-                event.wait()
-            todo = [i for i, _ in theirs]  # now stored (or released by a failed thread: claimed again)
-        return np.stack(q), f
-
-    def _compute(self, keys, mine, compute, q, f) -> None:
-        try:
-            qm, fm = compute(np.array(mine))
-        except BaseException:
-            self._release(keys, mine)
-            raise
-        with self._lock:
-            for j, i in enumerate(mine):
-                q[i], f[i] = qm[j], fm[j]
-                self._done[keys[i]] = (qm[j].copy(), float(fm[j]))
-            self.misses += len(mine)
-            while len(self._done) > self.capacity:
-                self._done.popitem(last=False)
-        self._release(keys, mine)
-
-    def _release(self, keys, mine) -> None:
-        with self._lock:
-            for i in mine:
-                self._pending.pop(keys[i]).set()
-
-
-MEMO = FitMemo()  # the ltc kind's (lutbake.kinds.ltc.LtcBake): shared by every table a process bakes
+# the ltc kind's per-texel fits (lutbake.kinds.ltc.LtcBake), shared by every table a process bakes: a texel's fit is a
+# pure function of its own inputs (lobe, metric grid, device, n.v, alpha, magnitude) and its candidate starts
+# (texel_keys), so two tables that fit a texel with equal inputs and candidates get the same bits; the memo fits it
+# once (the ltc-hdrp preset, alpha_min 1e-3, differs from ltc-ggx only in the columns whose clamped alpha or coarse
+# seeds differ). Rows (q, f) per texel.
+MEMO = RowMemo()
 
 
 def texel_keys(problem: Problem, texel: np.ndarray, points: np.ndarray, what: str) -> list[bytes]:
@@ -500,7 +436,7 @@ def texel_keys(problem: Problem, texel: np.ndarray, points: np.ndarray, what: st
 
 
 def fit_from(
-    problem: Problem, texel: np.ndarray, cands: np.ndarray, steps, memo: FitMemo | None = None
+    problem: Problem, texel: np.ndarray, cands: np.ndarray, steps, memo: RowMemo | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Nelder-Mead (``refine`` at ``steps``) from the best of the candidates (k, c, dof) per texel; (q, f).
     With ``memo``, a texel fitted before with equal inputs and candidates is taken from it, and one whose best
@@ -522,7 +458,7 @@ def coarse_nodes(n: int) -> np.ndarray:
 
 
 def coarse_pass(
-    problem: Problem, ny: int, nx: int, memo: FitMemo | None = None
+    problem: Problem, ny: int, nx: int, memo: RowMemo | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Fit the coarse-grid texels (rows ``iy``, columns ``ix``) from analytic guesses alone.
     Returns (iy nodes, ix nodes, q of shape (len(iy), len(ix), dof))."""
@@ -548,7 +484,7 @@ def seed_candidates(problem: Problem, texel: np.ndarray, nx: int, coarse) -> np.
 
 
 def fit_texels(
-    problem: Problem, texel: np.ndarray, nx: int, coarse, memo: FitMemo | None = None
+    problem: Problem, texel: np.ndarray, nx: int, coarse, memo: RowMemo | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Fitted M (k, 3, 3) and Heitz's error E (k,) at ``texel``, started from the best of its seed candidates."""
     q, f = fit_from(problem, texel, seed_candidates(problem, texel, nx, coarse), FINE_STEPS, memo)
