@@ -486,6 +486,12 @@ def plan_avg(spec) -> TexelPlan:
         }
         return est.evaluate(integrand, inputs, device)
 
+    def first_panels(t):
+        """(owner, lo, hi): the mu_starts panels of texels t, owner = the texel's position in t."""
+        ends = [starts[float(eta[i])] for i in t]
+        owner = np.concatenate([[j] * (len(e) - 1) for j, e in enumerate(ends)]).astype(int)
+        return owner, np.concatenate([e[:-1] for e in ends]), np.concatenate([e[1:] for e in ends])
+
     def panel_sums(t, lo, hi, device):
         """2 ∫ E mu dmu over the panels [lo, hi] of texels t by the Kronrod and the Gauss rule of the pair (the
         Gauss nodes are Kronrod nodes: 2 order + 1 evaluations a panel): (kronrod, gauss), (len(t), 3) each."""
@@ -502,9 +508,8 @@ def plan_avg(spec) -> TexelPlan:
         v, the worst channel: a layout's sum of two channels gets half), its panel with the largest d is bisected
         (greedy, as lutbake.sampling.ladder), up to MU_MAX_PANELS panels. Each texel's own panels: independent of
         which texels share the call."""
-        panels = [[(a, b) for a, b in zip(starts[float(eta[i])][:-1], starts[float(eta[i])][1:])] for i in t]
-        owner = np.concatenate([[j] * len(p) for j, p in enumerate(panels)]).astype(int)
-        lo, hi = (np.array([x[c] for p in panels for x in p]) for c in (0, 1))
+        owner, lo, hi = first_panels(t)
+        panels = [list(zip(lo[owner == j], hi[owner == j])) for j in range(len(t))]
         q, d = panel_sums(t[owner], lo, hi, device)
         d = np.abs(q - d)
         fine = [list(q[owner == j]) for j in range(len(t))]
@@ -574,16 +579,14 @@ def plan_avg(spec) -> TexelPlan:
         (2 ∫ mu dmu = 1: an error of E at every mu moves the average by at most its mu-weighted mean), so the
         probe needs neither the bisection nor the refined rule's own panels."""
         refined, how = estimator.refined()
-        lo = np.concatenate([starts[float(eta[i])][:-1] for i in idx])
-        hi = np.concatenate([starts[float(eta[i])][1:] for i in idx])
-        owner = np.concatenate([[i] * (len(starts[float(eta[i])]) - 1) for i in idx]).astype(int)
+        owner, lo, hi = first_panels(idx)
         mu = (lo[:, None] + (hi - lo)[:, None] * x_mu).ravel()
-        tt = np.repeat(owner, len(x_mu))
+        tt = np.repeat(idx[owner], len(x_mu))
         d = np.abs(e_at(tt, mu, estimator, device) - e_at(tt, mu, refined, device))
         d *= (2.0 * np.repeat(hi - lo, len(x_mu)) * mu * np.tile(w_kronrod, len(lo)))[:, None]
-        per_texel = np.zeros((len(alpha), 3))
-        np.add.at(per_texel, tt, d)
-        return float(np.max(energy_errors(per_texel[idx]))), how
+        per_texel = np.zeros((len(idx), 3))
+        np.add.at(per_texel, np.repeat(owner, len(x_mu)), d)
+        return float(np.max(energy_errors(per_texel))), how
 
     def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
         """The inner rule's share at the probe texels (inner_error) plus the largest per-texel mu-rule estimate (the
