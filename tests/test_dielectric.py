@@ -532,3 +532,7 @@ def test_avg_mu_rule_reaches_the_tolerance():
         assert np.all(err <= float(table.attributes["error_estimate"])), (k, alpha[k], eta[k], err)
     # float32's tolerance 1e-6: a quarter per channel for the mu rule, half for B = E_R + E_T
     assert mu_err[:, :2].max() <= 0.25e-6 and mu_err[:, 2].max() <= 0.5e-6
+    # the inner probe reuses the first pass's E where this process computed it, else computes it: the same bits
+    fresh = lookup_kind("dielectric_avg").plan(spec(**small, samples=432))
+    assert fresh.error_estimate(full.ravel(), "cpu") == plan.error_estimate(full.ravel(), "cpu")
+    assert float(table.attributes["error_estimate"]) == float(f"{plan.error_estimate(full.ravel(), 'cpu')[0]:.3e}")

@@ -494,11 +494,17 @@ def plan_avg(spec) -> TexelPlan:
 
     def panel_sums(t, lo, hi, device):
         """2 ∫ E mu dmu over the panels [lo, hi] of texels t by the Kronrod and the Gauss rule of the pair (the
-        Gauss nodes are Kronrod nodes: 2 order + 1 evaluations a panel): (kronrod, gauss), (len(t), 3) each."""
+        Gauss nodes are Kronrod nodes: 2 order + 1 evaluations a panel): (kronrod, gauss), (len(t), 3) each, and
+        E at the nodes (len(t), 2 order + 1, 3)."""
         mu = lo[:, None] + (hi - lo)[:, None] * x_mu
-        e = e_at(np.repeat(t, len(x_mu)), mu.ravel(), estimator, device).reshape(len(t), len(x_mu), -1)
-        e *= (2.0 * (hi - lo)[:, None] * mu)[:, :, None]
-        return np.einsum("tkc,k->tc", e, w_kronrod), np.einsum("tkc,k->tc", e, w_gauss)
+        raw = e_at(np.repeat(t, len(x_mu)), mu.ravel(), estimator, device).reshape(len(t), len(x_mu), -1)
+        e = raw * (2.0 * (hi - lo)[:, None] * mu)[:, :, None]
+        return np.einsum("tkc,k->tc", e, w_kronrod), np.einsum("tkc,k->tc", e, w_gauss), raw
+
+    # E at each texel's first-panel nodes, kept from the first pass for the inner probe (which needs them at the probe
+    # texels); a texel is computed once per plan (one thread writes its entry), and where the tiles ran elsewhere (a
+    # cluster) the probe computes them again: the same inputs, the same bits
+    first_e: dict[int, np.ndarray] = {}
 
     def averages(t, device):
         """(values, mu-rule estimates), (len(t), 3) float64 each: 2 ∫ E mu dmu of (E_R, E_T, E(F = 1)) at texels t.
@@ -510,7 +516,8 @@ def plan_avg(spec) -> TexelPlan:
         which texels share the call."""
         owner, lo, hi = first_panels(t)
         panels = [list(zip(lo[owner == j], hi[owner == j])) for j in range(len(t))]
-        q, d = panel_sums(t[owner], lo, hi, device)
+        q, d, raw = panel_sums(t[owner], lo, hi, device)
+        first_e.update({int(k): raw[owner == j] for j, k in enumerate(t)})
         d = np.abs(q - d)
         fine = [list(q[owner == j]) for j in range(len(t))]
         diff = [list(d[owner == j]) for j in range(len(t))]
@@ -530,7 +537,7 @@ def plan_avg(spec) -> TexelPlan:
                 np.array([panels[j][w][1] for j, w in zip(pick, worst)]),
             )
             m_ = 0.5 * (a_ + b_)
-            q, c = panel_sums(
+            q, c, _ = panel_sums(
                 np.concatenate([t[pick], t[pick]]), np.concatenate([a_, m_]), np.concatenate([m_, b_]), device
             )
             c = np.abs(q - c)
@@ -582,7 +589,11 @@ def plan_avg(spec) -> TexelPlan:
         owner, lo, hi = first_panels(idx)
         mu = (lo[:, None] + (hi - lo)[:, None] * x_mu).ravel()
         tt = np.repeat(idx[owner], len(x_mu))
-        d = np.abs(e_at(tt, mu, estimator, device) - e_at(tt, mu, refined, device))
+        if all(int(i) in first_e for i in idx):
+            e = np.concatenate([first_e[int(i)] for i in idx]).reshape(len(tt), -1)
+        else:
+            e = e_at(tt, mu, estimator, device)
+        d = np.abs(e - e_at(tt, mu, refined, device))
         d *= (2.0 * np.repeat(hi - lo, len(x_mu)) * mu * np.tile(w_kronrod, len(lo)))[:, None]
         per_texel = np.zeros((len(idx), 3))
         np.add.at(per_texel, np.repeat(owner, len(x_mu)), d)
