@@ -9,6 +9,9 @@
    computations (start-up, configs, hashing, writing, sidecars: the process total minus the tables' sum).
 3. The same ``make luts`` again, every table up to date: the cost of a no-op run (start-up, planning, hashing
    and the integrity check of every output).
+4. ``make luts`` of the batch it baked when issue 13 was filed (``configs/`` and FILING_PRESETS: 25 tables, ~190 s
+   then), into another empty folder: the same target on the batch it was set for, while later issues' presets grew
+   ``make luts`` to 40 tables.
 
 Writes outputs/bench/luts.json and prints a summary.
 """
@@ -29,6 +32,9 @@ ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "outputs" / "bench"
 TARGET_WALL = 30.0  # seconds, issue 13: make luts from a clean checkout, the bake part
 TOP = 10
+# make luts's presets when issue 13 was filed (Makefile PRESETS of 2026-11-22); the LTC, glass and later engine presets
+# came with issues 14-16
+FILING_PRESETS = "filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-eevee unreal"
 
 
 def children_cpu() -> float:
@@ -36,10 +42,11 @@ def children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def make_luts(out: Path) -> dict:
-    """One ``make luts OUT=out``: wall, CPU (user + sys of the children), load average before and after."""
+def make_luts(out: Path, *variables: str) -> dict:
+    """One ``make luts OUT=out`` (and make ``variables``): wall, CPU (user + sys of the children), load average
+    before and after."""
     load0, cpu0, t0 = os.getloadavg(), children_cpu(), time.perf_counter()
-    r = subprocess.run(["make", "-s", "luts", f"OUT={out}"], cwd=ROOT, capture_output=True, text=True)
+    r = subprocess.run(["make", "-s", "luts", f"OUT={out}", *variables], cwd=ROOT, capture_output=True, text=True)
     wall, cpu, load1 = time.perf_counter() - t0, children_cpu() - cpu0, os.getloadavg()
     if r.returncode != 0:
         raise SystemExit(f"make luts failed ({r.returncode}):\n{r.stdout}\n{r.stderr}")
@@ -56,6 +63,9 @@ def main() -> None:
         report = json.loads((out / "report.json").read_text())
         cache_bytes = sum(p.stat().st_size for p in (out / ".cache").iterdir())
         rerun = make_luts(out)
+        filing_out = Path(tmp) / "filing"
+        filing = make_luts(filing_out, f"PRESETS={FILING_PRESETS}")
+        filing_tables = len(json.loads((filing_out / "report.json").read_text())["tables"])
     tables = report["tables"]
     assert all(t["status"] == "baked" for t in tables), [t["name"] for t in tables if t["status"] != "baked"]
     table_cpu = sum(t["cpu_seconds"] for t in tables)
@@ -66,6 +76,11 @@ def main() -> None:
         "target_wall_s": TARGET_WALL,
         "clean": {k: v for k, v in clean.items() if k != "stdout"},
         "up_to_date_rerun": {k: v for k, v in rerun.items() if k != "stdout"},
+        "filing_batch": {
+            "presets": FILING_PRESETS,
+            "tables": filing_tables,
+            **{k: v for k, v in filing.items() if k != "stdout"},
+        },
         "tables": len(tables),
         "computations": len(tables) - len(shared),
         "shared": shared,
@@ -93,6 +108,11 @@ def main() -> None:
     print(
         f"  up-to-date rerun: {rerun['wall_s']:.2f} s wall, {rerun['cpu_s']:.2f} s CPU; "
         f"values cache {cache_bytes / 2**20:.1f} MiB"
+    )
+    print(
+        f"  the batch of issue 13's filing (configs/ + {FILING_PRESETS}: {filing_tables} tables): "
+        f"{filing['wall_s']:.1f} s wall, {filing['cpu_s']:.1f} s CPU; target <= {TARGET_WALL:.0f} s wall: "
+        + ("meets" if filing["wall_s"] <= TARGET_WALL else "misses")
     )
     print(f"  top {TOP} tables by CPU:")
     for t in top:
