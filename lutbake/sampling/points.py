@@ -22,8 +22,8 @@ def gauss_kronrod(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     nodes): Kronrod, "Nodes and weights of quadrature formulas" (1965). The added nodes are the roots of the
     Stieltjes polynomial E_(n+1), orthogonal to every polynomial of degree <= n under the weight P_n (its Legendre
     coefficients from those n + 1 conditions, integrated exactly by leggauss(2n + 4)); the weights solve the
-    moment equations in the Legendre basis. n = 7 and 10 reproduce QUADPACK's dqk15 and dqk21 (Piessens et al.
-    1983) to rounding (tests/test_points.py)."""
+    moment equations in the Legendre basis. n = 7 reproduces QUADPACK's dqk15 (Piessens et al. 1983) to rounding
+    (tests/test_gauss_legendre_rules.py)."""
     leg = np.polynomial.legendre
     xg, wg = leg.leggauss(n)
     xq, wq = leg.leggauss(2 * n + 4)
