@@ -48,3 +48,35 @@ def test_white_furnace_of_the_compensated_brdf(tables):
     assert np.max(worst) < FURNACE_TOL_SMOOTHEST
     uncompensated = 1.0 - e.data[..., 0]
     assert np.max(uncompensated) > 0.3  # without f_ms the rough rows lose a lot
+
+
+@pytest.mark.parametrize("ndf", ["ggx", "beckmann"])
+def test_albedo_avg_estimate_bounds_its_error(spec, graded_rule, ndf):
+    """Each E_avg texel's recorded estimate (the mu rule's |Kronrod - Gauss| plus its inner bounds) bounds its error
+    against a second mu rule: E(mu) at the nodes of a composite Gauss-Legendre rule graded toward mu = 0 and 1 (432
+    nodes), the inner integral converged (tolerance 1e-9: its float32 floor, ~1e-7)."""
+    from lutbake.kinds import lookup_kind
+    from lutbake.kinds.albedo import integrand_of
+    from lutbake.sampling.hemisphere import AdaptiveGaussLegendre
+
+    s = spec(kind="albedo_avg", roughness_size=8, ndf=ndf)
+    plan = lookup_kind("albedo_avg").plan(s)
+    plan.prepare("cpu")
+    out = plan.run_tile(0, plan.n_texels, "cpu")
+    got, estimate = out[:, 0], out[:, 1]
+    mu, w = graded_rule(0.0, 1.0, [0.0, 1.0])
+    alpha = plan.axes[0].alpha()
+    integrand = integrand_of(s.options)
+    inputs = {
+        "nov": np.tile(mu, len(alpha)).astype(np.float32),
+        "alpha": integrand.alpha_input(np.repeat(alpha, len(mu))),
+        "param": np.zeros(len(mu) * len(alpha), np.float32),
+    }
+    e = AdaptiveGaussLegendre(1e-9, 0.0).evaluate(integrand, inputs, "cpu")[:, 0].reshape(len(alpha), len(mu))
+    ref = 2.0 * e @ (w * mu)
+    err = np.abs(got - ref)
+    print(
+        f"\n{ndf} E_avg: max error {err.max():.2e}, max estimate {estimate.max():.2e}, worst error / estimate "
+        f"{np.max(err / estimate):.3f}"
+    )
+    assert np.all(err <= estimate) and estimate.max() <= 1e-6

@@ -9,8 +9,8 @@ integrates with the cosine to exactly 1 - E(n.v), so E + E_ms = 1 for every view
 tests/test_albedo.py). With Fresnel, f_ms is scaled by
     F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)),  F_avg = 2 ∫ F(mu) mu dmu  (lutbake.integrands.fresnel.f_avg).
 E is the `dfg` integral with channels (1, 0) (lutbake.integrands.specular.channels_albedo); E_avg evaluates the
-same integrand at Gauss-Legendre nodes in mu (two panels, mu_order nodes each: the grid's ``nodes``) and sums
-2 w E mu per roughness.
+same integrand at the Gauss-Kronrod nodes of adaptive mu panels (lutbake.sampling.mu_average) and sums 2 W E mu per
+roughness, to the tolerance, with an estimate per texel.
 """
 
 from __future__ import annotations
@@ -18,8 +18,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import Axis
-from ..sampling.plan import Grid, TexelPlan, per_texel_plan
-from ..tolerance import tolerance_of
+from ..sampling.mu_average import mu_averages
+from ..sampling.plan import TexelPlan, per_texel_plan
+from ..tolerance import Tolerance, tolerance_of
 from . import dfg
 from .base import Key, declare
 
@@ -32,15 +33,23 @@ ALBEDO_RECONSTRUCTION = (
     "or, for image-based lighting, specular *= 1 + f0 (1 / E_v - 1)"
 )
 
+# kind albedo_avg's mu rule (lutbake.sampling.mu_average): first panels (E(mu) varies fastest near grazing), the
+# shares of the tolerance of the mu rule and of the inner rule (they add up to the texel's estimate), the bisection cap
+MU_STARTS = np.array([0.0, 0.2, 1.0])
+MU_SHARE = 0.25
+INNER_SHARE = 1.0 - MU_SHARE
+MU_MAX_PANELS = 40
+
 AVG_KEYS = {
     "roughness_size": Key("roughness_size", "int", 128, "roughness texel count (the table is one row)", minimum=1),
     "mu_order": Key(
         "mu_order",
         "int",
-        24,
-        "Gauss-Legendre nodes in mu = n.v per panel (two panels, split at 0.2)",
+        7,
+        "Gauss points n of the Gauss-Kronrod pair (n, 2n + 1) per mu = n.v panel (from 0, 0.2, 1; bisected to the "
+        "tolerance)",
         minimum=2,
-        maximum=256,
+        maximum=64,
     ),
     **{k: dfg.KEYS[k] for k in ("roughness", "ndf", "masking", "model", "texel", "roughness_range")},
 }
@@ -78,31 +87,79 @@ def avg_roughness_axis(o: dict) -> Axis:
 
 
 def plan_albedo_avg(spec) -> TexelPlan:
-    """E_avg(r) = sum_k (2 w_k mu_k) E(mu_k, r): a texel is the weighted sum over the mu nodes (Grid.nodes)."""
-    from ..integrands.fresnel import mu_nodes
+    """E_avg(r) = 2 ∫ E(mu, r) mu dmu per roughness texel by lutbake.sampling.mu_average: Gauss-Kronrod panels from
+    mu = 0, 0.2, 1, bisected until the mu rule's estimate is within MU_SHARE of the tolerance; the inner integral E(mu)
+    by the kind's estimator, to INNER_SHARE of it where it adapts (the default), whose per-node bounds add up into
+    the texel's estimate (recorded as lutbake:error_estimate; a fixed-order or QMC inner estimator records none)."""
     from ..sampling.hemisphere import estimator_for
 
     o = spec.options
     rough = avg_roughness_axis(o)
     integrand = integrand_of(o)
-    mu, w = mu_nodes(o["mu_order"])
-    n = rough.count
-    alpha = np.repeat(rough.alpha(), len(mu))
-    grid = Grid(
-        [rough],
-        {"nov": np.tile(mu, n), "alpha": integrand.alpha_input(alpha), "param": np.zeros(n * len(mu), np.float32)},
-        nodes=w * mu,
-        scale=2.0,
-    )
-    return per_texel_plan(
-        integrand,
-        estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
-        grid,
+    tol = tolerance_of(o)
+    inner = Tolerance(INNER_SHARE * tol.absolute, INNER_SHARE * tol.relative)
+    estimator = estimator_for(o["estimator"], o["samples"], o["seed"], inner)
+    adaptive = hasattr(estimator, "evaluate_with_error")
+    alpha = rough.alpha()
+    order = o["mu_order"]
+    nch = integrand.nch
+
+    def e_at(t, mu, device):
+        """E (and its bounds, where the estimator adapts) at (alpha[t], mu), one launch."""
+        inputs = {
+            "nov": mu.astype(np.float32),
+            "alpha": integrand.alpha_input(alpha[t]),
+            "param": np.zeros(len(mu), np.float32),
+        }
+        if adaptive:
+            v, e = estimator.evaluate_with_error(integrand, inputs, device)
+            return v[:, :nch], e[:, :nch]
+        return estimator.evaluate(integrand, inputs, device)[:, :nch], None
+
+    def run(s, e, device):
+        """E_avg of texels [s, e), then each texel's estimate (mu rule + inner bounds: the aux column)."""
+        t = np.arange(s, e)
+        r = mu_averages(
+            lambda tt, mu: e_at(tt, mu, device),
+            t,
+            [MU_STARTS] * len(t),
+            order,
+            lambda total: MU_SHARE * np.maximum(tol.absolute, tol.relative * np.min(np.abs(total), axis=1)),
+            MU_MAX_PANELS,
+        )
+        return np.concatenate([r.values, r.mu_error + r.inner_error], axis=1)
+
+    def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
+        full = data.reshape(rough.count, -1)
+        values, err = full[:, :nch], full[:, nch:]
+        ratio = float(np.max(err / np.maximum(tol.absolute, tol.relative * np.abs(values))))
+        return float(np.max(err)), (
+            f"per texel: sum over mu panels of |Q(Kronrod {2 * order + 1}) - Q(Gauss {order})| + 2 sum W mu e(mu) over "
+            f"the Kronrod nodes, e the inner rule's own estimate at each node; max error / tolerance = {ratio:.3g}"
+        )
+
+    per = int(estimator.samples({"nov": [0.0]})[0]) * len(MU_STARTS) * (2 * order + 1)  # nominal: the first panels
+    return TexelPlan(
+        axes=[rough],
         channels=AVG_CHANNELS,
         reconstruction=AVG_RECONSTRUCTION,
+        n_texels=rough.count,
+        n_channels=nch,
+        run_tile=run,
+        prepare=lambda d: estimator.prepare(integrand, d),
+        samples=per,
+        estimator=estimator.name,
         terms=dfg.terms_record(o, "none (F = 1)"),
-        extra={"mu_nodes": str(len(mu)), **dfg.specular_extra(integrand)},
-        error_estimate=False,
+        cost=float(rough.count) * per,
+        extra={
+            "mu_quadrature": f"Gauss-Kronrod ({order}, {2 * order + 1}) per panel from mu = 0, 0.2, 1; the worst panel "
+            f"bisected until the sum of |Kronrod - Gauss| is within {MU_SHARE:g} x the tolerance (at most "
+            f"{MU_MAX_PANELS} panels); the inner rule to {INNER_SHARE:g} x the tolerance",
+            "tolerance": tol.text(),
+            **dfg.specular_extra(integrand),
+        },
+        error_estimate=error_estimate if adaptive else None,
+        aux_channels=nch,
     )
 
 

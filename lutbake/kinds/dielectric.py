@@ -40,6 +40,7 @@ from ..catalog import DIELECTRIC_MASKINGS, HEMISPHERE_ESTIMATORS, MASKINGS, NDF_
 from ..edge import alpha_policy
 from ..memo import RowMemo
 from ..sampling import points
+from ..sampling.mu_average import mu_averages
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan, probe_indices
 from ..tolerance import tolerance_of
 from . import dfg, dielectric_ratio
@@ -471,7 +472,7 @@ def plan_avg(spec) -> TexelPlan:
     integrand = dielectric_integrand(nd, mk, "exact_metal")
     estimator = estimator_for(o["estimator"], o["samples"], o["seed"])
     order = o["mu_order"]
-    x_mu, w_kronrod, w_gauss = points.gauss_kronrod(order)
+    x_mu, w_kronrod, _ = points.gauss_kronrod(order)
     tol = tolerance_of(o)
     starts = {e: mu_starts(e) for e in map(float, np.unique(eta))}
     grid = Grid(axes, {"alpha": alpha}, alpha=np.asarray(alpha, np.float64))
@@ -492,61 +493,26 @@ def plan_avg(spec) -> TexelPlan:
         owner = np.concatenate([[j] * (len(e) - 1) for j, e in enumerate(ends)]).astype(int)
         return owner, np.concatenate([e[:-1] for e in ends]), np.concatenate([e[1:] for e in ends])
 
-    def panel_sums(t, lo, hi, device):
-        """2 ∫ E mu dmu over the panels [lo, hi] of texels t by the Kronrod and the Gauss rule of the pair (the
-        Gauss nodes are Kronrod nodes: 2 order + 1 evaluations a panel): (kronrod, gauss), (len(t), 3) each, and
-        E at the nodes (len(t), 2 order + 1, 3)."""
-        mu = lo[:, None] + (hi - lo)[:, None] * x_mu
-        raw = e_at(np.repeat(t, len(x_mu)), mu.ravel(), estimator, device).reshape(len(t), len(x_mu), -1)
-        e = raw * (2.0 * (hi - lo)[:, None] * mu)[:, :, None]
-        return np.einsum("tkc,k->tc", e, w_kronrod), np.einsum("tkc,k->tc", e, w_gauss), raw
-
     # E at each texel's first-panel nodes, kept from the first pass for the inner probe (which needs them at the probe
     # texels); a texel is computed once per plan (one thread writes its entry), and where the tiles ran elsewhere (a
     # cluster) the probe computes them again: the same inputs, the same bits
     first_e: dict[int, np.ndarray] = {}
 
     def averages(t, device):
-        """(values, mu-rule estimates), (len(t), 3) float64 each: 2 ∫ E mu dmu of (E_R, E_T, E(F = 1)) at texels t.
-        Every panel (from mu_starts) takes the Gauss-Kronrod pair, d = |Q_kronrod - Q_gauss| its estimate (the Gauss
-        rule's error: pessimistic for the Kronrod value, which has 3 order + 1 degrees against 2 order - 1); while a
-        texel's sum of d exceeds a quarter of its target (max(tolerance, relative_tolerance |v|) at the first pass's
-        v, the worst channel: a layout's sum of two channels gets half), its panel with the largest d is bisected
-        (greedy, as lutbake.sampling.ladder), up to MU_MAX_PANELS panels. Each texel's own panels: independent of
-        which texels share the call."""
-        owner, lo, hi = first_panels(t)
-        panels = [list(zip(lo[owner == j], hi[owner == j])) for j in range(len(t))]
-        q, d, raw = panel_sums(t[owner], lo, hi, device)
-        first_e.update({int(k): raw[owner == j] for j, k in enumerate(t)})
-        d = np.abs(q - d)
-        fine = [list(q[owner == j]) for j in range(len(t))]
-        diff = [list(d[owner == j]) for j in range(len(t))]
-        total0 = np.array([np.sum(f, axis=0) for f in fine])
-        target = 0.25 * np.maximum(tol.absolute, tol.relative * np.min(np.abs(total0), axis=1))
-        while True:
-            pick = [
-                j
-                for j in range(len(t))
-                if np.max(np.sum(diff[j], axis=0)) > target[j] and len(panels[j]) < MU_MAX_PANELS
-            ]
-            if not pick:
-                break
-            worst = [int(np.argmax(np.max(diff[j], axis=1))) for j in pick]
-            a_, b_ = (
-                np.array([panels[j][w][0] for j, w in zip(pick, worst)]),
-                np.array([panels[j][w][1] for j, w in zip(pick, worst)]),
-            )
-            m_ = 0.5 * (a_ + b_)
-            q, c, _ = panel_sums(
-                np.concatenate([t[pick], t[pick]]), np.concatenate([a_, m_]), np.concatenate([m_, b_]), device
-            )
-            c = np.abs(q - c)
-            n = len(pick)
-            for i, (j, w) in enumerate(zip(pick, worst)):
-                panels[j][w : w + 1] = [(a_[i], m_[i]), (m_[i], b_[i])]
-                fine[j][w : w + 1] = [q[i], q[n + i]]
-                diff[j][w : w + 1] = [c[i], c[n + i]]
-        return np.array([np.sum(f, axis=0) for f in fine]), np.array([np.sum(e, axis=0) for e in diff])
+        """(values, mu-rule estimates), (len(t), 3) float64 each: 2 ∫ E mu dmu of (E_R, E_T, E(F = 1)) at texels t by
+        lutbake.sampling.mu_average from the panels of mu_starts, the mu rule to a quarter of the target
+        (max(tolerance, relative_tolerance |v|) at the first pass's v, the worst channel: a layout's sum of two
+        channels gets half); the inner rule's share is the probe's (inner_error)."""
+        r = mu_averages(
+            lambda tt, mu: (e_at(tt, mu, estimator, device), None),
+            t,
+            [starts[float(eta[i])] for i in t],
+            order,
+            lambda total: 0.25 * np.maximum(tol.absolute, tol.relative * np.min(np.abs(total), axis=1)),
+            MU_MAX_PANELS,
+        )
+        first_e.update({int(k): r.first_e[j] for j, k in enumerate(t)})
+        return r.values, r.mu_error
 
     memo = RowMemo(capacity=len(alpha))
 

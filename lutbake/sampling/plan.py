@@ -78,35 +78,21 @@ class TexelPlan:
 class Grid:
     """The texels of a table: ``axes`` and the per-texel ``inputs`` of the integrand (name -> array, row-major,
     slowest axis first). ``grazing`` and ``alpha`` (optional, per texel) pick the probe texels of the error
-    estimate. ``nodes``: a texel is ``scale`` times the weighted sum over len(nodes) sub-texels (input row
-    texel * len + k) with these weights (albedo_avg: E_avg = 2 ∫ E mu dmu, weights w_k mu_k, scale 2)."""
+    estimate. (An average over a texel's sub-directions, as kind albedo_avg's over mu, is a plan of its own:
+    lutbake.sampling.mu_average.)"""
 
     axes: list[Axis]
     inputs: dict[str, np.ndarray]
     grazing: np.ndarray | None = None
     alpha: np.ndarray | None = None
-    nodes: np.ndarray | None = None
-    scale: float = 1.0
 
     @property
     def n_texels(self) -> int:
-        n = len(next(iter(self.inputs.values())))
-        return n // (1 if self.nodes is None else len(self.nodes))
+        return len(next(iter(self.inputs.values())))
 
     def rows(self, idx) -> dict[str, Any]:
-        """The inputs of texels ``idx`` (a slice or an index array), every sub-texel included."""
-        if self.nodes is None:
-            return {k: v[idx] for k, v in self.inputs.items()}
-        k = len(self.nodes)
-        t = np.arange(self.n_texels)[idx]
-        sub = (t[:, None] * k + np.arange(k)[None, :]).reshape(-1)
-        return {name: v[sub] for name, v in self.inputs.items()}
-
-    def reduce(self, values: np.ndarray) -> np.ndarray:
-        if self.nodes is None:
-            return values
-        k = len(self.nodes)
-        return np.stack([self.scale * values[:, c].reshape(-1, k) @ self.nodes for c in range(values.shape[1])], 1)
+        """The inputs of texels ``idx`` (a slice or an index array)."""
+        return {k: v[idx] for k, v in self.inputs.items()}
 
 
 def probe_indices(grid: Grid) -> np.ndarray:
@@ -137,11 +123,11 @@ def per_texel_plan(
     tile_texels: int | None = None,
 ) -> TexelPlan:
     """The texel plan of ``grid``'s texels integrated by ``estimator``: texel i = estimator.evaluate(integrand,
-    grid inputs of i) (reduced over ``grid.nodes``), the first ``integrand.nch`` channels kept.
+    grid inputs of i), the first ``integrand.nch`` channels kept.
     ``relative_error``: the error estimate is max |a - b| / |b| over probe texels with |b| > 1e-6."""
 
     def run(idx, est, device):
-        return grid.reduce(est.evaluate(integrand, grid.rows(idx), device))[:, : integrand.nch]
+        return est.evaluate(integrand, grid.rows(idx), device)[:, : integrand.nch]
 
     adaptive = hasattr(estimator, "evaluate_with_error")
     tolerance_record = (
@@ -149,10 +135,9 @@ def per_texel_plan(
     )
 
     def run_adaptive(s: int, e: int, device: str) -> np.ndarray:
-        """Values of texels [s, e), then their error estimates (aux columns); sub-texels' errors add up with
-        |weights| (grid.reduce is linear, the GL weights positive)."""
+        """Values of texels [s, e), then their error estimates (aux columns)."""
         values, err = estimator.evaluate_with_error(integrand, grid.rows(slice(s, e)), device)
-        return np.concatenate([grid.reduce(values)[:, : integrand.nch], grid.reduce(err)[:, : integrand.nch]], 1)
+        return np.concatenate([values[:, : integrand.nch], err[:, : integrand.nch]], 1)
 
     def adaptive_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
         """The max over texels of the kernel's own per-texel estimate (the tiles' aux columns); the method names
@@ -186,8 +171,7 @@ def per_texel_plan(
         rel = float(np.max(err[ok] / np.abs(ref[ok]))) if ok.any() else 0.0
         return rel, f"max relative |{how}| {where} with |f| > 1e-6; max abs {float(np.max(err)):.3e}"
 
-    samples = estimator.samples(grid.inputs)  # evaluations per input row
-    k = 1 if grid.nodes is None else len(grid.nodes)
+    samples = estimator.samples(grid.inputs)  # evaluations per texel
     return TexelPlan(
         axes=grid.axes,
         channels=channels,
@@ -196,7 +180,7 @@ def per_texel_plan(
         n_channels=integrand.nch,
         run_tile=run_adaptive if adaptive else (lambda s, e, d: run(slice(s, e), estimator, d)),
         prepare=lambda d: estimator.prepare(integrand, d),
-        samples=int(round(np.mean(samples) * k)),
+        samples=int(round(np.mean(samples))),
         estimator=estimator.name,
         terms=terms,
         cost=float(np.sum(samples)),
