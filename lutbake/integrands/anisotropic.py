@@ -99,3 +99,120 @@ class AnisoIntegrand:
 def aniso_integrand(model: str, layout: str) -> AnisoIntegrand:
     sample, weight, f_cos = LOBES[model]
     return AnisoIntegrand(model, layout, channels_for(layout)[0], sample, weight, f_cos, model == "microfacet")
+
+
+# --------------------------------------------------------------- the view-azimuth average for the panelled rule
+# The kind's default table averages E over the view azimuth phi_v. Rotating v and h together leaves the panelled
+# Gauss-Legendre rule's geometry (horizon, v.h, n.l: lutbake.sampling.hemisphere) unchanged, so the average moves
+# inside the integrand: at each node h (kernel frame, v in the x-z plane) it averages the lobe over the orientation
+# beta of the tangent frame, g(h) = (1/pi) ∫_0^pi g_beta(h) dbeta (D and Lambda are pi-periodic in the azimuth), by the
+# periodic trapezoid rule at beta_j = j pi / M, nested with its even nodes (M / 2) for an estimate of its own error.
+# The average of a node set symmetric under beta -> -beta is even in phi, as the rule needs. Its integrand varies in
+# beta on a scale ~alpha_y / alpha_x (D's azimuthal peak in the lobe's tail; Lambda(v) at grazing view), so M grows
+# with the aspect r = alpha_max / alpha_min: M = AZIMUTH_NODES_PER_ASPECT r rounded up to a power of two (at most
+# AZIMUTH_NODES_MAX); r = 1 (isotropic) takes one node, exactly.
+AZIMUTH_NODES_PER_ASPECT = 16.0
+AZIMUTH_NODES_MAX = 256
+AVERAGED_CHANNELS = 4  # (scale, bias) over the M nodes, then over the M / 2 even ones (the nested estimate)
+
+
+@wp.func
+def azimuth_nodes(alpha_max: float, alpha_min: float):
+    """M for the aspect alpha_max / alpha_min (comment above)."""
+    r = alpha_max / wp.max(alpha_min, 1.0e-30)
+    if r <= 1.000001:
+        return 1
+    m = int(2)  # noqa: UP018 (Warp: a dynamic variable, mutated in the loop)
+    while float(m) < AZIMUTH_NODES_PER_ASPECT * r and m < AZIMUTH_NODES_MAX:
+        m = m * 2
+    return m
+
+
+def azimuth_nodes_np(alpha_max: np.ndarray, alpha_min: np.ndarray) -> np.ndarray:
+    """azimuth_nodes in numpy (the nominal cost of a texel)."""
+    r = np.asarray(alpha_max, np.float64) / np.maximum(np.asarray(alpha_min, np.float64), 1e-30)
+    m = 2.0 ** np.ceil(np.log2(np.maximum(AZIMUTH_NODES_PER_ASPECT * r, 2.0)))
+    return np.where(r <= 1.000001, 1, np.minimum(m, AZIMUTH_NODES_MAX)).astype(np.int64)
+
+
+@wp.func
+def averaged_weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha_min: float, alpha_max: float):
+    """(mean over the M nodes, mean over the even ones) of D G2 (v.h) / (n.v) with the tangent frame at beta_j:
+    anisotropic GGX (Heitz 2014, Eq. 85) with alpha_max along the frame's T, alpha_min along B, height-correlated
+    Smith G2 = 1 / (1 + Lambda(v) + Lambda(l)) with the anisotropic Lambda (Heitz 2014, Eq. 86). The frame's
+    cos, sin of beta_j by a float64 rotation recurrence (its rounding ~1e-16 j)."""
+    m = azimuth_nodes(alpha_max, alpha_min)
+    ax2 = alpha_max * alpha_max
+    ay2 = alpha_min * alpha_min
+    norm = 1.0 / (wp.pi * alpha_max * alpha_min)
+    hz2 = h[2] * h[2]
+    vx2 = v[0] * v[0]
+    vz2 = v[2] * v[2]
+    lz2 = l[2] * l[2]
+    step = wp.float64(wp.pi) / wp.float64(m)
+    c1 = wp.cos(step)
+    s1 = wp.sin(step)
+    c = wp.float64(1.0) + wp.float64(0.0)
+    s = wp.float64(0.0)
+    all_ = wp.float64(0.0)
+    even = wp.float64(0.0)
+    for j in range(m):
+        cf = float(c)
+        sf = float(s)
+        hx = h[0] * cf + h[1] * sf  # h in the frame at beta_j
+        hy = h[1] * cf - h[0] * sf
+        d = hx * hx / ax2 + hy * hy / ay2 + hz2
+        lx = l[0] * cf + l[1] * sf
+        ly = l[1] * cf - l[0] * sf
+        lam_l = 0.5 * (wp.sqrt(lz2 + ax2 * lx * lx + ay2 * ly * ly) / l[2] - 1.0)
+        lam_v = 0.5 * (wp.sqrt(vz2 + vx2 * (ax2 * cf * cf + ay2 * sf * sf)) / v[2] - 1.0)
+        w = wp.float64(norm / (d * d * (1.0 + lam_v + lam_l)))
+        all_ = all_ + w
+        if j % 2 == 0:
+            even = even + w
+        c_next = c * c1 - s * s1
+        s = s * c1 + c * s1
+        c = c_next
+    scale = VoH / v[2]
+    mean = float(all_ / wp.float64(m)) * scale
+    if m == 1:
+        return wp.vec2(mean, mean)
+    return wp.vec2(mean, float(even / wp.float64(m / 2)) * scale)
+
+
+@functools.lru_cache(maxsize=None)
+def averaged_integrand(layout: str):
+    """The integrand record of the view-azimuth-averaged anisotropic GGX table for the panelled Gauss-Legendre
+    kernel (lutbake.sampling.hemisphere.make_gauss_legendre): per texel (n.v, alpha = alpha_min, param = alpha_max),
+    g(h) = channels(v.h) x averaged_weight over AVERAGED_CHANNELS = 4 kernel channels (the M-node and the M/2-node
+    averages), the first 2 kept; the panels, the horizon map and the u = CDF(theta_h) variable of the NDF-peak
+    panel are those of isotropic GGX at alpha_min (the lobe's sharpest scale). alpha -> 0: the mirror limit."""
+    from ..edge import COS_EPS
+    from ..terms.distributions import NDFS
+    from .specular import SpecularIntegrand, half_vector_integrand
+
+    ch, _ = channels_for(layout)
+
+    @wp.func
+    def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float):
+        c = ch(VoH, 0.0)
+        w = averaged_weight(v, h, l, VoH, alpha, param)
+        return wp.vec4(c[0] * w[0], c[1] * w[0], c[0] * w[1], c[1] * w[1])
+
+    @wp.func
+    def mirror(v: wp.vec3, param: float):
+        if v[2] <= COS_EPS:
+            return wp.vec4()
+        c = ch(v[2], 0.0)
+        return wp.vec4(c[0], c[1], c[0], c[1])
+
+    return SpecularIntegrand(
+        ("ggx_aniso_averaged", "smith_height_correlated", layout, "microfacet"),
+        half_vector_integrand(lobe, wp.vec4, True),
+        wp.vec4,
+        wp.vec4d,
+        AVERAGED_CHANNELS,
+        2,
+        NDFS["ggx"],
+        mirror,
+    )

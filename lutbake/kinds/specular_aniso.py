@@ -4,7 +4,10 @@
 stored as z slices over the anisotropy a (a multi-part EXR, one part per a, as specular_3d stores f0), with the
 split-sum channels of ``dfg`` (Schlick F: scale/bias or multiscatter; the sheen and F82 layouts are not defined
 for these lobes). The lobes and the anisotropy -> (alpha_x, alpha_y) mapping: lutbake.integrands.anisotropic;
-the estimators (``sobol``, ``sobol_cosine``) and the view azimuth: lutbake.sampling.anisotropic.
+the estimators: ``gauss_legendre`` (the default) for anisotropic GGX with the view azimuth averaged, the panelled
+rule of lutbake.sampling.hemisphere over the azimuth-averaged integrand (lutbake.integrands.anisotropic.
+averaged_integrand), to the tolerance with a per-texel estimate; ``sobol``, ``sobol_cosine`` (QMC,
+lutbake.sampling.anisotropic) otherwise, without an estimate.
 
 Key ``view_azimuth``: ``average`` (default) integrates the view azimuth out, E = (1/2 pi) ∫ E(phi_v) dphi_v, which
 is what a shader looking up a 3D table without the azimuth should use (at a = 0 it is the isotropic table);
@@ -19,6 +22,7 @@ from ..axes import Axis
 from ..catalog import ANISO_ESTIMATORS, ANISO_LAYOUTS, ANISO_MODELS, AXES_FORMULA
 from ..edge import alpha_policy
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..tolerance import tolerance_of
 from . import dfg
 from .base import Estimation, Key, declare
 
@@ -28,6 +32,12 @@ VIEW_AZIMUTHS = {
     "bitangent": "phi_v = pi/2: v in the plane of the bitangent and the normal",
 }
 PHI_V = {"average": -1.0, "tangent": 0.0, "bitangent": 0.5 * np.pi}
+AZIMUTH_RULE = (
+    "inside the integrand: the lobe averaged over the tangent frame's orientation beta in [0, pi) by the periodic "
+    "trapezoid rule, M = 16 alpha_max / alpha_min nodes rounded up to a power of two (<= 256; 1 when isotropic), "
+    "its error estimated by |Q_M - Q_(M/2)| and added to each texel's estimate; the panels of isotropic GGX at "
+    "alpha_min (lutbake.integrands.anisotropic.averaged_integrand)"
+)
 
 KEYS = {
     "model": Key("model", "str", "microfacet", "the anisotropic lobe", ANISO_MODELS),
@@ -58,24 +68,55 @@ def axes_for(o: dict) -> list[Axis]:
     return [Axis("anisotropy", "z", o["anisotropy_size"], *o["anisotropy_range"], texel=o["texel"])] + dfg.axes_for(o)
 
 
+def panelled(o: dict) -> bool:
+    """True where the table takes the panelled ``gauss_legendre`` rule: it is asked for (the default), the lobe is
+    anisotropic GGX and the view azimuth averaged (lutbake.integrands.anisotropic.averaged_integrand); otherwise QMC
+    (``sobol``): Ashikhmin-Shirley's max(n.l, n.v) kink and a fixed view azimuth have no panels here."""
+    return o["estimator"] == "gauss_legendre" and o["model"] == "microfacet" and o["view_azimuth"] == "average"
+
+
 def plan(spec) -> TexelPlan:
     from ..integrands.anisotropic import alpha_xy, aniso_integrand
-    from ..sampling.anisotropic import AnisoSobol
 
     o = spec.options
     axes = axes_for(o)
     an_axis, rough, nov_axis = axes
     nx, ny, nz = nov_axis.count, rough.count, an_axis.count
-    integrand = aniso_integrand(o["model"], o["layout"])
+    qmc = aniso_integrand(o["model"], o["layout"])
     # texel t = (iz * ny + iy) * nx + ix: anisotropy slowest, then roughness, then NoV
     nov = np.tile(nov_axis.values(), ny * nz)
     alpha = np.tile(np.repeat(rough.alpha(), nx), nz)
-    ax, ay = alpha_xy(alpha, np.repeat(an_axis.values(), ny * nx), integrand.mirror)
-    grid = Grid(
-        axes,
-        {"nov": nov, "alpha_x": ax, "alpha_y": ay, "phi_v": np.full(len(nov), PHI_V[o["view_azimuth"]], np.float32)},
-        grazing=nov,
-    )
+    ax, ay = alpha_xy(alpha, np.repeat(an_axis.values(), ny * nx), qmc.mirror)
+    if panelled(o):
+        from ..integrands.anisotropic import averaged_integrand, azimuth_nodes_np
+        from ..sampling.anisotropic import AzimuthAveragedGaussLegendre
+        from ..sampling.hemisphere import GaussLegendre
+
+        integrand = averaged_integrand(o["layout"])
+        tol = tolerance_of(o)
+        estimator = (
+            GaussLegendre(o["samples"])
+            if o["samples"]
+            else AzimuthAveragedGaussLegendre(tol.absolute, tol.relative, azimuth_nodes_np)
+        )
+        inputs = {"nov": nov, "alpha": np.minimum(ax, ay), "param": np.maximum(ax, ay)}
+        how = {"view_azimuth_rule": AZIMUTH_RULE}
+    else:
+        from ..sampling.anisotropic import AnisoSobol
+
+        integrand = qmc
+        estimator = AnisoSobol(
+            "sobol_cosine" if o["estimator"] == "sobol_cosine" else "sobol",
+            o["samples"] or AnisoSobol.budget,
+            o["seed"],
+        )
+        inputs = {
+            "nov": nov,
+            "alpha_x": ax,
+            "alpha_y": ay,
+            "phi_v": np.full(len(nov), PHI_V[o["view_azimuth"]], np.float32),
+        }
+        how = {}
     terms = {
         "model": o["model"],
         "ndf": "ggx_aniso" if o["model"] == "microfacet" else "ashikhmin_shirley",
@@ -87,8 +128,8 @@ def plan(spec) -> TexelPlan:
     }
     return per_texel_plan(
         integrand,
-        AnisoSobol(o["estimator"], o["samples"] or AnisoSobol.budget, o["seed"]),
-        grid,
+        estimator,
+        Grid(axes, inputs, grazing=nov),
         channels=dfg.CHANNELS[o["layout"]],
         reconstruction=RECONSTRUCTION[o["layout"]],
         terms=terms,
@@ -96,9 +137,11 @@ def plan(spec) -> TexelPlan:
             "view_azimuth": f"{o['view_azimuth']}: {VIEW_AZIMUTHS[o['view_azimuth']]}",
             "anisotropy_mapping": f"Burley 2012, Addenda B.2: {AXES_FORMULA}",
             "tangent_frame": "T = +x (phi = 0), B = +y, n = +z",
-            "alpha_policy": alpha_policy(integrand.mirror),
+            "alpha_policy": alpha_policy(qmc.mirror),
+            **how,
         },
-        error_estimate=False,
+        # QMC: no estimate recorded (two scramblings' spread is not a bound: docs/estimators.md)
+        error_estimate=panelled(o),
     )
 
 
@@ -111,5 +154,5 @@ DESCRIPTION = (
     "anisotropic split-sum: NoV x roughness x anisotropy slices (anisotropic GGX or Ashikhmin-Shirley), "
     "scale/bias or multiscatter"
 )
-ESTIMATION = Estimation(ANISO_ESTIMATORS, "sobol", dfg.SAMPLES_DOC)
+ESTIMATION = Estimation(ANISO_ESTIMATORS, "gauss_legendre", dfg.SAMPLES_DOC)
 SPECULAR_ANISO = declare("specular_aniso", DESCRIPTION, KEYS, plan, ESTIMATION, aliases=("aniso",), texels=texel_count)

@@ -92,6 +92,12 @@ def store_row(out: wp.array2d(dtype=wp.float64), i: int, m: wp.vec3):  # noqa: F
     out[i, 2] = wp.float64(m[2])
 
 
+@wp.func
+def store_row(out: wp.array2d(dtype=wp.float64), i: int, m: wp.vec4):  # noqa: F811 (a Warp overload)
+    for c in range(4):
+        out[i, c] = wp.float64(m[c])
+
+
 Edges = wp.types.vector(length=MAX_PANELS + 1, dtype=wp.float64)  # a texel's panel ends in theta_h
 
 

@@ -40,6 +40,11 @@ def channel(x: wp.vec3d, c: int):  # noqa: F811 (a Warp overload)
     return x[c]
 
 
+@wp.func
+def channel(x: wp.vec4d, c: int):  # noqa: F811 (a Warp overload)
+    return x[c]
+
+
 @functools.lru_cache(maxsize=None)
 def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None):
     """``(integrate, climb, Panels, Sums, Orders)``: ``integrate(ctx, n_panels, rules, levels, target_abs, target_rel,
