@@ -236,7 +236,8 @@ class SpecularIntegrand:
     exists (the microfacet form: D -> delta about n, G2 -> 1 for n.v > 0, so E = channels(n.v, param); lutbake.edge),
     else None and alpha is clamped to ALPHA_MIN. ``nol_kink``: a cosine n.l where g is only C1 (Estevez & Kulla's
     Lambda fit switches formula at cos = 0.5: its second derivative jumps), which the gauss_legendre panels split at
-    (lutbake.sampling.hemisphere), else None. ``grazing_peak``: g has a Charlie lobe, whose NDF peaks at theta_h = pi/2
+    (lutbake.sampling.hemisphere), else None; ``kink_at_nov``: g is only C1 along n.l = n.v, a kink per texel
+(Ashikhmin-Shirley's max(n.l, n.v)), split the same way. ``grazing_peak``: g has a Charlie lobe, whose NDF peaks at theta_h = pi/2
     (the gauss_legendre panels grade towards the end of the half-vector domain). ``ndf_peak``: g has the lobe of
     ``distribution`` (False for the sheen layouts, whose GGX distribution only panels: no u = CDF(theta_h) variable).
     """
@@ -252,6 +253,7 @@ class SpecularIntegrand:
     nol_kink: float | None = None
     grazing_peak: bool = False
     ndf_peak: bool = True
+    kink_at_nov: bool = False
 
     def alpha_input(self, alpha) -> np.ndarray:
         """The per-texel alpha the kernels receive (float32): lutbake.edge.effective_alpha."""
@@ -299,6 +301,7 @@ def specular_integrand(
         else None,
         charlie,
         channels_name not in SHEEN_LAYOUTS,
+        form == "ashikhmin_shirley",
     )
 
 

@@ -29,7 +29,8 @@ lutbake.integrands.specular):
     By symmetry in phi,
         I = (1/pi) ∫_0^1 du ∫_0^phimax(u) dphi  g(h) / p(h).
     The integrand is then analytic in both variables and GL converges exponentially. An integrand only C1 along
-    n.l = kink (SpecularIntegrand.nol_kink: Charlie's Lambda) gets the same treatment for that level line
+    n.l = kink (SpecularIntegrand.nol_kink: Charlie's Lambda; kink_at_nov: n.l = n.v, Ashikhmin-Shirley's
+    max(n.l, n.v), whose level line passes through h = n at phi = pi/2) gets the same treatment for that level line
     (kink_band, kink_cos_phi); a Charlie lobe's panels also grade towards theta_b (next_toward).
 ``sobol_ndf`` / ``hammersley_ndf``  h from the NDF's inverse CDF (Distribution.sample_ndf) at scrambled Sobol'
     (or Hammersley) points, weight g / p / N with p = D(h)(n.h) (Distribution.pdf_ndf).
@@ -364,7 +365,7 @@ def panel_rule_for(spec):
     facet_weight = facet_weight_for(spec.g, spec.distribution.pdf_ndf)
     nch = spec.vec._length_
 
-    kinked = spec.nol_kink is not None
+    kinked = spec.nol_kink is not None or spec.kink_at_nov
 
     @wp.func
     def add_facet(acc: Any, f: OuterNode, cos_phi: wp.float64, sin_phi: wp.float64, w: wp.float64):
@@ -531,12 +532,15 @@ def make_gauss_legendre(spec):
         merge = wp.float64(1.0)  # the fixed orders keep every breakpoint (their pixels as before PEAK_MERGE)
         if levels.shape[0] > 1:
             merge = wp.float64(PEAK_MERGE)
+        kink_nol = wp.float64(wp.static(kink))
+        if wp.static(spec.kink_at_nov):  # the level line n.l = n.v (Ashikhmin-Shirley's max(n.l, n.v))
+            kink_nol = wp.float64(view_dir(texel[i][0])[2])
         t, n_panels = panel_texel(
             texel[i],
             phi_a,
             merge,
             wp.static(smooth),
-            wp.float64(wp.static(kink)),
+            kink_nol,
             wp.static(spec.grazing_peak),
             wp.static(spec.ndf_peak),
         )
