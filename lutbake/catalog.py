@@ -128,7 +128,7 @@ HEMISPHERE_ESTIMATORS = {
 }
 ANISO_ESTIMATORS = {
     "gauss_legendre": "panelled Gauss-Legendre to the tolerance, the view azimuth averaged inside the integrand "
-    "(default; anisotropic GGX with view_azimuth = average; Ashikhmin-Shirley and a fixed view azimuth take sobol)",
+    "(default; with view_azimuth = average: a fixed view azimuth takes sobol)",
     "sobol": "scrambled 3D Sobol' points: h by anisotropic GGX VNDF sampling (microfacet) or the Ashikhmin-Shirley "
     "h sampling; phi_v = 2 pi u3 when averaged",
     "sobol_cosine": "scrambled 3D Sobol' points: l cosine-weighted (independent of the lobe's sampler); "

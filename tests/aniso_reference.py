@@ -15,8 +15,20 @@ def lambda_aniso(w, ax, ay):
     return 0.5 * (np.sqrt(w[..., 2] ** 2 + ax * ax * w[..., 0] ** 2 + ay * ay * w[..., 1] ** 2) / w[..., 2] - 1.0)
 
 
-def averaged_split_sum(nov, ax, ay, nbeta=160, order=16, levels=14):
-    """(scale, bias) of the view-azimuth-averaged table at n.v = nov (module docstring)."""
+def ashikhmin_shirley_f_cos(hr, lr, nov, ax, ay):
+    """Ashikhmin & Shirley 2000: 4 (v.h) f (n.l) = p_h (n.l) / max(n.l, n.v), p_h = sqrt((nu + 1)(nv + 1)) / (2 pi)
+    (n.h)^((nu h_x^2 + nv h_y^2) / (1 - (n.h)^2)), nu = 2 / ax^2 - 2 along x, nv = 2 / ay^2 - 2 (both >= 0)."""
+    nu, nv = max(2.0 / ax**2 - 2.0, 0.0), max(2.0 / ay**2 - 2.0, 0.0)
+    x = hr[..., 0] ** 2 + hr[..., 1] ** 2
+    e = (nu * hr[..., 0] ** 2 + nv * hr[..., 1] ** 2) / np.maximum(x, 1e-300)
+    p_h = np.sqrt((nu + 1) * (nv + 1)) / (2 * np.pi) * np.exp(e * 0.5 * np.log1p(-x))
+    return p_h * lr[..., 2] / np.maximum(lr[..., 2], nov)
+
+
+def averaged_split_sum(nov, ax, ay, nbeta=160, order=16, levels=14, model="microfacet"):
+    """(scale, bias) of the view-azimuth-averaged table at n.v = nov (module docstring); ``model``:
+    "microfacet" (anisotropic GGX) or "ashikhmin_shirley" (its kink at n.l = n.v is a grading point of the l
+    rule: theta_l = theta_v)."""
     sv = np.sqrt(1.0 - nov * nov)
     t, wt = graded_gauss_legendre(0.0, np.pi / 2, [np.arccos(nov), np.pi / 2], levels=levels, order=order)
     p, wp_ = graded_gauss_legendre(0.0, 2 * np.pi, [np.pi], levels=levels, order=order)
@@ -32,9 +44,11 @@ def averaged_split_sum(nov, ax, ay, nbeta=160, order=16, levels=14):
         c, s = np.cos(b), np.sin(b)
         r = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # into the frame rotated by beta
         hr, lr, vr = h @ r.T, l @ r.T, r @ v
-        d = (hr[..., 0] / ax) ** 2 + (hr[..., 1] / ay) ** 2 + hr[..., 2] ** 2
-        f_cos = (
-            1.0 / (np.pi * ax * ay * d * d) / (1.0 + lambda_aniso(vr, ax, ay) + lambda_aniso(lr, ax, ay)) / (4 * nov)
-        )
+        if model == "microfacet":
+            d = (hr[..., 0] / ax) ** 2 + (hr[..., 1] / ay) ** 2 + hr[..., 2] ** 2
+            g2 = 1.0 + lambda_aniso(vr, ax, ay) + lambda_aniso(lr, ax, ay)
+            f_cos = 1.0 / (np.pi * ax * ay * d * d) / g2 / (4 * nov)
+        else:
+            f_cos = ashikhmin_shirley_f_cos(hr, lr, nov, ax, ay) / (4.0 * (hr @ vr))
         out += [np.sum(W * f_cos * (1.0 - fc)), np.sum(W * f_cos * fc)]
     return out / nbeta

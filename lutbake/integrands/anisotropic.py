@@ -180,23 +180,71 @@ def averaged_weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha_min: f
     return wp.vec2(mean, float(even / wp.float64(m / 2)) * scale)
 
 
+@wp.func
+def averaged_weight_ashikhmin_shirley(
+    v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha_min: float, alpha_max: float
+):
+    """As averaged_weight for Ashikhmin & Shirley 2000: p_h (n.l) / max(n.l, n.v) (the lobe's g / F) with nu (of
+    alpha_max) along the frame's T and nv (of alpha_min) along B, p_h = sqrt((nu + 1)(nv + 1)) / (2 pi)
+    (n.h)^((nu h_T^2 + nv h_B^2) / (1 - (n.h)^2)) (ndf.D_ashikhmin_shirley); log(n.h) / (1 - (n.h)^2), the same at
+    every frame orientation, once per node (ndf.log_cos; -1/2 at the pole)."""
+    m = azimuth_nodes(alpha_max, alpha_min)
+    nu = ndf.as_exponent(wp.min(alpha_max, 1.0))
+    nv = ndf.as_exponent(wp.min(alpha_min, 1.0))
+    x = wp.float64(h[0]) * wp.float64(h[0]) + wp.float64(h[1]) * wp.float64(h[1])
+    ratio = wp.float64(-0.5)
+    if x > wp.float64(1.0e-30):
+        ratio = wp.float64(ndf.log_cos(h)) / x
+    step = wp.float64(wp.pi) / wp.float64(m)
+    c1 = wp.cos(step)
+    s1 = wp.sin(step)
+    c = wp.float64(1.0) + wp.float64(0.0)
+    s = wp.float64(0.0)
+    all_ = wp.float64(0.0)
+    even = wp.float64(0.0)
+    for j in range(m):
+        cf = float(c)
+        sf = float(s)
+        hx = h[0] * cf + h[1] * sf  # h in the frame at beta_j
+        hy = h[1] * cf - h[0] * sf
+        w = wp.exp(wp.float64(nu * hx * hx + nv * hy * hy) * ratio)
+        all_ = all_ + w
+        if j % 2 == 0:
+            even = even + w
+        c_next = c * c1 - s * s1
+        s = s * c1 + c * s1
+        c = c_next
+    scale = wp.sqrt((nu + 1.0) * (nv + 1.0)) / (2.0 * wp.pi) * l[2] / wp.max(l[2], v[2])
+    mean = float(all_ / wp.float64(m)) * scale
+    if m == 1:
+        return wp.vec2(mean, mean)
+    return wp.vec2(mean, float(even / wp.float64(m / 2)) * scale)
+
+
+AVERAGED = {"microfacet": averaged_weight, "ashikhmin_shirley": averaged_weight_ashikhmin_shirley}
+
+
 @functools.lru_cache(maxsize=None)
-def averaged_integrand(layout: str):
-    """The integrand record of the view-azimuth-averaged anisotropic GGX table for the panelled Gauss-Legendre
-    kernel (lutbake.sampling.hemisphere.make_gauss_legendre): per texel (n.v, alpha = alpha_min, param = alpha_max),
-    g(h) = channels(v.h) x averaged_weight over AVERAGED_CHANNELS = 4 kernel channels (the M-node and the M/2-node
-    averages), the first 2 kept; the panels, the horizon map and the u = CDF(theta_h) variable of the NDF-peak
-    panel are those of isotropic GGX at alpha_min (the lobe's sharpest scale). alpha -> 0: the mirror limit."""
+def averaged_integrand(model: str, layout: str):
+    """The integrand record of a view-azimuth-averaged anisotropic table for the panelled Gauss-Legendre kernel
+    (lutbake.sampling.hemisphere.make_gauss_legendre): per texel (n.v, alpha = alpha_min, param = alpha_max),
+    g(h) = channels(v.h) x the lobe's averaged weight (AVERAGED) over AVERAGED_CHANNELS = 4 kernel channels (the
+    M-node and the M/2-node averages), the first 2 kept; the panels, the horizon map and the u = CDF(theta_h)
+    variable of the NDF-peak panel are those of the isotropic lobe at alpha_min (its sharpest scale): GGX, with the
+    mirror limit at alpha -> 0; for Ashikhmin-Shirley the Blinn-Phong CDF its isotropic tables use, and panels split
+    along its max(n.l, n.v) kink."""
     from ..edge import COS_EPS
     from ..terms.distributions import NDFS
     from .specular import SpecularIntegrand, half_vector_integrand
 
     ch, _ = channels_for(layout)
+    weight = AVERAGED[model]
+    microfacet = model == "microfacet"
 
     @wp.func
     def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float):
         c = ch(VoH, 0.0)
-        w = averaged_weight(v, h, l, VoH, alpha, param)
+        w = weight(v, h, l, VoH, alpha, param)
         return wp.vec4(c[0] * w[0], c[1] * w[0], c[0] * w[1], c[1] * w[1])
 
     @wp.func
@@ -207,12 +255,13 @@ def averaged_integrand(layout: str):
         return wp.vec4(c[0], c[1], c[0], c[1])
 
     return SpecularIntegrand(
-        ("ggx_aniso_averaged", "smith_height_correlated", layout, "microfacet"),
+        (f"{model}_aniso_averaged", "smith_height_correlated" if microfacet else "none", layout, model),
         half_vector_integrand(lobe, wp.vec4, True),
         wp.vec4,
         wp.vec4d,
         AVERAGED_CHANNELS,
         2,
-        NDFS["ggx"],
-        mirror,
+        NDFS["ggx" if microfacet else "blinn_phong"],
+        mirror if microfacet else None,
+        kink_at_nov=not microfacet,
     )

@@ -233,13 +233,14 @@ class SpecularIntegrand:
 
     ``distribution``: the NDF whose CDF / pdf / sampler the estimators use; ``kernel_channels``: the length of
     ``vec``, of which the first ``nch`` are kept; ``mirror(v, param) -> vec``: the exact alpha -> 0 limit where one
-    exists (the microfacet form: D -> delta about n, G2 -> 1 for n.v > 0, so E = channels(n.v, param); lutbake.edge),
-    else None and alpha is clamped to ALPHA_MIN. ``nol_kink``: a cosine n.l where g is only C1 (Estevez & Kulla's
-    Lambda fit switches formula at cos = 0.5: its second derivative jumps), which the gauss_legendre panels split at
-    (lutbake.sampling.hemisphere), else None; ``kink_at_nov``: g is only C1 along n.l = n.v, a kink per texel
-(Ashikhmin-Shirley's max(n.l, n.v)), split the same way. ``grazing_peak``: g has a Charlie lobe, whose NDF peaks at theta_h = pi/2
-    (the gauss_legendre panels grade towards the end of the half-vector domain). ``ndf_peak``: g has the lobe of
-    ``distribution`` (False for the sheen layouts, whose GGX distribution only panels: no u = CDF(theta_h) variable).
+    exists (the microfacet form: D -> delta about n, G2 -> 1 for n.v > 0, so E = channels(n.v, param);
+    lutbake.edge), else None and alpha is clamped to ALPHA_MIN. ``nol_kink``: a cosine n.l where g is only C1
+    (Estevez & Kulla's Lambda fit switches formula at cos = 0.5: its second derivative jumps), which the
+    gauss_legendre panels split at (lutbake.sampling.hemisphere), else None; ``kink_at_nov``: g is only C1 along
+    n.l = n.v, a kink per texel (Ashikhmin-Shirley's max(n.l, n.v)), split the same way. ``grazing_peak``: g has a
+    Charlie lobe, whose NDF peaks at theta_h = pi/2 (the gauss_legendre panels grade towards the end of the
+    half-vector domain). ``ndf_peak``: g has the lobe of ``distribution`` (False for the sheen layouts, whose GGX
+    distribution only panels: no u = CDF(theta_h) variable).
     """
 
     key: tuple

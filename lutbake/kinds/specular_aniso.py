@@ -4,10 +4,10 @@
 stored as z slices over the anisotropy a (a multi-part EXR, one part per a, as specular_3d stores f0), with the
 split-sum channels of ``dfg`` (Schlick F: scale/bias or multiscatter; the sheen and F82 layouts are not defined
 for these lobes). The lobes and the anisotropy -> (alpha_x, alpha_y) mapping: lutbake.integrands.anisotropic;
-the estimators: ``gauss_legendre`` (the default) for anisotropic GGX with the view azimuth averaged, the panelled
-rule of lutbake.sampling.hemisphere over the azimuth-averaged integrand (lutbake.integrands.anisotropic.
+the estimators: ``gauss_legendre`` (the default) with the view azimuth averaged, the panelled rule of
+lutbake.sampling.hemisphere over the azimuth-averaged integrand of either lobe (lutbake.integrands.anisotropic.
 averaged_integrand), to the tolerance with a per-texel estimate; ``sobol``, ``sobol_cosine`` (QMC,
-lutbake.sampling.anisotropic) otherwise, without an estimate.
+lutbake.sampling.anisotropic) at a fixed view azimuth, without an estimate.
 
 Key ``view_azimuth``: ``average`` (default) integrates the view azimuth out, E = (1/2 pi) ∫ E(phi_v) dphi_v, which
 is what a shader looking up a 3D table without the azimuth should use (at a = 0 it is the isotropic table);
@@ -35,7 +35,7 @@ PHI_V = {"average": -1.0, "tangent": 0.0, "bitangent": 0.5 * np.pi}
 AZIMUTH_RULE = (
     "inside the integrand: the lobe averaged over the tangent frame's orientation beta in [0, pi) by the periodic "
     "trapezoid rule, M = 16 alpha_max / alpha_min nodes rounded up to a power of two (<= 256; 1 when isotropic), "
-    "its error estimated by |Q_M - Q_(M/2)| and added to each texel's estimate; the panels of isotropic GGX at "
+    "its error estimated by |Q_M - Q_(M/2)| and added to each texel's estimate; the panels of the isotropic lobe at "
     "alpha_min (lutbake.integrands.anisotropic.averaged_integrand)"
 )
 
@@ -69,10 +69,10 @@ def axes_for(o: dict) -> list[Axis]:
 
 
 def panelled(o: dict) -> bool:
-    """True where the table takes the panelled ``gauss_legendre`` rule: it is asked for (the default), the lobe is
-    anisotropic GGX and the view azimuth averaged (lutbake.integrands.anisotropic.averaged_integrand); otherwise QMC
-    (``sobol``): Ashikhmin-Shirley's max(n.l, n.v) kink and a fixed view azimuth have no panels here."""
-    return o["estimator"] == "gauss_legendre" and o["model"] == "microfacet" and o["view_azimuth"] == "average"
+    """True where the table takes the panelled ``gauss_legendre`` rule: it is asked for (the default) and the view
+    azimuth averaged (lutbake.integrands.anisotropic.averaged_integrand, either lobe); otherwise QMC (``sobol``): at a
+    fixed view azimuth the lobe's azimuthal peak would sit on the panels' inner rule unaveraged."""
+    return o["estimator"] == "gauss_legendre" and o["view_azimuth"] == "average"
 
 
 def plan(spec) -> TexelPlan:
@@ -92,7 +92,7 @@ def plan(spec) -> TexelPlan:
         from ..sampling.anisotropic import AzimuthAveragedGaussLegendre
         from ..sampling.hemisphere import GaussLegendre
 
-        integrand = averaged_integrand(o["layout"])
+        integrand = averaged_integrand(o["model"], o["layout"])
         tol = tolerance_of(o)
         estimator = (
             GaussLegendre(o["samples"])

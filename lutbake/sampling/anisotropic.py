@@ -148,6 +148,7 @@ class AzimuthAveragedGaussLegendre:
     relative: float
     azimuth_nodes: Callable[[np.ndarray, np.ndarray], np.ndarray]
     name: str = "gauss_legendre"
+    estimate_note: str = ", plus the view-azimuth rule's |Q_M - Q_(M/2)|"
 
     def samples(self, inputs: dict) -> np.ndarray:  # nominal: the lobe evaluations of 3 panels at order 24
         return 3 * 24**2 * self.azimuth_nodes(inputs["param"], inputs["alpha"])

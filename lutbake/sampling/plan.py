@@ -154,8 +154,8 @@ def per_texel_plan(
             err = float(np.max(texel_error[ok] / np.abs(values[ok]))) if ok.any() else 0.0
         met = "every texel" if over == 0 else f"all but {over} of {grid.n_texels} texels, which ended at the last order"
         how = (
-            "per texel: sum over panels of |Q(order k) - Q(order k-1)| at the order that met the tolerance "
-            f"({met}); max error / tolerance = {ratio:.3g}"
+            "per texel: sum over panels of |Q(order k) - Q(order k-1)| at the order that met the tolerance"
+            f"{getattr(estimator, 'estimate_note', '')} ({met}); max error / tolerance = {ratio:.3g}"
         )
         if relative_error:
             how = "relative (|f| > 1e-6), " + how + f"; max abs {float(np.max(texel_error)):.3e}"
