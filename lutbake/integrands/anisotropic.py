@@ -135,49 +135,78 @@ def azimuth_nodes_np(alpha_max: np.ndarray, alpha_min: np.ndarray) -> np.ndarray
     return np.where(r <= 1.000001, 1, np.minimum(m, AZIMUTH_NODES_MAX)).astype(np.int64)
 
 
+def frame_average_for(term):
+    """``frame_average(v, h, l, alpha_min, alpha_max, pre) -> vec2``: (mean over the M orientations beta_j = j pi / M,
+    mean over the even ones) of ``term(v, h, l, alpha_min, alpha_max, pre, cos beta_j, sin beta_j)``, float64 sums;
+    ``pre``: what the term shares across orientations (a float64 vec3). The frame's cos, sin of beta_j by a float64
+    rotation recurrence (its rounding ~1e-16 j)."""
+
+    @wp.func
+    def frame_average(v: wp.vec3, h: wp.vec3, l: wp.vec3, alpha_min: float, alpha_max: float, pre: wp.vec3d):
+        m = azimuth_nodes(alpha_max, alpha_min)
+        step = wp.float64(wp.pi) / wp.float64(m)
+        c1 = wp.cos(step)
+        s1 = wp.sin(step)
+        c = wp.float64(1.0) + wp.float64(0.0)
+        s = wp.float64(0.0)
+        all_ = wp.float64(0.0)
+        even = wp.float64(0.0)
+        for j in range(m):
+            w = term(v, h, l, alpha_min, alpha_max, pre, float(c), float(s))
+            all_ = all_ + w
+            if j % 2 == 0:
+                even = even + w
+            c_next = c * c1 - s * s1
+            s = s * c1 + c * s1
+            c = c_next
+        mean = float(all_ / wp.float64(m))
+        if m == 1:
+            return wp.vec2(mean, mean)
+        return wp.vec2(mean, float(even / wp.float64(m / 2)))
+
+    return frame_average
+
+
 @wp.func
-def averaged_weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha_min: float, alpha_max: float):
-    """(mean over the M nodes, mean over the even ones) of D G2 (v.h) / (n.v) with the tangent frame at beta_j:
-    anisotropic GGX (Heitz 2014, Eq. 85) with alpha_max along the frame's T, alpha_min along B, height-correlated
-    Smith G2 = 1 / (1 + Lambda(v) + Lambda(l)) with the anisotropic Lambda (Heitz 2014, Eq. 86). The frame's
-    cos, sin of beta_j by a float64 rotation recurrence (its rounding ~1e-16 j)."""
-    m = azimuth_nodes(alpha_max, alpha_min)
+def ggx_in_frame(
+    v: wp.vec3, h: wp.vec3, l: wp.vec3, alpha_min: float, alpha_max: float, pre: wp.vec3d, cf: float, sf: float
+):
+    """D G2 with the tangent frame at (cos, sin) = (cf, sf): anisotropic GGX (Heitz 2014, Eq. 85) with alpha_max along
+    the frame's T, alpha_min along B, height-correlated Smith G2 = 1 / (1 + Lambda(v) + Lambda(l)) with the
+    anisotropic Lambda (Heitz 2014, Eq. 86)."""
     ax2 = alpha_max * alpha_max
     ay2 = alpha_min * alpha_min
-    norm = 1.0 / (wp.pi * alpha_max * alpha_min)
-    hz2 = h[2] * h[2]
-    vx2 = v[0] * v[0]
-    vz2 = v[2] * v[2]
-    lz2 = l[2] * l[2]
-    step = wp.float64(wp.pi) / wp.float64(m)
-    c1 = wp.cos(step)
-    s1 = wp.sin(step)
-    c = wp.float64(1.0) + wp.float64(0.0)
-    s = wp.float64(0.0)
-    all_ = wp.float64(0.0)
-    even = wp.float64(0.0)
-    for j in range(m):
-        cf = float(c)
-        sf = float(s)
-        hx = h[0] * cf + h[1] * sf  # h in the frame at beta_j
-        hy = h[1] * cf - h[0] * sf
-        d = hx * hx / ax2 + hy * hy / ay2 + hz2
-        lx = l[0] * cf + l[1] * sf
-        ly = l[1] * cf - l[0] * sf
-        lam_l = 0.5 * (wp.sqrt(lz2 + ax2 * lx * lx + ay2 * ly * ly) / l[2] - 1.0)
-        lam_v = 0.5 * (wp.sqrt(vz2 + vx2 * (ax2 * cf * cf + ay2 * sf * sf)) / v[2] - 1.0)
-        w = wp.float64(norm / (d * d * (1.0 + lam_v + lam_l)))
-        all_ = all_ + w
-        if j % 2 == 0:
-            even = even + w
-        c_next = c * c1 - s * s1
-        s = s * c1 + c * s1
-        c = c_next
-    scale = VoH / v[2]
-    mean = float(all_ / wp.float64(m)) * scale
-    if m == 1:
-        return wp.vec2(mean, mean)
-    return wp.vec2(mean, float(even / wp.float64(m / 2)) * scale)
+    hx = h[0] * cf + h[1] * sf  # h in the frame
+    hy = h[1] * cf - h[0] * sf
+    d = hx * hx / ax2 + hy * hy / ay2 + h[2] * h[2]
+    lx = l[0] * cf + l[1] * sf
+    ly = l[1] * cf - l[0] * sf
+    lam_l = 0.5 * (wp.sqrt(l[2] * l[2] + ax2 * lx * lx + ay2 * ly * ly) / l[2] - 1.0)
+    lam_v = 0.5 * (wp.sqrt(v[2] * v[2] + v[0] * v[0] * (ax2 * cf * cf + ay2 * sf * sf)) / v[2] - 1.0)
+    return wp.float64(1.0 / (wp.pi * alpha_max * alpha_min) / (d * d * (1.0 + lam_v + lam_l)))
+
+
+@wp.func
+def ashikhmin_shirley_in_frame(
+    v: wp.vec3, h: wp.vec3, l: wp.vec3, alpha_min: float, alpha_max: float, pre: wp.vec3d, cf: float, sf: float
+):
+    """(n.h)^((nu h_T^2 + nv h_B^2) / (1 - (n.h)^2)) with the tangent frame at (cf, sf); pre = (nu, nv,
+    log(n.h) / (1 - (n.h)^2)). The exponent in float64 (nu up to 2e8), its exp in float32: relative error |y| 6e-8
+    at exp(-y), <= 2.2e-8 of the lobe's peak (measured: the table within one float32 ulp of float64 exp)."""
+    hx = h[0] * cf + h[1] * sf  # h in the frame
+    hy = h[1] * cf - h[0] * sf
+    e = wp.float64(float(pre[0]) * hx * hx + float(pre[1]) * hy * hy)
+    return wp.float64(wp.exp(float(e * pre[2])))
+
+
+ggx_frame_average = frame_average_for(ggx_in_frame)
+ashikhmin_shirley_frame_average = frame_average_for(ashikhmin_shirley_in_frame)
+
+
+@wp.func
+def averaged_weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha_min: float, alpha_max: float):
+    """(mean over the M orientations, over the even ones) of D G2 (v.h) / (n.v) (ggx_in_frame)."""
+    return ggx_frame_average(v, h, l, alpha_min, alpha_max, wp.vec3d()) * (VoH / v[2])
 
 
 @wp.func
@@ -188,39 +217,15 @@ def averaged_weight_ashikhmin_shirley(
     alpha_max) along the frame's T and nv (of alpha_min) along B, p_h = sqrt((nu + 1)(nv + 1)) / (2 pi)
     (n.h)^((nu h_T^2 + nv h_B^2) / (1 - (n.h)^2)) (ndf.D_ashikhmin_shirley); log(n.h) / (1 - (n.h)^2), the same at
     every frame orientation, once per node (ndf.log_cos; -1/2 at the pole)."""
-    m = azimuth_nodes(alpha_max, alpha_min)
     nu = ndf.as_exponent(wp.min(alpha_max, 1.0))
     nv = ndf.as_exponent(wp.min(alpha_min, 1.0))
     x = wp.float64(h[0]) * wp.float64(h[0]) + wp.float64(h[1]) * wp.float64(h[1])
     ratio = wp.float64(-0.5)
     if x > wp.float64(1.0e-30):
         ratio = wp.float64(ndf.log_cos(h)) / x
-    step = wp.float64(wp.pi) / wp.float64(m)
-    c1 = wp.cos(step)
-    s1 = wp.sin(step)
-    c = wp.float64(1.0) + wp.float64(0.0)
-    s = wp.float64(0.0)
-    all_ = wp.float64(0.0)
-    even = wp.float64(0.0)
-    for j in range(m):
-        cf = float(c)
-        sf = float(s)
-        hx = h[0] * cf + h[1] * sf  # h in the frame at beta_j
-        hy = h[1] * cf - h[0] * sf
-        # the exponent in float64 (nu up to 2e8), its exp in float32: relative error |y| 6e-8 at exp(-y), <= 2.2e-8
-        # of the lobe's peak (measured: the table within one float32 ulp of float64 exp, 10 % faster)
-        w = wp.float64(wp.exp(float(wp.float64(nu * hx * hx + nv * hy * hy) * ratio)))
-        all_ = all_ + w
-        if j % 2 == 0:
-            even = even + w
-        c_next = c * c1 - s * s1
-        s = s * c1 + c * s1
-        c = c_next
+    pre = wp.vec3d(wp.float64(nu), wp.float64(nv), ratio)
     scale = wp.sqrt((nu + 1.0) * (nv + 1.0)) / (2.0 * wp.pi) * l[2] / wp.max(l[2], v[2])
-    mean = float(all_ / wp.float64(m)) * scale
-    if m == 1:
-        return wp.vec2(mean, mean)
-    return wp.vec2(mean, float(even / wp.float64(m / 2)) * scale)
+    return ashikhmin_shirley_frame_average(v, h, l, alpha_min, alpha_max, pre) * scale
 
 
 AVERAGED = {"microfacet": averaged_weight, "ashikhmin_shirley": averaged_weight_ashikhmin_shirley}
