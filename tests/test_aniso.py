@@ -123,7 +123,7 @@ def test_gauss_legendre_estimate_bounds_the_error(model):
 
     texels = np.array([(0.02, 0.3, 0.03), (0.5, 1.0, 0.1), (0.9, 0.05, 0.005), (0.2, 0.3, 0.2), (0.004, 0.1, 0.01)])
     nov, ax, ay = (texels[:, k].astype(np.float32) for k in range(3))
-    est = AzimuthAveragedGaussLegendre(1e-6, 0.0, azimuth_nodes_np)
+    est = AzimuthAveragedGaussLegendre(1e-6, 0.0, azimuth_nodes=azimuth_nodes_np)
     inputs = {"nov": nov, "alpha": ay, "param": ax}
     got, bound = est.evaluate_with_error(averaged_integrand(model, "scale_bias"), inputs, "cpu")
     ref = np.array([averaged_split_sum(float(n), float(x), float(y), model=model) for n, x, y in zip(nov, ax, ay)])

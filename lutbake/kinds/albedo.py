@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import Axis
-from ..sampling.mu_average import mu_averages
+from ..sampling.mu_average import mu_averages, mu_target
 from ..sampling.plan import TexelPlan, per_texel_plan
 from ..tolerance import Tolerance, tolerance_of
 from . import dfg
@@ -124,7 +124,7 @@ def plan_albedo_avg(spec) -> TexelPlan:
             t,
             [MU_STARTS] * len(t),
             order,
-            lambda total: MU_SHARE * np.maximum(tol.absolute, tol.relative * np.min(np.abs(total), axis=1)),
+            mu_target(tol, MU_SHARE),
             MU_MAX_PANELS,
         )
         return np.concatenate([r.values, r.mu_error + r.inner_error], axis=1)

@@ -40,7 +40,7 @@ from ..catalog import DIELECTRIC_MASKINGS, HEMISPHERE_ESTIMATORS, MASKINGS, NDF_
 from ..edge import alpha_policy
 from ..memo import RowMemo
 from ..sampling import points
-from ..sampling.mu_average import mu_averages
+from ..sampling.mu_average import mu_averages, mu_target
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan, probe_indices
 from ..tolerance import tolerance_of
 from . import dfg, dielectric_ratio
@@ -508,7 +508,7 @@ def plan_avg(spec) -> TexelPlan:
             t,
             [starts[float(eta[i])] for i in t],
             order,
-            lambda total: 0.25 * np.maximum(tol.absolute, tol.relative * np.min(np.abs(total), axis=1)),
+            mu_target(tol, 0.25),
             MU_MAX_PANELS,
         )
         first_e.update({int(k): r.first_e[j] for j, k in enumerate(t)})

@@ -97,7 +97,7 @@ def plan(spec) -> TexelPlan:
         estimator = (
             GaussLegendre(o["samples"])
             if o["samples"]
-            else AzimuthAveragedGaussLegendre(tol.absolute, tol.relative, azimuth_nodes_np)
+            else AzimuthAveragedGaussLegendre(tol.absolute, tol.relative, azimuth_nodes=azimuth_nodes_np)
         )
         inputs = {"nov": nov, "alpha": np.minimum(ax, ay), "param": np.maximum(ax, ay)}
         how = {"view_azimuth_rule": AZIMUTH_RULE}

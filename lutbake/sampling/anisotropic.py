@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import warp as wp
@@ -24,7 +24,7 @@ from ..terms import ndf
 from ..terms.frame import reflect
 from . import points
 from .arrays import Points2, Rows64
-from .hemisphere import store_row
+from .hemisphere import AdaptiveGaussLegendre, gl_launch, store_row
 
 DEFAULT_SAMPLES = 16384
 
@@ -137,37 +137,21 @@ LADDER_SHARE = 0.75
 
 
 @dataclass(frozen=True)
-class AzimuthAveragedGaussLegendre:
+class AzimuthAveragedGaussLegendre(AdaptiveGaussLegendre):
     """``gauss_legendre`` for the view-azimuth average (lutbake.integrands.anisotropic.averaged_integrand; inputs
     nov, alpha = alpha_min, param = alpha_max) to the tolerance max(absolute, relative |E|): the panel ladder of
-    lutbake.sampling.hemisphere to LADDER_SHARE of it, and each texel's estimate is the ladder's plus the azimuth
-    rule's |Q_M - Q_(M/2)| (the error of the coarser rule: pessimistic for Q_M, exponentially convergent).
+    AdaptiveGaussLegendre to LADDER_SHARE of it, and each texel's estimate is the ladder's plus the azimuth rule's
+    |Q_M - Q_(M/2)| (the error of the coarser rule: pessimistic for Q_M, exponentially convergent).
     ``azimuth_nodes(alpha_max, alpha_min) -> M`` per texel (the integrand's, in numpy): for the nominal cost only."""
 
-    absolute: float
-    relative: float
-    azimuth_nodes: Callable[[np.ndarray, np.ndarray], np.ndarray]
-    name: str = "gauss_legendre"
+    azimuth_nodes: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
     estimate_note: str = ", plus the view-azimuth rule's |Q_M - Q_(M/2)|"
 
     def samples(self, inputs: dict) -> np.ndarray:  # nominal: the lobe evaluations of 3 panels at order 24
         return 3 * 24**2 * self.azimuth_nodes(inputs["param"], inputs["alpha"])
 
-    def prepare(self, integrand, device: str) -> None:
-        from .hemisphere import gl_kernel, load
-
-        load(gl_kernel(integrand), device)
-
     def evaluate_with_error(self, integrand, inputs: dict, device: str) -> tuple[np.ndarray, np.ndarray]:
-        from .hemisphere import ADAPTIVE_ORDERS, gl_launch
-
         tol = (LADDER_SHARE * self.absolute, LADDER_SHARE * self.relative)
-        v, e = gl_launch(integrand, inputs, ADAPTIVE_ORDERS, tol, device)
+        v, e = gl_launch(integrand, inputs, self.orders, tol, device)
         n = integrand.nch
         return v[:, :n], e[:, :n] + np.abs(v[:, :n] - v[:, n : 2 * n])
-
-    def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
-        return self.evaluate_with_error(integrand, inputs, device)[0]
-
-    def refined(self):
-        return replace(self, absolute=self.absolute / 100, relative=self.relative / 100), "tolerance / 100"

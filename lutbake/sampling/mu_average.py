@@ -39,6 +39,12 @@ class MuAverages:
     panels: np.ndarray
 
 
+def mu_target(tol, share: float) -> Callable[[np.ndarray], np.ndarray]:
+    """mu_averages' ``target``: ``share`` of max(tol.absolute, tol.relative |v|) at the first pass's values, the
+    worst (smallest) channel of each texel."""
+    return lambda total: share * np.maximum(tol.absolute, tol.relative * np.min(np.abs(total), axis=1))
+
+
 def mu_averages(
     e_at: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray | None]],
     t: np.ndarray,
