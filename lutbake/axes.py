@@ -88,19 +88,27 @@ class Axis:
             return (i + 0.5) / self.count
         return i / max(self.count - 1, 1)
 
-    def _map(self, t: np.ndarray) -> np.ndarray:
+    def _map(self, t: np.ndarray, raw: bool = False) -> np.ndarray:
+        """The value at t; ``raw``: without ``clamp`` and ``texel_offset``'s min (Axis.regular)."""
         if self.mapping == "one_minus_t2":
             s = 1.0 - t * t
         elif self.mapping == "square":
             s = t * t
         elif self.mapping == "texel_offset":
-            s = np.minimum(t + 1.0 / self.count, 1.0)
+            s = t + 1.0 / self.count if raw else np.minimum(t + 1.0 / self.count, 1.0)
         else:
             s = t
         v = self.lo + (self.hi - self.lo) * s
-        if self.clamp is not None:
+        if self.clamp is not None and not raw:
             v = np.clip(v, *self.clamp)
         return v
+
+    def regular(self) -> np.ndarray:
+        """Per index: its value is the axis' analytic mapping of t, no clamp, ``texel_offset``'s min or edge policy
+        (axis_edge) applied (a ``listed`` axis: nowhere). The indices lutbake.sampling.interpolation may use."""
+        if self.mapping == "listed":
+            return np.zeros(self.count, bool)
+        return self._map(self.t(), raw=True).astype(np.float32) == self.values()
 
     def values(self) -> np.ndarray:
         """The parameter integrated at every index (float32, after the edge policy)."""

@@ -78,6 +78,7 @@ def plan_albedo(spec) -> TexelPlan:
         reconstruction=ALBEDO_RECONSTRUCTION,
         terms=dfg.terms_record(o, "none (F = 1)"),
         extra=dfg.specular_extra(integrand),
+        interpolate=o["interpolation"] == "verified",
     )
 
 

@@ -34,7 +34,7 @@ from ..catalog import (
     masking_allowed,
     model_terms,
 )
-from ..edge import alpha_policy
+from ..edge import ALPHA_MIN, alpha_policy
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from ..tolerance import tolerance_of
 from . import engine_layouts
@@ -124,6 +124,11 @@ AXIS_ORDERS = {
 NOV_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "one_minus_t2", "square")}
 ROUGHNESS_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "texel_offset")}
 
+INTERPOLATIONS = {
+    "verified": "interpolated from the coarse texels wherever each texel's own error estimate meets the tolerance, "
+    "else integrated (lutbake.sampling.interpolation)",
+    "off": "every texel integrated",
+}
 KEYS = {
     "size": Key("size", "int_pair", [128, 128], "[NoV, roughness] texel counts", minimum=1),
     "roughness": Key("roughness", "str", "perceptual", "what the roughness axis holds", ROUGHNESS_PARAMS),
@@ -153,6 +158,13 @@ KEYS = {
         "NoV clamped to [lo, hi] after the mapping (Blender EEVEE: [1e-4, 0.9999])",
         minimum=0.0,
         maximum=1.0,
+    ),
+    "interpolation": Key(
+        "interpolation",
+        "str",
+        "verified",
+        "texels between every 4th row and column of a table of >= 64 x 64 (gauss_legendre to a tolerance)",
+        INTERPOLATIONS,
     ),
 }
 
@@ -273,14 +285,19 @@ def texel_grid(axes: list[Axis]) -> tuple[np.ndarray, np.ndarray]:
 
 def grid_for(axes: list[Axis], integrand, param=None, repeat: int = 1) -> Grid:
     """The texels of a [(z,) y, x] specular table: (NoV, alpha) of the [y, x] grid (either axis order), row-major,
-    tiled ``repeat`` times (z slowest), and the per-texel ``param`` (f0 of specular_3d; 0 otherwise)."""
+    tiled ``repeat`` times (z slowest), and the per-texel ``param`` (f0 of specular_3d; 0 otherwise). ``smooth``
+    (lutbake.sampling.interpolation): both axes' values regular (Axis.regular) and alpha >= ALPHA_MIN (no mirror
+    limit, no clamp: lutbake.edge)."""
     nov, alpha = (np.tile(x, repeat) for x in texel_grid(axes[-2:]))
+    y_axis, x_axis = axes[-2:]
+    regular = np.outer(y_axis.regular(), x_axis.regular()).ravel()
     param = np.zeros(len(nov), np.float32) if param is None else param
     return Grid(
         axes,
         {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": param},
         grazing=nov,
         alpha=alpha.astype(np.float64),
+        smooth=np.tile(regular, repeat) & (alpha >= ALPHA_MIN),
     )
 
 
@@ -324,6 +341,7 @@ def plan(spec) -> TexelPlan:
         reconstruction=reconstruction(o["layout"], axes),
         terms=terms,
         extra=specular_extra(integrand),
+        interpolate=o["interpolation"] == "verified",
     )
     if base != o["layout"]:
         nov = texel_grid(axes)[0]

@@ -94,6 +94,7 @@ def plan(spec) -> TexelPlan:
         reconstruction=RECONSTRUCTION_METAL if metal else RECONSTRUCTION_3D,
         terms=terms,
         extra={**extra, **dfg.specular_extra(integrand)},
+        interpolate=o["interpolation"] == "verified",
     )
 
 

@@ -85,6 +85,9 @@ class Grid:
     inputs: dict[str, np.ndarray]
     grazing: np.ndarray | None = None
     alpha: np.ndarray | None = None
+    # per texel: its inputs are an analytic function of its texel coordinates (no edge policy cut them): the texels
+    # lutbake.sampling.interpolation may interpolate between; None: that kind's plan never interpolates
+    smooth: np.ndarray | None = None
 
     @property
     def n_texels(self) -> int:
@@ -121,10 +124,14 @@ def per_texel_plan(
     relative_error: bool = False,
     error_estimate: bool = True,
     tile_texels: int | None = None,
+    interpolate: bool = False,
 ) -> TexelPlan:
     """The texel plan of ``grid``'s texels integrated by ``estimator``: texel i = estimator.evaluate(integrand,
     grid inputs of i), the first ``integrand.nch`` channels kept.
-    ``relative_error``: the error estimate is max |a - b| / |b| over probe texels with |b| > 1e-6."""
+    ``relative_error``: the error estimate is max |a - b| / |b| over probe texels with |b| > 1e-6.
+    ``interpolate``: an adaptive estimator's texels come from lutbake.sampling.interpolation where the grid allows
+    (interpolation.applies: a ``grid.smooth`` mask, both image axes long enough), each within the tolerance."""
+    from . import interpolation
 
     def run(idx, est, device):
         return est.evaluate(integrand, grid.rows(idx), device)[:, : integrand.nch]
@@ -134,16 +141,26 @@ def per_texel_plan(
         {"tolerance": f"max({estimator.absolute:.3g}, {estimator.relative:.3g} |v|) per value"} if adaptive else {}
     )
 
+    def integrate(est, idx, device: str) -> tuple[np.ndarray, np.ndarray]:
+        """Values and estimates of texels ``idx`` (a slice or indices) by the adaptive estimator ``est``."""
+        values, err = est.evaluate_with_error(integrand, grid.rows(idx), device)
+        return values[:, : integrand.nch], err[:, : integrand.nch]
+
     def run_adaptive(s: int, e: int, device: str) -> np.ndarray:
         """Values of texels [s, e), then their error estimates (aux columns)."""
-        values, err = estimator.evaluate_with_error(integrand, grid.rows(slice(s, e)), device)
-        return np.concatenate([values[:, : integrand.nch], err[:, : integrand.nch]], 1)
+        return np.concatenate(integrate(estimator, slice(s, e), device), 1)
+
+    interpolating = adaptive and interpolate and interpolation.applies(grid, grid.axes)
+    verified = interpolation.VerifiedInterpolation(grid, estimator, integrate, integrand.nch) if interpolating else None
+    if interpolating:
+        tolerance_record["interpolation"] = interpolation.METHOD
 
     def adaptive_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
         """The max over texels of the kernel's own per-texel estimate (the tiles' aux columns); the method names
         the worst ratio to the tolerance (<= 1: every texel met it)."""
         full = data.reshape(grid.n_texels, -1)
-        values, texel_error = full[:, : integrand.nch], full[:, integrand.nch :]
+        nch = integrand.nch
+        values, texel_error = full[:, :nch], full[:, nch : 2 * nch]
         target = np.maximum(estimator.absolute, estimator.relative * np.abs(values))
         ratio = float(np.max(texel_error / target))
         # texels whose panels all reached the last order short of the target (the kernel's comparison, with rounding)
@@ -157,6 +174,8 @@ def per_texel_plan(
             "per texel: sum over panels of |Q(order k) - Q(order k-1)| at the order that met the tolerance"
             f"{getattr(estimator, 'estimate_note', '')} ({met}); max error / tolerance = {ratio:.3g}"
         )
+        if interpolating:
+            how += "; " + interpolation.describe(full[:, 2 * nch])
         if relative_error:
             how = "relative (|f| > 1e-6), " + how + f"; max abs {float(np.max(texel_error)):.3e}"
         return err, how
@@ -174,6 +193,10 @@ def per_texel_plan(
         rel = float(np.max(err[ok] / np.abs(ref[ok]))) if ok.any() else 0.0
         return rel, f"max relative |{how}| {where} with |f| > 1e-6; max abs {float(np.max(err)):.3e}"
 
+    def run_fixed(s: int, e: int, device: str) -> np.ndarray:
+        return run(slice(s, e), estimator, device)
+
+    run_tile = verified.run_tile if verified else run_adaptive if adaptive else run_fixed
     samples = estimator.samples(grid.inputs)  # evaluations per texel
     return TexelPlan(
         axes=grid.axes,
@@ -181,7 +204,7 @@ def per_texel_plan(
         reconstruction=reconstruction,
         n_texels=grid.n_texels,
         n_channels=integrand.nch,
-        run_tile=run_adaptive if adaptive else (lambda s, e, d: run(slice(s, e), estimator, d)),
+        run_tile=run_tile,
         prepare=lambda d: estimator.prepare(integrand, d),
         samples=int(round(np.mean(samples))),
         estimator=estimator.name,
@@ -189,6 +212,6 @@ def per_texel_plan(
         cost=float(np.sum(samples)),
         extra={**(extra or {}), **tolerance_record},
         error_estimate=(adaptive_estimate if adaptive else estimate) if error_estimate else None,
-        aux_channels=integrand.nch if adaptive else 0,
-        tile_texels=tile_texels,
+        aux_channels=(integrand.nch + (1 if verified else 0)) if adaptive else 0,
+        tile_texels=interpolation.tile_texels(grid.axes) if verified else tile_texels,
     )
