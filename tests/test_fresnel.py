@@ -35,7 +35,8 @@ def test_F_conductor_matches_complex_fresnel(metal):
     m = METALS[metal]
     for n, k in zip(m.n, m.k):
         got = evaluate(C, n=n, k=k)["conductor"]
-        np.testing.assert_allclose(got, fresnel_complex_ref(n + 1j * k, C), atol=F32_TOL)
+        # float32: <= 2.2e-7 for every metal (silver's a2b2 + t0 cancelled to 2.1e-6 before F_conductor's k > n form)
+        np.testing.assert_allclose(got, fresnel_complex_ref(n + 1j * k, C), atol=3e-7)
 
 
 @pytest.mark.parametrize("n", [1.1, 1.33, 1.5, 2.4, 4.0])
