@@ -127,11 +127,11 @@ def test_dfg_interpolated_estimates_bound_errors_on_every_texel(gltf_256):
 
 
 def test_dfg_interpolation_records_its_method(bake):
-    table = bake(kind="dfg", size=[64, 64])
+    table = bake(kind="dfg", size=[128, 128])
     assert "interpolated from" in table.attributes["error_estimate_method"]
     assert "lutbake.sampling.interpolation" in table.attributes["interpolation"]
-    small = bake(kind="dfg", size=[32, 64])  # an axis under MIN_AXIS: every texel integrated
+    small = bake(kind="dfg", size=[64, 128])  # an axis under MIN_AXIS: every texel integrated
     assert "interpolated" not in small.attributes["error_estimate_method"]
-    off = bake(kind="dfg", size=[64, 64], interpolation="off")
+    off = bake(kind="dfg", size=[128, 128], interpolation="off")
     assert "interpolated" not in off.attributes["error_estimate_method"]
     assert np.abs(off.data - table.data).max() <= 2.0e-6  # both within 1e-6 of the truth

@@ -42,7 +42,10 @@ from ..memo import RowMemo
 STRIDE = 4  # coarse texels: every STRIDE-th index of each image axis, and the last
 COARSE_SHARE = 0.25  # their tolerance: this share of the table's (their errors reach interpolated texels x Lebesgue)
 SAFETY = 2.0  # the estimate: SAFETY x the largest difference between the interpolants
-MIN_AXIS = 64  # both image axes at least this long, else no interpolation (a 32^2 table has 8 coarse nodes per axis)
+# both image axes at least this long, else every texel integrated: at 64^2 the edges (3 coarse gaps on each side) leave
+# 3-15 % of the texels to interpolate, less than the coarse texels' tighter tolerance costs (make luts's 64^2 tables:
+# 0.8-1.0x the time without); at 128^2, 45-55 % and 1.4-1.8x less CPU (benchmarks/bench_interpolation.py)
+MIN_AXIS = 128
 TILE_TARGET = 16384  # texels per tile: whole rows, about this many
 TERMS_ROUNDING = 1.0e-7  # lutbake.sampling.hemisphere.TERMS_ROUNDING (not imported: it is a Warp constant there)
 INTEGRATED, COARSE, INTERPOLATED = 0.0, 1.0, 2.0  # a texel's flag in the tile's last aux column
