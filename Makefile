@@ -65,10 +65,12 @@ clean:
 # every kind against converged references, C and numpy baselines: outputs/bench/report.json + accuracy_vs_time.png;
 # then the Dask executor (local:2) against the thread executor on the make-luts batch, and a scaling projection:
 # outputs/bench/cluster.json (docs/cluster.md); first, `make luts` into an empty folder timed (wall, CPU, top ten
-# tables): outputs/bench/luts.json
+# tables): outputs/bench/luts.json; every table that interpolates between texels against itself integrated (CPU ratio,
+# honesty): outputs/bench/interpolation.json
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_luts.py
 	$(BIN)/python benchmarks/bench.py
+	$(BIN)/python benchmarks/bench_interpolation.py
 	$(BIN)/python benchmarks/bench_dielectric.py
 	$(BIN)/python benchmarks/bench_ltc.py
 	$(BIN)/python benchmarks/bench_cluster.py

@@ -46,7 +46,8 @@ SAFETY = 2.0  # the estimate: SAFETY x the largest difference between the interp
 # 3-15 % of the texels to interpolate, less than the coarse texels' tighter tolerance costs (make luts's 64^2 tables:
 # 0.8-1.0x the time without); at 128^2, 45-55 % and 1.4-1.8x less CPU (benchmarks/bench_interpolation.py)
 MIN_AXIS = 128
-TILE_TARGET = 16384  # texels per tile: whole rows, about this many
+TILE_TARGET = 16384  # texels per tile: whole rows, at most about this many
+MIN_TILES = 8  # ... and at least this many tiles per slice (a 128^2 table in one tile kept one core busy)
 TERMS_ROUNDING = 1.0e-7  # lutbake.sampling.hemisphere.TERMS_ROUNDING (not imported: it is a Warp constant there)
 INTEGRATED, COARSE, INTERPOLATED = 0.0, 1.0, 2.0  # a texel's flag in the tile's last aux column
 # interpolants along one axis, as (first node, node count) relative to k, the first coarse node above the texel
@@ -120,9 +121,11 @@ def applies(grid, axes) -> bool:
 
 
 def tile_texels(axes) -> int:
-    """Whole rows per tile, about TILE_TARGET texels."""
+    """Whole rows per tile, a multiple of STRIDE: at most about TILE_TARGET texels, at least MIN_TILES tiles a slice
+    (the coarse texels two tiles share are computed once: VerifiedInterpolation.memo)."""
     nx, ny = axes[-1].count, axes[-2].count
-    return nx * min(ny, max(STRIDE, TILE_TARGET // nx))
+    rows = min(TILE_TARGET // nx, -(-ny // MIN_TILES))
+    return nx * min(ny, STRIDE * max(1, -(-rows // STRIDE)))
 
 
 METHOD = (
