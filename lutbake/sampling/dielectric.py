@@ -59,6 +59,7 @@ from .hemisphere import (
     load,
     next_geometric,
     outer_variable_for,
+    phi_b,
     store_row,
     texel_view,
 )
@@ -223,6 +224,24 @@ def panel_rule_for(spec):
     nch = spec.vec._length_
 
     @wp.func
+    def add_facet(
+        acc: Any,
+        x: DielectricTexel,
+        sin_h: wp.float64,
+        cos_h: wp.float64,
+        cos_phi: wp.float64,
+        sin_phi: wp.float64,
+        w: wp.float64,
+        in_u: bool,
+    ):
+        """acc plus w g / p (or w g) at the facet (theta_h, phi)."""
+        h = wp.vec3(float(sin_h * cos_phi), float(sin_h * sin_phi), float(cos_h))
+        gw = facet_weight(x.v, h, x.a, x.eta, in_u)
+        for c in range(wp.static(nch)):
+            acc[c] = acc[c] + w * wp.float64(gw[c])
+        return acc
+
+    @wp.func
     def panel_add(x: DielectricTexel, j: int, rules: Rule, off: int, n: int, acc: Any):
         cos_v = x.cos_v
         sin_v = x.sin_v
@@ -277,34 +296,46 @@ def panel_rule_for(spec):
                 dp = p_hi - p_lo
                 horizon_end = (p_hi == phi_l and phi_l < PI64) or (p_hi == phi_t)
                 kink_lo = p_lo > ZERO64
-                eps = PI64
                 if horizon_end:
-                    slope = TWO64 * cos_h * sin_v * sin_h * wp.max(wp.sin(p_hi), wp.float64(1.0e-12))
+                    # sinh map (Johnston & Elliott 2005) towards p_hi: phi = p_hi - eps sinh(A (1 - y)); cos and sin
+                    # of phi from those of p_hi (float64, once a piece) and of the distance to it (phi_b)
+                    c_hi = wp.cos(p_hi)
+                    s_hi = wp.sin(p_hi)
+                    slope = TWO64 * cos_h * sin_v * sin_h * wp.max(s_hi, wp.float64(1.0e-12))
                     if p_hi == phi_t:
                         slope = wp.max(dnot_dphi(cos_v, sin_v, cos_h, sin_h, p_hi, eta), wp.float64(1.0e-12))
                     eps = wp.max(x.eps_l / slope, wp.float64(1.0e-12))
-                big_a = asinh64(dp / eps)
-                for jj in range(n):
-                    y = rules[off + jj][0]
-                    wy = rules[off + jj][1]
-                    phi = p_lo
-                    w = wk
-                    if horizon_end:
-                        if kink_lo:
-                            wy = wy * TWO64 * y
-                            y = y * y
-                        # sinh map (Johnston & Elliott 2005) towards p_hi: phi = p_hi - eps sinh(A (1 - y))
-                        ex = wp.exp(big_a * (ONE64 - y))  # sinh and cosh from one exp
-                        inv_ex = ONE64 / ex
-                        phi = p_hi - eps * HALF64 * (ex - inv_ex)
-                        w = wk * wy * eps * HALF64 * (ex + inv_ex) * big_a
-                    else:
-                        phi = p_lo + dp * y * y * (wp.float64(3.0) - TWO64 * y)
-                        w = wk * wy * dp * wp.float64(6.0) * y * (ONE64 - y)
-                    h = wp.vec3(float(sin_h * wp.cos(phi)), float(sin_h * wp.sin(phi)), float(cos_h))
-                    gw = facet_weight(x.v, h, x.a, x.eta, in_u)
-                    for c in range(wp.static(nch)):
-                        acc[c] = acc[c] + w * wp.float64(gw[c])
+                    big_a = asinh64(dp / eps)
+                    if kink_lo:  # y -> y^2 at the kink: the nodes are not symmetric, one exp each
+                        for jj in range(n):
+                            y = rules[off + jj][0]
+                            ex = wp.exp(big_a * (ONE64 - y * y))
+                            r = phi_b(ex, ONE64 / ex, eps, big_a, c_hi, s_hi)
+                            w = wk * rules[off + jj][1] * TWO64 * y * r[2]
+                            acc = add_facet(acc, x, sin_h, cos_h, r[0], r[1], w, in_u)
+                    else:  # the GL nodes pair up, y_(n-1-j) = 1 - y_j: one exp per pair (as hemisphere.sinh_piece)
+                        e_a = wp.exp(big_a)
+                        inv_e_a = ONE64 / e_a
+                        for jj in range((n + 1) // 2):
+                            ex = wp.exp(big_a * (ONE64 - rules[off + jj][0]))
+                            inv_ex = ONE64 / ex
+                            r = phi_b(ex, inv_ex, eps, big_a, c_hi, s_hi)
+                            acc = add_facet(acc, x, sin_h, cos_h, r[0], r[1], wk * rules[off + jj][1] * r[2], in_u)
+                            if n - 1 - jj > jj:
+                                r = phi_b(e_a * inv_ex, ex * inv_e_a, eps, big_a, c_hi, s_hi)
+                                w = wk * rules[off + n - 1 - jj][1] * r[2]
+                                acc = add_facet(acc, x, sin_h, cos_h, r[0], r[1], w, in_u)
+                else:
+                    # smoothstep: phi = p_lo + d, cos and sin of p_lo in float64 (once a piece), of d in float32
+                    c_lo = wp.cos(p_lo)
+                    s_lo = wp.sin(p_lo)
+                    for jj in range(n):
+                        y = rules[off + jj][0]
+                        d = float(dp * y * y * (wp.float64(3.0) - TWO64 * y))
+                        cd = wp.float64(wp.cos(d))
+                        sd = wp.float64(wp.sin(d))
+                        w = wk * rules[off + jj][1] * dp * wp.float64(6.0) * y * (ONE64 - y)
+                        acc = add_facet(acc, x, sin_h, cos_h, c_lo * cd - s_lo * sd, s_lo * cd + c_lo * sd, w, in_u)
                 p_lo = p_hi
         return acc
 
