@@ -136,13 +136,12 @@ def azimuth_nodes_np(alpha_max: np.ndarray, alpha_min: np.ndarray) -> np.ndarray
 
 
 def frame_average_for(term):
-    """``frame_average(v, h, l, alpha_min, alpha_max, pre) -> vec2``: (mean over the M orientations beta_j = j pi / M,
-    mean over the even ones) of ``term(v, h, l, alpha_min, alpha_max, pre, cos beta_j, sin beta_j)``, float64 sums;
-    ``pre``: what the term shares across orientations (a float64 vec3). The frame's cos, sin of beta_j by a float64
-    rotation recurrence (its rounding ~1e-16 j)."""
+    """``frame_average(v, h, l, alpha_min, alpha_max) -> vec2``: (mean over the M orientations beta_j = j pi / M,
+    mean over the even ones) of ``term(v, h, l, alpha_min, alpha_max, cos beta_j, sin beta_j)``, float64 sums. The
+    frame's cos, sin of beta_j by a float64 rotation recurrence (its rounding ~1e-16 j)."""
 
     @wp.func
-    def frame_average(v: wp.vec3, h: wp.vec3, l: wp.vec3, alpha_min: float, alpha_max: float, pre: wp.vec3d):
+    def frame_average(v: wp.vec3, h: wp.vec3, l: wp.vec3, alpha_min: float, alpha_max: float):
         m = azimuth_nodes(alpha_max, alpha_min)
         step = wp.float64(wp.pi) / wp.float64(m)
         c1 = wp.cos(step)
@@ -152,7 +151,7 @@ def frame_average_for(term):
         all_ = wp.float64(0.0)
         even = wp.float64(0.0)
         for j in range(m):
-            w = term(v, h, l, alpha_min, alpha_max, pre, float(c), float(s))
+            w = term(v, h, l, alpha_min, alpha_max, float(c), float(s))
             all_ = all_ + w
             if j % 2 == 0:
                 even = even + w
@@ -168,9 +167,7 @@ def frame_average_for(term):
 
 
 @wp.func
-def ggx_in_frame(
-    v: wp.vec3, h: wp.vec3, l: wp.vec3, alpha_min: float, alpha_max: float, pre: wp.vec3d, cf: float, sf: float
-):
+def ggx_in_frame(v: wp.vec3, h: wp.vec3, l: wp.vec3, alpha_min: float, alpha_max: float, cf: float, sf: float):
     """D G2 with the tangent frame at (cos, sin) = (cf, sf): anisotropic GGX (Heitz 2014, Eq. 85) with alpha_max along
     the frame's T, alpha_min along B, height-correlated Smith G2 = 1 / (1 + Lambda(v) + Lambda(l)) with the
     anisotropic Lambda (Heitz 2014, Eq. 86)."""
@@ -186,49 +183,45 @@ def ggx_in_frame(
     return wp.float64(1.0 / (wp.pi * alpha_max * alpha_min) / (d * d * (1.0 + lam_v + lam_l)))
 
 
-@wp.func
-def ashikhmin_shirley_in_frame(
-    v: wp.vec3, h: wp.vec3, l: wp.vec3, alpha_min: float, alpha_max: float, pre: wp.vec3d, cf: float, sf: float
-):
-    """(n.h)^((nu h_T^2 + nv h_B^2) / (1 - (n.h)^2)) with the tangent frame at (cf, sf); pre = (nu, nv,
-    log(n.h) / (1 - (n.h)^2)). The exponent in float64 (nu up to 2e8), its exp in float32: relative error |y| 6e-8
-    at exp(-y), <= 2.2e-8 of the lobe's peak (measured: the table within one float32 ulp of float64 exp)."""
-    hx = h[0] * cf + h[1] * sf  # h in the frame
-    hy = h[1] * cf - h[0] * sf
-    e = wp.float64(float(pre[0]) * hx * hx + float(pre[1]) * hy * hy)
-    return wp.float64(wp.exp(float(e * pre[2])))
-
-
 ggx_frame_average = frame_average_for(ggx_in_frame)
-ashikhmin_shirley_frame_average = frame_average_for(ashikhmin_shirley_in_frame)
 
 
 @wp.func
 def averaged_weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha_min: float, alpha_max: float):
     """(mean over the M orientations, over the even ones) of D G2 (v.h) / (n.v) (ggx_in_frame)."""
-    return ggx_frame_average(v, h, l, alpha_min, alpha_max, wp.vec3d()) * (VoH / v[2])
+    return ggx_frame_average(v, h, l, alpha_min, alpha_max) * (VoH / v[2])
 
 
 @wp.func
 def averaged_weight_ashikhmin_shirley(
     v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha_min: float, alpha_max: float
 ):
-    """As averaged_weight for Ashikhmin & Shirley 2000: p_h (n.l) / max(n.l, n.v) (the lobe's g / F) with nu (of
-    alpha_max) along the frame's T and nv (of alpha_min) along B, p_h = sqrt((nu + 1)(nv + 1)) / (2 pi)
-    (n.h)^((nu h_T^2 + nv h_B^2) / (1 - (n.h)^2)) (ndf.D_ashikhmin_shirley); log(n.h) / (1 - (n.h)^2), the same at
-    every frame orientation, once per node (ndf.log_cos; -1/2 at the pole)."""
+    """As averaged_weight for Ashikhmin & Shirley 2000: p_h (n.l) / max(n.l, n.v) (the lobe's g / F) averaged over the
+    frame's orientation beta in closed form. p_h = sqrt((nu + 1)(nv + 1)) / (2 pi) (n.h)^((nu h_T^2 + nv h_B^2) /
+    (1 - (n.h)^2)) (ndf.D_ashikhmin_shirley), nu (of alpha_max) along the frame's T, nv (of alpha_min) along B. With
+    L = log(n.h) (ndf.log_cos64: float64, the exponents reach 2e8) and psi the azimuth of h, the exponent is
+    L ((nu + nv) / 2 + (nu - nv) / 2 cos 2(psi - beta)), and (1 / pi) ∫_0^pi exp(c cos 2 beta) dbeta = I0(c)
+    (Abramowitz & Stegun 1964, Eq. 9.6.16), so the mean is
+        exp(L (nu + nv) / 2) I0(L (nu - nv) / 2) = exp(L min(nu, nv)) i0e(|L| |nu - nv| / 2)     (L <= 0)
+    (ndf.bessel_i0e: no overflow for nu ~ 2e8). Exact: both kernel channels (the M- and M/2-node means of the GGX lobe)
+    hold it, so the azimuth rule's estimate is 0 (it replaced a periodic trapezoid of up to 256 orientations)."""
     nu = ndf.as_exponent(wp.min(alpha_max, 1.0))
     nv = ndf.as_exponent(wp.min(alpha_min, 1.0))
-    x = wp.float64(h[0]) * wp.float64(h[0]) + wp.float64(h[1]) * wp.float64(h[1])
-    ratio = wp.float64(-0.5)
-    if x > wp.float64(1.0e-30):
-        ratio = wp.float64(ndf.log_cos(h)) / x
-    pre = wp.vec3d(wp.float64(nu), wp.float64(nv), ratio)
+    lg = ndf.log_cos64(h)
+    mean = wp.exp(lg * wp.float64(wp.min(nu, nv))) * ndf.bessel_i0e(lg * wp.float64(0.5) * wp.float64(wp.abs(nu - nv)))
     scale = wp.sqrt((nu + 1.0) * (nv + 1.0)) / (2.0 * wp.pi) * l[2] / wp.max(l[2], v[2])
-    return ashikhmin_shirley_frame_average(v, h, l, alpha_min, alpha_max, pre) * scale
+    return wp.vec2(float(mean), float(mean)) * scale
 
 
 AVERAGED = {"microfacet": averaged_weight, "ashikhmin_shirley": averaged_weight_ashikhmin_shirley}
+
+
+def one_node(alpha_max: np.ndarray, alpha_min: np.ndarray) -> np.ndarray:
+    """The closed-form mean's node count (averaged_weight_ashikhmin_shirley): one evaluation a node."""
+    return np.ones(np.shape(alpha_max), np.int64)
+
+
+AVERAGED_NODES = {"microfacet": azimuth_nodes_np, "ashikhmin_shirley": one_node}  # per texel, for the nominal cost
 
 
 @functools.lru_cache(maxsize=None)

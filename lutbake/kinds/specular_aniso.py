@@ -32,12 +32,16 @@ VIEW_AZIMUTHS = {
     "bitangent": "phi_v = pi/2: v in the plane of the bitangent and the normal",
 }
 PHI_V = {"average": -1.0, "tangent": 0.0, "bitangent": 0.5 * np.pi}
-AZIMUTH_RULE = (
-    "inside the integrand: the lobe averaged over the tangent frame's orientation beta in [0, pi) by the periodic "
-    "trapezoid rule, M = 16 alpha_max / alpha_min nodes rounded up to a power of two (<= 256; 1 when isotropic), "
-    "its error estimated by |Q_M - Q_(M/2)| and added to each texel's estimate; the panels of the isotropic lobe at "
-    "alpha_min (lutbake.integrands.anisotropic.averaged_integrand)"
-)
+AZIMUTH_RULES = {
+    "microfacet": "inside the integrand: the lobe averaged over the tangent frame's orientation beta in [0, pi) by the "
+    "periodic trapezoid rule, M = 16 alpha_max / alpha_min nodes rounded up to a power of two (<= 256; 1 when "
+    "isotropic), its error estimated by |Q_M - Q_(M/2)| and added to each texel's estimate; the panels of the "
+    "isotropic lobe at alpha_min (lutbake.integrands.anisotropic.averaged_integrand)",
+    "ashikhmin_shirley": "inside the integrand, in closed form: the lobe's mean over the tangent frame's orientation "
+    "beta, exp(log(n.h) min(nu, nv)) i0e(|log(n.h)| |nu - nv| / 2) (Abramowitz & Stegun 1964, Eq. 9.6.16; exact, no "
+    "azimuth error); the panels of the isotropic lobe at alpha_min, split along n.l = n.v "
+    "(lutbake.integrands.anisotropic.averaged_weight_ashikhmin_shirley)",
+}
 
 KEYS = {
     "model": Key("model", "str", "microfacet", "the anisotropic lobe", ANISO_MODELS),
@@ -88,7 +92,7 @@ def plan(spec) -> TexelPlan:
     alpha = np.tile(np.repeat(rough.alpha(), nx), nz)
     ax, ay = alpha_xy(alpha, np.repeat(an_axis.values(), ny * nx), qmc.mirror)
     if panelled(o):
-        from ..integrands.anisotropic import averaged_integrand, azimuth_nodes_np
+        from ..integrands.anisotropic import AVERAGED_NODES, averaged_integrand
         from ..sampling.anisotropic import AzimuthAveragedGaussLegendre
         from ..sampling.hemisphere import GaussLegendre
 
@@ -97,10 +101,10 @@ def plan(spec) -> TexelPlan:
         estimator = (
             GaussLegendre(o["samples"])
             if o["samples"]
-            else AzimuthAveragedGaussLegendre(tol.absolute, tol.relative, azimuth_nodes=azimuth_nodes_np)
+            else AzimuthAveragedGaussLegendre(tol.absolute, tol.relative, azimuth_nodes=AVERAGED_NODES[o["model"]])
         )
         inputs = {"nov": nov, "alpha": np.minimum(ax, ay), "param": np.maximum(ax, ay)}
-        how = {"view_azimuth_rule": AZIMUTH_RULE}
+        how = {"view_azimuth_rule": AZIMUTH_RULES[o["model"]]}
     else:
         from ..sampling.anisotropic import AnisoSobol
 

@@ -6,6 +6,8 @@ are the inverse and forward CDFs of the polar angle under the density D(m)(n.m) 
 quadrature breakpoints where 1 - u underflows float32 for small alpha).
 """
 
+from typing import Any
+
 import warp as wp
 
 from ..edge import COS_EPS
@@ -107,14 +109,20 @@ def expm1_64(y: wp.float64):
 
 
 @wp.func
-def log_cos(h: wp.vec3):
-    """log(n.h) for a unit h, as 0.5 log(1 - x) with x = h.x^2 + h.y^2 in float64: float32 n.h rounds to 1
-    within ~3e-4 rad of the pole, where (n.h)^s with s ~ 1e8 still varies, and log(n.h) from a rounded n.h
-    has a relative error ~6e-8 / |log(n.h)| that the exponent s amplifies."""
+def log_cos64(h: wp.vec3):
+    """log(n.h) for a unit h in float64, as 0.5 log(1 - x) with x = h.x^2 + h.y^2: float32 n.h rounds to 1 within
+    ~3e-4 rad of the pole, where (n.h)^s with s ~ 1e8 still varies, and log(n.h) from a rounded n.h has a relative
+    error ~6e-8 / |log(n.h)| that the exponent s amplifies."""
     x = wp.float64(h[0]) * wp.float64(h[0]) + wp.float64(h[1]) * wp.float64(h[1])
     if x > wp.float64(0.5):  # n.h < 0.71: log(n.h) directly (|log| > 0.34, no cancellation; finite at n.h -> 0+)
-        return wp.log(wp.max(h[2], 1.0e-30))
-    return float(wp.float64(0.5) * log1p64(-x))
+        return wp.log(wp.max(wp.float64(h[2]), wp.float64(1.0e-30)))
+    return wp.float64(0.5) * log1p64(-x)
+
+
+@wp.func
+def log_cos(h: wp.vec3):
+    """log_cos64 rounded to float32."""
+    return float(log_cos64(h))
 
 
 @wp.func
@@ -184,6 +192,95 @@ def D_ashikhmin_shirley(h: wp.vec3, nu: float, nv: float):
     else:
         r = wp.log(h[2]) / x
     return wp.sqrt((nu + 1.0) * (nv + 1.0)) * 0.5 * INV_PI * wp.exp((nu * h[0] * h[0] + nv * h[1] * h[1]) * r)
+
+
+# --- exp(-x) I0(x), the scaled modified Bessel function of order 0 --------------------------------------------------
+# Cephes' i0e (S. L. Moshier, Cephes Math Library, i0.c; the same tables as numpy.i0): Chebyshev series of exp(-x) I0(x)
+# in t = x / 2 - 2 on [0, 8] and of exp(-x) sqrt(x) I0(x) in t = 32 / x - 2 beyond, summed by Clenshaw's recurrence
+# (Cephes chbevl); relative error ~1e-16 (tests/test_terms.py: against scipy.special.i0e).
+I0E_A = (
+    -4.4153416464793395e-18,
+    3.3307945188222384e-17,
+    -2.431279846547955e-16,
+    1.715391285555133e-15,
+    -1.1685332877993451e-14,
+    7.676185498604936e-14,
+    -4.856446783111929e-13,
+    2.95505266312964e-12,
+    -1.726826291441556e-11,
+    9.675809035373237e-11,
+    -5.189795601635263e-10,
+    2.6598237246823866e-09,
+    -1.300025009986248e-08,
+    6.046995022541919e-08,
+    -2.670793853940612e-07,
+    1.1173875391201037e-06,
+    -4.4167383584587505e-06,
+    1.6448448070728896e-05,
+    -5.754195010082104e-05,
+    0.00018850288509584165,
+    -0.0005763755745385824,
+    0.0016394756169413357,
+    -0.004324309995050576,
+    0.010546460394594998,
+    -0.02373741480589947,
+    0.04930528423967071,
+    -0.09490109704804764,
+    0.17162090152220877,
+    -0.3046826723431984,
+    0.6767952744094761,
+)
+I0E_B = (
+    -7.233180487874754e-18,
+    -4.830504485944182e-18,
+    4.46562142029676e-17,
+    3.461222867697461e-17,
+    -2.8276239805165836e-16,
+    -3.425485619677219e-16,
+    1.7725601330565263e-15,
+    3.8116806693526224e-15,
+    -9.554846698828307e-15,
+    -4.150569347287222e-14,
+    1.54008621752141e-14,
+    3.8527783827421426e-13,
+    7.180124451383666e-13,
+    -1.7941785315068062e-12,
+    -1.3215811840447713e-11,
+    -3.1499165279632416e-11,
+    1.1889147107846439e-11,
+    4.94060238822497e-10,
+    3.3962320257083865e-09,
+    2.266668990498178e-08,
+    2.0489185894690638e-07,
+    2.8913705208347567e-06,
+    6.889758346916825e-05,
+    0.0033691164782556943,
+    0.8044904110141088,
+)
+_I0E_A = wp.constant(wp.types.vector(length=len(I0E_A), dtype=wp.float64)(*I0E_A))
+_I0E_B = wp.constant(wp.types.vector(length=len(I0E_B), dtype=wp.float64)(*I0E_B))
+
+
+@wp.func
+def chebyshev_sum(t: wp.float64, c: Any):
+    """Cephes chbevl: sum_k c_k T_k(t / 2) - c_0 / 2 (Clenshaw's recurrence from the last coefficient)."""
+    b0 = c[0]
+    b1 = wp.float64(0.0)
+    b2 = wp.float64(0.0)
+    for k in range(1, c.length):
+        b2 = b1
+        b1 = b0
+        b0 = t * b1 - b2 + c[k]
+    return wp.float64(0.5) * (b0 - b2)
+
+
+@wp.func
+def bessel_i0e(x: wp.float64):
+    """exp(-|x|) I0(x) (Cephes i0e; I0 is even)."""
+    x = wp.abs(x)
+    if x <= wp.float64(8.0):
+        return chebyshev_sum(x * wp.float64(0.5) - wp.float64(2.0), _I0E_A)
+    return chebyshev_sum(wp.float64(32.0) / x - wp.float64(2.0), _I0E_B) / wp.sqrt(x)
 
 
 @wp.func
