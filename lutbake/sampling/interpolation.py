@@ -169,11 +169,7 @@ class VerifiedInterpolation:
         flat = (z * self.ny + self.y.coarse[rows])[:, None] * self.nx + cols[None, :]
         keys = [int(i).to_bytes(8, "little") for i in flat.ravel()]
 
-        def compute(which):
-            v, e = self.integrate(self.coarse_estimator, flat.ravel()[which], device)
-            return v, e
-
-        v, e = self.memo.run(keys, compute)
+        v, e = self.memo.run(keys, lambda which: self.integrate(self.coarse_estimator, flat.ravel()[which], device))
         shape = (len(rows), len(cols), self.nch)
         return v.reshape(shape), e.reshape(shape), self.grid.smooth[flat]
 
