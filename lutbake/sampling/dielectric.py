@@ -51,10 +51,11 @@ from .hemisphere import (
     PI64,
     TERMS_ROUNDING,
     GaussLegendre,
+    OuterNode,
     _launch,
     _texels,
     asinh64,
-    facet_weight_for,
+    facet_rules_for,
     gl_levels,
     load,
     next_geometric,
@@ -220,26 +221,7 @@ def panel_rule_for(spec):
     acc_type = spec.acc
     d = spec.distribution
     outer_range, outer_node = outer_variable_for(d.tan2_from_u, d.u_from_tan2)
-    facet_weight = facet_weight_for(spec.g, d.pdf_ndf)
-    nch = spec.vec._length_
-
-    @wp.func
-    def add_facet(
-        acc: Any,
-        x: DielectricTexel,
-        sin_h: wp.float64,
-        cos_h: wp.float64,
-        cos_phi: wp.float64,
-        sin_phi: wp.float64,
-        w: wp.float64,
-        in_u: bool,
-    ):
-        """acc plus w g / p (or w g) at the facet (theta_h, phi)."""
-        h = wp.vec3(float(sin_h * cos_phi), float(sin_h * sin_phi), float(cos_h))
-        gw = facet_weight(x.v, h, x.a, x.eta, in_u)
-        for c in range(wp.static(nch)):
-            acc[c] = acc[c] + w * wp.float64(gw[c])
-        return acc
+    add_facet, sinh_piece, _ = facet_rules_for(spec)
 
     @wp.func
     def panel_add(x: DielectricTexel, j: int, rules: Rule, off: int, n: int, acc: Any):
@@ -256,6 +238,7 @@ def panel_rule_for(spec):
             s = rules[off + k][0]
             xs = x_lo + dx * s * s * (wp.float64(3.0) - TWO64 * s)  # smoothstep
             cos_h, sin_h, wk = outer_node(xs, rules[off + k][1] * dx * wp.float64(6.0) * s * (ONE64 - s), in_u, x.a64)
+            f = OuterNode(x.v, x.a, x.eta, in_u, cos_h, sin_h, wk)
             # phi-breakpoints at this theta_h (module docstring)
             den = sin_v * sin_h
             phi_l = PI64
@@ -311,20 +294,9 @@ def panel_rule_for(spec):
                             y = rules[off + jj][0]
                             ex = wp.exp(big_a * (ONE64 - y * y))
                             r = phi_b(ex, ONE64 / ex, eps, big_a, c_hi, s_hi)
-                            w = wk * rules[off + jj][1] * TWO64 * y * r[2]
-                            acc = add_facet(acc, x, sin_h, cos_h, r[0], r[1], w, in_u)
-                    else:  # the GL nodes pair up, y_(n-1-j) = 1 - y_j: one exp per pair (as hemisphere.sinh_piece)
-                        e_a = wp.exp(big_a)
-                        inv_e_a = ONE64 / e_a
-                        for jj in range((n + 1) // 2):
-                            ex = wp.exp(big_a * (ONE64 - rules[off + jj][0]))
-                            inv_ex = ONE64 / ex
-                            r = phi_b(ex, inv_ex, eps, big_a, c_hi, s_hi)
-                            acc = add_facet(acc, x, sin_h, cos_h, r[0], r[1], wk * rules[off + jj][1] * r[2], in_u)
-                            if n - 1 - jj > jj:
-                                r = phi_b(e_a * inv_ex, ex * inv_e_a, eps, big_a, c_hi, s_hi)
-                                w = wk * rules[off + n - 1 - jj][1] * r[2]
-                                acc = add_facet(acc, x, sin_h, cos_h, r[0], r[1], w, in_u)
+                            acc = add_facet(acc, f, r[0], r[1], wk * rules[off + jj][1] * TWO64 * y * r[2])
+                    else:  # the paired-exp sinh rule of the dfg panels
+                        acc = sinh_piece(acc, f, c_hi, s_hi, eps, dp, rules, off, n)
                 else:
                     # smoothstep: phi = p_lo + d, cos and sin of p_lo in float64 (once a piece), of d in float32
                     c_lo = wp.cos(p_lo)
@@ -335,7 +307,7 @@ def panel_rule_for(spec):
                         cd = wp.float64(wp.cos(d))
                         sd = wp.float64(wp.sin(d))
                         w = wk * rules[off + jj][1] * dp * wp.float64(6.0) * y * (ONE64 - y)
-                        acc = add_facet(acc, x, sin_h, cos_h, c_lo * cd - s_lo * sd, s_lo * cd + c_lo * sd, w, in_u)
+                        acc = add_facet(acc, f, c_lo * cd - s_lo * sd, s_lo * cd + c_lo * sd, w)
                 p_lo = p_hi
         return acc
 

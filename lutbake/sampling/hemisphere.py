@@ -355,17 +355,13 @@ def facet_weight_for(integrand, pdf):
 
 
 @functools.lru_cache(maxsize=None)
-def panel_rule_for(spec):
-    """``(panel_of, first_level)`` of make_gauss_legendre's ladder for an integrand record: ``panel_of(t, j, rules,
-    off, n)``, the n x n product rule over panel j of texel t (a PanelTexel of panel_texel), and ``first_level(t,
-    j)``, the panel's first level in ADAPTIVE_ORDERS (also used by benchmarks/replay_ladder.py, which integrates
-    every panel at every order)."""
-    acc_type = spec.acc
-    outer_range, outer_node = outer_variable_for(spec.distribution.tan2_from_u, spec.distribution.u_from_tan2)
+def facet_rules_for(spec):
+    """``(add_facet, sinh_piece, plain_piece)``: the inner rule's pieces for an integrand record (the panel rules of
+    this module and of lutbake.sampling.dielectric). ``add_facet(acc, f, cos phi, sin phi, w)`` adds w g / p at the
+    facet (theta_h of the OuterNode f, phi); ``sinh_piece`` adds the rule over [phimax - width, phimax] by the sinh
+    map, ``plain_piece`` the plain rule over [0, width]."""
     facet_weight = facet_weight_for(spec.g, spec.distribution.pdf_ndf)
     nch = spec.vec._length_
-
-    kinked = spec.nol_kink is not None or spec.kink_at_nov
 
     @wp.func
     def add_facet(acc: Any, f: OuterNode, cos_phi: wp.float64, sin_phi: wp.float64, w: wp.float64):
@@ -414,6 +410,20 @@ def panel_rule_for(spec):
             phi = width * rules[off + j][0]
             acc = add_facet(acc, f, wp.float64(wp.cos(phi)), wp.float64(wp.sin(phi)), f.wk * rules[off + j][1] * width)
         return acc
+
+    return add_facet, sinh_piece, plain_piece
+
+
+@functools.lru_cache(maxsize=None)
+def panel_rule_for(spec):
+    """``(panel_of, first_level)`` of make_gauss_legendre's ladder for an integrand record: ``panel_of(t, j, rules,
+    off, n)``, the n x n product rule over panel j of texel t (a PanelTexel of panel_texel), and ``first_level(t,
+    j)``, the panel's first level in ADAPTIVE_ORDERS (also used by benchmarks/replay_ladder.py, which integrates
+    every panel at every order)."""
+    acc_type = spec.acc
+    outer_range, outer_node = outer_variable_for(spec.distribution.tan2_from_u, spec.distribution.u_from_tan2)
+    add_facet, sinh_piece, plain_piece = facet_rules_for(spec)
+    kinked = spec.nol_kink is not None or spec.kink_at_nov
 
     @wp.func
     def panel_sum(t: PanelTexel, t_lo: wp.float64, t_hi: wp.float64, rules: Rule, off: int, n: int):
