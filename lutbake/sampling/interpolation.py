@@ -142,8 +142,9 @@ def describe(flags: np.ndarray) -> str:
     k = int(np.count_nonzero(flags == INTERPOLATED))
     c = int(np.count_nonzero(flags == COARSE))
     return (
-        f"{k} of {n} texels ({100.0 * k / max(n, 1):.1f} %) interpolated from {c} coarse texels to the tolerance, "
-        f"{n - k - c} integrated (lutbake.sampling.interpolation)"
+        f"{SAFETY:g} max |V(stencil shifted by one node) - V| + sum |w_a w_b| e_ab + 1e-7 |V| "
+        f"(lutbake.sampling.interpolation): {k} of {n} texels ({100.0 * k / max(n, 1):.1f} %) interpolated from {c} "
+        f"coarse ones, {n - k - c} integrated"
     )
 
 

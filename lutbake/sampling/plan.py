@@ -171,11 +171,12 @@ def per_texel_plan(
             err = float(np.max(texel_error[ok] / np.abs(values[ok]))) if ok.any() else 0.0
         met = "every texel" if over == 0 else f"all but {over} of {grid.n_texels} texels, which ended at the last order"
         how = (
-            "per texel: sum over panels of |Q(order k) - Q(order k-1)| at the order that met the tolerance"
-            f"{getattr(estimator, 'estimate_note', '')} ({met}); max error / tolerance = {ratio:.3g}"
+            f"per {'integrated (and coarse) ' if interpolating else ''}texel: sum over panels of |Q(order k) - "
+            f"Q(order k-1)| at the order that met the tolerance{getattr(estimator, 'estimate_note', '')}"
         )
         if interpolating:
-            how += "; " + interpolation.describe(full[:, 2 * nch])
+            how += "; per interpolated texel: " + interpolation.describe(full[:, 2 * nch])
+        how += f" ({met}); max error / tolerance = {ratio:.3g}"
         if relative_error:
             how = "relative (|f| > 1e-6), " + how + f"; max abs {float(np.max(texel_error)):.3e}"
         return err, how
