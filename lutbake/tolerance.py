@@ -33,6 +33,9 @@ HALF_SUBNORMAL_STEP = 2.0**-24
 FLOAT32_ABSOLUTE = 1.0e-6  # the project's float32 accuracy bar (module docstring)
 FLOAT32_RELATIVE = 0.0  # absolute only (the module docstring: 1e-6 is the float32 bar for values up to ~1)
 QUARTER = 0.25
+# the float32 BRDF terms' rounding carried by a texel value, relative (lutbake.sampling.hemisphere adds it to every
+# adaptive estimate; lutbake.sampling.interpolation to the interpolated texels')
+TERMS_ROUNDING = 1.0e-7
 
 
 @dataclass(frozen=True)

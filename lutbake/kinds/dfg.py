@@ -163,7 +163,7 @@ KEYS = {
         "interpolation",
         "str",
         "verified",
-        "texels between every 4th row and column of a table of >= 64 x 64 (gauss_legendre to a tolerance)",
+        "how the texels between every 4th row and column are found (tables of >= 128 x 128 to a tolerance)",
         INTERPOLATIONS,
     ),
 }

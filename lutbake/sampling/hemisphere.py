@@ -57,6 +57,7 @@ from typing import Any
 import numpy as np
 import warp as wp
 
+from .. import tolerance
 from ..catalog import HEMISPHERE_ESTIMATORS
 from ..terms.frame import view_dir
 from . import points
@@ -68,7 +69,7 @@ PI64 = wp.constant(wp.float64(math.pi))
 
 # the BRDF terms run in float32: a texel value carries their rounding, ~1e-7 relative (measured: orders 48 and 64
 # differ by 3e-8 on the 128^2 dfg), which no difference of two orders sees; the error estimate adds it
-TERMS_ROUNDING = wp.constant(wp.float64(1.0e-7))
+TERMS_ROUNDING = wp.constant(wp.float64(tolerance.TERMS_ROUNDING))
 MAX_PANELS = 32  # a texel's panels: <= 22 for n.v >= NOV_MIN, alpha >= ALPHA_MIN (lutbake.edge), 23 with a Charlie lobe
 # an NDF-peak breakpoint within this factor of a horizon breakpoint (or of the panel's start) is dropped: a sliver
 # panel costs a whole product rule at two orders (measured, 256^2 glTF grid: 5.9 -> 4.9 panels per texel; every

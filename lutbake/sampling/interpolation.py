@@ -38,6 +38,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..memo import RowMemo
+from ..tolerance import TERMS_ROUNDING
 
 STRIDE = 4  # coarse texels: every STRIDE-th index of each image axis, and the last
 COARSE_SHARE = 0.25  # their tolerance: this share of the table's (their errors reach interpolated texels x Lebesgue)
@@ -48,7 +49,6 @@ SAFETY = 2.0  # the estimate: SAFETY x the largest difference between the interp
 MIN_AXIS = 128
 TILE_TARGET = 16384  # texels per tile: whole rows, at most about this many
 MIN_TILES = 8  # ... and at least this many tiles per slice (a 128^2 table in one tile kept one core busy)
-TERMS_ROUNDING = 1.0e-7  # lutbake.sampling.hemisphere.TERMS_ROUNDING (not imported: it is a Warp constant there)
 INTEGRATED, COARSE, INTERPOLATED = 0.0, 1.0, 2.0  # a texel's flag in the tile's last aux column
 # interpolants along one axis, as (first node, node count) relative to k, the first coarse node above the texel
 VARIANTS = {"c": (-3, 6), "l": (-4, 6), "r": (-2, 6)}
@@ -115,8 +115,9 @@ def along(a: np.ndarray, idx: np.ndarray, w: np.ndarray, axis: int) -> np.ndarra
     return acc
 
 
-def applies(grid, axes) -> bool:
+def applies(grid) -> bool:
     """Whether a plan of ``grid`` interpolates: a smoothness mask and both image axes at least MIN_AXIS long."""
+    axes = grid.axes
     return grid.smooth is not None and len(axes) >= 2 and min(axes[-1].count, axes[-2].count) >= MIN_AXIS
 
 

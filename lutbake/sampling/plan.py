@@ -150,9 +150,9 @@ def per_texel_plan(
         """Values of texels [s, e), then their error estimates (aux columns)."""
         return np.concatenate(integrate(estimator, slice(s, e), device), 1)
 
-    interpolating = adaptive and interpolate and interpolation.applies(grid, grid.axes)
-    verified = interpolation.VerifiedInterpolation(grid, estimator, integrate, integrand.nch) if interpolating else None
-    if interpolating:
+    verified = None
+    if adaptive and interpolate and interpolation.applies(grid):
+        verified = interpolation.VerifiedInterpolation(grid, estimator, integrate, integrand.nch)
         tolerance_record["interpolation"] = interpolation.METHOD
 
     def adaptive_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
@@ -171,10 +171,10 @@ def per_texel_plan(
             err = float(np.max(texel_error[ok] / np.abs(values[ok]))) if ok.any() else 0.0
         met = "every texel" if over == 0 else f"all but {over} of {grid.n_texels} texels, which ended at the last order"
         how = (
-            f"per {'integrated (and coarse) ' if interpolating else ''}texel: sum over panels of |Q(order k) - "
+            f"per {'integrated (and coarse) ' if verified else ''}texel: sum over panels of |Q(order k) - "
             f"Q(order k-1)| at the order that met the tolerance{getattr(estimator, 'estimate_note', '')}"
         )
-        if interpolating:
+        if verified:
             how += "; per interpolated texel: " + interpolation.describe(full[:, 2 * nch])
         how += f" ({met}); max error / tolerance = {ratio:.3g}"
         if relative_error:
