@@ -30,9 +30,10 @@ kink; the other panels are smoothstep-mapped.
 Per texel: (n.v, alpha, eta) (eta = the kernel's ``param``); GL (node, weight) rules on [0, 1] for the outer and
 inner variables. float64 accumulation, float32 terms. alpha = 0 takes the integrand's closed-form mirror limit.
 ``DielectricGaussLegendre`` is this quadrature at a fixed order, ``DielectricAdaptive`` to a tolerance (each panel up
-DIELECTRIC_ORDERS, the worst panel first: make_adaptive_dielectric), estimators of the lutbake.sampling.plan
-protocol; the QMC estimators of lutbake.sampling.hemisphere serve as the second estimator unchanged (the integrand
-lives in the same half-vector measure).
+DIELECTRIC_ORDERS, the worst panel first, the first estimate x ESTIMATE_SAFETY: make_adaptive_dielectric; an NDF-peak
+point within PEAK_MERGE of another breakpoint dropped, as the dfg estimator's), estimators of the
+lutbake.sampling.plan protocol; the QMC estimators of lutbake.sampling.hemisphere serve as the second estimator
+unchanged (the integrand lives in the same half-vector measure).
 """
 
 from __future__ import annotations
@@ -48,6 +49,7 @@ from . import points
 from .arrays import Levels, Rows64, Rule
 from .hemisphere import (
     PANEL_RATIO,
+    PEAK_MERGE,
     PI64,
     TERMS_ROUNDING,
     GaussLegendre,
@@ -70,6 +72,7 @@ ZERO64 = wp.constant(wp.float64(0.0))
 ONE64 = wp.constant(wp.float64(1.0))
 TWO64 = wp.constant(wp.float64(2.0))
 HALF64 = wp.constant(wp.float64(0.5))
+MERGE64 = wp.constant(wp.float64(PEAK_MERGE))
 MAX_PANELS = 96  # outer panels per texel (a guard; grazing texels at the smallest alpha use ~30)
 vec4d = wp.types.vector(length=4, dtype=wp.float64)
 vec7d = wp.types.vector(length=7, dtype=wp.float64)
@@ -77,17 +80,22 @@ vec7d = wp.types.vector(length=7, dtype=wp.float64)
 
 @wp.func
 def next_theta_dielectric(
-    t_lo: wp.float64, theta_a: wp.float64, theta_b: wp.float64, theta_peak: wp.float64, kinks: vec7d
+    t_lo: wp.float64,
+    theta_a: wp.float64,
+    theta_b: wp.float64,
+    theta_peak: wp.float64,
+    kinks: vec7d,
+    merge: wp.float64,
 ):
-    """Upper edge of the outer panel starting at t_lo: the smallest candidate above t_lo among the NDF-peak points
-    theta_peak R^j, the horizon grading (theta_a R^j below pi/4; pi/2 - (pi/2 - t_lo)/R up to theta_b) and the kinks."""
+    """Upper edge of the outer panel starting at t_lo: the smallest candidate above t_lo among the horizon grading
+    (theta_a R^j below pi/4; pi/2 - (pi/2 - t_lo)/R up to theta_b), the kinks and the NDF-peak points
+    theta_peak R^j; a peak point within a factor ``merge`` of the next other candidate or of t_lo is skipped (D is
+    analytic there: a scale, not a kink; PEAK_MERGE to a tolerance, 1 at the fixed order, as
+    lutbake.sampling.hemisphere.next_theta)."""
     quarter = PI64 * wp.float64(0.25)
     half = PI64 * wp.float64(0.5)
     tiny = wp.float64(1.0e-12) * (wp.float64(1.0) + t_lo)
     t = half
-    c = next_geometric(t_lo, theta_peak)
-    if c > t_lo + tiny:
-        t = wp.min(t, c)
     if t_lo < quarter:
         c = wp.min(next_geometric(t_lo, theta_a), quarter)
     else:
@@ -101,6 +109,9 @@ def next_theta_dielectric(
         c = wp.min(next_geometric(t_lo, kinks[1]), quarter)
         if c > t_lo + tiny:
             t = wp.min(t, c)
+    tp = next_geometric(t_lo, theta_peak)
+    if tp > t_lo + tiny and tp < t and tp * merge <= t and (t_lo <= ZERO64 or t_lo * merge <= tp):
+        t = tp
     return t
 
 
@@ -167,8 +178,9 @@ class DielectricTexel:
 
 
 @wp.func
-def dielectric_texel(t: wp.vec3):
-    """The texel (n.v, alpha, eta) with its kinks and outer panels (module docstring); no panel at alpha = 0."""
+def dielectric_texel(t: wp.vec3, merge: wp.float64):
+    """The texel (n.v, alpha, eta) with its kinks and outer panels (module docstring; ``merge``:
+    next_theta_dielectric's); no panel at alpha = 0."""
     v, a, eta_f, a64, cos_v, sin_v, eps_l, theta_a, theta_b, theta_peak = texel_view(t)
     eta = wp.float64(eta_f)
     half = PI64 * HALF64
@@ -193,7 +205,7 @@ def dielectric_texel(t: wp.vec3):
     n_panels = wp.int32(0)  # a dynamic variable (a literal 0 is a constant to Warp)
     edges[0] = t_lo
     while t_lo < half:
-        t_lo = next_theta_dielectric(t_lo, theta_a, theta_b, theta_peak, kinks)
+        t_lo = next_theta_dielectric(t_lo, theta_a, theta_b, theta_peak, kinks, merge)
         if n_panels == MAX_PANELS - 1:  # never reached (MAX_PANELS): the last panel takes the rest, none is dropped
             t_lo = half
         n_panels += 1
@@ -329,7 +341,7 @@ def make_gauss_legendre_dielectric(spec):
     @wp.kernel(enable_backward=False, module="unique")
     def gauss_legendre_dielectric_kernel(texel: wp.array(dtype=wp.vec3), rule: Rule, out: Rows64):
         i = wp.tid()
-        x = dielectric_texel(texel[i])
+        x = dielectric_texel(texel[i], ONE64)  # every breakpoint at the fixed order (its values as before PEAK_MERGE)
         acc = acc_type()
         for j in range(x.n_panels):
             acc = panel_add(x, j, rule, 0, rule.shape[0], acc)
@@ -343,12 +355,13 @@ def make_gauss_legendre_dielectric(spec):
 
 def make_adaptive_dielectric(spec):
     """The kernel to a tolerance: the outer panels of the fixed-order kernel up the GL orders ``levels``, refined
-    greedily (lutbake.sampling.ladder.greedy_ladder_for) until, per channel c, the estimate err = sum over panels of
-    |Q_(k) - Q_(k-1)| / pi + TERMS_ROUNDING |I_c| (float32 terms, as lutbake.sampling.hemisphere.make_gauss_legendre)
-    is within max(tol_abs[c], tol_rel[c] |I_c|). Inputs: texel, rules, levels (lutbake.sampling.hemisphere.gl_levels),
-    tol_abs, tol_rel (vec3d: per kernel channel), out, err."""
+    greedily (lutbake.sampling.ladder.greedy_ladder_for) until, per channel c, the estimate
+    err = sum over panels of |Q_(k) - Q_(k-1)| / pi (x ESTIMATE_SAFETY at a panel's first two orders)
+    + TERMS_ROUNDING |I_c| (float32 terms, as lutbake.sampling.hemisphere.make_gauss_legendre) is within
+    max(tol_abs[c], tol_rel[c] |I_c|) (the outer panels with the peak merge). Inputs: texel, rules, levels
+    (lutbake.sampling.hemisphere.gl_levels), tol_abs, tol_rel (vec3d: per kernel channel), out, err."""
     mirror = spec.mirror
-    integrate = greedy_ladder_for(panel_rule_for(spec)[1], MAX_PANELS, spec.acc._length_)[0]
+    integrate = greedy_ladder_for(panel_rule_for(spec)[1], MAX_PANELS, spec.acc._length_, safety=ESTIMATE_SAFETY)[0]
     nch = spec.vec._length_
 
     @wp.kernel(enable_backward=False, module="unique")
@@ -362,7 +375,7 @@ def make_adaptive_dielectric(spec):
         err: Rows64,
     ):
         i = wp.tid()
-        x = dielectric_texel(texel[i])
+        x = dielectric_texel(texel[i], MERGE64)
         # the estimate, TERMS_ROUNDING included, within the tolerance (in units of the sum: I = sum / pi)
         total, e = integrate(x, x.n_panels, rules, levels, PI64 * tol_abs, tol_rel, TERMS_ROUNDING)
         for c in range(wp.static(nch)):
@@ -398,16 +411,20 @@ class DielectricGaussLegendre(GaussLegendre):
         return _launch(self._kernel(integrand), inputs, [rule], integrand.kernel_channels, device)
 
 
-# the ladder's orders, from 8 in steps of 8 (2x first). Close first orders agreed by coincidence where the convergence
-# stagnates (measured against order 64 on 3005 random + edge texels: at (n.v, alpha, eta) = (0.24, 0.042, 0.49) order 8
-# is off by 9e-7, order 12 by 6e-7; error / estimate up to 10.6 from (8, 10), 2.2 from (8, 12), 1.3 from (6, 8)), and
-# (6, 12) on EEVEE's btdf grazing row (n.v = 1e-4, alpha = 0.071, eta = 1.063: error 1.12e-6 under an estimate of
-# 8.4e-7, its transmission channel alone driving the ladder); from (8, 16) every estimate bounds the error there
-# (tests/test_dielectric.py), at ~10 % more work than from (6, 12). The first climb is 16 -> 20 (was 24): replayed
-# offline on every panel's orders 6..64 (benchmarks/replay_ladder.py: 2500 random texels and the grazing row of each of
-# EEVEE's btdf and bsdf, Turquin's and OpenPBR's tables) 7-9 % fewer evaluations, worst error / estimate 0.90 (from
-# 16 -> 24: 0.43); 8 -> 14 saved 14-22 % but reached 0.97, and 8 -> 12 passed errors over their estimates (2.2)
-DIELECTRIC_ORDERS = (8, 16, 20, 24, 32, 48, 64)
+# the ladder's orders and the factor on its first estimate (lutbake.sampling.ladder's ``safety``: a panel's first two
+# levels only). Close first orders agree by coincidence where the convergence stagnates (against order 64 on 3005
+# random + edge texels: at (n.v, alpha, eta) = (0.24, 0.042, 0.49) order 8 is off by 9e-7, order 12 by 6e-7; error /
+# estimate up to 10.6 from (8, 10), 2.2 from (8, 12); from (6, 12) 1.33 on EEVEE's btdf grazing row, n.v = 1e-4,
+# alpha = 0.071, eta = 1.063). Until 2026-12-02 the ladder started at (8, 16), factor 1. Replayed offline on every
+# panel's orders 4..64 (benchmarks/replay_ladder.py: 1500 random texels and the grazing row of each of EEVEE's btdf and
+# bsdf, Turquin's and OpenPBR's tables, the peak merge of next_theta_dielectric in place), (6, 11, 16, ...) with factor
+# 2 on the first pair costs 0.73-0.79x the evaluations of (8, 16, ...), no estimate passed by its error, worst error /
+# estimate 0.39, 0.69, 0.35, 0.50 (from (8, 16): 0.40, 0.89, 0.30, 0.26); factor 1 from (6, 12) reached 1.30 on the
+# bsdf, factor 2 from (6, 9, ...) 2.8 and from (4, 6, ...) 9.1; the factor on every climb too passed more texels' top
+# order (48 -> 64) over their tolerance (16 against 3 on the bsdf) for 3 % less work. The first climb is 16 -> 20
+# (16 -> 24 cost 7-9 % more)
+DIELECTRIC_ORDERS = (6, 11, 16, 20, 24, 32, 48, 64)
+ESTIMATE_SAFETY = 2.0
 
 
 @dataclass(frozen=True)
