@@ -339,9 +339,9 @@ def make_gauss_legendre_dielectric(spec):
     nch = spec.vec._length_
 
     @wp.kernel(enable_backward=False, module="unique")
-    def gauss_legendre_dielectric_kernel(texel: wp.array(dtype=wp.vec3), rule: Rule, out: Rows64):
+    def gauss_legendre_dielectric_kernel(texel: wp.array(dtype=wp.vec3), rule: Rule, merge: wp.float64, out: Rows64):
         i = wp.tid()
-        x = dielectric_texel(texel[i], ONE64)  # every breakpoint at the fixed order (its values as before PEAK_MERGE)
+        x = dielectric_texel(texel[i], merge)
         acc = acc_type()
         for j in range(x.n_panels):
             acc = panel_add(x, j, rule, 0, rule.shape[0], acc)
@@ -401,14 +401,19 @@ def adaptive_dielectric_kernel(spec):
 @dataclass(frozen=True)
 class DielectricGaussLegendre(GaussLegendre):
     """The ``gauss_legendre`` estimator of the dielectric kinds (lutbake.sampling.hemisphere.GaussLegendre with this
-    module's kernel): order n = gl_order(budget) per panel in both variables; the panel count varies per texel."""
+    module's kernel): order n = gl_order(budget) per panel in both variables; the panel count varies per texel.
+    ``merge``: next_theta_dielectric's (1: every breakpoint, the pixels of a fixed-order table as before PEAK_MERGE;
+    PEAK_MERGE: kind dielectric_avg's inner rule, whose error its probe measures)."""
+
+    merge: float = 1.0
 
     def _kernel(self, integrand):
         return gl_dielectric_kernel(integrand)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         rule = wp.array(np.stack(points.gauss_legendre(self.order), axis=1), dtype=wp.vec2d, device=device)
-        return _launch(self._kernel(integrand), inputs, [rule], integrand.kernel_channels, device)
+        args = [rule, wp.float64(self.merge)]
+        return _launch(self._kernel(integrand), inputs, args, integrand.kernel_channels, device)
 
 
 # the ladder's orders and the factor on its first estimate (lutbake.sampling.ladder's ``safety``: a panel's first two
