@@ -522,6 +522,24 @@ def test_adaptive_first_pair_is_the_merged_fixed_rules_with_a_doubled_estimate()
     )
 
 
+@pytest.mark.parametrize(
+    "texel",
+    [
+        (0.9999, 0.017778, 1.0e-4),  # EEVEE bsdf's clamped eta column: a transmitting cone 5e-9 wide in v.h
+        (0.9999, 0.017778, 0.003),
+        (0.99241, 0.0044444, 0.126),  # the view at the critical angle, smallest roughness
+        (1.0e-4, 0.017778, 1.0002),  # EEVEE btdf's grazing row, clamped eta column
+    ],
+)
+def test_small_eta_and_critical_angle_match_numpy(texel):
+    """v.h and the refraction in float64 (lutbake.integrands.dielectric g64): float32's v.h, amplified by 1/eta^2
+    next to total internal reflection, and v's float32 components (unit to ~1e-8) left these 1e-6 to 4e-5 off."""
+    nov, alpha, eta = (np.atleast_1d(x) for x in f32(*texel))
+    e = kd.integrate(("ggx", "smith_separable", "eevee", "gauss_legendre"), nov, alpha, eta, 3 * HIGH_ORDER**2)[0]
+    want = ref.energies(float(nov[0]), float(alpha[0]), float(eta[0]), fresnel="eevee")
+    np.testing.assert_allclose(e, want, rtol=0, atol=NUMPY_ACCURACY)  # measured: within 5.9e-8 (float32 D, G)
+
+
 def test_avg_mu_rule_reaches_the_tolerance():
     """kind dielectric_avg's mu rule bisects each texel's worst panel until the Gauss-Kronrod pair (7, 15) agrees
     within a quarter of the tolerance: inside the glass at small roughness E(mu) crosses the total-internal-reflection

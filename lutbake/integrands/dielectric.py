@@ -19,6 +19,10 @@ A *Fresnel mode* picks the channels (each a weight of the two lobes at the same 
                  s = (1 - |x.h|)^5, x = v for eta >= 1 (ggx_btdf_gt_one), x = t for eta < 1 (ggx_bsdf_split_sum;
                  s = 1 under total internal reflection, where EEVEE's refract() returns 0)
 with w_R = D G2(v, l) (v.h) / mu [n.l > 0] and w_T = D G2(v, t) (v.h) / mu [n.t < 0].
+Precision: v.h, cos theta_t, n.t and the exact Fresnel term are float64 (``g64`` takes v.h from the panel rules'
+float64 angles; ``g`` rounds it from float32 v and h), the rest float32: next to total internal reflection
+eta^2 - 1 + (v.h)^2 cancels and float32's rounding of v.h reaches cos theta_t amplified by 1/eta^2
+(docs/transmission.md).
 """
 
 from __future__ import annotations
@@ -30,7 +34,7 @@ import warp as wp
 from ..catalog import DIELECTRIC_MASKINGS
 from ..edge import COS_EPS
 from ..terms import fresnel
-from ..terms.dielectric import cos_transmitted, refract
+from ..terms.dielectric import F_dielectric64, cos_transmitted, cos_transmitted64
 from ..terms.distributions import NDFS
 from ..terms.frame import reflect
 from .specular import SpecularIntegrand
@@ -44,7 +48,8 @@ FRESNEL_MODES = {
 
 @functools.lru_cache(maxsize=None)
 def integrand_for(ndf_name: str, masking_name: str, mode: str):
-    """``g(v, h, alpha, eta) -> wp.vec3`` (module docstring); 0 for v.h, n.v <= COS_EPS or n.h <= 0."""
+    """``(g, g64)``: ``g(v, h, alpha, eta) -> wp.vec3`` (module docstring; 0 for v.h, n.v <= COS_EPS or n.h <= 0) and
+    ``g64(v, h, alpha, eta, v.h as float64)``, the same given v.h to float64 (the panel rules know it)."""
     if mode not in FRESNEL_MODES:
         raise KeyError(f"unknown Fresnel mode {mode!r}; valid: {', '.join(FRESNEL_MODES)}")
     if masking_name not in DIELECTRIC_MASKINGS:
@@ -55,9 +60,12 @@ def integrand_for(ndf_name: str, masking_name: str, mode: str):
     G2 = NDFS[ndf_name].G2(masking_name)
 
     @wp.func
-    def integrand(v: wp.vec3, h: wp.vec3, alpha: float, eta: float):
+    def integrand64(v: wp.vec3, h: wp.vec3, alpha: float, eta: float, c: wp.float64):
+        """The integrand given v.h = c to float64: the refraction (cos theta_t, n.t) and the Fresnel term from c in
+        float64 (lutbake.terms.dielectric.cos_transmitted64: near total internal reflection float32's v.h is
+        amplified by 1/eta^2), the rest in float32."""
         NoV = v[2]
-        VoH = wp.dot(v, h)
+        VoH = float(c)
         if NoV <= COS_EPS or VoH <= COS_EPS or h[2] <= 0.0:
             return wp.vec3()
         w = D(h, alpha) * VoH / NoV
@@ -65,23 +73,30 @@ def integrand_for(ndf_name: str, masking_name: str, mode: str):
         w_r = w * 0.0  # dynamic (a literal is a constant to Warp)
         if NoL > COS_EPS:
             w_r = w * G2(NoV, NoL, h[2], VoH, alpha)
-        t = refract(v, h, eta)
-        NoT = -t[2]
+        e = wp.float64(eta)
+        ct = cos_transmitted64(e, c)  # -1 under total internal reflection
         w_t = w * 0.0
-        if NoT > COS_EPS:
-            w_t = w * G2(NoV, NoT, h[2], VoH, alpha)
+        if ct >= wp.float64(0.0):
+            # t = (v.h / eta - cos theta_t) h - v / eta (lutbake.terms.dielectric.refract), n.t in float64
+            NoT = float((wp.float64(v[2]) / e) - (c / e - ct) * wp.float64(h[2]))
+            if NoT > COS_EPS:
+                w_t = w * G2(NoV, NoT, h[2], VoH, alpha)
         if wp.static(mode == "eevee"):
             x = VoH
             if eta < 1.0:
-                x = -wp.dot(t, h)  # 0 under TIR: s = 1
+                x = float(wp.max(ct, wp.float64(0.0)))  # t.h = -cos theta_t; 0 under TIR: s = 1
             s = fresnel.Fc_schlick(x)
             return wp.vec3((1.0 - s) * w_r, s * w_r, (1.0 - s) * w_t)
-        F = fresnel.F_dielectric(eta, VoH)
+        F = float(F_dielectric64(e, c, ct))
         if wp.static(mode == "exact_metal"):
             return wp.vec3(F * w_r, (1.0 - F) * w_t, w_r)
         return wp.vec3(F * w_r, (1.0 - F) * w_t, F * w_r + (1.0 - F) * w_t)
 
-    return integrand
+    @wp.func
+    def integrand(v: wp.vec3, h: wp.vec3, alpha: float, eta: float):
+        return integrand64(v, h, alpha, eta, wp.float64(wp.dot(v, h)))
+
+    return integrand, integrand64
 
 
 @functools.lru_cache(maxsize=None)
@@ -114,13 +129,15 @@ def mirror_for(mode: str):
 def dielectric_integrand(ndf_name: str, masking_name: str, mode: str, nch: int = 3) -> SpecularIntegrand:
     """The integrand record (lutbake.integrands.specular.SpecularIntegrand: g, vec, distribution, mirror) of a
     (terms, Fresnel mode) key; the kernels' per-texel ``param`` is the relative IOR eta."""
+    g, g64 = integrand_for(ndf_name, masking_name, mode)
     return SpecularIntegrand(
         ("dielectric", ndf_name, masking_name, mode),
-        integrand_for(ndf_name, masking_name, mode),
+        g,
         wp.vec3,
         wp.vec3d,
         3,
         nch,
         NDFS[ndf_name],
         mirror_for(mode),
+        g64=g64,
     )

@@ -240,7 +240,9 @@ class SpecularIntegrand:
     n.l = n.v, a kink per texel (Ashikhmin-Shirley's max(n.l, n.v)), split the same way. ``grazing_peak``: g has a
     Charlie lobe, whose NDF peaks at theta_h = pi/2 (the gauss_legendre panels grade towards the end of the
     half-vector domain). ``ndf_peak``: g has the lobe of ``distribution`` (False for the sheen layouts, whose GGX
-    distribution only panels: no u = CDF(theta_h) variable).
+    distribution only panels: no u = CDF(theta_h) variable). ``g64(v, h, alpha, param, v.h as float64)``: g given
+    v.h to float64, where float32's rounding of it matters (the dielectric's refraction near total internal
+    reflection); the gauss_legendre panel rules pass it (lutbake.sampling.hemisphere.facet_rules_for), else None.
     """
 
     key: tuple
@@ -255,6 +257,7 @@ class SpecularIntegrand:
     grazing_peak: bool = False
     ndf_peak: bool = True
     kink_at_nov: bool = False
+    g64: object | None = None
 
     def alpha_input(self, alpha) -> np.ndarray:
         """The per-texel alpha the kernels receive (float32): lutbake.edge.effective_alpha."""

@@ -28,7 +28,9 @@ phi-breakpoints: a panel ending at a horizon (phi_l or phi_t) uses the sinh map 
 (G2 has a pole at n.o = -alpha / (1 + 2 Lambda(v)) just past the cut), with x -> x^2 at its lower end when that end is a
 kink; the other panels are smoothstep-mapped.
 Per texel: (n.v, alpha, eta) (eta = the kernel's ``param``); GL (node, weight) rules on [0, 1] for the outer and
-inner variables. float64 accumulation, float32 terms. alpha = 0 takes the integrand's closed-form mirror limit.
+inner variables. float64 accumulation, float32 terms but for v.h, the refraction and the Fresnel term (the
+integrand's g64, from the node's float64 angles: near total internal reflection float32's v.h is amplified by 1/eta^2).
+alpha = 0 takes the integrand's closed-form mirror limit.
 ``DielectricGaussLegendre`` is this quadrature at a fixed order, ``DielectricAdaptive`` to a tolerance (each panel up
 DIELECTRIC_ORDERS, the worst panel first, the first estimate x ESTIMATE_SAFETY: make_adaptive_dielectric; an NDF-peak
 point within PEAK_MERGE of another breakpoint dropped, as the dfg estimator's), estimators of the
@@ -182,6 +184,9 @@ def dielectric_texel(t: wp.vec3, merge: wp.float64):
     """The texel (n.v, alpha, eta) with its kinks and outer panels (module docstring; ``merge``:
     next_theta_dielectric's); no panel at alpha = 0."""
     v, a, eta_f, a64, cos_v, sin_v, eps_l, theta_a, theta_b, theta_peak = texel_view(t)
+    # v's float32 components are unit to ~1e-8 only: sin theta_v from n.v (the texel's) in float64, as the panel
+    # rule's v.h (the critical angle's cone, 1 - cos theta_c = eta^2 / 2 wide in v.h, is that narrow at eta = 1e-4)
+    sin_v = wp.sqrt(wp.max(ONE64 - cos_v * cos_v, ZERO64))
     eta = wp.float64(eta_f)
     half = PI64 * HALF64
     theta_v = wp.atan2(sin_v, cos_v)

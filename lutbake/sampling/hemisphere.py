@@ -355,6 +355,22 @@ def facet_weight_for(integrand, pdf):
     return facet_weight
 
 
+def facet_weight64_for(integrand64, pdf):
+    """facet_weight for an integrand that takes v.h to float64 too (SpecularIntegrand.g64)."""
+
+    @wp.func
+    def facet_weight64(v: wp.vec3, h: wp.vec3, a: float, prm: float, in_u: bool, voh: wp.float64):
+        g = integrand64(v, h, a, prm, voh)
+        if in_u:
+            p = pdf(v, h, a)
+            if p > 0.0:
+                return g / p
+            return g * 0.0
+        return g
+
+    return facet_weight64
+
+
 @functools.lru_cache(maxsize=None)
 def facet_rules_for(spec):
     """``(add_facet, sinh_piece, plain_piece)``: the inner rule's pieces for an integrand record (the panel rules of
@@ -362,13 +378,23 @@ def facet_rules_for(spec):
     facet (theta_h of the OuterNode f, phi); ``sinh_piece`` adds the rule over [phimax - width, phimax] by the sinh
     map, ``plain_piece`` the plain rule over [0, width]."""
     facet_weight = facet_weight_for(spec.g, spec.distribution.pdf_ndf)
+    with_voh = getattr(spec, "g64", None) is not None
+    if with_voh:
+        facet_weight64 = facet_weight64_for(spec.g64, spec.distribution.pdf_ndf)
     nch = spec.vec._length_
 
     @wp.func
     def add_facet(acc: Any, f: OuterNode, cos_phi: wp.float64, sin_phi: wp.float64, w: wp.float64):
-        """acc plus w g / p at the facet (theta_h of the outer node f, phi)."""
+        """acc plus w g / p at the facet (theta_h of the outer node f, phi); an integrand with g64 gets v.h from
+        the node's float64 angles and v = (sqrt(1 - (n.v)^2), 0, n.v) in float64 (unit)."""
         h = wp.vec3(float(f.sin_h * cos_phi), float(f.sin_h * sin_phi), float(f.cos_h))
-        gw = facet_weight(f.v, h, f.a, f.prm, f.in_u)
+        if wp.static(with_voh):
+            v2 = wp.float64(f.v[2])
+            v0 = wp.sqrt(wp.max(wp.float64(1.0) - v2 * v2, wp.float64(0.0)))
+            voh = f.sin_h * cos_phi * v0 + f.cos_h * v2
+            gw = facet_weight64(f.v, h, f.a, f.prm, f.in_u, voh)
+        else:
+            gw = facet_weight(f.v, h, f.a, f.prm, f.in_u)
         for c in range(wp.static(nch)):
             acc[c] = acc[c] + w * wp.float64(gw[c])
         return acc

@@ -29,6 +29,28 @@ def cos_transmitted(eta: float, VoH: float):
 
 
 @wp.func
+def cos_transmitted64(eta: wp.float64, VoH: wp.float64):
+    """cos_transmitted in float64, for a v.h known to float64: near total internal reflection eta^2 - 1 + (v.h)^2
+    cancels, and float32's rounding of v.h (~6e-8) reaches cos theta_t amplified by 1/eta^2 (63 at eta = 0.126)."""
+    s = (eta * eta - wp.float64(1.0) + VoH * VoH) / (eta * eta)
+    if s <= wp.float64(0.0):
+        return wp.float64(-1.0)
+    return wp.sqrt(s)
+
+
+@wp.func
+def F_dielectric64(eta: wp.float64, c: wp.float64, ct: wp.float64):
+    """F_dielectric (Walter et al. 2007, Eq. 22) in float64 from v.h = c and cos theta_t = ct (cos_transmitted64;
+    g = eta ct): 1 under total internal reflection (ct < 0)."""
+    if ct < wp.float64(0.0):
+        return wp.float64(1.0)
+    g = eta * ct
+    a = (g - c) / (g + c)
+    b = (c * (g + c) - wp.float64(1.0)) / (c * (g - c) + wp.float64(1.0))
+    return wp.float64(0.5) * a * a * (wp.float64(1.0) + b * b)
+
+
+@wp.func
 def refract(v: wp.vec3, h: wp.vec3, eta: float):
     """The direction t refracted from v through the facet h (Walter et al. 2007, Eq. 40, with v pointing away from
     the surface on the incident side, v.h > 0):  t = (v.h / eta - cos theta_t) h - v / eta,  so t.h = -cos theta_t.
