@@ -36,7 +36,8 @@ def read_exr(path: Path) -> np.ndarray:
         while inp.seek_subimage(sub, 0):
             spec = inp.spec()
             parts.append(
-                np.asarray(inp.read_image(0, spec.nchannels, oiio.FLOAT), np.float64).reshape(
+                # (subimage, miplevel, chbegin, chend, format): read_image(chbegin, chend, format) returns part 0
+                np.asarray(inp.read_image(sub, 0, 0, spec.nchannels, oiio.FLOAT), np.float64).reshape(
                     spec.height, spec.width, spec.nchannels
                 )
             )

@@ -9,10 +9,6 @@ the last order stays; of several channels over their targets, the one furthest o
 of the tolerance, the texel's error budget goes where the error is: panels far below the tolerance stop at the second
 order.
 
-``safety`` (>= 1) scales the d of every panel's first two levels: low, close first orders (cheap) can agree by
-coincidence where the convergence has not set in, and a factor on that first estimate keeps it a bound there; a panel
-one order up has d unscaled (measured per ladder by benchmarks/replay_ladder.py).
-
 ``greedy_ladder_for(panel_sum, max_panels, nch)`` closes over the panel rule ``panel_sum(ctx, j, rules, offset, order)
 -> value`` (``ctx``: the texel's constants, a Warp struct; ``j``: the panel's index, 0 .. n_panels - 1; an empty
 panel returns 0 at every order); the value is a float64 (nch = 1) or a float64 vector of nch channels (vec2d, vec3d),
@@ -50,7 +46,7 @@ def channel(x: wp.vec4d, c: int):  # noqa: F811 (a Warp overload)
 
 
 @functools.lru_cache(maxsize=None)
-def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None, safety: float = 1.0):
+def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None):
     """``(integrate, climb, Panels, Sums, Orders)``: ``integrate(ctx, n_panels, rules, levels, target_abs, target_rel,
     floor) -> (total, err)`` (``Sums``: float64 vectors of nch, the targets per channel too): every panel at the first
     two levels, then refined until err_c = sum_p d_(p,c) <= max(target_abs_c, target_rel_c |total_c|) - floor
@@ -62,8 +58,7 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None
     fine0 at levels[lev[j]], coarse0 at levels[lev[j] - 1]; ``Orders``: int32 vectors of max_panels), e.g. computed
     for several texels that share per-node work: the same float operations, so the same result.
     ``first_level(ctx, j) -> k`` (optional): panel j starts at levels k and k + 1 instead of the first two (a panel
-    class known to converge fast; clamped to the ladder). ``safety``: the factor on the first two levels' d (module
-    docstring)."""
+    class known to converge fast; clamped to the ladder)."""
     Panels = wp.types.matrix(shape=(max_panels, nch), dtype=wp.float64)
     Sums = wp.types.vector(length=nch, dtype=wp.float64)
     Orders = wp.types.vector(length=max_panels, dtype=wp.int32)  # a panel's level
@@ -87,7 +82,7 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None
         for j in range(n_panels):
             for c in range(wp.static(nch)):
                 q[j, c] = fine0[j, c]
-                d[j, c] = wp.float64(wp.static(safety)) * wp.abs(fine0[j, c] - coarse0[j, c])
+                d[j, c] = wp.abs(fine0[j, c] - coarse0[j, c])
         total = Sums()
         err = Sums()
         climbing = wp.bool(True)  # a dynamic variable (Warp: a bare literal is a constant)
