@@ -496,29 +496,29 @@ def test_adaptive_estimate_of_eevee_btdf_grazing_row_bounds_the_error():
     print(f"eevee_btdf grazing: worst error / estimate {honesty_ratio(err, est[:, 2]):.3f}")
 
 
-def test_adaptive_first_pair_is_the_merged_fixed_rules_with_a_doubled_estimate():
-    """With a tolerance no texel misses, every panel stops at the ladder's first pair (orders 6 and 11): the value is
-    the fixed-order rule of order 11 on the same merged panels (DielectricGaussLegendre with merge = PEAK_MERGE, one
-    accumulator instead of a sum per panel: equal to rounding), and the estimate is ESTIMATE_SAFETY x the sum over
-    panels of |Q_11 - Q_6| plus the terms' floor, so at least twice |I_11 - I_6| of the whole texel."""
+def test_adaptive_first_pair_is_the_merged_fixed_rules():
+    """With a tolerance no texel misses, every panel stops at the ladder's first pair (orders 8 and 16): the value is
+    the fixed-order rule of order 16 on the same merged panels (DielectricGaussLegendre with merge = PEAK_MERGE, one
+    accumulator instead of a sum per panel: equal to rounding), and the estimate is the sum over panels of
+    |Q_16 - Q_8| plus the terms' floor, so at least |I_16 - I_8| of the whole texel."""
     from lutbake.integrands.dielectric import dielectric_integrand
     from lutbake.sampling import dielectric as sd
     from lutbake.sampling.hemisphere import PEAK_MERGE
 
-    assert sd.DIELECTRIC_ORDERS[:2] == (6, 11) and sd.ESTIMATE_SAFETY == 2.0
+    assert sd.DIELECTRIC_ORDERS[:2] == (8, 16)
     nov, alpha, eta = (np.asarray(c, np.float32) for c in zip(*HONESTY_TEXELS))
     integrand = dielectric_integrand("ggx", "smith_separable", "exact")
     inputs = {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": eta}
     values, est = sd.DielectricAdaptive((1.0,) * 3, (0.0,) * 3).evaluate_with_error(integrand, inputs, "cpu")
-    q6, q11 = (
-        sd.DielectricGaussLegendre(3 * n * n, merge=PEAK_MERGE).evaluate(integrand, inputs, "cpu") for n in (6, 11)
+    q8, q16 = (
+        sd.DielectricGaussLegendre(3 * n * n, merge=PEAK_MERGE).evaluate(integrand, inputs, "cpu") for n in (8, 16)
     )
-    np.testing.assert_allclose(values, q11, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(values, q16, rtol=0, atol=1e-14)
     quadrature = est - TERMS_FLOOR * np.abs(values)
-    assert np.all(quadrature >= 2.0 * np.abs(q11 - q6) * (1.0 - 1e-9))  # (rounding of est - floor |v|)
+    assert np.all(quadrature >= np.abs(q16 - q8) * (1.0 - 1e-9))  # (rounding of est - floor |v|)
     # the merge drops some texel's NDF-peak breakpoints (a fixed-order table keeps them all)
     assert np.any(
-        q11 != kd.integrate(("ggx", "smith_separable", "exact", "gauss_legendre"), nov, alpha, eta, 3 * 11**2)
+        q16 != kd.integrate(("ggx", "smith_separable", "exact", "gauss_legendre"), nov, alpha, eta, 3 * 16**2)
     )
 
 

@@ -32,10 +32,10 @@ inner variables. float64 accumulation, float32 terms but for v.h, the refraction
 integrand's g64, from the node's float64 angles: near total internal reflection float32's v.h is amplified by 1/eta^2).
 alpha = 0 takes the integrand's closed-form mirror limit.
 ``DielectricGaussLegendre`` is this quadrature at a fixed order, ``DielectricAdaptive`` to a tolerance (each panel up
-DIELECTRIC_ORDERS, the worst panel first, the first estimate x ESTIMATE_SAFETY: make_adaptive_dielectric; an NDF-peak
-point within PEAK_MERGE of another breakpoint dropped, as the dfg estimator's), estimators of the
-lutbake.sampling.plan protocol; the QMC estimators of lutbake.sampling.hemisphere serve as the second estimator
-unchanged (the integrand lives in the same half-vector measure).
+DIELECTRIC_ORDERS, the worst panel first: make_adaptive_dielectric; an NDF-peak point within PEAK_MERGE of another
+breakpoint dropped, as the dfg estimator's), estimators of the lutbake.sampling.plan protocol; the QMC estimators of
+lutbake.sampling.hemisphere serve as the second estimator unchanged (the integrand lives in the same half-vector
+measure).
 """
 
 from __future__ import annotations
@@ -359,14 +359,13 @@ def make_gauss_legendre_dielectric(spec):
 
 
 def make_adaptive_dielectric(spec):
-    """The kernel to a tolerance: the outer panels of the fixed-order kernel up the GL orders ``levels``, refined
-    greedily (lutbake.sampling.ladder.greedy_ladder_for) until, per channel c, the estimate
-    err = sum over panels of |Q_(k) - Q_(k-1)| / pi (x ESTIMATE_SAFETY at a panel's first two orders)
-    + TERMS_ROUNDING |I_c| (float32 terms, as lutbake.sampling.hemisphere.make_gauss_legendre) is within
-    max(tol_abs[c], tol_rel[c] |I_c|) (the outer panels with the peak merge). Inputs: texel, rules, levels
-    (lutbake.sampling.hemisphere.gl_levels), tol_abs, tol_rel (vec3d: per kernel channel), out, err."""
+    """The kernel to a tolerance: the outer panels of the fixed-order kernel (with the peak merge) up the GL orders
+    ``levels``, refined greedily (lutbake.sampling.ladder.greedy_ladder_for) until, per channel c, the estimate
+    err = sum over panels of |Q_(k) - Q_(k-1)| / pi + TERMS_ROUNDING |I_c| (float32 terms, as
+    lutbake.sampling.hemisphere.make_gauss_legendre) is within max(tol_abs[c], tol_rel[c] |I_c|). Inputs: texel,
+    rules, levels (lutbake.sampling.hemisphere.gl_levels), tol_abs, tol_rel (vec3d: per kernel channel), out, err."""
     mirror = spec.mirror
-    integrate = greedy_ladder_for(panel_rule_for(spec)[1], MAX_PANELS, spec.acc._length_, safety=ESTIMATE_SAFETY)[0]
+    integrate = greedy_ladder_for(panel_rule_for(spec)[1], MAX_PANELS, spec.acc._length_)[0]
     nch = spec.vec._length_
 
     @wp.kernel(enable_backward=False, module="unique")
@@ -421,20 +420,20 @@ class DielectricGaussLegendre(GaussLegendre):
         return _launch(self._kernel(integrand), inputs, args, integrand.kernel_channels, device)
 
 
-# the ladder's orders and the factor on its first estimate (lutbake.sampling.ladder's ``safety``: a panel's first two
-# levels only). Close first orders agree by coincidence where the convergence stagnates (against order 64 on 3005
-# random + edge texels: at (n.v, alpha, eta) = (0.24, 0.042, 0.49) order 8 is off by 9e-7, order 12 by 6e-7; error /
-# estimate up to 10.6 from (8, 10), 2.2 from (8, 12); from (6, 12) 1.33 on EEVEE's btdf grazing row, n.v = 1e-4,
-# alpha = 0.071, eta = 1.063). Until 2026-12-02 the ladder started at (8, 16), factor 1. Replayed offline on every
-# panel's orders 4..64 (benchmarks/replay_ladder.py: 1500 random texels and the grazing row of each of EEVEE's btdf and
-# bsdf, Turquin's and OpenPBR's tables, the peak merge of next_theta_dielectric in place), (6, 11, 16, ...) with factor
-# 2 on the first pair costs 0.73-0.79x the evaluations of (8, 16, ...), no estimate passed by its error, worst error /
-# estimate 0.39, 0.69, 0.35, 0.50 (from (8, 16): 0.40, 0.89, 0.30, 0.26); factor 1 from (6, 12) reached 1.30 on the
-# bsdf, factor 2 from (6, 9, ...) 4.0 and from (4, 6, ...) 20.6; the factor on every climb too passed more texels' top
-# order (48 -> 64) over their tolerance (16 against 3 on the bsdf) for 3 % less work. The first climb is 16 -> 20
-# (16 -> 24 cost 7-9 % more)
-DIELECTRIC_ORDERS = (6, 11, 16, 20, 24, 32, 48, 64)
-ESTIMATE_SAFETY = 2.0
+# the ladder's orders, from 8 in steps of 8 (2x first). Close first orders agreed by coincidence where the convergence
+# stagnates (measured against order 64 on 3005 random + edge texels: at (n.v, alpha, eta) = (0.24, 0.042, 0.49) order 8
+# is off by 9e-7, order 12 by 6e-7; error / estimate up to 10.6 from (8, 10), 2.2 from (8, 12), 1.3 from (6, 8)), and
+# (6, 12) on EEVEE's btdf grazing row (n.v = 1e-4, alpha = 0.071, eta = 1.063: error 1.12e-6 under an estimate of
+# 8.4e-7, its transmission channel alone driving the ladder); from (8, 16) every estimate bounds the error there
+# (tests/test_dielectric.py), at ~10 % more work than from (6, 12). The first climb is 16 -> 20 (was 24): replayed
+# offline on every panel's orders 6..64 (benchmarks/replay_ladder.py: 2500 random texels and the grazing row of each of
+# EEVEE's btdf and bsdf, Turquin's and OpenPBR's tables) 7-9 % fewer evaluations, worst error / estimate 0.90 (from
+# 16 -> 24: 0.43); 8 -> 14 saved 14-22 % but reached 0.97, and 8 -> 12 passed errors over their estimates (2.2)
+# Tried 2026-12-02 (night) and dropped: from (6, 11) with twice the first difference as the first estimate, 0.73-0.79x
+# the evaluations in the replay (no violation among its 1500 random texels per preset), but benchmarks/
+# bench_dielectric.py's sample of a 32^3 table found a texel, (n.v, alpha, eta) = (0.172, 0.041, 0.435), where orders 6
+# and 11 of one panel agree to 9.6e-8 while order 11 is 1.5e-6 off: error 1.5e-6 under an estimate of 8.3e-7
+DIELECTRIC_ORDERS = (8, 16, 20, 24, 32, 48, 64)
 
 
 @dataclass(frozen=True)
