@@ -338,35 +338,41 @@ def outer_variable_for(tan2_from_u, u_from_tan2):
 
 
 @functools.lru_cache(maxsize=None)
-def facet_weight_for(integrand, pdf):
-    """``facet_weight(v, h, alpha, param, in_u)``: g(h) / p(h) where the outer variable is the NDF's CDF u (D cancels;
-    0 where p = 0), g(h) where it is theta_h itself."""
+def over_pdf_for(pdf):
+    """``over_pdf(g, v, h, alpha, in_u)``: g / p(h) where the outer variable is the NDF's CDF u (D cancels; 0 where
+    p = 0), g where it is theta_h itself."""
 
     @wp.func
-    def facet_weight(v: wp.vec3, h: wp.vec3, a: float, prm: float, in_u: bool):
-        g = integrand(v, h, a, prm)
+    def over_pdf(g: Any, v: wp.vec3, h: wp.vec3, a: float, in_u: bool):
         if in_u:
             p = pdf(v, h, a)
             if p > 0.0:
                 return g / p
             return g * 0.0
         return g
+
+    return over_pdf
+
+
+@functools.lru_cache(maxsize=None)
+def facet_weight_for(integrand, pdf):
+    """``facet_weight(v, h, alpha, param, in_u)``: g(h) / p(h) (over_pdf_for)."""
+    over_pdf = over_pdf_for(pdf)
+
+    @wp.func
+    def facet_weight(v: wp.vec3, h: wp.vec3, a: float, prm: float, in_u: bool):
+        return over_pdf(integrand(v, h, a, prm), v, h, a, in_u)
 
     return facet_weight
 
 
 def facet_weight64_for(integrand64, pdf):
     """facet_weight for an integrand that takes v.h to float64 too (SpecularIntegrand.g64)."""
+    over_pdf = over_pdf_for(pdf)
 
     @wp.func
     def facet_weight64(v: wp.vec3, h: wp.vec3, a: float, prm: float, in_u: bool, voh: wp.float64):
-        g = integrand64(v, h, a, prm, voh)
-        if in_u:
-            p = pdf(v, h, a)
-            if p > 0.0:
-                return g / p
-            return g * 0.0
-        return g
+        return over_pdf(integrand64(v, h, a, prm, voh), v, h, a, in_u)
 
     return facet_weight64
 
