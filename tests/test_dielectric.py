@@ -498,21 +498,18 @@ def test_adaptive_estimate_of_eevee_btdf_grazing_row_bounds_the_error():
 
 def test_adaptive_first_pair_is_the_merged_fixed_rules():
     """With a tolerance no texel misses, every panel stops at the ladder's first pair (orders 8 and 16): the value is
-    the fixed-order rule of order 16 on the same merged panels (DielectricGaussLegendre with merge = PEAK_MERGE, one
+    the fixed-order rule of order 16 on the same merged panels (DielectricGaussLegendre with merged = True, one
     accumulator instead of a sum per panel: equal to rounding), and the estimate is the sum over panels of
     |Q_16 - Q_8| plus the terms' floor, so at least |I_16 - I_8| of the whole texel."""
     from lutbake.integrands.dielectric import dielectric_integrand
     from lutbake.sampling import dielectric as sd
-    from lutbake.sampling.hemisphere import PEAK_MERGE
 
     assert sd.DIELECTRIC_ORDERS[:2] == (8, 16)
     nov, alpha, eta = (np.asarray(c, np.float32) for c in zip(*HONESTY_TEXELS))
     integrand = dielectric_integrand("ggx", "smith_separable", "exact")
     inputs = {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": eta}
     values, est = sd.DielectricAdaptive((1.0,) * 3, (0.0,) * 3).evaluate_with_error(integrand, inputs, "cpu")
-    q8, q16 = (
-        sd.DielectricGaussLegendre(3 * n * n, merge=PEAK_MERGE).evaluate(integrand, inputs, "cpu") for n in (8, 16)
-    )
+    q8, q16 = (sd.DielectricGaussLegendre(3 * n * n, merged=True).evaluate(integrand, inputs, "cpu") for n in (8, 16))
     np.testing.assert_allclose(values, q16, rtol=0, atol=1e-14)
     quadrature = est - TERMS_FLOOR * np.abs(values)
     assert np.all(quadrature >= np.abs(q16 - q8) * (1.0 - 1e-9))  # (rounding of est - floor |v|)

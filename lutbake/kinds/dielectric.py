@@ -280,14 +280,15 @@ def terms_of(o: dict) -> tuple[str, str]:
     return o["ndf"], o["masking"]
 
 
-def estimator_for(name: str, samples: int | None = None, seed: int = 0, merge: float = 1.0):
-    """The dielectric kinds' estimator ``name``: the panelled Gauss-Legendre of lutbake.sampling.dielectric (``merge``:
-    its NDF-peak merge), or a QMC estimator of lutbake.sampling.hemisphere (the same half-vector measure)."""
+def estimator_for(name: str, samples: int | None = None, seed: int = 0, merged: bool = False):
+    """The dielectric kinds' estimator ``name``: the panelled Gauss-Legendre of lutbake.sampling.dielectric
+    (``merged``: its NDF-peak breakpoints merged), or a QMC estimator of lutbake.sampling.hemisphere (the same
+    half-vector measure)."""
     from ..sampling.dielectric import DielectricGaussLegendre
     from ..sampling.hemisphere import QuasiMonteCarlo
 
     if name == "gauss_legendre":
-        return DielectricGaussLegendre(samples or DEFAULT_SAMPLES[name], merge=merge)
+        return DielectricGaussLegendre(samples or DEFAULT_SAMPLES[name], merged=merged)
     return QuasiMonteCarlo(name, samples or DEFAULT_SAMPLES[name], seed)
 
 
@@ -470,10 +471,8 @@ def plan_avg(spec) -> TexelPlan:
     axes, alpha, eta = avg_grid(o)
     nd, mk = terms_of(o)
     integrand = dielectric_integrand(nd, mk, "exact_metal")
-    from ..sampling.hemisphere import PEAK_MERGE
-
     # the inner rule's panels merged as the adaptive kernel's (its error is the probe's: inner_error)
-    estimator = estimator_for(o["estimator"], o["samples"], o["seed"], PEAK_MERGE)
+    estimator = estimator_for(o["estimator"], o["samples"], o["seed"], merged=True)
     order = o["mu_order"]
     x_mu, w_kronrod, _ = points.gauss_kronrod(order)
     tol = tolerance_of(o)

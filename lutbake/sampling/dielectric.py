@@ -406,17 +406,17 @@ def adaptive_dielectric_kernel(spec):
 class DielectricGaussLegendre(GaussLegendre):
     """The ``gauss_legendre`` estimator of the dielectric kinds (lutbake.sampling.hemisphere.GaussLegendre with this
     module's kernel): order n = gl_order(budget) per panel in both variables; the panel count varies per texel.
-    ``merge``: next_theta_dielectric's (1: every breakpoint, the pixels of a fixed-order table as before PEAK_MERGE;
-    PEAK_MERGE: kind dielectric_avg's inner rule, whose error its probe measures)."""
+    ``merged``: the NDF-peak breakpoints merged as the adaptive kernel's (PEAK_MERGE: kind dielectric_avg's inner
+    rule, whose error its probe measures); else every breakpoint (a fixed-order table's pixels as before the merge)."""
 
-    merge: float = 1.0
+    merged: bool = False
 
     def _kernel(self, integrand):
         return gl_dielectric_kernel(integrand)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         rule = wp.array(np.stack(points.gauss_legendre(self.order), axis=1), dtype=wp.vec2d, device=device)
-        args = [rule, wp.float64(self.merge)]
+        args = [rule, MERGE64 if self.merged else ONE64]
         return _launch(self._kernel(integrand), inputs, args, integrand.kernel_channels, device)
 
 

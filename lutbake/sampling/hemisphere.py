@@ -366,17 +366,6 @@ def facet_weight_for(integrand, pdf):
     return facet_weight
 
 
-def facet_weight64_for(integrand64, pdf):
-    """facet_weight for an integrand that takes v.h to float64 too (SpecularIntegrand.g64)."""
-    over_pdf = over_pdf_for(pdf)
-
-    @wp.func
-    def facet_weight64(v: wp.vec3, h: wp.vec3, a: float, prm: float, in_u: bool, voh: wp.float64):
-        return over_pdf(integrand64(v, h, a, prm, voh), v, h, a, in_u)
-
-    return facet_weight64
-
-
 @functools.lru_cache(maxsize=None)
 def facet_rules_for(spec):
     """``(add_facet, sinh_piece, plain_piece)``: the inner rule's pieces for an integrand record (the panel rules of
@@ -384,9 +373,7 @@ def facet_rules_for(spec):
     facet (theta_h of the OuterNode f, phi); ``sinh_piece`` adds the rule over [phimax - width, phimax] by the sinh
     map, ``plain_piece`` the plain rule over [0, width]."""
     facet_weight = facet_weight_for(spec.g, spec.distribution.pdf_ndf)
-    with_voh = getattr(spec, "g64", None) is not None
-    if with_voh:
-        facet_weight64 = facet_weight64_for(spec.g64, spec.distribution.pdf_ndf)
+    over_pdf, g64 = over_pdf_for(spec.distribution.pdf_ndf), spec.g64
     nch = spec.vec._length_
 
     @wp.func
@@ -394,11 +381,11 @@ def facet_rules_for(spec):
         """acc plus w g / p at the facet (theta_h of the outer node f, phi); an integrand with g64 gets v.h from
         the node's float64 angles and v = (sqrt(1 - (n.v)^2), 0, n.v) in float64 (unit)."""
         h = wp.vec3(float(f.sin_h * cos_phi), float(f.sin_h * sin_phi), float(f.cos_h))
-        if wp.static(with_voh):
+        if wp.static(g64 is not None):
             v2 = wp.float64(f.v[2])
             v0 = wp.sqrt(wp.max(wp.float64(1.0) - v2 * v2, wp.float64(0.0)))
             voh = f.sin_h * cos_phi * v0 + f.cos_h * v2
-            gw = facet_weight64(f.v, h, f.a, f.prm, f.in_u, voh)
+            gw = over_pdf(g64(f.v, h, f.a, f.prm, voh), f.v, h, f.a, f.in_u)
         else:
             gw = facet_weight(f.v, h, f.a, f.prm, f.in_u)
         for c in range(wp.static(nch)):
