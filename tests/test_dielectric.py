@@ -577,3 +577,68 @@ def test_avg_mu_rule_reaches_the_tolerance():
     fresh = lookup_kind("dielectric_avg").plan(spec(**small, samples=432))
     assert fresh.error_estimate(full.ravel(), "cpu") == plan.error_estimate(full.ravel(), "cpu")
     assert float(table.attributes["error_estimate"]) == float(f"{plan.error_estimate(full.ravel(), 'cpu')[0]:.3e}")
+
+
+# texels with equal (n.v, alpha) and several eta >= 1 (one row over MEMBERS: two groups), with eta < 1, alpha = 0
+# and a lone texel beside them (neither grouped)
+SHARED_ROWS = [(0.37, 0.2), (1.0e-4, 0.07111), (0.9, 0.0044)]
+SHARED_ETAS = [1.0, 1.0629, 1.33, 1.5, 2.5, 0.7]
+SHARED_TEXELS = (
+    [(n, a, e) for n, a in SHARED_ROWS for e in SHARED_ETAS]
+    + [(0.61, 0.3, 1.0 + 0.05 * k) for k in range(18)]
+    + [(0.5, 0.0, 1.5), (0.5, 0.0, 1.7), (0.8, 0.45, 1.2)]
+)
+
+
+def test_member_groups_hold_texels_that_differ_only_in_eta_at_least_one():
+    from lutbake.sampling import dielectric as sd
+
+    texel = np.array(SHARED_TEXELS, np.float32)
+    groups, singles = sd.member_groups(texel)
+    members = groups[groups >= 0]
+    assert sorted(np.concatenate([members, singles]).tolist()) == list(range(len(texel)))  # each texel once
+    assert groups.shape == (5, sd.MEMBERS)  # 3 rows of 5, the 18-row as 16 + 2
+    for row in groups:
+        m = texel[row[row >= 0]]
+        assert len(m) >= 2 and np.all(m[:, 2] >= 1.0) and np.all(m[:, 1] > 0.0)
+        assert np.all(m[:, :2] == m[0, :2])
+    assert {tuple(texel[i]) for i in singles} == {tuple(np.float32(x) for x in t) for t in SHARED_TEXELS[-3:]} | {
+        tuple(np.float32(x) for x in (n, a, 0.7)) for n, a in SHARED_ROWS
+    }
+
+
+def test_shared_pass_gives_each_texel_its_own_bits(monkeypatch):
+    """A group's pass evaluates every node once for all its members (the eta-free part of the integrand once): each
+    member's value and estimate are those of the texel alone, to the bit, in the adaptive and the fixed kernel."""
+    from lutbake.integrands.dielectric import dielectric_integrand
+    from lutbake.sampling import dielectric as sd
+
+    nov, alpha, eta = (np.asarray(c, np.float32) for c in zip(*SHARED_TEXELS))
+    integrand = dielectric_integrand("ggx", "smith_separable", "exact")
+    inputs = {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": eta}
+    adaptive, fixed = sd.DielectricAdaptive((1e-7,) * 3, (0.0,) * 3), sd.DielectricGaussLegendre(3 * 12**2, merged=True)
+    grouped = [*adaptive.evaluate_with_error(integrand, inputs, "cpu"), fixed.evaluate(integrand, inputs, "cpu")]
+    monkeypatch.setattr(sd, "member_groups", lambda t: (np.zeros((0, sd.MEMBERS), np.int32), np.arange(len(t))))
+    alone = [*adaptive.evaluate_with_error(integrand, inputs, "cpu"), fixed.evaluate(integrand, inputs, "cpu")]
+    for a, b in zip(grouped, alone):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_sibling_tiles_bake_the_ior_slices_together_and_any_tiling_alike():
+    """A tile within one IOR slice (Turquin's and OpenPBR's layout: IOR slowest) is evaluated with the same texels
+    of every eta >= 1 slice (sibling_tiles), once per plan; every tiling gives the same bits."""
+    from lutbake.sampling.dielectric import sibling_tiles
+
+    s = spec(kind="dielectric", size=[4, 3], ior_size=6, ior_range=[0.7, 1.6], masking="smith_separable")
+    slice_n, plan = 12, lookup_kind("dielectric").plan(s)
+    eta = np.repeat([0.7, 0.9, 1.0, 1.2, 1.4, 1.6], slice_n)  # slices 2 .. 5 have eta >= 1
+    nov = np.tile(np.linspace(0.1, 0.9, slice_n), 6)
+    sib = sibling_tiles({"nov": nov, "alpha": np.full(len(eta), 0.1), "param": eta})
+    assert sib(0, slice_n) is None  # eta < 1: nothing shared
+    assert sib(0, 72) is None  # the tile's own texels form the groups
+    np.testing.assert_array_equal(sib(3 * slice_n + 1, 3 * slice_n + 2), [25, 37, 49, 61])  # position 1, 4 slices
+    whole = plan.run_tile(0, plan.n_texels, "cpu")
+    for cut in (slice_n, 5):
+        fresh = lookup_kind("dielectric").plan(s)  # a new memo
+        tiles = [fresh.run_tile(a, min(a + cut, fresh.n_texels), "cpu") for a in range(0, fresh.n_texels, cut)]
+        np.testing.assert_array_equal(np.concatenate(tiles), whole)

@@ -46,10 +46,22 @@ FRESNEL_MODES = {
 }
 
 
+@wp.struct
+class Facet:
+    """The eta-free part of the integrand at a facet h (integrand_for's ``facet64``): ``ok`` (n.v, v.h and n.h past
+    COS_EPS), w = D(h) (v.h) / (n.v) and the reflection lobe's w_r = w G2(v, l) [n.l > 0]."""
+
+    ok: wp.bool
+    w: float
+    w_r: float
+
+
 @functools.lru_cache(maxsize=None)
 def integrand_for(ndf_name: str, masking_name: str, mode: str):
-    """``(g, g64)``: ``g(v, h, alpha, eta) -> wp.vec3`` (module docstring; 0 for v.h, n.v <= COS_EPS or n.h <= 0) and
-    ``g64(v, h, alpha, eta, v.h as float64)``, the same given v.h to float64 (the panel rules know it)."""
+    """``(g, g64, facet64, lobes64)``: ``g(v, h, alpha, eta) -> wp.vec3`` (module docstring; 0 for v.h, n.v <= COS_EPS
+    or n.h <= 0) and ``g64(v, h, alpha, eta, v.h as float64)``, the same given v.h to float64 (the panel rules know
+    it), in two parts: g64 = lobes64(facet64(v, h, alpha, v.h), v, h, alpha, eta, v.h), the first free of eta (texels
+    that differ only in eta share it: lutbake.sampling.dielectric.make_adaptive_members)."""
     if mode not in FRESNEL_MODES:
         raise KeyError(f"unknown Fresnel mode {mode!r}; valid: {', '.join(FRESNEL_MODES)}")
     if masking_name not in DIELECTRIC_MASKINGS:
@@ -60,19 +72,32 @@ def integrand_for(ndf_name: str, masking_name: str, mode: str):
     G2 = NDFS[ndf_name].G2(masking_name)
 
     @wp.func
-    def integrand64(v: wp.vec3, h: wp.vec3, alpha: float, eta: float, c: wp.float64):
-        """The integrand given v.h = c to float64: the refraction (cos theta_t, n.t) and the Fresnel term from c in
-        float64 (lutbake.terms.dielectric.cos_transmitted64: near total internal reflection float32's v.h is
-        amplified by 1/eta^2), the rest in float32."""
+    def facet64(v: wp.vec3, h: wp.vec3, alpha: float, c: wp.float64):
+        """The eta-free part (Facet) given v.h = c to float64."""
+        fc = Facet()
         NoV = v[2]
         VoH = float(c)
         if NoV <= COS_EPS or VoH <= COS_EPS or h[2] <= 0.0:
-            return wp.vec3()
-        w = D(h, alpha) * VoH / NoV
+            return fc
+        fc.ok = True
+        fc.w = D(h, alpha) * VoH / NoV
         NoL = reflect(v, h)[2]
-        w_r = w * 0.0  # dynamic (a literal is a constant to Warp)
+        fc.w_r = fc.w * 0.0  # dynamic (a literal is a constant to Warp)
         if NoL > COS_EPS:
-            w_r = w * G2(NoV, NoL, h[2], VoH, alpha)
+            fc.w_r = fc.w * G2(NoV, NoL, h[2], VoH, alpha)
+        return fc
+
+    @wp.func
+    def lobes64(fc: Facet, v: wp.vec3, h: wp.vec3, alpha: float, eta: float, c: wp.float64):
+        """The channels from the facet's part: the refraction (cos theta_t, n.t) and the Fresnel term from v.h = c in
+        float64 (lutbake.terms.dielectric.cos_transmitted64: near total internal reflection float32's v.h is
+        amplified by 1/eta^2), the rest in float32."""
+        if not fc.ok:
+            return wp.vec3()
+        NoV = v[2]
+        VoH = float(c)
+        w = fc.w
+        w_r = fc.w_r
         e = wp.float64(eta)
         ct = cos_transmitted64(e, c)  # -1 under total internal reflection
         w_t = w * 0.0
@@ -93,10 +118,15 @@ def integrand_for(ndf_name: str, masking_name: str, mode: str):
         return wp.vec3(F * w_r, (1.0 - F) * w_t, F * w_r + (1.0 - F) * w_t)
 
     @wp.func
+    def integrand64(v: wp.vec3, h: wp.vec3, alpha: float, eta: float, c: wp.float64):
+        """The integrand given v.h = c to float64 (facet64, then lobes64)."""
+        return lobes64(facet64(v, h, alpha, c), v, h, alpha, eta, c)
+
+    @wp.func
     def integrand(v: wp.vec3, h: wp.vec3, alpha: float, eta: float):
         return integrand64(v, h, alpha, eta, wp.float64(wp.dot(v, h)))
 
-    return integrand, integrand64
+    return integrand, integrand64, facet64, lobes64
 
 
 @functools.lru_cache(maxsize=None)
@@ -129,7 +159,7 @@ def mirror_for(mode: str):
 def dielectric_integrand(ndf_name: str, masking_name: str, mode: str, nch: int = 3) -> SpecularIntegrand:
     """The integrand record (lutbake.integrands.specular.SpecularIntegrand: g, vec, distribution, mirror) of a
     (terms, Fresnel mode) key; the kernels' per-texel ``param`` is the relative IOR eta."""
-    g, g64 = integrand_for(ndf_name, masking_name, mode)
+    g, g64, facet64, lobes64 = integrand_for(ndf_name, masking_name, mode)
     return SpecularIntegrand(
         ("dielectric", ndf_name, masking_name, mode),
         g,
@@ -140,4 +170,5 @@ def dielectric_integrand(ndf_name: str, masking_name: str, mode: str, nch: int =
         NDFS[ndf_name],
         mirror_for(mode),
         g64=g64,
+        g64_parts=(facet64, lobes64),
     )

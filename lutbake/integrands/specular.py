@@ -243,6 +243,8 @@ class SpecularIntegrand:
     distribution only panels: no u = CDF(theta_h) variable). ``g64(v, h, alpha, param, v.h as float64)``: g given
     v.h to float64, where float32's rounding of it matters (the dielectric's refraction near total internal
     reflection); the gauss_legendre panel rules pass it (lutbake.sampling.hemisphere.facet_rules_for), else None.
+    ``g64_parts``: (part, rest) with g64(v, h, alpha, param, c) = rest(part(v, h, alpha, c), v, h, alpha, param, c),
+    ``part`` free of the param (texels that differ only in it share it per node), else None.
     """
 
     key: tuple
@@ -258,6 +260,7 @@ class SpecularIntegrand:
     ndf_peak: bool = True
     kink_at_nov: bool = False
     g64: object | None = None
+    g64_parts: tuple | None = None
 
     def alpha_input(self, alpha) -> np.ndarray:
         """The per-texel alpha the kernels receive (float32): lutbake.edge.effective_alpha."""

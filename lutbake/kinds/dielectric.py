@@ -402,6 +402,7 @@ def terms_record(key: tuple, layout: str) -> dict:
 
 def plan(spec) -> TexelPlan:
     from ..integrands.dielectric import dielectric_integrand
+    from ..sampling.dielectric import sibling_tiles
 
     o = spec.options
     layout = o["layout"]
@@ -424,6 +425,7 @@ def plan(spec) -> TexelPlan:
         reconstruction=RECONSTRUCTION[layout],
         terms=terms_record((nd, mk, MODE[layout]), layout),
         extra={**extra, "alpha_policy": alpha_policy(True)},
+        siblings=sibling_tiles(inputs),
     )
 
 

@@ -56,12 +56,12 @@ from .hemisphere import (
     TERMS_ROUNDING,
     GaussLegendre,
     OuterNode,
-    _launch,
     _texels,
     asinh64,
     facet_rules_for,
     gl_levels,
     load,
+    members_of,
     next_geometric,
     outer_variable_for,
     phi_b,
@@ -231,14 +231,15 @@ def dielectric_texel(t: wp.vec3, merge: wp.float64):
 
 
 @functools.lru_cache(maxsize=None)
-def panel_rule_for(spec):
+def panel_rule_for(spec, members: int = 0):
     """``(panel_add, panel_sum)``: ``panel_add(x, j, rules, off, n, acc)`` adds the n x n product rule
     (rules[off : off + n] in both variables) over outer panel j of texel x to ``acc``, node by node (module
-    docstring); ``panel_sum(x, j, rules, off, n)``: the same from 0 (the panel rule of lutbake.sampling.ladder)."""
-    acc_type = spec.acc
+    docstring); ``panel_sum(x, j, rules, off, n)``: the same from 0 (the panel rule of lutbake.sampling.ladder).
+    ``members`` > 0: acc is a lutbake.sampling.hemisphere.members_of record, every member's eta on x's panels."""
+    acc_type = spec.acc if members == 0 else members_of(spec.acc._length_, members)
     d = spec.distribution
     outer_range, outer_node = outer_variable_for(d.tan2_from_u, d.u_from_tan2)
-    add_facet, sinh_piece, _ = facet_rules_for(spec)
+    add_facet, sinh_piece, _ = facet_rules_for(spec, members)
 
     @wp.func
     def panel_add(x: DielectricTexel, j: int, rules: Rule, off: int, n: int, acc: Any):
@@ -358,15 +359,57 @@ def make_gauss_legendre_dielectric(spec):
     return gauss_legendre_dielectric_kernel
 
 
+def make_gauss_legendre_members(spec):
+    """make_gauss_legendre_dielectric for groups of up to MEMBERS texels that differ only in eta >= 1 (member_groups,
+    make_adaptive_members): every node once for all members, the same bits. Inputs: texel, groups, rule, merge,
+    out."""
+    nch = spec.acc._length_
+    member_params = member_params_for(nch)
+    panel_add = panel_rule_for(spec, MEMBERS)[0]
+
+    @wp.kernel(enable_backward=False, module="unique")
+    def gauss_legendre_members_kernel(
+        texel: wp.array(dtype=wp.vec3), groups: wp.array2d(dtype=int), rule: Rule, merge: wp.float64, out: Rows64
+    ):
+        g = wp.tid()
+        x = dielectric_texel(texel[groups[g, 0]], merge)
+        acc, count = member_params(texel, groups, g)
+        for j in range(x.n_panels):
+            acc = panel_add(x, j, rule, 0, rule.shape[0], acc)
+        for k in range(count):
+            for c in range(wp.static(nch)):
+                out[groups[g, k], c] = acc[k, c] / PI64
+
+    return gauss_legendre_members_kernel
+
+
+@functools.lru_cache(maxsize=None)
+def texel_store_for(spec):
+    """``store_texel(x, i, total, e, out, err)``: texel i's values (total / pi, or the mirror limit at alpha = 0) and
+    estimates (e / pi plus TERMS_ROUNDING |value|) of the kernels to a tolerance."""
+    mirror = spec.mirror
+    nch = spec.vec._length_
+
+    @wp.func
+    def store_texel(x: DielectricTexel, i: int, total: Any, e: Any, out: Rows64, err: Rows64):
+        for c in range(wp.static(nch)):
+            out[i, c] = total[c] / PI64
+        if x.a <= 0.0:  # the mirror limit (lutbake.edge)
+            store_row(out, i, mirror(x.v, x.eta))
+        for c in range(wp.static(nch)):
+            err[i, c] = e[c] / PI64 + TERMS_ROUNDING * wp.abs(out[i, c])
+
+    return store_texel
+
+
 def make_adaptive_dielectric(spec):
     """The kernel to a tolerance: the outer panels of the fixed-order kernel (with the peak merge) up the GL orders
     ``levels``, refined greedily (lutbake.sampling.ladder.greedy_ladder_for) until, per channel c, the estimate
     err = sum over panels of |Q_(k) - Q_(k-1)| / pi + TERMS_ROUNDING |I_c| (float32 terms, as
     lutbake.sampling.hemisphere.make_gauss_legendre) is within max(tol_abs[c], tol_rel[c] |I_c|). Inputs: texel,
     rules, levels (lutbake.sampling.hemisphere.gl_levels), tol_abs, tol_rel (vec3d: per kernel channel), out, err."""
-    mirror = spec.mirror
     integrate = greedy_ladder_for(panel_rule_for(spec)[1], MAX_PANELS, spec.acc._length_)[0]
-    nch = spec.vec._length_
+    store_texel = texel_store_for(spec)
 
     @wp.kernel(enable_backward=False, module="unique")
     def adaptive_dielectric_kernel(
@@ -382,14 +425,164 @@ def make_adaptive_dielectric(spec):
         x = dielectric_texel(texel[i], MERGE64)
         # the estimate, TERMS_ROUNDING included, within the tolerance (in units of the sum: I = sum / pi)
         total, e = integrate(x, x.n_panels, rules, levels, PI64 * tol_abs, tol_rel, TERMS_ROUNDING)
-        for c in range(wp.static(nch)):
-            out[i, c] = total[c] / PI64
-        if x.a <= 0.0:  # the mirror limit (lutbake.edge)
-            store_row(out, i, mirror(x.v, x.eta))
-        for c in range(wp.static(nch)):
-            err[i, c] = e[c] / PI64 + TERMS_ROUNDING * wp.abs(out[i, c])
+        store_texel(x, i, total, e, out, err)
 
     return adaptive_dielectric_kernel
+
+
+# texels sharing one first pass (make_adaptive_members): EEVEE btdf's 64 IOR columns of a (n.v, alpha) row in 4 groups
+MEMBERS = 16
+
+
+@functools.lru_cache(maxsize=None)
+def member_params_for(nch: int):
+    """``member_params(texel, groups, g) -> (acc, count)``: group g's accumulator (members_of), zero sums and row k's
+    param the eta of member k (of the first member in an unused row), and its member count."""
+    shared = members_of(nch, MEMBERS)
+
+    @wp.func
+    def member_params(texel: wp.array(dtype=wp.vec3), groups: wp.array2d(dtype=int), g: int):
+        acc = shared()
+        count = wp.int32(0)  # dynamic (a literal is a constant to Warp)
+        for k in range(MEMBERS):
+            i = groups[g, 0]
+            if groups[g, k] >= 0:
+                i = groups[g, k]
+                count = k + 1
+            acc[k, nch] = wp.float64(texel[i][2])
+        return acc, count
+
+    return member_params
+
+
+def make_adaptive_members(spec):
+    """make_adaptive_dielectric for groups of up to MEMBERS texels that differ only in eta >= 1: their outer panels
+    and phi-breakpoints depend on (n.v, alpha) alone (module docstring: the TIR and refraction-horizon cuts exist for
+    eta < 1 only), so one pass over the nodes of the first two levels serves every member (the facet, v.h, D, the
+    weights: lutbake.sampling.hemisphere.facet_rules_for with ``members``), each member's sums taking the same float
+    operations in the same order as its own kernel's; each member then climbs alone (lutbake.sampling.ladder's climb).
+    The same bits as make_adaptive_dielectric. Inputs: texel, groups (rows of texel indices, -1 padded), rules, levels,
+    tol_abs, tol_rel, first (scratch: (groups x MEMBERS, MAX_PANELS, 2, channels) float64), out, err."""
+    nch = spec.acc._length_
+    member_params = member_params_for(nch)
+    panel_add = panel_rule_for(spec, MEMBERS)[0]
+    _, climb, Panels, _, Orders = greedy_ladder_for(panel_rule_for(spec)[1], MAX_PANELS, nch)
+    store_texel = texel_store_for(spec)
+
+    @wp.kernel(enable_backward=False, module="unique")
+    def adaptive_members_kernel(
+        texel: wp.array(dtype=wp.vec3),
+        groups: wp.array2d(dtype=int),
+        rules: Rule,
+        levels: Levels,
+        tol_abs: wp.vec3d,
+        tol_rel: wp.vec3d,
+        first: wp.array4d(dtype=wp.float64),
+        out: Rows64,
+        err: Rows64,
+    ):
+        g = wp.tid()
+        x = dielectric_texel(texel[groups[g, 0]], MERGE64)
+        base, count = member_params(texel, groups, g)
+        for j in range(x.n_panels):
+            for lv in range(2):  # the ladder's first two levels, as its integrate
+                acc = panel_add(x, j, rules, levels[lv][0], levels[lv][1], base)
+                for k in range(count):
+                    for c in range(wp.static(nch)):
+                        first[g * MEMBERS + k, j, lv, c] = acc[k, c]
+        for k in range(count):
+            i = groups[g, k]
+            y = dielectric_texel(texel[i], MERGE64)
+            fine0 = Panels()
+            coarse0 = Panels()
+            lev = Orders()
+            for j in range(y.n_panels):
+                for c in range(wp.static(nch)):
+                    fine0[j, c] = first[g * MEMBERS + k, j, 1, c]
+                    coarse0[j, c] = first[g * MEMBERS + k, j, 0, c]
+                lev[j] = 1
+            total, e = climb(y, y.n_panels, rules, levels, PI64 * tol_abs, tol_rel, TERMS_ROUNDING, fine0, coarse0, lev)
+            store_texel(y, i, total, e, out, err)
+
+    return adaptive_members_kernel
+
+
+def member_groups(texel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(groups, singles) of texels (n, 3) float32 (n.v, alpha, eta): rows of up to MEMBERS indices (-1 padded) of
+    texels with equal (n.v, alpha), alpha > 0 and eta >= 1 (make_adaptive_members), in index order; the other texels'
+    indices. Any cut gives the same values (each texel's bits do not depend on its group)."""
+    shareable = (texel[:, 2] >= np.float32(1.0)) & (texel[:, 1] > np.float32(0.0))
+    idx = np.flatnonzero(shareable)
+    key = np.ascontiguousarray(texel[idx, :2]).view(np.int64)[:, 0]  # (n.v, alpha) bits
+    order = idx[np.argsort(key, kind="stable")]
+    keys = np.ascontiguousarray(texel[order, :2]).view(np.int64)[:, 0]
+    starts = np.flatnonzero(np.r_[True, keys[1:] != keys[:-1]])
+    rows, singles = [], list(np.flatnonzero(~shareable))
+    for a, b in zip(starts, np.r_[starts[1:], len(order)]):
+        run = order[a:b]
+        if len(run) < 2:
+            singles += list(run)
+            continue
+        for c in range(0, len(run), MEMBERS):
+            rows.append(np.pad(run[c : c + MEMBERS], (0, MEMBERS - len(run[c : c + MEMBERS])), constant_values=-1))
+    groups = np.array(rows, dtype=np.int32).reshape(-1, MEMBERS)
+    return groups, np.sort(np.array(singles, dtype=np.int64))
+
+
+def sibling_tiles(inputs: dict):
+    """``siblings(start, stop)`` of lutbake.sampling.plan.per_texel_plan for a dielectric grid (inputs nov, alpha,
+    param): where each texel of tile [start, stop) that member_groups could group (alpha > 0, eta >= 1) is the only
+    one of its (n.v, alpha) in the tile -- a tile within one IOR slice, as Turquin's and OpenPBR's 3D tables (IOR the
+    slowest axis) are cut on the CPU -- the tile with every texel that shares their (n.v, alpha) at eta >= 1 (so they
+    form groups); else None (the tile's texels group among themselves: EEVEE's btdf rows, a cluster's larger tiles)."""
+    texel = np.stack([np.asarray(inputs[k], dtype=np.float32) for k in ("nov", "alpha", "param")], axis=1)
+    shareable = (texel[:, 2] >= np.float32(1.0)) & (texel[:, 1] > np.float32(0.0))
+    key = np.ascontiguousarray(texel[:, :2]).view(np.int64)[:, 0]
+    pool = np.flatnonzero(shareable)
+    pool = pool[np.argsort(key[pool], kind="stable")]
+    pool_keys = key[pool]
+
+    def siblings(start: int, stop: int) -> np.ndarray | None:
+        own = np.arange(start, stop)[shareable[start:stop]]
+        if len(own) == 0 or len(np.unique(key[own])) < len(own):
+            return None
+        lo, hi = np.searchsorted(pool_keys, key[own], "left"), np.searchsorted(pool_keys, key[own], "right")
+        if np.all(hi - lo < 2):
+            return None
+        return np.union1d(np.arange(start, stop), np.concatenate([pool[a:b] for a, b in zip(lo, hi)]))
+
+    return siblings
+
+
+GROUP_BATCH = 64  # member groups per launch (bounds the adaptive kernel's first-pass scratch: 4.7 MB)
+
+
+def launch_by_groups(inputs: dict, nch: int, n_out: int, members: tuple, single: tuple, device: str) -> list:
+    """``n_out`` float64 arrays (texels, nch) of the texels (n.v, alpha, eta) of ``inputs``: member_groups' groups by
+    ``members`` = (kernel, args, scratch(groups) -> list of extra arrays) (inputs: texel, groups, args, scratch, the
+    outputs indexed by texel), the other texels by ``single`` = (kernel, args) (inputs: their texels, args, outputs)."""
+    n, texel = _texels(inputs, device)
+    host = texel.numpy()
+    groups, singles = member_groups(host)
+    outs = [np.zeros((n, nch)) for _ in range(n_out)]
+    (m_kernel, m_args, scratch), (s_kernel, s_args) = members, single
+    if len(groups):
+        arrs = [wp.zeros((n, nch), dtype=wp.float64, device=device) for _ in range(n_out)]
+        for b in range(0, len(groups), GROUP_BATCH):
+            batch = groups[b : b + GROUP_BATCH]
+            rows = wp.array(batch, dtype=int, device=device)
+            args = [texel, rows, *m_args, *scratch(len(batch)), *arrs]
+            wp.launch(m_kernel, dim=len(batch), inputs=args, device=device)
+        member = groups[groups >= 0]
+        for o, a in zip(outs, arrs):
+            o[member] = a.numpy()[member]
+    if len(singles):
+        arrs = [wp.zeros((len(singles), nch), dtype=wp.float64, device=device) for _ in range(n_out)]
+        sub = wp.array(host[singles], dtype=wp.vec3, device=device)
+        wp.launch(s_kernel, dim=len(singles), inputs=[sub, *s_args, *arrs], device=device)
+        for o, a in zip(outs, arrs):
+            o[singles] = a.numpy()
+    return outs
 
 
 @functools.lru_cache(maxsize=None)
@@ -398,8 +591,18 @@ def gl_dielectric_kernel(spec):
 
 
 @functools.lru_cache(maxsize=None)
+def gl_members_kernel(spec):
+    return make_gauss_legendre_members(spec)
+
+
+@functools.lru_cache(maxsize=None)
 def adaptive_dielectric_kernel(spec):
     return make_adaptive_dielectric(spec)
+
+
+@functools.lru_cache(maxsize=None)
+def adaptive_members_kernel(spec):
+    return make_adaptive_members(spec)
 
 
 @dataclass(frozen=True)
@@ -414,10 +617,18 @@ class DielectricGaussLegendre(GaussLegendre):
     def _kernel(self, integrand):
         return gl_dielectric_kernel(integrand)
 
+    def prepare(self, integrand, device: str) -> None:
+        load(self._kernel(integrand), device)
+        load(gl_members_kernel(integrand), device)
+
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
+        """The texels that differ only in eta >= 1 in groups (make_gauss_legendre_members), the others one by one:
+        the same bits either way."""
         rule = wp.array(np.stack(points.gauss_legendre(self.order), axis=1), dtype=wp.vec2d, device=device)
         args = [rule, MERGE64 if self.merged else ONE64]
-        return _launch(self._kernel(integrand), inputs, args, integrand.kernel_channels, device)
+        members, single = (gl_members_kernel(integrand), args, lambda b: []), (self._kernel(integrand), args)
+        (out,) = launch_by_groups(inputs, integrand.kernel_channels, 1, members, single, device)
+        return out
 
 
 # the ladder's orders, from 8 in steps of 8 (2x first). Close first orders agreed by coincidence where the convergence
@@ -452,22 +663,27 @@ class DielectricAdaptive:
 
     def prepare(self, integrand, device: str) -> None:
         load(adaptive_dielectric_kernel(integrand), device)
+        load(adaptive_members_kernel(integrand), device)
 
     def evaluate_with_error(self, integrand, inputs: dict, device: str) -> tuple[np.ndarray, np.ndarray]:
-        n, texel = _texels(inputs, device)
+        """Values and estimates (n, kernel channels) each: the texels that share their (n.v, alpha) at eta >= 1 in
+        groups (make_adaptive_members), the others one by one (make_adaptive_dielectric): the same bits either way."""
+        assert len(self.orders) >= 2, "the ladder needs two orders for its first estimate"
         rules, levels = gl_levels(tuple(self.orders))
-        out, err = (wp.zeros((n, integrand.kernel_channels), dtype=wp.float64, device=device) for _ in range(2))
+        nch = integrand.kernel_channels
         args = [
-            texel,
             wp.array(rules, dtype=wp.vec2d, device=device),
             wp.array(levels, dtype=wp.vec2i, device=device),
             wp.vec3d(*self.absolute),
             wp.vec3d(*self.relative),
-            out,
-            err,
         ]
-        wp.launch(adaptive_dielectric_kernel(integrand), dim=n, inputs=args, device=device)
-        return out.numpy(), err.numpy()
+
+        def scratch(n_groups: int) -> list:
+            return [wp.empty((n_groups * MEMBERS, MAX_PANELS, 2, nch), dtype=wp.float64, device=device)]
+
+        members = (adaptive_members_kernel(integrand), args, scratch)
+        out, err = launch_by_groups(inputs, nch, 2, members, (adaptive_dielectric_kernel(integrand), args), device)
+        return out, err
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         return self.evaluate_with_error(integrand, inputs, device)[0]

@@ -344,14 +344,22 @@ def over_pdf_for(pdf):
 
     @wp.func
     def over_pdf(g: Any, v: wp.vec3, h: wp.vec3, a: float, in_u: bool):
+        p = wp.float32(0.0)  # dynamic (a literal is a constant to Warp)
         if in_u:
             p = pdf(v, h, a)
-            if p > 0.0:
-                return g / p
-            return g * 0.0
-        return g
+        return over_p(g, p, in_u)
 
     return over_pdf
+
+
+@wp.func
+def over_p(g: Any, p: float, in_u: bool):
+    """over_pdf_for's g / p given p (0 where p = 0; g where the outer variable is theta_h)."""
+    if in_u:
+        if p > 0.0:
+            return g / p
+        return g * 0.0
+    return g
 
 
 @functools.lru_cache(maxsize=None)
@@ -367,29 +375,59 @@ def facet_weight_for(integrand, pdf):
 
 
 @functools.lru_cache(maxsize=None)
-def facet_rules_for(spec):
+def members_of(nch: int, size: int):
+    """The accumulator of ``size`` texels that share every node of their panel rules and differ only in the
+    integrand's param (the dielectric tables' eta >= 1 at one (n.v, alpha): lutbake.sampling.dielectric): a float64
+    matrix, row k member k, columns 0 .. nch - 1 its sums and column nch its param (a float32, exact in float64). A
+    plain matrix, not a struct: Warp updates a local matrix in place, while a struct's matrix field is loaded whole
+    for every element read (measured 2.5x the time of the single-texel rule)."""
+    return wp.types.matrix(shape=(size, nch + 1), dtype=wp.float64)
+
+
+@functools.lru_cache(maxsize=None)
+def facet_rules_for(spec, members: int = 0):
     """``(add_facet, sinh_piece, plain_piece)``: the inner rule's pieces for an integrand record (the panel rules of
     this module and of lutbake.sampling.dielectric). ``add_facet(acc, f, cos phi, sin phi, w)`` adds w g / p at the
     facet (theta_h of the OuterNode f, phi); ``sinh_piece`` adds the rule over [phimax - width, phimax] by the sinh
-    map, ``plain_piece`` the plain rule over [0, width]."""
+    map, ``plain_piece`` the plain rule over [0, width]. ``members`` > 0 (an integrand with g64_parts): acc is a
+    ``members_of(nch, members)`` matrix and each node's facet, v.h, weight, density and param-free part serve every
+    member's param, each member's sum taking the same float operations, in the same order, as its own rule's."""
     facet_weight = facet_weight_for(spec.g, spec.distribution.pdf_ndf)
-    over_pdf, g64 = over_pdf_for(spec.distribution.pdf_ndf), spec.g64
+    pdf = spec.distribution.pdf_ndf
+    over_pdf, g64 = over_pdf_for(pdf), spec.g64
+    part, rest = spec.g64_parts if members > 0 else (None, None)
     nch = spec.vec._length_
+
+    @wp.func
+    def facet_voh(f: OuterNode, cos_phi: wp.float64, sin_phi: wp.float64):
+        """v.h in float64 from the node's float64 angles and v = (sqrt(1 - (n.v)^2), 0, n.v) (unit)."""
+        v2 = wp.float64(f.v[2])
+        v0 = wp.sqrt(wp.max(wp.float64(1.0) - v2 * v2, wp.float64(0.0)))
+        return f.sin_h * cos_phi * v0 + f.cos_h * v2
 
     @wp.func
     def add_facet(acc: Any, f: OuterNode, cos_phi: wp.float64, sin_phi: wp.float64, w: wp.float64):
         """acc plus w g / p at the facet (theta_h of the outer node f, phi); an integrand with g64 gets v.h from
-        the node's float64 angles and v = (sqrt(1 - (n.v)^2), 0, n.v) in float64 (unit)."""
+        facet_voh."""
         h = wp.vec3(float(f.sin_h * cos_phi), float(f.sin_h * sin_phi), float(f.cos_h))
-        if wp.static(g64 is not None):
-            v2 = wp.float64(f.v[2])
-            v0 = wp.sqrt(wp.max(wp.float64(1.0) - v2 * v2, wp.float64(0.0)))
-            voh = f.sin_h * cos_phi * v0 + f.cos_h * v2
-            gw = over_pdf(g64(f.v, h, f.a, f.prm, voh), f.v, h, f.a, f.in_u)
+        if wp.static(members > 0):
+            # the param-free part and the density once a node (over_pdf's operations, in two steps)
+            voh = facet_voh(f, cos_phi, sin_phi)
+            shared = part(f.v, h, f.a, voh)
+            p = wp.float32(0.0)
+            if f.in_u:
+                p = pdf(f.v, h, f.a)
+            for k in range(wp.static(members)):
+                gk = over_p(rest(shared, f.v, h, f.a, float(acc[k, nch]), voh), p, f.in_u)
+                for c in range(wp.static(nch)):
+                    acc[k, c] = acc[k, c] + w * wp.float64(gk[c])
         else:
-            gw = facet_weight(f.v, h, f.a, f.prm, f.in_u)
-        for c in range(wp.static(nch)):
-            acc[c] = acc[c] + w * wp.float64(gw[c])
+            if wp.static(g64 is not None):
+                gw = over_pdf(g64(f.v, h, f.a, f.prm, facet_voh(f, cos_phi, sin_phi)), f.v, h, f.a, f.in_u)
+            else:
+                gw = facet_weight(f.v, h, f.a, f.prm, f.in_u)
+            for c in range(wp.static(nch)):
+                acc[c] = acc[c] + w * wp.float64(gw[c])
         return acc
 
     @wp.func

@@ -125,12 +125,18 @@ def per_texel_plan(
     error_estimate: bool = True,
     tile_texels: int | None = None,
     interpolate: bool = False,
+    siblings: Callable[[int, int], np.ndarray | None] | None = None,
 ) -> TexelPlan:
     """The texel plan of ``grid``'s texels integrated by ``estimator``: texel i = estimator.evaluate(integrand,
     grid inputs of i), the first ``integrand.nch`` channels kept.
     ``relative_error``: the error estimate is max |a - b| / |b| over probe texels with |b| > 1e-6.
     ``interpolate``: an adaptive estimator's texels come from lutbake.sampling.interpolation where the grid allows
-    (interpolation.applies: a ``grid.smooth`` mask, both image axes long enough), each within the tolerance."""
+    (interpolation.applies: a ``grid.smooth`` mask, both image axes long enough), each within the tolerance.
+    ``siblings(start, stop)``: the texels (sorted, a superset of the tile's) to evaluate in one call with tile
+    [start, stop), or None for the tile alone: an estimator that shares work between texels of one call
+    (lutbake.sampling.dielectric.sibling_tiles) gets them together; each texel is evaluated once per plan (a memo:
+    the tiles of its siblings take its row), and its value does not depend on its company."""
+    from ..memo import RowMemo
     from . import interpolation
 
     def run(idx, est, device):
@@ -146,9 +152,20 @@ def per_texel_plan(
         values, err = est.evaluate_with_error(integrand, grid.rows(idx), device)
         return values[:, : integrand.nch], err[:, : integrand.nch]
 
+    memo = RowMemo(capacity=grid.n_texels) if siblings else None
+
+    def tile_rows(s: int, e: int, rows_of: Callable[[Any], np.ndarray]) -> np.ndarray:
+        """rows_of(texels) of tile [s, e), evaluated with the tile's siblings where it has them."""
+        idx = siblings(s, e) if siblings else None
+        if idx is None:
+            return rows_of(slice(s, e))
+        keys = [int(i).to_bytes(8, "little") for i in idx]
+        (rows,) = memo.run(keys, lambda j: (rows_of(idx[j]),))
+        return rows[np.searchsorted(idx, np.arange(s, e))]
+
     def run_adaptive(s: int, e: int, device: str) -> np.ndarray:
         """Values of texels [s, e), then their error estimates (aux columns)."""
-        return np.concatenate(integrate(estimator, slice(s, e), device), 1)
+        return tile_rows(s, e, lambda idx: np.concatenate(integrate(estimator, idx, device), 1))
 
     verified = None
     if adaptive and interpolate and interpolation.applies(grid):
@@ -195,7 +212,7 @@ def per_texel_plan(
         return rel, f"max relative |{how}| {where} with |f| > 1e-6; max abs {float(np.max(err)):.3e}"
 
     def run_fixed(s: int, e: int, device: str) -> np.ndarray:
-        return run(slice(s, e), estimator, device)
+        return tile_rows(s, e, lambda idx: run(idx, estimator, device))
 
     run_tile = verified.run_tile if verified else run_adaptive if adaptive else run_fixed
     samples = estimator.samples(grid.inputs)  # evaluations per texel
