@@ -50,3 +50,30 @@ def test_exr_has_a_part_per_f0_slice(eq6_3d, tmp_path):
     assert data.shape == (3, 3, 5, 1)
     np.testing.assert_allclose(data, eq6_3d.data)
     assert attrs["kind"] == "diffuse_3d" and "f0" in attrs["axes"]
+
+
+def test_f0_slices_share_their_nodes_and_keep_their_bits(monkeypatch):
+    """The f0 slices of a (n.v, sigma) texel are integrated over one set of nodes (lutbake.sampling.swapped: groups
+    of 16, the cosines and f0-free factors once): each value is the texel's own evaluation to the bit, the table is
+    the same for any tiling (its single-slice tiles take their siblings), and a group of 17 is cut 16 + 1."""
+    from lutbake.integrands.diffuse import diffuse_integrand
+    from lutbake.sampling import swapped
+
+    integrand = diffuse_integrand("microfacet", "dielectric_f0")
+    nov, alpha = np.repeat([0.05, 0.5, 0.9], 17), np.repeat([0.3, 0.05, 0.7], 17)
+    f0 = np.tile(np.linspace(0.0, 0.96, 17), 3)
+    grouped = swapped.integrate_swapped(integrand, nov, alpha, f0, order=8)
+    monkeypatch.setattr(
+        swapped, "group_rows", lambda key, ok, size: (np.zeros((0, size), np.int32), np.arange(len(key)))
+    )
+    alone = swapped.integrate_swapped(integrand, nov, alpha, f0, order=8)
+    np.testing.assert_array_equal(grouped, alone)
+    monkeypatch.undo()
+    from lutbake.config import validate_table
+    from lutbake.kinds import lookup_kind
+
+    spec = validate_table({**D3, "f0_size": 4, "f0_range": [0.0, 0.9]}, "<test>", 0)
+    whole = lookup_kind("diffuse_3d").plan(spec)  # 60 texels in one tile: the groups form in it
+    plan = lookup_kind("diffuse_3d").plan(spec)
+    tiles = [plan.run_tile(a, a + 5, "cpu") for a in range(0, plan.n_texels, 5)]  # 5 texels: within a slice
+    np.testing.assert_array_equal(np.concatenate(tiles), whole.run_tile(0, whole.n_texels, "cpu"))

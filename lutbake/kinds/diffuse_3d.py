@@ -17,6 +17,7 @@ import numpy as np
 
 from ..axes import Axis
 from ..catalog import FACET_FRESNEL, f0_factor
+from ..sampling.groups import key_of, siblings_by_key
 from ..sampling.plan import TexelPlan, per_texel_plan
 from . import diffuse
 from .base import Key, declare
@@ -60,10 +61,14 @@ def plan(spec) -> TexelPlan:
     if model == "microfacet":
         terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff, sigma_to_alpha=o["sigma_to_alpha"])
     axes = [f0_axis, sig_axis, nov_axis]
+    grid = diffuse.diffuse_grid(axes, nov, sigma, f0, o["sigma_to_alpha"])
+    # a CPU tile lies in one f0 slice: it is evaluated with the same (n.v, sigma) texels of every slice, which the
+    # microfacet estimator integrates over one set of nodes (lutbake.sampling.swapped; the same bits)
+    siblings = siblings_by_key(key_of(grid.inputs["nov"], grid.inputs["alpha"]), np.ones(grid.n_texels, bool))
     return per_texel_plan(
         diffuse_integrand(model, ff),
         diffuse.estimator_of(o),
-        diffuse.diffuse_grid(axes, nov, sigma, f0, o["sigma_to_alpha"]),
+        grid,
         channels={
             "E": "∫ f_r (n.l) dω_l for rho = 1 at the slice's f0: directional diffuse reflectance under "
             "uniform white light"
@@ -76,6 +81,7 @@ def plan(spec) -> TexelPlan:
             "factoring_form": f0_factor(model, ff),
             **diffuse.sigma_record(sig_axis),
         },
+        siblings=siblings if model == "microfacet" and o["estimator"] == "gauss_legendre" else None,
     )
 
 

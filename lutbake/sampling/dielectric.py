@@ -49,6 +49,7 @@ import warp as wp
 
 from . import points
 from .arrays import Levels, Rows64, Rule
+from .groups import group_rows, key_of, siblings_by_key
 from .hemisphere import (
     PANEL_RATIO,
     PEAK_MERGE,
@@ -507,51 +508,23 @@ def make_adaptive_members(spec):
     return adaptive_members_kernel
 
 
+def shareable_texels(texel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(key, shareable) of texels (n, 3) float32 (n.v, alpha, eta) for lutbake.sampling.groups: the texels of one
+    (n.v, alpha) with alpha > 0 and eta >= 1 share their panels and nodes (make_adaptive_members)."""
+    return key_of(texel[:, 0], texel[:, 1]), (texel[:, 2] >= np.float32(1.0)) & (texel[:, 1] > np.float32(0.0))
+
+
 def member_groups(texel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(groups, singles) of texels (n, 3) float32 (n.v, alpha, eta): rows of up to MEMBERS indices (-1 padded) of
-    texels with equal (n.v, alpha), alpha > 0 and eta >= 1 (make_adaptive_members), in index order; the other texels'
-    indices. Any cut gives the same values (each texel's bits do not depend on its group)."""
-    shareable = (texel[:, 2] >= np.float32(1.0)) & (texel[:, 1] > np.float32(0.0))
-    idx = np.flatnonzero(shareable)
-    key = np.ascontiguousarray(texel[idx, :2]).view(np.int64)[:, 0]  # (n.v, alpha) bits
-    order = idx[np.argsort(key, kind="stable")]
-    keys = np.ascontiguousarray(texel[order, :2]).view(np.int64)[:, 0]
-    starts = np.flatnonzero(np.r_[True, keys[1:] != keys[:-1]])
-    rows, singles = [], list(np.flatnonzero(~shareable))
-    for a, b in zip(starts, np.r_[starts[1:], len(order)]):
-        run = order[a:b]
-        if len(run) < 2:
-            singles += list(run)
-            continue
-        for c in range(0, len(run), MEMBERS):
-            rows.append(np.pad(run[c : c + MEMBERS], (0, MEMBERS - len(run[c : c + MEMBERS])), constant_values=-1))
-    groups = np.array(rows, dtype=np.int32).reshape(-1, MEMBERS)
-    return groups, np.sort(np.array(singles, dtype=np.int64))
+    """(groups of up to MEMBERS, singles) of texels (n, 3) float32 (n.v, alpha, eta) (lutbake.sampling.groups)."""
+    return group_rows(*shareable_texels(texel), MEMBERS)
 
 
 def sibling_tiles(inputs: dict):
     """``siblings(start, stop)`` of lutbake.sampling.plan.per_texel_plan for a dielectric grid (inputs nov, alpha,
-    param): where each texel of tile [start, stop) that member_groups could group (alpha > 0, eta >= 1) is the only
-    one of its (n.v, alpha) in the tile -- a tile within one IOR slice, as Turquin's and OpenPBR's 3D tables (IOR the
-    slowest axis) are cut on the CPU -- the tile with every texel that shares their (n.v, alpha) at eta >= 1 (so they
-    form groups); else None (the tile's texels group among themselves: EEVEE's btdf rows, a cluster's larger tiles)."""
+    param; lutbake.sampling.groups.siblings_by_key): a CPU tile within one IOR slice, as Turquin's and OpenPBR's 3D
+    tables (IOR the slowest axis) are cut, is evaluated with the same texels of every eta >= 1 slice."""
     texel = np.stack([np.asarray(inputs[k], dtype=np.float32) for k in ("nov", "alpha", "param")], axis=1)
-    shareable = (texel[:, 2] >= np.float32(1.0)) & (texel[:, 1] > np.float32(0.0))
-    key = np.ascontiguousarray(texel[:, :2]).view(np.int64)[:, 0]
-    pool = np.flatnonzero(shareable)
-    pool = pool[np.argsort(key[pool], kind="stable")]
-    pool_keys = key[pool]
-
-    def siblings(start: int, stop: int) -> np.ndarray | None:
-        own = np.arange(start, stop)[shareable[start:stop]]
-        if len(own) == 0 or len(np.unique(key[own])) < len(own):
-            return None
-        lo, hi = np.searchsorted(pool_keys, key[own], "left"), np.searchsorted(pool_keys, key[own], "right")
-        if np.all(hi - lo < 2):
-            return None
-        return np.union1d(np.arange(start, stop), np.concatenate([pool[a:b] for a, b in zip(lo, hi)]))
-
-    return siblings
+    return siblings_by_key(*shareable_texels(texel))
 
 
 GROUP_BATCH = 64  # member groups per launch (bounds the adaptive kernel's first-pass scratch: 4.7 MB)

@@ -39,6 +39,7 @@ import warp as wp
 
 from ..terms.masking import Lambda_ggx64
 from . import points
+from .groups import group_rows, key_of
 from .panels import (
     MAX_TAIL_CUTS,
     PI64,
@@ -54,10 +55,13 @@ from .panels import (
 
 
 @functools.lru_cache(maxsize=None)
-def swapped_kernel(T):
-    """Kernel: E(nov[i]) / c(f0) for alpha[i], f0[i] and the facet transmission ``T(c, f0)`` (float64;
-    lutbake.terms.diffuse.T_*). rule[i] = (n_u, n_μ, n_φ), the texel's GL orders for u, μ = n.l and the arcs:
-    row n of xs, ws (``rules``) is the n-point rule on [0, 1], ns[n] = n."""
+def swapped_kernel(T, members: int = 1):
+    """Kernel: E(nov[g]) / c(f0) for alpha[g] and ``members`` values f0[g, k] (a group of texels that share (n.v,
+    alpha) and orders, lutbake.sampling.groups: every node, its cosines and the f0-free factors once; the facet
+    transmission ``T(c, f0)`` (float64; lutbake.terms.diffuse.T_*) per member, each member's sums taking the same float
+    operations in the same order as alone). rule[g] = (n_u, n_μ, n_φ), the group's GL orders for u, μ = n.l and the
+    arcs: row n of xs, ws (``rules``) is the n-point rule on [0, 1], ns[n] = n. out[g, k]: member k."""
+    Members = wp.types.vector(length=members, dtype=wp.float64)
 
     @wp.func
     def arc_integral(
@@ -65,20 +69,21 @@ def swapped_kernel(T):
         sm: wp.float64,
         cx: wp.float64,
         sx: wp.float64,
-        f0: wp.float64,
+        f0: Members,
         xp: wp.array2d(dtype=wp.float64),
         wpp: wp.array2d(dtype=wp.float64),
         rp: int,
         n: int,
     ):
-        """∫ (m.x)+ T(m.x) dφ over the arc where m.x > 0 (2 ∫_0^w, the arc being symmetric)."""
+        """∫ (m.x)+ T(m.x) dφ over the arc where m.x > 0 (2 ∫_0^w, the arc being symmetric), per member."""
         w = arc_half_width(cm, sm, cx, sx)
-        acc = wp.float64(0.0)
+        acc = Members()
         if w > wp.float64(0.0):
             for j in range(n):
                 c = cm * cx + sm * sx * wp.cos(w * xp[rp, j])
                 if c > wp.float64(0.0):
-                    acc = acc + wpp[rp, j] * c * T(c, f0)
+                    for k in range(wp.static(members)):
+                        acc[k] = acc[k] + wpp[rp, j] * c * T(c, f0[k])
         return wp.float64(2.0) * w * acc
 
     @wp.func
@@ -93,7 +98,7 @@ def swapped_kernel(T):
     def albedo_kernel(
         nov: wp.array(dtype=wp.float64),
         alpha: wp.array(dtype=wp.float64),
-        f0: wp.array(dtype=wp.float64),
+        f0: wp.array2d(dtype=wp.float64),
         rule: wp.array2d(dtype=int),
         xs: wp.array2d(dtype=wp.float64),
         ws: wp.array2d(dtype=wp.float64),
@@ -105,7 +110,9 @@ def swapped_kernel(T):
         zero = wp.float64(0.0)
         cv = nov[i]
         a = alpha[i]
-        ff = f0[i]
+        ff = Members()
+        for k in range(wp.static(members)):
+            ff[k] = f0[i, k]
         ru = rule[i, 0]
         rm = rule[i, 1]
         rp = rule[i, 2]
@@ -118,7 +125,7 @@ def swapped_kernel(T):
         u_v = cv * cv / den_v
         om_v = a * a * (one - cv * cv) / den_v  # 1 - u_v without cancellation
         n_geo = n_tail_cuts(a)
-        acc = zero
+        acc = Members()
         prev = zero
         om_prev = one
         for k in range(n_geo + 1):
@@ -147,7 +154,7 @@ def swapped_kernel(T):
                         cm = csm[0]
                         sm = csm[1]
                         V = arc_integral(cm, sm, cv, sv, ff, xs, ws, rp, npp)
-                        if V > zero:
+                        if wp.max(V) > zero:
                             # H(theta_m): mu = n.l on four panels cut at sin(theta_m), 2 alpha and 16 alpha (sorted)
                             cuts = sort4(
                                 zero,
@@ -155,7 +162,7 @@ def swapped_kernel(T):
                                 wp.min(wp.float64(2.0) * a, one),
                                 wp.min(wp.float64(16.0) * a, one),
                             )
-                            H = zero
+                            H = Members()
                             for pm in range(4):
                                 ends = interval(pm, cuts, one)
                                 mlo = ends[0]
@@ -168,15 +175,19 @@ def swapped_kernel(T):
                                         sl = wp.sqrt(wp.max(one - mu * mu, zero))
                                         g2 = one / (one + lam_v + Lambda_ggx64(mu, a))
                                         H = H + wmu * g2 * arc_integral(cm, sm, mu, sl, ff, xs, ws, rp, npp)
-                            acc = acc + wu * V * H / cm
+                            for m in range(wp.static(members)):  # a member whose V is 0 takes nothing (as alone)
+                                if V[m] > zero:
+                                    acc[m] = acc[m] + wu * V[m] * H[m] / cm
             prev = cut
             om_prev = om_cut
-        out[i, 0] = acc / (wp.float64(2.0) * PI64 * PI64 * cv)
+        for m in range(wp.static(members)):
+            out[i, m] = acc[m] / (wp.float64(2.0) * PI64 * PI64 * cv)
 
     return albedo_kernel
 
 
 MAX_ORDER = 96
+MEMBERS = 16  # texels per group (diffuse_3d: the 16 f0 slices of a (n.v, sigma) texel)
 GRAZING_NOV = 0.1
 
 
@@ -218,22 +229,26 @@ def integrate_swapped(
     if orders is None:
         orders = orders_for(nov, alpha, order)
     orders = np.ascontiguousarray(np.minimum(orders, MAX_ORDER), dtype=np.int32)
-    out = wp.zeros((n, 1), dtype=wp.float64, device=device)
-    wp.launch(
-        swapped_kernel(integrand.transmission),
-        dim=n,
-        inputs=[
-            wp.array(nov, dtype=wp.float64, device=device),
-            wp.array(alpha, dtype=wp.float64, device=device),
-            wp.array(f0a, dtype=wp.float64, device=device),
-            wp.array(orders, dtype=int, device=device),
-            *rules(device),
-            out,
-        ],
-        device=device,
-    )
+    # texels of one (n.v, alpha, orders) share every node (diffuse_3d's f0 slices): in groups of MEMBERS, the others
+    # one by one; the same bits either way
+    groups, singles = group_rows(key_of(nov, alpha, *orders.T), np.ones(n, bool), MEMBERS)
+    e = np.zeros(n)
+    for rows, size in ((groups, MEMBERS), (singles[:, None], 1)):
+        if len(rows) == 0:
+            continue
+        lead = rows[:, 0]
+        f0_rows = np.where(rows >= 0, f0a[rows], f0a[lead][:, None])  # an unused row: the first member's f0
+        out = wp.zeros((len(rows), size), dtype=wp.float64, device=device)
+        args = [nov[lead], alpha[lead], f0_rows, orders[lead]]
+        args = [wp.array(np.ascontiguousarray(x), dtype=wp.float64, device=device) for x in args[:3]] + [
+            wp.array(args[3], dtype=int, device=device)
+        ]
+        kernel = swapped_kernel(integrand.transmission, size)
+        wp.launch(kernel, dim=len(rows), inputs=[*args, *rules(device), out], device=device)
+        used = rows >= 0
+        e[rows[used]] = out.numpy()[used]
     c = integrand.f0_scale
-    return out.numpy()[:, 0] * np.array([c(x) for x in f0a]) if n else np.zeros(0)
+    return e * np.array([c(x) for x in f0a]) if n else np.zeros(0)
 
 
 def u_panels(nov: np.ndarray, alpha: np.ndarray) -> np.ndarray:
@@ -278,7 +293,8 @@ class SwappedGaussLegendre:
         return evaluations(self._orders(inputs), nov, alpha)
 
     def prepare(self, integrand, device: str) -> None:
-        wp.load_module(swapped_kernel(integrand.transmission).module, device=device)
+        for size in (1, MEMBERS):
+            wp.load_module(swapped_kernel(integrand.transmission, size).module, device=device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         nov, alpha, f0 = (np.asarray(inputs[k], np.float64) for k in ("nov", "alpha", "f0"))
