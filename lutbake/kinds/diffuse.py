@@ -67,9 +67,10 @@ def order_for(o: dict) -> int:
     return DEFAULT_ORDER.get(o["model"], CLOSED_ORDER)
 
 
-def estimator_of(o: dict):
-    """gauss_legendre: the swapped integral for the microfacet model, the 2 x 2-panel rule over l otherwise;
-    sobol_cosine: cosine-weighted Sobol' directions l (lutbake.sampling.diffuse)."""
+def estimator_of(o: dict, members: int = 1):
+    """gauss_legendre: the swapped integral for the microfacet model (``members``: its f0 groups, kind diffuse_3d),
+    the 2 x 2-panel rule over l otherwise; sobol_cosine: cosine-weighted Sobol' directions l
+    (lutbake.sampling.diffuse)."""
     from ..sampling.diffuse import CosineSobol, DiffuseGaussLegendre
     from ..sampling.swapped import SwappedGaussLegendre
 
@@ -77,7 +78,7 @@ def estimator_of(o: dict):
     if o["estimator"] == "sobol_cosine":
         return CosineSobol(o["samples"] or DEFAULT_COSINE_SAMPLES, o["seed"], inner_order=order)
     if o["model"] == "microfacet":
-        return SwappedGaussLegendre(order)
+        return SwappedGaussLegendre(order, members=members)
     return DiffuseGaussLegendre(order)
 
 

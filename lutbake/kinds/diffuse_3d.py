@@ -45,6 +45,7 @@ RECONSTRUCTION = (
 
 def plan(spec) -> TexelPlan:
     from ..integrands.diffuse import diffuse_integrand
+    from ..sampling.swapped import MEMBERS
 
     o = spec.options
     n_nov, n_sigma = o["size"]
@@ -67,7 +68,7 @@ def plan(spec) -> TexelPlan:
     siblings = siblings_by_key(key_of(grid.inputs["nov"], grid.inputs["alpha"]), np.ones(grid.n_texels, bool))
     return per_texel_plan(
         diffuse_integrand(model, ff),
-        diffuse.estimator_of(o),
+        diffuse.estimator_of(o, MEMBERS),
         grid,
         channels={
             "E": "∫ f_r (n.l) dω_l for rho = 1 at the slice's f0: directional diffuse reflectance under "

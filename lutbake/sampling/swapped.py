@@ -32,7 +32,7 @@ view), and the error estimate re-integrates probe texels with every order + 8.
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import warp as wp
@@ -82,7 +82,7 @@ def swapped_kernel(T, members: int = 1):
             for j in range(n):
                 c = cm * cx + sm * sx * wp.cos(w * xp[rp, j])
                 if c > wp.float64(0.0):
-                    for k in range(wp.static(members)):
+                    for k in range(wp.static(members)):  # unrolled: T of every member vectorised (a loop: 1.4x)
                         acc[k] = acc[k] + wpp[rp, j] * c * T(c, f0[k])
         return wp.float64(2.0) * w * acc
 
@@ -217,11 +217,19 @@ def orders_for(nov: np.ndarray, alpha: np.ndarray, base: int) -> np.ndarray:
 
 
 def integrate_swapped(
-    integrand, nov, alpha, f0=0.0, order: int = 12, orders: np.ndarray | None = None, device: str = "cpu"
+    integrand,
+    nov,
+    alpha,
+    f0=0.0,
+    order: int = 12,
+    orders: np.ndarray | None = None,
+    device: str = "cpu",
+    members: int = 1,
 ) -> np.ndarray:
     """E(nov_i) for GGX alpha_i and f0 (rho = 1) of the microfacet diffuse ``integrand`` (its ``transmission``
     T and factor c(f0): lutbake.integrands.diffuse), float64 (N,). ``orders``: (N, 3) per texel (u, μ, φ);
-    omitted: ``orders_for(nov, alpha, order)``."""
+    omitted: ``orders_for(nov, alpha, order)``. ``members`` (1 or MEMBERS): texels of one (n.v, alpha, orders) in
+    groups of that many (the same bits)."""
     nov = np.ascontiguousarray(nov, dtype=np.float64).reshape(-1)
     n = len(nov)
     alpha = np.ascontiguousarray(np.broadcast_to(np.asarray(alpha, np.float64), (n,)))
@@ -231,9 +239,9 @@ def integrate_swapped(
     orders = np.ascontiguousarray(np.minimum(orders, MAX_ORDER), dtype=np.int32)
     # texels of one (n.v, alpha, orders) share every node (diffuse_3d's f0 slices): in groups of MEMBERS, the others
     # one by one; the same bits either way
-    groups, singles = group_rows(key_of(nov, alpha, *orders.T), np.ones(n, bool), MEMBERS)
+    groups, singles = group_rows(key_of(nov, alpha, *orders.T), np.full(n, members > 1), max(members, 1))
     e = np.zeros(n)
-    for rows, size in ((groups, MEMBERS), (singles[:, None], 1)):
+    for rows, size in ((groups, members), (singles[:, None], 1)):
         if len(rows) == 0:
             continue
         lead = rows[:, 0]
@@ -284,6 +292,7 @@ class SwappedGaussLegendre:
     order: int = 12
     extra: int = 0
     name: str = "gauss_legendre_swapped"
+    members: int = 1  # MEMBERS: texels that differ only in f0 in groups (diffuse_3d; integrate_swapped)
 
     def _orders(self, inputs: dict) -> np.ndarray:
         return orders_for(inputs["nov"], inputs["alpha"], self.order) + self.extra
@@ -293,13 +302,14 @@ class SwappedGaussLegendre:
         return evaluations(self._orders(inputs), nov, alpha)
 
     def prepare(self, integrand, device: str) -> None:
-        for size in (1, MEMBERS):
+        for size in sorted({1, self.members}):
             wp.load_module(swapped_kernel(integrand.transmission, size).module, device=device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         nov, alpha, f0 = (np.asarray(inputs[k], np.float64) for k in ("nov", "alpha", "f0"))
-        return integrate_swapped(integrand, nov, alpha, f0, orders=self._orders(inputs), device=device)[:, None]
+        orders = self._orders(inputs)
+        return integrate_swapped(integrand, nov, alpha, f0, orders=orders, device=device, members=self.members)[:, None]
 
     def refined(self):
         e = self.extra + ESTIMATE_EXTRA_ORDER
-        return SwappedGaussLegendre(self.order, e), f"orders (n_u, n_mu, n_phi) - orders + {e}"
+        return replace(self, extra=e), f"orders (n_u, n_mu, n_phi) - orders + {e}"
