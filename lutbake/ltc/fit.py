@@ -131,10 +131,14 @@ def kernels(lobe_name: str):
         mag = magnitude[t]
         acc = wp.float64(0.0)
         for s in range(cos_dirs.shape[0]):
-            # LTC sample: l = M w_o / |M w_o|, w_o cosine-distributed (p_ltc = D, the normalised LTC)
-            ld = wp.normalize(mi * cos_dirs[s])
+            # LTC sample: l = M w_o / |M w_o|, w_o cosine-distributed (p_ltc = D, the normalised LTC). There
+            # M^-1 l = w_o / |M w_o|, so Eq. 3 is D(l) = (w_o.z / pi) |det M^-1| |M w_o|^3: no second matrix product
+            wo = cos_dirs[s]
+            mw = mi * wo
+            r = wp.length(mw)
+            ld = mw / r
             l = wp.vec3(float(ld[0]), float(ld[1]), float(ld[2]))
-            d = ltc_eval(m_inv, det_inv, ld)
+            d = wo[2] * wp.float64(0.3183098861837907) * det_inv * r * r * r
             fp = f_pdf(vi, l, a, tab, t)
             e = wp.abs(wp.float64(fp[0]) - mag * d)
             q = d + wp.float64(fp[1])
