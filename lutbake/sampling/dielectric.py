@@ -35,7 +35,9 @@ alpha = 0 takes the integrand's closed-form mirror limit.
 DIELECTRIC_ORDERS, the worst panel first: make_adaptive_dielectric; an NDF-peak point within PEAK_MERGE of another
 breakpoint dropped, as the dfg estimator's), estimators of the lutbake.sampling.plan protocol; the QMC estimators of
 lutbake.sampling.hemisphere serve as the second estimator unchanged (the integrand lives in the same half-vector
-measure).
+measure). Both evaluate the texels of one (n.v, alpha) with eta >= 1, whose panels and phi-breakpoints are the same,
+in groups of up to MEMBERS (make_adaptive_members, make_gauss_legendre_members; lutbake.sampling.groups): every node
+and the integrand's eta-free part once, the rest per member, each member's value the bits of its own evaluation.
 """
 
 from __future__ import annotations
