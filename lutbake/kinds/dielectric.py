@@ -280,15 +280,15 @@ def terms_of(o: dict) -> tuple[str, str]:
     return o["ndf"], o["masking"]
 
 
-def estimator_for(name: str, samples: int | None = None, seed: int = 0, merged: bool = False):
+def estimator_for(name: str, samples: int | None = None, seed: int = 0, merged: bool = False, members: bool = True):
     """The dielectric kinds' estimator ``name``: the panelled Gauss-Legendre of lutbake.sampling.dielectric
-    (``merged``: its NDF-peak breakpoints merged), or a QMC estimator of lutbake.sampling.hemisphere (the same
-    half-vector measure)."""
+    (``merged``: its NDF-peak breakpoints merged; ``members``: texels that differ only in eta >= 1 in groups), or a
+    QMC estimator of lutbake.sampling.hemisphere (the same half-vector measure)."""
     from ..sampling.dielectric import DielectricGaussLegendre
     from ..sampling.hemisphere import QuasiMonteCarlo
 
     if name == "gauss_legendre":
-        return DielectricGaussLegendre(samples or DEFAULT_SAMPLES[name], merged=merged)
+        return DielectricGaussLegendre(samples or DEFAULT_SAMPLES[name], merged=merged, members=members)
     return QuasiMonteCarlo(name, samples or DEFAULT_SAMPLES[name], seed)
 
 
@@ -377,17 +377,18 @@ class LayoutChannelsAdaptive(LayoutChannels):
         return replace(self, inner=inner, absolute=self.absolute / 100, relative=self.relative / 100), how
 
 
-def layout_estimator(o: dict):
+def layout_estimator(o: dict, members: bool = True):
     """The estimator of a ``dielectric`` spec: to its tolerance (lutbake.tolerance) when ``samples`` is unset and the
-    estimator is gauss_legendre, else estimator_for at ``samples``, through the layout's channels."""
+    estimator is gauss_legendre, else estimator_for at ``samples``, through the layout's channels (``members``: the
+    grid has texels that differ only in eta >= 1, which the gauss_legendre kernels take in groups)."""
     layout = o["layout"]
     if o["estimator"] == "gauss_legendre" and o["samples"] is None:
         from ..sampling.dielectric import DielectricAdaptive
 
         tol = tolerance_of(o)
-        inner = DielectricAdaptive(*kernel_tolerance(layout, tol))
+        inner = DielectricAdaptive(*kernel_tolerance(layout, tol), members=members)
         return LayoutChannelsAdaptive(inner, layout, tol.absolute, tol.relative)
-    return LayoutChannels(estimator_for(o["estimator"], o["samples"], o["seed"]), layout)
+    return LayoutChannels(estimator_for(o["estimator"], o["samples"], o["seed"], members=members), layout)
 
 
 def terms_record(key: tuple, layout: str) -> dict:
@@ -416,7 +417,7 @@ def plan(spec) -> TexelPlan:
         "param": np.asarray(eta, np.float32),
     }
     grid = Grid(axes, inputs, grazing=inputs["nov"], alpha=np.asarray(alpha, np.float64))
-    est = layout_estimator(o)
+    est = layout_estimator(o, members=bool(np.any(np.asarray(eta) >= 1.0)))
     return per_texel_plan(
         integrand,
         est,

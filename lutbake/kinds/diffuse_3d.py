@@ -65,10 +65,12 @@ def plan(spec) -> TexelPlan:
     grid = diffuse.diffuse_grid(axes, nov, sigma, f0, o["sigma_to_alpha"])
     # a CPU tile lies in one f0 slice: it is evaluated with the same (n.v, sigma) texels of every slice, which the
     # microfacet estimator integrates over one set of nodes (lutbake.sampling.swapped; the same bits)
+    estimator = diffuse.estimator_of(o, MEMBERS)
+    grouped = getattr(estimator, "members", 1) > 1
     siblings = siblings_by_key(key_of(grid.inputs["nov"], grid.inputs["alpha"]), np.ones(grid.n_texels, bool))
     return per_texel_plan(
         diffuse_integrand(model, ff),
-        diffuse.estimator_of(o, MEMBERS),
+        estimator,
         grid,
         channels={
             "E": "∫ f_r (n.l) dω_l for rho = 1 at the slice's f0: directional diffuse reflectance under "
@@ -82,7 +84,7 @@ def plan(spec) -> TexelPlan:
             "factoring_form": f0_factor(model, ff),
             **diffuse.sigma_record(sig_axis),
         },
-        siblings=siblings if model == "microfacet" and o["estimator"] == "gauss_legendre" else None,
+        siblings=siblings if grouped else None,
     )
 
 

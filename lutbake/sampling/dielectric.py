@@ -532,16 +532,18 @@ def sibling_tiles(inputs: dict):
 GROUP_BATCH = 64  # member groups per launch (bounds the adaptive kernel's first-pass scratch: 4.7 MB)
 
 
-def launch_by_groups(inputs: dict, nch: int, n_out: int, members: tuple, single: tuple, device: str) -> list:
+def launch_by_groups(inputs: dict, nch: int, n_out: int, members: tuple | None, single: tuple, device: str) -> list:
     """``n_out`` float64 arrays (texels, nch) of the texels (n.v, alpha, eta) of ``inputs``: member_groups' groups by
     ``members`` = (kernel, args, scratch(groups) -> list of extra arrays) (inputs: texel, groups, args, scratch, the
-    outputs indexed by texel), the other texels by ``single`` = (kernel, args) (inputs: their texels, args, outputs)."""
+    outputs indexed by texel), the other texels by ``single`` = (kernel, args) (inputs: their texels, args, outputs);
+    ``members`` None: every texel by ``single``."""
     n, texel = _texels(inputs, device)
     host = texel.numpy()
-    groups, singles = member_groups(host)
+    groups, singles = member_groups(host) if members else (np.zeros((0, MEMBERS), np.int32), np.arange(n))
     outs = [np.zeros((n, nch)) for _ in range(n_out)]
-    (m_kernel, m_args, scratch), (s_kernel, s_args) = members, single
+    s_kernel, s_args = single
     if len(groups):
+        m_kernel, m_args, scratch = members
         arrs = [wp.zeros((n, nch), dtype=wp.float64, device=device) for _ in range(n_out)]
         for b in range(0, len(groups), GROUP_BATCH):
             batch = groups[b : b + GROUP_BATCH]
@@ -588,20 +590,23 @@ class DielectricGaussLegendre(GaussLegendre):
     rule, whose error its probe measures); else every breakpoint (a fixed-order table's pixels as before the merge)."""
 
     merged: bool = False
+    members: bool = True  # texels that differ only in eta >= 1 in groups (False: a grid without any; no such kernel)
 
     def _kernel(self, integrand):
         return gl_dielectric_kernel(integrand)
 
     def prepare(self, integrand, device: str) -> None:
         load(self._kernel(integrand), device)
-        load(gl_members_kernel(integrand), device)
+        if self.members:
+            load(gl_members_kernel(integrand), device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         """The texels that differ only in eta >= 1 in groups (make_gauss_legendre_members), the others one by one:
         the same bits either way."""
         rule = wp.array(np.stack(points.gauss_legendre(self.order), axis=1), dtype=wp.vec2d, device=device)
         args = [rule, MERGE64 if self.merged else ONE64]
-        members, single = (gl_members_kernel(integrand), args, lambda b: []), (self._kernel(integrand), args)
+        members = (gl_members_kernel(integrand), args, lambda b: []) if self.members else None
+        single = (self._kernel(integrand), args)
         (out,) = launch_by_groups(inputs, integrand.kernel_channels, 1, members, single, device)
         return out
 
@@ -632,13 +637,15 @@ class DielectricAdaptive:
     relative: tuple[float, ...]
     orders: tuple[int, ...] = DIELECTRIC_ORDERS
     name: str = "gauss_legendre"
+    members: bool = True  # texels that differ only in eta >= 1 in groups (False: a grid without any; no such kernel)
 
     def samples(self, inputs: dict) -> np.ndarray:  # nominal: 3 panels at the first two orders (the work adapts)
         return np.full(len(inputs["nov"]), 3 * sum(n * n for n in self.orders[:2]))
 
     def prepare(self, integrand, device: str) -> None:
         load(adaptive_dielectric_kernel(integrand), device)
-        load(adaptive_members_kernel(integrand), device)
+        if self.members:
+            load(adaptive_members_kernel(integrand), device)
 
     def evaluate_with_error(self, integrand, inputs: dict, device: str) -> tuple[np.ndarray, np.ndarray]:
         """Values and estimates (n, kernel channels) each: the texels that share their (n.v, alpha) at eta >= 1 in
@@ -656,7 +663,7 @@ class DielectricAdaptive:
         def scratch(n_groups: int) -> list:
             return [wp.empty((n_groups * MEMBERS, MAX_PANELS, 2, nch), dtype=wp.float64, device=device)]
 
-        members = (adaptive_members_kernel(integrand), args, scratch)
+        members = (adaptive_members_kernel(integrand), args, scratch) if self.members else None
         out, err = launch_by_groups(inputs, nch, 2, members, (adaptive_dielectric_kernel(integrand), args), device)
         return out, err
 

@@ -247,10 +247,8 @@ def integrate_swapped(
         lead = rows[:, 0]
         f0_rows = np.where(rows >= 0, f0a[rows], f0a[lead][:, None])  # an unused row: the first member's f0
         out = wp.zeros((len(rows), size), dtype=wp.float64, device=device)
-        args = [nov[lead], alpha[lead], f0_rows, orders[lead]]
-        args = [wp.array(np.ascontiguousarray(x), dtype=wp.float64, device=device) for x in args[:3]] + [
-            wp.array(args[3], dtype=int, device=device)
-        ]
+        args = [wp.array(np.ascontiguousarray(x), dtype=wp.float64, device=device) for x in (nov[lead], alpha[lead])]
+        args += [wp.array(f0_rows, dtype=wp.float64, device=device), wp.array(orders[lead], dtype=int, device=device)]
         kernel = swapped_kernel(integrand.transmission, size)
         wp.launch(kernel, dim=len(rows), inputs=[*args, *rules(device), out], device=device)
         used = rows >= 0
