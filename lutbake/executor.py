@@ -21,7 +21,6 @@ from .sampling.plan import TexelPlan
 TILE_TEXELS = 512
 # progress(label, n_texels, cost) -> update(n_done_in_this_tile) or None: called once per table before its tiles run
 Progress = Callable[[str, int, float], "Callable[[int], None] | None"]
-_PREPARE_LOCK = threading.Lock()  # kernels compile/load one at a time when tables bake in parallel
 
 
 class Cancelled(Exception):
@@ -69,10 +68,10 @@ def execute_tiles(
         return remote.execute(spec, plan, device, progress=progress, label=label, cancel=cancel)
     workers = workers or default_workers()
     cpu = cpu if cpu is not None else []
-    with _PREPARE_LOCK:
-        t0 = time.thread_time()
-        plan.prepare(device)
-        cpu.append(time.thread_time() - t0)
+    # tables prepare in parallel: their kernels compile on every core (lutbake.warp_runtime.load_module)
+    t0 = time.thread_time()
+    plan.prepare(device)
+    cpu.append(time.thread_time() - t0)
     parts = tiles(plan.n_texels, plan_tile_texels(plan, device))
     out = np.empty((plan.n_texels, plan.tile_width), dtype=np.float64)
     update = progress(label, plan.n_texels, plan.cost) if progress is not None else None

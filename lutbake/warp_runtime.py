@@ -58,3 +58,28 @@ def init_warp():
                     wp.init()
             _started = True
     return wp
+
+
+# one lock per (Warp module, device): load_module's
+_MODULE_LOCKS: dict = {}
+
+
+def parallel_loads(wp=None) -> bool:
+    """Whether this Warp compiles different modules in parallel threads: its own parallel loader
+    (``warp.force_load(max_workers=...)``, configured by ``warp.config.load_module_max_workers``) runs the Python
+    codegen under Warp's codegen lock and the native compile unlocked. Older releases load one module at a time."""
+    wp = wp or init_warp()
+    return hasattr(wp.config, "load_module_max_workers")
+
+
+def load_module(module, device: str = "cpu") -> None:
+    """Compile (or load from Warp's kernel cache) a Warp module on ``device`` before worker threads launch its
+    kernels. Tables prepare in parallel (lutbake.batch runs two at once on two cores): on a cold kernel cache their
+    modules compile on both cores (parallel_loads), one thread per module, so a module two tables need compiles once.
+    A Warp without parallel loading compiles one module at a time, whichever table asks."""
+    wp = init_warp()
+    key = (module, str(device)) if parallel_loads(wp) else None
+    with _LOCK:
+        lock = _MODULE_LOCKS.setdefault(key, threading.Lock())
+    with lock:
+        wp.load_module(module, device=device)

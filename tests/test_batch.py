@@ -334,3 +334,33 @@ def test_every_format_is_skipped_when_up_to_date(tmp_path, fmt, ext):
     assert again.exit_code == 0 and f"skipped {out / ('t' + ext)} (up to date)" in again.output
     changed = bake(cfg, "--out-dir", out, "--set", "samples=64")
     assert changed.exit_code == 0 and "(up to date)" not in changed.output
+
+
+def test_modules_load_in_parallel_each_once(monkeypatch):
+    """Tables prepare in parallel (no batch-wide lock): two different Warp modules load at the same time, while two
+    tables asking for the same module load it one after the other (the second finds it loaded: compiled once)."""
+    import threading
+
+    import warp as wp
+
+    from lutbake import warp_runtime
+
+    spans = []
+
+    def slow_load(module, device=None):
+        t0 = time.perf_counter()
+        time.sleep(0.3)
+        spans.append((module, t0, time.perf_counter()))
+
+    monkeypatch.setattr(wp, "load_module", slow_load)
+    monkeypatch.setattr(warp_runtime, "_MODULE_LOCKS", {})
+    a, b = object(), object()  # stand-ins for two Warp modules
+    threads = [threading.Thread(target=warp_runtime.load_module, args=(m, "cpu")) for m in (a, a, b)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    (a0, a1), (b0,) = [sorted(s[1:] for s in spans if s[0] is m) for m in (a, b)]
+    assert warp_runtime.parallel_loads()
+    assert a1[0] >= a0[1]  # the same module: one load after the other
+    assert b0[0] < max(a0[1], a1[1]) and min(a0[0], a1[0]) < b0[1]  # another module: at the same time

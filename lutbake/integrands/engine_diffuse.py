@@ -30,6 +30,7 @@ import warp as wp
 
 from ..sampling.plan import TexelPlan
 from ..terms.engine_diffuse import Fd_disney_hdrp, Fd_fabric_lambert_hdrp
+from ..warp_runtime import load_module
 
 DIFFUSE_ORDER = 24  # Gauss-Legendre nodes per dimension (mu, phi)
 HDRP_DIFFUSE_OFFSET = 0.5  # HDRP stores the Disney FGD minus 0.5 (range [0.5, 1.5] -> [0, 1] for its UNORM target)
@@ -129,7 +130,7 @@ def with_diffuse_channel(
 
     def prepare(device: str) -> None:
         base_prepare(device)
-        wp.load_module((fabric_kernel() if layout == "charlie_fabric" else diffuse_kernel()).module, device=device)
+        load_module((fabric_kernel() if layout == "charlie_fabric" else diffuse_kernel()).module, device=device)
 
     base_estimate = plan.error_estimate
     scale = HDRP_UNIFORM_SCALE if layout == "charlie_fabric" else 1.0

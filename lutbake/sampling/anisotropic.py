@@ -22,6 +22,7 @@ import warp as wp
 from ..edge import COS_EPS
 from ..terms import ndf
 from ..terms.frame import reflect
+from ..warp_runtime import load_module
 from . import points
 from .arrays import Points2, Rows64
 from .hemisphere import AdaptiveGaussLegendre, gl_launch, store_row
@@ -108,7 +109,7 @@ class AnisoSobol:
         return aniso_kernel(lobe, self.name == "sobol_cosine")
 
     def prepare(self, lobe, device: str) -> None:
-        wp.load_module(self._kernel(lobe).module, device=device)
+        load_module(self._kernel(lobe).module, device=device)
 
     def evaluate(self, lobe, inputs: dict, device: str) -> np.ndarray:
         n = len(inputs["nov"])

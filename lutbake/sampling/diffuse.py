@@ -25,6 +25,7 @@ import numpy as np
 import warp as wp
 
 from ..terms.frame import view_dir
+from ..warp_runtime import load_module
 from . import points
 from .arrays import Floats, Levels, Points2, Rows64, Rule, Values64
 from .facets import (
@@ -147,7 +148,7 @@ class DiffuseGaussLegendre:
         return np.full(len(inputs["nov"]), 4 * (self.outer_order or self.order) ** 2)
 
     def prepare(self, integrand, device: str) -> None:
-        wp.load_module(albedo_kernel(integrand.brdf).module, device=device)
+        load_module(albedo_kernel(integrand.brdf).module, device=device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         rules = [gl_rule(self.outer_order or self.order, device), gl_rule(self.order, device)]
@@ -184,7 +185,7 @@ class CosineSobol(ScrambledSobol):
     name: str = "sobol_cosine"
 
     def prepare(self, integrand, device: str) -> None:
-        wp.load_module(cosine_kernel(integrand.brdf).module, device=device)
+        load_module(cosine_kernel(integrand.brdf).module, device=device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         arrays = [
@@ -225,7 +226,7 @@ class PointEvaluation:
         return np.full(len(inputs["order"]), self.evaluations)
 
     def prepare(self, integrand, device: str) -> None:
-        wp.load_module(brdf_kernel(integrand.brdf).module, device=device)
+        load_module(brdf_kernel(integrand.brdf).module, device=device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         out = np.empty((len(inputs["order"]), 1))
@@ -262,7 +263,7 @@ class PointSobol(ScrambledSobol):
     name: str = "sobol_ndf"
 
     def prepare(self, integrand, device: str) -> None:
-        wp.load_module(sobol_point_kernel(integrand.facet).module, device=device)
+        load_module(sobol_point_kernel(integrand.facet).module, device=device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         lv = np.ascontiguousarray(np.stack([inputs["l"], inputs["v"]], axis=1), dtype=np.float32)
@@ -374,7 +375,7 @@ class PointAdaptive:
         return np.full(len(inputs["alpha"]), self.evaluations)
 
     def prepare(self, integrand, device: str) -> None:
-        wp.load_module(adaptive_azimuths_kernel(integrand.facet).module, device=device)
+        load_module(adaptive_azimuths_kernel(integrand.facet).module, device=device)
 
     def evaluate_with_error(self, integrand, inputs: dict, device: str) -> tuple[np.ndarray, np.ndarray]:
         n = len(inputs["alpha"])

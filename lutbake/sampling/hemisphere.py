@@ -60,6 +60,7 @@ import warp as wp
 from .. import tolerance
 from ..catalog import HEMISPHERE_ESTIMATORS
 from ..terms.frame import view_dir
+from ..warp_runtime import load_module
 from . import points
 from .arrays import PhiRule, Points2, Rows64, Rule, Values64
 from .ladder import greedy_ladder_for
@@ -695,7 +696,7 @@ def qmc_kernel(spec, vndf: bool):
 
 def load(kernel, device: str = "cpu") -> None:
     """Compile (or load from Warp's cache) a kernel's module before worker threads launch it."""
-    wp.load_module(kernel.module, device=device)
+    load_module(kernel.module, device=device)
 
 
 def _texels(inputs: dict, device: str):

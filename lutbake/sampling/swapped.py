@@ -38,6 +38,7 @@ import numpy as np
 import warp as wp
 
 from ..terms.masking import Lambda_ggx64
+from ..warp_runtime import load_module
 from . import points
 from .groups import group_rows, key_of
 from .panels import (
@@ -301,7 +302,7 @@ class SwappedGaussLegendre:
 
     def prepare(self, integrand, device: str) -> None:
         for size in sorted({1, self.members}):
-            wp.load_module(swapped_kernel(integrand.transmission, size).module, device=device)
+            load_module(swapped_kernel(integrand.transmission, size).module, device=device)
 
     def evaluate(self, integrand, inputs: dict, device: str) -> np.ndarray:
         nov, alpha, f0 = (np.asarray(inputs[k], np.float64) for k in ("nov", "alpha", "f0"))
