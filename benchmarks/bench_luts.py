@@ -12,6 +12,9 @@
 4. ``make luts`` of the batch it baked when issue 13 was filed (``configs/`` and FILING_PRESETS: 25 tables, ~190 s
    then), into another empty folder: the same target on the batch it was set for, while later issues' presets grew
    ``make luts`` to 40 tables.
+5. Both batches again on a new machine: an empty Warp kernel cache (WARP_CACHE_PATH, a temporary folder per batch),
+   so every kernel module compiles first, as on a user's first ``make luts`` (the runs above load the modules from the
+   kernel cache of this machine). ``--no-cold`` skips them.
 
 Writes outputs/bench/luts.json and prints a summary.
 """
@@ -42,11 +45,14 @@ def children_cpu() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def make_luts(out: Path, *variables: str) -> dict:
+def make_luts(out: Path, *variables: str, warp_cache: Path | None = None) -> dict:
     """One ``make luts OUT=out`` (and make ``variables``): wall, CPU (user + sys of the children), load average
-    before and after."""
+    before and after. ``warp_cache``: Warp's kernel cache folder for the run (WARP_CACHE_PATH), else the default."""
+    env = {**os.environ, **({"WARP_CACHE_PATH": str(warp_cache)} if warp_cache is not None else {})}
     load0, cpu0, t0 = os.getloadavg(), children_cpu(), time.perf_counter()
-    r = subprocess.run(["make", "-s", "luts", f"OUT={out}", *variables], cwd=ROOT, capture_output=True, text=True)
+    r = subprocess.run(
+        ["make", "-s", "luts", f"OUT={out}", *variables], cwd=ROOT, capture_output=True, text=True, env=env
+    )
     wall, cpu, load1 = time.perf_counter() - t0, children_cpu() - cpu0, os.getloadavg()
     if r.returncode != 0:
         raise SystemExit(f"make luts failed ({r.returncode}):\n{r.stdout}\n{r.stderr}")
@@ -56,6 +62,7 @@ def make_luts(out: Path, *variables: str) -> dict:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=OUT / "luts.json")
+    ap.add_argument("--no-cold", action="store_true", help="skip part 5 (the empty kernel cache runs)")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory(prefix="lutbake-bench-luts-") as tmp:
         out = Path(tmp) / "outputs"
@@ -66,6 +73,13 @@ def main() -> None:
         filing_out = Path(tmp) / "filing"
         filing = make_luts(filing_out, f"PRESETS={FILING_PRESETS}")
         filing_tables = len(json.loads((filing_out / "report.json").read_text())["tables"])
+        cold = {}
+        if not args.no_cold:
+            tmp_path = Path(tmp)
+            cold["make_luts"] = make_luts(tmp_path / "cold", warp_cache=tmp_path / "warp-all")
+            cold["filing_batch"] = make_luts(
+                tmp_path / "cold-filing", f"PRESETS={FILING_PRESETS}", warp_cache=tmp_path / "warp-filing"
+            )
     tables = report["tables"]
     assert all(t["status"] == "baked" for t in tables), [t["name"] for t in tables if t["status"] != "baked"]
     table_cpu = sum(t["cpu_seconds"] for t in tables)
@@ -81,6 +95,7 @@ def main() -> None:
             "tables": filing_tables,
             **{k: v for k, v in filing.items() if k != "stdout"},
         },
+        "empty_kernel_cache": {k: {f: v for f, v in c.items() if f != "stdout"} for k, c in cold.items()},
         "tables": len(tables),
         "computations": len(tables) - len(shared),
         "shared": shared,
@@ -114,6 +129,11 @@ def main() -> None:
         f"{filing['wall_s']:.1f} s wall, {filing['cpu_s']:.1f} s CPU; target <= {TARGET_WALL:.0f} s wall: "
         + ("meets" if filing["wall_s"] <= TARGET_WALL else "misses")
     )
+    for what, c in cold.items():
+        print(
+            f"  {what.replace('_', ' ')} on an empty kernel cache (every module compiles first): {c['wall_s']:.1f} s "
+            f"wall, {c['cpu_s']:.1f} s CPU"
+        )
     print(f"  top {TOP} tables by CPU:")
     for t in top:
         print(f"    {t['name']:<40} {t['cpu_seconds']:7.2f} s CPU  {t['seconds']:7.2f} s wall (tiles)")
