@@ -92,23 +92,41 @@ N_CHANNELS = {
 }
 
 
+# the metals' complex indices as one constant table, row i = METAL_ORDER[i]: (n_R, n_G, n_B, k_R, k_G, k_B). Every
+# metal table runs the one "metal" integrand (its per-texel param is the row), so a batch compiles one kernel module
+# for all of them (a module per metal before: ~1 s of compile each on a new machine)
+METAL_ORDER = tuple(metals.METALS)
+METAL_NK = wp.constant(
+    wp.types.matrix(shape=(len(METAL_ORDER), 6), dtype=float)(
+        *[float(x) for name in METAL_ORDER for x in (*metals.METALS[name].n, *metals.METALS[name].k)]
+    )
+)
+
+
+def metal_param(name: str) -> float:
+    """The per-texel param of the "metal" channels: the metal's row of METAL_NK."""
+    return float(METAL_ORDER.index(metals.lookup_metal(name).name))
+
+
+@wp.func
+def channels_metal(VoH: float, row: float):
+    """RGB = F_conductor(n_c + i k_c, v.h) of the metal in row ``row`` of METAL_NK (lutbake.metals)."""
+    m = METAL_NK
+    i = int(row)
+    return wp.vec3(
+        fresnel.F_conductor(m[i, 0], m[i, 3], VoH),
+        fresnel.F_conductor(m[i, 1], m[i, 4], VoH),
+        fresnel.F_conductor(m[i, 2], m[i, 5], VoH),
+    )
+
+
 @functools.lru_cache(maxsize=None)
 def channels_for(channels_name: str):
-    """(channel wp.func (VoH, param) -> vec, vec type): a name of CHANNEL_FUNCS, or "metal:<name>"
-    for RGB = F_conductor(n_c, k_c, v.h) of a metal of lutbake.metals (constants closed over)."""
+    """(channel wp.func (VoH, param) -> vec, vec type): a name of CHANNEL_FUNCS, or "metal" for RGB =
+    F_conductor(n_c, k_c, v.h) of the metal whose METAL_NK row is the param (metal_param)."""
     if channels_name in CHANNEL_FUNCS:
         return CHANNEL_FUNCS[channels_name], (wp.vec3 if channels_name in THREE_CHANNELS else wp.vec2)
-    if channels_name.startswith("metal:"):
-        m = metals.lookup_metal(channels_name[len("metal:") :])
-        nr, ng, nb = (float(x) for x in m.n)
-        kr, kg, kb = (float(x) for x in m.k)
-
-        @wp.func
-        def channels_metal(VoH: float, f0: float):
-            return wp.vec3(
-                fresnel.F_conductor(nr, kr, VoH), fresnel.F_conductor(ng, kg, VoH), fresnel.F_conductor(nb, kb, VoH)
-            )
-
+    if channels_name == "metal":
         return channels_metal, wp.vec3
     raise KeyError(channels_name)
 

@@ -61,19 +61,21 @@ def axes_for(o: dict) -> list[Axis]:
 
 
 def plan(spec) -> TexelPlan:
-    from ..integrands.specular import specular_integrand
+    from ..integrands.specular import metal_param, specular_integrand
     from ..sampling.hemisphere import estimator_for
 
     o = spec.options
     axes = axes_for(o)
     metal = o["metal"]
-    channels_name = f"metal:{metal}" if metal else f"F:{o['fresnel']}"
+    channels_name = "metal" if metal else f"F:{o['fresnel']}"
     form, nd, mk = dfg.terms_of(o)
     nch = 3 if metal else 1
     integrand = specular_integrand(nd, mk, channels_name, form, nch)
     nz = 1 if metal else axes[0].count
-    # texel t = (iz * ny + iy) * nx + ix: z (f0) slowest, then roughness, then NoV
-    f0 = None if metal else np.repeat(axes[0].values(), axes[-2].count * axes[-1].count)
+    # texel t = (iz * ny + iy) * nx + ix: z (f0) slowest, then roughness, then NoV; a metal's param is its row of
+    # lutbake.integrands.specular.METAL_NK
+    n_image = axes[-2].count * axes[-1].count
+    f0 = np.full(n_image, metal_param(metal), np.float32) if metal else np.repeat(axes[0].values(), n_image)
     if metal:
         m = METALS[metal]
         channels = {
