@@ -168,6 +168,7 @@ def magnitude_fresnel(
 
     def integrate(integrand):
         inputs = {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": zero}
+        est.prepare(integrand, device)  # compiled once, whichever table asks first (tables prepare in parallel)
         return est.evaluate(integrand, inputs, device)
 
     _, which = lb.magnitude.split(":")

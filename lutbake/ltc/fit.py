@@ -37,6 +37,7 @@ import warp as wp
 
 from ..catalog import LTC_FIT_GRID
 from ..memo import RowMemo
+from ..warp_runtime import load_module
 from .lobes import lobe
 
 NELDER_MEAD_TOL = 1.0e-5  # ltc_code fit(): NelderMead(..., epsilon, 1e-5, 100, ...)
@@ -209,6 +210,7 @@ class Problem:
         grid = stratified_grid(n_grid)
         lobe_samples, self._heitz, self._values = kernels(lobe_name)
         d = device
+        load_module(lobe_samples.module, d)  # the three kernels' module, compiled once when tables prepare in parallel
         lb = lobe(lobe_name)
         # a tabulated lobe's per-texel table (lutbake.ltc.tabulated, ``workers`` threads), else a 1-element placeholder
         tab = lb.tabulate(self.v, self.alpha, d, workers) if lb.tabulate else np.zeros((1, 1, 1), np.float32)

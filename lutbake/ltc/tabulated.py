@@ -32,6 +32,7 @@ from ..sampling.diffuse import gl_rule
 from ..sampling.facets import fd_microfacet_for
 from ..terms import masking
 from ..terms.diffuse import F_facet_eq6
+from ..warp_runtime import load_module
 
 TAB_THETA = 32  # theta_l cell centres on [0, pi/2]
 TAB_PHI = 17  # phi_l endpoints on [0, pi]
@@ -86,6 +87,7 @@ def tabulate_gotanda(v: np.ndarray, alpha: np.ndarray, device: str = "cpu", work
     dirs = wp.array(grid_directions(), dtype=wp.vec3, device=device)
     rule = gl_rule(TAB_ORDER, device)
     kernel = tabulate_kernel()
+    load_module(kernel.module, device)  # compiled once, before the chunks' threads launch it
     out = np.zeros((n, TAB_THETA, TAB_PHI), np.float32)
 
     def run(start: int) -> None:
