@@ -579,6 +579,35 @@ def test_avg_mu_rule_reaches_the_tolerance():
     assert float(table.attributes["error_estimate"]) == float(f"{plan.error_estimate(full.ravel(), 'cpu')[0]:.3e}")
 
 
+def test_avg_inner_order_climbs_to_a_tight_tolerance():
+    """Without ``samples``, kind dielectric_avg's inner rule climbs INNER_ORDERS until its probe share is within half
+    of the target: at tolerance 1e-7 order 12 leaves ~3e-7 (above it, as the fixed order 12 of before recorded), so
+    the table takes order 16 (its probe against order 20) and records an estimate within the tolerance; against fine
+    uniform mu panels at inner order 28 (independent of both), every value is within that estimate."""
+    from lutbake.api import bake_table
+
+    small = dict(
+        kind="dielectric_avg", roughness_size=3, roughness_range=[0.06, 1.0], ior_size=2, ior_range=[0.4, 0.83]
+    )
+    table, _, _ = bake_table(spec(**small, tolerance=1.0e-7))
+    estimate = float(table.attributes["error_estimate"])
+    assert estimate <= 1.0e-7
+    assert "|order 16 - order 20|" in table.attributes["error_estimate_method"]
+    values = table.data.reshape(-1, 3).astype(np.float64)
+    _, alpha, eta = kd.avg_grid(spec(**small).options)
+    edges = np.unique(np.concatenate([np.linspace(0, 1, 41), [1e-3, 3e-3, 1e-2, 3e-2]]))
+    x, w = np.polynomial.legendre.leggauss(24)
+    mu = (edges[:-1, None] + np.diff(edges)[:, None] * (x + 1) / 2).ravel()
+    wt = (np.diff(edges)[:, None] * w / 2).ravel()
+    key = ("ggx", "smith_separable", "exact_metal", "gauss_legendre")
+    for k in range(0, len(alpha), 2):  # three of the six texels, both etas
+        e = kd.integrate(key, mu, np.full(len(mu), alpha[k]), np.full(len(mu), eta[k]), samples=3 * 28**2)
+        ref = 2 * (wt * mu) @ e
+        err = np.abs(values[k] - [ref[0], ref[1], ref[0] + ref[1]])
+        # float32 storage rounds a value ~0.5 by up to 3e-8 on top of the estimate
+        assert np.all(err <= estimate + 3.0e-8), (k, alpha[k], eta[k], err, estimate)
+
+
 # texels with equal (n.v, alpha) and several eta >= 1 (one row over MEMBERS: two groups), with eta < 1, alpha = 0
 # and a lone texel beside them (neither grouped)
 SHARED_ROWS = [(0.37, 0.2), (1.0e-4, 0.07111), (0.9, 0.0044)]

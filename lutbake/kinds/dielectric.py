@@ -31,6 +31,7 @@ Layouts (key ``layout``) fix the channels, and for the engine layouts the whole 
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -61,6 +62,15 @@ AVG_LAYOUT_KEYS = ()
 # E_T is not analytic at further points inside the glass (mu = eta among them: mu_starts): the fixed 16 nodes per panel
 # of before were off by up to 2.0e-4 on OpenPBR's eta < 1 rows (alpha = 0.004)
 MU_MAX_PANELS = 40
+# kind dielectric_avg's inner rule (fixed-order Gauss-Legendre at the mu nodes, its error the probe's): without
+# ``samples``, its order climbs these until the probe's share is within INNER_SHARE of the target at every probe texel
+# (the mu rule's is within the other half: a quarter per kernel channel, at most two of them summed); each order's
+# refined rule (order + 4) is the next order. Order 12 was the fixed default: Turquin's float32 average needs it (order
+# 10: 1.53e-6 against 5e-7), OpenPBR's UNORM16 one would take 10 (1.47e-6 against 1.9e-6) but the try costs as much
+# as it saves, so the climb starts at 12 and tolerances tighter than order 12 reaches now climb instead of recording
+# an estimate above them (tolerance 1e-7: 2.99e-7 at order 12 before)
+INNER_ORDERS = (12, 16, 20, 24, 28, 32)
+INNER_SHARE = 0.5
 NO_TARGET = 1.0e300  # the tolerance of a kernel channel a layout drops (it never refines)
 
 LAYOUTS = {
@@ -474,8 +484,10 @@ def plan_avg(spec) -> TexelPlan:
     axes, alpha, eta = avg_grid(o)
     nd, mk = terms_of(o)
     integrand = dielectric_integrand(nd, mk, "exact_metal")
-    # the inner rule's panels merged as the adaptive kernel's (its error is the probe's: inner_error)
+    # the inner rule's panels merged as the adaptive kernel's (its error is the probe's: inner_rule); ``samples``
+    # unset: its order climbs INNER_ORDERS until the probe fits the tolerance
     estimator = estimator_for(o["estimator"], o["samples"], o["seed"], merged=True)
+    climb = o["samples"] is None and o["estimator"] == "gauss_legendre"
     order = o["mu_order"]
     x_mu, w_kronrod, _ = points.gauss_kronrod(order)
     tol = tolerance_of(o)
@@ -498,25 +510,71 @@ def plan_avg(spec) -> TexelPlan:
         owner = np.concatenate([[j] * (len(e) - 1) for j, e in enumerate(ends)]).astype(int)
         return owner, np.concatenate([e[:-1] for e in ends]), np.concatenate([e[1:] for e in ends])
 
-    # E at each texel's first-panel nodes, kept from the first pass for the inner probe (which needs them at the probe
-    # texels); a texel is computed once per plan (one thread writes its entry), and where the tiles ran elsewhere (a
-    # cluster) the probe computes them again: the same inputs, the same bits
-    first_e: dict[int, np.ndarray] = {}
+    # the inner rule (chosen once per plan, by one thread: inner_rule) and E at the probe texels' first-panel nodes at
+    # its order, which the table's first pass takes instead of computing them again (the same inputs, the same bits)
+    chosen: dict = {}
+    known: dict[tuple[int, float], np.ndarray] = {}
+    lock = threading.Lock()
+
+    def inner_rule(device):
+        """(estimator, inner estimate, text): the inner rule's share, 2 Σ W mu |E - E_refined| over the Kronrod nodes
+        of the first panels (mu_starts) of the probe texels, per texel through the layout's channels (energy_errors).
+        It bounds |2 ∫ mu (E - E_refined) dmu| whatever nodes the mu rule ends on (2 ∫ mu dmu = 1: an error of E at
+        every mu moves the average by at most its mu-weighted mean), so it needs neither the bisection nor the
+        refined rule's own panels. With ``climb``, the first order of INNER_ORDERS whose share is within INNER_SHARE
+        of every probe texel's target (max(tolerance, relative_tolerance |v|), v its first-pass average, the worst
+        channel, as the mu rule's), each order's refined rule the next order (order + 4)."""
+        with lock:
+            if chosen:
+                return chosen["est"], chosen["inner"], chosen["how"]
+            idx = probe_indices(grid)
+            owner, lo, hi = first_panels(idx)
+            mu = (lo[:, None] + (hi - lo)[:, None] * x_mu).ravel()
+            tt = np.repeat(idx[owner], len(x_mu))
+            w = (2.0 * np.repeat(hi - lo, len(x_mu)) * mu * np.tile(w_kronrod, len(lo)))[:, None]
+            rows = np.repeat(owner, len(x_mu))
+            est = estimator_for(o["estimator"], 3 * INNER_ORDERS[0] ** 2, merged=True) if climb else estimator
+            e = e_at(tt, mu, est, device)
+            total = np.zeros((len(idx), e.shape[1]))
+            np.add.at(total, rows, e * w)
+            target = INNER_SHARE * np.maximum(tol.absolute, tol.relative * np.min(np.abs(total), axis=1))
+            while True:
+                refined, how = est.refined()
+                e_ref = e_at(tt, mu, refined, device)
+                per_texel = np.zeros((len(idx), e.shape[1]))
+                np.add.at(per_texel, rows, np.abs(e - e_ref) * w)
+                err = energy_errors(per_texel)
+                if not climb or np.all(err <= target[:, None]) or est.order >= INNER_ORDERS[-1]:
+                    break
+                est, e = refined, e_ref
+            known.update({(int(k), float(m)): v for k, m, v in zip(tt, mu, e)})
+            chosen.update(est=est, inner=float(np.max(err)), how=how)
+            return est, chosen["inner"], how
+
+    def e_known(t, mu, est, device):
+        """e_at, the rows the probe computed (the table's order) taken from it."""
+        out = np.empty((len(t), 3))
+        got = np.array([(int(k), float(m)) in known for k, m in zip(t, mu)], bool)
+        if np.any(got):
+            out[got] = [known[(int(k), float(m))] for k, m in zip(t[got], mu[got])]
+        if not np.all(got):
+            out[~got] = e_at(t[~got], mu[~got], est, device)
+        return out
 
     def averages(t, device):
         """(values, mu-rule estimates), (len(t), 3) float64 each: 2 ∫ E mu dmu of (E_R, E_T, E(F = 1)) at texels t by
         lutbake.sampling.mu_average from the panels of mu_starts, the mu rule to a quarter of the target
         (max(tolerance, relative_tolerance |v|) at the first pass's v, the worst channel: a layout's sum of two
-        channels gets half); the inner rule's share is the probe's (inner_error)."""
+        channels gets half); the inner rule's share is the probe's (inner_rule)."""
+        est = inner_rule(device)[0]
         r = mu_averages(
-            lambda tt, mu: (e_at(tt, mu, estimator, device), None),
+            lambda tt, mu: (e_known(tt, mu, est, device), None),
             t,
             [starts[float(eta[i])] for i in t],
             order,
             mu_target(tol, 0.25),
             MU_MAX_PANELS,
         )
-        first_e.update({int(k): r.first_e[j] for j, k in enumerate(t)})
         return r.values, r.mu_error
 
     memo = RowMemo(capacity=len(alpha))
@@ -551,32 +609,13 @@ def plan_avg(spec) -> TexelPlan:
             return error_post_process("openpbr", err)
         return np.stack([err[:, 0], err[:, 1], err[:, 0] + err[:, 1]], axis=1)
 
-    def inner_error(idx, device) -> tuple[float, str]:
-        """The inner rule's share: at the probe texels idx, 2 Σ W mu |E - E_refined| over the Kronrod nodes of the
-        texel's first panels (mu_starts). It bounds |2 ∫ mu (E - E_refined) dmu| whatever nodes the mu rule ends on
-        (2 ∫ mu dmu = 1: an error of E at every mu moves the average by at most its mu-weighted mean), so the
-        probe needs neither the bisection nor the refined rule's own panels."""
-        refined, how = estimator.refined()
-        owner, lo, hi = first_panels(idx)
-        mu = (lo[:, None] + (hi - lo)[:, None] * x_mu).ravel()
-        tt = np.repeat(idx[owner], len(x_mu))
-        if all(int(i) in first_e for i in idx):
-            e = np.concatenate([first_e[int(i)] for i in idx]).reshape(len(tt), -1)
-        else:
-            e = e_at(tt, mu, estimator, device)
-        d = np.abs(e - e_at(tt, mu, refined, device))
-        d *= (2.0 * np.repeat(hi - lo, len(x_mu)) * mu * np.tile(w_kronrod, len(lo)))[:, None]
-        per_texel = np.zeros((len(idx), 3))
-        np.add.at(per_texel, np.repeat(owner, len(x_mu)), d)
-        return float(np.max(energy_errors(per_texel))), how
-
     def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
-        """The inner rule's share at the probe texels (inner_error) plus the largest per-texel mu-rule estimate (the
+        """The inner rule's share at the probe texels (inner_rule) plus the largest per-texel mu-rule estimate (the
         aux columns); OpenPBR's ratio (channel A) is reported apart (0/0-like where E_c,avg -> 0)."""
         full = data.reshape(len(alpha), -1)
         energy = 3
         idx = probe_indices(grid)
-        inner, how = inner_error(idx, device)
+        _, inner, how = inner_rule(device)
         mu = float(np.max(full[:, n_channels : n_channels + energy]))
         text = (
             f"2 sum W mu |{how}| at the Kronrod nodes of the first mu panels of {len(idx)} strided probe texels "
@@ -599,7 +638,7 @@ def plan_avg(spec) -> TexelPlan:
         n_texels=len(alpha),
         n_channels=n_channels,
         run_tile=lambda s, e, d: run(slice(s, e), d),
-        prepare=lambda d: estimator.prepare(integrand, d),
+        prepare=lambda d: (estimator.prepare(integrand, d), inner_rule(d)),
         samples=per,
         aux_channels=n_channels,
         estimator=estimator.name,
