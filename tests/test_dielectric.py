@@ -580,7 +580,7 @@ def test_avg_mu_rule_reaches_the_tolerance():
 
 
 def test_avg_inner_order_climbs_to_a_tight_tolerance():
-    """Without ``samples``, kind dielectric_avg's inner rule climbs INNER_ORDERS until its probe share is within half
+    """Without ``samples``, kind dielectric_avg's inner rule climbs 12, 16, ... until its probe share is within half
     of the target: at tolerance 1e-7 order 12 leaves ~3e-7 (above it, as the fixed order 12 of before recorded), so
     the table takes order 16 (its probe against order 20) and records an estimate within the tolerance; against fine
     uniform mu panels at inner order 28 (independent of both), every value is within that estimate."""

@@ -63,13 +63,13 @@ AVG_LAYOUT_KEYS = ()
 # of before were off by up to 2.0e-4 on OpenPBR's eta < 1 rows (alpha = 0.004)
 MU_MAX_PANELS = 40
 # kind dielectric_avg's inner rule (fixed-order Gauss-Legendre at the mu nodes, its error the probe's): without
-# ``samples``, its order climbs these until the probe's share is within INNER_SHARE of the target at every probe texel
-# (the mu rule's is within the other half: a quarter per kernel channel, at most two of them summed); each order's
-# refined rule (order + 4) is the next order. Order 12 was the fixed default: Turquin's float32 average needs it (order
-# 10: 1.53e-6 against 5e-7), OpenPBR's UNORM16 one would take 10 (1.47e-6 against 1.9e-6) but the try costs as much
-# as it saves, so the climb starts at 12 and tolerances tighter than order 12 reaches now climb instead of recording
-# an estimate above them (tolerance 1e-7: 2.99e-7 at order 12 before)
-INNER_ORDERS = (12, 16, 20, 24, 28, 32)
+# ``samples``, its order climbs from the default 12 by 4 (each order's refined rule, order + 4, is the next order) up
+# to INNER_ORDER_MAX until the probe's share is within INNER_SHARE of the target at every probe texel (the mu rule's is
+# within the other half: a quarter per kernel channel, at most two of them summed). Order 12 was the fixed default:
+# Turquin's float32 average needs it (order 10: 1.53e-6 against 5e-7), OpenPBR's UNORM16 one would take 10 (1.47e-6
+# against 1.9e-6) but the try costs as much as it saves, so the climb starts at 12 and tolerances tighter than order
+# 12 reaches now climb instead of recording an estimate above them (tolerance 1e-7: 2.99e-7 at order 12 before)
+INNER_ORDER_MAX = 32
 INNER_SHARE = 0.5
 NO_TARGET = 1.0e300  # the tolerance of a kernel channel a layout drops (it never refines)
 
@@ -485,7 +485,7 @@ def plan_avg(spec) -> TexelPlan:
     nd, mk = terms_of(o)
     integrand = dielectric_integrand(nd, mk, "exact_metal")
     # the inner rule's panels merged as the adaptive kernel's (its error is the probe's: inner_rule); ``samples``
-    # unset: its order climbs INNER_ORDERS until the probe fits the tolerance
+    # unset: its order climbs (INNER_ORDER_MAX) until the probe fits the tolerance
     estimator = estimator_for(o["estimator"], o["samples"], o["seed"], merged=True)
     climb = o["samples"] is None and o["estimator"] == "gauss_legendre"
     order = o["mu_order"]
@@ -521,9 +521,9 @@ def plan_avg(spec) -> TexelPlan:
         of the first panels (mu_starts) of the probe texels, per texel through the layout's channels (energy_errors).
         It bounds |2 ∫ mu (E - E_refined) dmu| whatever nodes the mu rule ends on (2 ∫ mu dmu = 1: an error of E at
         every mu moves the average by at most its mu-weighted mean), so it needs neither the bisection nor the
-        refined rule's own panels. With ``climb``, the first order of INNER_ORDERS whose share is within INNER_SHARE
-        of every probe texel's target (max(tolerance, relative_tolerance |v|), v its first-pass average, the worst
-        channel, as the mu rule's), each order's refined rule the next order (order + 4)."""
+        refined rule's own panels. With ``climb``, the first order of 12, 16, ... INNER_ORDER_MAX (each order's
+        refined rule the next) whose share is within INNER_SHARE of every probe texel's target (max(tolerance,
+        relative_tolerance |v|), v its first-pass average, the worst channel, as the mu rule's)."""
         with lock:
             if chosen:
                 return chosen["est"], chosen["inner"], chosen["how"]
@@ -533,7 +533,7 @@ def plan_avg(spec) -> TexelPlan:
             tt = np.repeat(idx[owner], len(x_mu))
             w = (2.0 * np.repeat(hi - lo, len(x_mu)) * mu * np.tile(w_kronrod, len(lo)))[:, None]
             rows = np.repeat(owner, len(x_mu))
-            est = estimator_for(o["estimator"], 3 * INNER_ORDERS[0] ** 2, merged=True) if climb else estimator
+            est = estimator
             e = e_at(tt, mu, est, device)
             total = np.zeros((len(idx), e.shape[1]))
             np.add.at(total, rows, e * w)
@@ -544,7 +544,7 @@ def plan_avg(spec) -> TexelPlan:
                 per_texel = np.zeros((len(idx), e.shape[1]))
                 np.add.at(per_texel, rows, np.abs(e - e_ref) * w)
                 err = energy_errors(per_texel)
-                if not climb or np.all(err <= target[:, None]) or est.order >= INNER_ORDERS[-1]:
+                if not climb or np.all(err <= target[:, None]) or est.order >= INNER_ORDER_MAX:
                     break
                 est, e = refined, e_ref
             known.update({(int(k), float(m)): v for k, m, v in zip(tt, mu, e)})
