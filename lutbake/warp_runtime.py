@@ -83,3 +83,24 @@ def load_module(module, device: str = "cpu") -> None:
         lock = _MODULE_LOCKS.setdefault(key, threading.Lock())
     with lock:
         wp.load_module(module, device=device)
+
+
+# LLVM's inlining budget for lutbake's CPU kernels. Warp's default flags (warp.config.cpu_compiler_flags) raise LLVM's
+# inline threshold to 9000 and its cold-call-site threshold to 3000; lutbake's kernels inline whole integrands and
+# quadrature ladders into each launch, and at Warp's budget a new machine spends 68 s of CPU compiling the 36 modules
+# of `make luts`. At 1000 / 300 it spends 50 s, every table of `make luts` is byte-identical and the kernels run as
+# fast (docs/accuracy.md, "Issue 13, 2026-12-03: a leaner compile"); at LLVM's own defaults (225) the glass and
+# average kernels run 1.6-1.7x slower. The flags are part of each module's hash in Warp's kernel cache.
+CPU_COMPILER_FLAGS = (
+    "-march=native -mllvm=-inline-threshold=1000 -mllvm=-inline-cold-callsite-threshold=300"
+    " -mllvm=-slp-recursion-max-depth=4"
+)
+# the options of every lutbake Warp module: forward code only (no kernel is differentiated), CPU_COMPILER_FLAGS
+MODULE_OPTIONS = {"enable_backward": False, "cpu_compiler_flags": CPU_COMPILER_FLAGS}
+
+
+def unique_kernel(f):
+    """``wp.kernel`` for a kernel factory's kernels: a Warp module of its own per variant (``module="unique"``: a
+    factory's variants differ in the functions they close over), built with MODULE_OPTIONS. Modules holding several
+    fixed kernels set MODULE_OPTIONS with ``wp.set_module_options`` instead."""
+    return init_warp().kernel(f, enable_backward=False, module="unique", module_options=MODULE_OPTIONS)

@@ -364,3 +364,33 @@ def test_modules_load_in_parallel_each_once(monkeypatch):
     assert warp_runtime.parallel_loads()
     assert a1[0] >= a0[1]  # the same module: one load after the other
     assert b0[0] < max(a0[1], a1[1]) and min(a0[0], a1[0]) < b0[1]  # another module: at the same time
+
+
+def test_every_lutbake_kernel_module_compiles_with_lutbakes_options():
+    """Every Warp module holding a lutbake kernel (the factories' unique modules and the fixed ones) is built with
+    lutbake.warp_runtime.MODULE_OPTIONS: forward code only, LLVM's leaner inlining (CPU_COMPILER_FLAGS). Checks the
+    kernels this test makes plus every one the test session made before it."""
+    import importlib
+    import pkgutil
+
+    import lutbake
+    from lutbake import warp_runtime
+    from lutbake.integrands import fresnel
+    from lutbake.ltc import fit
+
+    for m in pkgutil.walk_packages(lutbake.__path__, "lutbake."):
+        if not m.name.endswith("__main__"):
+            importlib.import_module(m.name)
+    fresnel._kernel()
+    fit.kernels("ggx")
+    from warp._src.context import user_modules
+
+    ours = {
+        name: mod
+        for name, mod in list(user_modules.items())
+        if any(k.func.__module__.startswith("lutbake.") for k in mod.kernels.values())
+    }
+    assert len(ours) >= 3  # lutbake.validate.probe, lutbake.ltc.fit and fresnel's unique module at least
+    for name, mod in ours.items():
+        for key, value in warp_runtime.MODULE_OPTIONS.items():
+            assert mod.options[key] == value, (name, key)

@@ -30,7 +30,9 @@ import warp as wp
 
 from ..sampling.plan import TexelPlan
 from ..terms.engine_diffuse import Fd_disney_hdrp, Fd_fabric_lambert_hdrp
-from ..warp_runtime import load_module
+from ..warp_runtime import MODULE_OPTIONS, load_module
+
+wp.set_module_options(MODULE_OPTIONS)
 
 DIFFUSE_ORDER = 24  # Gauss-Legendre nodes per dimension (mu, phi)
 HDRP_DIFFUSE_OFFSET = 0.5  # HDRP stores the Disney FGD minus 0.5 (range [0.5, 1.5] -> [0, 1] for its UNORM target)

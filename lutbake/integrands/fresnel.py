@@ -18,13 +18,14 @@ from ..catalog import FRESNELS
 from ..metals import LAZANYI_ALPHA
 from ..sampling.arrays import Floats
 from ..terms import fresnel as fr
+from ..warp_runtime import unique_kernel
 
 COLUMNS = tuple(FRESNELS)
 
 
 @functools.lru_cache(maxsize=None)
 def _kernel():
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def eval_fresnel(f0: Floats, n: Floats, k: Floats, a: Floats, c: Floats, out: wp.array2d(dtype=float)):
         i = wp.tid()
         out[i, 0] = fr.F_schlick(f0[i], c[i])

@@ -37,8 +37,10 @@ import warp as wp
 
 from ..catalog import LTC_FIT_GRID
 from ..memo import RowMemo
-from ..warp_runtime import load_module
+from ..warp_runtime import MODULE_OPTIONS, load_module
 from .lobes import lobe
+
+wp.set_module_options(MODULE_OPTIONS)
 
 NELDER_MEAD_TOL = 1.0e-5  # ltc_code fit(): NelderMead(..., epsilon, 1e-5, 100, ...)
 NELDER_MEAD_ITERS = 100

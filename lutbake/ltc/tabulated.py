@@ -32,7 +32,9 @@ from ..sampling.diffuse import gl_rule
 from ..sampling.facets import fd_microfacet_for
 from ..terms import masking
 from ..terms.diffuse import F_facet_eq6
-from ..warp_runtime import load_module
+from ..warp_runtime import MODULE_OPTIONS, load_module
+
+wp.set_module_options(MODULE_OPTIONS)
 
 TAB_THETA = 32  # theta_l cell centres on [0, pi/2]
 TAB_PHI = 17  # phi_l endpoints on [0, pi]

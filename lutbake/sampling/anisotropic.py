@@ -22,7 +22,7 @@ import warp as wp
 from ..edge import COS_EPS
 from ..terms import ndf
 from ..terms.frame import reflect
-from ..warp_runtime import load_module
+from ..warp_runtime import load_module, unique_kernel
 from . import points
 from .arrays import Points2, Rows64
 from .hemisphere import AdaptiveGaussLegendre, gl_launch, store_row
@@ -44,7 +44,7 @@ def aniso_kernel(lobe, cosine: bool):
     nch = 2
     smooth = lobe.mirror
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def aniso_qmc_kernel(texel: wp.array(dtype=wp.vec4), pts: Points2, out: Rows64):
         """texel[i] = (n.v, alpha_x, alpha_y, phi_v)."""
         i = wp.tid()

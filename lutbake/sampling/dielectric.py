@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 import warp as wp
 
+from ..warp_runtime import unique_kernel
 from . import points
 from .arrays import Levels, Rows64, Rule
 from .groups import group_rows, key_of, siblings_by_key
@@ -347,7 +348,7 @@ def make_gauss_legendre_dielectric(spec):
     panel_add = panel_rule_for(spec)[0]
     nch = spec.vec._length_
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def gauss_legendre_dielectric_kernel(texel: wp.array(dtype=wp.vec3), rule: Rule, merge: wp.float64, out: Rows64):
         i = wp.tid()
         x = dielectric_texel(texel[i], merge)
@@ -370,7 +371,7 @@ def make_gauss_legendre_members(spec):
     member_params = member_params_for(nch)
     panel_add = panel_rule_for(spec, MEMBERS)[0]
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def gauss_legendre_members_kernel(
         texel: wp.array(dtype=wp.vec3), groups: wp.array2d(dtype=int), rule: Rule, merge: wp.float64, out: Rows64
     ):
@@ -414,7 +415,7 @@ def make_adaptive_dielectric(spec):
     integrate = greedy_ladder_for(panel_rule_for(spec)[1], MAX_PANELS, spec.acc._length_)[0]
     store_texel = texel_store_for(spec)
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def adaptive_dielectric_kernel(
         texel: wp.array(dtype=wp.vec3),
         rules: Rule,
@@ -472,7 +473,7 @@ def make_adaptive_members(spec):
     _, climb, Panels, _, Orders = greedy_ladder_for(panel_rule_for(spec)[1], MAX_PANELS, nch)
     store_texel = texel_store_for(spec)
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def adaptive_members_kernel(
         texel: wp.array(dtype=wp.vec3),
         groups: wp.array2d(dtype=int),

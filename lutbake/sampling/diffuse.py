@@ -25,7 +25,7 @@ import numpy as np
 import warp as wp
 
 from ..terms.frame import view_dir
-from ..warp_runtime import load_module
+from ..warp_runtime import load_module, unique_kernel
 from . import points
 from .arrays import Floats, Levels, Points2, Rows64, Rule, Values64
 from .facets import (
@@ -46,7 +46,7 @@ def albedo_kernel(brdf):
     """Kernel: E(v) = ∫ f (n.l) dω_l per texel (n.v, sigma, alpha, f0); outer GL rule_o on 2 x 2 panels, inner GL
     rule for the microfacet integral (``brdf``: lutbake.integrands.diffuse)."""
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def albedo_gl_kernel(texel: wp.array(dtype=wp.vec4), rule_o: Rule, rule: Rule, out: Rows64):
         i = wp.tid()
         t = texel[i]
@@ -79,7 +79,7 @@ def albedo_kernel(brdf):
 def brdf_kernel(brdf):
     """Kernel: f(l, v) at direction pairs lv[i] = (l, v) with sa[i] = (sigma, alpha) (tests, plots, BTF slices)."""
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def brdf_point_kernel(
         lv: wp.array2d(dtype=wp.vec3), sa: wp.array(dtype=wp.vec2), f0: float, rule: Rule, out: Values64
     ):
@@ -93,7 +93,7 @@ def brdf_kernel(brdf):
 def cosine_kernel(brdf):
     """Kernel: E(v) = (pi / N) sum_k f(l_k, v), l_k cosine-weighted from the 2D points ``pts``."""
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def albedo_cosine_kernel(texel: wp.array(dtype=wp.vec4), pts: Points2, rule: Rule, out: Rows64):
         i = wp.tid()
         t = texel[i]
@@ -246,7 +246,7 @@ def sobol_point_kernel(facet):
     """Kernel: the microfacet f(l, v) at lv[i] = (l, v) with its m-integral by the 2D points ``pts``."""
     f = fd_microfacet_sobol_for(facet)
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def brdf_sobol_kernel(lv: wp.array2d(dtype=wp.vec3), alpha: Floats, f0: float, pts: Points2, out: Values64):
         i = wp.tid()
         out[i] = f(lv[i, 0], lv[i, 1], alpha[i], f0, pts)
@@ -282,7 +282,7 @@ def adaptive_point_kernel(facet):
     estimate (lutbake.sampling.facets.fd_microfacet_adaptive_for)."""
     f = fd_microfacet_adaptive_for(facet)
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def brdf_adaptive_kernel(
         lv: wp.array2d(dtype=wp.vec3), alpha: Floats, f0: float, tol: wp.vec2d, rules: Rule, levels: Levels, out: Rows64
     ):
@@ -301,7 +301,7 @@ def adaptive_azimuths_kernel(facet):
     (lutbake.sampling.facets.fd_microfacet_adaptive_azimuths_for); the same values as adaptive_point_kernel."""
     f = fd_microfacet_adaptive_azimuths_for(facet)
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def brdf_adaptive_azimuths_kernel(
         lv: wp.array2d(dtype=wp.vec3),
         alpha: Floats,

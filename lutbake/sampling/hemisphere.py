@@ -60,7 +60,7 @@ import warp as wp
 from .. import tolerance
 from ..catalog import HEMISPHERE_ESTIMATORS
 from ..terms.frame import view_dir
-from ..warp_runtime import load_module
+from ..warp_runtime import load_module, unique_kernel
 from . import points
 from .arrays import PhiRule, Points2, Rows64, Rule, Values64
 from .ladder import greedy_ladder_for
@@ -594,7 +594,7 @@ def make_gauss_legendre(spec):
     panel_of, first_level = panel_rule_for(spec)
     integrate, _, _, Sums, _ = greedy_ladder_for(panel_of, MAX_PANELS, nch, first_level)
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def gauss_legendre_kernel(
         texel: wp.array(dtype=wp.vec3),
         rules: Rule,
@@ -648,7 +648,7 @@ def make_qmc(spec, vndf: bool):
     nch = vec_type._length_
     smooth = mirror is not None
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def qmc_kernel(texel: wp.array(dtype=wp.vec3), pts: Points2, wts: Values64, out: Rows64):
         i = wp.tid()
         v = view_dir(texel[i][0])

@@ -38,7 +38,7 @@ import numpy as np
 import warp as wp
 
 from ..terms.masking import Lambda_ggx64
-from ..warp_runtime import load_module
+from ..warp_runtime import load_module, unique_kernel
 from . import points
 from .groups import group_rows, key_of
 from .panels import (
@@ -95,7 +95,7 @@ def swapped_kernel(T, members: int = 1):
     def smooth_w(lo: wp.float64, hi: wp.float64, s: wp.float64):
         return (hi - lo) * wp.float64(6.0) * s * (wp.float64(1.0) - s)
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def albedo_kernel(
         nov: wp.array(dtype=wp.float64),
         alpha: wp.array(dtype=wp.float64),

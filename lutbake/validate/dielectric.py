@@ -30,6 +30,7 @@ from ..terms import dielectric as td
 from ..terms import fresnel
 from ..terms.distributions import NDFS
 from ..terms.frame import reflect
+from ..warp_runtime import unique_kernel
 from .checks import _result
 
 SMOOTH_LIMIT_TOL = 2.0e-5  # |E_R - F|, |E_T - (1 - F)| at alpha = ALPHA_MIN, |mu - cos theta_c| >= SMOOTH_KINK_GAP
@@ -121,7 +122,7 @@ def _bsdf_kernel(masking: str):
     D = NDFS["ggx"].D
     G2 = NDFS["ggx"].G2(masking)
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def eval_bsdf(
         i: wp.array(dtype=wp.vec3),
         o: wp.array(dtype=wp.vec3),

@@ -38,8 +38,9 @@ from ..catalog import MASKINGS
 from ..edge import COS_EPS
 from ..terms import fresnel, masking, ndf
 from ..terms.distributions import NDFS
+from ..warp_runtime import MODULE_OPTIONS
 
-wp.set_module_options({"enable_backward": False})
+wp.set_module_options(MODULE_OPTIONS)
 
 
 @wp.struct
