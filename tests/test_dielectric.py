@@ -427,6 +427,9 @@ HONESTY_TEXELS = (
         (float(np.sqrt(1 - 0.6**2)) - 0.01, 0.05, 0.6),  # just inside (total internal reflection)
         (0.3, 0.6, 2.5),
         (1.0e-4, 0.07111, 1.0629),  # EEVEE's clamped grazing row (not honest from orders (6, 12), see below)
+        (0.24, 0.042, 0.49),  # orders 8 and 12 agree there, both off by ~6e-7 (lutbake.sampling.dielectric)
+        (0.172, 0.041, 0.435),  # orders 6 and 11 of one panel agree to 9.6e-8, both 1.5e-6 off (the same)
+        (0.5599, 0.2844, 0.4714),  # K_11 and G_5 agree, K_11 1.35e-6 off (the same)
     ]
 )
 # EEVEE btdf's grazing row with only its transmission channel driving the ladder (kinds.dielectric.kernel_tolerance)

@@ -43,6 +43,23 @@ def test_gl_levels_offsets_address_each_order():
         np.testing.assert_array_equal(rules[off : off + n, 1], w)
 
 
+def test_gl_levels_with_a_kronrod_pair():
+    """``kronrod`` (a ladder replayed and checked by benchmarks/check_glass_ladder.py): level 1 is the Kronrod extension
+    of level 0: its nodes hold level 0's, its weights are Kronrod's; the other levels stay Gauss-Legendre. A pair that
+    is not (n, 2n + 1) is refused."""
+    orders = (5, 11, 16, 20, 24, 32, 48, 64)
+    rules, levels = gl_levels(orders, True)
+    (o0, n0), (o1, n1) = levels[:2]
+    x, wk, wg = points.gauss_kronrod(n0)
+    assert n1 == 2 * n0 + 1
+    np.testing.assert_array_equal(rules[o1 : o1 + n1], np.stack([x, wk], axis=1))
+    np.testing.assert_allclose(rules[o0 : o0 + n0, 0], x[wg > 0], atol=1e-15)
+    for (off, n), order in zip(levels[2:], orders[2:]):
+        np.testing.assert_array_equal(rules[off : off + n, 0], points.gauss_legendre(order)[0])
+    with pytest.raises(ValueError, match="Gauss-Kronrod"):
+        gl_levels((8, 16), True)
+
+
 # QUADPACK dqk15 (Piessens, de Doncker-Kapenga, Ueberhuber, Kahaner 1983), on [-1, 1], x >= 0 half: the independent
 # reference of points.gauss_kronrod(7)
 QK15_XGK = [0.0, 0.207784955007898467600689403773245, 0.405845151377397166906606412076961,

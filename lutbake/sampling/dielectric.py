@@ -625,6 +625,14 @@ class DielectricGaussLegendre(GaussLegendre):
 # the evaluations in the replay (no violation among its 1500 random texels per preset), but benchmarks/
 # bench_dielectric.py's sample of a 32^3 table found a texel, (n.v, alpha, eta) = (0.172, 0.041, 0.435), where orders 6
 # and 11 of one panel agree to 9.6e-8 while order 11 is 1.5e-6 off: error 1.5e-6 under an estimate of 8.3e-7
+# Tried 2026-12-03 and dropped: from the Gauss-Kronrod pair (5, 11) (DielectricAdaptive.kronrod: a panel's first
+# value the 11-node Kronrod rule's, its estimate |K_11 - G_5|; 25 + 121 evaluations against 64 + 256). Replayed on 6000
+# random texels plus the grazing row of each glass preset (benchmarks/replay_ladder.py --glass 6000 1): 0.70-0.77x
+# the evaluations, no texel past its estimate. But over whole tables (benchmarks/check_glass_ladder.py: every texel
+# against this ladder at tolerance / 100) 13 texels were, 12 of EEVEE's bsdf (8 of them at its clamp eta = 1e-4, errors
+# <= 1.5e-12) and 1 of OpenPBR's, among them (n.v, alpha, eta) = (0.5599, 0.2844, 0.4714) of EEVEE's bsdf, 1.35e-6 off
+# under an estimate of 8.0e-7 (over the tolerance itself); and the kernel time fell only to 0.83-0.89x (EEVEE's btdf
+# 1.20x)
 DIELECTRIC_ORDERS = (8, 16, 20, 24, 32, 48, 64)
 
 
@@ -637,6 +645,7 @@ class DielectricAdaptive:
     absolute: tuple[float, ...]
     relative: tuple[float, ...]
     orders: tuple[int, ...] = DIELECTRIC_ORDERS
+    kronrod: bool = False  # orders[:2] a Gauss-Kronrod pair (n, 2n + 1): measured, not honest (DIELECTRIC_ORDERS)
     name: str = "gauss_legendre"
     members: bool = True  # texels that differ only in eta >= 1 in groups (False: a grid without any; no such kernel)
 
@@ -652,7 +661,7 @@ class DielectricAdaptive:
         """Values and estimates (n, kernel channels) each: the texels that share their (n.v, alpha) at eta >= 1 in
         groups (make_adaptive_members), the others one by one (make_adaptive_dielectric): the same bits either way."""
         assert len(self.orders) >= 2, "the ladder needs two orders for its first estimate"
-        rules, levels = gl_levels(tuple(self.orders))
+        rules, levels = gl_levels(tuple(self.orders), self.kronrod)
         nch = integrand.kernel_channels
         args = [
             wp.array(rules, dtype=wp.vec2d, device=device),

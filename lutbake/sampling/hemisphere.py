@@ -724,9 +724,16 @@ ADAPTIVE_ORDERS = (4, 6, 9, 12, 16, 24, 32, 48, 64)
 
 
 @functools.lru_cache(maxsize=None)
-def gl_levels(orders: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray]:
-    """The GL rules of ``orders`` on [0, 1], concatenated ((node, weight) rows), and (offset, order) per order."""
-    rules = np.concatenate([np.stack(points.gauss_legendre(n), axis=1) for n in orders])
+def gl_levels(orders: tuple[int, ...], kronrod: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """The GL rules of ``orders`` on [0, 1], concatenated ((node, weight) rows), and (offset, order) per order.
+    ``kronrod``: the second rule is the Kronrod extension of the first (orders[1] = 2 orders[0] + 1 nodes, the first's
+    among them; lutbake.sampling.points.gauss_kronrod), so the first two levels are a Gauss-Kronrod pair."""
+    rule = [np.stack(points.gauss_legendre(n), axis=1) for n in orders]
+    if kronrod:
+        if len(orders) < 2 or orders[1] != 2 * orders[0] + 1:
+            raise ValueError(f"a Gauss-Kronrod pair is (n, 2n + 1) nodes, not {orders[:2]}")
+        rule[1] = np.stack(points.gauss_kronrod(orders[0])[:2], axis=1)
+    rules = np.concatenate(rule)
     offsets = np.cumsum([0] + list(orders[:-1]))
     return rules, np.stack([offsets, orders], axis=1).astype(np.int32)
 
