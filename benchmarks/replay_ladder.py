@@ -63,7 +63,7 @@ DFG_CANDIDATES = [
 GLASS_CANDIDATES = [
     ("8,16,20,24,32,48,64", 1.0),  # the default (DIELECTRIC_ORDERS)
     # the Gauss-Kronrod pairs (G5, K11), (G7, K15) (2026-12-03): (5, 11) replays honest on 6000 random texels a preset
-    # at 0.70-0.77x, but benchmarks/check_glass_ladder.py finds 13 texels of the whole tables past their estimates
+    # at 0.77-0.82x, but benchmarks/check_glass_ladder.py finds 13 texels of the whole tables past their estimates
     ("5,K11,16,20,24,32,48,64", 1.0),
     ("7,K15,20,24,32,48,64", 1.0),
     ("6,11,16,20,24,32,48,64", 2.0),  # tried and dropped (lutbake.sampling.dielectric's comment)

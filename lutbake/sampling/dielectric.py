@@ -627,7 +627,7 @@ class DielectricGaussLegendre(GaussLegendre):
 # and 11 of one panel agree to 9.6e-8 while order 11 is 1.5e-6 off: error 1.5e-6 under an estimate of 8.3e-7
 # Tried 2026-12-03 and dropped: from the Gauss-Kronrod pair (5, 11) (DielectricAdaptive.kronrod: a panel's first
 # value the 11-node Kronrod rule's, its estimate |K_11 - G_5|; 25 + 121 evaluations against 64 + 256). Replayed on 6000
-# random texels plus the grazing row of each glass preset (benchmarks/replay_ladder.py --glass 6000 1): 0.70-0.77x
+# random texels plus the grazing row of each glass preset (benchmarks/replay_ladder.py --glass 6000 1): 0.77-0.82x
 # the evaluations, no texel past its estimate. But over whole tables (benchmarks/check_glass_ladder.py: every texel
 # against this ladder at tolerance / 100) 13 texels were, 12 of EEVEE's bsdf (8 of them at its clamp eta = 1e-4, errors
 # <= 1.5e-12) and 1 of OpenPBR's, among them (n.v, alpha, eta) = (0.5599, 0.2844, 0.4714) of EEVEE's bsdf, 1.35e-6 off
