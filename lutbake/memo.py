@@ -39,7 +39,7 @@ class RowMemo:
         rows: list[tuple | None] = [None] * len(keys)
         todo = list(range(len(keys)))
         while todo:
-            mine, theirs = [], []
+            mine, theirs = [], {}
             with self._lock:
                 for i in todo:
                     k = keys[i]
@@ -47,15 +47,18 @@ class RowMemo:
                         rows[i] = self._done[k]
                         self.hits += 1
                     elif k in self._pending:
-                        theirs.append((i, self._pending[k]))
+                        theirs[i] = self._pending[k]
                     else:
-                        self._pending[k] = threading.Event()
                         mine.append(i)
+                if mine:  # one event for the whole claim: set once its rows are stored (or released)
+                    claim = threading.Event()
+                    for i in mine:
+                        self._pending[keys[i]] = claim
             if mine:
                 self._compute(keys, mine, compute, rows)
-            for _, event in theirs:
+            for event in {id(e): e for e in theirs.values()}.values():
                 event.wait()
-            todo = [i for i, _ in theirs]  # now stored (or released by a failed thread: claimed again)
+            todo = list(theirs)  # now stored (or released by a failed thread: claimed again)
         return tuple(np.stack([r[p] for r in rows]) for p in range(len(rows[0]))) if rows else ()
 
     def _compute(self, keys, mine, compute, rows) -> None:
@@ -64,9 +67,11 @@ class RowMemo:
         except BaseException:
             self._release(keys, mine)
             raise
+        # each stored row a view of its own copy of the parts (one copy per part, not one per row)
+        parts = [np.array(p, copy=True) for p in parts]
         with self._lock:
             for j, i in enumerate(mine):
-                rows[i] = tuple(np.array(p[j], copy=True) for p in parts)
+                rows[i] = tuple(p[j] for p in parts)
                 self._done[keys[i]] = rows[i]
             self.misses += len(mine)
             while len(self._done) > self.capacity:
@@ -75,5 +80,7 @@ class RowMemo:
 
     def _release(self, keys, mine) -> None:
         with self._lock:
-            for i in mine:
-                self._pending.pop(keys[i]).set()
+            claim = self._pending.pop(keys[mine[0]])
+            for i in mine[1:]:
+                self._pending.pop(keys[i])
+        claim.set()
