@@ -25,12 +25,13 @@ import json
 import signal
 import threading
 import time
+from collections import deque
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import __version__
+from . import __version__, warp_runtime
 from .config import TableSpec
 from .errors import LutbakeError
 from .executor import Cancelled, Progress, default_workers
@@ -42,6 +43,7 @@ from .pipeline import Computed, assemble, compute
 from .provenance import HASH_ATTRIBUTE, content_hash, read_header, sources_digest
 from .sharing import group_by, values_key
 from .values_cache import ValuesCache
+from .warp_runtime import ModuleBusy
 
 STATUSES = ("baked", "skipped", "failed", "interrupted")
 EXIT_OK, EXIT_FAILED, EXIT_SIGINT, EXIT_SIGTERM = 0, 1, 130, 143
@@ -179,6 +181,8 @@ def _bake_group(
         if computed is None:
             computed = compute(lead.spec, workers, device, progress, cancel=cancel)
             _store(cache, lead, computed)
+    except ModuleBusy:  # before any tile ran (warp_runtime.defer_if_busy): the caller runs another group first
+        raise
     except Exception as e:  # every table of the group lacks its values
         for job in group:
             _record_failure(job, e)
@@ -256,18 +260,38 @@ def run(
     per_table = workers
     cancel = threading.Event()
     pool = ThreadPoolExecutor(max_workers=threads, thread_name_prefix="lutbake-table")
-    futures: dict = {}
+    queue = deque(groups)
+    queue_lock = threading.Lock()
+    set_back: set[int] = set()
+
+    def bake_next() -> list[Job]:
+        """Bake the group at the head of the queue. A group whose first kernel module another table's thread is
+        compiling steps back once, behind the next group (warp_runtime.defer_if_busy: that core compiles or bakes
+        something else meanwhile); each task bakes exactly one group."""
+        while True:
+            with queue_lock:
+                g = queue.popleft()
+                may_defer = bool(queue) and id(g) not in set_back
+            try:
+                with warp_runtime.defer_if_busy() if may_defer else contextlib.nullcontext():
+                    return _bake_group(g, per_table, device, progress, cancel, cache)
+            except ModuleBusy:
+                with queue_lock:
+                    set_back.add(id(g))
+                    queue.insert(1, g)
+
+    futures: list = []
     signum = None
-    reported: set = set()
+    reported: set[int] = set()
     try:
-        for g in groups:
-            futures[pool.submit(_bake_group, g, per_table, device, progress, cancel, cache)] = g
+        futures = [pool.submit(bake_next) for _ in groups]
         remaining = set(futures)
         while remaining:
             done, remaining = wait(remaining, timeout=poll, return_when=FIRST_COMPLETED)
             for f in done:
-                reported.add(f)
-                for j in f.result():
+                g = f.result()
+                reported.add(id(g))
+                for j in g:
                     if on_done:
                         on_done(j)
     except (KeyboardInterrupt, Interrupted) as e:
@@ -281,8 +305,8 @@ def run(
         for j in pending:
             if j.status == "pending":  # cancelled before it started
                 j.status, j.message = "interrupted", "not started; nothing written"
-        for f, g in futures.items():
-            if f not in reported and on_done:
+        for g in groups:
+            if id(g) not in reported and on_done:
                 for j in g:
                     on_done(j)
     return signum

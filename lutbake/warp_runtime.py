@@ -72,17 +72,46 @@ def parallel_loads(wp=None) -> bool:
     return hasattr(wp.config, "load_module_max_workers")
 
 
+class ModuleBusy(Exception):
+    """Raised by the first load_module of a thread inside ``defer_if_busy()`` when another thread is loading
+    (compiling) that module: the caller may do other work first instead of waiting."""
+
+
+_DEFER = threading.local()
+
+
+@contextlib.contextmanager
+def defer_if_busy():
+    """Within it, this thread's first load_module raises ModuleBusy, instead of waiting, if another thread is loading
+    that module (later loads wait). lutbake.batch starts a table under it: two tables that need one kernel module
+    and start together (filament's two presets, the four metals) would leave a core idle while one of them compiles
+    it (~1-3 s on a new machine, the first compile of a thread building Warp's precompiled header); the second table
+    is set back behind the next one, whose module compiles meanwhile."""
+    _DEFER.armed = True
+    try:
+        yield
+    finally:
+        _DEFER.armed = False
+
+
 def load_module(module, device: str = "cpu") -> None:
     """Compile (or load from Warp's kernel cache) a Warp module on ``device`` before worker threads launch its
     kernels. Tables prepare in parallel (lutbake.batch runs two at once on two cores): on a cold kernel cache their
-    modules compile on both cores (parallel_loads), one thread per module, so a module two tables need compiles once.
-    A Warp without parallel loading compiles one module at a time, whichever table asks."""
+    modules compile on both cores (parallel_loads), one thread per module, so a module two tables need compiles once
+    (a table that finds its first module busy may step back: ``defer_if_busy``). A Warp without parallel loading
+    compiles one module at a time, whichever table asks."""
     wp = init_warp()
     key = (module, str(device)) if parallel_loads(wp) else None
     with _LOCK:
         lock = _MODULE_LOCKS.setdefault(key, threading.Lock())
-    with lock:
+    armed = getattr(_DEFER, "armed", False)
+    _DEFER.armed = False
+    if not lock.acquire(blocking=not armed):
+        raise ModuleBusy(getattr(module, "name", str(module)))
+    try:
         wp.load_module(module, device=device)
+    finally:
+        lock.release()
 
 
 # LLVM's inlining budget for lutbake's CPU kernels. Warp's default flags (warp.config.cpu_compiler_flags) raise LLVM's

@@ -366,6 +366,68 @@ def test_modules_load_in_parallel_each_once(monkeypatch):
     assert b0[0] < max(a0[1], a1[1]) and min(a0[0], a1[0]) < b0[1]  # another module: at the same time
 
 
+def test_a_busy_module_defers_only_the_first_load_of_an_armed_thread(monkeypatch):
+    """warp_runtime.defer_if_busy: while another thread loads module a, this thread's first load_module of a raises
+    ModuleBusy (it may do other work) instead of waiting; a load outside the context, or a later one inside it, waits
+    and then finds a loaded; an idle module loads at once."""
+    import threading
+
+    import warp as wp
+
+    from lutbake import warp_runtime
+
+    loading, release, loads = threading.Event(), threading.Event(), []
+
+    def held_load(module, device=None):
+        loads.append(module)
+        if module == "a" and len(loads) == 1:
+            loading.set()
+            release.wait(5)
+
+    monkeypatch.setattr(wp, "load_module", held_load)
+    monkeypatch.setattr(warp_runtime, "_MODULE_LOCKS", {})
+    first = threading.Thread(target=warp_runtime.load_module, args=("a", "cpu"))
+    first.start()
+    assert loading.wait(5)
+    with warp_runtime.defer_if_busy():
+        with pytest.raises(warp_runtime.ModuleBusy):
+            warp_runtime.load_module("a")
+        warp_runtime.load_module("b")  # no longer armed: a plain load (b is free anyway)
+    with warp_runtime.defer_if_busy():
+        warp_runtime.load_module("b")  # armed, but b is free: loads
+    release.set()
+    first.join()
+    warp_runtime.load_module("a")  # unarmed: waits for the lock, then loads
+    assert loads == ["a", "b", "b", "a"]
+
+
+def test_a_table_whose_module_is_busy_steps_back_behind_the_next(monkeypatch, tmp_path):
+    """batch.run: a group that raises ModuleBusy (its first kernel module compiling in the other table thread) is set
+    back once, behind the next group, and baked after it; the last group in the queue never steps back; every table is
+    baked once and reported."""
+    cfg = write_config(tmp_path, *[table(n, seed=i) for i, n in enumerate(("a", "b", "c"))])
+    jobs = batch.schedule(load_configs([cfg]), tmp_path / "out")
+    order, tries = [], {}
+    real = batch._bake_group
+
+    def fake(group, *args, **kw):
+        name = group[0].name
+        tries[name] = tries.get(name, 0) + 1
+        if name in ("a", "c") and tries[name] == 1:  # a: set back behind b; c: last in the queue, never set back
+            armed = getattr(batch.warp_runtime._DEFER, "armed", False)
+            assert armed == (name == "a")
+            if armed:
+                raise batch.ModuleBusy(name)
+        order.append(name)
+        return real(group, *args, **kw)
+
+    monkeypatch.setattr(batch, "_bake_group", fake)
+    done = []
+    assert batch.run(jobs, workers=1, on_done=done.append) is None
+    assert order == ["b", "a", "c"] and tries == {"a": 2, "b": 1, "c": 1}
+    assert sorted(j.name for j in done) == ["a", "b", "c"] and all(j.status == "baked" for j in jobs)
+
+
 def test_every_lutbake_kernel_module_compiles_with_lutbakes_options():
     """Every Warp module holding a lutbake kernel (the factories' unique modules and the fixed ones) is built with
     lutbake.warp_runtime.MODULE_OPTIONS: forward code only, LLVM's leaner inlining (CPU_COMPILER_FLAGS). Checks the
