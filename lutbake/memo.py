@@ -40,23 +40,21 @@ class RowMemo:
         todo = list(range(len(keys)))
         while todo:
             mine, theirs = [], {}
+            claim = threading.Event()  # one event for every key this pass claims: set once their rows are stored
             with self._lock:
                 for i in todo:
                     k = keys[i]
                     if k in self._done:
                         rows[i] = self._done[k]
                         self.hits += 1
-                    elif k in self._pending:
+                    elif k in self._pending:  # another thread's, or a repeat of a key claimed here: waited for
                         theirs[i] = self._pending[k]
                     else:
+                        self._pending[k] = claim
                         mine.append(i)
-                if mine:  # one event for the whole claim: set once its rows are stored (or released)
-                    claim = threading.Event()
-                    for i in mine:
-                        self._pending[keys[i]] = claim
             if mine:
                 self._compute(keys, mine, compute, rows)
-            for event in {id(e): e for e in theirs.values()}.values():
+            for event in {id(e): e for e in theirs.values() if e is not claim}.values():
                 event.wait()
             todo = list(theirs)  # now stored (or released by a failed thread: claimed again)
         return tuple(np.stack([r[p] for r in rows]) for p in range(len(rows[0]))) if rows else ()

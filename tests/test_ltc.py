@@ -373,3 +373,19 @@ def test_fit_memo_waits_for_another_thread_and_refits_what_a_failed_one_released
         memo.run([b"d"], fail)
     q, f = memo.run([b"d"], lambda i: (np.zeros((1, 2)), np.array([7.0])))
     assert f[0] == 7.0 and memo.misses == 4
+
+
+def test_memo_computes_a_key_repeated_in_one_call_once():
+    """A key twice in one run (two texels of equal inputs: ltc-hdrp's clamped columns) is claimed and computed once,
+    its repeat taken from it (a hit)."""
+    from lutbake.memo import RowMemo
+
+    memo, calls = RowMemo(), []
+
+    def compute(i):
+        calls.append(list(i))
+        return (np.asarray(i, float)[:, None],)
+
+    (rows,) = memo.run([b"a", b"b", b"a"], compute)
+    assert calls == [[0, 1]] and rows[:, 0].tolist() == [0.0, 1.0, 0.0]
+    assert memo.misses == 2 and memo.hits == 1
