@@ -31,7 +31,7 @@ from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import __version__, warp_runtime
+from . import __version__
 from .config import TableSpec
 from .errors import LutbakeError
 from .executor import Cancelled, Progress, default_workers
@@ -43,7 +43,7 @@ from .pipeline import Computed, assemble, compute
 from .provenance import HASH_ATTRIBUTE, content_hash, read_header, sources_digest
 from .sharing import group_by, values_key
 from .values_cache import ValuesCache
-from .warp_runtime import ModuleBusy
+from .warp_runtime import ModuleBusy, defer_if_busy
 
 STATUSES = ("baked", "skipped", "failed", "interrupted")
 EXIT_OK, EXIT_FAILED, EXIT_SIGINT, EXIT_SIGTERM = 0, 1, 130, 143
@@ -266,14 +266,14 @@ def run(
 
     def bake_next() -> list[Job]:
         """Bake the group at the head of the queue. A group whose first kernel module another table's thread is
-        compiling steps back once, behind the next group (warp_runtime.defer_if_busy: that core compiles or bakes
-        something else meanwhile); each task bakes exactly one group."""
+        compiling steps back once, behind the next group (lutbake.warp_runtime.defer_if_busy: that core compiles or
+        bakes something else meanwhile); each task bakes exactly one group."""
         while True:
             with queue_lock:
                 g = queue.popleft()
                 may_defer = bool(queue) and id(g) not in set_back
             try:
-                with warp_runtime.defer_if_busy() if may_defer else contextlib.nullcontext():
+                with defer_if_busy() if may_defer else contextlib.nullcontext():
                     return _bake_group(g, per_table, device, progress, cancel, cache)
             except ModuleBusy:
                 with queue_lock:

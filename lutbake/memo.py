@@ -53,17 +53,17 @@ class RowMemo:
                         self._pending[k] = claim
                         mine.append(i)
             if mine:
-                self._compute(keys, mine, compute, rows)
+                self._compute(keys, mine, claim, compute, rows)
             for event in {id(e): e for e in theirs.values() if e is not claim}.values():
                 event.wait()
             todo = list(theirs)  # now stored (or released by a failed thread: claimed again)
         return tuple(np.stack([r[p] for r in rows]) for p in range(len(rows[0]))) if rows else ()
 
-    def _compute(self, keys, mine, compute, rows) -> None:
+    def _compute(self, keys, mine, claim, compute, rows) -> None:
         try:
             parts = compute(np.array(mine))
         except BaseException:
-            self._release(keys, mine)
+            self._release(keys, mine, claim)
             raise
         # each stored row a view of its own copy of the parts (one copy per part, not one per row)
         parts = [np.array(p, copy=True) for p in parts]
@@ -74,11 +74,10 @@ class RowMemo:
             self.misses += len(mine)
             while len(self._done) > self.capacity:
                 self._done.popitem(last=False)
-        self._release(keys, mine)
+        self._release(keys, mine, claim)
 
-    def _release(self, keys, mine) -> None:
+    def _release(self, keys, mine, claim) -> None:
         with self._lock:
-            claim = self._pending.pop(keys[mine[0]])
-            for i in mine[1:]:
-                self._pending.pop(keys[i])
+            for i in mine:
+                del self._pending[keys[i]]
         claim.set()
