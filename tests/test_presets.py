@@ -171,6 +171,23 @@ def test_blender_preset_matches_brdf_ggx_within_generator_noise(shipped, bake_pr
     assert mx[2] < 3e-4 and mean[2] < 5e-6, (mx, mean)  # measured 1.3e-4 / 1.5e-6
 
 
+def test_blender_presets_aim_at_their_rgba16f_texture(bake_preset):
+    """Blender uploads brdf_ggx, bsdf_ggx and btdf_ggx into its RGBA16F utility texture (eevee_pipeline.hh,
+    UtilityTexture: SFLOAT_16_16_16_16): the three presets take half's tolerance while their headers stay float32,
+    and the baked table records it."""
+    from lutbake.tolerance import default_tolerance, tolerance_of
+
+    half = default_tolerance({"dtype": "half"})
+    for name in ("blender-eevee", "blender-eevee-btdf", "blender-eevee-bsdf"):
+        (spec,) = load_config(preset_path(name))
+        assert (spec.options["dtype"], spec.options["format"]) == ("float32", "h")
+        assert tolerance_of(spec.options) == half
+    _, table = bake_preset("blender-eevee")
+    assert table.attributes["tolerance"] == half.text()
+    bound = max(half.absolute, half.relative * float(np.abs(table.data).max()))  # the largest texel's target
+    assert float(table.attributes["error_estimate"]) <= bound
+
+
 # --------------------------------------------------------------------------------------------- Unreal
 
 
