@@ -540,6 +540,17 @@ def test_small_eta_and_critical_angle_match_numpy(texel):
     np.testing.assert_allclose(e, want, rtol=0, atol=NUMPY_ACCURACY)  # measured: within 5.9e-8 (float32 D, G)
 
 
+def test_avg_mu_starts_grade_towards_the_critical_angle():
+    """Inside the glass the first mu panels end at 0, 0.2, eta, cos theta_c, 1 and at cos theta_c +- alpha 4^k below
+    0.25 (the ~alpha-wide total-internal-reflection transition); outside it, or at the mirror limit, no grading."""
+    eta, alpha = 0.6, 0.01
+    c = np.sqrt(1 - eta * eta)
+    graded = [c + s * alpha * 4.0**k for k in range(3) for s in (-1, 1)]  # 0.01, 0.04, 0.16
+    np.testing.assert_allclose(kd.mu_starts(eta, alpha), np.sort([0.0, 0.2, eta, c, 1.0, *graded]), rtol=1e-12)
+    np.testing.assert_allclose(kd.mu_starts(eta, 0.0), [0.0, 0.2, eta, c, 1.0], rtol=1e-12)
+    np.testing.assert_array_equal(kd.mu_starts(1.5, alpha), [0.0, 0.2, 1.0])
+
+
 def test_avg_mu_rule_reaches_the_tolerance():
     """kind dielectric_avg's mu rule bisects each texel's worst panel until the Gauss-Kronrod pair (7, 15) agrees
     within a quarter of the tolerance: inside the glass at small roughness E(mu) crosses the total-internal-reflection
