@@ -38,7 +38,7 @@ import numpy as np
 
 from ..axes import Axis
 from ..catalog import DIELECTRIC_MASKINGS, HEMISPHERE_ESTIMATORS, MASKINGS, NDF_DESCRIPTIONS, SMITH_NDFS, VNDF_NDFS
-from ..edge import alpha_policy
+from ..edge import ALPHA_MIN, alpha_policy
 from ..memo import RowMemo
 from ..sampling import points
 from ..sampling.mu_average import mu_averages, mu_target
@@ -62,10 +62,9 @@ AVG_LAYOUT_KEYS = ()
 # E_T is not analytic at further points inside the glass (mu = eta among them: mu_starts): the fixed 16 nodes per panel
 # of before were off by up to 2.0e-4 on OpenPBR's eta < 1 rows (alpha = 0.004)
 MU_MAX_PANELS = 40
-# inside the glass the first mu panels are also graded towards cos theta_c (mu_starts): ends at cos theta_c +- alpha
-# MU_GRADE_RATIO^k below MU_GRADE_MAX, from alpha >= MU_GRADE_ALPHA (below it the mirror limit, whose kink is the
-# cos theta_c end itself): Turquin's average 0.84x the mu evaluations, OpenPBR's 0.88x (docs/transmission.md)
-MU_GRADE_ALPHA, MU_GRADE_MAX, MU_GRADE_RATIO = 1.0e-4, 0.25, 4.0
+# inside the glass the first mu panels are also graded towards cos theta_c (mu_starts): Turquin's average 0.84x the mu
+# evaluations, OpenPBR's 0.88x (docs/transmission.md)
+MU_GRADE_MAX, MU_GRADE_RATIO = 0.25, 4.0
 # kind dielectric_avg's inner rule (fixed-order Gauss-Legendre at the mu nodes, its error the probe's): without
 # ``samples``, its order climbs from the default 12 by 4 (each order's refined rule, order + 4, is the next order) up
 # to INNER_ORDER_MAX until the probe's share is within INNER_SHARE of the target at every probe texel (the mu rule's is
@@ -449,15 +448,16 @@ def mu_starts(eta: float, alpha: float = 0.0) -> np.ndarray:
     (where E(mu) has its total-internal-reflection kink in the smooth limit) and mu = eta = sin theta_c, where
     theta_v + theta_c = pi/2: the outer cut theta_h = theta_v + theta_c of the dielectric estimator (phi_c,
     lutbake.sampling.dielectric) enters the hemisphere there and E(mu) is not analytic (rough texels bisected
-    around it: 11 % of turquin_dielectric_e_avg's mu nodes). For eta < 1 at alpha >= MU_GRADE_ALPHA the panels are
-    also graded towards cos theta_c, ends at cos theta_c +- alpha 4^k below MU_GRADE_MAX: the transition there is
-    ~alpha wide, which bisection from the first panels reached only after up to 16 halvings of 30 evaluations each."""
+    around it: 11 % of turquin_dielectric_e_avg's mu nodes). For eta < 1 off the mirror limit (alpha >= ALPHA_MIN,
+    lutbake.edge: the mirror's kink is the cos theta_c end itself) the panels are also graded towards cos theta_c,
+    ends at cos theta_c +- alpha MU_GRADE_RATIO^k below MU_GRADE_MAX: the transition there is ~alpha wide, which
+    bisection from the first panels reached only after up to 16 halvings of 30 evaluations each."""
     cuts = [0.0, 0.2, 1.0]
     if eta < 1.0:
         c = float(np.sqrt(1.0 - eta * eta))
         cuts += [c, float(eta)]
         w = float(alpha)
-        while MU_GRADE_ALPHA <= w < MU_GRADE_MAX:
+        while ALPHA_MIN <= w < MU_GRADE_MAX:
             cuts += [c - w, c + w]
             w *= MU_GRADE_RATIO
     return np.unique(np.clip(cuts, 0.0, 1.0))
