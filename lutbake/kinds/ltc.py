@@ -229,8 +229,27 @@ class LtcBake:
                 # not depend on the thread count)
                 threads = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
                 p = fit.Problem(self.o["lobe"], self.nov, self.alpha, mag, self.o["fit_samples"], device, threads)
-                self.coarse = fit.coarse_pass(p, self.n_view, self.n_rough, fit.MEMO)
+                nodes = self.unclamped_nodes(device, threads)
+                self.coarse = fit.coarse_pass(p, self.n_view, self.n_rough, fit.MEMO, nodes)
                 self.problem = p
+
+    def unclamped_nodes(self, device: str, threads: int):
+        """The coarse pass's own problem where ``alpha_min`` clamps a coarse texel's alpha: the coarse texels at the
+        lobe's alpha (>= lutbake's ALPHA_MIN) and magnitude, as a table without the clamp fits them; None where no
+        coarse texel is clamped. The coarse fits only seed the texels, so the table's seeds are then the unclamped
+        table's, and through the fit memo so is every texel the clamp leaves alone (ltc-hdrp, alpha_min 1e-3, fits
+        its two clamped columns of 64 beside ltc-ggx instead of the nine of the first coarse cell)."""
+        from ..ltc import fit
+
+        idx = fit.coarse_texels(self.n_view, self.n_rough)
+        nov, alpha = texel_params(self.axes)
+        if np.array_equal(alpha[idx], self.alpha[idx]):
+            return None
+        o = self.o
+        mag, _ = magnitude_fresnel(
+            o["lobe"], nov[idx], magnitude_alpha(self.axes)[idx], o["samples"], device, o["estimator"], o["seed"]
+        )
+        return fit.Problem(o["lobe"], nov[idx], alpha[idx], mag, o["fit_samples"], device, threads)
 
     def fitted(self, start: int, stop: int) -> list:
         """[packed ltc_1 (k, 4), relative error (k,)] of texels [start, stop) of a slice (fitted once)."""
@@ -348,7 +367,8 @@ def plan(spec) -> TexelPlan:
                 "optimiser": f"Nelder-Mead (ltc_code nelder_mead.h), tol {fit.NELDER_MEAD_TOL}, "
                 f"<= {fit.NELDER_MEAD_ITERS} iterations per restart, simplex sizes {list(fit.COARSE_STEPS)} "
                 f"(coarse pass), {list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11{q_tail})",
-                "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses; each texel starts "
+                "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses, at the lobe's alpha "
+                f"(>= {ALPHA_MIN:g}, unclamped by alpha_min); each texel starts "
                 "from the best of the analytic guesses and the surrounding coarse fits (no chaining)",
                 "alpha_min": o["alpha_min"],
                 "theta_max": THETA_MAX,

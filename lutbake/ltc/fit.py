@@ -465,15 +465,22 @@ def coarse_nodes(n: int) -> np.ndarray:
     return np.unique(np.round(np.linspace(0, n - 1, min(COARSE_NODES, n))).astype(int))
 
 
+def coarse_texels(ny: int, nx: int) -> np.ndarray:
+    """The coarse-grid texels (rows coarse_nodes(ny), columns coarse_nodes(nx)), row-major in the ny x nx grid."""
+    return (coarse_nodes(ny)[:, None] * nx + coarse_nodes(nx)[None, :]).ravel()
+
+
 def coarse_pass(
-    problem: Problem, ny: int, nx: int, memo: RowMemo | None = None
+    problem: Problem, ny: int, nx: int, memo: RowMemo | None = None, nodes: Problem | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Fit the coarse-grid texels (rows ``iy``, columns ``ix``) from analytic guesses alone.
+    """Fit the coarse-grid texels (rows ``iy``, columns ``ix``) from analytic guesses alone: texels of ``problem``,
+    or the texels 0, 1, ... of ``nodes``, a problem holding just the coarse texels (coarse_texels' order), e.g. at
+    other inputs than the table's (lutbake.kinds.ltc: the lobe's own alpha where a table clamps it).
     Returns (iy nodes, ix nodes, q of shape (len(iy), len(ix), dof))."""
     iy, ix = coarse_nodes(ny), coarse_nodes(nx)
-    texel = (iy[:, None] * nx + ix[None, :]).ravel()
-    q, _ = fit_from(problem, texel, analytic_guesses(problem, texel), COARSE_STEPS, memo)
-    return iy, ix, q.reshape(len(iy), len(ix), problem.dof)
+    p, texel = (problem, coarse_texels(ny, nx)) if nodes is None else (nodes, np.arange(len(iy) * len(ix)))
+    q, _ = fit_from(p, texel, analytic_guesses(p, texel), COARSE_STEPS, memo)
+    return iy, ix, q.reshape(len(iy), len(ix), p.dof)
 
 
 def seed_candidates(problem: Problem, texel: np.ndarray, nx: int, coarse) -> np.ndarray:
