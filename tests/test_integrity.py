@@ -30,7 +30,7 @@ sys.path.insert(0, str(ROOT))
 
 from lutbake import api, batch  # noqa: E402
 from lutbake.config import load_configs  # noqa: E402
-from lutbake.io import atomic, formats  # noqa: E402
+from lutbake.io import atomic, conventions  # noqa: E402
 from lutbake.io.formats import EXTENSIONS  # noqa: E402
 from lutbake.io.integrity import sha256_file, sidecar_path, verified_attributes  # noqa: E402
 
@@ -274,7 +274,7 @@ def test_a_full_disk_between_data_and_sidecar_makes_the_next_run_rebake(pristine
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(sidecar_path(out / "t.npy")))
 
     with monkeypatch.context() as m:
-        m.setattr(formats, "write_sidecar", full_disk)
+        m.setattr(conventions, "write_sidecar", full_disk)
         (job,) = batch.schedule([b], out)
         batch.run([job], workers=1, progress=None)
     assert job.status == "failed" and "no space left on device" in job.message, job.message

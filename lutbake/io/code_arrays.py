@@ -8,7 +8,7 @@
 - ``rs``: <name>.rs, ``pub const <NAME>: [u16; N]`` of half bits (``half::f16::from_bits``; wgpu ``Rg16Float``:
   upload the bits little-endian) or ``[f32; N]``, with ``<NAME>_HEIGHT`` / ``_WIDTH`` / ``_CHANNELS``.
 - ``ktx2zst``: <name>.ktx2, KTX2 with supercompressionScheme 2 (Zstandard), as ``ktx2`` otherwise (Bevy, libktx).
-Every text format starts with the conventions comment block of the C header (lutbake.io.formats.convention_lines),
+Every text format starts with the conventions comment block of the C header (lutbake.io.conventions.convention_lines),
 including a ``lutbake:shape = [rows, columns, channels]`` line; row 0 of the array is table row 0. A ``.json``
 sidecar is written beside each file (so every format is skipped when up to date).
 """
@@ -23,6 +23,7 @@ from ..table import Table, metadata
 from ..table import pixels as checked_pixels
 from . import ktx2
 from .atomic import atomic_write_bytes
+from .conventions import c_ident, convention_lines, write_conventions
 
 PER_LINE = 16
 
@@ -68,12 +69,11 @@ SOURCE_SYNTAX = {
 def source_text(table: Table, fmt: str, dtype: str = "float32") -> str:
     """The JS / WGSL / Rust source of ``table`` (module docstring)."""
     from .. import __version__
-    from .formats import _c_ident, convention_lines
 
     if fmt not in SOURCE_SYNTAX:
         raise ValueError(f"unknown source format {fmt!r}; allowed: {', '.join(SOURCE_SYNTAX)}")
     pixels = checked_pixels(table, dtype)
-    ident = _c_ident(table.name).upper()
+    ident = c_ident(table.name).upper()
     dims = list(pixels.shape)
     n = int(np.prod(dims))
     half = dtype == "half"
@@ -97,14 +97,12 @@ def source_text(table: Table, fmt: str, dtype: str = "float32") -> str:
 
 def _writer(fmt: str):
     def write(table: Table, path, dtype: str = "float32") -> Path:
-        from .formats import _sidecar
-
         if fmt == "js" and table.kind == "ltc":  # three.js' LTC_MAT_1 / LTC_MAT_2 module (lutbake.io.ltc)
             from .ltc import write_js
 
             return write_js(table, path, dtype)
         path = atomic_write_bytes(Path(path), source_text(table, fmt, dtype).encode("utf-8"))
-        _sidecar(table, path, fmt)
+        write_conventions(table, path, fmt)
         return path
 
     return write
@@ -112,14 +110,13 @@ def _writer(fmt: str):
 
 def write_ktx2_zstd(table: Table, path, dtype: str = "float32") -> Path:
     from .. import __version__
-    from .formats import _sidecar
 
     pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write_bytes(
         path, ktx2.encode(pixels, metadata(table), writer=f"lutbake {__version__}", supercompression="zstd")
     )
-    _sidecar(table, path, "ktx2zst", {"supercompression": "zstd (scheme 2)", "zstd_level": ktx2.ZSTD_LEVEL})
+    write_conventions(table, path, "ktx2zst", {"supercompression": "zstd (scheme 2)", "zstd_level": ktx2.ZSTD_LEVEL})
     return path
 
 

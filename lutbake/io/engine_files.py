@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .lut_files import literal_values, parse_text_array, strip_comments
+from .text_arrays import literal_values, parse_text_array, strip_comments
 
 HDRP_CHANNELS = {
     "R": ("m00_over_m22", "M^-1_00 / M^-1_22 (HDRP texel .x; FP16, saturated to +-65504)"),
@@ -102,7 +102,7 @@ def _hdrp_cs(path: Path, doc: dict, dims: dict) -> np.ndarray:
 
 
 def _openpbr_h(path: Path, doc: dict, dims: dict, attrs: dict) -> np.ndarray:
-    from .openpbr import UNORM_ONE, _camel
+    from .openpbr import UNORM_ONE, camel
 
     text = path.read_text(encoding="utf-8")
     names = json.loads(attrs["channel_names"])
@@ -113,7 +113,7 @@ def _openpbr_h(path: Path, doc: dict, dims: dict, attrs: dict) -> np.ndarray:
             continue
         ch = names[letter]
         own = shape[1:] if ch.startswith("ideal_metal") else shape  # the metal array: one IOR slice
-        codes = _values(text, f"OpenPBR_{_camel(ch)}_Array", own)
+        codes = _values(text, f"OpenPBR_{camel(ch)}_Array", own)
         channels.append(np.broadcast_to(codes / UNORM_ONE, shape))
     return np.stack(channels, axis=-1)
 

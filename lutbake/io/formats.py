@@ -14,17 +14,16 @@ Row 0 of every file is table row 0 (no flip); column 0 is x index 0. Every write
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import numpy as np
 
 from ..table import Table, metadata
 from ..table import pixels as checked_pixels
-from . import dds, ktx2
+from . import code_arrays, dds, ktx2, ltc, openpbr
 from .atomic import atomic_write, atomic_write_bytes
+from .conventions import c_ident, convention_lines, write_conventions
 from .exr import write_exr
-from .integrity import legacy_sidecar, write_sidecar
 
 FORMATS = {
     "exr": "OpenEXR via OpenImageIO, float32 or half, lutbake:* header attributes (default)",
@@ -47,20 +46,11 @@ EXTENSIONS = {
 }
 
 
-def _sidecar(table: Table, path: Path, fmt: str, extra: dict | None = None) -> None:
-    """The last step of every non-EXR write: ``<file>.json`` naming the data's sha256 (lutbake.io.integrity);
-    a pre-issue-11 ``<stem>.json`` that described this file is removed (it would contradict the new one)."""
-    write_sidecar(path, fmt, metadata(table), extra)
-    old = legacy_sidecar(path)
-    if old is not None:
-        old.unlink(missing_ok=True)
-
-
 def write_npy(table: Table, path, dtype: str = "float32") -> Path:
     pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write(path, lambda tmp: np.save(tmp, pixels, allow_pickle=False))
-    _sidecar(table, path, "npy", {"dtype": str(pixels.dtype), "shape": list(pixels.shape)})
+    write_conventions(table, path, "npy", {"dtype": str(pixels.dtype), "shape": list(pixels.shape)})
     return path
 
 
@@ -107,7 +97,7 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
             raise OSError(f"cannot write {path}: {out.geterror()}")
 
     atomic_write(path, write)
-    _sidecar(
+    write_conventions(
         table,
         path,
         "png16",
@@ -124,7 +114,9 @@ def write_dds(table: Table, path, dtype: str = "float32") -> Path:
     path = Path(path)
     atomic_write_bytes(path, dds.encode(pixels))
     fmt = dds.DXGI_NAMES[dds.DXGI[(dtype, 4 if pixels.shape[-1] == 3 else pixels.shape[-1])]]
-    _sidecar(table, path, "dds", {"dxgi_format": fmt, "dimension": "TEXTURE3D" if pixels.ndim == 4 else "TEXTURE2D"})
+    write_conventions(
+        table, path, "dds", {"dxgi_format": fmt, "dimension": "TEXTURE3D" if pixels.ndim == 4 else "TEXTURE2D"}
+    )
     return path
 
 
@@ -134,60 +126,8 @@ def write_ktx2(table: Table, path, dtype: str = "float32", array: bool = False) 
     pixels = checked_pixels(table, dtype)
     path = Path(path)
     atomic_write_bytes(path, ktx2.encode(pixels, metadata(table), array=array, writer=f"lutbake {__version__}"))
-    _sidecar(table, path, "ktx2", {"array": array})
+    write_conventions(table, path, "ktx2", {"array": array})
     return path
-
-
-def _c_ident(name: str) -> str:
-    s = re.sub(r"[^A-Za-z0-9_]", "_", name)
-    return s if not s[0].isdigit() else "_" + s
-
-
-def convention_lines(table: Table, pixels: np.ndarray, dtype: str, ident: str, values: str | None = None) -> list[str]:
-    """The conventions comment block every source-code output carries (C header, JS/TS, WGSL, Rust), one
-    line per item, without comment markers: array layout, axes (texel, mapping, order, uv), channels,
-    reconstruction, provenance and the config."""
-    dims = pixels.shape
-    lines = [
-        "",
-        f"kind: {table.kind}",
-        f"array: {ident}["
-        + " * ".join(str(n) for n in dims)
-        + "], flat: element "
-        + ("((z * H + y) * W + x) * C + c" if pixels.ndim == 4 else "(y * W + x) * C + c")
-        + " (rows y, columns x, channels c)",
-        f"lutbake:shape = [{', '.join(str(n) for n in dims)}]",
-        "row 0 = table row 0 (y index 0); column 0 = x index 0. Upload row 0 first (OpenGL: t = 0 at row 0).",
-        "values: "
-        + (
-            values
-            or (
-                "IEEE 754 binary16 bit patterns (uint16_t); upload as GL_HALF_FLOAT / DXGI *_FLOAT"
-                if dtype == "half"
-                else "float32"
-            )
-        ),
-        "",
-        "axes:",
-    ]
-    for ax in table.axes:
-        d = ax.describe()
-        lines += [
-            f"  {d['name']}: {d['dim']} ({d['image']}), count {d['count']}, texel {d['texel']} "
-            f"({d['texel_formula']}), order {d['order']}",
-            f"    mapping {d['mapping']}: {d['mapping_formula']}"
-            + (f", clamped to {d['clamp']}" if d.get("clamp") else ""),
-            f"    index 0 = {d['values'][0]:.9g}, index {d['count'] - 1} = {d['values'][-1]:.9g}",
-            f"    sample at {d['uv_formula']}",
-        ]
-    lines += ["channels:"] + [f"  {c} = {n}: {m}" for c, (n, m) in zip("RGBA", table.channels.items())]
-    lines += ["reconstruction:", f"  {table.reconstruction}", "", "provenance:"]
-    for k in ("terms", "estimator", "samples", "seed", "version", "warp_version"):
-        if k in table.attributes:
-            lines.append(f"  {k}: {table.attributes[k]}")
-    lines.append("config:")
-    lines += [f"  {line}" for line in table.attributes.get("config", "").splitlines()]
-    return lines
 
 
 def header_text(table: Table, dtype: str = "float32") -> str:
@@ -197,7 +137,7 @@ def header_text(table: Table, dtype: str = "float32") -> str:
     from .. import __version__
 
     pixels = checked_pixels(table, dtype)
-    ident = _c_ident(table.name)
+    ident = c_ident(table.name)
     macro = ident.upper()
     dims = pixels.shape
     lines = [f"/* {table.name}.h -- generated by lutbake {__version__}; do not edit."]
@@ -226,14 +166,12 @@ def header_text(table: Table, dtype: str = "float32") -> str:
 def write_header(table: Table, path, dtype: str = "float32") -> Path:
     text = header_text(table, dtype)
     path = atomic_write_bytes(Path(path), text.encode("utf-8"))
-    _sidecar(table, path, "h")
+    write_conventions(table, path, "h")
     return path
 
 
 def write_openpbr(table: Table, path, dtype: str = "float32") -> Path:
-    from .openpbr import write_openpbr_header
-
-    return write_openpbr_header(table, path, dtype)
+    return openpbr.write_openpbr_header(table, path, dtype)
 
 
 WRITERS = {
@@ -244,28 +182,25 @@ WRITERS = {
     "ktx2": write_ktx2,
     "h": write_header,
     "openpbr_h": write_openpbr,
+    **ltc.WRITERS,  # the LTC engine layouts (kind ltc only): lutbake.io.ltc
+    **code_arrays.WRITERS,  # JS / WGSL / Rust arrays and zstd KTX2 (lutbake.io.code_arrays); its js serves ltc too
 }
-# the LTC engine layouts (kind ltc only): lutbake.io.ltc
-from . import ltc as _ltc_export  # noqa: E402
-
-WRITERS.update(_ltc_export.WRITERS)
-EXTENSIONS.update(_ltc_export.EXTENSIONS)
-
-
-def _register_code_arrays() -> None:
-    """JS / WGSL / Rust arrays and zstd KTX2 (lutbake.io.code_arrays)."""
-    from . import code_arrays
-
-    FORMATS.update(code_arrays.FORMATS)
-    EXTENSIONS.update(code_arrays.EXTENSIONS)
-    WRITERS.update(code_arrays.WRITERS)
-
-
-_register_code_arrays()
+FORMATS = {**FORMATS, **code_arrays.FORMATS}  # what a table of any kind can be written as (lutbake.kinds.base)
+ALL_FORMATS = {**FORMATS, **ltc.FORMATS}  # every format: the --format option; each kind's ``format`` key allows a
+# subset (lutbake.kinds.allowed_formats), which the config check and its message use
+EXTENSIONS = {**EXTENSIONS, **ltc.EXTENSIONS, **code_arrays.EXTENSIONS}
 
 
 def output_path(out_dir, name: str, fmt: str) -> Path:
     return Path(out_dir) / f"{name}{EXTENSIONS[fmt]}"
+
+
+def written_files(name: str, fmt: str) -> list[str]:
+    """The names of the files a table ``name`` writes in ``fmt``: its data file(s), then its sidecar (every format but
+    EXR, whose header holds the conventions)."""
+    data = output_path(".", name, fmt).name
+    files = [data] + ([data.replace("_1.dds", "_2.dds")] if fmt == "ltc_dds" else [])
+    return files + ([] if fmt == "exr" else [data + ".json"])
 
 
 def write_table(table: Table, out_dir, fmt: str = "exr", dtype: str = "float32") -> Path:

@@ -22,9 +22,15 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
+from .conventions import write_conventions
 
 FP16_MAX = 65504.0
 EXTENSIONS = {"ltc_dds": "_1.dds", "js": ".js", "c": ".cc", "cs": ".cs"}
+FORMATS = {  # js: lutbake.io.code_arrays' format, which writes an ltc table as three.js' module (write_js)
+    "ltc_dds": "ltc_code's two files <name>_1.dds, <name>_2.dds: RGBA16F (dtype half) or RGBA32F (kind ltc)",
+    "c": "Blender EEVEE C arrays ltc_mat_<lobe>, ltc_mag_<lobe>, ltc_disk_integral (kind ltc)",
+    "cs": "Unity HDRP C# table s_LtcMatrixData_BRDF_<LOBE>, FP16 bits of one RGBA16F slice (kind ltc)",
+}
 
 
 def engine_textures(table: Table) -> tuple[np.ndarray, np.ndarray]:
@@ -47,7 +53,6 @@ def _flat(a: np.ndarray, fmt: str = "{:.9g}") -> str:
 def write_ltc_dds(table: Table, path, dtype: str = "half") -> Path:
     from . import dds
     from .atomic import atomic_write_bytes
-    from .formats import _sidecar
 
     t1, t2 = engine_textures(table)
     path = Path(path)
@@ -55,7 +60,7 @@ def write_ltc_dds(table: Table, path, dtype: str = "half") -> Path:
     np_dtype = np.float16 if dtype == "half" else np.float32
     atomic_write_bytes(second, dds.encode(t2.astype(np_dtype)))
     atomic_write_bytes(path, dds.encode(t1.astype(np_dtype)))
-    _sidecar(
+    write_conventions(
         table,
         path,
         "ltc_dds",
@@ -91,10 +96,9 @@ def js_text(table: Table) -> str:
 
 def write_js(table: Table, path, dtype: str = "float32") -> Path:
     from .atomic import atomic_write_bytes
-    from .formats import _sidecar
 
     path = atomic_write_bytes(Path(path), js_text(table).encode("utf-8"))
-    _sidecar(table, path, "js", {"exports": ["LTC_SIZE", "LTC_MAT_1", "LTC_MAT_2"]})
+    write_conventions(table, path, "js", {"exports": ["LTC_SIZE", "LTC_MAT_1", "LTC_MAT_2"]})
     return path
 
 
@@ -128,10 +132,9 @@ def c_text(table: Table) -> str:
 
 def write_c(table: Table, path, dtype: str = "float32") -> Path:
     from .atomic import atomic_write_bytes
-    from .formats import _sidecar
 
     path = atomic_write_bytes(Path(path), c_text(table).encode("utf-8"))
-    _sidecar(table, path, "c", {"arrays": ["ltc_mat_<lobe>", "ltc_mag_<lobe>", "ltc_disk_integral"]})
+    write_conventions(table, path, "c", {"arrays": ["ltc_mat_<lobe>", "ltc_mag_<lobe>", "ltc_disk_integral"]})
     return path
 
 
@@ -181,10 +184,11 @@ def cs_text(table: Table) -> str:
 
 def write_cs(table: Table, path, dtype: str = "half") -> Path:
     from .atomic import atomic_write_bytes
-    from .formats import _sidecar
 
     path = atomic_write_bytes(Path(path), cs_text(table).encode("utf-8"))
-    _sidecar(table, path, "cs", {"array": "s_LtcMatrixData_BRDF_<LOBE>: ushort FP16 bits, RGBA16F slice of _LtcData"})
+    write_conventions(
+        table, path, "cs", {"array": "s_LtcMatrixData_BRDF_<LOBE>: ushort FP16 bits, RGBA16F slice of _LtcData"}
+    )
     return path
 
 

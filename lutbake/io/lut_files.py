@@ -1,7 +1,8 @@
 """Read any LUT file lutbake can audit into a float64 (rows, columns, channels) array.
 
 ``read_lut(path, shape=None, encoding=None) -> LutFile``. Formats, by extension:
-- ``.exr``: OpenImageIO, float; the ``lutbake:*`` attributes when present.
+- ``.exr``: OpenImageIO (any tool's: float or half, RG/RGB/RGBA, layer-prefixed or other channel names, one part); the
+  ``lutbake:*`` attributes when present.
 - ``.png``: OpenImageIO, the raw UNORM codes (8 or 16 bit), value = code / (2^bits - 1), **no transfer function**.
 - ``.dds``: DX10 header, R16G16_FLOAT ... RGBA32F (lutbake.io.dds); ``.ktx2``: lutbake.io.ktx2.decode (plain or zstd).
 - ``.npy``, ``.npz``: an integer array is UNORM codes (value = code / dtype max), a float array values (npz: the
@@ -18,11 +19,12 @@ Row 0 of the result is the first row stored in the file (no flip). A JSON sideca
 from __future__ import annotations
 
 import json
-import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from .text_arrays import parse_text_array
 
 TEXT_EXTENSIONS = (".h", ".hpp", ".inc", ".js", ".mjs", ".ts", ".wgsl", ".rs")
 READABLE = (".exr", ".png", ".dds", ".ktx2", ".npy", ".npz") + TEXT_EXTENSIONS
@@ -67,58 +69,30 @@ def _read_png(path: Path) -> tuple[np.ndarray, str]:
     return _unorm(np.asarray(codes))
 
 
-def _text_shape(text: str, shape) -> tuple[int, ...]:
-    if shape is not None:
-        return tuple(int(s) for s in shape)
-    m = re.search(r"lutbake:shape\s*[=:]\s*\[?\s*(\d+)\s*,\s*(\d+)\s*,\s*(\d+)", text)
-    if m:
-        return tuple(int(g) for g in m.groups())
-    dims = {k: int(v) for k, v in re.findall(r"#define\s+\w+?_(HEIGHT|WIDTH|CHANNELS)\s+(\d+)", text)}
-    if len(dims) == 3:
-        return dims["HEIGHT"], dims["WIDTH"], dims["CHANNELS"]
-    raise ValueError(
-        "the array's layout is not declared in the file: give shape=(rows, columns, channels) "
-        "(CLI: --shape ROWSxCOLUMNSxCHANNELS)"
-    )
+def _read_exr(path: Path) -> tuple[np.ndarray, dict, str]:
+    """Any tool's 2D EXR: (values (y, x, C), lutbake attributes or {}, storage "half" / "float32"). Channels R, G, B,
+    A in that order, also under a layer prefix (``dfg.R``, ``dfg.G``: file order is alphabetical); other names
+    (``Y``, ``scale``, ``bias``) in file order. A multi-part file is a 3D table, which audit does not compare."""
+    from .readers import exr_parts
 
-
-def strip_comments(text: str) -> str:
-    """Source text without its /* ... */ and // comments."""
-    return re.sub(r"//[^\n]*", " ", re.sub(r"/\*.*?\*/", " ", text, flags=re.S))
-
-
-def literal_values(payload: str, n: int) -> tuple[np.ndarray, str]:
-    """The first ``n`` numbers of an array literal's body (float64) and how they are stored: hex literals are
-    IEEE 754 binary16 bit patterns ("half"), decimal literals floats ("float32")."""
-    hexes = re.findall(r"0x([0-9a-fA-F]{1,4})\b", payload)
-    if hexes:
-        bits = np.array([int(h, 16) for h in hexes[:n]], dtype=np.uint16)
-        return bits.view(np.float16).astype(np.float64), "half"
-    payload = re.sub(r"_?f(?:32|64)\b", "", payload)  # Rust's 0.5_f32 / 1f64 type suffixes
-    nums = re.findall(r"[-+]?(?:\d+\.\d*|\.\d+|\d+)(?:[eE][-+]?\d+)?", payload)
-    return np.array([float(x) for x in nums[:n]], dtype=np.float64), "float32"
-
-
-def parse_text_array(text: str, shape=None) -> tuple[np.ndarray, str]:
-    """The values of the first ``{...}`` / ``[...]`` array literal after its declaration (literal_values);
-    comments are skipped."""
-    # "= {", "= [", "( [" (JS), or "= array<f32, N>(" (WGSL): the literal's first number follows
-    m = re.search(r"(?:=|\()\s*[^{\[;(]*?(?:[{\[]|\()\s*((?:0x|[-+.\d])[^;]*)", strip_comments(text))
-    if not m:
-        raise ValueError("no array literal found")
-    shp = _text_shape(text, shape)
-    n = int(np.prod(shp))
-    arr, storage = literal_values(m.group(1), n)
-    if arr.size != n:
-        raise ValueError(f"the array holds {arr.size} values, the declared shape {shp} needs {n}")
-    return arr.reshape(shp), storage
+    try:
+        parts = exr_parts(path)
+    except ValueError as e:
+        raise ValueError(f"{path}: not a readable EXR ({e})") from None
+    if len(parts) != 1:
+        raise ValueError(f"{path}: {len(parts)} parts (a 3D table, one part per slice); audit compares 2D tables")
+    arr, attrs, facts = parts[0]
+    suffixes = [c.rpartition(".")[2] for c in facts["channels"]]
+    if len(set(suffixes)) == len(suffixes) and set(suffixes) <= set("RGBA"):
+        arr = arr[..., [suffixes.index(c) for c in "RGBA" if c in suffixes]]
+    storage = "half" if facts["pixel_type"] == "half" else "float32"
+    return arr.astype(np.float64), attrs, storage
 
 
 def read_lut(path, shape=None) -> LutFile:
     """Read ``path`` (see the module docstring). ``shape``: (rows, columns, channels) of a text array
     whose file does not declare it."""
     from .dds import decode as dds_decode
-    from .exr import read_exr
     from .ktx2 import decode as ktx2_decode
 
     path = Path(path)
@@ -134,8 +108,8 @@ def read_lut(path, shape=None) -> LutFile:
             attrs = sidecar.get("lutbake", {})
             break
     if ext == ".exr":
-        data, attrs = read_exr(path)
-        storage = "float32"
+        data, exr_attrs, storage = _read_exr(path)
+        attrs = exr_attrs or attrs
     elif ext == ".png":
         data, storage = _read_png(path)
     elif ext == ".dds":

@@ -20,12 +20,14 @@ import numpy as np
 
 from ..table import Table
 from .atomic import atomic_write_bytes
+from .conventions import write_conventions
 
 METAL_SLICE = 16  # eta = 1 in OpenPBR's IOR axis
 UNORM_ONE = 65535.0
 
 
-def _camel(channel: str) -> str:
+def camel(channel: str) -> str:
+    """OpenPBR's array name part of a channel: ideal_metal_energy -> IdealMetalEnergy."""
     return "".join(w.capitalize() for w in channel.split("_"))
 
 
@@ -44,7 +46,7 @@ def arrays(table: Table) -> dict[str, np.ndarray]:
         data = table.data[..., c]
         if name.startswith("ideal_metal"):
             data = data[METAL_SLICE]
-        out[f"OpenPBR_{_camel(name)}_Array"] = unorm16(data)
+        out[f"OpenPBR_{camel(name)}_Array"] = unorm16(data)
     return out
 
 
@@ -71,8 +73,6 @@ def header_text(table: Table) -> str:
 
 
 def write_openpbr_header(table: Table, path, dtype: str = "float32") -> Path:
-    from .formats import _sidecar
-
     path = atomic_write_bytes(Path(path), header_text(table).encode("utf-8"))
-    _sidecar(table, path, "openpbr_h")
+    write_conventions(table, path, "openpbr_h")
     return path
