@@ -25,17 +25,17 @@ def test_validate_labels_every_number_and_ends_with_a_total(monkeypatch):
     from click.testing import CliRunner
 
     from lutbake.cli import main
-    from lutbake.validate import checks
+    from lutbake.validate import checks, results
 
     fake = [
-        checks._result(
+        results.check_result(
             "a_check",
             8.7e-6,
             2e-5,
             "max |E + E_ms - 1| over rows r >= 0.1; worst at r=0.2",
             ("rows with r < 0.1: max 3.4e-03",),
         ),
-        checks._result("b_check", 3.0, 1.0, "max |x|"),
+        results.check_result("b_check", 3.0, 1.0, "max |x|"),
     ]
     monkeypatch.setattr(checks, "run_all", lambda names=None: fake)
     r = CliRunner().invoke(main, ["validate"])

@@ -15,7 +15,6 @@ variables), with panels graded geometrically towards every point where the integ
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -25,6 +24,7 @@ from ..integrands.specular import hemisphere_integral
 from ..sampling import points
 from ..terms.distributions import NDFS
 from .probe import BRDF_PAIRS, evaluate_brdfs, evaluate_terms
+from .results import CheckResult, check_result
 
 # Tolerances (absolute unless said otherwise). The terms run in float32: ~1e-7 is the floor.
 PROJECTED_AREA_TOL = 1.0e-6  # |∫ D(m)(n.m) dω_m - 1|
@@ -86,53 +86,6 @@ PANEL_RATIO = 2.0  # geometric panel growth away from an anchor
 CUT_FIRST_PANEL = 1.0e-6  # first panel width next to a cut (rad)
 
 
-@dataclass(frozen=True)
-class CheckResult:
-    """``measured`` is the one number compared with ``tolerance``; ``detail`` says what it is, then (after
-    "; ") where it is worst; ``notes`` are secondary figures, each labelled, never compared."""
-
-    name: str
-    measured: float
-    tolerance: float
-    passed: bool
-    detail: str
-    notes: tuple[str, ...] = ()
-
-    @property
-    def what(self) -> str:
-        """What ``measured`` is (the first clause of ``detail``)."""
-        return self.detail.split("; ")[0]
-
-    @property
-    def secondary(self) -> list[str]:
-        """Every other figure: the rest of ``detail`` (where the worst case is), then ``notes``."""
-        return self.detail.split("; ")[1:] + list(self.notes)
-
-    def lines(self) -> list[str]:
-        """The report: status and name, then one labelled line per number."""
-        return [
-            f"{'PASS' if self.passed else 'FAIL'}  {self.name}",
-            f"      measured   {self.measured:.3e}   = {self.what}",
-            f"      tolerance  {self.tolerance:.1e}   (pass: measured <= tolerance)",
-        ] + [f"      {text}" for text in self.secondary]
-
-    def __str__(self) -> str:
-        return "\n".join(self.lines())
-
-
-def _result(name: str, measured: float, tolerance: float, detail: str, notes: tuple[str, ...] = ()) -> CheckResult:
-    measured = float(measured)
-    return CheckResult(
-        name, measured, tolerance, bool(np.isfinite(measured) and measured <= tolerance), detail, tuple(notes)
-    )
-
-
-def summary(results: list[CheckResult]) -> str:
-    """The closing line of ``lutbake validate``: "37 passed, 0 failed"."""
-    passed = sum(r.passed for r in results)
-    return f"{passed} passed, {len(results) - passed} failed"
-
-
 # --- quadrature helpers --------------------------------------------------------------------------
 
 
@@ -170,7 +123,7 @@ def ndf_projected_area_is_one(ndf_name: str) -> CheckResult:
     """∫ D(m)(n.m) dω_m = 2 pi ∫_0^{pi/2} D(theta) cos(theta) sin(theta) dtheta = 1 (Walter et al. 2007, Eq. 4),
     composite GL in theta, panels graded geometrically from the pole at the NDF's scale atan(alpha)."""
     err, detail = _projected_area(f"D_{ndf_name}", lambda alpha: (0.0, np.arctan(alpha) / 16.0))
-    return _result(f"ndf_projected_area_is_one[{ndf_name}]", err, PROJECTED_AREA_TOL, detail)
+    return check_result(f"ndf_projected_area_is_one[{ndf_name}]", err, PROJECTED_AREA_TOL, detail)
 
 
 def _projected_area(term: str, grade_at) -> tuple[float, str]:
@@ -191,7 +144,7 @@ def charlie_projected_area_is_one() -> CheckResult:
     normalised in projected area: 2 pi ∫ D cos sin dtheta = 1. Its mass sits within ~sqrt(alpha) of the
     horizon, so the panels are graded towards theta = pi/2."""
     err, detail = _projected_area("D_charlie", lambda alpha: (np.pi / 2, np.sqrt(alpha) / 16.0))
-    return _result("ndf_projected_area_is_one[charlie]", err, CHARLIE_AREA_TOL, detail)
+    return check_result("ndf_projected_area_is_one[charlie]", err, CHARLIE_AREA_TOL, detail)
 
 
 def weak_white_furnace(ndf_name: str) -> CheckResult:
@@ -228,7 +181,7 @@ def weak_white_furnace(ndf_name: str) -> CheckResult:
     k = int(np.argmax(errors))
     grid = f"n.v in {FURNACE_NOVS} x alpha in {FURNACE_ALPHAS}"
     detail = f"max |∫G1(v)max(0,v.m)D(m)dω - n.v| over {grid}; worst at (n.v, alpha)={where[k]}"
-    return _result(f"weak_white_furnace[{ndf_name}]", errors[k], WEAK_FURNACE_TOL, detail)
+    return check_result(f"weak_white_furnace[{ndf_name}]", errors[k], WEAK_FURNACE_TOL, detail)
 
 
 def _aniso_pairs(alphas=PROJECTED_AREA_ALPHAS) -> list[tuple[float, float, float, float]]:
@@ -273,7 +226,7 @@ def ndf_projected_area_is_one_aniso() -> CheckResult:
     alpha in PROJECTED_AREA_ALPHAS x anisotropy in ANISOTROPIES (Burley mapping); composite GL in theta graded
     from the pole at atan(min(alpha_x, alpha_y)) and in phi graded towards both axes."""
     err, where = _aniso_measure("D_ggx_aniso", lambda t: np.cos(t) * np.sin(t))
-    return _result(
+    return check_result(
         "ndf_projected_area_is_one[ggx_aniso]",
         err,
         ANISO_AREA_TOL,
@@ -287,7 +240,7 @@ def ashikhmin_shirley_density_is_one() -> CheckResult:
     1 over the hemisphere (a solid-angle density: ∫ p_h dω = 1, not the projected area), for nu, nv of the
     same (alpha_x, alpha_y) pairs (nu = max(2/alpha_x^2 - 2, 0))."""
     err, where = _aniso_measure("D_ashikhmin_shirley", lambda t: np.sin(t), horizon=True)
-    return _result(
+    return check_result(
         "ashikhmin_shirley_density_is_one",
         err,
         AS_DENSITY_TOL,
@@ -325,7 +278,7 @@ def weak_white_furnace_aniso() -> CheckResult:
                 errors.append(abs(integral - nov))
                 where.append((nov, round(phi_v, 4), alpha, a))
     k = int(np.argmax(errors))
-    return _result(
+    return check_result(
         "weak_white_furnace[ggx_aniso]",
         errors[k],
         ANISO_FURNACE_TOL,
@@ -365,7 +318,7 @@ def kulla_conty_white_furnace() -> CheckResult:
     loss = float(np.max(1.0 - e.data[..., 0]))
     smooth = rough < 0.1
     rows = ", ".join(f"r={r:.3f}: {w:.1e}" for r, w in zip(rough[smooth], worst[smooth]))
-    return _result(
+    return check_result(
         "kulla_conty_white_furnace",
         measured,
         KC_FURNACE_TOL,
@@ -399,7 +352,7 @@ def albedo_le_one_and_mirror_limit(ndf_name: str, masking_name: str) -> CheckRes
     i, j = np.unravel_index(np.argmax(E), E.shape)
     mirror = _integrate(ndf_name, masking_name, "albedo", MIRROR_NOVS, np.full(len(MIRROR_NOVS), ALPHA_MIN))[:, 0]
     mirror_err = float(np.max(np.abs(mirror - 1.0)))
-    return _result(
+    return check_result(
         f"albedo_le_one_and_mirror_limit[{ndf_name},{masking_name}]",
         max(excess, mirror_err),
         ALBEDO_TOL,
@@ -422,7 +375,7 @@ def dfg_mirror_limit(ndf_name: str, masking_name: str) -> CheckResult:
     k = int(np.argmax(err))
     what = f"|scale - (1-(1-n.v)^5)|, |bias - (1-n.v)^5| at alpha={ALPHA_MIN}"
     detail = f"max over n.v in [0.05, 1] of {what}; worst at n.v={nov[k]:.4g}"
-    return _result(f"dfg_mirror_limit[{ndf_name},{masking_name}]", err[k], DFG_MIRROR_TOL, detail)
+    return check_result(f"dfg_mirror_limit[{ndf_name},{masking_name}]", err[k], DFG_MIRROR_TOL, detail)
 
 
 def estimators_agree() -> CheckResult:
@@ -433,7 +386,7 @@ def estimators_agree() -> CheckResult:
     qmc = _integrate("ggx", "smith_height_correlated", "scale_bias", nov, alpha, "sobol_vndf", ESTIMATOR_QMC_SAMPLES)
     err = np.abs(gl - qmc)
     k = int(np.argmax(err.max(axis=1)))
-    return _result(
+    return check_result(
         "estimators_agree",
         err.max(),
         ESTIMATOR_AGREEMENT_TOL,
@@ -471,7 +424,7 @@ def reciprocity(ndf_name: str, masking_name: str) -> CheckResult:
     scale = np.maximum(np.maximum(np.abs(a), np.abs(b)), np.finfo(np.float64).tiny)
     rel = np.where((a == 0.0) & (b == 0.0), 0.0, np.abs(a - b) / scale)
     nonzero = int(np.count_nonzero(a))
-    return _result(
+    return check_result(
         f"reciprocity[{ndf_name},{masking_name}]",
         rel.max(),
         RECIPROCITY_RTOL,
@@ -489,7 +442,7 @@ def fresnel_eq2_is_exact_dielectric() -> CheckResult:
     exact = evaluate_terms(eta=(1.0 + s) / (1.0 - s), cos_theta=c)["F_dielectric"].astype(np.float64)
     err = np.abs(eq2 - exact)
     i, j = np.unravel_index(np.argmax(err), err.shape)
-    return _result(
+    return check_result(
         "fresnel_eq2_is_exact_dielectric",
         err.max(),
         FRESNEL_EQ2_TOL,
@@ -505,7 +458,7 @@ def schlick_endpoints() -> CheckResult:
     at_grazing = evaluate_terms(f0=f0, cos_theta=0.0)["F_schlick"].astype(np.float64)
     err_n = np.max(np.abs(at_normal - f0.astype(np.float32)))
     err_g = np.max(np.abs(at_grazing - 1.0))
-    return _result(
+    return check_result(
         "schlick_endpoints",
         max(err_n, err_g),
         SCHLICK_ENDPOINT_TOL,
@@ -547,7 +500,7 @@ def diffuse_sigma0_is_lambert_eq6() -> CheckResult:
         w = lambda c: 1 - (1 - c) ** 5  # noqa: E731
         ref = 1.05 * (1 - f0) * w(l[:, 2]) * w(v[:, 2]) / np.pi
         worst = max(worst, float(np.max(np.abs(f - ref) / ref)))
-    return _result(
+    return check_result(
         "diffuse_sigma0_is_lambert_eq6",
         worst,
         DIFFUSE_SIGMA0_RTOL,
@@ -564,7 +517,7 @@ def diffuse_reciprocity() -> CheckResult:
     a = eval_brdf("microfacet", l, v, sigma, 0.04, "eq6", "sigma", DIFFUSE_ORDER)
     b = eval_brdf("microfacet", v, l, sigma, 0.04, "eq6", "sigma", DIFFUSE_ORDER)
     rel = np.abs(a - b) / np.maximum(np.maximum(a, b), 1e-30)
-    return _result(
+    return check_result(
         "diffuse_reciprocity",
         float(rel.max()),
         DIFFUSE_RECIPROCITY_RTOL,
@@ -586,7 +539,7 @@ def diffuse_albedo_le_one() -> CheckResult:
             e = albedo_swapped(N, A, f0, form, order=DIFFUSE_ORDER)
             top = max(top, float(e.max()))
             worst = max(worst, float(np.max(e - 1.0)))
-    return _result(
+    return check_result(
         "diffuse_albedo_le_one",
         max(worst, 0.0),
         DIFFUSE_ALBEDO_TOL,
@@ -608,7 +561,9 @@ def ltc_sphere_table_is_snyder() -> CheckResult:
     got = sphere.cap_projected_solid_angle(omega, sigma)
     want = np.vectorize(sphere.snyder_cap)(omega, sigma)
     err = np.max(np.abs(got - want) / (np.pi * np.sin(sigma) ** 2))
-    return _result("ltc_sphere_table_is_snyder", err, LTC_SPHERE_TOL, "max |integrated - closed form| / (pi sin^2)")
+    return check_result(
+        "ltc_sphere_table_is_snyder", err, LTC_SPHERE_TOL, "max |integrated - closed form| / (pi sin^2)"
+    )
 
 
 EON_ALBEDO_TOL = 1.0e-6  # EON (rho = 1) albedo by GL vs 1: measured 1.0e-7
@@ -622,7 +577,7 @@ def eon_albedo_is_one() -> CheckResult:
 
     nov, r = np.meshgrid([0.01, 0.1, 0.3, 0.6, 0.9, 1.0], [0.0, 0.25, 0.5, 0.75, 1.0])
     err = np.max(np.abs(albedo_gl("eon", nov.ravel(), r.ravel(), order=24) - 1.0))
-    return _result("eon_albedo_is_one", err, EON_ALBEDO_TOL, "max |E_EON - 1| over 6 NoV x 5 r, rho = 1")
+    return check_result("eon_albedo_is_one", err, EON_ALBEDO_TOL, "max |E_EON - 1| over 6 NoV x 5 r, rho = 1")
 
 
 def ltc_eon_r0_is_identity() -> CheckResult:
@@ -638,7 +593,9 @@ def ltc_eon_r0_is_identity() -> CheckResult:
     texels = np.arange(len(col0))
     m, _ = fit.fit_texels(p, texels, 1, fit.coarse_pass(p, len(col0), 1))
     err = np.max(np.abs(fit.pack_inverse(m) - np.array([1.0, 0.0, 0.0, 1.0])))
-    return _result("ltc_eon_r0_is_identity", err, LTC_IDENTITY_TOL, "max |packed M^-1 - (1, 0, 0, 1)| over 6 views")
+    return check_result(
+        "ltc_eon_r0_is_identity", err, LTC_IDENTITY_TOL, "max |packed M^-1 - (1, 0, 0, 1)| over 6 views"
+    )
 
 
 # --- registry ------------------------------------------------------------------------------------------

@@ -31,7 +31,7 @@ from ..terms import dielectric as td
 from ..terms import fresnel
 from ..terms.distributions import NDFS
 from ..terms.frame import reflect
-from .checks import _result
+from .results import check_result
 
 SMOOTH_LIMIT_TOL = 2.0e-5  # |E_R - F|, |E_T - (1 - F)| at alpha = ALPHA_MIN, |mu - cos theta_c| >= SMOOTH_KINK_GAP
 SMOOTH_KINK_GAP = 0.02
@@ -79,7 +79,7 @@ def smooth_limit() -> tuple[float, str]:
 
 def dielectric_smooth_limit():
     worst, where = smooth_limit()
-    return _result(
+    return check_result(
         "dielectric_smooth_limit",
         worst,
         SMOOTH_LIMIT_TOL,
@@ -108,7 +108,7 @@ def dielectric_index_matched():
         exp = index_matched_expected(mu, alpha, m)
         worst = max(worst, float(np.max(np.abs(e[:, 0]))), float(np.max(np.abs(e[:, 1] - exp))))
         loss = max(loss, float(np.max(1 - exp)))
-    return _result(
+    return check_result(
         "dielectric_index_matched",
         worst,
         INDEX_MATCHED_TOL,
@@ -234,7 +234,7 @@ def dielectric_reciprocity():
     for m in ("smith_separable", "smith_height_correlated"):
         r, t, a = reciprocity_errors(m)
         worst, every = max(worst, r, t), max(every, a)
-    return _result(
+    return check_result(
         "dielectric_reciprocity",
         worst,
         RECIPROCITY_RTOL,
@@ -257,7 +257,7 @@ def dielectric_energy_le_one():
     e = _integrate(M, A, E)
     s = e[:, 0] + e[:, 1]
     k = int(np.argmax(1 - s))
-    return _result(
+    return check_result(
         "dielectric_energy_le_one",
         max(float(s.max()) - 1.0, 0.0),
         ENERGY_TOL,
@@ -272,7 +272,7 @@ def dielectric_estimators_agree():
     eta = np.array([1.5, 0.67, 1.33, 0.75, 0.9], np.float32)
     a = _integrate(mu, alpha, eta)
     b = _integrate(mu, alpha, eta, estimator="sobol_vndf", samples=1 << 16)
-    return _result(
+    return check_result(
         "dielectric_estimators_agree",
         float(np.max(np.abs(a - b))),
         ESTIMATOR_TOL,
@@ -308,7 +308,7 @@ def openpbr_reflection_ratio_reciprocity():
     res = [reciprocity_residual(rows[a][:, 3], rows[a][:, 0], rows[b][:, 3], rows[b][:, 0]) for a, b in RATIO_ROW_PAIRS]
     x = np.concatenate([r[:, 3] for r in rows.values()])
     out_of_range = float(max(0.0, -x.min(), x.max() - 1.0))
-    return _result(
+    return check_result(
         "openpbr_reflection_ratio_reciprocity",
         max(float(np.max(np.abs(res))), out_of_range),
         RATIO_RECIPROCITY_TOL,
