@@ -166,7 +166,13 @@ def _store(cache: ValuesCache | None, job: Job, computed: Computed) -> None:
 
 
 def _bake_group(
-    group: list[Job], workers: int, device: str, progress, cancel: threading.Event, cache: ValuesCache | None = None
+    group: list[Job],
+    workers: int,
+    device: str,
+    progress,
+    cancel: threading.Event,
+    cache: ValuesCache | None = None,
+    runner=None,
 ) -> list[Job]:
     """Compute the values of ``group`` (pending jobs with one values key, lutbake.sharing) once, or take them from
     ``cache``, then assemble and write each job's table in its own layout; any failure is recorded on the jobs
@@ -179,7 +185,7 @@ def _bake_group(
         computed = _cached(cache, lead)
         origin = "cache" if computed is not None else None
         if computed is None:
-            computed = compute(lead.spec, workers, device, progress, cancel=cancel)
+            computed = compute(lead.spec, workers, device, progress, cancel=cancel, runner=runner)
             _store(cache, lead, computed)
     except ModuleBusy:  # before any tile ran (warp_runtime.defer_if_busy): the caller runs another group first
         raise
@@ -236,6 +242,7 @@ def run(
     on_done: Callable[[Job], None] | None = None,
     poll: float = 0.2,
     cache: ValuesCache | None = None,
+    runner=None,
 ) -> int | None:
     """Bake every ``pending`` job; ``on_done(job)`` is called in the calling thread as each finishes.
 
@@ -246,6 +253,7 @@ def run(
     Returns None, or the signal number if the run was interrupted (the unfinished jobs are then marked
     ``interrupted``; finished files are kept). ``progress``: lutbake.runtime.executor.Progress, per table.
     ``cache``: lutbake.values_cache.ValuesCache, whose entries of other sources are pruned first.
+    ``runner``: where the tiles run (lutbake.runtime.cluster.DaskRunner); None: this process' threads.
     """
     workers = workers or default_workers()
     for d in sorted({j.path.parent for j in jobs}):
@@ -275,7 +283,7 @@ def run(
                 may_defer = bool(queue) and id(g) not in set_back
             try:
                 with defer_if_busy() if may_defer else contextlib.nullcontext():
-                    return _bake_group(g, per_table, device, progress, cancel, cache)
+                    return _bake_group(g, per_table, device, progress, cancel, cache, runner)
             except ModuleBusy:
                 with queue_lock:
                     set_back.add(id(g))

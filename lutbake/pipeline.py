@@ -2,10 +2,10 @@
 
     spec (lutbake.config) -> lutbake.kinds.<kind>.plan = per_texel_plan(integrand, estimator, grid)
          -> lutbake.runtime.executor.execute -> finite check -> lutbake.table.Table (lutbake.provenance.attributes)
-``compute`` runs everything up to the values (plan, tiles, finite check, error estimate); ``assemble`` makes the
-Table of one spec from them (name, config, content hash). ``bake_table`` is both. The batch (lutbake.batch) computes
-once per distinct values key (lutbake.sharing) and assembles per table; the batch and the Python API (lutbake.api)
-write.
+``compute`` runs everything up to the values (plan, tiles, finite check, error estimate); ``compute_at`` the
+same plan at arbitrary texels (audit and size); ``assemble`` makes the Table of one spec from them (name, config,
+content hash). ``bake_table`` is both. The batch (lutbake.batch) computes once per distinct values key
+(lutbake.sharing) and assembles per table; the batch and the Python API (lutbake.api) write.
 """
 
 from __future__ import annotations
@@ -39,17 +39,31 @@ class Computed:
 
 
 def compute(
-    spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: Progress | None = None, cancel=None
+    spec: TableSpec,
+    workers: int | None = None,
+    device: str = "cpu",
+    progress: Progress | None = None,
+    cancel=None,
+    runner=None,
 ) -> Computed:
     """The values of ``spec``'s table (nothing written). Raises TableError if a value is not finite;
-    executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
+    executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs. ``runner``: where the
+    tiles run (lutbake.runtime.cluster.DaskRunner); None: this process' threads."""
     cpu: list[float] = []  # CPU seconds of each part, measured in the thread that ran it (time.thread_time)
     t0 = time.thread_time()
     plan = lookup_kind(spec.kind).plan(spec)
     cpu.append(time.thread_time() - t0)
     with Timer() as t:
         full = execute_tiles(
-            plan, workers=workers, device=device, progress=progress, label=spec.name, cancel=cancel, spec=spec, cpu=cpu
+            plan,
+            workers=workers,
+            device=device,
+            progress=progress,
+            label=spec.name,
+            cancel=cancel,
+            spec=spec,
+            cpu=cpu,
+            runner=runner,
         )
     t0 = time.thread_time()
     data = full[:, : plan.n_channels].reshape(plan.shape)
@@ -57,7 +71,7 @@ def compute(
         bad = int(np.size(data) - np.count_nonzero(np.isfinite(data)))
         raise TableError(f"{spec.source}: table '{spec.name}': {bad} non-finite values; nothing written")
     extra = {}
-    estimate = estimate_error(plan, full, device, spec)
+    estimate = estimate_error(plan, full, device, spec, runner)
     if estimate is not None:
         err, how = estimate
         extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)
@@ -65,6 +79,16 @@ def compute(
         extra.update(plan.attributes_after(data))
     cpu.append(time.thread_time() - t0)
     return Computed(plan, data, extra, t.seconds, sum(cpu))
+
+
+def compute_at(spec: TableSpec, points: dict[str, np.ndarray], workers: int | None = None, device: str = "cpu"):
+    """``spec``'s integrand and estimator at arbitrary texels instead of its grid: float64 (n, channels), nothing
+    written. ``points``: flat per-texel arrays the kind's plan reads ({"nov", "alpha", "rough"} for dfg, whose
+    ``plan(spec, points=...)`` takes them). The reference of ``lutbake audit`` and ``lutbake size``
+    (lutbake.commands.reference): the bake's own plan and tile executor, at the points those commands need."""
+    plan = lookup_kind(spec.kind).plan(spec, points=points)
+    full = execute_tiles(plan, workers=workers, device=device)
+    return full[:, : plan.n_channels]
 
 
 def assemble(spec: TableSpec, computed: Computed) -> Table:
@@ -83,9 +107,15 @@ def assemble(spec: TableSpec, computed: Computed) -> Table:
 
 
 def bake_table(
-    spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: Progress | None = None, cancel=None
+    spec: TableSpec,
+    workers: int | None = None,
+    device: str = "cpu",
+    progress: Progress | None = None,
+    cancel=None,
+    runner=None,
 ) -> tuple[Table, float, int]:
     """Bake one spec into a Table (nothing written): (table, seconds, samples per texel). Raises TableError if a
-    value is not finite; executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
-    c = compute(spec, workers, device, progress, cancel)
+    value is not finite; executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs;
+    ``runner``: see compute."""
+    c = compute(spec, workers, device, progress, cancel, runner)
     return assemble(spec, c), c.seconds, c.plan.samples

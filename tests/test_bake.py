@@ -13,16 +13,16 @@ def one_worker(bake):
 
 
 def test_output_is_bit_identical_for_1_and_n_workers(one_worker, bake):
-    from lutbake.runtime import executor
+    from lutbake.runtime import devices
 
-    old = executor.TILE_TEXELS
+    old = devices.CPU_TILE_TEXELS
     try:
-        executor.TILE_TEXELS = 37  # odd tiles too
+        devices.CPU_TILE_TEXELS = 37  # odd tiles too (the executor's tiles are sized by lutbake.runtime.devices)
         for w in (2, 3):
             t = bake(DFG, workers=w)
             assert np.array_equal(t.data, one_worker.data)
     finally:
-        executor.TILE_TEXELS = old
+        devices.CPU_TILE_TEXELS = old
 
 
 def test_table_layout_row0_is_smoothest_and_col0_is_grazing(one_worker):

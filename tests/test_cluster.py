@@ -22,12 +22,13 @@ from click.testing import CliRunner
 
 distributed = pytest.importorskip("distributed")
 
-from lutbake import batch, cluster  # noqa: E402
+from lutbake import batch  # noqa: E402
 from lutbake.api import bake_table  # noqa: E402
 from lutbake.cli import main  # noqa: E402
 from lutbake.config import load_configs, preset_path, validate_table  # noqa: E402
 from lutbake.io.exr import read_exr  # noqa: E402
 from lutbake.kinds import lookup_kind  # noqa: E402
+from lutbake.runtime import cluster  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 pytestmark = pytest.mark.usefixtures("terminal_sigint")  # the interrupt tests and deadline() need SIGINT
@@ -145,8 +146,8 @@ def test_cluster_bake_is_bit_identical_to_the_thread_executor(runner):
     specs = [spec(n, **kw) for n, kw in SPECS.items()]
     specs += load_configs([preset_path(LTC_PRESET[0])], LTC_PRESET[1])
     local = {s.name: bake_table(s, workers=2)[0] for s in specs}
-    with deadline(), cluster.activate(runner):
-        remote = {s.name: bake_table(s, workers=2)[0] for s in specs}
+    with deadline():
+        remote = {s.name: bake_table(s, workers=2, runner=runner)[0] for s in specs}
     for s in specs:
         a, b = local[s.name], remote[s.name]
         assert a.data.shape == b.data.shape and np.array_equal(a.data, b.data), s.name
@@ -186,8 +187,8 @@ def test_a_killed_worker_costs_only_its_tiles(client, tmp_path):
 
     r.on_tile = kill_one
     jobs = batch.schedule(specs, tmp_path / "out")
-    with deadline(), cluster.activate(r):
-        assert batch.run(jobs, workers=len(jobs)) is None
+    with deadline():
+        assert batch.run(jobs, workers=len(jobs), runner=r) is None
     assert killed and killed["tiles"] >= 1 and killed["remaining"] > 1  # the kill happened mid-bake, with tiles on it
     assert [j.status for j in jobs] == ["baked"] * 3, [j.message for j in jobs]
     assert r.stats.tiles == 3 * per_table  # every tile delivered once: the finished ones were never recomputed

@@ -393,25 +393,6 @@ class DaskRunner:
         return fut.result()
 
 
-_ACTIVE: DaskRunner | None = None
-
-
-def active() -> DaskRunner | None:
-    """The runner of the enclosing session() / activate() block, or None (bake locally)."""
-    return _ACTIVE
-
-
-@contextlib.contextmanager
-def activate(runner: DaskRunner):
-    """Inside this block every bake of this process runs its tiles on ``runner``."""
-    global _ACTIVE
-    previous, _ACTIVE = _ACTIVE, runner
-    try:
-        yield runner
-    finally:
-        _ACTIVE = previous
-
-
 def _distributed():
     try:
         import distributed
@@ -424,9 +405,10 @@ def _distributed():
 
 @contextlib.contextmanager
 def session(scheduler: str, device: str = "cpu"):
-    """Connect to ``scheduler`` (``local:N`` starts a LocalCluster), check its workers, and make every
-    bake inside the block run its tiles there; closes what it opened. Raises ConfigError (bad form,
-    distributed missing, scheduler unreachable) or WorkerRefused before any tile runs."""
+    """Connect to ``scheduler`` (``local:N`` starts a LocalCluster), check its workers, and yield the DaskRunner
+    that bakes run their tiles on when given it (lutbake.runtime.executor, ``runner=``); closes what it opened.
+    Raises ConfigError (bad form, distributed missing, scheduler unreachable) or WorkerRefused before any tile
+    runs."""
     form, where = parse_scheduler(scheduler)
     distributed = _distributed()
     cluster = None
@@ -461,8 +443,7 @@ def session(scheduler: str, device: str = "cpu"):
         runner.check_workers()
         if form == "local":
             client.register_worker_callbacks(setup=setup_local_worker)
-        with activate(runner):
-            yield runner
+        yield runner
     finally:
         client.close()
         if cluster is not None:

@@ -19,7 +19,7 @@ differ in the last bits of each sample (docs/cluster.md says how that difference
 
 from __future__ import annotations
 
-from .executor import TILE_TEXELS as CPU_TILE_TEXELS
+CPU_TILE_TEXELS = 512  # texels per tile on the CPU (lutbake.runtime.executor.TILE_TEXELS)
 
 CUDA_TILE_MAX_EVALS = 1 << 34  # integrand evaluations in one CUDA launch (~1.7e10: about a second on an H100)
 CUDA_MEMORY_FRACTION = 0.25  # of the device's free memory, for one launch's per-texel arrays

@@ -17,8 +17,9 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 
 from ..sampling.plan import TexelPlan
+from .devices import CPU_TILE_TEXELS as TILE_TEXELS
+from .devices import plan_tile_texels
 
-TILE_TEXELS = 512
 # progress(label, n_texels, cost) -> update(n_done_in_this_tile) or None: called once per table before its tiles run
 Progress = Callable[[str, int, float], "Callable[[int], None] | None"]
 
@@ -50,22 +51,20 @@ def execute_tiles(
     cancel: threading.Event | None = None,
     spec=None,
     cpu: list[float] | None = None,
+    runner=None,
 ) -> np.ndarray:
     """Evaluate every tile of ``plan``; returns float64 (n_texels, plan.tile_width): the values, then the aux
     columns (lutbake.sampling.plan.TexelPlan.aux_channels).
 
     ``progress``: a ``Progress`` factory; its update is called in the calling thread after each tile.
     ``cancel``: when set (by another thread), no further tile starts and Cancelled is raised.
-    ``spec``: the TableSpec ``plan`` came from; inside a lutbake.runtime.cluster session the tiles run on the
-    cluster's workers instead (as tasks of (spec, tile range)). Tiles are TILE_TEXELS on the CPU, device-sized
-    on CUDA (lutbake.runtime.devices). ``cpu``: a list that receives the CPU seconds of the kernels' preparation and of
-    each tile, each measured in the thread that ran it (time.thread_time; not for tiles run on a cluster)."""
-    from . import cluster
-    from .devices import plan_tile_texels
-
-    remote = cluster.active() if spec is not None else None
-    if remote is not None:
-        return remote.execute(spec, plan, device, progress=progress, label=label, cancel=cancel)
+    ``spec``: the TableSpec ``plan`` came from; with a ``runner`` (lutbake.runtime.cluster.DaskRunner, or any object
+    with its ``execute`` and ``estimate_error``) the tiles run there instead, as tasks of (spec, tile range). Tiles
+    are TILE_TEXELS on the CPU, device-sized on CUDA (lutbake.runtime.devices). ``cpu``: a list that receives the
+    CPU seconds of the kernels' preparation and of each tile, each measured in the thread that ran it
+    (time.thread_time; not for tiles run on a cluster)."""
+    if runner is not None and spec is not None:
+        return runner.execute(spec, plan, device, progress=progress, label=label, cancel=cancel)
     workers = workers or default_workers()
     cpu = cpu if cpu is not None else []
     # tables prepare in parallel: their kernels compile on every core (lutbake.runtime.warp_runtime.load_module)
@@ -100,16 +99,15 @@ def execute_tiles(
     return out
 
 
-def estimate_error(plan: TexelPlan, data: np.ndarray, device: str = "cpu", spec=None) -> tuple[float, str] | None:
+def estimate_error(
+    plan: TexelPlan, data: np.ndarray, device: str = "cpu", spec=None, runner=None
+) -> tuple[float, str] | None:
     """``plan.error_estimate`` of baked ``data`` (flat float64, (n_texels, tile_width)), None if the kind has
-    none; inside a lutbake.runtime.cluster session it runs on a worker, as the tiles did."""
-    from . import cluster
-
+    none; with a ``runner`` (see execute_tiles) it runs on a worker, as the tiles did."""
     if plan.error_estimate is None:
         return None
-    remote = cluster.active() if spec is not None else None
-    if remote is not None:
-        return remote.estimate_error(spec, data, device)
+    if runner is not None and spec is not None:
+        return runner.estimate_error(spec, data, device)
     return plan.error_estimate(data, device)
 
 
