@@ -8,7 +8,7 @@ from click.testing import CliRunner
 from scipy.ndimage import map_coordinates
 
 from lutbake.cli import main
-from lutbake.commands.audit import conventions
+from lutbake.commands.reference import conventions
 from lutbake.commands.size import axis_at, bilinear_half, measure, smallest_sizes, store
 
 SMOOTH_NOV = 0.3  # away from the grazing corner the DFG is smooth: bilinear error ~ h^2

@@ -35,22 +35,18 @@ from pathlib import Path
 import numpy as np
 
 from ..axes import Axis
-from ..catalog import SHEEN_LAYOUTS
 from ..edge import NOV_MIN
 from ..io.lut_files import LutFile, read_lut
-from ..tolerance import Tolerance
+from .audit_report import METRICS, MISMATCH_RATIO, PERCENTILES, metric_value, stats, subset, write_error_map
+from .audit_tables import dispatch
+from .reference import Conventions, Reference, conventions
 
 MAX_SIDE = 128  # default subset: at most this many rows and columns are re-integrated
-MISMATCH_RATIO = 0.5  # an alternative convention is the diagnosis when its RMS is below this x the nominal RMS
 QUANT_TOL = 1e-3  # a value is on a UNORM code grid when |v (2^b - 1) - round| <= this (in codes)
 UNORM_BITS = (8, 10, 12, 16)
 NOISE_SAMPLES = (64, 256, 1024, 4096, 16384)  # the calibration bakes of the noise estimate
 NOISE_TEXELS = 1024  # texels of the subset used for the noise calibration (fixed, evenly spread)
 NOISE_FLOOR_RATIO = 1.5  # noise is reported when the residual exceeds this x what the quantisation explains
-PERCENTILES = (50, 95, 99)
-METRICS = ("max", "p99", "mean")
-REFERENCE_TOLERANCE = 1e-7  # the re-bake: adaptive Gauss-Legendre to 1e-7 per value (its estimates bound the error:
-# docs/accuracy.md); a fixed order 12 leaves ~1e-5 at NoV = 1e-4 and would flag a correct table
 
 
 def srgb_eotf(v):
@@ -97,37 +93,6 @@ class Hypothesis:
     transform: object = None  # values: callable(pred) -> pred, or None
     rms: float = math.nan
     max: float = math.nan
-
-
-@dataclass
-class Conventions:
-    """A dfg spec's options, with its axes at the file's size."""
-
-    options: dict
-    axes: list[Axis]  # [y, x]
-    source: str
-
-    @property
-    def layout(self) -> str:
-        return self.options["layout"]
-
-
-def conventions(config=None, preset=None, overrides=(), shape=None) -> Conventions:
-    """The declared conventions: a config file or preset, ``--set`` overrides, size from ``shape`` (rows, cols)."""
-    from ..config import load_config, parse_overrides, preset_path
-    from ..errors import ConfigError
-    from ..kinds.dfg import axes_for
-
-    path = Path(config) if config else preset_path(preset or "default")
-    ovr = parse_overrides(overrides)
-    spec = load_config(path, ovr)[0]
-    if spec.kind != "dfg":
-        raise ConfigError(path, "kind", spec.kind, "dfg", "audit compares dfg tables")
-    if shape is not None:
-        rows, cols = shape
-        size = [cols, rows] if spec.options.get("axis_order", "nov_x") == "nov_x" else [rows, cols]
-        spec = load_config(path, ovr + [(None, "size", size)])[0]
-    return Conventions(dict(spec.options), axes_for(spec.options), str(path))
 
 
 def _axis_values(axis: Axis, shift: float) -> np.ndarray:
@@ -250,77 +215,6 @@ def hypotheses(conv: Conventions) -> list[Hypothesis]:
     return hs
 
 
-class Integrator:
-    """Converged (and, for the noise estimate, Hammersley) integrals at arbitrary (NoV, alpha), cached."""
-
-    def __init__(self, conv: Conventions, workers: int | None = None):
-        from ..integrands import engine_diffuse, specular
-        from ..kinds.dfg import terms_of
-        from ..kinds.engine_layouts import BASE_LAYOUT
-
-        self.specular = specular
-        self.engine_diffuse = engine_diffuse
-        o = conv.options
-        self.form, self.ndf, self.masking = terms_of(o)
-        self.layout = o["layout"]
-        self.base = BASE_LAYOUT.get(self.layout, self.layout)  # the specular integrand's layout
-        self.nch = specular.N_CHANNELS[self.base]
-        self.workers = workers
-        self._cache: dict[bytes, np.ndarray] = {}
-
-    def _run(self, layout, estimator, samples, nch, nov, alpha, tolerance=None) -> np.ndarray:
-        """The (terms, layout) integrand at texels (nov[i], alpha[i]) by ``estimator``, tiles on every worker."""
-        from ..runtime.executor import execute
-        from ..sampling.hemisphere import estimator_for
-        from ..sampling.plan import Grid, per_texel_plan
-
-        integrand = self.specular.specular_integrand(self.ndf, self.masking, layout, self.form, nch)
-        n = len(nov)
-        grid = Grid(
-            [Axis("i", "x", n)],
-            {
-                "nov": np.asarray(nov, np.float32),
-                "alpha": integrand.alpha_input(alpha),
-                "param": np.zeros(n, np.float32),
-            },
-        )
-        plan = per_texel_plan(
-            integrand,
-            estimator_for(estimator, samples, 0, tolerance),
-            grid,
-            channels={},
-            reconstruction="",
-            terms={},
-            error_estimate=False,
-        )
-        return execute(plan, workers=self.workers).reshape(n, nch)
-
-    def converged(self, nov: np.ndarray, alpha: np.ndarray, rough: np.ndarray | None = None) -> np.ndarray:
-        """Every channel of the layout at (NoV, alpha); ``rough`` (perceptual) feeds an engine diffuse channel
-        (default sqrt(alpha))."""
-        rough = np.sqrt(alpha) if rough is None else rough
-        key = b"".join(a.astype(np.float32).tobytes() for a in (nov, alpha, rough))
-        if key not in self._cache:
-            tol = Tolerance(REFERENCE_TOLERANCE, 0.0)
-            out = self._run(self.base, "gauss_legendre", None, self.nch, nov, alpha, tol)
-            if self.base != self.layout:
-                out = self.engine_diffuse.engine_channels(self.layout, out, nov, rough)
-            self._cache[key] = out
-        return self._cache[key]
-
-    def hammersley(self, nov, alpha, samples: int) -> np.ndarray | None:
-        """The engines' usual estimator (R, G of the split-sum layout), or None for the sheen layouts."""
-        if self.base in SHEEN_LAYOUTS or self.form != "microfacet":
-            return None
-        base = "multiscatter" if self.base.startswith("multiscatter") else "scale_bias"
-        return self._run(base, "hammersley_ndf", samples, 2, nov, alpha)
-
-
-def subset(n: int, max_side: int) -> np.ndarray:
-    stride = max(1, math.ceil(n / max_side))
-    return np.unique(np.r_[np.arange(0, n, stride), n - 1])
-
-
 def detect_quantisation(values: np.ndarray, storage: str) -> dict:
     """How the values are stored: the UNORM bit depth whose code grid holds every value, else half floats."""
     v = values[np.isfinite(values)].ravel()
@@ -337,6 +231,29 @@ def detect_quantisation(values: np.ndarray, storage: str) -> dict:
     return {"kind": "float", "step": None, "description": f"floats (file storage {storage})"}
 
 
+def rounding_step(values: np.ndarray, quant: dict) -> np.ndarray:
+    """The storage's rounding step at each stored value: 1 / (2^b - 1) for b-bit UNORM, the spacing of half floats
+    at |v| (2^-24 below 2^-14) or of float32."""
+    if quant["kind"].startswith("unorm"):
+        return np.full(np.shape(values), quant["step"])
+    dtype = np.float16 if quant["kind"] == "half" else np.float32
+    return np.spacing(np.abs(np.asarray(values)).astype(dtype)).astype(np.float64)
+
+
+def recorded_attributes(path, shape=None) -> dict:
+    """The lutbake attributes the file records (EXR header, KTX2 key/value data, or its ``<file>.json`` sidecar);
+    {} for another tool's file."""
+    try:
+        return read_lut(path, shape=shape).attrs
+    except (ValueError, OSError):
+        side = Path(path).with_name(Path(path).name + ".json")
+        try:
+            doc = json.loads(side.read_text(encoding="utf-8")) if side.is_file() else {}
+        except (ValueError, OSError):
+            return {}
+        return doc.get("lutbake", {}) if isinstance(doc, dict) else {}
+
+
 def quantise(values: np.ndarray, quant: dict) -> np.ndarray:
     if quant["kind"].startswith("unorm"):
         m = 1.0 / quant["step"]
@@ -344,13 +261,6 @@ def quantise(values: np.ndarray, quant: dict) -> np.ndarray:
     if quant["kind"] == "half":
         return values.astype(np.float16).astype(np.float64)
     return values
-
-
-def _stats(err: np.ndarray) -> dict:
-    a = np.abs(err)
-    d = {"max": float(a.max()), "mean": float(a.mean())}
-    d.update({f"p{p}": float(np.percentile(a, p)) for p in PERCENTILES})
-    return d
 
 
 @dataclass
@@ -397,14 +307,20 @@ class AuditReport:
         if self.error_map:
             lines.append(f"  error map: {self.error_map}")
         verdict = "PASS" if self.passed else "FAIL"
+        raw = self.extra.get("raw_error")
         lines.append(
-            f"  {verdict}: {self.metric} error {self.value:.3g} {'<=' if self.passed else '>'} "
-            f"tolerance {self.tolerance:g}"
+            f"  {verdict}: {self.metric} error beyond the storage rounding {self.value:.3g} "
+            f"{'<=' if self.passed else '>'} tolerance {self.tolerance:g}"
+            + (
+                f" (|file - converged| max {raw['max']:.3g}, where one rounding step is {raw['step_at_max']:.3g})"
+                if raw
+                else ""
+            )
         )
         return "\n".join(lines)
 
 
-def _noise_estimate(integ: Integrator, pos_sub: Positions, data: np.ndarray, ref: np.ndarray, quant: dict) -> dict:
+def _noise_estimate(integ: Reference, pos_sub: Positions, data: np.ndarray, ref: np.ndarray, quant: dict) -> dict:
     """Estimated Monte-Carlo sample count of the file's generator (see the module docstring)."""
     flat = np.arange(pos_sub.nov.size)
     pick = flat[np.linspace(0, flat.size - 1, min(NOISE_TEXELS, flat.size)).round().astype(int)]
@@ -464,12 +380,12 @@ def audit(
     shape=None,
     workers: int | None = None,
 ) -> AuditReport:
-    """Audit the LUT at ``path`` against conventions(**conv_args) (see the module docstring)."""
+    """Audit the LUT at ``path`` against the declared conventions (conv_args {"preset", "config", "overrides"}; with
+    neither a preset nor a config, the conventions the file records; see the module docstring)."""
     if metric not in METRICS:
         raise ValueError(f"metric {metric!r}: allowed {', '.join(METRICS)}")
-    from .audit_tables import dispatch  # LTC and OpenPBR conventions: lutbake.commands.audit_tables
-
-    other = dispatch(path, conv_args, tolerance, metric, max_side, error_map)
+    recorded = recorded_attributes(path, shape)
+    other = dispatch(path, conv_args, tolerance, metric, max_side, error_map, recorded)  # LTC and OpenPBR
     if other is not None:
         return other
     lut: LutFile = read_lut(path, shape=shape)
@@ -481,8 +397,8 @@ def audit(
             f"{path}: {int(bad.sum())} non-finite values (NaN/Inf), the first at row {r}, column {c}, "
             f"channel {'RGBA'[ch] if ch < 4 else ch}: a LUT must hold finite values"
         )
-    conv = conventions(**(conv_args or {}), shape=(rows, cols))
-    integ = Integrator(conv, workers)
+    conv = conventions(**(conv_args or {}), shape=(rows, cols), recorded=lut.attrs, path=path)
+    integ = Reference(conv, workers)
     from ..kinds.dfg import CHANNELS
 
     names = list(CHANNELS[conv.layout])
@@ -533,7 +449,7 @@ def audit(
     x_vals = conv.axes[1].values()[ix]
     errors = {}
     for c in compared:
-        s = _stats(err[..., c])
+        s = stats(err[..., c])
         k = np.unravel_index(np.argmax(np.abs(err[..., c])), err[..., c].shape)
         s["where"] = (
             f"row {int(iy[k[0]])} ({conv.axes[0].name} {y_vals[k[0]]:.4g}), column {int(ix[k[1]])} "
@@ -541,7 +457,13 @@ def audit(
         )
         errors["RGBA"[c] + " = " + names[c]] = s
     allerr = np.abs(err[..., compared])
-    value = {"max": float(allerr.max()), "p99": float(np.percentile(allerr, 99)), "mean": float(allerr.mean())}[metric]
+    # judged: what exceeds one rounding step of the storage at each stored value (a table that is exactly a
+    # converged bake, rounded to its storage, is within half a step plus its bake tolerance)
+    step = rounding_step(data[..., compared], quant)
+    beyond = np.clip(allerr - step, 0.0, None)
+    value = metric_value(beyond, metric)
+    k = np.unravel_index(np.argmax(allerr), allerr.shape)
+    raw = {"max": float(allerr.max()), "step_at_max": float(step[k]), "metric": metric_value(allerr, metric)}
     report = AuditReport(
         file=str(path),
         conventions=f"{conv.source} (layout {conv.layout}, {conv.axes[0].name} rows "
@@ -565,7 +487,7 @@ def audit(
         tolerance=tolerance,
         value=value,
         passed=bool(value <= tolerance),
-        extra={"best": best.name, "chosen": chosen.name, "storage": lut.storage},
+        extra={"best": best.name, "chosen": chosen.name, "storage": lut.storage, "raw_error": raw},
     )
     if error_map is not None:
         report.error_map = str(
@@ -574,38 +496,6 @@ def audit(
             )
         )
     return report
-
-
-def write_error_map(out: Path, err: np.ndarray, names: list[str], axes: list[Axis], iy, ix, title: str) -> Path:
-    """PNG: |file - reference| per channel, image row 0 at the bottom, ticks = the declared axis values."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from ..io.atomic import atomic_write
-
-    n = err.shape[-1]
-    fig, axs = plt.subplots(1, n, figsize=(4.2 * n, 3.8), dpi=100, squeeze=False)
-    for c in range(n):
-        ax = axs[0, c]
-        im = ax.imshow(np.abs(err[..., c]), origin="lower", cmap="magma", interpolation="nearest", aspect="auto")
-        ax.set_title(f"|file - converged|  {'RGBA'[c]} = {names[c]}", fontsize=9)
-        for axis, idx, setter, ticker in (
-            (axes[1], ix, ax.set_xlabel, ax.set_xticks),
-            (axes[0], iy, ax.set_ylabel, ax.set_yticks),
-        ):
-            vals = axis.values()
-            pos = np.unique(np.linspace(0, len(idx) - 1, 5).round().astype(int))
-            ticker(pos, [f"{vals[idx[p]]:.3g}" for p in pos], fontsize=7)
-            setter(f"{axis.name} ({axis.texel}, {axis.mapping}, {axis.order}); index 0 at origin", fontsize=8)
-        fig.colorbar(im, ax=ax, fraction=0.046, pad=0.04).ax.tick_params(labelsize=7)
-    fig.suptitle(f"lutbake audit: {title}", fontsize=10)
-    fig.tight_layout()
-    out = Path(out)
-    atomic_write(out, lambda tmp: fig.savefig(tmp, format="png"))
-    plt.close(fig)
-    return out
 
 
 def report_json(report: AuditReport) -> str:

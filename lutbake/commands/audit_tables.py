@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .audit import MISMATCH_RATIO, PERCENTILES, _stats, subset
+from .audit_report import MISMATCH_RATIO, PERCENTILES, metric_value, stats, subset, write_error_map
 
 FIT_RATIO_MAX = 2.0  # the file's median Heitz fit error may be at most this x lutbake's fit at the same texels
 AREA_TEXELS = 6  # texels (a spread of roughness and view) of the area-light comparison
@@ -49,13 +49,6 @@ OPENPBR_KEYS = (
     ("ideal_metal_avg_energy_complement", "dielectric_avg", 2),
 )
 RATIO_CHANNEL = 3  # of the openpbr dielectric_avg layout: ideal_dielectric_reflection_ratio
-
-
-def _metric(abs_err: np.ndarray, metric: str) -> float:
-    """The statistic of |error| held against --tolerance (lutbake.commands.audit.METRICS)."""
-    return {"max": float(abs_err.max()), "p99": float(np.percentile(abs_err, 99)), "mean": float(abs_err.mean())}[
-        metric
-    ]
 
 
 @dataclass
@@ -219,12 +212,12 @@ def audit_ltc(
 
     for name, got, want in (("magnitude (t2.x)", f_t2[:, 0], mag), ("fresnel (t2.y)", f_t2[:, 1], fres)):
         err = got - want
-        s = _stats(err)
+        s = stats(err)
         s["where"] = where(int(np.argmax(np.abs(err))))
         errors[name] = s
     if n_view == n_rough:
         sph = sphere.sphere_table(n_rough).reshape(-1)[texel]
-        errors["sphere (t2.w)"] = _stats(f_t2[:, 3] - sph)
+        errors["sphere (t2.w)"] = stats(f_t2[:, 3] - sph)
     # the matrices: fit quality, not coefficients
     sub_ny, sub_nx = len(iy), len(ix)
     problem = fit.Problem(o["lobe"], nov, a_fit, mag, o["fit_samples"])
@@ -273,11 +266,9 @@ def audit_ltc(
             f"fit {area['lutbake fit']['median']:.3g} (p90 {area['lutbake fit']['p90']:.3g})"
         )
     allerr = np.abs(np.concatenate([f_t2[:, 0] - mag, f_t2[:, 1] - fres]))
-    value = _metric(allerr, metric)
+    value = metric_value(allerr, metric)
     passed = bool(value <= tolerance and fit_ratio <= FIT_RATIO_MAX and not mismatch)
     if error_map is not None:
-        from .audit import write_error_map
-
         err = np.stack([f_t2[:, 0] - mag, f_t2[:, 1] - fres], 1).reshape(len(iy), len(ix), 2)
         error_map = str(write_error_map(error_map, err, ["magnitude", "fresnel"], axes[1:], iy, ix, Path(path).name))
         findings.append(f"error map: {error_map}")
@@ -333,16 +324,16 @@ def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> 
             ours = ours3[..., ch]
             got = a[np.ix_(iz, iy)] if a.ndim == 3 else np.broadcast_to(a[iy][None], ours.shape)
             body, edge = (got - ours)[..., 1:], (got - ours)[..., 0]
-            s = _stats(body)
+            s = stats(body)
             k = np.unravel_index(np.argmax(np.abs(body)), body.shape)
             s["where"] = f"ior index {iz[k[0]]}, alpha index {iy[k[1]]}, cos index {k[2] + 1}"
             errors[f"{key} (cos > 0)"] = s
-            errors[f"{key} (cos = 0 column)"] = _stats(edge)
+            errors[f"{key} (cos = 0 column)"] = stats(edge)
             judged.append(body.ravel())
         else:
             ours = ours_avg[..., ch]
             got = a[iz] if a.ndim == 2 else np.broadcast_to(a[None], ours.shape)
-            s = _stats(got - ours)
+            s = stats(got - ours)
             errors[key] = s
             judged.append((got - ours).ravel())
     # the reflection ratio (lutbake.kinds.dielectric_ratio): judged where OpenPBR reads it (alpha index >= 2, eta != 1);
@@ -352,11 +343,11 @@ def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> 
     body = np.zeros(diff.shape, bool)
     body[:, 2:] = True
     body[np.isin(iz, (n // 2 - 1, n // 2)), :] = False  # the two eta = 1 slices (lutbake.kinds.dielectric, openpbr)
-    s = _stats(diff[body])
+    s = stats(diff[body])
     k = np.unravel_index(np.argmax(np.where(body, np.abs(diff), -1.0)), diff.shape)
     s["where"] = f"ior index {iz[k[0]]}, alpha index {k[1]}"
     errors["ideal_dielectric_reflection_ratio (alpha index >= 2, eta != 1)"] = s
-    errors["ideal_dielectric_reflection_ratio (alpha index < 2 or eta = 1)"] = _stats(diff[~body])
+    errors["ideal_dielectric_reflection_ratio (alpha index < 2 or eta = 1)"] = stats(diff[~body])
     judged.append(diff[body].ravel())
     ec = shipped["ideal_dielectric_avg_energy_complement"]
     k = np.arange(1, n // 2)
@@ -374,7 +365,7 @@ def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> 
         f"storage UNORM16 (rounding RMS {rms_q:.2g}); residual RMS over cos > 0 {np.sqrt(np.mean(allerr**2)):.3g}: "
         "Monte Carlo noise of OpenPBR's generator above the rounding",
     )
-    value = _metric(allerr, metric)
+    value = metric_value(allerr, metric)
     return TableAuditReport(
         file=str(path),
         conventions=f"preset openpbr ([ior][alpha][cos] {n}^3, separable Smith, exact Fresnel); {len(iz)} IOR slices "
@@ -391,16 +382,14 @@ def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> 
 
 
 def dispatch(
-    path, conv_args: dict, tolerance: float, metric: str, max_side: int, error_map=None
+    path, conv_args: dict, tolerance: float, metric: str, max_side: int, error_map=None, recorded=None
 ) -> TableAuditReport | None:
     """The LTC / OpenPBR audit when the declared conventions are one (a preset or config of kind ltc, or layout
-    openpbr); None for the dfg family (lutbake.commands.audit)."""
-    from ..config import load_config, parse_overrides, preset_path
+    openpbr; without either, the file's ``recorded`` conventions); None for the dfg family
+    (lutbake.commands.audit)."""
+    from .reference import declared_specs
 
-    conv_args = conv_args or {}
-    cfg = conv_args.get("config")
-    p = Path(cfg) if cfg else preset_path(conv_args.get("preset") or "default")
-    specs = load_config(p, parse_overrides(conv_args.get("overrides") or ()))
+    specs = declared_specs(conv_args, recorded, path)
     if specs[0].kind == "ltc":
         return audit_ltc(path, specs[0], tolerance, metric, max_side, error_map=error_map)
     if specs[0].options.get("layout") == "openpbr":

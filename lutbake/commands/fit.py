@@ -145,13 +145,15 @@ class FitResult:
 
 def _karis_target(n: int, offset: float = 0.5):
     from ..axes import Axis
-    from .audit import Conventions, Integrator
+    from ..config import validate_table
+    from .reference import Conventions, Reference
 
     t = (np.arange(n) + offset) / n
     nov, r = np.meshgrid(t, t)
     axes = [Axis("perceptual_roughness", "y", n), Axis("NoV", "x", n)]
-    conv = Conventions({"layout": "scale_bias", "ndf": "ggx", "masking": "smith_height_correlated"}, axes, "fit")
-    ref = Integrator(conv).converged(nov.ravel(), r.ravel() ** 2).reshape(n, n, 2)
+    terms = {"layout": "scale_bias", "ndf": "ggx", "masking": "smith_height_correlated"}
+    spec = validate_table({"name": "fit", "kind": "dfg", **terms}, "fit", 0)
+    ref = Reference(Conventions(spec, axes, "fit")).converged(nov.ravel(), r.ravel() ** 2).reshape(n, n, 2)
     return nov, r, ref
 
 

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..axes import Axis
 from ..edge import NOV_MIN
-from .audit import Conventions, Integrator, conventions
+from .reference import Conventions, Reference, conventions
 
 STORAGE = {
     "unorm8": "8-bit UNORM (R8G8)",
@@ -122,7 +122,7 @@ def measure(conv_args: dict, n: int, channels=None, workers=None, nov_min: float
     """{format: max error after bilinear filtering} of an n x n table (module docstring), over the points
     with NoV >= ``nov_min``."""
     conv = conventions(**conv_args, shape=(n, n))
-    integ = Integrator(conv, workers)
+    integ = Reference(conv, workers)
     nov, alpha, rough = half_grid(conv)
     ref = integ.converged(nov.ravel(), alpha.ravel(), rough.ravel()).reshape(nov.shape + (-1,))
     if channels is not None:

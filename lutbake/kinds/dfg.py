@@ -305,7 +305,22 @@ def specular_extra(integrand) -> dict[str, str]:
     return {"alpha_policy": alpha_policy(integrand.mirror is not None)}
 
 
-def plan(spec) -> TexelPlan:
+def points_grid(points: dict, integrand) -> Grid:
+    """Texels at arbitrary (NoV, alpha): ``points`` {"nov", "alpha"} (flat, one per texel) as a one-axis grid."""
+    n = len(points["nov"])
+    nov = np.asarray(points["nov"], np.float32)
+    return Grid(
+        [Axis("i", "x", n)],
+        {"nov": nov, "alpha": integrand.alpha_input(points["alpha"]), "param": np.zeros(n, np.float32)},
+        grazing=nov,
+        alpha=np.asarray(points["alpha"], np.float64),
+    )
+
+
+def plan(spec, points: dict | None = None) -> TexelPlan:
+    """The plan of ``spec``'s table; with ``points`` ({"nov", "alpha", "rough"}: flat arrays, "rough" the perceptual
+    roughness an engine diffuse channel reads) the same integrand and estimator at those texels instead of the grid
+    (lutbake.pipeline.compute_at: audit's and size's reference)."""
     from ..integrands import engine_diffuse
     from ..integrands.specular import N_CHANNELS, specular_integrand
     from ..sampling.hemisphere import estimator_for
@@ -336,16 +351,17 @@ def plan(spec) -> TexelPlan:
     plan = per_texel_plan(
         integrand,
         estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
-        grid_for(axes, integrand),
+        grid_for(axes, integrand) if points is None else points_grid(points, integrand),
         channels=CHANNELS[o["layout"]],
         reconstruction=reconstruction(o["layout"], axes),
         terms=terms,
         extra=specular_extra(integrand),
-        interpolate=o["interpolation"] == "verified",
+        interpolate=o["interpolation"] == "verified" and points is None,
+        error_estimate=points is None,
     )
     if base != o["layout"]:
-        nov = texel_grid(axes)[0]
-        rough = engine_diffuse.perceptual_roughness_grid(axes)
+        nov = texel_grid(axes)[0] if points is None else np.asarray(points["nov"])
+        rough = engine_diffuse.perceptual_roughness_grid(axes) if points is None else np.asarray(points["rough"])
         plan = engine_diffuse.with_diffuse_channel(plan, nov, rough, o["layout"])
     return plan
 

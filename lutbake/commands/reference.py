@@ -1,0 +1,142 @@
+"""The declared conventions of ``lutbake audit`` and ``lutbake size``, and their reference: the bake's own pipeline.
+
+``declared_specs(conv_args, recorded)``: the table specs the file is held against: a config (``--config``), a
+preset (``--preset``), else the config the file itself records (its EXR header or sidecar: lutbake's own files),
+else the ``default`` preset; ``--set`` keys apply on top. ``Reference(conventions)`` evaluates the spec's integral at
+arbitrary texels through lutbake.pipeline.compute_at (the kind's plan and the tile executor ``bake`` uses): converged
+by adaptive Gauss-Legendre to REFERENCE_TOLERANCE, or by the engines' usual Hammersley estimator.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..axes import Axis
+from ..catalog import SHEEN_LAYOUTS
+from ..config import TableSpec, load_config, parse_overrides, preset_path, validate_table
+from ..errors import ConfigError
+from ..pipeline import compute_at
+
+REFERENCE_TOLERANCE = 1e-7  # the re-bake: adaptive Gauss-Legendre to 1e-7 per value (its estimates bound the error:
+# docs/accuracy.md); a fixed order 12 leaves ~1e-5 at NoV = 1e-4 and would flag a correct table
+
+
+def recorded_specs(config_text: str, where: str, overrides=()) -> list[TableSpec]:
+    """The specs of the ``[[table]]`` text a lutbake file records (its ``config`` attribute), ``overrides`` applied."""
+    try:
+        doc = tomllib.loads(config_text)
+    except tomllib.TOMLDecodeError as e:
+        raise ConfigError(where, "config", message=f"the recorded config is not valid TOML: {e}") from None
+    specs = []
+    for i, raw in enumerate(doc.get("table") or []):
+        raw = dict(raw)
+        for table, key, value in overrides:
+            if table is None or table == raw.get("name"):
+                raw[key] = value
+        specs.append(validate_table(raw, where, i))
+    if not specs:
+        raise ConfigError(where, "config", message="the recorded config holds no [[table]]")
+    return specs
+
+
+def declared_specs(conv_args: dict | None, recorded: dict | None = None, path=None) -> list[TableSpec]:
+    """``conv_args`` {"preset", "config", "overrides", "size"}; ``recorded``: the file's lutbake attributes (used
+    when neither a preset nor a config is given and they hold a ``config``)."""
+    conv_args = conv_args or {}
+    ovr = parse_overrides(conv_args.get("overrides") or ())
+    if conv_args.get("size") is not None:
+        ovr = ovr + [(None, "size", conv_args["size"])]
+    if conv_args.get("config"):
+        return load_config(Path(conv_args["config"]), ovr)
+    if not conv_args.get("preset") and recorded and recorded.get("config"):
+        return recorded_specs(recorded["config"], f"{path} (its recorded config)", ovr)
+    return load_config(preset_path(conv_args.get("preset") or "default"), ovr)
+
+
+@dataclass
+class Conventions:
+    """A dfg spec (the file's size) and its axes [y, x]."""
+
+    spec: TableSpec
+    axes: list[Axis]
+    source: str
+
+    @property
+    def options(self) -> dict:
+        return dict(self.spec.options)
+
+    @property
+    def layout(self) -> str:
+        return self.spec.options["layout"]
+
+
+def conventions(config=None, preset=None, overrides=(), shape=None, recorded=None, path=None) -> Conventions:
+    """The declared dfg conventions (declared_specs' first table); size from ``shape`` (rows, columns)."""
+    from ..kinds.dfg import axes_for
+
+    args = {"config": config, "preset": preset, "overrides": overrides}
+    spec = declared_specs(args, recorded, path)[0]
+    if spec.kind != "dfg":
+        raise ConfigError(spec.source, "kind", spec.kind, "dfg", "audit and size compare dfg tables")
+    if shape is not None:
+        rows, cols = shape
+        size = [cols, rows] if spec.options.get("axis_order", "nov_x") == "nov_x" else [rows, cols]
+        spec = declared_specs({**args, "size": size}, recorded, path)[0]
+    return Conventions(spec, axes_for(spec.options), spec.source)
+
+
+def _with(spec: TableSpec, **options) -> TableSpec:
+    return TableSpec(spec.name, spec.kind, {**spec.options, **options}, spec.source, spec.index)
+
+
+class Reference:
+    """Converged (and, for the noise estimate, Hammersley) integrals of a dfg spec at arbitrary (NoV, alpha),
+    through lutbake.pipeline.compute_at; cached by the points."""
+
+    def __init__(self, conv: Conventions, workers: int | None = None):
+        from ..kinds.dfg import terms_of
+        from ..kinds.engine_layouts import BASE_LAYOUT
+
+        self.layout = conv.layout
+        self.form = terms_of(conv.spec.options)[0]
+        self.base = BASE_LAYOUT.get(self.layout, self.layout)  # the specular integrand's layout
+        self.converged_spec = _with(
+            conv.spec,
+            estimator="gauss_legendre",
+            samples=None,
+            tolerance=REFERENCE_TOLERANCE,
+            relative_tolerance=0.0,
+            interpolation="off",
+        )
+        self.workers = workers
+        self._cache: dict[bytes, np.ndarray] = {}
+
+    def converged(self, nov: np.ndarray, alpha: np.ndarray, rough: np.ndarray | None = None) -> np.ndarray:
+        """Every channel of the layout at (NoV, alpha); ``rough`` (perceptual) feeds an engine diffuse channel
+        (default sqrt(alpha))."""
+        rough = np.sqrt(alpha) if rough is None else rough
+        key = b"".join(np.asarray(a, np.float32).tobytes() for a in (nov, alpha, rough))
+        if key not in self._cache:
+            points = {"nov": nov, "alpha": alpha, "rough": rough}
+            self._cache[key] = compute_at(self.converged_spec, points, self.workers)
+        return self._cache[key]
+
+    def hammersley(self, nov, alpha, samples: int) -> np.ndarray | None:
+        """The engines' usual estimator (R, G of the split-sum layout), or None for the sheen layouts."""
+        if self.base in SHEEN_LAYOUTS or self.form != "microfacet":
+            return None
+        base = "multiscatter" if self.base.startswith("multiscatter") else "scale_bias"
+        spec = _with(
+            self.converged_spec,
+            layout=base,
+            estimator="hammersley_ndf",
+            samples=samples,
+            seed=0,
+            tolerance=None,
+            relative_tolerance=None,
+        )
+        return compute_at(spec, {"nov": nov, "alpha": alpha, "rough": np.sqrt(alpha)}, self.workers)[:, :2]
