@@ -183,68 +183,98 @@ def test_api_bake_skips_up_to_date_outputs_unless_forced(spec, tmp_path):
     np.testing.assert_array_equal(forced[0].table.data, first[0].table.data)
 
 
-# ---- import layers: no circle, no module imports upward ----------------------------------------------------------
-# lowest first; a module may import its own layer's siblings and any lower layer, never a higher one
-LAYERS = [
-    {"errors", "edge", "axes", "table", "textsafe", "tolerance", "warp_runtime", "catalog", "metals", "memo"},
-    {"io"},
-    {"terms"},
-    {"sampling"},
-    {"integrands", "ltc"},
-    {"kinds", "value_bounds"},
-    {"config", "preflight"},
-    # cluster: the executor's Dask counterpart
-    {"executor", "provenance", "sharing", "values_cache", "devices", "cluster", "cluster_probe"},
-    {"pipeline"},
-    {"batch"},
-    {"api"},
-    {"validate", "figures", "preview", "audit", "audit_tables", "size", "fit"},
-    {"cli", "cli_engines", "__main__", "__init__", "_entry"},
-]
-LAYER_OF = {name: i for i, layer in enumerate(LAYERS) for name in layer}
+# ---- imports: no cycle, module by module ------------------------------------------------------------------------
 
 
-GROUPS = {"runtime", "commands"}  # folders of modules that sit on different layers: each module is its own unit
+def _module_name(path: Path, root: Path) -> str:
+    parts = list(path.relative_to(root.parent).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def _unit(path: Path) -> str:
-    rel = path.relative_to(PACKAGE).parts
-    if rel[0] in GROUPS and len(rel) > 1:
-        return rel[1].removesuffix(".py")
-    return rel[0] if len(rel) > 1 else rel[0].removesuffix(".py")
+def import_graph(root: Path = PACKAGE) -> dict[str, set[str]]:
+    """Module -> the package's modules it imports: every ``import`` / ``from ... import`` statement of the file, at
+    any depth (function-level imports too), relative or absolute; ``from pkg import mod`` is an edge to pkg.mod. An
+    import of a.b.c also runs the packages a.b and a (their __init__): edges to those, except the importer's own
+    packages (already initialised when it runs)."""
+    files = {_module_name(p, root): p for p in sorted(root.rglob("*.py"))}
+    graph: dict[str, set[str]] = {}
+    for me, path in files.items():
+        is_pkg = path.name == "__init__.py"
+        targets = []
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                targets += [a.name for a in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                if node.level:
+                    base = me.split(".")[: len(me.split(".")) - node.level + (1 if is_pkg else 0)]
+                    module = ".".join(base + ([node.module] if node.module else []))
+                else:
+                    module = node.module or ""
+                targets += [f"{module}.{a.name}" if f"{module}.{a.name}" in files else module for a in node.names]
+        deps = set()
+        for t in targets:
+            while t and t not in files:
+                t = t.rpartition(".")[0]  # an attribute of a module: the module
+            while t:
+                if t != me and not me.startswith(t + "."):
+                    deps.add(t)
+                t = t.rpartition(".")[0]
+        graph[me] = deps
+    return graph
 
 
-def _first_unit(mod: list[str], names: list[str]) -> list[str]:
-    if mod and mod[0] in GROUPS:
-        return [mod[1]] if len(mod) > 1 else names
-    return [mod[0]] if mod else names
+def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:
+    """One import cycle [a, b, ..., a] of ``graph``, or None (depth-first search, white/grey/black)."""
+    state: dict[str, int] = {}
+    stack: list[str] = []
+
+    def visit(v: str) -> list[str] | None:
+        state[v] = 1
+        stack.append(v)
+        for w in sorted(graph[v]):
+            if state.get(w) == 1:
+                return stack[stack.index(w) :] + [w]
+            if w not in state and (found := visit(w)):
+                return found
+        stack.pop()
+        state[v] = 2
+        return None
+
+    for v in sorted(graph):
+        if v not in state and (found := visit(v)):
+            return found
+    return None
 
 
-def _imports(path: Path) -> set[str]:
-    """First-party units imported by a module (relative or absolute lutbake imports, any depth in the file)."""
-    out = set()
-    pkg = path.relative_to(PACKAGE).parts[:-1]
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-        if isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = list(pkg[: len(pkg) - node.level + 1])
-                mod = base + (node.module.split(".") if node.module else [])
-                names = _first_unit(mod, [a.name for a in node.names])
-            elif node.module and node.module.split(".")[0] == "lutbake":
-                parts = node.module.split(".")[1:]
-                names = _first_unit(parts, [a.name for a in node.names])
-            else:
-                continue
-            out.update(n for n in names if n != "__version__")
-    return out
+def import_depth(graph: dict[str, set[str]]) -> int:
+    """The longest chain of imports (modules on it) of an acyclic ``graph``."""
+    memo: dict[str, int] = {}
+
+    def depth(v: str) -> int:
+        if v not in memo:
+            memo[v] = 1 + max((depth(w) for w in graph[v]), default=0)
+        return memo[v]
+
+    return max(depth(v) for v in graph)
 
 
-def test_no_module_imports_upward():
-    bad = []
-    for f in sorted(PACKAGE.rglob("*.py")):
-        me = _unit(f)
-        for other in _imports(f) - {me}:
-            if other in LAYER_OF and LAYER_OF[other] > LAYER_OF[me] and me != "__init__":
-                bad.append(f"{f.relative_to(REPO)} imports {other}")
-    assert not bad, bad
-    assert set(LAYER_OF) >= {_unit(f) for f in PACKAGE.rglob("*.py")} - {"__init__"}
+def test_the_import_graph_of_lutbake_has_no_cycle():
+    graph = import_graph()
+    assert len(graph) > 100 and graph["lutbake.api"] >= {"lutbake.batch", "lutbake.pipeline"}
+    cycle = find_cycle(graph)
+    assert cycle is None, "import cycle: " + " -> ".join(cycle)
+    assert import_depth(graph) >= 5
+
+
+def test_the_cycle_check_finds_a_function_level_and_a_package_cycle(tmp_path):
+    pkg = tmp_path / "pkg"
+    (pkg / "sub").mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "a.py").write_text("from . import b\n")
+    (pkg / "b.py").write_text("def f():\n    from .sub import c\n")
+    (pkg / "sub" / "__init__.py").write_text("from .c import X\n")
+    (pkg / "sub" / "c.py").write_text("X = 1\n")
+    graph = import_graph(pkg)
+    assert graph["pkg.b"] == {"pkg.sub", "pkg.sub.c"} and find_cycle(graph) is None
+    (pkg / "sub" / "c.py").write_text("def g():\n    from ..a import b\n")  # c -> a (-> b -> c), inside a function
+    assert find_cycle(import_graph(pkg)) == ["pkg.a", "pkg.b", "pkg.sub", "pkg.sub.c", "pkg.a"]
