@@ -391,3 +391,22 @@ def test_memo_computes_a_key_repeated_in_one_call_once():
     (rows,) = memo.run([b"a", b"b", b"a"], compute)
     assert calls == [[0, 1]] and rows[:, 0].tolist() == [0.0, 1.0, 0.0]
     assert memo.misses == 2 and memo.hits == 1
+
+
+def test_every_file_of_an_ltc_dds_pair_carries_its_conventions(small_ltc, tmp_path):
+    """Issue 39: `lutbake inspect ltc_ggx_2.dds` said "no lutbake metadata"; the pair's sidecar lists both files."""
+    from lutbake.io.describe import describe
+    from lutbake.io.formats import write_table, written_files
+    from lutbake.io.readers import read_table
+
+    write_table(small_ltc, tmp_path, "ltc_dds", "half")
+    files = written_files(small_ltc.name, "ltc_dds")
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(files)
+    for name in (n for n in files if not n.endswith(".json")):
+        text = describe(tmp_path / name)
+        assert "no lutbake metadata" not in text and "ltc" in text, (name, text)
+        view = read_table(tmp_path / name)
+        assert view.kind == "ltc"
+        np.testing.assert_array_equal(
+            view.data[1][..., [0, 1, 3]], small_ltc.data[1][..., [0, 1, 3]].astype(np.float16)
+        )

@@ -55,7 +55,9 @@ def _float_storage(arr: np.ndarray) -> str:
 def _read_png(path: Path) -> tuple[np.ndarray, str]:
     import OpenImageIO as oiio
 
-    inp = oiio.ImageInput.open(str(path))
+    config = oiio.ImageSpec()
+    config.attribute("oiio:UnassociatedAlpha", 1)  # the stored codes: a grey+alpha or RGBA table is not premultiplied
+    inp = oiio.ImageInput.open(str(path), config)
     if inp is None:
         raise ValueError(f"{path}: cannot open PNG: {oiio.geterror()}")
     try:

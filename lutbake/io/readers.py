@@ -147,7 +147,7 @@ def _engine_sidecar(path: Path) -> LoadedFile | None:
     for side in sidecar_candidates(path):
         if side.is_file() and side != path:
             doc = _load_json(side)
-            if isinstance(doc, dict) and doc.get("file") == path.name and doc.get("format") not in GENERIC_FORMATS:
+            if isinstance(doc, dict) and _describes(doc, path) and doc.get("format") not in GENERIC_FORMATS:
                 return _engine_values(path, _load_sidecar(side, doc), f"sidecar {side.name}")
     return None
 
@@ -374,8 +374,18 @@ def _string_attrs(meta, where: Path, what: str) -> dict[str, str]:
 
 
 def sidecar_candidates(path: Path) -> list[Path]:
-    """Where the sidecar of a data file may be: <name>.<ext>.json, then <name>.json."""
-    return [path.with_name(path.name + ".json"), path.with_suffix(".json")]
+    """Where the sidecar of a data file may be: <name>.<ext>.json, then <name>.json; for the second texture of an
+    ltc_dds pair (<stem>_2.dds), the pair's sidecar <stem>_1.dds.json (it lists both in ``files``)."""
+    out = [path.with_name(path.name + ".json"), path.with_suffix(".json")]
+    if path.name.endswith("_2.dds"):
+        out.append(path.with_name(path.name[: -len("_2.dds")] + "_1.dds.json"))
+    return out
+
+
+def _describes(doc: dict, path: Path) -> bool:
+    """Whether a sidecar names ``path`` as its data file (``file``) or one of its files (``files``)."""
+    files = doc.get("files")
+    return doc.get("file") == path.name or (isinstance(files, list) and path.name in files)
 
 
 def _with_sidecar(loaded: LoadedFile) -> LoadedFile:
@@ -385,7 +395,7 @@ def _with_sidecar(loaded: LoadedFile) -> LoadedFile:
             continue
         doc = _load_sidecar(side)
         named = doc.get("file")
-        if named not in (None, loaded.path.name):
+        if named is not None and not _describes(doc, loaded.path):
             loaded.notes.append(f"{side.name} describes {named}, not this file")
             continue
         loaded.attrs, loaded.meta_source = doc["lutbake"], f"sidecar {side.name}"
