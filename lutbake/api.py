@@ -1,29 +1,32 @@
-"""The public Python API: ``bake`` configs (or specs) into tables and files, through the same path as the CLI.
+"""The public Python API: ``bake`` configs (or specs) into tables and files; ``lutbake bake`` is this function.
 
-    bake(configs) = config.load_configs -> batch.schedule (skip what is up to date unless ``force``) -> batch.run
+    bake(configs) = config.load_configs -> preflight (out-dir, outputs, report) -> batch.schedule (skip what is up to
+                    date unless ``force``) -> [cluster session] -> batch.run -> [report]
 Each table goes through lutbake.pipeline.bake_table (``bake_table`` here: one table, nothing written).
 """
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 from pathlib import Path
 
 from . import batch, preflight
 from .config import TableSpec, load_configs
-from .errors import TableError
+from .errors import ConfigError, TableError
 from .pipeline import bake_table
 from .runtime.executor import Progress
 from .table import Table
 from .values_cache import open_cache
 
-__all__ = ["BakeResult", "bake", "bake_table"]
+__all__ = ["BakeResult", "BakeResults", "bake", "bake_table"]
 
 
 @dataclass
 class BakeResult:
-    """One table of ``bake``: its spec, the baked Table (None when ``skipped``: its output was up to date), the
-    written path, seconds, samples per texel and the status (baked or skipped)."""
+    """One table of ``bake``: its spec, the baked Table (None unless ``baked``), the written path, seconds, samples
+    per texel, the status (lutbake.batch.STATUSES: baked, skipped (its output was up to date), failed,
+    interrupted), why (``message``), and the table whose computation its values came from (``values_from``)."""
 
     spec: TableSpec
     table: Table | None
@@ -31,6 +34,26 @@ class BakeResult:
     seconds: float
     samples: int | None
     status: str = "baked"
+    message: str = ""
+    values_from: str | None = None
+    shape: str = ""
+
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+
+class BakeResults(list):
+    """``bake``'s results, one per table in config order, with the run's outcome: ``interrupted_by`` (the signal
+    number, or None), ``exit_status`` (0, 1 if a table failed, 130 / 143 after SIGINT / SIGTERM) and
+    ``report_error`` (why ``report`` could not be written, or None)."""
+
+    interrupted_by: int | None = None
+    exit_status: int = batch.EXIT_OK
+    report_error: str | None = None
+
+    def counts(self) -> dict[str, int]:
+        return {s: sum(r.status == s for r in self) for s in batch.STATUSES}
 
 
 def samples_note(spec: TableSpec, effective: int | None) -> str:
@@ -54,6 +77,32 @@ def samples_note(spec: TableSpec, effective: int | None) -> str:
     return f"samples = {asked} asked; the {spec.kind} quadrature evaluates {effective} per texel (docs/config.md)"
 
 
+def _result(job: batch.Job) -> BakeResult:
+    return BakeResult(
+        job.spec,
+        job.table,
+        job.path,
+        job.seconds or 0.0,
+        job.samples,
+        job.status,
+        job.message,
+        job.values_from,
+        job.shape,
+    )
+
+
+def _check_device(device: str, scheduler: str | None) -> None:
+    from .runtime import cluster
+
+    if scheduler is not None:
+        cluster.parse_scheduler(scheduler)
+    elif device == "cuda":  # on a cluster the workers' GPUs count (lutbake.runtime.cluster checks them)
+        from .runtime.warp_runtime import init_warp
+
+        if not init_warp().is_cuda_available():
+            raise ConfigError("--device", "device", "cuda", "cpu", "no CUDA device is available")
+
+
 def bake(
     configs,
     out_dir="outputs",
@@ -65,20 +114,35 @@ def bake(
     on_result=None,
     force: bool = False,
     cache_dir=None,
-) -> list[BakeResult]:
+    *,
+    fmt: str | None = None,
+    scheduler: str | None = None,
+    report=None,
+    on_schedule=None,
+    check: bool = True,
+) -> BakeResults:
     """Validate every config, then bake each table and write ``out_dir/<name>.<ext>`` (key ``format``, default
     EXR) atomically; a table whose output is up to date (same content hash, lutbake.provenance) is skipped unless
     ``force``. ``write=False`` bakes every table and writes nothing.
 
-    ``configs``: paths to TOML files, or TableSpecs. Nothing runs unless every config is valid. A table that
-    fails raises TableError (after the other tables finished). ``on_result(BakeResult)`` is called as each ends.
+    ``configs``: paths to TOML files, or TableSpecs. Nothing runs unless every config is valid and every path the
+    batch writes can be written (ConfigError). ``fmt``: the format of every table (as ``format`` in each; blamed
+    as --format). ``on_schedule(results)``: called once, before anything runs, with every table's BakeResult
+    (status ``pending`` or ``skipped``). ``on_result(BakeResult)`` is called as each ends (skipped ones first).
     ``cache_dir``: the values cache of ``lutbake bake --cache`` (lutbake.values_cache; ``force`` reads no entry).
+    ``scheduler``: run the tiles on a Dask cluster (lutbake.runtime.cluster: ``local:N`` or ``tcp://HOST:PORT``),
+    started only when a table is to be baked. ``report``: write the JSON summary there (lutbake.batch.write_report).
+    ``check``: raise TableError when a table failed and KeyboardInterrupt when the run was interrupted (after the
+    others finished); False: return every result, with the outcome on the BakeResults.
     """
     specs = [c for c in configs if isinstance(c, TableSpec)]
     paths = [c for c in configs if not isinstance(c, TableSpec)]
+    if fmt is not None:
+        overrides = list(overrides) + [(None, "format", fmt, "--format")]
     specs += load_configs(paths, overrides) if paths else []
+    _check_device(device, scheduler)
+    results = BakeResults()
     if not write:
-        results = []
         for spec in specs:
             table, seconds, samples = bake_table(spec, workers, device, progress)
             results.append(BakeResult(spec, table, None, seconds, samples))
@@ -88,21 +152,57 @@ def bake(
     preflight.check_out_dir(out_dir)
     jobs = batch.schedule(specs, out_dir, force=force)
     preflight.check_outputs(jobs)
-    results: dict[int, BakeResult] = {}
+    if report is not None:
+        preflight.check_report(report, jobs, paths)
+    if on_schedule:
+        on_schedule([_result(j) for j in jobs])
+    done: dict[int, BakeResult] = {}
 
-    def done(job: batch.Job):
-        r = BakeResult(job.spec, job.table, job.path, job.seconds or 0.0, job.samples, job.status)
-        results[id(job)] = r
-        if on_result and job.status in ("baked", "skipped"):
-            on_result(r)
+    def finished(job: batch.Job):
+        done[id(job)] = _result(job)
+        if on_result:
+            on_result(done[id(job)])
 
     for job in jobs:
         if job.status == "skipped":
-            done(job)
-    signum = batch.run(jobs, workers, device, progress, on_done=done, cache=open_cache(cache_dir, force))
-    if signum is not None:
-        raise KeyboardInterrupt(batch.signal_name(signum))
-    failed = [j for j in jobs if j.status == "failed"]
-    if failed:
-        raise TableError("; ".join(j.message for j in failed))
-    return [results[id(j)] for j in jobs]
+            finished(job)
+    pending = sum(j.status == "pending" for j in jobs)
+    signum = None
+    try:
+        with contextlib.ExitStack() as stack:
+            runner = None
+            if scheduler is not None and pending:
+                from .runtime import cluster
+
+                runner = stack.enter_context(cluster.session(scheduler, device))
+                workers = pending  # every table in flight: the client's threads only wait for tiles
+            signum = batch.run(
+                jobs, workers, device, progress, on_done=finished, cache=open_cache(cache_dir, force), runner=runner
+            )
+    except (KeyboardInterrupt, batch.Interrupted) as e:  # a second Ctrl-C while tables wind down
+        signum = getattr(e, "signum", 2)
+        for job in jobs:
+            if job.status == "pending":
+                job.status, job.message = "interrupted", "interrupted; nothing written"
+    results.extend(done.get(id(j)) or _result(j) for j in jobs)
+    results.interrupted_by = signum
+    results.exit_status = batch.exit_status(jobs, signum)
+    if report is not None:
+        try:
+            batch.write_report(report, jobs, results.exit_status, signum)
+        except OSError as e:
+            from .io.oserror import os_error_text
+            from .textsafe import escape_controls
+
+            results.report_error = (
+                f"cannot write the report {escape_controls(str(report))}: "
+                f"{escape_controls(os_error_text(e, Path(report).parent))}"
+            )
+            results.exit_status = results.exit_status or batch.EXIT_FAILED
+    if check:
+        if signum is not None:
+            raise KeyboardInterrupt(batch.signal_name(signum))
+        failed = [j for j in jobs if j.status == "failed"]
+        if failed:
+            raise TableError("; ".join(j.message for j in failed))
+    return results

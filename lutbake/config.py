@@ -16,7 +16,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from .errors import ConfigError
+from .errors import ConfigError, did_you_mean
 from .kinds import KINDS, Key, lookup_kind
 from .preflight import config_file_problem, nesting_problem
 from .value_bounds import unit_range
@@ -81,7 +81,9 @@ def presets() -> dict[str, Path]:
 def preset_path(name: str) -> Path:
     ps = presets()
     if name not in ps:
-        raise ConfigError("--preset", None, message=f"unknown preset {name!r}", allowed=", ".join(ps))
+        raise ConfigError(
+            "--preset", None, message=f"unknown preset {name!r}{did_you_mean(name, ps)}", allowed=", ".join(ps)
+        )
     return ps[name]
 
 
@@ -99,7 +101,7 @@ def _check_value(key: Key, value, file, table) -> Any:
         if key.type == "name" and not NAME_RE.fullmatch(value):
             fail("must be 1-128 letters, digits, '-' or '_' (it names the output file)")
         if key.choices is not None and value not in key.choices:
-            fail("is not a known value", ", ".join(key.choices))
+            fail("is not a known value" + did_you_mean(value, key.choices), ", ".join(key.choices))
         return value
     if key.type == "int":
         if isinstance(value, bool) or not isinstance(value, int):
@@ -170,11 +172,23 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
     try:
         kind = lookup_kind(raw["kind"])
     except KeyError:
-        raise ConfigError(file, "kind", raw["kind"], ", ".join(KINDS), "is not a known table kind", label) from None
+        raise ConfigError(
+            file,
+            "kind",
+            raw["kind"],
+            ", ".join(KINDS),
+            "is not a known table kind" + did_you_mean(raw["kind"], KINDS),
+            label,
+        ) from None
     unknown = sorted(set(raw) - set(kind.keys))
     if unknown:
         raise ConfigError(
-            file, unknown[0], raw[unknown[0]], ", ".join(kind.keys), f"is not a key of kind '{kind.name}'", label
+            file,
+            unknown[0],
+            raw[unknown[0]],
+            ", ".join(kind.keys),
+            f"is not a key of kind '{kind.name}'" + did_you_mean(unknown[0], kind.keys),
+            label,
         )
     options: dict[str, Any] = {}
     for k in kind.keys.values():
@@ -270,16 +284,26 @@ def load_config(path, overrides=()) -> list[TableSpec]:
         if not isinstance(raw, dict):
             raise ConfigError(path, "table", raw, message=f"entry #{i + 1} must be a [[table]]")
         raw = dict(raw)
-        for table, key, value in overrides:
+        origin = {}  # key -> the command-line argument that set it, blamed for its errors
+        for table, key, value, *where in overrides:
             if table is None or table == raw.get("name"):
                 raw[key] = value
-        specs.append(validate_table(raw, path, i))
+                origin[key] = where[0] if where else f"--set {table + '.' if table else ''}{key}={_toml_value(value)}"
+        try:
+            specs.append(validate_table(raw, path, i))
+        except ConfigError as e:
+            if e.key in origin:
+                raise e.blamed(origin[e.key]) from None
+            raise
     return specs
 
 
 def load_configs(paths, overrides=()) -> list[TableSpec]:
-    """Validate every config before anything runs; table names must be unique across the batch."""
-    ovr = parse_overrides(overrides)
+    """Validate every config before anything runs; table names must be unique across the batch. ``overrides``:
+    ``--set`` texts, or (table, key, value, blamed argument) tuples (``--format``)."""
+    ovr = parse_overrides([o for o in overrides if isinstance(o, str)]) + [
+        o for o in overrides if not isinstance(o, str)
+    ]
     specs: list[TableSpec] = []
     seen: dict[str, str] = {}
     for p in paths:
@@ -294,7 +318,7 @@ def load_configs(paths, overrides=()) -> list[TableSpec]:
                 )
             seen[s.name] = s.source
             specs.append(s)
-    names = {n for n, _, _ in ovr if n is not None}
+    names = {o[0] for o in ovr if o[0] is not None}
     missing = names - set(seen)
     if missing:
         raise ConfigError("--set", sorted(missing)[0], None, ", ".join(seen), "names no table of the batch")

@@ -4,7 +4,17 @@ RecursionError reaches the user."""
 
 from __future__ import annotations
 
+import difflib
+
 from .textsafe import escape_controls, safe_repr
+
+
+def did_you_mean(value, names) -> str:
+    """ "; did you mean 'x'?" for the name of ``names`` closest to ``value`` (difflib), or "" when none is close."""
+    if not isinstance(value, str):
+        return ""
+    close = difflib.get_close_matches(value, [str(n) for n in names], n=1, cutoff=0.6)
+    return f"; did you mean {close[0]!r}?" if close else ""
 
 
 class LutbakeError(Exception):
@@ -22,6 +32,7 @@ class ConfigError(LutbakeError):
         table: str | None = None,
     ):
         self.file, self.key, self.value, self.allowed, self.table = str(file), key, value, allowed, table
+        self.message = message
         where = self.file
         if table is not None:
             where += f": table {table}"
@@ -35,6 +46,10 @@ class ConfigError(LutbakeError):
         if allowed:
             text += f" (allowed: {allowed})"
         super().__init__(escape_controls(text))
+
+    def blamed(self, file) -> ConfigError:
+        """The same error, naming ``file`` (the --set argument that set the key) as its source."""
+        return ConfigError(file, self.key, self.value, self.allowed, self.message, self.table)
 
 
 class TableError(LutbakeError):

@@ -106,16 +106,9 @@ def assemble(spec: TableSpec, computed: Computed) -> Table:
     )
 
 
-def bake_table(
-    spec: TableSpec,
-    workers: int | None = None,
-    device: str = "cpu",
-    progress: Progress | None = None,
-    cancel=None,
-    runner=None,
-) -> tuple[Table, float, int]:
-    """Bake one spec into a Table (nothing written): (table, seconds, samples per texel). Raises TableError if a
-    value is not finite; executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs;
-    ``runner``: see compute."""
-    c = compute(spec, workers, device, progress, cancel, runner)
+def bake_table(spec: TableSpec, *args, **options) -> tuple[Table, float, int]:
+    """Bake one spec into a Table (nothing written): (table, seconds, samples per texel): ``compute`` (same
+    arguments: workers, device, progress, cancel, runner) then ``assemble``. Raises TableError if a value is not
+    finite; executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
+    c = compute(spec, *args, **options)
     return assemble(spec, c), c.seconds, c.plan.samples

@@ -1,5 +1,6 @@
 """CLI smoke runs: bake, list, inspect, bad input (exit 2, nothing written), python -m lutbake."""
 
+import re
 import subprocess
 import sys
 
@@ -25,8 +26,10 @@ def test_bake_prints_one_line_per_table_and_writes_exr(tmp_path):
     cfg.write_text(CONFIG)
     r = run("bake", str(cfg), "--out-dir", str(tmp_path / "out"), "--workers", "2")
     assert r.exit_code == 0, r.output
-    line = r.output.strip().splitlines()[-1]
+    *_, line, closing = r.output.strip().splitlines()
+    assert line.startswith("[1/1] ")
     assert "small.exr" in line and "8x16x2" in line and "samples/texel" in line and " s " in line
+    assert re.fullmatch(r"1 table: 1 baked, 0 up to date, 0 failed, \d+ s", closing), closing
     assert (tmp_path / "out" / "small.exr").is_file()
     i = run("inspect", str(tmp_path / "out" / "small.exr"))
     assert i.exit_code == 0, i.output
@@ -92,3 +95,58 @@ def test_preview_writes_a_png_for_exr_and_npy(tmp_path):
         assert (tmp_path / f"{name}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     r = run("preview", str(tmp_path / "none.exr"))
     assert r.exit_code != 0 and "none.exr" in r.output
+
+
+def test_list_prints_whole_preset_descriptions_and_the_files_each_writes():
+    """Issue 39: descriptions were cut at their first comment line, mid-sentence; the files were not named."""
+    import tomllib
+
+    from lutbake.config import presets
+    from lutbake.io.formats import written_files
+
+    out = " ".join(run("list").output.split())  # the wrapping undone
+    for name, path in presets().items():
+        text = path.read_text(encoding="utf-8")
+        comment = " ".join(ln.lstrip("#").strip() for ln in text.splitlines()[: _leading_comments(text)])
+        assert " ".join(comment.split()) in out, name
+        files = [f for t in tomllib.loads(text)["table"] for f in written_files(t["name"], t.get("format", "exr"))]
+        assert f"Writes: {', '.join(files)}." in out, name
+    assert "filament_dfg.dds, filament_dfg.dds.json" in out and "ltc_ggx_1.dds, ltc_ggx_2.dds" in out
+
+
+def _leading_comments(text: str) -> int:
+    lines = text.splitlines()
+    return next((i for i, ln in enumerate(lines) if not ln.startswith("#")), len(lines))
+
+
+def test_bake_closes_with_the_same_summary_line_on_a_rerun(tmp_path):
+    """Issue 39: no totals; now one closing line, first run and rerun alike."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(CONFIG + CONFIG.replace('"small"', '"other"').replace("samples = 48", "samples = 48\nseed = 1"))
+    first = run("bake", str(cfg), "--out-dir", str(tmp_path / "out"))
+    again = run("bake", str(cfg), "--out-dir", str(tmp_path / "out"))
+    assert re.fullmatch(r"2 tables: 2 baked, 0 up to date, 0 failed, \d+ s", first.output.splitlines()[-1]), (
+        first.output
+    )
+    assert re.fullmatch(r"2 tables: 0 baked, 2 up to date, 0 failed, \d+ s", again.output.splitlines()[-1]), (
+        again.output
+    )
+    assert [ln[:6] for ln in again.output.splitlines()[:2]] == ["[1/2] ", "[2/2] "]
+
+
+def test_bake_progress_on_a_terminal_shows_done_total_running_and_estimate(tmp_path):
+    """--progress (the default on a terminal): a line redrawn in place with tables done / total, the running table,
+    the elapsed seconds and, once a table finished, an estimate of the time left."""
+    cfg = tmp_path / "c.toml"
+    cfg.write_text(
+        "".join(
+            CONFIG.replace('"small"', f'"t{i}"').replace("samples = 48", f"samples = 48\nseed = {i}") for i in range(3)
+        )
+    )
+    r = CliRunner().invoke(main, ["bake", str(cfg), "--out-dir", str(tmp_path / "o"), "--progress", "--workers", "1"])
+    assert r.exit_code == 0, r.output
+    redraws = [s for s in r.output.split("\r") if s.startswith("[")]  # click drops the erase code off a terminal
+    assert any(re.match(r"\[0/3\]  running t\d( \+\d)?  \d+ s", s) for s in redraws), redraws
+    assert any(re.match(r"\[[12]/3\]  running t\d( \+\d)?  \d+ s, ~\d+ s left", s) for s in redraws), redraws
+    plain = run("bake", str(cfg), "--out-dir", str(tmp_path / "p"), "--workers", "1")  # not a terminal: no redraws
+    assert "\r" not in plain.output and plain.output.count("samples/texel") == 3

@@ -2,7 +2,7 @@
 
 import pytest
 
-from lutbake.config import load_configs, parse_overrides
+from lutbake.config import load_config, load_configs, parse_overrides, preset_path
 from lutbake.errors import ConfigError
 
 GOOD = """
@@ -122,3 +122,31 @@ def test_shipped_configs_are_valid():
     paths = sorted((Path(__file__).parent.parent / "configs").glob("*.toml"))
     specs = load_configs(paths)
     assert {s.kind for s in specs} >= {"dfg", "albedo", "albedo_avg", "specular_3d"}
+
+
+def test_unknown_names_get_the_nearest_name(tmp_path):
+    """Issue 39: `--preset filamnet` listed 23 names without "did you mean"; the same for kinds, keys and values."""
+    with pytest.raises(ConfigError, match=r"unknown preset 'filamnet'; did you mean 'filament'\?"):
+        preset_path("filamnet")
+    for line, fragment in (
+        ('kind = "dgf"', "did you mean 'dfg'?"),
+        ("sampels = 64", "did you mean 'samples'?"),
+        ('layout = "multiscater"', "did you mean 'multiscatter'?"),
+    ):
+        p = tmp_path / "c.toml"
+        p.write_text(f'[[table]]\nname = "t"\n{line}\n' + ("" if "kind" in line else 'kind = "dfg"\n'))
+        with pytest.raises(ConfigError) as e:
+            load_config(p)
+        assert fragment in str(e.value), str(e.value)
+
+
+def test_a_bad_set_argument_is_blamed_not_the_preset():
+    """`--set sampels=2048` named presets/default.toml, a file the user never wrote."""
+    with pytest.raises(ConfigError) as e:
+        load_configs([preset_path("default")], ["sampels=2048"])
+    text = str(e.value)
+    assert text.startswith("--set sampels=2048: ") and "default.toml" not in text, text
+    assert "did you mean 'samples'?" in text
+    with pytest.raises(ConfigError) as e:
+        load_configs([preset_path("default")], ["samples=0"])
+    assert str(e.value).startswith("--set samples=0: "), str(e.value)

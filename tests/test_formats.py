@@ -279,5 +279,27 @@ def test_cli_format_option_writes_that_format(tmp_path):
 
 
 def test_cli_format_choices_are_the_writers():
+    from lutbake.io.formats import ALL_FORMATS, WRITERS
+
     opt = next(p for p in main.commands["bake"].params if p.name == "fmt")
-    assert list(opt.type.choices) == list(FORMATS)
+    assert list(opt.type.choices) == list(ALL_FORMATS) and set(ALL_FORMATS) == set(WRITERS)
+    assert set(FORMATS) < set(ALL_FORMATS)
+
+
+def test_format_option_accepts_every_format_a_kind_allows_and_the_refusal_lists_only_those(tmp_path):
+    """One source: each kind's ``format`` key (its allowed values) is what the config check accepts and lists, and
+    the --format option accepts every one of them (issue 39: ``--preset ltc-ggx --format c`` was refused by click)."""
+    import re
+
+    from lutbake.kinds import KINDS
+
+    opt = next(p for p in main.commands["bake"].params if p.name == "fmt")
+    for kind in KINDS.values():
+        assert set(kind.keys["format"].choices) <= set(opt.type.choices), kind.name
+    r = CliRunner().invoke(main, ["bake", "--preset", "ltc-ggx", "--format", "png16", "--out-dir", str(tmp_path / "o")])
+    assert r.exit_code == 2 and "--format" in r.output, r.output
+    listed = re.search(r"\(allowed: ([^)]*)\)", r.output).group(1).split(", ")
+    assert listed == list(KINDS["ltc"].keys["format"].choices)
+    for fmt in listed:  # every format the message lists passes the option and the check (bad --out-dir: exit 2 after)
+        r = CliRunner().invoke(main, ["bake", "--preset", "ltc-ggx", "--format", fmt, "--out-dir", "/proc/x"])
+        assert "--format" not in r.output and "Invalid value" not in r.output, (fmt, r.output)

@@ -37,7 +37,16 @@ import numpy as np
 from ..axes import Axis
 from ..edge import NOV_MIN
 from ..io.lut_files import LutFile, read_lut
-from .audit_report import METRICS, MISMATCH_RATIO, PERCENTILES, metric_value, stats, subset, write_error_map
+from .audit_report import (
+    METRICS,
+    MISMATCH_RATIO,
+    PERCENTILES,
+    metric_value,
+    stats,
+    subset,
+    verdict,
+    write_error_map,
+)
 from .audit_tables import dispatch
 from .reference import Conventions, Reference, conventions
 
@@ -483,10 +492,7 @@ def audit(
         diagnosis=diagnosis,
         quantisation=quant,
         noise=noise,
-        metric=metric,
-        tolerance=tolerance,
-        value=value,
-        passed=bool(value <= tolerance),
+        **verdict(metric, tolerance, value),
         extra={"best": best.name, "chosen": chosen.name, "storage": lut.storage, "raw_error": raw},
     )
     if error_map is not None:

@@ -36,6 +36,17 @@ def metric_value(abs_err: np.ndarray, metric: str) -> float:
     ]
 
 
+def verdict(metric: str, tolerance: float, value: float, passed: bool | None = None) -> dict:
+    """The verdict fields of every audit report: the metric, the tolerance, the value held against it and whether it
+    passed (default: value <= tolerance)."""
+    return {
+        "metric": metric,
+        "tolerance": tolerance,
+        "value": value,
+        "passed": bool(value <= tolerance) if passed is None else passed,
+    }
+
+
 def write_error_map(out: Path, err: np.ndarray, names: list[str], axes: list[Axis], iy, ix, title: str) -> Path:
     """PNG: |file - reference| per channel, image row 0 at the bottom, ticks = the declared axis values."""
     import matplotlib

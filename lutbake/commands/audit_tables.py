@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .audit_report import MISMATCH_RATIO, PERCENTILES, metric_value, stats, subset, write_error_map
+from .audit_report import MISMATCH_RATIO, PERCENTILES, metric_value, stats, subset, verdict, write_error_map
 
 FIT_RATIO_MAX = 2.0  # the file's median Heitz fit error may be at most this x lutbake's fit at the same texels
 AREA_TEXELS = 6  # texels (a spread of roughness and view) of the area-light comparison
@@ -284,10 +284,7 @@ def audit_ltc(
         kind="ltc",
         errors=errors,
         findings=findings,
-        metric=metric,
-        tolerance=tolerance,
-        value=value,
-        passed=passed,
+        **verdict(metric, tolerance, value, passed),
         extra={
             "fit_ratio": fit_ratio,
             "fit_no_worse_fraction": no_worse,
@@ -373,10 +370,7 @@ def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> 
         kind="openpbr",
         errors=errors,
         findings=findings,
-        metric=metric,
-        tolerance=tolerance,
-        value=value,
-        passed=bool(value <= tolerance),
+        **verdict(metric, tolerance, value),
         extra={"reciprocity_residual_max": float(np.abs(res).max())},
     )
 

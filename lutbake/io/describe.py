@@ -20,26 +20,24 @@ def _fmt(x: float) -> str:
     return f"{x:.6g}"
 
 
+CONTAINERS = {  # format -> what its container says, from LoadedFile.facts
+    "exr": lambda f: f"{f.get('pixel_type')} pixels, {f.get('compression')} compression",
+    "dds": lambda f: f"DXGI {f['dxgi_format']}, {f['dimension']}, {f['mips']} mip level(s)",
+    "ktx2": lambda f: f"{f['vk_format']}, {f['dimension']} texture, orientation {f.get('KTXorientation', '?')}",
+    "png": lambda f: f"{f['bit_depth']}-bit, linear values = {f['encoding']}",
+    "npy": lambda f: f"dtype {f['dtype']}, shape {tuple(f['shape'])}",
+    "h": lambda f: f"array {f['array']} of {f['element_type']}",
+    "engine": lambda f: f"{f.get('format')}" + (f", values: {f['engine_values']}" if "engine_values" in f else ""),
+    "report": lambda f: f"{len(f.get('tables') or [])} table(s)",
+}
+
+
 def _container(loaded: LoadedFile) -> str:
     f = loaded.facts
-    if loaded.format == "exr":
-        return f"{f.get('pixel_type')} pixels, {f.get('compression')} compression"
-    if loaded.format == "dds":
-        return f"DXGI {f['dxgi_format']}, {f['dimension']}, {f['mips']} mip level(s)"
-    if loaded.format == "ktx2":
-        return f"{f['vk_format']}, {f['dimension']} texture, orientation {f.get('KTXorientation', '?')}"
-    if loaded.format == "png":
-        return f"{f['bit_depth']}-bit, linear values = {f['encoding']}"
-    if loaded.format == "npy":
-        return f"dtype {f['dtype']}, shape {tuple(f['shape'])}"
-    if loaded.format == "h":
-        return f"array {f['array']} of {f['element_type']}"
-    if loaded.format == "engine":
-        return f"{f.get('format')}" + (f", values: {f['engine_values']}" if "engine_values" in f else "")
+    if loaded.format in CONTAINERS:
+        return CONTAINERS[loaded.format](f)
     if "data_file" in f:
         return f"describes {f['data_file']} ({f['data_format']})"
-    if loaded.format == "report":
-        return f"{len(f.get('tables') or [])} table(s)"
     return "no data file"
 
 

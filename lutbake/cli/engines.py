@@ -1,4 +1,5 @@
-"""CLI commands for shipping tables to engines: ``audit``, ``size``, ``fit`` (registered by lutbake.cli)."""
+"""The commands for shipping tables to engines: ``audit``, ``size``, ``fit`` (each parses, calls
+lutbake.commands.<name>, prints)."""
 
 from __future__ import annotations
 
@@ -7,15 +8,15 @@ from pathlib import Path
 
 import click
 
-EXIT_CONFIG = 2
-
-
-def _quiet():
-    """Start Warp without its banner and CUDA-driver warning (lutbake.runtime.warp_runtime; --verbose brings them
-    back)."""
-    from .runtime.warp_runtime import init_warp
-
-    init_warp()
+from .options import (
+    conventions_of,
+    conventions_options,
+    fail,
+    json_option,
+    out_file_option,
+    quiet_warp,
+    workers_option,
+)
 
 
 def _shape(text: str | None):
@@ -32,17 +33,7 @@ def _shape(text: str | None):
 
 @click.command()
 @click.argument("file", type=click.Path(path_type=Path))
-@click.option(
-    "--preset", default=None, metavar="NAME", help="Conventions of a preset (lutbake list); default 'default'."
-)
-@click.option("--config", type=click.Path(path_type=Path), default=None, help="Conventions of a config's first table.")
-@click.option(
-    "--set",
-    "overrides",
-    multiple=True,
-    metavar="KEY=VALUE",
-    help="Override a convention key (texel, row_order, roughness, layout, ...); the size is the file's.",
-)
+@conventions_options("Override a convention key (texel, row_order, roughness, layout, ...); the size is the file's.")
 @click.option(
     "--tolerance",
     type=float,
@@ -77,8 +68,8 @@ def _shape(text: str | None):
     metavar="PNG",
     help="Write |file - converged| per channel with labelled axes.",
 )
-@click.option("--json", "as_json", is_flag=True, help="Print the report as JSON (for CI).")
-@click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
+@json_option("report (for CI)")
+@workers_option
 def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, error_map, as_json, workers):
     """Compare the LUT FILE with a converged re-bake under declared conventions and diagnose mistakes.
 
@@ -94,18 +85,16 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
       lutbake audit lut_ggx.png --preset gltf --error-map lut_ggx.err.png --json
       lutbake audit brdf.h --set texel=endpoint --set axis_order=roughness_x --shape 64x64x3
     """
-    from .commands.audit import audit as run_audit
-    from .commands.audit import report_json
-    from .errors import ConfigError
+    from ..commands.audit import audit as run_audit
+    from ..commands.audit import report_json
+    from ..errors import ConfigError
 
-    _quiet()
-    if preset and config:
-        click.echo("error: give --preset or --config, not both", err=True)
-        sys.exit(EXIT_CONFIG)
+    conventions = conventions_of(preset, config, overrides)
+    quiet_warp()
     try:
         report = run_audit(
             file,
-            {"preset": preset, "config": config, "overrides": overrides},
+            conventions,
             tolerance=tolerance,
             metric=metric,
             max_side=max_side,
@@ -113,22 +102,14 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
             shape=_shape(shape),
             workers=workers,
         )
-    except ConfigError as e:
-        click.echo(f"error: {e}", err=True)
-        sys.exit(EXIT_CONFIG)
-    except (OSError, ValueError) as e:
-        click.echo(f"error: {e}", err=True)
-        sys.exit(EXIT_CONFIG)
+    except (ConfigError, OSError, ValueError) as e:
+        fail(e)
     click.echo(report_json(report) if as_json else report.text())
     sys.exit(0 if report.passed else 1)
 
 
 @click.command()
-@click.option(
-    "--preset", default=None, metavar="NAME", help="Conventions of a preset (lutbake list); default 'default'."
-)
-@click.option("--config", type=click.Path(path_type=Path), default=None, help="Conventions of a config's first table.")
-@click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE", help="Override a convention key.")
+@conventions_options("Override a convention key.")
 @click.option("--max-error", type=float, required=True, help="Target max |bilinear(table) - integral| between texels.")
 @click.option(
     "--sizes",
@@ -143,8 +124,8 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
     show_default=True,
     help="Measure only where NoV >= this (the grazing corner never converges on a linear NoV axis).",
 )
-@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
-@click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
+@json_option("result")
+@workers_option
 def size(preset, config, overrides, max_error, sizes, nov_min, as_json, workers):
     """Smallest N x N resolution per storage format (UNORM8/10/16, F16, F32) whose max error after bilinear
     filtering, measured between texels against the integral, is within --max-error.
@@ -156,45 +137,37 @@ def size(preset, config, overrides, max_error, sizes, nov_min, as_json, workers)
     """
     import json
 
-    from .commands.size import smallest_sizes
-    from .errors import ConfigError
+    from ..commands.size import smallest_sizes
+    from ..errors import ConfigError
 
-    _quiet()
+    conventions = conventions_of(preset, config, overrides)
     try:
         ns = tuple(int(s) for s in sizes.split(","))
         if not ns or min(ns) < 2:
             raise ValueError
     except ValueError:
-        click.echo(f"error: --sizes {sizes!r}: a comma-separated list of integers >= 2", err=True)
-        sys.exit(EXIT_CONFIG)
+        fail(f"--sizes {sizes!r}: a comma-separated list of integers >= 2")
     if max_error <= 0:
-        click.echo("error: --max-error must be > 0", err=True)
-        sys.exit(EXIT_CONFIG)
+        fail("--max-error must be > 0")
+    quiet_warp()
     try:
         result = smallest_sizes(
-            {"preset": preset, "config": config, "overrides": overrides},
+            conventions,
             max_error,
             ns,
             workers=workers,
             nov_min=nov_min,
         )
     except (ConfigError, OSError, ValueError) as e:
-        click.echo(f"error: {e}", err=True)
-        sys.exit(EXIT_CONFIG)
+        fail(e)
     click.echo(json.dumps(result.as_dict(), indent=1) if as_json else result.text())
 
 
 @click.command()
 @click.argument("family", type=click.Choice(["karis-mobile", "gotanda-eq8"]))
 @click.option("--lang", type=click.Choice(["glsl", "hlsl"]), default="glsl", show_default=True)
-@click.option(
-    "-o",
-    "--out",
-    type=click.Path(path_type=Path, dir_okay=False),
-    default=None,
-    help="Write the shader function here (default: print it after the error table).",
-)
-@click.option("--json", "as_json", is_flag=True, help="Print constants and errors as JSON.")
+@out_file_option("the shader function here (default: print it after the error table)")
+@json_option("constants and errors")
 def fit(family, lang, out, as_json):
     """Refit a published closed form to lutbake's integral and emit it as GLSL/HLSL with its measured error
     (published constants vs refit, side by side).
@@ -206,10 +179,10 @@ def fit(family, lang, out, as_json):
     """
     import json
 
-    from .commands.fit import fit as run_fit
-    from .io.atomic import atomic_write_bytes
+    from ..commands.fit import fit as run_fit
+    from ..io.atomic import atomic_write_bytes
 
-    _quiet()
+    quiet_warp()
     result = run_fit(family)
     if as_json:
         click.echo(

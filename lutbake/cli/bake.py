@@ -1,0 +1,238 @@
+"""``lutbake bake``: parse, call lutbake.api.bake, print a line per table, the progress of the batch and a closing
+summary."""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import click
+
+from ..io.formats import ALL_FORMATS
+from .options import fail, out_dir_option, set_option, workers_option
+
+PROGRESS_MIN_EVALS = 1.5e7  # about a second of work on two busy cores: a single table shows a bar above it
+
+
+@click.command()
+@click.argument("configs", nargs=-1, type=click.Path(path_type=Path))
+@click.option("--preset", "presets", multiple=True, metavar="NAME", help="Bake a preset config (lutbake list).")
+@out_dir_option("outputs", "tables")
+@set_option("Override a key in every table (KEY=VALUE) or one table (NAME.KEY=VALUE); VALUE is TOML.")
+@workers_option
+@click.option(
+    "--device", type=click.Choice(["cpu", "cuda"]), default="cpu", help="Warp device of the kernels: cpu, cuda."
+)
+@click.option(
+    "--progress/--no-progress",
+    default=None,
+    help="Progress of the batch (tables done / total, the running table, elapsed, an estimate) on stderr; "
+    "default: on a terminal.",
+)
+@click.option("--force", is_flag=True, help="Rebake every table, even those whose output is up to date.")
+@click.option(
+    "--cache",
+    "cache_dir",
+    type=click.Path(path_type=Path, file_okay=False),
+    default=None,
+    metavar="DIR",
+    help="Keep each computation's values in DIR (content-addressed) and lay out again from there, without "
+    "computing, any table whose values are known (make luts: <out-dir>/.cache). --force reads no entry.",
+)
+@click.option(
+    "--report",
+    type=click.Path(path_type=Path, dir_okay=False),
+    default=None,
+    metavar="FILE.json",
+    help="Write a JSON summary: per table status, path, content hash, seconds, samples, error estimate.",
+)
+@click.option(
+    "--scheduler",
+    default=None,
+    metavar="local:N|tcp://HOST:PORT",
+    help="Run the tiles on a Dask cluster: local:N starts N worker processes here, tcp://HOST:8786 uses a running "
+    "`dask scheduler` (pip install 'lutbake[dask]'; docs/cluster.md). Same files as without.",
+)
+@click.option(
+    "--format",
+    "fmt",
+    type=click.Choice(list(ALL_FORMATS)),
+    default=None,
+    help="Output format of every table (same as --set format=...; default: each table's `format`, exr); each kind "
+    "allows some of these (lutbake list; an ltc table: exr, npy, ltc_dds, js, c, cs).",
+)
+def bake(configs, presets, out_dir, overrides, workers, device, progress, force, cache_dir, report, scheduler, fmt):
+    """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.<ext> (EXR unless `format` / --format says otherwise).
+
+    All configs are validated before any kernel runs; a bad config exits with status 2 and writes
+    nothing; so does an out-dir or --report that cannot be written. A table whose output exists with
+    the same content hash (its config, the lutbake version and the kernels' source), and whose bytes
+    match the sha256 recorded with it, is skipped ("skipped PATH (up to date)"); --force rebakes it. Tables bake
+    in parallel; each prints one line: path, shape, seconds, samples per texel; on a terminal a progress line
+    shows tables done / total, the running table, elapsed time and an estimate. The last line sums up the batch
+    ("40 tables: 12 baked, 28 up to date, 0 failed, 64 s"). A table that fails does not stop the others; the exit
+    status is then 1. Outputs are replaced atomically: Ctrl-C (exit 130) or SIGTERM (exit 143) keeps finished
+    tables, writes no unfinished one, and lists the tables that did not finish; the next run bakes only those.
+
+    \b
+    Examples:
+      lutbake bake configs/dfg.toml
+      lutbake bake configs/*.toml --report outputs/report.json
+      lutbake bake configs/dfg.toml --force --set size=[64,64] --set layout=multiscatter
+      lutbake bake configs/dfg.toml --set dfg.estimator=sobol_vndf --set dfg.samples=4096
+      lutbake bake --preset unreal --format dds        # -> outputs/preintegrated_gf.dds (R16G16_FLOAT)
+      lutbake bake configs/*.toml --scheduler local:2  # tiles on 2 Dask worker processes
+      lutbake bake configs/*.toml --scheduler tcp://farm:8786 --device cuda
+    """
+    from .. import api, batch
+    from ..config import preset_path
+    from ..errors import ConfigError, LutbakeError
+
+    t0 = time.perf_counter()
+    terminal = sys.stderr.isatty() if progress is None else progress
+    display = BatchProgress(terminal, t0)
+    try:
+        paths = [preset_path(p) for p in presets] + list(configs)
+        if not paths:
+            raise ConfigError("<command line>", None, message="give at least one CONFIG or --preset")
+        with batch.signal_handlers():
+            results = api.bake(
+                paths,
+                out_dir,
+                overrides,
+                workers,
+                device,
+                progress=display.texels,
+                on_result=display.done,
+                force=force,
+                cache_dir=cache_dir,
+                fmt=fmt,
+                scheduler=scheduler,
+                report=report,
+                on_schedule=display.scheduled,
+                check=False,
+            )
+    except LutbakeError as e:  # a bad config or path, an unreachable scheduler: before any kernel ran
+        display.close()
+        fail(e)
+    except RecursionError:  # a value nested too deeply for some check that slipped past load_configs
+        fail("a config or --set value is nested too deeply")
+    except (KeyboardInterrupt, batch.Interrupted) as e:
+        display.close()
+        signum = getattr(e, "signum", batch.signal.SIGINT)
+        click.echo(f"interrupted ({batch.signal_name(signum)}) while planning: nothing was baked or written", err=True)
+        sys.exit(batch.exit_status([], signum))
+    display.close()
+    if results.report_error:
+        click.echo(f"error: {results.report_error}", err=True)
+    failed = [r.name for r in results if r.status == "failed"]
+    unfinished = [r.name for r in results if r.status in ("interrupted", "pending")]
+    if failed:
+        click.echo(f"{len(failed)} of {len(results)} tables failed: {', '.join(failed)}", err=True)
+    if results.interrupted_by is not None:
+        click.echo(
+            f"interrupted ({batch.signal_name(results.interrupted_by)}): {len(unfinished)} of {len(results)} tables "
+            f"did not finish: {', '.join(unfinished) or '-'}; run the same command again to bake only those",
+            err=True,
+        )
+    click.echo(summary(results, time.perf_counter() - t0))
+    sys.exit(results.exit_status)
+
+
+def summary(results, seconds: float) -> str:
+    """The closing line: "40 tables: 12 baked, 28 up to date, 0 failed, 64 s" (and how many were interrupted)."""
+    n = {s: sum(r.status == s for r in results) for s in ("baked", "skipped", "failed", "interrupted", "pending")}
+    stopped = n["interrupted"] + n["pending"]
+    return (
+        f"{len(results)} table{'s' if len(results) != 1 else ''}: {n['baked']} baked, {n['skipped']} up to date, "
+        f"{n['failed']} failed" + (f", {stopped} interrupted" if stopped else "") + f", {seconds:.0f} s"
+    )
+
+
+class BatchProgress:
+    """What ``lutbake bake`` prints while the batch runs: one line per table as it ends ("[done/total] ...", stdout:
+    plain lines wherever the output goes) and, on a terminal,
+    a progress line on stderr redrawn in place: tables done / total, the running tables, elapsed, an estimate of
+    the time left (from the finished tables' share of the work); a single long table gets a texel bar instead."""
+
+    def __init__(self, terminal: bool, t0: float):
+        self.terminal, self.t0 = terminal, t0
+        self.total = self.finished = self.pending = 0
+        self.running: list[str] = []
+        self.shown = False
+
+    def scheduled(self, results) -> None:
+        self.total = len(results)
+        self.pending = sum(r.status == "pending" for r in results)
+        self.done_pending = 0
+
+    def texels(self, label: str, n_texels: int, cost: float):
+        """lutbake.runtime.executor.Progress: a table starts (its tiles are about to run)."""
+        self.running.append(label)
+        self.draw()
+        if self.terminal and self.pending == 1 and cost > PROGRESS_MIN_EVALS:
+            return self._texel_bar(label, n_texels)
+        return None
+
+    def _texel_bar(self, label: str, n_texels: int):
+        self.clear()
+        bar = click.progressbar(length=n_texels, label=label, file=sys.stderr, show_eta=True)
+        bar.__enter__()
+        left = [n_texels]
+
+        def update(n: int) -> None:
+            bar.update(n)
+            left[0] -= n
+            if left[0] <= 0:
+                bar.__exit__(None, None, None)
+
+        return update
+
+    def done(self, r) -> None:
+        from ..api import samples_note
+        from ..textsafe import escape_controls
+
+        if r.name in self.running:
+            self.running.remove(r.name)
+        self.finished += 1
+        self.clear()
+        count = f"[{self.finished}/{self.total}] "
+        if r.status == "skipped":
+            click.echo(f"{count}skipped {escape_controls(str(r.path))} (up to date)")
+        elif r.status == "baked":
+            self.done_pending += 1
+            note = samples_note(r.spec, r.samples)
+            if r.values_from is not None:
+                note = "; ".join(filter(None, (note, f"values computed once with {r.values_from}")))
+            click.echo(
+                f"{count}{escape_controls(str(r.path))}  {r.shape}  {r.seconds:.2f} s  {r.samples} samples/texel"
+                + (f" ({note})" if note else "")
+            )
+        elif r.status == "failed":
+            self.done_pending += 1
+            click.echo(f"{count}FAILED {r.name}: {escape_controls(r.message)}", err=True)
+        self.draw()
+
+    def line(self) -> str:
+        elapsed = time.perf_counter() - self.t0
+        left = ""
+        if 0 < self.done_pending < self.pending:
+            left = f", ~{elapsed / self.done_pending * (self.pending - self.done_pending):.0f} s left"
+        running = ""
+        if self.running:
+            running = f"  running {self.running[0]}" + (f" +{len(self.running) - 1}" if len(self.running) > 1 else "")
+        return f"[{self.finished}/{self.total}]{running}  {elapsed:.0f} s{left}"
+
+    def draw(self) -> None:
+        if self.terminal and self.total and self.finished < self.total and self.pending > 1:
+            click.echo("\r\x1b[2K" + self.line(), nl=False, err=True)
+            self.shown = True
+
+    def clear(self) -> None:
+        if self.shown:
+            click.echo("\r\x1b[2K", nl=False, err=True)
+            self.shown = False
+
+    def close(self) -> None:
+        self.clear()
