@@ -277,13 +277,16 @@ def audit_ltc(
         f"magnitude / fresnel (unique integrals) {metric} |error| {value:.3g}; storage "
         + ("6 significant digits (text)" if not str(path).endswith(".dds") else "as the DDS"),
     )
+    conventions = (
+        f"preset ltc (lobe {o['lobe']}, rows NoV = 1 - t^2 endpoints, columns {axes[2].name} endpoints, "
+        f"alpha >= {o['alpha_min']:g}); {len(iy)} x {len(ix)} of {n_view} x {n_rough} texels"
+    )
     return TableAuditReport(
-        file=str(path),
-        conventions=f"preset ltc (lobe {o['lobe']}, rows NoV = 1 - t^2 endpoints, columns {axes[2].name} endpoints, "
-        f"alpha >= {o['alpha_min']:g}); {len(iy)} x {len(ix)} of {n_view} x {n_rough} texels",
-        kind="ltc",
-        errors=errors,
-        findings=findings,
+        str(path),
+        conventions,
+        "ltc",
+        errors,
+        findings,
         **verdict(metric, tolerance, value, passed),
         extra={
             "fit_ratio": fit_ratio,
@@ -363,13 +366,16 @@ def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> 
         "Monte Carlo noise of OpenPBR's generator above the rounding",
     )
     value = metric_value(allerr, metric)
+    conventions = (
+        f"preset openpbr ([ior][alpha][cos] {n}^3, separable Smith, exact Fresnel); {len(iz)} IOR slices "
+        f"x {len(iy)} alpha rows x {n} cos of {n}^3"
+    )
     return TableAuditReport(
-        file=str(path),
-        conventions=f"preset openpbr ([ior][alpha][cos] {n}^3, separable Smith, exact Fresnel); {len(iz)} IOR slices "
-        f"x {len(iy)} alpha rows x {n} cos of {n}^3",
-        kind="openpbr",
-        errors=errors,
-        findings=findings,
+        str(path),
+        conventions,
+        "openpbr",
+        errors,
+        findings,
         **verdict(metric, tolerance, value),
         extra={"reciprocity_residual_max": float(np.abs(res).max())},
     )

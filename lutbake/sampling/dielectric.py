@@ -563,24 +563,11 @@ def launch_by_groups(inputs: dict, nch: int, n_out: int, members: tuple | None, 
     return outs
 
 
-@functools.lru_cache(maxsize=None)
-def gl_dielectric_kernel(spec):
-    return make_gauss_legendre_dielectric(spec)
-
-
-@functools.lru_cache(maxsize=None)
-def gl_members_kernel(spec):
-    return make_gauss_legendre_members(spec)
-
-
-@functools.lru_cache(maxsize=None)
-def adaptive_dielectric_kernel(spec):
-    return make_adaptive_dielectric(spec)
-
-
-@functools.lru_cache(maxsize=None)
-def adaptive_members_kernel(spec):
-    return make_adaptive_members(spec)
+# the kernel factories, each cached by its spec (one compiled kernel per spec)
+gl_dielectric_kernel = functools.lru_cache(maxsize=None)(make_gauss_legendre_dielectric)
+gl_members_kernel = functools.lru_cache(maxsize=None)(make_gauss_legendre_members)
+adaptive_dielectric_kernel = functools.lru_cache(maxsize=None)(make_adaptive_dielectric)
+adaptive_members_kernel = functools.lru_cache(maxsize=None)(make_adaptive_members)
 
 
 @dataclass(frozen=True)
