@@ -45,6 +45,3 @@ def main(verbose):
 
 for _command in (bake, list_, inspect, plot, validate, preview, audit, size, fit):
     main.add_command(_command)
-
-if __name__ == "__main__":
-    main()
