@@ -177,6 +177,7 @@ def uv_expression(row: str) -> str:
 
 
 UV_PRESETS = [
+    "default",
     "filament",
     "filament-corrected",
     "gltf",
