@@ -1,4 +1,4 @@
-"""Baking on a Dask cluster (lutbake.cluster): bit-identical to the thread executor, a killed worker costs
+"""Baking on a Dask cluster (lutbake.runtime.cluster): bit-identical to the thread executor, a killed worker costs
 only its tiles, mismatched or broken workers are refused before any tile runs, interrupts cancel the
 futures and write no unfinished table.
 

@@ -39,7 +39,7 @@ import numpy as np
 from ..axes import Axis
 from ..catalog import DIELECTRIC_MASKINGS, HEMISPHERE_ESTIMATORS, MASKINGS, NDF_DESCRIPTIONS, SMITH_NDFS, VNDF_NDFS
 from ..edge import ALPHA_MIN, alpha_policy
-from ..memo import RowMemo
+from ..runtime.memo import RowMemo
 from ..sampling import points
 from ..sampling.mu_average import mu_averages, mu_target
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan, probe_indices
