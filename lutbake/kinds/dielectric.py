@@ -8,7 +8,7 @@ eta = eta_o / eta_i is the relative IOR seen from the view's side: eta > 1 outsi
 (total internal reflection past the critical angle). The integrands are lutbake.integrands.dielectric, the default
 quadrature lutbake.sampling.dielectric (panelled Gauss-Legendre split at every kink; kind dielectric to the
 tolerance, kind dielectric_avg at a fixed order); docs/transmission.md has the
-derivation, every engine's conventions and the measured accuracy.
+derivation and the measured accuracy, docs/glass-layouts.md every engine's conventions.
 
 Layouts (key ``layout``; lutbake.layouts: energy in plain.py, eevee_btdf / eevee_bsdf in eevee.py, openpbr in
 openpbr.py) fix the channels and, for the engine layouts, the whole grid; the estimators are

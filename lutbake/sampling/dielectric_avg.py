@@ -24,7 +24,7 @@ from .plan import Grid, TexelPlan, probe_indices
 # of before were off by up to 2.0e-4 on OpenPBR's eta < 1 rows (alpha = 0.004)
 MU_MAX_PANELS = 40
 # inside the glass the first mu panels are also graded towards cos theta_c (mu_starts): Turquin's average 0.84x the mu
-# evaluations, OpenPBR's 0.88x (docs/transmission.md)
+# evaluations, OpenPBR's 0.88x (docs/decisions.md)
 MU_GRADE_MAX, MU_GRADE_RATIO = 0.25, 4.0
 # kind dielectric_avg's inner rule (fixed-order Gauss-Legendre at the mu nodes, its error the probe's): without
 # ``samples``, its order climbs from the default 12 by 4 (each order's refined rule, order + 4, is the next order) up
