@@ -191,6 +191,7 @@ LAYERS = [
     {"terms"},
     {"sampling"},
     {"integrands", "ltc"},
+    {"layouts"},
     {"kinds", "value_bounds"},
     {"config", "preflight"},
     # cluster: the executor's Dask counterpart
