@@ -231,8 +231,10 @@ def test_a_worker_without_lutbake_is_refused_with_a_clear_message(client):
     victim = sorted(client.scheduler_info()["workers"])[-1]
     with sabotaged(
         client,
-        "import sys; sys.modules['_lutbake'] = sys.modules['lutbake']; sys.modules['lutbake'] = None",
-        "import sys; sys.modules['lutbake'] = sys.modules.pop('_lutbake')",
+        # every lutbake module hidden (the probe imports lutbake.runtime.cluster), then restored
+        "import sys; sys._lutbake = {k: v for k, v in sys.modules.items() if k.split('.')[0] == 'lutbake'}; "
+        "sys.modules.update(dict.fromkeys(sys._lutbake))",
+        "import sys; sys.modules.update(sys._lutbake)",
         workers=[victim],
     ):
         with pytest.raises(cluster.WorkerRefused) as e:

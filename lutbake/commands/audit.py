@@ -70,11 +70,12 @@ def srgb_oetf(v):
     return np.where(v <= 0.0031308, 12.92 * v, 1.055 * v ** (1 / 2.4) - 0.055)
 
 
-def other_layout(pred: np.ndarray, layout: str) -> np.ndarray:
-    """The same table written in the other split-sum layout (channels R, G; a third channel is kept)."""
+def other_layout(pred: np.ndarray, split_sum: str | None) -> np.ndarray:
+    """The same table written in the other split-sum layout (channels R, G; a third channel is kept); ``split_sum``:
+    the declared layout's pair (lutbake.layouts.base.Layout.split_sum)."""
     out = pred.copy()
     r, g = pred[..., 0], pred[..., 1]
-    if layout.startswith("multiscatter"):  # (Fc, E) -> (scale, bias) = (E - Fc, Fc)
+    if split_sum == "multiscatter":  # (Fc, E) -> (scale, bias) = (E - Fc, Fc)
         out[..., 0], out[..., 1] = g - r, r
     else:  # (scale, bias) -> (Fc, E) = (bias, scale + bias)
         out[..., 0], out[..., 1] = g, r + g
@@ -212,13 +213,15 @@ def hypotheses(conv: Conventions) -> list[Hypothesis]:
             lambda p: np.concatenate([p[..., 1:2], p[..., 0:1], p[..., 2:]], axis=-1),
         )
     )
-    other = "scale_bias" if conv.layout.startswith("multiscatter") else "multiscatter"
+    if "other_split_sum" not in conv.record.audit:
+        return hs
+    other = "scale_bias" if conv.record.split_sum == "multiscatter" else "multiscatter"
     hs.append(
         Hypothesis(
             "layout_" + other,
             f"the file is in the {other} layout, declared {conv.layout} (multiscatter (R, G) = (bias, scale + bias))",
             nominal,
-            lambda p: other_layout(p, conv.layout),
+            lambda p: other_layout(p, conv.record.split_sum),
         )
     )
     return hs
@@ -408,9 +411,7 @@ def audit(
         )
     conv = conventions(**(conv_args or {}), shape=(rows, cols), recorded=lut.attrs, path=path)
     integ = Reference(conv, workers)
-    from ..kinds.dfg import CHANNELS
-
-    names = list(CHANNELS[conv.layout])
+    names = list(conv.record.channels)
     nch = min(fch, len(names))
     # the sheen layouts keep their value in B only (charlie) or R, G: compare what the layout fills
     compared = [c for c in range(nch) if not names[c].startswith("zero")]

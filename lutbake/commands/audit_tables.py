@@ -18,9 +18,9 @@ within the tolerance and ``fit_ratio`` <= FIT_RATIO_MAX.
 OpenPBR (adobe/openpbr-bsdf ``impl/data/openpbr_*_data.h``, UNORM16): each energy array against lutbake's bake
 under the ``openpbr`` preset's conventions (its [ior][alpha][cos] grid, separable Smith, exact Fresnel), at a
 strided subset of IOR slices and roughness rows; the reflection ratio against lutbake's (its Kulla-Conty split of
-the two sides' averages, lutbake.kinds.dielectric_ratio) where OpenPBR reads it (alpha index >= 2, eta != 1; the rest
-reported apart), and against the reciprocity identity of OpenPBR's multiple-scattering lobe (1 - x(eta)) E_avg(eta) =
-(1 - x(1/eta)) E_avg(1/eta). The cos = 0 column is reported apart: lutbake evaluates
+the two sides' averages, lutbake.integrands.dielectric_ratio) where OpenPBR reads it (alpha index >= 2, eta != 1;
+the rest reported apart), and against the reciprocity identity of OpenPBR's multiple-scattering lobe
+(1 - x(eta)) E_avg(eta) = (1 - x(1/eta)) E_avg(1/eta). The cos = 0 column is reported apart: lutbake evaluates
 NoV >= NOV_MIN there (lutbake.edge), a limit the shipped Monte Carlo estimator does not take.
 """
 
@@ -303,7 +303,7 @@ def audit_ltc(
 
 def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> TableAuditReport:
     from ..kinds import lookup_kind
-    from ..kinds.dielectric import OPENPBR_SIZE
+    from ..layouts.openpbr import OPENPBR_SIZE
 
     n = OPENPBR_SIZE
     with np.load(Path(path)) as z:
@@ -336,8 +336,8 @@ def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> 
             s = stats(got - ours)
             errors[key] = s
             judged.append((got - ours).ravel())
-    # the reflection ratio (lutbake.kinds.dielectric_ratio): judged where OpenPBR reads it (alpha index >= 2, eta != 1);
-    # at alpha index 0-1 and on the eta = 1 row the averages are ~0 and their rounding decides the ratio
+    # the reflection ratio (lutbake.integrands.dielectric_ratio): judged where OpenPBR reads it (alpha index >= 2,
+    # eta != 1); at alpha index 0-1 and on the eta = 1 row the averages are ~0 and their rounding decides the ratio
     x = shipped["ideal_dielectric_reflection_ratio"]
     diff = x[iz] - ours_avg[..., RATIO_CHANNEL]
     body = np.zeros(diff.shape, bool)
@@ -387,12 +387,14 @@ def dispatch(
     """The LTC / OpenPBR audit when the declared conventions are one (a preset or config of kind ltc, or layout
     openpbr; without either, the file's ``recorded`` conventions); None for the dfg family
     (lutbake.commands.audit)."""
+    from ..layouts import REGISTRY
     from .reference import declared_specs
 
     specs = declared_specs(conv_args, recorded, path)
     if specs[0].kind == "ltc":
         return audit_ltc(path, specs[0], tolerance, metric, max_side, error_map=error_map)
-    if specs[0].options.get("layout") == "openpbr":
+    record = REGISTRY.get((specs[0].kind, specs[0].options.get("layout")))
+    if record is not None and "openpbr_arrays" in record.audit:  # the layout's record names its audit
         if error_map is not None:
             raise ValueError("--error-map: not drawn for OpenPBR's 3D arrays (the report names where each maximum is)")
         return audit_openpbr(path, specs, tolerance, metric, max_side)

@@ -90,6 +90,15 @@ def lookup(data: np.ndarray, axes: list[Axis], coords: dict[str, np.ndarray | fl
     return out
 
 
+def split_sum_form(layout: str) -> str | None:
+    """How a file's R, G (B) rebuild E, from its layout's record (lutbake.layouts.base.Layout.split_sum): scale_bias,
+    multiscatter, sheen or None (also for a layout this lutbake does not know)."""
+    from ..layouts import REGISTRY
+
+    lay = REGISTRY.get(("dfg", layout))
+    return lay.split_sum if lay is not None else None
+
+
 def split_sum(view: TableView):
     """(how the spheres are shaded, E(nov, roughness value) -> RGB, broad) from the file's own
     reconstruction, or None where the kind has none. ``roughness value`` is in the units of the table's
@@ -99,7 +108,7 @@ def split_sum(view: TableView):
     rough = next((n for n in names if n in ROUGHNESS_AXES), None)
     if view.kind is None or "NoV" not in names or rough is None or view.data.ndim != 3 + (len(axes) == 3):
         return None
-    layout = view.terms.get("layout", "scale_bias")
+    form = split_sum_form(view.terms.get("layout", "scale_bias"))
     z = axes[0] if len(axes) == 3 else None
     nch = view.data.shape[-1]
 
@@ -112,21 +121,21 @@ def split_sum(view: TableView):
     if view.kind in ("dfg", "specular_aniso") and nch >= 2:
         zmid = float(z.values()[z.count // 2]) if z is not None else None
         where = f", {_short(z, zmid)}" if z is not None else ""
-        if layout in ("scale_bias", "scale_bias_f82"):  # Karis 2013: E = f0 * scale + bias
+        if form == "scale_bias":  # Karis 2013: E = f0 * scale + bias
 
             def E_scale_bias(nov, r):
                 t = at(nov, r, zmid)
                 return SPHERE_F0 * t[..., 0:1] + t[..., 1:2]
 
             return f"E = f0 R + G, f0 = gold{where}", E_scale_bias, False
-        if layout in ("multiscatter", "multiscatter_cloth"):  # Filament: E = mix(R, G, f0)
+        if form == "multiscatter":  # Filament: E = mix(R, G, f0)
 
             def E_multiscatter(nov, r):
                 t = at(nov, r, zmid)
                 return (1 - SPHERE_F0) * t[..., 0:1] + SPHERE_F0 * t[..., 1:2]
 
             return f"E = (1 - f0) R + f0 G, f0 = gold{where}", E_multiscatter, False
-        if layout in ("charlie", "charlie_clamped") and nch >= 3:
+        if form == "sheen" and nch >= 3:
             # the sheen lobe is broad: its prefiltered (Charlie) environment is close to the mean radiance
             return (
                 "sheen = prefiltered_charlie sheenColor B, sheenColor = white",

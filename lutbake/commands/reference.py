@@ -16,13 +16,12 @@ from pathlib import Path
 import numpy as np
 
 from ..axes import Axis
-from ..catalog import SHEEN_LAYOUTS
 from ..config import TableSpec, load_config, parse_overrides, preset_path, validate_table
 from ..errors import ConfigError
 from ..pipeline import compute_at
 
 REFERENCE_TOLERANCE = 1e-7  # the re-bake: adaptive Gauss-Legendre to 1e-7 per value (its estimates bound the error:
-# docs/accuracy.md); a fixed order 12 leaves ~1e-5 at NoV = 1e-4 and would flag a correct table
+# docs/validation.md); a fixed order 12 leaves ~1e-5 at NoV = 1e-4 and would flag a correct table
 
 
 def recorded_specs(config_text: str, where: str, overrides=()) -> list[TableSpec]:
@@ -73,6 +72,13 @@ class Conventions:
     def layout(self) -> str:
         return self.spec.options["layout"]
 
+    @property
+    def record(self):
+        """The declared layout's record (lutbake.layouts)."""
+        from ..layouts import lookup_layout
+
+        return lookup_layout("dfg", self.layout)
+
 
 def conventions(config=None, preset=None, overrides=(), shape=None, recorded=None, path=None) -> Conventions:
     """The declared dfg conventions (declared_specs' first table); size from ``shape`` (rows, columns)."""
@@ -99,11 +105,10 @@ class Reference:
 
     def __init__(self, conv: Conventions, workers: int | None = None):
         from ..kinds.dfg import terms_of
-        from ..kinds.engine_layouts import BASE_LAYOUT
 
         self.layout = conv.layout
+        self.record = conv.record
         self.form = terms_of(conv.spec.options)[0]
-        self.base = BASE_LAYOUT.get(self.layout, self.layout)  # the specular integrand's layout
         self.converged_spec = _with(
             conv.spec,
             estimator="gauss_legendre",
@@ -127,9 +132,9 @@ class Reference:
 
     def hammersley(self, nov, alpha, samples: int) -> np.ndarray | None:
         """The engines' usual estimator (R, G of the split-sum layout), or None for the sheen layouts."""
-        if self.base in SHEEN_LAYOUTS or self.form != "microfacet":
+        if self.record.terms.ndf is not None or self.form != "microfacet":  # a sheen layout fixes its own NDF
             return None
-        base = "multiscatter" if self.base.startswith("multiscatter") else "scale_bias"
+        base = "multiscatter" if self.record.split_sum == "multiscatter" else "scale_bias"
         spec = _with(
             self.converged_spec,
             layout=base,

@@ -19,6 +19,7 @@ import numpy as np
 from ..sampling.plan import TexelPlan
 from .devices import CPU_TILE_TEXELS as TILE_TEXELS
 from .devices import plan_tile_texels
+from .warp_runtime import defining
 
 # progress(label, n_texels, cost) -> update(n_done_in_this_tile) or None: called once per table before its tiles run
 Progress = Callable[[str, int, float], "Callable[[int], None] | None"]
@@ -67,9 +68,11 @@ def execute_tiles(
         return runner.execute(spec, plan, device, progress=progress, label=label, cancel=cancel)
     workers = workers or default_workers()
     cpu = cpu if cpu is not None else []
-    # tables prepare in parallel: their kernels compile on every core (lutbake.runtime.warp_runtime.load_module)
+    # tables prepare in parallel: one builds its Warp kernels at a time (warp_runtime.defining), their modules
+    # compile on every core (warp_runtime.load_module)
     t0 = time.thread_time()
-    plan.prepare(device)
+    with defining():
+        plan.prepare(device)
     cpu.append(time.thread_time() - t0)
     parts = tiles(plan.n_texels, plan_tile_texels(plan, device))
     out = np.empty((plan.n_texels, plan.tile_width), dtype=np.float64)
@@ -108,7 +111,8 @@ def estimate_error(
         return None
     if runner is not None and spec is not None:
         return runner.estimate_error(spec, data, device)
-    return plan.error_estimate(data, device)
+    with defining():  # the refined estimator builds its kernels here
+        return plan.error_estimate(data, device)
 
 
 class Timer:
