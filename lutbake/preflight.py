@@ -187,8 +187,8 @@ def check_collisions(jobs) -> None:
 
 def check_outputs(jobs) -> None:
     """No two tables write one file (check_collisions). Every file a table writes (planned_files) must be a regular
-    file or absent (a directory or device there fails the rename after the bake); a ``png16`` output must be a 2D table (PNG has no depth: the table's shape comes
-    from its plan, which runs no kernel)."""
+    file or absent (a directory or device there fails the rename after the bake); a ``png16`` output must be a 2D
+    table (PNG has no depth: the table's shape comes from its plan, which runs no kernel)."""
     from .kinds import lookup_kind
 
     check_collisions(jobs)
