@@ -229,9 +229,9 @@ def parse_overrides(items: tuple[str, ...] | list[str]) -> list[tuple[str | None
             raise ConfigError("--set", item, message="must look like KEY=VALUE or TABLE.KEY=VALUE")
         lhs, rhs = item.split("=", 1)
         table, dot, key = lhs.strip().rpartition(".")
-        if dot and not table.strip() or not key.strip():
+        if dot and not table.strip():
             raise ConfigError(
-                "--set", lhs, message="an empty table or key name: must look like KEY=VALUE or TABLE.KEY=VALUE"
+                "--set", key.strip(), message="an empty table name before the '.' (KEY=VALUE or TABLE.KEY=VALUE)"
             )
         problem = nesting_problem(rhs)
         if problem:

@@ -151,8 +151,8 @@ def planned_files(job) -> list[tuple[Path, str]]:
     files = [(job.path, "output")]
     if fmt == "ltc_dds":
         files.append((job.path.with_name(job.path.name.replace("_1.dds", "_2.dds")), "second texture"))
-    if fmt != "exr":
-        files += [(sidecar_path(p), f"sidecar of {p.name}") for p, _ in list(files)]
+    # an EXR writes none, but <name>.exr.json is where readers look for one: it is claimed too
+    files += [(sidecar_path(p), f"sidecar of {p.name}") for p, _ in list(files)]
     return files
 
 

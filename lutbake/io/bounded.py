@@ -28,9 +28,9 @@ import numpy as np
 
 from ..limits import MAX_TEXELS
 
-MAX_READ_TEXELS = 4 * MAX_TEXELS  # texels of one file (z x y x x): an ltc pair or an engine's tiled slices included
+MAX_READ_TEXELS = 2 * MAX_TEXELS  # texels of one file (z x y x x): the largest table a config allows, as an ltc pair
 MAX_CHANNELS = 4
-MAX_READ_BYTES = MAX_READ_TEXELS * MAX_CHANNELS * 8 // 4  # 2 GiB: float64 RGBA at MAX_TEXELS texels
+MAX_READ_BYTES = MAX_READ_TEXELS * MAX_CHANNELS * 4  # 2 GiB: float32 RGBA at MAX_READ_TEXELS texels
 MAX_TEXT_BYTES = 64 << 20  # a C/JS/WGSL/Rust array of a 1024^2 RGBA table is about 50 MiB
 MAX_JSON_BYTES = 16 << 20  # a sidecar or a cache entry is a few KiB (a listed axis: tens of KiB)
 MAX_JSON_DEPTH = 64  # lutbake's deepest JSON is 4 levels (sidecar > lutbake > axes > values)
@@ -46,7 +46,7 @@ _FILE_TYPES = (
 
 
 def what_is(mode: int) -> str:
-    return next((name for test, name in _FILE_TYPES if test(mode)), "not a regular file")
+    return next((name for test, name in _FILE_TYPES if test(mode)), "a special file")
 
 
 def regular_file_problem(path, follow: bool = True) -> str | None:
@@ -61,7 +61,7 @@ def regular_file_problem(path, follow: bool = True) -> str | None:
     if stat.S_ISLNK(st.st_mode):
         return "is a symlink"
     if not stat.S_ISREG(st.st_mode):
-        return f"is {what_is(st.st_mode)}, not a file"
+        return f"is {what_is(st.st_mode)}, not a regular file"
     return None
 
 
@@ -72,7 +72,7 @@ def _open_regular(path, limit: int, what: str):
     try:
         st = os.fstat(fd)
         if not stat.S_ISREG(st.st_mode):
-            raise ValueError(f"is {what_is(st.st_mode)}, not a file")
+            raise ValueError(f"is {what_is(st.st_mode)}, not a regular file")
         if st.st_size > limit:
             raise ValueError(f"is {st.st_size} bytes; {what} is at most {limit} bytes")
         return os.fdopen(fd, "rb"), st.st_size
@@ -85,9 +85,9 @@ def read_bytes(path, limit: int = MAX_READ_BYTES, what: str = "a table file") ->
     """The bytes of the regular file ``path``, at most ``limit`` of them (ValueError otherwise)."""
     f, size = _open_regular(path, limit, what)
     with f:
-        data = f.read(limit + 1)
-    if len(data) > limit:
-        raise ValueError(f"grew past {limit} bytes while being read")
+        data = f.read(size + 1)  # read(n) allocates n bytes up front: the file's size, never the cap
+    if len(data) > size:
+        raise ValueError(f"grew past {size} bytes while being read")
     return data
 
 
@@ -148,7 +148,7 @@ def check_texels(shape, what: str = "the file", channels: int | None = None) -> 
     if texels > MAX_READ_TEXELS:
         raise ValueError(
             f"{what} declares {shown} ({texels} texels); a table lutbake reads is at most {MAX_READ_TEXELS} texels "
-            f"(4 x MAX_TEXELS): refused before reading"
+            f"(2 x lutbake.config.MAX_TEXELS): refused before reading"
         )
     if channels > MAX_CHANNELS:
         raise ValueError(f"{what} declares {shown}: {channels} channels (a table has 1 to {MAX_CHANNELS})")
@@ -204,10 +204,12 @@ def _npy_header(f, where: str) -> tuple[tuple[int, ...], np.dtype, bool]:
     return shape, dtype, fortran
 
 
-def _npy_data(f, shape, dtype, fortran, available: int, where: str) -> np.ndarray:
-    if len(shape) == 2:
+def _npy_data(f, shape, dtype, fortran, available: int, where: str, table: bool = True) -> np.ndarray:
+    """The array data after a header; ``table``: (y, x[, C]) or (z, y, x, C), else any array of at most 4
+    dimensions (an engine's arrays, e.g. OpenPBR's 32^3 energy tables) whose values count as texels."""
+    if len(shape) == 2 or not table and 1 <= len(shape) <= 4:
         check_texels(shape, where, channels=1)
-    elif 3 <= len(shape) <= 4:
+    elif table and 3 <= len(shape) <= 4:
         check_texels(shape, where)
     else:
         raise ValueError(f"{where}: array of shape {shape} is not a table (2 to 4 dimensions)")
@@ -273,7 +275,8 @@ def load_npz_all(path, limit: int = MAX_READ_BYTES, max_members: int = 64) -> di
                     with z.open(info) as m:
                         where = f"member {info.filename}"
                         shape, dtype, fortran = _npy_header(m, where)
-                        out[info.filename[: -len(".npy")]] = _npy_data(m, shape, dtype, fortran, info.file_size, where)
+                        arr = _npy_data(m, shape, dtype, fortran, info.file_size, where, table=False)
+                        out[info.filename[: -len(".npy")]] = arr
         except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, NotImplementedError, OSError) as e:
             raise ValueError(f"not a readable .npz ({e})") from None
     return out

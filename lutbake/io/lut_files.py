@@ -90,15 +90,18 @@ def _text_shape(text: str, shape) -> tuple[int, ...]:
     )
 
 
-_COMMENT_OR_STRING = re.compile(r"/\*|//|\n")
-
-
 def strip_comments(text: str) -> str:
     """Source text without its /* ... */ and // comments, in one pass (linear time: an unclosed ``/*`` ends the
     text, it is never searched for again from each later ``/*``)."""
     out, pos, n = [], 0, len(text)
+    block = line = 0  # the next "/*" and "//" at or after pos (-1: none left), each searched for again only once passed
     while pos < n:
-        block, line = text.find("/*", pos), text.find("//", pos)
+        if 0 <= block < pos:
+            block = text.find("/*", pos)
+        if 0 <= line < pos:
+            line = text.find("//", pos)
+        if pos == 0:
+            block, line = text.find("/*"), text.find("//")
         if block < 0 and line < 0:
             out.append(text[pos:])
             break

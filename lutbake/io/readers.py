@@ -101,10 +101,9 @@ class TableView:
 
 def sniff(path: Path) -> str:
     """The format of ``path`` from its first bytes (FORMAT_NAMES); ReadError for anything else."""
-    if not path.exists():
-        raise ReadError(f"{path}: no such file")
-    if not path.is_file():
-        raise ReadError(f"{path}: not a regular file")
+    problem = bounded.regular_file_problem(path)  # "no such file", "is a FIFO (named pipe), not a file", ...
+    if problem:
+        raise ReadError(f"{path}: {problem}")
     with open(path, "rb") as f:
         head = f.read(MAGIC_BYTES)
     for magic, fmt in (
