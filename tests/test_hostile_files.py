@@ -243,7 +243,11 @@ def test_c_header_of_repeated_declarations_is_parsed_in_linear_time(tmp_path):
     assert time.perf_counter() - t0 < LINEAR_S
 
 
-@pytest.mark.parametrize("body", ["=" * 200_000, "/*" * 100_000, "x = {" * 40_000, "( " * 100_000, "/*x*/" * 40_000])
+@pytest.mark.parametrize(
+    "body",
+    ["=" * 200_000, "/*" * 100_000, "x = {" * 40_000, "( " * 100_000, "/*x*/" * 40_000],
+    ids=["equals", "open_comments", "open_braces", "open_parens", "comments"],
+)
 def test_text_arrays_are_parsed_in_linear_time(body):
     t0 = time.perf_counter()
     with pytest.raises(ValueError):
@@ -299,6 +303,7 @@ NESTED = "[" * 100_000 + "]" * 100_000
 @pytest.mark.parametrize(
     "name, sidecar",
     [("nested", '{"lutbake": ' + NESTED + "}"), ("array", '[1, 2, {"lutbake": {}}]'), ("deep_raw", NESTED)],
+    ids=["nested", "array", "deep_raw"],
 )
 def test_a_hostile_sidecar_is_one_line_in_inspect_preview_and_audit(tmp_path, name, sidecar):
     path = _npy_with_sidecar(tmp_path)
