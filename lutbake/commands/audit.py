@@ -50,7 +50,7 @@ NOISE_FLOOR_RATIO = 1.5  # noise is reported when the residual exceeds this x wh
 PERCENTILES = (50, 95, 99)
 METRICS = ("max", "p99", "mean")
 REFERENCE_TOLERANCE = 1e-7  # the re-bake: adaptive Gauss-Legendre to 1e-7 per value (its estimates bound the error:
-# docs/accuracy.md); a fixed order 12 leaves ~1e-5 at NoV = 1e-4 and would flag a correct table
+# docs/validation.md); a fixed order 12 leaves ~1e-5 at NoV = 1e-4 and would flag a correct table
 
 
 def srgb_eotf(v):

@@ -30,7 +30,8 @@ table cancels its futures and writes nothing).
 
 Python API::
 
-    from lutbake import batch, cluster
+    from lutbake import batch
+    from lutbake.runtime import cluster
     with cluster.session("local:2"):            # or "tcp://HOST:8786"
         batch.run(batch.schedule(specs, "outputs"))  # lutbake.bake(...) works the same inside the block
 """

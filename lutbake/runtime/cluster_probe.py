@@ -10,7 +10,7 @@ from lutbake at module level.
 def probe() -> dict:
     """lutbake.runtime.cluster.worker_info() of this worker, or {"error": why lutbake cannot be imported here}."""
     try:
-        from lutbake import cluster
+        from lutbake.runtime import cluster
     except Exception as e:  # ImportError, or a broken install raising anything while importing
         return {"error": f"cannot import lutbake ({type(e).__name__}: {e})"}
     return cluster.worker_info()
