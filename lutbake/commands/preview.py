@@ -345,19 +345,19 @@ def figure(path):
 
     path = Path(path)
     view = read_table(path)
-    matplotlib.rcParams["text.parse_math"] = False  # names from the file are text: a "$" is not a formula
     spheres = split_sum(view)
     dims = {a.dim for a in view.axes}
-    if "y_block" in dims:
-        fig, inches = _fig_btf(plt, view)
-    elif view.axes and dims == {"x"}:
-        fig, inches = _fig_1d(plt, view)
-    elif view.data.ndim == 4:
-        fig, inches = _fig_3d(plt, view, spheres)
-    else:
-        fig, inches = _fig_2d(plt, view, spheres)
-    note = "" if spheres or not view.kind else f"\n(no sphere row: {view.kind} has no split-sum reconstruction)"
-    fig.suptitle(_suptitle(view, path, int(inches * CHARS_PER_INCH)) + note, fontsize=9)
+    with matplotlib.rc_context({"text.parse_math": False}):  # names from the file are text: "$x$" is no formula
+        if "y_block" in dims:
+            fig, inches = _fig_btf(plt, view)
+        elif view.axes and dims == {"x"}:
+            fig, inches = _fig_1d(plt, view)
+        elif view.data.ndim == 4:
+            fig, inches = _fig_3d(plt, view, spheres)
+        else:
+            fig, inches = _fig_2d(plt, view, spheres)
+        note = "" if spheres or not view.kind else f"\n(no sphere row: {view.kind} has no split-sum reconstruction)"
+        fig.suptitle(_suptitle(view, path, int(inches * CHARS_PER_INCH)) + note, fontsize=9)
     return fig
 
 
