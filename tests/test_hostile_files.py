@@ -117,7 +117,10 @@ def test_a_non_utf8_byte_in_out_dir_or_config_name_exits_2_up_front(tmp_path):
     line = one_line_error(bake(cfg, "--out-dir", tmp_path / bad))
     assert "\\xff" in line and not (tmp_path / bad).exists()
     odd = tmp_path / os.fsdecode(b"c\xff.toml")
-    odd.write_text(SMALL.format(name="t"))
+    try:
+        odd.write_text(SMALL.format(name="t"))
+    except OSError:  # a file system that takes UTF-8 names only (APFS): no such config can exist there
+        pytest.skip("this file system refuses a name that is not UTF-8")
     line = one_line_error(bake(odd, "--out-dir", tmp_path / "o"))
     assert "\\xff" in line and not (tmp_path / "o").exists()
 

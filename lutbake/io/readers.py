@@ -323,7 +323,7 @@ def read_ktx2(path: Path) -> LoadedFile:
 # with one str.find of its closing brace, never by a pattern that rescans the rest of the file from each candidate.
 _DEFINE = re.compile(r"^#define[ \t]{1,64}(\w{1,128}?)_(DEPTH|HEIGHT|WIDTH|CHANNELS)[ \t]{1,64}(\d{1,12})[ \t]*$", re.M)
 _ARRAY = re.compile(
-    r"static\s{1,64}const\s{1,64}(uint16_t|float)\s{1,64}(\w{1,128})\s{0,64}\[[^\]\n]{0,64}\]\s{0,64}=\s{0,64}\{"
+    r"static\s{1,64}const\s{1,64}(uint16_t|float)\s{1,64}(\w{1,128})\s{0,64}\[[^\]\n]{0,1024}\]\s{0,64}=\s{0,64}\{"
 )
 
 
