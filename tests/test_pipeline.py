@@ -186,7 +186,7 @@ def test_api_bake_skips_up_to_date_outputs_unless_forced(spec, tmp_path):
 # ---- import layers: no circle, no module imports upward ----------------------------------------------------------
 # lowest first; a module may import its own layer's siblings and any lower layer, never a higher one
 LAYERS = [
-    {"errors", "edge", "axes", "table", "textsafe", "tolerance", "warp_runtime", "catalog", "metals", "memo"},
+    {"errors", "edge", "axes", "table", "textsafe", "limits", "tolerance", "warp_runtime", "catalog", "metals", "memo"},
     {"io"},
     {"terms"},
     {"sampling"},
