@@ -73,6 +73,31 @@ KEYS = {
         minimum=ALPHA_MIN,
         maximum=0.1,
     ),
+    "fit": Key(
+        "fit",
+        "str",
+        "auto",
+        "what the fit minimises",
+        {
+            "auto": "shaded where it was measured to win on the area-light benchmark (lobes in "
+            "lutbake.ltc.shaded.DEFAULT_LOBES), else l3",
+            "shaded": "the l3 fit refined to the polygon-light integrals the shader computes (lutbake.ltc.shaded): "
+            "matrix, magnitude and fresnel fitted to the lobe's integrals over training lights",
+            "l3": "Heitz et al. 2016's L3 distance to the lobe (ltc_code's fit); magnitude and fresnel the exact "
+            "integrals",
+        },
+    ),
+    "magnitude": Key(
+        "magnitude",
+        "str",
+        "fitted",
+        "the magnitude the shaded fit pairs with its matrix",
+        {
+            "fitted": "fitted with the matrix (ltc_2.x; the shader multiplies by it)",
+            "albedo": "the lobe's albedo, fixed (for shaders that take the magnitude from another table, e.g. Unity "
+            "HDRP's PreIntegratedFGD)",
+        },
+    ),
     "format": Key("format", "str", "exr", "output file format", FORMATS),
 }
 CHANNELS = {
@@ -108,6 +133,13 @@ def axes_for(o: dict) -> list[Axis]:
         Axis("NoV", "y", n_view, 0.0, 1.0, texel="endpoint", mapping="one_minus_t2", clamp=(NOV_LO, 1.0)),
         Axis(rname, "x", n_rough, 0.0, 1.0, texel="endpoint", alpha_map=amap),
     ]
+
+
+def uses_shaded_fit(o: dict) -> bool:
+    """Whether the table's texels are the shaded fit's (lutbake.ltc.shaded) or the L3 fit's."""
+    from ..ltc.shaded import DEFAULT_LOBES
+
+    return o["fit"] == "shaded" or (o["fit"] == "auto" and o["lobe"] in DEFAULT_LOBES)
 
 
 def lobe_parameter(rough: Axis) -> np.ndarray:
@@ -212,6 +244,8 @@ class LtcBake:
         self._fits: dict[tuple[int, int], tuple[threading.Lock, list]] = {}
         self.problem = None
         self.coarse = None
+        self.shaded = uses_shaded_fit(o)
+        self.device = "cpu"
         self.sphere = sphere.sphere_table(self.n_rough) if self.n_view == self.n_rough else None
 
     def prepare(self, device: str) -> None:
@@ -225,6 +259,8 @@ class LtcBake:
                     o["lobe"], self.nov, alpha, o["samples"], device, o["estimator"], o["seed"]
                 )
                 self.fresnel = fres
+                self.device = device
+                self.has_fresnel = not np.array_equal(mag, fres)  # lobes without Fresnel store fresnel = magnitude
                 # a tabulated lobe's table is built here on every available core (the executor's default; values do
                 # not depend on the thread count)
                 threads = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
@@ -260,8 +296,16 @@ class LtcBake:
         with lock:
             if not box:
                 texel = np.arange(start, stop)
-                m, err = fit.fit_texels(self.problem, texel, self.n_rough, self.coarse, fit.MEMO)
-                box += [fit.pack_inverse(m), self.problem.relative(texel, err)]
+                p = self.problem
+                m, err = fit.fit_texels(p, texel, self.n_rough, self.coarse, fit.MEMO)
+                packed, mag, fres = fit.pack_inverse(m), p.magnitude[texel], self.fresnel[texel]
+                if self.shaded:
+                    from ..ltc import shaded
+
+                    free = self.o["magnitude"] == "fitted"
+                    packed, mag, fres = shaded.refine(p, texel, packed, free, self.device, fresnel=self.has_fresnel)
+                    err = p.error(texel, np.linalg.inv(fit.unpack_inverse(packed)))
+                box += [packed, p.relative(texel, err), mag, fres]
         return box
 
     def run_tile(self, start: int, stop: int, device: str) -> np.ndarray:
@@ -272,13 +316,13 @@ class LtcBake:
         while pos < stop:  # a tile may straddle the two slices
             z, s = divmod(pos, n)
             e = min(stop - z * n, n)
-            packed, rel = self.fitted(s, e)
+            packed, rel, mag, fres = self.fitted(s, e)
             rows = slice(pos - start, pos - start + e - s)
             if z == 0:
                 out[rows] = packed
             else:
                 sph = self.sphere.ravel()[s:e] if self.sphere is not None else np.zeros(e - s)
-                out[rows] = np.stack([self.problem.magnitude[s:e], self.fresnel[s:e], rel, sph], axis=1)
+                out[rows] = np.stack([mag, fres, rel, sph], axis=1)
             pos += e - s
         return out
 
@@ -301,6 +345,24 @@ def magnitude_record(lb, estimator: str, samples) -> str:
             "f0 = 0): equal to that table at the same texels; fresnel channel = magnitude"
         )
     return f"{estimator}, {samples or 'default'} samples (lutbake albedo / dfg integrands)"
+
+
+def shaded_record(o: dict) -> dict:
+    if not uses_shaded_fit(o):
+        return {"fit": "l3: the matrices minimise the L3 distance; magnitude and fresnel are the exact integrals"}
+    from ..ltc import shaded
+
+    mag = (
+        "magnitude fitted with the matrix, fresnel the least-squares Schlick scale"
+        if o["magnitude"] == "fitted"
+        else "magnitude = the exact albedo (fixed), fresnel the least-squares Schlick scale"
+    )
+    return {
+        "fit": f"shaded: the l3 fit refined by Levenberg-Marquardt ({shaded.ITERATIONS} steps) to minimise "
+        f"Σ ((magnitude I_j - G_j) / (G_j + {shaded.ABS_WEIGHT:g} albedo))^2 over {shaded.LIGHTS} training lights per "
+        f"texel (lutbake.ltc.lights, seed {shaded.SEED}), G_j from the lobe's {shaded.SAMPLES}^2 importance samples; "
+        + mag
+    }
 
 
 def tabulation_record(lb) -> dict:
@@ -373,6 +435,7 @@ def plan(spec) -> TexelPlan:
                 "alpha_min": o["alpha_min"],
                 "theta_max": THETA_MAX,
                 "magnitude": magnitude_record(lb, o["estimator"], m_samples),
+                **shaded_record(o),
                 "roughness_axis": ROUGHNESS_AXES[lb.roughness],
                 **tabulation_record(lb),
             }

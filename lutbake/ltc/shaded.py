@@ -1,0 +1,327 @@
+"""The shaded fit: LTC texels refined to the polygon-light integrals a shader computes, not to the lobe's L3 distance.
+
+A shader shows, for a polygon light P, value(P) = magnitude * I_P(M^-1), I_P the clamped-cosine integral of the
+polygon transformed by M^-1 and clipped to the horizon (Heitz et al. 2016, Eq. 11; lutbake.ltc.polygon). The shaded
+fit chooses each texel's packed M^-1 (4 coefficients, ltc_code's layout) and its magnitude to minimise
+
+    C = Σ_j ( (magnitude I_j - G_j) / (G_j + c A) )^2,     G_j = ∫_{P_j} f(v, l)(n.l) dω_l,
+
+over ``LIGHTS`` training lights per texel (lutbake.ltc.lights, seeded by the texel's inputs; the area-light
+benchmark draws other seeds), A = the lobe's albedo, c = ``ABS_WEIGHT``: relative errors of lights brighter than
+c A, absolute errors (in units of c A) of dimmer ones. G_j uses one fixed set of the lobe's importance samples per
+texel (the L3 fit's own lobe sampler, lutbake.ltc.fit ``lobe_samples``, on a ``SAMPLES`` x ``SAMPLES`` stratified
+grid): G_j = 1/K Σ_k f_k / p_k [l_k in P_j]. The Fresnel channel is then the least-squares scale of the same I_j
+against the Schlick part H_j = ∫_P f (1 - v.h)^5 (n.l) dω under the same weights (the shader's f0 t2.x + (1 - f0)
+t2.y is then right for every f0, linear in f0).
+
+Search: Levenberg-Marquardt from the texel's L3 fit (lutbake.ltc.fit), ``ITERATIONS`` steps, forward-difference
+Jacobian of the 4 coefficients (the magnitude is linear), float64 throughout; at normal incidence the lobe is
+isotropic and only (M^-1_22, magnitude) are free (M^-1_00 = M^-1_11, no skew), as ltc_code's table. The
+I_j are one Warp launch per step over (texel, trial, light). Every texel is independent of every other and of how
+texels are grouped: bit-identical for any tiling or worker count.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import warp as wp
+
+from ..warp_runtime import MODULE_OPTIONS, load_module
+from . import lights as ltc_lights
+
+wp.set_module_options(MODULE_OPTIONS)
+
+LIGHTS = 128  # training lights per texel
+SAMPLES = 48  # the lobe's importance samples per texel: SAMPLES x SAMPLES stratified
+ABS_WEIGHT = 0.2  # c: errors relative to G_j + c A
+ROBUST_SCALE = 0.05  # s of the soft-L1 loss on the weighted residuals
+ITERATIONS = 8
+LAMBDA0 = 1e-2  # initial Levenberg-Marquardt damping (relative to diag(J^T J))
+FD_STEP = 1e-6  # forward-difference step, relative to max(|coefficient|, 1)
+SEED = 40
+DEFAULT_LOBES = frozenset({"ggx"})  # the ltc kind's fit = "auto": lobes where the shaded fit wins the benchmark
+
+
+@wp.func
+def edge_z(a: wp.vec3d, b: wp.vec3d):
+    """acos(a.b) (a x b).z / |a x b| / (2 pi) for unit a, b (the exact edge integral; 0 for a = b)."""
+    c = wp.cross(a, b)
+    s = wp.length(c)
+    if s <= wp.float64(0.0):
+        return wp.float64(0.0)
+    th = wp.atan2(s, wp.dot(a, b))
+    return c[2] * th / (s * wp.float64(6.283185307179586))
+
+
+@wp.func
+def clipped_integral(p0: wp.vec3d, p1: wp.vec3d, p2: wp.vec3d, p3: wp.vec3d):
+    """|I| of the quad (p0..p3) clipped to z >= 0 (Sutherland-Hodgman, <= 5 vertices), exact edges, two-sided."""
+    c0 = wp.vec3d()
+    c1 = wp.vec3d()
+    c2 = wp.vec3d()
+    c3 = wp.vec3d()
+    c4 = wp.vec3d()
+    n = int(0)  # noqa: UP018 - a dynamic Warp variable (mutated in the loop)
+    for i in range(4):
+        a = p0
+        b = p1
+        if i == 1:
+            a = p1
+            b = p2
+        elif i == 2:
+            a = p2
+            b = p3
+        elif i == 3:
+            a = p3
+            b = p0
+        ina = a[2] >= wp.float64(0.0)
+        inb = b[2] >= wp.float64(0.0)
+        for k in range(2):
+            emit = bool(False)  # noqa: UP018 - dynamic
+            q = a
+            if k == 0 and ina:
+                emit = True
+            if k == 1 and ina != inb:
+                t = a[2] / (a[2] - b[2])
+                q = a + t * (b - a)
+                q = wp.vec3d(q[0], q[1], wp.float64(0.0))
+                emit = True
+            if emit:
+                if n == 0:
+                    c0 = q
+                elif n == 1:
+                    c1 = q
+                elif n == 2:
+                    c2 = q
+                elif n == 3:
+                    c3 = q
+                else:
+                    c4 = q
+                n += 1
+    if n < 3:
+        return wp.float64(0.0)
+    u0 = wp.normalize(c0)
+    u1 = wp.normalize(c1)
+    u2 = wp.normalize(c2)
+    s = edge_z(u0, u1) + edge_z(u1, u2)
+    if n == 3:
+        s += edge_z(u2, u0)
+    else:
+        u3 = wp.normalize(c3)
+        s += edge_z(u2, u3)
+        if n == 4:
+            s += edge_z(u3, u0)
+        else:
+            u4 = wp.normalize(c4)
+            s += edge_z(u3, u4) + edge_z(u4, u0)
+    return wp.abs(s)
+
+
+@wp.kernel(enable_backward=False)
+def polygon_integrals(
+    texel: wp.array(dtype=int),
+    minv: wp.array(dtype=wp.mat33d),
+    polys: wp.array3d(dtype=wp.vec3d),
+    out: wp.array2d(dtype=wp.float64),
+):
+    """out[i, j] = I of light j of texel[i] through M^-1 = minv[i] (the shader's integral, exact edges)."""
+    i, j = wp.tid()
+    t = texel[i]
+    m = minv[i]
+    out[i, j] = clipped_integral(m * polys[t, j, 0], m * polys[t, j, 1], m * polys[t, j, 2], m * polys[t, j, 3])
+
+
+@functools.lru_cache(maxsize=None)
+def _loaded(device: str) -> bool:
+    load_module(polygon_integrals.module, device)
+    return True
+
+
+def integrals(minv: np.ndarray, texel: np.ndarray, polys: np.ndarray, device: str = "cpu") -> np.ndarray:
+    """I (k, L) of the lights polys (T, L, 4, 3) of texels ``texel`` (k,) through M^-1 ``minv`` (k, 3, 3)."""
+    _loaded(device)
+    k, nl = len(texel), polys.shape[1]
+    out = wp.zeros((k, nl), dtype=wp.float64, device=device)
+    wp.launch(
+        polygon_integrals,
+        dim=(k, nl),
+        inputs=[
+            wp.array(np.asarray(texel, np.int32), dtype=int, device=device),
+            wp.array(np.ascontiguousarray(minv, np.float64), dtype=wp.mat33d, device=device),
+            wp.array(
+                np.ascontiguousarray(polys.reshape(polys.shape[0], nl, 4, 3), np.float64), dtype=wp.vec3d, device=device
+            ),
+            out,
+        ],
+        device=device,
+    )
+    return out.numpy()
+
+
+def robust(z: np.ndarray) -> np.ndarray:
+    """The soft-L1 loss 2 s^2 (sqrt(1 + (z / s)^2) - 1), s = ROBUST_SCALE: quadratic below s, linear above (lights
+    the one clamped cosine cannot follow, e.g. below its transformed horizon, do not dominate the fit)."""
+    s2 = ROBUST_SCALE * ROBUST_SCALE
+    return 2.0 * s2 * (np.sqrt(1.0 + z * z / s2) - 1.0)
+
+
+def robust_weight(z: np.ndarray) -> np.ndarray:
+    """The IRLS weight of ``robust``: 1 / sqrt(1 + (z / s)^2)."""
+    return 1.0 / np.sqrt(1.0 + z * z / (ROBUST_SCALE * ROBUST_SCALE))
+
+
+def unpack(theta: np.ndarray) -> np.ndarray:
+    """Packed (k, 4) -> M^-1 (k, 3, 3) (rows (x, 0, z), (0, 1, 0), (y, 0, w); lutbake.ltc.fit.unpack_inverse)."""
+    k = len(theta)
+    inv = np.zeros((k, 3, 3))
+    inv[:, 0, 0], inv[:, 2, 0], inv[:, 0, 2], inv[:, 2, 2] = theta[:, 0], theta[:, 1], theta[:, 2], theta[:, 3]
+    inv[:, 1, 1] = 1.0
+    return inv
+
+
+def texel_lights(nov: np.ndarray, alpha: np.ndarray, count: int = LIGHTS, seed: int = SEED) -> np.ndarray:
+    """Training lights (k, count, 4, 3) per texel: one fixed set of uniform numbers (``seed``) mapped through each
+    texel's own (n.v, alpha) (lutbake.ltc.lights.from_uniforms), so a texel's lights depend on its inputs alone."""
+    u = np.random.default_rng(seed).random((2 * count + 16, ltc_lights.UNIFORMS))
+    nv = np.asarray(nov, np.float64)
+    v = np.stack([np.sqrt(np.maximum(1.0 - nv * nv, 0.0)), np.zeros_like(nv), nv], axis=1)
+    p = ltc_lights.from_uniforms(u[None], v[:, None, :], np.asarray(alpha, np.float64)[:, None])
+    return ltc_lights.first_lit(p, count)
+
+
+@wp.kernel(enable_backward=False)
+def light_integrals(
+    dirs: wp.array2d(dtype=wp.vec3d),
+    w: wp.array2d(dtype=wp.float64),
+    wf: wp.array2d(dtype=wp.float64),
+    polys: wp.array3d(dtype=wp.vec3d),
+    g: wp.array2d(dtype=wp.float64),
+    h: wp.array2d(dtype=wp.float64),
+):
+    """g[t, j] = Σ_s w[t, s] [dirs[t, s] in light j], h likewise with wf: the lobe's integral over each light from
+    its importance samples (weights f / p / K), and its Schlick part."""
+    t, j = wp.tid()
+    p0 = polys[t, j, 0]
+    p1 = polys[t, j, 1]
+    p2 = polys[t, j, 2]
+    p3 = polys[t, j, 3]
+    e0 = wp.cross(p0, p1)
+    e1 = wp.cross(p1, p2)
+    e2 = wp.cross(p2, p3)
+    e3 = wp.cross(p3, p0)
+    zero = wp.float64(0.0)
+    sg = wp.float64(0.0)
+    sh = wp.float64(0.0)
+    for s in range(dirs.shape[1]):
+        l = dirs[t, s]
+        if wp.dot(l, e0) >= zero and wp.dot(l, e1) >= zero and wp.dot(l, e2) >= zero and wp.dot(l, e3) >= zero:
+            sg += w[t, s]
+            sh += wf[t, s]
+    g[t, j] = sg
+    h[t, j] = sh
+
+
+def targets(problem, texel: np.ndarray, polys: np.ndarray, device: str = "cpu") -> tuple[np.ndarray, np.ndarray]:
+    """(G, H): the lobe's integral over each training light (k, L) and its Schlick part ∫_P f (1 - v.h)^5 (n.l) dω,
+    from the problem's lobe samples (lutbake.ltc.fit.Problem: its sampler on its stratified grid)."""
+    _loaded(device)
+    dirs, f, p = problem.lobe_sample_arrays(texel)
+    w = np.where(p > 0.0, f / np.where(p > 0.0, p, 1.0), 0.0) / dirs.shape[1]
+    v = problem.v[texel].astype(np.float64)
+    hv = dirs + v[:, None, :]
+    hv /= np.maximum(np.linalg.norm(hv, axis=2, keepdims=True), 1e-300)
+    f5 = (1.0 - np.clip(np.einsum("ksj,kj->ks", hv, v), 0.0, 1.0)) ** 5
+    k, nl = len(texel), polys.shape[1]
+    g = wp.zeros((k, nl), dtype=wp.float64, device=device)
+    h = wp.zeros((k, nl), dtype=wp.float64, device=device)
+    arr = functools.partial(wp.array, device=device)
+    inputs = [arr(np.ascontiguousarray(dirs), dtype=wp.vec3d), arr(w, dtype=wp.float64), arr(w * f5, dtype=wp.float64)]
+    inputs += [arr(np.ascontiguousarray(polys, np.float64), dtype=wp.vec3d), g, h]
+    wp.launch(light_integrals, dim=(k, nl), inputs=inputs, device=device)
+    return g.numpy(), h.numpy()
+
+
+def refine(
+    problem,
+    texel: np.ndarray,
+    packed: np.ndarray,
+    fit_magnitude: bool = True,
+    device: str = "cpu",
+    lights: int = LIGHTS,
+    samples: int = SAMPLES,
+    fresnel: bool = True,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Levenberg-Marquardt from ``packed`` (k, 4) at ``texel``: (packed (k, 4), magnitude (k,), fresnel (k,)).
+    ``fit_magnitude`` False keeps the problem's magnitude (the albedo) and fits the matrix alone (for layouts whose
+    shader takes the magnitude elsewhere, e.g. HDRP's PreIntegratedFGD)."""
+    from .fit import Problem
+
+    k = len(texel)
+    polys = texel_lights(problem.nov[texel], problem.alpha[texel], lights)
+    sp = Problem(problem.lobe, problem.nov[texel], problem.alpha[texel], problem.magnitude[texel], samples, device)
+    G, H = targets(sp, np.arange(k), polys, device)
+    A = problem.magnitude[texel]
+    sw = 1.0 / (G + ABS_WEIGHT * A[:, None])  # sqrt of the weights
+    local = np.arange(k)
+    iso = problem.isotropic[texel]
+    free = np.ones((k, 4), bool)
+    free[iso, :3] = False  # normal incidence: (1, 0, 0, w)
+
+    def evaluate(theta):
+        return integrals(unpack(theta), local, polys, device)
+
+    def best_mag(I, omega):
+        if not fit_magnitude:
+            return A.copy()
+        a = I * sw
+        return np.einsum("kj,kj,kj->k", omega, a, G * sw) / np.maximum(np.einsum("kj,kj,kj->k", omega, a, a), 1e-300)
+
+    def residual(I, m):
+        return (m[:, None] * I - G) * sw
+
+    def cost(z):
+        return np.sum(robust(z), axis=1)
+
+    theta = np.array(packed, np.float64)
+    I = evaluate(theta)
+    omega = np.ones_like(G)
+    m = best_mag(I, omega)
+    z = residual(I, m)
+    c = cost(z)
+    lam = np.full(k, LAMBDA0)
+    np_ = 5 if fit_magnitude else 4
+    for _ in range(ITERATIONS):
+        omega = robust_weight(z)  # IRLS: the robust cost's local quadratic model
+        so = np.sqrt(omega)
+        # Jacobian of z = (m I - G) sw in (theta, m), forward differences in theta
+        h = FD_STEP * np.maximum(np.abs(theta), 1.0)
+        trials = np.repeat(theta[:, None, :], 4, axis=1)
+        trials[:, np.arange(4), np.arange(4)] += h
+        It = integrals(unpack(trials.reshape(-1, 4)), np.repeat(local, 4), polys, device).reshape(k, 4, -1)
+        J = np.zeros((k, G.shape[1], np_))
+        J[:, :, :4] = (m[:, None, None] * (It - I[:, None, :]) / h[:, :, None]).transpose(0, 2, 1) * sw[:, :, None]
+        J[:, :, :4] *= free[:, None, :]
+        if fit_magnitude:
+            J[:, :, 4] = I * sw
+        J *= so[:, :, None]
+        JtJ = np.einsum("kja,kjb->kab", J, J)
+        Jtr = np.einsum("kja,kj->ka", J, z * so)
+        d = np.einsum("kaa->ka", JtJ).copy()
+        d[d <= 0.0] = 1.0
+        step = -np.linalg.solve(JtJ + lam[:, None, None] * d[:, :, None] * np.eye(np_)[None], Jtr[:, :, None])[..., 0]
+        th_new = theta + step[:, :4] * free
+        I_new = evaluate(th_new)
+        m_new = best_mag(I_new, omega)
+        z_new = residual(I_new, m_new)
+        c_new = cost(z_new)
+        ok = np.isfinite(c_new) & (c_new < c)
+        theta[ok], I[ok], m[ok], z[ok], c[ok] = th_new[ok], I_new[ok], m_new[ok], z_new[ok], c_new[ok]
+        lam = np.where(ok, lam / 3.0, lam * 4.0)
+    omega = robust_weight(z)
+    if not fresnel:  # a lobe without Fresnel: its fresnel channel is the magnitude
+        return theta, m, m.copy()
+    a = I * sw
+    fres = np.einsum("kj,kj,kj->k", omega, a, H * sw) / np.maximum(np.einsum("kj,kj,kj->k", omega, a, a), 1e-300)
+    return theta, m, fres
