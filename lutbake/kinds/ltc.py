@@ -76,16 +76,23 @@ KEYS = {
     "fit": Key(
         "fit",
         "str",
-        "auto",
+        "l3",
         "what the fit minimises",
         {
-            "auto": "shaded where it was measured to win on the area-light benchmark (lobes in "
-            "lutbake.ltc.shaded.DEFAULT_LOBES), else l3",
-            "shaded": "the l3 fit refined to the polygon-light integrals the shader computes (lutbake.ltc.shaded): "
-            "matrix, magnitude and fresnel fitted to the lobe's integrals over training lights",
             "l3": "Heitz et al. 2016's L3 distance to the lobe (ltc_code's fit); magnitude and fresnel the exact "
             "integrals",
+            "shaded": "the l3 fit refined to the polygon-light integrals the shader computes (lutbake.ltc.shaded): "
+            "matrix, magnitude and fresnel fitted to the lobe's integrals over training lights",
         },
+    ),
+    "fit_f0_weight": Key(
+        "fit_f0_weight",
+        "float",
+        0.7,
+        "shaded fit, lobes with Fresnel: weight of the dielectric (f0 = 0.04) shading errors beside F = 1 (0: F = 1 "
+        "alone; one matrix serves every f0)",
+        minimum=0.0,
+        maximum=1.0,
     ),
     "magnitude": Key(
         "magnitude",
@@ -137,9 +144,7 @@ def axes_for(o: dict) -> list[Axis]:
 
 def uses_shaded_fit(o: dict) -> bool:
     """Whether the table's texels are the shaded fit's (lutbake.ltc.shaded) or the L3 fit's."""
-    from ..ltc.shaded import DEFAULT_LOBES
-
-    return o["fit"] == "shaded" or (o["fit"] == "auto" and o["lobe"] in DEFAULT_LOBES)
+    return o["fit"] == "shaded" and o["lobe"] != "lambert"  # lambert: the L3 fit is exact
 
 
 def lobe_parameter(rough: Axis) -> np.ndarray:
@@ -303,7 +308,10 @@ class LtcBake:
                     from ..ltc import shaded
 
                     free = self.o["magnitude"] == "fitted"
-                    packed, mag, fres = shaded.refine(p, texel, packed, free, self.device, fresnel=self.has_fresnel)
+                    exact_fres = fres if self.has_fresnel else None
+                    packed, mag, fres = shaded.refine(
+                        p, texel, packed, exact_fres, free, self.device, f0_weight=self.o["fit_f0_weight"]
+                    )
                     err = p.error(texel, np.linalg.inv(fit.unpack_inverse(packed)))
                 box += [packed, p.relative(texel, err), mag, fres]
         return box
@@ -358,10 +366,11 @@ def shaded_record(o: dict) -> dict:
         else "magnitude = the exact albedo (fixed), fresnel the least-squares Schlick scale"
     )
     return {
-        "fit": f"shaded: the l3 fit refined by Levenberg-Marquardt ({shaded.ITERATIONS} steps) to minimise "
-        f"Σ ((magnitude I_j - G_j) / (G_j + {shaded.ABS_WEIGHT:g} albedo))^2 over {shaded.LIGHTS} training lights per "
-        f"texel (lutbake.ltc.lights, seed {shaded.SEED}), G_j from the lobe's {shaded.SAMPLES}^2 importance samples; "
-        + mag
+        "fit": f"shaded: the l3 fit refined by Levenberg-Marquardt ({shaded.ITERATIONS} steps) to minimise the soft-L1 "
+        f"(scale {shaded.ROBUST_SCALE:g}) of (value_j - G_j) / (G_j + {shaded.ABS_WEIGHT:g} albedo) over "
+        f"{shaded.LIGHTS} training lights per texel (lutbake.ltc.lights, seed {shaded.SEED}), G_j from the lobe's "
+        f"{shaded.SAMPLES}^2 importance samples, for F = 1 and (weight {o['fit_f0_weight']:g}) f0 = "
+        f"{shaded.F0_TRAIN:g}; " + mag
     }
 
 

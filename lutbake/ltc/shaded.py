@@ -35,13 +35,14 @@ wp.set_module_options(MODULE_OPTIONS)
 
 LIGHTS = 128  # training lights per texel
 SAMPLES = 48  # the lobe's importance samples per texel: SAMPLES x SAMPLES stratified
-ABS_WEIGHT = 0.2  # c: errors relative to G_j + c A
+ABS_WEIGHT = 0.4  # c: errors relative to G_j + c A
 ROBUST_SCALE = 0.05  # s of the soft-L1 loss on the weighted residuals
 ITERATIONS = 8
 LAMBDA0 = 1e-2  # initial Levenberg-Marquardt damping (relative to diag(J^T J))
 FD_STEP = 1e-6  # forward-difference step, relative to max(|coefficient|, 1)
 SEED = 40
-DEFAULT_LOBES = frozenset({"ggx"})  # the ltc kind's fit = "auto": lobes where the shaded fit wins the benchmark
+F0_TRAIN = 0.04  # the dielectric reflectance fitted beside F = 1 (lobes with Fresnel)
+F0_WEIGHT = 0.7  # default weight of the f0 = F0_TRAIN residuals beside F = 1 (0: F = 1 alone)
 
 
 @wp.func
@@ -247,15 +248,21 @@ def refine(
     problem,
     texel: np.ndarray,
     packed: np.ndarray,
+    fresnel: np.ndarray | None = None,
     fit_magnitude: bool = True,
     device: str = "cpu",
     lights: int = LIGHTS,
     samples: int = SAMPLES,
-    fresnel: bool = True,
+    f0_weight: float = F0_WEIGHT,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Levenberg-Marquardt from ``packed`` (k, 4) at ``texel``: (packed (k, 4), magnitude (k,), fresnel (k,)).
-    ``fit_magnitude`` False keeps the problem's magnitude (the albedo) and fits the matrix alone (for layouts whose
-    shader takes the magnitude elsewhere, e.g. HDRP's PreIntegratedFGD)."""
+
+    ``fresnel``: the exact Schlick channel ∫ f (1 - v.h)^5 (n.l) dω of the texels, or None for a lobe without
+    Fresnel (its fresnel channel is then the magnitude, and only F = 1 is fitted). With Fresnel the residuals are
+    those of F = 1 and of f0 = ``F0_TRAIN`` (value (f0 magnitude + (1 - f0) fresnel) I against f0 G + (1 - f0) H,
+    relative to the same mix of the albedos), so the one matrix serves metals and dielectrics.
+    ``fit_magnitude`` False keeps magnitude = the albedo and fresnel = the exact channel and fits the matrix alone
+    (for shaders that take the magnitude from another table, e.g. HDRP's PreIntegratedFGD)."""
     from .fit import Problem
 
     k = len(texel)
@@ -263,65 +270,74 @@ def refine(
     sp = Problem(problem.lobe, problem.nov[texel], problem.alpha[texel], problem.magnitude[texel], samples, device)
     G, H = targets(sp, np.arange(k), polys, device)
     A = problem.magnitude[texel]
-    sw = 1.0 / (G + ABS_WEIGHT * A[:, None])  # sqrt of the weights
+    f0s = (1.0,) if fresnel is None or f0_weight == 0.0 else (1.0, F0_TRAIN)
+    AH = A if fresnel is None else np.asarray(fresnel, np.float64)
+    # per reflectance: target (k, L), sqrt weight (k, L), d value / d (magnitude, fresnel) per unit I
+    tg = [f0 * G + (1.0 - f0) * H for f0 in f0s]
+    sw = [
+        (1.0 if f0 == 1.0 else f0_weight) / (t + ABS_WEIGHT * (f0 * A + (1.0 - f0) * AH)[:, None])
+        for f0, t in zip(f0s, tg)
+    ]
+    target = np.concatenate(tg, axis=1)
+    sw = np.concatenate(sw, axis=1)
+    coef_m = np.concatenate([np.full(G.shape, f0) for f0 in f0s], axis=1)
+    coef_f = 1.0 - coef_m
     local = np.arange(k)
     iso = problem.isotropic[texel]
     free = np.ones((k, 4), bool)
     free[iso, :3] = False  # normal incidence: (1, 0, 0, w)
+    lin = (["m"] if fit_magnitude else []) + (["f"] if fit_magnitude and len(f0s) > 1 else [])
+    npar = 4 + len(lin)
 
     def evaluate(theta):
-        return integrals(unpack(theta), local, polys, device)
+        return np.tile(integrals(unpack(theta), local, polys, device), (1, len(f0s)))
 
-    def best_mag(I, omega):
-        if not fit_magnitude:
-            return A.copy()
-        a = I * sw
-        return np.einsum("kj,kj,kj->k", omega, a, G * sw) / np.maximum(np.einsum("kj,kj,kj->k", omega, a, a), 1e-300)
-
-    def residual(I, m):
-        return (m[:, None] * I - G) * sw
+    def residual(I, m, f):
+        return ((coef_m * m[:, None] + coef_f * f[:, None]) * I - target) * sw
 
     def cost(z):
         return np.sum(robust(z), axis=1)
 
     theta = np.array(packed, np.float64)
+    m, f = A.copy(), AH.copy()
     I = evaluate(theta)
-    omega = np.ones_like(G)
-    m = best_mag(I, omega)
-    z = residual(I, m)
+    z = residual(I, m, f)
     c = cost(z)
     lam = np.full(k, LAMBDA0)
-    np_ = 5 if fit_magnitude else 4
     for _ in range(ITERATIONS):
-        omega = robust_weight(z)  # IRLS: the robust cost's local quadratic model
-        so = np.sqrt(omega)
-        # Jacobian of z = (m I - G) sw in (theta, m), forward differences in theta
+        so = np.sqrt(robust_weight(z))  # IRLS: the robust cost's local quadratic model
+        # Jacobian of z in (theta, magnitude, fresnel), forward differences in theta
         h = FD_STEP * np.maximum(np.abs(theta), 1.0)
         trials = np.repeat(theta[:, None, :], 4, axis=1)
         trials[:, np.arange(4), np.arange(4)] += h
         It = integrals(unpack(trials.reshape(-1, 4)), np.repeat(local, 4), polys, device).reshape(k, 4, -1)
-        J = np.zeros((k, G.shape[1], np_))
-        J[:, :, :4] = (m[:, None, None] * (It - I[:, None, :]) / h[:, :, None]).transpose(0, 2, 1) * sw[:, :, None]
-        J[:, :, :4] *= free[:, None, :]
-        if fit_magnitude:
-            J[:, :, 4] = I * sw
+        dI = np.tile((It - I[:, None, : G.shape[1]]) / h[:, :, None], (1, 1, len(f0s)))  # (k, 4, R)
+        scale = (coef_m * m[:, None] + coef_f * f[:, None]) * sw
+        J = np.empty((k, target.shape[1], npar))
+        J[:, :, :4] = (dI * scale[:, None, :]).transpose(0, 2, 1) * free[:, None, :]
+        for i, name in enumerate(lin):
+            J[:, :, 4 + i] = (coef_m if name == "m" else coef_f) * I * sw
         J *= so[:, :, None]
         JtJ = np.einsum("kja,kjb->kab", J, J)
         Jtr = np.einsum("kja,kj->ka", J, z * so)
         d = np.einsum("kaa->ka", JtJ).copy()
         d[d <= 0.0] = 1.0
-        step = -np.linalg.solve(JtJ + lam[:, None, None] * d[:, :, None] * np.eye(np_)[None], Jtr[:, :, None])[..., 0]
+        step = -np.linalg.solve(JtJ + lam[:, None, None] * d[:, :, None] * np.eye(npar)[None], Jtr[:, :, None])[..., 0]
         th_new = theta + step[:, :4] * free
+        m_new, f_new = m.copy(), f.copy()
+        for i, name in enumerate(lin):
+            if name == "m":
+                m_new = m + step[:, 4 + i]
+            else:
+                f_new = f + step[:, 4 + i]
         I_new = evaluate(th_new)
-        m_new = best_mag(I_new, omega)
-        z_new = residual(I_new, m_new)
+        z_new = residual(I_new, m_new, f_new)
         c_new = cost(z_new)
         ok = np.isfinite(c_new) & (c_new < c)
-        theta[ok], I[ok], m[ok], z[ok], c[ok] = th_new[ok], I_new[ok], m_new[ok], z_new[ok], c_new[ok]
+        theta[ok], I[ok], m[ok], f[ok], z[ok], c[ok] = th_new[ok], I_new[ok], m_new[ok], f_new[ok], z_new[ok], c_new[ok]
         lam = np.where(ok, lam / 3.0, lam * 4.0)
-    omega = robust_weight(z)
-    if not fresnel:  # a lobe without Fresnel: its fresnel channel is the magnitude
-        return theta, m, m.copy()
-    a = I * sw
-    fres = np.einsum("kj,kj,kj->k", omega, a, H * sw) / np.maximum(np.einsum("kj,kj,kj->k", omega, a, a), 1e-300)
-    return theta, m, fres
+    if fresnel is None:
+        f = m.copy()
+    elif fit_magnitude and len(f0s) == 1:  # F = 1 alone: the Schlick channel is the exact integral
+        f = AH.copy()
+    return theta, m, f

@@ -18,7 +18,8 @@ fetch of both textures (clamp to edge), M^-1 from ltc_1, horizon clip, exact edg
 value = (f0 t2.x + (1 - f0) t2.y) I.
 
 Errors, per light: relative |value - truth| / truth where the truth exceeds ``REL_FLOOR`` x the albedo (the whole
-lobe's integral ∫ f (n.l) dω, by the same samples); and |value - truth| / albedo (every light).
+lobe's integral ∫ f (n.l) dω, by the same samples); and |value - truth| / albedo (every light). With Schlick Fresnel
+of reflectance f0 the truth is f0 lobe + (1 - f0) schlick and the albedo likewise.
 """
 
 from __future__ import annotations
@@ -110,7 +111,12 @@ def ground_truth(case: dict, s: int, sampler: str = "vndf") -> dict:
     l, w, f5 = l[keep], w[keep], f5[keep]
     hit = ltc_lights.inside(l, case["lights"])
     n = s * s
-    return {"lobe": (w @ hit) / n, "schlick": ((w * f5) @ hit) / n, "albedo": float(w.sum() / n)}
+    return {
+        "lobe": (w @ hit) / n,
+        "schlick": ((w * f5) @ hit) / n,
+        "albedo": float(w.sum() / n),
+        "schlick_albedo": float((w * f5).sum() / n),
+    }
 
 
 def shade(ltc_1: np.ndarray, ltc_2: np.ndarray, case: dict) -> np.ndarray:
@@ -129,8 +135,7 @@ def errors(ltc_1: np.ndarray, ltc_2: np.ndarray, cs: list[dict], truths: list[di
         val = shade(ltc_1, ltc_2, c)
         got = f0 * val[0] + (1.0 - f0) * val[1]
         want = f0 * g["lobe"] + (1.0 - f0) * g["schlick"]
-        alb = g["albedo"] if f0 == 1.0 else f0 * g["albedo"] + (1.0 - f0) * 0.0
-        alb = max(alb, 1e-12)
+        alb = max(f0 * g["albedo"] + (1.0 - f0) * g["schlick_albedo"], 1e-12)
         e = np.abs(got - want)
         rel.append(np.where(want > REL_FLOOR * alb, e / np.where(want > 0, want, 1.0), np.nan))
         ab.append(e / alb)
@@ -183,3 +188,39 @@ def report(err: dict) -> dict:
             sel = (err["rough"] == i) & (err["view"] == j)
             out[f"{band_name('rough', i)} / {band_name('view', j)}"] = stats(err, sel)
     return out
+
+
+def lookup_texels(cs: list[dict], n: int) -> list[tuple[int, int]]:
+    """The (view row, roughness column) texels the shader's bilinear lookups of the cases read (n x n table)."""
+    out = set()
+    for c in cs:
+        u, v = polygon.lookup_uv(n, c["r"], c["nov"])
+        x, y = np.clip(u * n - 0.5, 0.0, n - 1.0), np.clip(v * n - 0.5, 0.0, n - 1.0)
+        for a in {int(np.floor(x)), min(int(np.floor(x)) + 1, n - 1)}:
+            for t in {int(np.floor(y)), min(int(np.floor(y)) + 1, n - 1)}:
+                out.add((t, a))
+    return sorted(out)
+
+
+def fitted_texels(
+    texels: list[tuple[int, int]], fit_kind: str = "shaded", n: int = 64, f0_weight: float | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """A GGX n x n table (ltc_1, ltc_2) with only ``texels`` filled, fitted as the ``ltc`` kind fits them (its
+    magnitude, its coarse pass and seeding, and for ``fit_kind`` "shaded" its refinement; the sphere and fit-error
+    channels are left 0): enough for the cases whose lookups read only these texels, at a fraction of a table's cost."""
+    from ..kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
+    from ..ltc import fit, shaded
+
+    axes = axes_for({"lobe": "ggx", "size": [n, n]})
+    nov, alpha = texel_params(axes)
+    mag, fres = magnitude_fresnel("ggx", nov, magnitude_alpha(axes), None)
+    prob = fit.Problem("ggx", nov, alpha, mag)
+    idx = np.array([t * n + a for t, a in texels])
+    m, _ = fit.fit_texels(prob, idx, n, fit.coarse_pass(prob, n, n))
+    packed, mg, fr = fit.pack_inverse(m), mag[idx], fres[idx]
+    if fit_kind == "shaded":
+        w = shaded.F0_WEIGHT if f0_weight is None else f0_weight
+        packed, mg, fr = shaded.refine(prob, idx, packed, fres[idx], f0_weight=w)
+    t1, t2 = np.zeros((n * n, 4)), np.zeros((n * n, 4))
+    t1[idx], t2[idx, 0], t2[idx, 1] = packed, mg, fr
+    return t1.reshape(n, n, 4), t2.reshape(n, n, 4)
