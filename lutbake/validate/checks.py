@@ -641,7 +641,7 @@ def ltc_eon_r0_is_identity() -> CheckResult:
     return _result("ltc_eon_r0_is_identity", err, LTC_IDENTITY_TOL, "max |packed M^-1 - (1, 0, 0, 1)| over 6 views")
 
 
-LTC_AREA_REL_MEDIAN = 0.05  # GGX shaded fit, area-light benchmark (16 shading points x 8 lights), F = 1: measured 0.030
+LTC_AREA_REL_MEDIAN = 0.05  # GGX shaded fit, area-light benchmark (16 shading points x 8 lights), F = 1: measured 0.036
 
 
 def ltc_area_benchmark_median() -> CheckResult:
