@@ -74,6 +74,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_dielectric.py
 	$(BIN)/python benchmarks/bench_ltc.py
 	$(BIN)/python benchmarks/bench_cluster.py
+	$(BIN)/python benchmarks/write_benchmarks_md.py
 
 # LTC fits (kind ltc): fit time per lobe at 64^2, the straight-port baseline, area-light errors: outputs/bench/ltc.json
 bench-ltc: $(STAMP)

@@ -36,12 +36,13 @@ import warp as wp
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from lutbake import batch, cluster  # noqa: E402
+from lutbake import batch  # noqa: E402
 from lutbake.config import load_configs, preset_path  # noqa: E402
-from lutbake.executor import default_workers  # noqa: E402
 from lutbake.io.exr import read_exr  # noqa: E402
 from lutbake.io.integrity import sidecar_path  # noqa: E402
 from lutbake.kinds import lookup_kind  # noqa: E402
+from lutbake.runtime import cluster  # noqa: E402
+from lutbake.runtime.executor import default_workers  # noqa: E402
 
 OUT = ROOT / "outputs" / "bench"
 PRESETS = ("filament", "filament-corrected", "gltf", "gltf-charlie", "gltf-sheen-e", "blender-eevee", "unreal")

@@ -29,9 +29,9 @@ wp.config.quiet = True
 
 from lutbake.api import bake_table  # noqa: E402
 from lutbake.config import validate_table  # noqa: E402
-from lutbake.executor import default_workers  # noqa: E402
 from lutbake.kinds import dielectric as kd  # noqa: E402
 from lutbake.provenance import sources_digest  # noqa: E402
+from lutbake.runtime.executor import default_workers  # noqa: E402
 
 OUT = ROOT / "outputs" / "bench"
 REF_ORDER = 24

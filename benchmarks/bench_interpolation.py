@@ -40,8 +40,8 @@ def tiles(spec, **overrides):
     """(data (n, tile width), CPU seconds of the tiles, wall seconds, the plan's channel count) of spec with
     ``overrides``."""
     from lutbake.config import validate_table
-    from lutbake.executor import execute_tiles
     from lutbake.kinds import lookup_kind
+    from lutbake.runtime.executor import execute_tiles
 
     s = validate_table({**{k: v for k, v in spec.options.items() if v is not None}, **overrides}, "<bench>", 0)
     cpu: list[float] = []

@@ -1,4 +1,4 @@
-"""LTC search investigation (issue 13; docs/accuracy.md, "Issue 13, 2026-12-03 (night)"): would a damped Newton method
+"""LTC search investigation (docs/decisions.md, "LTC fit"): would a damped Newton method
 fit the texels with fewer objective evaluations than ltc_code's Nelder-Mead (lutbake.ltc.fit.refine), and as well?
 On ``--texels`` random texels of the 64^2 GGX fit, from the same starts (the best seed candidate of each texel, as
 lutbake.ltc.fit.fit_from), it runs Nelder-Mead as the table does, the Newton method alone, and Nelder-Mead to a looser

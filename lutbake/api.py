@@ -12,8 +12,8 @@ from pathlib import Path
 from . import batch, preflight
 from .config import TableSpec, load_configs
 from .errors import TableError
-from .executor import Progress
 from .pipeline import bake_table
+from .runtime.executor import Progress
 from .table import Table
 from .values_cache import open_cache
 

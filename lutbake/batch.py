@@ -34,16 +34,16 @@ from pathlib import Path
 from . import __version__
 from .config import TableSpec
 from .errors import LutbakeError
-from .executor import Cancelled, Progress, default_workers
 from .io.atomic import atomic_write_bytes, remove_stale_temps
 from .io.formats import output_path, write_table
 from .io.oserror import os_error_text
 from .kinds import lookup_kind
 from .pipeline import Computed, assemble, compute
 from .provenance import HASH_ATTRIBUTE, content_hash, read_header, sources_digest
+from .runtime.executor import Cancelled, Progress, default_workers
+from .runtime.warp_runtime import ModuleBusy, defer_if_busy
 from .sharing import group_by, values_key
 from .values_cache import ValuesCache
-from .warp_runtime import ModuleBusy, defer_if_busy
 
 STATUSES = ("baked", "skipped", "failed", "interrupted")
 EXIT_OK, EXIT_FAILED, EXIT_SIGINT, EXIT_SIGTERM = 0, 1, 130, 143
@@ -244,7 +244,7 @@ def run(
     a big table keeps every core busy after the small ones are done (the OS shares the cores while
     several tables run; the result is bit-identical either way).
     Returns None, or the signal number if the run was interrupted (the unfinished jobs are then marked
-    ``interrupted``; finished files are kept). ``progress``: lutbake.executor.Progress, per table.
+    ``interrupted``; finished files are kept). ``progress``: lutbake.runtime.executor.Progress, per table.
     ``cache``: lutbake.values_cache.ValuesCache, whose entries of other sources are pruned first.
     """
     workers = workers or default_workers()
@@ -266,7 +266,8 @@ def run(
 
     def bake_next() -> list[Job]:
         """Bake the group at the head of the queue. A group whose first kernel module another table's thread is
-        compiling steps back once, behind the next group (lutbake.warp_runtime.defer_if_busy: that core compiles or
+        compiling steps back once, behind the next group (lutbake.runtime.warp_runtime.defer_if_busy: that core
+        compiles or
         bakes something else meanwhile); each task bakes exactly one group."""
         while True:
             with queue_lock:

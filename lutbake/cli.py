@@ -48,7 +48,7 @@ def main(verbose):
     if verbose:
         import os
 
-        from .warp_runtime import VERBOSE_ENV
+        from .runtime.warp_runtime import VERBOSE_ENV
 
         os.environ[VERBOSE_ENV] = "1"
 
@@ -124,10 +124,11 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     """
     import contextlib
 
-    from . import batch, cluster, preflight
+    from . import batch, preflight
     from .api import samples_note
     from .config import load_configs, preset_path
     from .errors import ConfigError, LutbakeError
+    from .runtime import cluster
     from .textsafe import escape_controls
     from .values_cache import open_cache
 
@@ -141,8 +142,8 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
         preflight.check_out_dir(out_dir)
         if scheduler is not None:
             cluster.parse_scheduler(scheduler)
-        elif device == "cuda":  # on a cluster the workers' GPUs count (lutbake.cluster checks them)
-            from .warp_runtime import init_warp
+        elif device == "cuda":  # on a cluster the workers' GPUs count (lutbake.runtime.cluster checks them)
+            from .runtime.warp_runtime import init_warp
 
             if not init_warp().is_cuda_available():
                 raise ConfigError("--device", "device", "cuda", "cpu", "no CUDA device is available")
@@ -229,7 +230,7 @@ PROGRESS_MIN_EVALS = 1.5e7  # about a second of work on two busy cores: show a b
 
 
 def progress_bars(label: str, n_texels: int, cost: float):
-    """lutbake.executor.Progress drawn as a click progress bar on stderr (tables above PROGRESS_MIN_EVALS)."""
+    """lutbake.runtime.executor.Progress drawn as a click progress bar on stderr (tables above PROGRESS_MIN_EVALS)."""
     if cost <= PROGRESS_MIN_EVALS:
         return None
     bar = click.progressbar(length=n_texels, label=label, file=sys.stderr, show_eta=True)
@@ -353,7 +354,7 @@ def plot(out_dir, sigma_to_alpha, order, no_png):
     Example:
       lutbake plot --out-dir outputs/figures
     """
-    from .figures import error_table, plot_all
+    from .commands.figures import error_table, plot_all
 
     if not no_png:
         for p in plot_all(out_dir, sigma_to_alpha, order):
@@ -414,8 +415,8 @@ def preview(file, out):
     Example:
       lutbake preview outputs/dfg.exr        # -> outputs/dfg.preview.png
     """
+    from .commands.preview import render
     from .errors import LutbakeError
-    from .preview import render
 
     try:
         path = render(file, out)

@@ -11,8 +11,9 @@ EXIT_CONFIG = 2
 
 
 def _quiet():
-    """Start Warp without its banner and CUDA-driver warning (lutbake.warp_runtime; --verbose brings them back)."""
-    from .warp_runtime import init_warp
+    """Start Warp without its banner and CUDA-driver warning (lutbake.runtime.warp_runtime; --verbose brings them
+    back)."""
+    from .runtime.warp_runtime import init_warp
 
     init_warp()
 
@@ -93,8 +94,8 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
       lutbake audit lut_ggx.png --preset gltf --error-map lut_ggx.err.png --json
       lutbake audit brdf.h --set texel=endpoint --set axis_order=roughness_x --shape 64x64x3
     """
-    from .audit import audit as run_audit
-    from .audit import report_json
+    from .commands.audit import audit as run_audit
+    from .commands.audit import report_json
     from .errors import ConfigError
 
     _quiet()
@@ -155,8 +156,8 @@ def size(preset, config, overrides, max_error, sizes, nov_min, as_json, workers)
     """
     import json
 
+    from .commands.size import smallest_sizes
     from .errors import ConfigError
-    from .size import smallest_sizes
 
     _quiet()
     try:
@@ -205,7 +206,7 @@ def fit(family, lang, out, as_json):
     """
     import json
 
-    from .fit import fit as run_fit
+    from .commands.fit import fit as run_fit
     from .io.atomic import atomic_write_bytes
 
     _quiet()

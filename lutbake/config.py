@@ -55,7 +55,7 @@ class TableSpec:
     def toml(self) -> str:
         return "[[table]]\n" + "".join(f"{k} = {_toml_value(v)}\n" for k, v in self.options.items() if v is not None)
 
-    def __reduce__(self):  # a mappingproxy does not pickle; lutbake.cluster ships specs to Dask workers
+    def __reduce__(self):  # a mappingproxy does not pickle; lutbake.runtime.cluster ships specs to Dask workers
         return (_table_spec, (self.name, self.kind, dict(self.options), self.source, self.index))
 
 

@@ -1,7 +1,7 @@
 """One table through the pipeline: spec -> kind's texel plan -> executor -> Table (with its provenance).
 
     spec (lutbake.config) -> lutbake.kinds.<kind>.plan = per_texel_plan(integrand, estimator, grid)
-         -> lutbake.executor.execute -> finite check -> lutbake.table.Table (lutbake.provenance.attributes)
+         -> lutbake.runtime.executor.execute -> finite check -> lutbake.table.Table (lutbake.provenance.attributes)
 ``compute`` runs everything up to the values (plan, tiles, finite check, error estimate); ``assemble`` makes the
 Table of one spec from them (name, config, content hash). ``bake_table`` is both. The batch (lutbake.batch) computes
 once per distinct values key (lutbake.sharing) and assembles per table; the batch and the Python API (lutbake.api)
@@ -17,9 +17,9 @@ import numpy as np
 
 from .config import TableSpec
 from .errors import TableError
-from .executor import Progress, Timer, estimate_error, execute_tiles
 from .kinds import lookup_kind
 from .provenance import attributes
+from .runtime.executor import Progress, Timer, estimate_error, execute_tiles
 from .sampling.plan import TexelPlan
 from .table import Table
 
@@ -28,7 +28,8 @@ from .table import Table
 class Computed:
     """What ``compute`` made of a spec: its plan, the float64 values (plan.shape), the attributes known only after
     the bake (error estimate, plan.attributes_after), the tiles' wall seconds, and the CPU seconds of the whole
-    computation in this process, every thread's share (in a lutbake.cluster session the workers' are not counted)."""
+    computation in this process, every thread's share (in a lutbake.runtime.cluster session the workers' are not
+    counted)."""
 
     plan: TexelPlan
     data: np.ndarray

@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from lutbake.audit import audit
 from lutbake.cli import main
+from lutbake.commands.audit import audit
 from lutbake.integrands.specular import hemisphere_integral
 
 DATA = Path(__file__).parent / "data"
@@ -39,7 +39,7 @@ def clean():
 
 
 def srgb_decode(v):
-    """IEC 61966-2-1 EOTF, written out here independently of lutbake.audit."""
+    """IEC 61966-2-1 EOTF, written out here independently of lutbake.commands.audit."""
     return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
 
 
@@ -237,7 +237,7 @@ def test_audit_runs_on_every_shipped_table(name):
     Monte Carlo noise and its reflection ratio obeys the reciprocity identity and matches lutbake's on average, and
     ltc_code's unique LTC quantities match (sphere to its printed digits, magnitude to its sampling noise) with
     matrices that fit the lobe within FIT_RATIO_MAX of lutbake's own fit."""
-    from lutbake.audit_tables import FIT_RATIO_MAX, UNORM16_STEP
+    from lutbake.commands.audit_tables import FIT_RATIO_MAX, UNORM16_STEP
 
     preset, kw = SHIPPED[name]
     r = audit(DATA / name, {"preset": preset}, max_side=FAST_SIDE, **kw)
@@ -268,7 +268,7 @@ def write_ltc_js(path, t1, t2):
 def test_ltc_audit_fails_a_table_whose_matrices_are_packed_in_the_wrong_order(tmp_path):
     """ltc_code's table with ltc_1's (y, z) coefficients exchanged (glm's column-major invM read row-major, a
     classic port mistake): the magnitudes are intact, so only the fit-quality check can catch it -- and does."""
-    from lutbake.audit_tables import FIT_RATIO_MAX, read_ltc_pair
+    from lutbake.commands.audit_tables import FIT_RATIO_MAX, read_ltc_pair
 
     t1, t2 = read_ltc_pair(DATA / "ltc_code_ltc.js.gz")
     path = write_ltc_js(tmp_path / "ltc_swapped.js", t1[..., [0, 2, 1, 3]], t2)
@@ -280,7 +280,7 @@ def test_ltc_audit_fails_a_table_whose_matrices_are_packed_in_the_wrong_order(tm
 
 def test_ltc_audit_names_flipped_view_rows(tmp_path):
     """ltc_code's table with its view rows in reverse order (both textures): the magnitude hypotheses name it."""
-    from lutbake.audit_tables import read_ltc_pair
+    from lutbake.commands.audit_tables import read_ltc_pair
 
     t1, t2 = read_ltc_pair(DATA / "ltc_code_ltc.js.gz")
     r = audit(write_ltc_js(tmp_path / "ltc_flipped.js", t1[::-1], t2[::-1]), {"preset": "ltc-ggx"}, max_side=FAST_SIDE)

@@ -13,7 +13,7 @@ def one_worker(bake):
 
 
 def test_output_is_bit_identical_for_1_and_n_workers(one_worker, bake):
-    from lutbake import executor
+    from lutbake.runtime import executor
 
     old = executor.TILE_TEXELS
     try:

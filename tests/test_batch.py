@@ -343,7 +343,7 @@ def test_modules_load_in_parallel_each_once(monkeypatch):
 
     import warp as wp
 
-    from lutbake import warp_runtime
+    from lutbake.runtime import warp_runtime
 
     spans = []
 
@@ -374,7 +374,7 @@ def test_a_busy_module_defers_only_the_first_load_of_an_armed_thread(monkeypatch
 
     import warp as wp
 
-    from lutbake import warp_runtime
+    from lutbake.runtime import warp_runtime
 
     loading, release, loads = threading.Event(), threading.Event(), []
 
@@ -405,7 +405,7 @@ def test_a_table_whose_module_is_busy_steps_back_behind_the_next(monkeypatch, tm
     """batch.run: a group that raises ModuleBusy (its first kernel module compiling in the other table thread) is set
     back once, behind the next group, and baked after it; the last group in the queue never steps back; every table is
     baked once and reported."""
-    from lutbake import warp_runtime
+    from lutbake.runtime import warp_runtime
 
     cfg = write_config(tmp_path, *[table(n, seed=i) for i, n in enumerate(("a", "b", "c"))])
     jobs = batch.schedule(load_configs([cfg]), tmp_path / "out")
@@ -432,15 +432,16 @@ def test_a_table_whose_module_is_busy_steps_back_behind_the_next(monkeypatch, tm
 
 def test_every_lutbake_kernel_module_compiles_with_lutbakes_options():
     """Every Warp module holding a lutbake kernel (the factories' unique modules and the fixed ones) is built with
-    lutbake.warp_runtime.MODULE_OPTIONS: forward code only, LLVM's leaner inlining (CPU_COMPILER_FLAGS). Checks the
+    lutbake.runtime.warp_runtime.MODULE_OPTIONS: forward code only, LLVM's leaner inlining (CPU_COMPILER_FLAGS).
+    Checks the
     kernels this test makes plus every one the test session made before it."""
     import importlib
     import pkgutil
 
     import lutbake
-    from lutbake import warp_runtime
     from lutbake.integrands import fresnel
     from lutbake.ltc import fit
+    from lutbake.runtime import warp_runtime
 
     for m in pkgutil.walk_packages(lutbake.__path__, "lutbake."):
         if not m.name.endswith("__main__"):

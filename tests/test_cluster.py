@@ -1,4 +1,4 @@
-"""Baking on a Dask cluster (lutbake.cluster): bit-identical to the thread executor, a killed worker costs
+"""Baking on a Dask cluster (lutbake.runtime.cluster): bit-identical to the thread executor, a killed worker costs
 only its tiles, mismatched or broken workers are refused before any tile runs, interrupts cancel the
 futures and write no unfinished table.
 
@@ -22,12 +22,13 @@ from click.testing import CliRunner
 
 distributed = pytest.importorskip("distributed")
 
-from lutbake import batch, cluster  # noqa: E402
+from lutbake import batch  # noqa: E402
 from lutbake.api import bake_table  # noqa: E402
 from lutbake.cli import main  # noqa: E402
 from lutbake.config import load_configs, preset_path, validate_table  # noqa: E402
 from lutbake.io.exr import read_exr  # noqa: E402
 from lutbake.kinds import lookup_kind  # noqa: E402
+from lutbake.runtime import cluster  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 pytestmark = pytest.mark.usefixtures("terminal_sigint")  # the interrupt tests and deadline() need SIGINT
@@ -230,8 +231,10 @@ def test_a_worker_without_lutbake_is_refused_with_a_clear_message(client):
     victim = sorted(client.scheduler_info()["workers"])[-1]
     with sabotaged(
         client,
-        "import sys; sys.modules['_lutbake'] = sys.modules['lutbake']; sys.modules['lutbake'] = None",
-        "import sys; sys.modules['lutbake'] = sys.modules.pop('_lutbake')",
+        # every lutbake module hidden (the probe imports lutbake.runtime.cluster), then restored
+        "import sys; sys._lutbake = {k: v for k, v in sys.modules.items() if k.split('.')[0] == 'lutbake'}; "
+        "sys.modules.update(dict.fromkeys(sys._lutbake))",
+        "import sys; sys.modules.update(sys._lutbake)",
         workers=[victim],
     ):
         with pytest.raises(cluster.WorkerRefused) as e:

@@ -1,4 +1,4 @@
-"""Tiles per device (lutbake.devices): 512-texel CPU tiles, whole tables or device-sized tiles on CUDA.
+"""Tiles per device (lutbake.runtime.devices): 512-texel CPU tiles, whole tables or device-sized tiles on CUDA.
 
 The sizing logic and the executor's use of it are tested here on the CPU (a fake plan, a stated free
 memory). The CUDA bake itself is compared with the CPU bake only where Warp finds a CUDA device; on a
@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 import warp as wp
 
-from lutbake import devices, executor
 from lutbake.api import bake_table
 from lutbake.axes import Axis
 from lutbake.config import validate_table
-from lutbake.devices import CPU_TILE_TEXELS, CUDA_MEMORY_FRACTION, CUDA_TILE_MAX_EVALS, tile_texels
+from lutbake.runtime import devices, executor
+from lutbake.runtime.devices import CPU_TILE_TEXELS, CUDA_MEMORY_FRACTION, CUDA_TILE_MAX_EVALS, tile_texels
 from lutbake.sampling.plan import TexelPlan
 
 GIB = 1 << 30

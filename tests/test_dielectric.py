@@ -273,11 +273,11 @@ def test_openpbr_reflection_ratio_is_tied_to_the_averages_by_the_lobes_reciproci
 # lutbake's ratio channel vs the shipped one at alpha index >= 16: the shipped averages' Monte Carlo noise (max 4.2e-4)
 # divided by E_c,avg (measured max 6.9e-4 over every eta != 1 row)
 RATIO_BAKED_ATOL = 1.0e-3
-OPENPBR_ETA_ONE_ROWS = (15, 16)  # both eta = 1: the shipped rows are degenerate there (docs/transmission.md)
+OPENPBR_ETA_ONE_ROWS = (15, 16)  # both eta = 1: the shipped rows are degenerate there (docs/glass-layouts.md)
 
 
 def kulla_conty_ratio(ec, ec_mirror, eta):
-    """The reflection ratio transcribed independently (scalar, explicit branches) from docs/transmission.md."""
+    """The reflection ratio transcribed independently (scalar, explicit branches) from docs/glass-layouts.md."""
 
     def f_avg(e):  # Kulla & Conty 2017, slide 18 (OpenPBR's openpbr_average_fresnel)
         return (e - 1) / (4.08567 + 1.00071 * e) if e > 1 else 0.997118 + 0.1014 * e - 0.965241 * e**2 - 0.130607 * e**3

@@ -253,7 +253,7 @@ def test_microfacet_is_reciprocal():
 
 
 def test_fitted_model_matches_integrated_at_sigma_0_normal_view():
-    from lutbake.figures import FIGURES, curves
+    from lutbake.commands.figures import FIGURES, curves
 
     fig = FIGURES[0]  # Fig. 11a: n.e = 1, sigma = 0
     assert (fig.fixed_cos, fig.sigma) == (1.0, 0.0)

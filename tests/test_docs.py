@@ -1,14 +1,31 @@
-"""Every registered kind, key and allowed value is documented in docs/config.md; README has the two commands."""
+"""The documentation as a reference: every kind, key and value documented in docs/config.md; the README gives the two
+commands and one table engine -> preset -> files -> shader line whose uv formulas are the code's; no page is a diary
+(no dates, issue numbers, machine names or load figures outside docs/benchmarks.md); sizes; every relative link and
+anchor resolves; docs/benchmarks.md is rendered from the benchmarks' JSON."""
 
+import json
+import re
+import sys
+import unicodedata
 from pathlib import Path
+
+import numpy as np
+import pytest
 
 from lutbake.kinds import KINDS
 
 ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+PAGES = sorted(DOCS.glob("*.md"))
+README_MAX_BYTES = 10 * 1024
+PAGE_MAX_BYTES = 30 * 1024
+# the issue's check: dates, issue numbers, machine names and load figures belong to docs/benchmarks.md alone
+DIARY = re.compile(r"issue [0-9]+|20[0-9]{2}-[0-9]{2}-[0-9]{2}|EPYC|Xeon|load [0-9]", re.IGNORECASE)
+MEASURED_PAGE = DOCS / "benchmarks.md"
 
 
 def test_every_kind_key_and_value_is_documented():
-    doc = (ROOT / "docs" / "config.md").read_text()
+    doc = (DOCS / "config.md").read_text()
     for kind in KINDS.values():
         assert f"`{kind.name}`" in doc, kind.name
         for key in kind.keys.values():
@@ -17,33 +34,213 @@ def test_every_kind_key_and_value_is_documented():
                 assert f"`{value}`" in doc, (kind.name, key.name, value)
 
 
-def test_readme_gives_the_two_commands():
+def test_readme_gives_the_two_commands_and_the_kernel_cache():
     readme = (ROOT / "README.md").read_text()
     assert "make luts" in readme and "make test" in readme
+    assert "WARP_CACHE_PATH" in readme and "~/.cache/warp" in readme
 
 
-QUICK_START_LINES = 60
+@pytest.mark.parametrize("page", [ROOT / "README.md", *PAGES], ids=lambda p: p.name)
+def test_reference_pages_are_no_diary(page):
+    if page == MEASURED_PAGE:
+        pytest.skip("docs/benchmarks.md names machine and date: make bench writes it")
+    hits = [m.group(0) for m in DIARY.finditer(page.read_text())]
+    assert not hits, f"{page.name}: {hits[:5]} (measured figures go to docs/benchmarks.md, history to git)"
 
 
-def test_readme_is_a_quick_start_with_a_table_of_contents_and_no_outside_references():
-    import re
+def test_page_sizes():
+    assert (ROOT / "README.md").stat().st_size <= README_MAX_BYTES
+    too_big = {p.name: p.stat().st_size for p in PAGES if p.stat().st_size > PAGE_MAX_BYTES}
+    assert not too_big, f"pages over {PAGE_MAX_BYTES} bytes: {too_big} (split them by topic)"
 
+
+def slug(heading: str) -> str:
+    """GitHub's anchor of a Markdown heading: lower case, punctuation dropped (letters, digits, '_', '-' and spaces
+    kept, any script), spaces to '-'."""
+    text = heading.strip().lower()
+    kept = "".join(c for c in text if c in " -_" or unicodedata.category(c)[0] in "LN")
+    return kept.replace(" ", "-")
+
+
+def anchors(page: Path) -> set[str]:
+    seen: dict[str, int] = {}
+    out = set()
+    in_code = False
+    for line in page.read_text().splitlines():
+        if line.startswith("```"):
+            in_code = not in_code
+        if in_code or not line.startswith("#"):
+            continue
+        base = slug(line.lstrip("#"))
+        n = seen.get(base, 0)
+        seen[base] = n + 1
+        out.add(base if n == 0 else f"{base}-{n}")
+    return out
+
+
+LINK = re.compile(r"\]\(([^)\s]+)\)")
+
+
+@pytest.mark.parametrize("page", [ROOT / "README.md", *PAGES], ids=lambda p: p.name)
+def test_relative_links_and_anchors_resolve(page):
+    text = re.sub(r"```.*?```", "", page.read_text(), flags=re.S)
+    for target in LINK.findall(text):
+        if target.startswith(("http://", "https://", "mailto:")):
+            continue
+        path, _, anchor = target.partition("#")
+        dest = (page.parent / path).resolve() if path else page
+        assert dest.exists(), f"{page.name}: link to {target}: no such file"
+        if anchor and dest.suffix == ".md":
+            assert anchor in anchors(dest), f"{page.name}: link to {target}: no such heading in {dest.name}"
+
+
+def test_no_references_outside_the_repository():
     readme = (ROOT / "README.md").read_text()
-    lines = readme.splitlines()
-    toc = lines.index("## Documentation")
-    toc_end = next(i for i in range(toc + 2, len(lines)) if not lines[i].startswith("|"))
-    assert toc_end <= QUICK_START_LINES  # one screen of quick start, then the table of contents into docs/
-    for later in (line for line in lines[toc_end:] if line.startswith("## ")):  # then short topic sections
-        section = readme.split(later + "\n", 1)[1].split("\n## ", 1)[0]
-        assert "](docs/" in section, f"{later}: a README section links to its docs page"
-    for topic in ("kinds", "presets", "formats", "conventions", "accuracy", "batch"):
-        assert f"(docs/{topic}.md)" in readme, topic
-    for page in re.findall(r"\]\(([^)#]+)", readme):
-        assert page.startswith("http") or (ROOT / page).exists(), page
-    docs = "".join(p.read_text() for p in (ROOT / "docs").glob("*.md"))
+    docs = "".join(p.read_text() for p in PAGES)
     for text in (readme, docs):
         # the sibling folder of the development checkout, spelled in two parts so no tool mistakes it for a read
         for outside in ("/".join(("..", "shared")), "seeds/", "lecture 003", "issue-6", "the seed's", "EQUATIONS.md"):
             assert outside not in text, outside
-    for page in re.findall(r"\]\(([^)#]+)", docs):
-        assert page.startswith("http") or (ROOT / "docs" / page).exists(), page
+
+
+def makefile_presets() -> list[str]:
+    text = (ROOT / "Makefile").read_text()
+    m = re.search(r"^PRESETS \?=((?:.*\\\n)*.*)$", text, re.M)
+    return m.group(1).replace("\\\n", " ").split()
+
+
+def preset_files(name: str) -> list[str]:
+    from lutbake.config import load_config, preset_path
+    from lutbake.io.formats import EXTENSIONS
+
+    files = []
+    for spec in load_config(preset_path(name)):
+        fmt = spec.options.get("format") or "exr"
+        files.append(f"{spec.name}_1.dds" if fmt == "ltc_dds" else f"{spec.name}{EXTENSIONS[fmt]}")
+    return files
+
+
+def readme_rows() -> dict[str, str]:
+    """The README's engine table: preset name -> its row."""
+    readme = (ROOT / "README.md").read_text()
+    section = readme.split("## Which file for my engine", 1)[1].split("\n## ", 1)[0]
+    rows = {}
+    for line in section.splitlines():
+        cells = line.split(" | ")
+        if line.startswith("| ") and len(cells) >= 4:
+            for preset in re.findall(r"`([a-z0-9-]+)`", cells[1]):
+                rows[preset] = line
+    return rows
+
+
+def test_readme_table_names_every_make_luts_preset_and_its_files():
+    rows = readme_rows()
+    for preset in makefile_presets():
+        assert preset in rows, f"README's engine table has no row for preset {preset}"
+        for file in preset_files(preset):
+            assert file in rows[preset], f"README: preset {preset} writes {file}, its row does not say so"
+
+
+class V:
+    """Just enough of GLSL's vec2 to evaluate the README's uv expressions on numpy arrays."""
+
+    def __init__(self, x, y):
+        self.x, self.y = np.asarray(x, np.float64), np.asarray(y, np.float64)
+
+    def _op(self, o, f):
+        return V(f(self.x, o.x), f(self.y, o.y)) if isinstance(o, V) else V(f(self.x, o), f(self.y, o))
+
+    def __add__(self, o):
+        return self._op(o, np.add)
+
+    def __mul__(self, o):
+        return self._op(o, np.multiply)
+
+    def __truediv__(self, o):
+        return self._op(o, np.divide)
+
+    __radd__, __rmul__ = __add__, __mul__
+
+
+def uv_expression(row: str) -> str:
+    """The first vec2(...) / float2(...) of a README row's shader line, with a trailing '* a/b + c/d' if any."""
+    shader = row.split(" | ")[3]
+    m = re.search(r"(vec2<f32>|vec2|float2)\(", shader)
+    assert m, row
+    depth, i = 0, m.end() - 1
+    for i in range(m.end() - 1, len(shader)):
+        depth += {"(": 1, ")": -1}.get(shader[i], 0)
+        if depth == 0:
+            break
+    tail = re.match(r"(\s*[*+]\s*[0-9.]+\s*/\s*[0-9.]+)*", shader[i + 1 :]).group(0)
+    return "vec2(" + shader[m.end() : i + 1] + tail
+
+
+UV_PRESETS = [
+    "default",
+    "filament",
+    "filament-corrected",
+    "gltf",
+    "gltf-charlie",
+    "gltf-sheen-e",
+    "blender-eevee",
+    "unreal",
+    "unity-hdrp",
+    "unity-hdrp-charlie",
+    "godot",
+    "bevy",
+    "threejs",
+    "ltc-ggx",
+]
+ROUGHNESS_NAMES = ("r", "roughness", "Roughness", "perceptual_roughness", "sheenRoughness")
+NOV_NAMES = ("NoV", "NdotV", "dotNV")
+
+
+@pytest.mark.parametrize("preset", UV_PRESETS)
+def test_readme_uv_formula_is_the_files_own(preset):
+    """The README's uv for a preset, evaluated, equals the axes' uv (lutbake:axes uv_formula, what the GL test samples
+    with) at interior points: one formula everywhere, the code's."""
+    from lutbake.config import load_config, preset_path
+    from lutbake.kinds import lookup_kind
+
+    spec = load_config(preset_path(preset))[0]
+    axes = lookup_kind(spec.kind).plan(spec).axes
+    rng = np.random.default_rng(7)
+    nov, r = rng.uniform(0.1, 0.9, 64), rng.uniform(0.1, 0.9, 64)
+    value = {"NoV": nov}
+    expect = {}
+    for axis in axes:
+        if axis.dim in ("x", "y"):
+            expect[axis.dim] = axis.uv(value.get(axis.name, r))
+    names = {
+        "vec2": V,
+        "float2": V,
+        "sqrt": np.sqrt,
+        **dict.fromkeys(ROUGHNESS_NAMES, r),
+        **dict.fromkeys(NOV_NAMES, nov),
+    }
+    expr = uv_expression(readme_rows()[preset]).replace("vec2<f32>", "vec2")
+    got = eval(expr, {"__builtins__": {}}, names)  # noqa: S307 - the README's own arithmetic on arrays
+    np.testing.assert_allclose(got.x, expect["x"], atol=1e-12, err_msg=f"{preset}: u of {expr}")
+    np.testing.assert_allclose(got.y, expect["y"], atol=1e-12, err_msg=f"{preset}: v of {expr}")
+
+
+def test_benchmarks_page_is_rendered_from_the_json(tmp_path):
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import write_benchmarks_md
+
+    (tmp_path / "luts.json").write_text(
+        json.dumps({"machine": "test box", "tables": 3, "computations": 2, "clean": {"wall_s": 1.5, "cpu_s": 2.5}})
+    )
+    (tmp_path / "report.json").write_text(
+        json.dumps({"targets": {"dfg kernel <= 0.3 s": {"value": 0.25, "limit": 0.3, "met": True}}, "cases": {}})
+    )
+    text = write_benchmarks_md.render(tmp_path)
+    assert text.count("**Machine:**") == 1 and text.count("**Date:**") == 1
+    assert "test box" in text and "| every table baked, kernels compiled | 1.5 | 2.5 |" in text
+    assert "dfg kernel <= 0.3 s" in text
+    assert "`ltc.json` missing" in text  # a benchmark not run says so
+    assert MEASURED_PAGE.read_text().startswith("# Benchmarks"), "docs/benchmarks.md is the writer's output"
+    make = (ROOT / "Makefile").read_text()
+    bench = make.split("\nbench:", 1)[1].split("\n\n", 1)[0]
+    assert bench.rstrip().endswith("benchmarks/write_benchmarks_md.py"), "make bench renders the page last"

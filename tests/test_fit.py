@@ -5,7 +5,7 @@ import pytest
 from click.testing import CliRunner
 
 from lutbake.cli import main
-from lutbake.fit import GOTANDA_PUBLISHED, KARIS_PUBLISHED, fit_gotanda, fit_karis, gotanda_eq8, karis_mobile
+from lutbake.commands.fit import GOTANDA_PUBLISHED, KARIS_PUBLISHED, fit_gotanda, fit_karis, gotanda_eq8, karis_mobile
 from lutbake.integrands import diffuse
 
 EQ8_RTOL = 1e-5  # float32 Warp term vs float64 numpy

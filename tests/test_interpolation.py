@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from lutbake.axes import Axis
-from lutbake.executor import execute_tiles
 from lutbake.kinds import lookup_kind
+from lutbake.runtime.executor import execute_tiles
 from lutbake.sampling import interpolation
 from lutbake.sampling.interpolation import COARSE, INTEGRATED, INTERPOLATED, VARIANTS, axis_stencils
 from lutbake.sampling.plan import Grid

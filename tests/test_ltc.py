@@ -348,7 +348,7 @@ def test_hdrp_shares_the_ggx_texels_it_would_fit_alike_and_gets_the_same_bits():
 def test_fit_memo_waits_for_another_thread_and_refits_what_a_failed_one_released():
     import threading
 
-    from lutbake.memo import RowMemo
+    from lutbake.runtime.memo import RowMemo
 
     memo = RowMemo()
     started, go, calls = threading.Event(), threading.Event(), []
@@ -384,7 +384,7 @@ def test_fit_memo_waits_for_another_thread_and_refits_what_a_failed_one_released
 def test_memo_computes_a_key_repeated_in_one_call_once():
     """A key twice in one run (two texels of equal inputs: ltc-hdrp's clamped columns) is claimed and computed once,
     its repeat taken from it (a hit)."""
-    from lutbake.memo import RowMemo
+    from lutbake.runtime.memo import RowMemo
 
     memo, calls = RowMemo(), []
 

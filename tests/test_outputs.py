@@ -77,7 +77,7 @@ def test_preview_draws_every_file_make_luts_writes(luts, tmp_path):
     """Every file, sidecars and engine layouts included, gets its preview figure; one file per kind of picture is
     drawn to a PNG as well."""
     plt = pytest.importorskip("matplotlib.pyplot")
-    from lutbake.preview import figure, render
+    from lutbake.commands.preview import figure, render
 
     files = sorted(p for p in luts.rglob("*.*") if not p.name.endswith(".preview.png"))
     assert {p.suffix for p in files} >= {".js", ".cc", ".cs", ".h", ".dds", ".json"}

@@ -13,7 +13,7 @@ from lutbake.io.readers import read_table
 from lutbake.table import Table
 
 plt = pytest.importorskip("matplotlib.pyplot")
-from lutbake.preview import figure, lookup, sphere, split_sum  # noqa: E402
+from lutbake.commands.preview import figure, lookup, sphere, split_sum  # noqa: E402
 
 LOOKUP_TOL = 1e-6  # float32 table values, float64 interpolation weights
 

@@ -7,9 +7,9 @@ import pytest
 from click.testing import CliRunner
 from scipy.ndimage import map_coordinates
 
-from lutbake.audit import conventions
 from lutbake.cli import main
-from lutbake.size import axis_at, bilinear_half, measure, smallest_sizes, store
+from lutbake.commands.audit import conventions
+from lutbake.commands.size import axis_at, bilinear_half, measure, smallest_sizes, store
 
 SMOOTH_NOV = 0.3  # away from the grazing corner the DFG is smooth: bilinear error ~ h^2
 H2_RATIO_MIN = 3.0  # error ratio per doubling of N there (4 in the limit)

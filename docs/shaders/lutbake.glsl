@@ -34,7 +34,8 @@ vec2 lutbake_hdrp_uv(float NoV, float roughness, float N) {
 }
 // preset threejs (DFGLUTData.js): columns = roughness, rows = NoV, texel centres: texture2D(dfgLUT, vec2(roughness, dotNV)).
 vec2 lutbake_threejs_uv(float NoV, float roughness) { return vec2(roughness, NoV); }
-// presets godot, bevy: as lutbake_dfg_uv (columns NoV, rows r, texel centres).
+// preset bevy: as lutbake_dfg_uv (columns NoV, rows r, texel centres); preset godot (rows roughest first):
+// as lutbake_filament_corrected_uv, vec2(NoV, 1.0 - r), which is Godot's own runtime lookup.
 
 // ---- reconstruction ---------------------------------------------------------------------------
 // layout scale_bias (R = scale, G = bias): E = f0 * scale + f90 * bias (f90 = 1 in the Schlick split sum).

@@ -28,9 +28,9 @@ import functools
 import numpy as np
 import warp as wp
 
+from ..runtime.warp_runtime import MODULE_OPTIONS, load_module
 from ..sampling.plan import TexelPlan
 from ..terms.engine_diffuse import Fd_disney_hdrp, Fd_fabric_lambert_hdrp
-from ..warp_runtime import MODULE_OPTIONS, load_module
 
 wp.set_module_options(MODULE_OPTIONS)
 

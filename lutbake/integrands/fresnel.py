@@ -16,9 +16,9 @@ import warp as wp
 
 from ..catalog import FRESNELS
 from ..metals import LAZANYI_ALPHA
+from ..runtime.warp_runtime import unique_kernel
 from ..sampling.arrays import Floats
 from ..terms import fresnel as fr
-from ..warp_runtime import unique_kernel
 
 COLUMNS = tuple(FRESNELS)
 

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..axes import IMAGE_DIMS, MAPPINGS, ORDERS, TEXELS, Axis
 from ..errors import LutbakeError
-from ..warp_runtime import stderr_silenced
+from ..runtime.warp_runtime import stderr_silenced
 from . import dds, ktx2
 
 PREFIX = "lutbake:"

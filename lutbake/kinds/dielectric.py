@@ -8,7 +8,7 @@ eta = eta_o / eta_i is the relative IOR seen from the view's side: eta > 1 outsi
 (total internal reflection past the critical angle). The integrands are lutbake.integrands.dielectric, the default
 quadrature lutbake.sampling.dielectric (panelled Gauss-Legendre split at every kink; kind dielectric to the
 tolerance, kind dielectric_avg at a fixed order); docs/transmission.md has the
-derivation, every engine's conventions and the measured accuracy.
+derivation and the measured accuracy, docs/glass-layouts.md every engine's conventions.
 
 Layouts (key ``layout``) fix the channels, and for the engine layouts the whole grid:
     energy      z = IOR slices (ior_size, ior_range, ior_mapping), y/x = roughness / NoV as the dfg kind;
@@ -39,7 +39,7 @@ import numpy as np
 from ..axes import Axis
 from ..catalog import DIELECTRIC_MASKINGS, HEMISPHERE_ESTIMATORS, MASKINGS, NDF_DESCRIPTIONS, SMITH_NDFS, VNDF_NDFS
 from ..edge import ALPHA_MIN, alpha_policy
-from ..memo import RowMemo
+from ..runtime.memo import RowMemo
 from ..sampling import points
 from ..sampling.mu_average import mu_averages, mu_target
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan, probe_indices
@@ -63,7 +63,7 @@ AVG_LAYOUT_KEYS = ()
 # of before were off by up to 2.0e-4 on OpenPBR's eta < 1 rows (alpha = 0.004)
 MU_MAX_PANELS = 40
 # inside the glass the first mu panels are also graded towards cos theta_c (mu_starts): Turquin's average 0.84x the mu
-# evaluations, OpenPBR's 0.88x (docs/transmission.md)
+# evaluations, OpenPBR's 0.88x (docs/decisions.md)
 MU_GRADE_MAX, MU_GRADE_RATIO = 0.25, 4.0
 # kind dielectric_avg's inner rule (fixed-order Gauss-Legendre at the mu nodes, its error the probe's): without
 # ``samples``, its order climbs from the default 12 by 4 (each order's refined rule, order + 4, is the next order) up

@@ -11,7 +11,7 @@ so energy conservation holds for any x and the transmission lobe is symmetric if
 
 The source ships x without its generator ("a custom Monte Carlo integration tool"). The shipped array is reproduced,
 with the shipped averages as input, within the worst-case effect of the arrays' UNORM16 rounding at every texel with
-alpha > 0 and eta != 1 (max 6.5e-5 at alpha index >= 16; docs/transmission.md) by this closed form in the two averages
+alpha > 0 and eta != 1 (max 6.5e-5 at alpha index >= 16; docs/glass-layouts.md) by this closed form in the two averages
 and the hemispherical Fresnel average
 F_avg of Kulla & Conty 2017 ("Revisiting physically based shading at Imageworks", SIGGRAPH course, slide 18; the fit
 OpenPBR's openpbr_average_fresnel implements): for the two sides s, s' of the interface (eta_s' = 1/eta_s) put
@@ -24,7 +24,7 @@ the side with the smaller P_s splits its energy in the ratio F_avg(eta_s) E_c,av
 
 and the other side follows from the reciprocity relation. Both branches agree where P_s = P_s' (x = F_avg on both
 sides there), so x is continuous. A random walk on the microsurface (Heitz et al. 2016) does not give this array
-(measured max 0.58, mean 0.17 off; docs/transmission.md).
+(measured max 0.58, mean 0.17 off; docs/glass-layouts.md).
 """
 
 from __future__ import annotations

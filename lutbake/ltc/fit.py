@@ -36,8 +36,8 @@ import numpy as np
 import warp as wp
 
 from ..catalog import LTC_FIT_GRID
-from ..memo import RowMemo
-from ..warp_runtime import MODULE_OPTIONS, load_module
+from ..runtime.memo import RowMemo
+from ..runtime.warp_runtime import MODULE_OPTIONS, load_module
 from .lobes import lobe
 
 wp.set_module_options(MODULE_OPTIONS)

@@ -28,11 +28,11 @@ import numpy as np
 import warp as wp
 
 from ..edge import COS_EPS
+from ..runtime.warp_runtime import MODULE_OPTIONS, load_module
 from ..sampling.diffuse import gl_rule
 from ..sampling.facets import fd_microfacet_for
 from ..terms import masking
 from ..terms.diffuse import F_facet_eq6
-from ..warp_runtime import MODULE_OPTIONS, load_module
 
 wp.set_module_options(MODULE_OPTIONS)
 

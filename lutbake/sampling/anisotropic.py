@@ -20,9 +20,9 @@ import numpy as np
 import warp as wp
 
 from ..edge import COS_EPS
+from ..runtime.warp_runtime import load_module, unique_kernel
 from ..terms import ndf
 from ..terms.frame import reflect
-from ..warp_runtime import load_module, unique_kernel
 from . import points
 from .arrays import Points2, Rows64
 from .hemisphere import AdaptiveGaussLegendre, gl_launch, store_row

@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 import warp as wp
 
-from ..warp_runtime import unique_kernel
+from ..runtime.warp_runtime import unique_kernel
 from . import points
 from .arrays import Levels, Rows64, Rule
 from .groups import group_rows, key_of, siblings_by_key

@@ -24,8 +24,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 import warp as wp
 
+from ..runtime.warp_runtime import load_module, unique_kernel
 from ..terms.frame import view_dir
-from ..warp_runtime import load_module, unique_kernel
 from . import points
 from .arrays import Floats, Levels, Points2, Rows64, Rule, Values64
 from .facets import (

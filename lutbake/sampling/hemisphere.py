@@ -59,8 +59,8 @@ import warp as wp
 
 from .. import tolerance
 from ..catalog import HEMISPHERE_ESTIMATORS
+from ..runtime.warp_runtime import load_module, unique_kernel
 from ..terms.frame import view_dir
-from ..warp_runtime import load_module, unique_kernel
 from . import points
 from .arrays import PhiRule, Points2, Rows64, Rule, Values64
 from .ladder import greedy_ladder_for

@@ -6,7 +6,7 @@ or clamps at alpha -> 0, clamped cosines; ``Grid.smooth``), and at 1024^2 it is 
 features need: the glTF table's values change by ~1e-3 per texel. Per 2D slice (the last two axes, y and x):
 
 1. The *coarse* texels, every STRIDE-th index of each axis plus the last, are integrated by the table's adaptive
-   estimator at COARSE_SHARE of its tolerance (``lutbake.memo.RowMemo``: once per process, whichever tile asks).
+   estimator at COARSE_SHARE of its tolerance (``lutbake.runtime.memo.RowMemo``: once per process, whichever tile asks).
 2. Every other texel of a *smooth* stencil is the tensor product of degree-5 Lagrange interpolants in the texel index
    (6 coarse nodes per axis: 3 on each side). Its error is estimated from the same coarse data interpolated by the
    degree-5 stencil shifted one node to either side, along x, then along y. Where the function is resolved, a
@@ -37,7 +37,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..memo import RowMemo
+from ..runtime.memo import RowMemo
 from ..tolerance import TERMS_ROUNDING
 
 STRIDE = 4  # coarse texels: every STRIDE-th index of each image axis, and the last

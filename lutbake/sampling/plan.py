@@ -51,8 +51,8 @@ class TexelPlan:
     # they travel with the tile, so the estimate is a pure function of the tiles wherever they ran, and are
     # handed to error_estimate, never stored in the table
     aux_channels: int = 0
-    # texels per CPU tile where the plan wants other than lutbake.executor.TILE_TEXELS (kind btf: whole (sigma, phi)
-    # blocks, so that a tile holds a texel and its reciprocal); any cut still gives the same values
+    # texels per CPU tile where the plan wants other than lutbake.runtime.executor.TILE_TEXELS (kind btf: whole
+    # (sigma, phi) blocks, so that a tile holds a texel and its reciprocal); any cut still gives the same values
     tile_texels: int | None = None
 
     @property
@@ -136,7 +136,7 @@ def per_texel_plan(
     [start, stop), or None for the tile alone: an estimator that shares work between texels of one call
     (lutbake.sampling.dielectric.sibling_tiles) gets them together; each texel is evaluated once per plan (a memo:
     the tiles of its siblings take its row), and its value does not depend on its company."""
-    from ..memo import RowMemo
+    from ..runtime.memo import RowMemo
     from . import interpolation
 
     def run(idx, est, device):

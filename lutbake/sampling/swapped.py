@@ -37,8 +37,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 import warp as wp
 
+from ..runtime.warp_runtime import load_module, unique_kernel
 from ..terms.masking import Lambda_ggx64
-from ..warp_runtime import load_module, unique_kernel
 from . import points
 from .groups import group_rows, key_of
 from .panels import (

@@ -7,8 +7,8 @@ Host code picks terms by name: one ``Distribution`` object per NDF in :mod:`.dis
 (with the masking forms), composed into integrands by :mod:`lutbake.integrands`.
 """
 
-from ..warp_runtime import init_warp
+from ..runtime.warp_runtime import init_warp
 
 # Every lutbake kernel is composed of these terms, so any module that can launch one has imported this
-# package first: Warp starts here, quietly unless LUTBAKE_VERBOSE is set (lutbake.warp_runtime).
+# package first: Warp starts here, quietly unless LUTBAKE_VERBOSE is set (lutbake.runtime.warp_runtime).
 init_warp()

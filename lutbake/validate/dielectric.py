@@ -26,11 +26,11 @@ import numpy as np
 import warp as wp
 
 from ..edge import ALPHA_MIN
+from ..runtime.warp_runtime import unique_kernel
 from ..terms import dielectric as td
 from ..terms import fresnel
 from ..terms.distributions import NDFS
 from ..terms.frame import reflect
-from ..warp_runtime import unique_kernel
 from .checks import _result
 
 SMOOTH_LIMIT_TOL = 2.0e-5  # |E_R - F|, |E_T - (1 - F)| at alpha = ALPHA_MIN, |mu - cos theta_c| >= SMOOTH_KINK_GAP

@@ -36,9 +36,9 @@ import warp as wp
 
 from ..catalog import MASKINGS
 from ..edge import COS_EPS
+from ..runtime.warp_runtime import MODULE_OPTIONS
 from ..terms import fresnel, masking, ndf
 from ..terms.distributions import NDFS
-from ..warp_runtime import MODULE_OPTIONS
 
 wp.set_module_options(MODULE_OPTIONS)
 

@@ -60,7 +60,7 @@ def curves(
     order: int = 12,
 ) -> dict[str, np.ndarray]:
     """L_r = f_r (n.l) per model along the figure's abscissa."""
-    from .integrands.diffuse import eval_brdf
+    from ..integrands.diffuse import eval_brdf
 
     l, v = directions(fig, theta)
     out = {}

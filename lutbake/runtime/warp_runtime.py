@@ -118,7 +118,7 @@ def load_module(module, device: str = "cpu") -> None:
 # inline threshold to 9000 and its cold-call-site threshold to 3000; lutbake's kernels inline whole integrands and
 # quadrature ladders into each launch, and at Warp's budget a new machine spends 68 s of CPU compiling the 36 modules
 # of `make luts`. At 1000 / 300 it spends 50 s, every table of `make luts` is byte-identical and the kernels run as
-# fast (docs/accuracy.md, "Issue 13, 2026-12-03: a leaner compile, …"); at LLVM's own defaults (225) the glass and
+# fast (docs/decisions.md, "Compiling Warp kernels"); at LLVM's own defaults (225) the glass and
 # average kernels run 1.6-1.7x slower. The flags are part of each module's hash in Warp's kernel cache.
 CPU_COMPILER_FLAGS = (
     "-march=native -mllvm=-inline-threshold=1000 -mllvm=-inline-cold-callsite-threshold=300"

@@ -2,7 +2,7 @@
 diagnose the usual hand-over mistakes by testing each one against the data.
 
 The conventions are a ``dfg`` table spec (a preset or config, plus ``--set`` keys; the size is the file's); a
-preset or config of kind ``ltc`` or layout ``openpbr`` is audited by lutbake.audit_tables instead.
+preset or config of kind ``ltc`` or layout ``openpbr`` is audited by lutbake.commands.audit_tables instead.
 Every file texel (row y, column x) then has a declared (NoV, alpha) (lutbake.kinds.dfg.axes_for); the
 reference is lutbake's Gauss-Legendre integral at those points (error ~4e-7), on a strided subset of at most
 ``max_side`` x ``max_side`` texels (the last row and column always included).
@@ -34,11 +34,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .axes import Axis
-from .catalog import SHEEN_LAYOUTS
-from .edge import NOV_MIN
-from .io.lut_files import LutFile, read_lut
-from .tolerance import Tolerance
+from ..axes import Axis
+from ..catalog import SHEEN_LAYOUTS
+from ..edge import NOV_MIN
+from ..io.lut_files import LutFile, read_lut
+from ..tolerance import Tolerance
 
 MAX_SIDE = 128  # default subset: at most this many rows and columns are re-integrated
 MISMATCH_RATIO = 0.5  # an alternative convention is the diagnosis when its RMS is below this x the nominal RMS
@@ -50,7 +50,7 @@ NOISE_FLOOR_RATIO = 1.5  # noise is reported when the residual exceeds this x wh
 PERCENTILES = (50, 95, 99)
 METRICS = ("max", "p99", "mean")
 REFERENCE_TOLERANCE = 1e-7  # the re-bake: adaptive Gauss-Legendre to 1e-7 per value (its estimates bound the error:
-# docs/accuracy.md); a fixed order 12 leaves ~1e-5 at NoV = 1e-4 and would flag a correct table
+# docs/validation.md); a fixed order 12 leaves ~1e-5 at NoV = 1e-4 and would flag a correct table
 
 
 def srgb_eotf(v):
@@ -114,9 +114,9 @@ class Conventions:
 
 def conventions(config=None, preset=None, overrides=(), shape=None) -> Conventions:
     """The declared conventions: a config file or preset, ``--set`` overrides, size from ``shape`` (rows, cols)."""
-    from .config import load_config, parse_overrides, preset_path
-    from .errors import ConfigError
-    from .kinds.dfg import axes_for
+    from ..config import load_config, parse_overrides, preset_path
+    from ..errors import ConfigError
+    from ..kinds.dfg import axes_for
 
     path = Path(config) if config else preset_path(preset or "default")
     ovr = parse_overrides(overrides)
@@ -254,9 +254,9 @@ class Integrator:
     """Converged (and, for the noise estimate, Hammersley) integrals at arbitrary (NoV, alpha), cached."""
 
     def __init__(self, conv: Conventions, workers: int | None = None):
-        from .integrands import engine_diffuse, specular
-        from .kinds.dfg import terms_of
-        from .kinds.engine_layouts import BASE_LAYOUT
+        from ..integrands import engine_diffuse, specular
+        from ..kinds.dfg import terms_of
+        from ..kinds.engine_layouts import BASE_LAYOUT
 
         self.specular = specular
         self.engine_diffuse = engine_diffuse
@@ -270,9 +270,9 @@ class Integrator:
 
     def _run(self, layout, estimator, samples, nch, nov, alpha, tolerance=None) -> np.ndarray:
         """The (terms, layout) integrand at texels (nov[i], alpha[i]) by ``estimator``, tiles on every worker."""
-        from .executor import execute
-        from .sampling.hemisphere import estimator_for
-        from .sampling.plan import Grid, per_texel_plan
+        from ..runtime.executor import execute
+        from ..sampling.hemisphere import estimator_for
+        from ..sampling.plan import Grid, per_texel_plan
 
         integrand = self.specular.specular_integrand(self.ndf, self.masking, layout, self.form, nch)
         n = len(nov)
@@ -467,7 +467,7 @@ def audit(
     """Audit the LUT at ``path`` against conventions(**conv_args) (see the module docstring)."""
     if metric not in METRICS:
         raise ValueError(f"metric {metric!r}: allowed {', '.join(METRICS)}")
-    from .audit_tables import dispatch  # LTC and OpenPBR conventions: lutbake.audit_tables
+    from .audit_tables import dispatch  # LTC and OpenPBR conventions: lutbake.commands.audit_tables
 
     other = dispatch(path, conv_args, tolerance, metric, max_side, error_map)
     if other is not None:
@@ -483,7 +483,7 @@ def audit(
         )
     conv = conventions(**(conv_args or {}), shape=(rows, cols))
     integ = Integrator(conv, workers)
-    from .kinds.dfg import CHANNELS
+    from ..kinds.dfg import CHANNELS
 
     names = list(CHANNELS[conv.layout])
     nch = min(fch, len(names))
@@ -583,7 +583,7 @@ def write_error_map(out: Path, err: np.ndarray, names: list[str], axes: list[Axi
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .io.atomic import atomic_write
+    from ..io.atomic import atomic_write
 
     n = err.shape[-1]
     fig, axs = plt.subplots(1, n, figsize=(4.2 * n, 3.8), dpi=100, squeeze=False)

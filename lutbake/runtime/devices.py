@@ -5,7 +5,7 @@ thread), so how a table is cut changes no bit of a CPU bake; the size only trade
 against parallelism:
 
 - ``cpu``: CPU_TILE_TEXELS. One Warp CPU launch runs on one core, so a table is cut into many small
-  tiles that threads (lutbake.executor) or Dask workers (lutbake.cluster) share.
+  tiles that threads (lutbake.runtime.executor) or Dask workers (lutbake.runtime.cluster) share.
 - ``cuda``: one launch covers as many texels as the device can take at once: the whole table, unless
   its integrand evaluations exceed CUDA_TILE_MAX_EVALS (a launch of a few seconds at most, well under a
   desktop GPU's display watchdog, and several tiles of a huge table for a cluster's GPUs to share) or

@@ -16,7 +16,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from .sampling.plan import TexelPlan
+from ..sampling.plan import TexelPlan
 
 TILE_TEXELS = 512
 # progress(label, n_texels, cost) -> update(n_done_in_this_tile) or None: called once per table before its tiles run
@@ -56,9 +56,9 @@ def execute_tiles(
 
     ``progress``: a ``Progress`` factory; its update is called in the calling thread after each tile.
     ``cancel``: when set (by another thread), no further tile starts and Cancelled is raised.
-    ``spec``: the TableSpec ``plan`` came from; inside a lutbake.cluster session the tiles run on the
+    ``spec``: the TableSpec ``plan`` came from; inside a lutbake.runtime.cluster session the tiles run on the
     cluster's workers instead (as tasks of (spec, tile range)). Tiles are TILE_TEXELS on the CPU, device-sized
-    on CUDA (lutbake.devices). ``cpu``: a list that receives the CPU seconds of the kernels' preparation and of
+    on CUDA (lutbake.runtime.devices). ``cpu``: a list that receives the CPU seconds of the kernels' preparation and of
     each tile, each measured in the thread that ran it (time.thread_time; not for tiles run on a cluster)."""
     from . import cluster
     from .devices import plan_tile_texels
@@ -68,7 +68,7 @@ def execute_tiles(
         return remote.execute(spec, plan, device, progress=progress, label=label, cancel=cancel)
     workers = workers or default_workers()
     cpu = cpu if cpu is not None else []
-    # tables prepare in parallel: their kernels compile on every core (lutbake.warp_runtime.load_module)
+    # tables prepare in parallel: their kernels compile on every core (lutbake.runtime.warp_runtime.load_module)
     t0 = time.thread_time()
     plan.prepare(device)
     cpu.append(time.thread_time() - t0)
@@ -102,7 +102,7 @@ def execute_tiles(
 
 def estimate_error(plan: TexelPlan, data: np.ndarray, device: str = "cpu", spec=None) -> tuple[float, str] | None:
     """``plan.error_estimate`` of baked ``data`` (flat float64, (n_texels, tile_width)), None if the kind has
-    none; inside a lutbake.cluster session it runs on a worker, as the tiles did."""
+    none; inside a lutbake.runtime.cluster session it runs on a worker, as the tiles did."""
     from . import cluster
 
     if plan.error_estimate is None:

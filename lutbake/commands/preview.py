@@ -25,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .axes import Axis
-from .io.readers import TableView, read_table
+from ..axes import Axis
+from ..io.readers import TableView, read_table
 
 N_SPHERES = 5
 MAX_SLICES = 6  # columns of a 3D slice grid
@@ -361,7 +361,7 @@ def render(path, out=None, dpi: int = 100) -> Path:
     """Write the preview PNG of the table at ``path`` (default: <path stem>.preview.png beside it)."""
     import matplotlib.pyplot as plt
 
-    from .io.atomic import atomic_write
+    from ..io.atomic import atomic_write
 
     path = Path(path)
     fig = figure(path)

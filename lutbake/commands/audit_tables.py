@@ -1,5 +1,5 @@
 """``lutbake audit`` for the table kinds beyond the split-sum family: LTC tables (``--preset ltc-ggx``) and OpenPBR's
-energy arrays (``--preset openpbr``). lutbake.audit dispatches here by the preset's kind.
+energy arrays (``--preset openpbr``). lutbake.commands.audit dispatches here by the preset's kind.
 
 LTC (Heitz, Dupuy, Hill, Neubelt 2016, "Real-Time Polygonal-Light Shading with Linearly Transformed Cosines").
 A user auditing a shipped LTC table needs to know (1) whether the *unique* quantities are right: the magnitude
@@ -52,7 +52,7 @@ RATIO_CHANNEL = 3  # of the openpbr dielectric_avg layout: ideal_dielectric_refl
 
 
 def _metric(abs_err: np.ndarray, metric: str) -> float:
-    """The statistic of |error| held against --tolerance (lutbake.audit.METRICS)."""
+    """The statistic of |error| held against --tolerance (lutbake.commands.audit.METRICS)."""
     return {"max": float(abs_err.max()), "p99": float(np.percentile(abs_err, 99)), "mean": float(abs_err.mean())}[
         metric
     ]
@@ -60,7 +60,8 @@ def _metric(abs_err: np.ndarray, metric: str) -> float:
 
 @dataclass
 class TableAuditReport:
-    """The report of an LTC or OpenPBR audit (same interface as lutbake.audit.AuditReport: text, as_dict, passed)."""
+    """The report of an LTC or OpenPBR audit (same interface as lutbake.commands.audit.AuditReport: text, as_dict,
+    passed)."""
 
     file: str
     conventions: str
@@ -103,7 +104,7 @@ def read_ltc_pair(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """(ltc_1, ltc_2) as (N, N, 4) float64, row = view index, column = roughness index: ltc_code's ``ltc.js``
     (``g_ltc_1``, ``g_ltc_2``; three.js' ``LTC_MAT_1/2`` alike; also gzip-compressed), lutbake's ``_1.dds`` pair, or
     any text holding two numeric arrays of N x N x 4 values (the first two are taken)."""
-    from .io import dds
+    from ..io import dds
 
     path = Path(path)
     if path.name.endswith("_1.dds"):
@@ -134,7 +135,7 @@ def ltc_hypotheses(lobe, axes, iy, ix, nov_all, alpha_mag, mag, got) -> list[dic
     rows or columns in reverse order, axes swapped (square tables), the roughness axis read as alpha (alpha = r,
     not r^2), and the view rows in ltc_code's parameterisation before fa68f58 (theta = t pi/2 linear, NoV =
     cos theta, not sqrt(1 - NoV) = t) -- a table of one used with the other's uv."""
-    from .kinds.ltc import magnitude_fresnel
+    from ..kinds.ltc import magnitude_fresnel
 
     n_view, n_rough = axes[1].count, axes[2].count
     nov_row, alpha_col = nov_all[::n_rough].astype(np.float64), alpha_mag[:n_rough].astype(np.float64)
@@ -178,9 +179,9 @@ def ltc_hypotheses(lobe, axes, iy, ix, nov_all, alpha_mag, mag, got) -> list[dic
 def audit_ltc(
     path, spec, tolerance: float, metric: str, max_side: int, area_texels: int = AREA_TEXELS, error_map=None
 ) -> TableAuditReport:
-    from .kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
-    from .ltc import fit, sphere
-    from .validate import ltc_area
+    from ..kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
+    from ..ltc import fit, sphere
+    from ..validate import ltc_area
 
     t1, t2 = read_ltc_pair(Path(path))
     n_view, n_rough = t1.shape[:2]
@@ -310,8 +311,8 @@ def audit_ltc(
 
 
 def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> TableAuditReport:
-    from .kinds import lookup_kind
-    from .kinds.dielectric import OPENPBR_SIZE
+    from ..kinds import lookup_kind
+    from ..kinds.dielectric import OPENPBR_SIZE
 
     n = OPENPBR_SIZE
     with np.load(Path(path)) as z:
@@ -393,8 +394,8 @@ def dispatch(
     path, conv_args: dict, tolerance: float, metric: str, max_side: int, error_map=None
 ) -> TableAuditReport | None:
     """The LTC / OpenPBR audit when the declared conventions are one (a preset or config of kind ltc, or layout
-    openpbr); None for the dfg family (lutbake.audit)."""
-    from .config import load_config, parse_overrides, preset_path
+    openpbr); None for the dfg family (lutbake.commands.audit)."""
+    from ..config import load_config, parse_overrides, preset_path
 
     conv_args = conv_args or {}
     cfg = conv_args.get("config")

@@ -144,8 +144,8 @@ class FitResult:
 
 
 def _karis_target(n: int, offset: float = 0.5):
+    from ..axes import Axis
     from .audit import Conventions, Integrator
-    from .axes import Axis
 
     t = (np.arange(n) + offset) / n
     nov, r = np.meshgrid(t, t)
@@ -203,7 +203,7 @@ def _gotanda_grid(n_cos: int = 12, n_phi: int = 7, n_sigma: int = 9, offset: flo
 
 
 def _gotanda_target(grid, order: int = 16):
-    from .integrands import diffuse
+    from ..integrands import diffuse
 
     L, V, lov, S, sl, sv, P = grid
     sp = np.sqrt(np.maximum(1 - P * P, 0))

@@ -14,14 +14,15 @@ table cancels its futures and writes nothing).
   that dies costs only the tiles it held; the scheduler runs them again elsewhere
   (``distributed.scheduler.allowed-failures`` deaths of one task before it gives up on it; the table
   then fails with the KilledWorker message, the others go on).
-- **Refusal before any tile runs**: ``check_workers()`` probes every worker (lutbake.cluster_probe, sent
+- **Refusal before any tile runs**: ``check_workers()`` probes every worker (lutbake.runtime.cluster_probe, sent
   by value so it reaches a worker that cannot import lutbake) and refuses the cluster unless each
   worker has this client's lutbake version and kernel sources digest (the ones in every content hash),
   Warp, numpy and scipy. Every tile carries a token of that identity, so a worker that joins later with
   another one fails its tile with the same message instead of baking different bits.
 - **Devices**: ``--device cpu`` runs CLUSTER_TILE_TEXELS-texel tiles on any worker (any cut gives the same
   bits; larger than the thread executor's 512 so that Dask's per-task cost stays small); ``--device cuda``
-  runs device-sized tiles (lutbake.devices) on the workers that have a CUDA device, and refuses a cluster with none. A
+  runs device-sized tiles (lutbake.runtime.devices) on the workers that have a CUDA device, and refuses a cluster
+  with none. A
   table's tiles all run on one kind of device: its bits never depend on which worker took which tile.
 - **Local clusters** (``local:N``): a distributed.LocalCluster of N single-threaded worker processes on
   this machine; they ignore SIGINT (Ctrl-C in a terminal reaches the whole process group: the client
@@ -29,7 +30,8 @@ table cancels its futures and writes nothing).
 
 Python API::
 
-    from lutbake import batch, cluster
+    from lutbake import batch
+    from lutbake.runtime import cluster
     with cluster.session("local:2"):            # or "tcp://HOST:8786"
         batch.run(batch.schedule(specs, "outputs"))  # lutbake.bake(...) works the same inside the block
 """
@@ -53,8 +55,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .config import BYTES_PER_TEXEL, MAX_TEXELS
-from .errors import ConfigError, LutbakeError
+from ..config import BYTES_PER_TEXEL, MAX_TEXELS
+from ..errors import ConfigError, LutbakeError
 
 SCHEDULER_FORMS = (
     "local:N (a LocalCluster of N worker processes here, N >= 1) or a Dask scheduler address such as tcp://HOST:8786"
@@ -145,8 +147,8 @@ def identity() -> dict[str, str]:
     import scipy
     import warp
 
-    from . import __version__
-    from .provenance import sources_digest
+    from .. import __version__
+    from ..provenance import sources_digest
 
     return {
         "lutbake": __version__,
@@ -183,7 +185,7 @@ def _check_token(expect: str) -> None:
 
 def worker_plan(spec, device: str):
     """The plan of ``spec`` in this worker process, built and its kernels loaded for ``device`` once."""
-    from .kinds import lookup_kind
+    from ..kinds import lookup_kind
 
     key = (spec.kind, spec.toml(), device)
     with _WORKER_LOCK:
@@ -320,8 +322,8 @@ class DaskRunner:
         label: str = "",
         cancel: threading.Event | None = None,
     ) -> np.ndarray:
-        """lutbake.executor.execute_tiles() on the cluster: float64 (n_texels, plan.tile_width) (``progress``: an
-        executor.Progress factory, updated in the calling thread as tiles arrive)."""
+        """lutbake.runtime.executor.execute_tiles() on the cluster: float64 (n_texels, plan.tile_width)
+        (``progress``: an executor.Progress factory, updated in the calling thread as tiles arrive)."""
         from .devices import plan_tile_texels
         from .executor import Cancelled, tiles
 

@@ -22,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..axes import Axis
+from ..edge import NOV_MIN
 from .audit import Conventions, Integrator, conventions
-from .axes import Axis
-from .edge import NOV_MIN
 
 STORAGE = {
     "unorm8": "8-bit UNORM (R8G8)",
