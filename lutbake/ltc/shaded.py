@@ -28,7 +28,7 @@ import functools
 import numpy as np
 import warp as wp
 
-from ..warp_runtime import MODULE_OPTIONS, load_module
+from ..runtime.warp_runtime import MODULE_OPTIONS, load_module
 from . import lights as ltc_lights
 
 wp.set_module_options(MODULE_OPTIONS)
