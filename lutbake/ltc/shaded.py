@@ -41,6 +41,7 @@ ITERATIONS = 8
 LAMBDA0 = 1e-2  # initial Levenberg-Marquardt damping (relative to diag(J^T J))
 FD_STEP = 1e-6  # forward-difference step, relative to max(|coefficient|, 1)
 SEED = 40
+TINY = 1e-30  # floor of a residual's scale (a lobe whose albedo vanishes, e.g. sheen at grazing, alpha -> 0)
 F0_TRAIN = 0.04  # the dielectric reflectance fitted beside F = 1 (lobes with Fresnel)
 F0_WEIGHT = 0.7  # default weight of the f0 = F0_TRAIN residuals beside F = 1 (0: F = 1 alone)
 
@@ -275,7 +276,7 @@ def refine(
     # per reflectance: target (k, L), sqrt weight (k, L), d value / d (magnitude, fresnel) per unit I
     tg = [f0 * G + (1.0 - f0) * H for f0 in f0s]
     sw = [
-        (1.0 if f0 == 1.0 else f0_weight) / (t + ABS_WEIGHT * (f0 * A + (1.0 - f0) * AH)[:, None])
+        (1.0 if f0 == 1.0 else f0_weight) / np.maximum(t + ABS_WEIGHT * (f0 * A + (1.0 - f0) * AH)[:, None], TINY)
         for f0, t in zip(f0s, tg)
     ]
     target = np.concatenate(tg, axis=1)
