@@ -18,6 +18,8 @@ t = sqrt(1 - cos theta_v) at endpoint texels t/(N - 1), theta_v <= 1.57 rad (NoV
 Shaders sample uv = vec2(roughness, sqrt(1 - NoV)) * (N - 1)/N + 0.5/N. Differences from ltc_code, all recorded
 in the metadata: alpha >= 1e-4 (lutbake.edge; ltc_code 1e-5), magnitude and fresnel integrated exactly
 (ltc_code: 32^2 samples), every texel fitted independently from a coarse pass (ltc_code: chained).
+Key ``fit``: "l3" (default) as above; "shaded" refines the L3 fit's texels to the polygon-light integrals the shader
+computes, magnitude and fresnel included (lutbake.ltc.shaded; docs/ltc_shaded.md).
 The sphere channel's own axes: x = z * 0.5 + 0.5 (z = cos of the form-factor direction's elevation), y =
 len = |form factor|, both endpoint (ltc_code genSphereTab).
 """
@@ -108,7 +110,8 @@ KEYS = {
     "format": Key("format", "str", "exr", "output file format", FORMATS),
 }
 CHANNELS = {
-    "x": "slice 0 (ltc_1): M^-1_00 / M^-1_11; slice 1 (ltc_2): magnitude = ∫ f (n.l) dω_l with F = 1",
+    "x": "slice 0 (ltc_1): M^-1_00 / M^-1_11; slice 1 (ltc_2): magnitude = ∫ f (n.l) dω_l with F = 1 (fit = shaded: "
+    "fitted with the matrix)",
     "y": "slice 0: M^-1_20 / M^-1_11 (glm invM[0][2]); slice 1: fresnel = ∫ f (1 - v.h)^5 (n.l) dω_l "
     "(= magnitude for lobes without Fresnel)",
     "z": "slice 0: M^-1_02 / M^-1_11 (glm invM[2][0]); slice 1: fit_error = (E / ∫ f^3 dω)^(1/3), E = Heitz's L3 "

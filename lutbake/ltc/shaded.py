@@ -1,22 +1,24 @@
 """The shaded fit: LTC texels refined to the polygon-light integrals a shader computes, not to the lobe's L3 distance.
 
-A shader shows, for a polygon light P, value(P) = magnitude * I_P(M^-1), I_P the clamped-cosine integral of the
-polygon transformed by M^-1 and clipped to the horizon (Heitz et al. 2016, Eq. 11; lutbake.ltc.polygon). The shaded
-fit chooses each texel's packed M^-1 (4 coefficients, ltc_code's layout) and its magnitude to minimise
+A shader shows, for a polygon light P and Schlick reflectance f0, value(P) = (f0 magnitude + (1 - f0) fresnel) I_P,
+I_P the clamped-cosine integral of the polygon transformed by M^-1 and clipped to the horizon (Heitz et al. 2016,
+Eq. 11; lutbake.ltc.polygon), one matrix for every f0. The shaded fit chooses each texel's packed M^-1 (4
+coefficients, ltc_code's layout), magnitude and fresnel to minimise
 
-    C = Σ_j ( (magnitude I_j - G_j) / (G_j + c A) )^2,     G_j = ∫_{P_j} f(v, l)(n.l) dω_l,
+    C = Σ_j ρ(z_j),  z_j = (value_j - T_j) / (T_j + c A),  ρ(z) = 2 s^2 (sqrt(1 + z^2 / s^2) - 1)   (soft L1)
 
-over ``LIGHTS`` training lights per texel (lutbake.ltc.lights, seeded by the texel's inputs; the area-light
-benchmark draws other seeds), A = the lobe's albedo, c = ``ABS_WEIGHT``: relative errors of lights brighter than
-c A, absolute errors (in units of c A) of dimmer ones. G_j uses one fixed set of the lobe's importance samples per
-texel (the L3 fit's own lobe sampler, lutbake.ltc.fit ``lobe_samples``, on a ``SAMPLES`` x ``SAMPLES`` stratified
-grid): G_j = 1/K Σ_k f_k / p_k [l_k in P_j]. The Fresnel channel is then the least-squares scale of the same I_j
-against the Schlick part H_j = ∫_P f (1 - v.h)^5 (n.l) dω under the same weights (the shader's f0 t2.x + (1 - f0)
-t2.y is then right for every f0, linear in f0).
+over ``LIGHTS`` training lights per texel (lutbake.ltc.lights, from the texel's inputs; the area-light benchmark
+draws another seed), for F = 1 (T_j = G_j = ∫_{P_j} f (n.l) dω, A the albedo) and, weighted by ``f0_weight``, for
+f0 = ``F0_TRAIN`` (T_j = f0 G_j + (1 - f0) H_j, H_j = ∫_{P_j} f (1 - v.h)^5 (n.l) dω, A the same mix of the
+albedos); c = ``ABS_WEIGHT``: relative errors of lights brighter than c A, absolute errors of dimmer ones; s =
+``ROBUST_SCALE``: lights the clamped cosine cannot follow (below its transformed horizon) do not dominate. G_j and
+H_j use one fixed set of the lobe's importance samples per texel (the L3 fit's own sampler, lutbake.ltc.fit
+``lobe_samples``, ``SAMPLES`` x ``SAMPLES`` stratified): G_j = 1/K Σ_k f_k / p_k [l_k in P_j]. With ``f0_weight`` 0
+(or a lobe without Fresnel) only F = 1 is fitted and fresnel is the exact channel (resp. the magnitude).
 
 Search: Levenberg-Marquardt from the texel's L3 fit (lutbake.ltc.fit), ``ITERATIONS`` steps, forward-difference
-Jacobian of the 4 coefficients (the magnitude is linear), float64 throughout; at normal incidence the lobe is
-isotropic and only (M^-1_22, magnitude) are free (M^-1_00 = M^-1_11, no skew), as ltc_code's table. The
+Jacobian of the 4 coefficients (magnitude and fresnel are linear), float64 throughout; at normal incidence the lobe
+is isotropic and only M^-1_22 of the matrix is free (M^-1_00 = M^-1_11, no skew), as ltc_code's table. The
 I_j are one Warp launch per step over (texel, trial, light). Every texel is independent of every other and of how
 texels are grouped: bit-identical for any tiling or worker count.
 """
