@@ -104,6 +104,22 @@ def test_shaded_fit_is_independent_of_how_texels_are_grouped():
         np.testing.assert_array_equal(np.concatenate([apart[0][i], apart[1][i]]), together[i])
 
 
+def test_shaded_fit_keeps_texels_the_l3_fit_represents_exactly():
+    """EON at r = 0 is Lambert, an exact LTC: the shaded fit keeps those texels' L3 fit (bit for bit) instead of adding
+    its training samples' noise, and refines the others."""
+    from pathlib import Path
+
+    from lutbake.api import bake_table
+    from lutbake.config import load_configs
+
+    tables = {}
+    for f in ("l3", "shaded"):
+        over = ["size=[6,6]", 'format="exr"', 'dtype="float32"', f'fit="{f}"']
+        tables[f] = bake_table(load_configs([Path("lutbake/presets/ltc-eon.toml")], over)[0], workers=2)[0].data
+    np.testing.assert_array_equal(tables["shaded"][:, :, 0], tables["l3"][:, :, 0])
+    assert not np.array_equal(tables["shaded"][0, 1:, 1:], tables["l3"][0, 1:, 1:])
+
+
 @pytest.fixture(scope="module")
 def small_benchmark():
     cases = ltc_bench.cases(2, 8)

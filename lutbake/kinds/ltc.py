@@ -310,12 +310,17 @@ class LtcBake:
                 if self.shaded:
                     from ..ltc import shaded
 
+                    # texels the L3 fit represents exactly (EON at r = 0: Lambert) keep it: the training lights'
+                    # sampled targets would only add their noise
+                    sel = np.flatnonzero(p.relative(texel, err) >= shaded.EXACT_L3)
                     free = self.o["magnitude"] == "fitted"
-                    exact_fres = fres if self.has_fresnel else None
-                    packed, mag, fres = shaded.refine(
-                        p, texel, packed, exact_fres, free, self.device, f0_weight=self.o["fit_f0_weight"]
+                    exact_fres = fres[sel] if self.has_fresnel else None
+                    w = self.o["fit_f0_weight"]
+                    packed, mag, fres, err = packed.copy(), mag.copy(), fres.copy(), err.copy()
+                    packed[sel], mag[sel], fres[sel] = shaded.refine(
+                        p, texel[sel], packed[sel], exact_fres, free, self.device, f0_weight=w
                     )
-                    err = p.error(texel, np.linalg.inv(fit.unpack_inverse(packed)))
+                    err[sel] = p.error(texel[sel], np.linalg.inv(fit.unpack_inverse(packed[sel])))
                 box += [packed, p.relative(texel, err), mag, fres]
         return box
 

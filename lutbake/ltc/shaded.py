@@ -43,6 +43,7 @@ ITERATIONS = 8
 LAMBDA0 = 1e-2  # initial Levenberg-Marquardt damping (relative to diag(J^T J))
 FD_STEP = 1e-6  # forward-difference step, relative to max(|coefficient|, 1)
 SEED = 40
+EXACT_L3 = 1e-3  # relative L3 error below which a texel's L3 fit is kept as exact (the kind skips refining it)
 TINY = 1e-30  # floor of a residual's scale (a lobe whose albedo vanishes, e.g. sheen at grazing, alpha -> 0)
 F0_TRAIN = 0.04  # the dielectric reflectance fitted beside F = 1 (lobes with Fresnel)
 F0_WEIGHT = 0.7  # default weight of the f0 = F0_TRAIN residuals beside F = 1 (0: F = 1 alone)
