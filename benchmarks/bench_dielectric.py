@@ -29,7 +29,9 @@ wp.config.quiet = True
 
 from lutbake.api import bake_table  # noqa: E402
 from lutbake.config import validate_table  # noqa: E402
+from lutbake.integrands.dielectric import integrate  # noqa: E402
 from lutbake.kinds import dielectric as kd  # noqa: E402
+from lutbake.layouts import lookup_layout  # noqa: E402
 from lutbake.provenance import sources_digest  # noqa: E402
 from lutbake.runtime.executor import default_workers  # noqa: E402
 
@@ -66,7 +68,7 @@ def reference(name: str, kw: dict):
         return np.load(path)["idx"], np.load(path)["ref"]
     k = (*kd.terms_of(o), kd.MODE[o["layout"]], "gauss_legendre")
     f = [np.asarray(a[idx], np.float32) for a in (nov, alpha, eta)]
-    ref = kd.post_process(o["layout"], kd.integrate(k, *f, 3 * REF_ORDER**2, 0))
+    ref = lookup_layout("dielectric", o["layout"]).stored(integrate(k, *f, 3 * REF_ORDER**2, 0))
     OUT.mkdir(parents=True, exist_ok=True)
     np.savez(path, idx=idx, ref=ref)
     return idx, ref

@@ -405,7 +405,8 @@ def validate():
     default=None,
     help="PNG to write (default: FILE's stem + .preview.png beside it).",
 )
-def preview(file, out):
+@click.option("--force", is_flag=True, help="Write the PNG even under a name that does not end in .png.")
+def preview(file, out, force):
     """Render a PNG of a table file (any format lutbake writes; see inspect): 1D tables as curves, 2D
     tables as colour-mapped channels with labelled axes, 3D tables as labelled slice grids, btf tables as
     light x view images per sigma and phi; and, where the table has a split-sum reconstruction, a row of
@@ -419,7 +420,7 @@ def preview(file, out):
     from .errors import LutbakeError
 
     try:
-        path = render(file, out)
+        path = render(file, out, force=force)
     except ImportError as e:
         click.echo(f"error: preview needs matplotlib (pip install 'lutbake[plot]'): {e}", err=True)
         sys.exit(EXIT_CONFIG)

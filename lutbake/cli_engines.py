@@ -79,7 +79,8 @@ def _shape(text: str | None):
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the report as JSON (for CI).")
 @click.option("--workers", type=click.IntRange(min=1), default=None, help="Worker threads (default: every core).")
-def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, error_map, as_json, workers):
+@click.option("--force", is_flag=True, help="Write --error-map even under a name that does not end in .png.")
+def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, error_map, as_json, workers, force):
     """Compare the LUT FILE with a converged re-bake under declared conventions and diagnose mistakes.
 
     Reports max/mean/percentile |file - converged| per channel and where the maximum sits, tests each usual
@@ -103,6 +104,9 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
         click.echo("error: give --preset or --config, not both", err=True)
         sys.exit(EXIT_CONFIG)
     try:
+        from .preflight import check_image_output, input_files
+
+        check_image_output(error_map, input_files(file) + ([config] if config else []), force, "--error-map")
         report = run_audit(
             file,
             {"preset": preset, "config": config, "overrides": overrides},

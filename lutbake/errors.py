@@ -4,7 +4,9 @@ RecursionError reaches the user."""
 
 from __future__ import annotations
 
-from .textsafe import escape_controls, safe_repr
+from .textsafe import safe_repr, shorten
+
+MESSAGE_LIMIT = 2000  # characters of one error line: a 10 000-character name is shown cut in the middle
 
 
 class LutbakeError(Exception):
@@ -22,7 +24,7 @@ class ConfigError(LutbakeError):
         table: str | None = None,
     ):
         self.file, self.key, self.value, self.allowed, self.table = str(file), key, value, allowed, table
-        where = self.file
+        where = shorten(self.file)
         if table is not None:
             where += f": table {table}"
         parts = [where]
@@ -34,7 +36,7 @@ class ConfigError(LutbakeError):
             text += f": {message}"
         if allowed:
             text += f" (allowed: {allowed})"
-        super().__init__(escape_controls(text))
+        super().__init__(shorten(text, MESSAGE_LIMIT))
 
 
 class TableError(LutbakeError):

@@ -2,8 +2,8 @@
 
 - **Content hash.** Every output records ``lutbake:content_hash`` = sha256 of the table's canonical TOML
   (``TableSpec.toml()``), the lutbake version and the source text of the modules that define what a table holds
-  (``HASH_SOURCES``: terms, integrands, sampling, kinds, axes, edge policy). An output with the same hash is up to
-  date (lutbake.batch skips it); anything else (no file, unreadable file, other hash) is baked again.
+  (``HASH_SOURCES``: terms, integrands, sampling, kinds, layouts, axes, edge policy). An output with the same hash is
+  up to date (lutbake.batch skips it); anything else (no file, unreadable file, other hash) is baked again.
 - **Provenance.** ``attributes(spec, plan)``: terms, estimator, samples, seed, config text, versions, the plan's
   own records and the content hash, written as ``lutbake:*`` (EXR header or the JSON sidecar).
 """
@@ -25,6 +25,7 @@ HASH_SOURCES = (
     "integrands/*.py",
     "sampling/*.py",
     "kinds/*.py",
+    "layouts/*.py",
     "ltc/*.py",
     "axes.py",
     "edge.py",

@@ -18,14 +18,12 @@ tests/test_value_bounds.py against bakes of every kind, layout and model:
 
 from __future__ import annotations
 
-# dfg layouts whose channels are weighted single-scattering albedos (each weight in [0, 1]), and the others
-# charlie_fabric (Unity HDRP): R, G = the sheen albedo / 2 pi (Charlie's Smith-form visibility; measured <= 0.131),
-# B = lerp(1, 0.5, alpha) in [0.5, 1]
-UNIT_LAYOUTS = frozenset({"scale_bias", "multiscatter", "scale_bias_f82", "charlie_fabric"})
-# multiscatter_disney (Unity HDRP): B = Disney FGD - 0.5 spans [-0.028, 1.0036] on endpoint texels (NoV = 0 rows)
-ABOVE_ONE_LAYOUTS = frozenset(
-    {"multiscatter_cloth", "charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped", "multiscatter_disney"}
-)
+from .layouts import layouts_of
+
+# dfg layouts whose channels are weighted single-scattering albedos (each weight in [0, 1]), and the others: each
+# layout record says which (lutbake.layouts.base.Layout.unit_range, with the reason in ``above_one``)
+UNIT_LAYOUTS = frozenset(name for name, lay in layouts_of("dfg").items() if lay.unit_range)
+ABOVE_ONE_LAYOUTS = frozenset(name for name, lay in layouts_of("dfg").items() if not lay.unit_range)
 # specular models whose directional albedo is at most 1 (energy conserving), and the others
 UNIT_SPECULAR_MODELS = frozenset({"microfacet", "cook_torrance", "ashikhmin_shirley"})
 ABOVE_ONE_SPECULAR_MODELS = frozenset({"blinn_phong"})

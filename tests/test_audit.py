@@ -217,6 +217,14 @@ SHIPPED = {
     "bevy_dfg.ktx2": ("bevy", {}),
     "openpbr_energy_tables.npz": ("openpbr", {}),
     "ltc_code_ltc.js.gz": ("ltc-ggx", {}),
+    # its sheen channel's smooth grazing corner (36.5 shipped vs 26.6 converged) outweighs a 6 x 6 subset's other texels
+    "babylon_environment_brdf.npz": ("babylon", {"max_side": 64}),
+    "babylon_openpbr_brdf.npz": ("babylon-openpbr", {}),
+}
+# tables of tests/data no preset bakes: the model they hold is not one lutbake integrates
+UNAUDITED = {
+    "babylon_environment_fuzz_brdf.npz": "Zeltner, Burley & Chiang 2022's LTC fit of a volumetric sheen "
+    "(lutbake.layouts.babylon)",
 }
 FAST_SIDE = 6  # the loop's subset (its own tests above use MAX_SIDE)
 OPENPBR_RATIO_MEAN = 2e-3  # the ratio re-baked: its averages' noise divided by them (measured mean 6.1e-4, all slices)
@@ -227,7 +235,7 @@ LTC_MAGNITUDE_P50 = 2e-3  # ltc_code's 32 x 32-sample magnitudes (measured media
 
 def test_every_shipped_table_in_tests_data_is_audited():
     tables = {p.name for p in DATA.iterdir() if p.suffix not in (".json", ".md")}
-    assert tables == set(SHIPPED), tables ^ set(SHIPPED)
+    assert tables == set(SHIPPED) | set(UNAUDITED), tables ^ (set(SHIPPED) | set(UNAUDITED))
 
 
 @pytest.mark.parametrize("name", sorted(SHIPPED))
@@ -240,7 +248,7 @@ def test_audit_runs_on_every_shipped_table(name):
     from lutbake.commands.audit_tables import FIT_RATIO_MAX, UNORM16_STEP
 
     preset, kw = SHIPPED[name]
-    r = audit(DATA / name, {"preset": preset}, max_side=FAST_SIDE, **kw)
+    r = audit(DATA / name, {"preset": preset}, **{"max_side": FAST_SIDE, **kw})
     text = r.text()
     assert text.startswith(f"audit {DATA / name}") and ("PASS" in text or "FAIL" in text)
     if preset == "openpbr":

@@ -10,8 +10,13 @@ import pytest
 
 from lutbake.config import validate_table
 from lutbake.edge import ALPHA_MIN, NOV_MIN
+from lutbake.integrands.dielectric import integrate
 from lutbake.kinds import dielectric as kd
 from lutbake.kinds import lookup_kind
+from lutbake.layouts import lookup_layout
+from lutbake.layouts.base import ior_values
+from lutbake.sampling.dielectric_avg import mu_starts
+from lutbake.sampling.dielectric_layout import DEFAULT_SAMPLES, kernel_tolerance
 from lutbake.validate import dielectric as vd
 
 REFERENCE_ATOL = 1.0e-6  # |table - numpy reference| per channel, every texel below
@@ -51,10 +56,10 @@ def f32(*xs):
 @pytest.mark.parametrize("texel", RANDOM + EDGES)
 def test_energies_match_numpy_integral_over_the_outgoing_sphere(texel):
     nov, alpha, eta = f32(*texel)
-    e = kd.integrate(
+    e = integrate(
         ("ggx", "smith_separable", "exact", "gauss_legendre"),
         *(np.atleast_1d(x) for x in (nov, alpha, eta)),
-        kd.DEFAULT_SAMPLES["gauss_legendre"],
+        DEFAULT_SAMPLES["gauss_legendre"],
         0,
     )[0]
     er, et = ref.energies(float(nov), float(alpha), float(eta))
@@ -67,9 +72,7 @@ def test_energies_match_numpy_integral_over_the_outgoing_sphere(texel):
 )
 def test_other_terms_match_numpy_integral(ndf, masking, texel):
     nov, alpha, eta = (np.atleast_1d(x) for x in f32(*texel))
-    e = kd.integrate(
-        (ndf, masking, "exact", "gauss_legendre"), nov, alpha, eta, kd.DEFAULT_SAMPLES["gauss_legendre"], 0
-    )[0]
+    e = integrate((ndf, masking, "exact", "gauss_legendre"), nov, alpha, eta, DEFAULT_SAMPLES["gauss_legendre"], 0)[0]
     er, et = ref.energies(float(nov[0]), float(alpha[0]), float(eta[0]), ndf, masking)
     np.testing.assert_allclose(e[:2], [er, et], rtol=0, atol=REFERENCE_ATOL)
 
@@ -78,8 +81,8 @@ def test_other_terms_match_numpy_integral(ndf, masking, texel):
 def test_eevee_channels_match_numpy_integral(texel):
     """EEVEE's Schlick split-sum channels (scale, bias, transmission factor) against the reference's own weights."""
     nov, alpha, eta = (np.atleast_1d(x) for x in f32(*texel))
-    e = kd.integrate(
-        ("ggx", "smith_separable", "eevee", "gauss_legendre"), nov, alpha, eta, kd.DEFAULT_SAMPLES["gauss_legendre"], 0
+    e = integrate(
+        ("ggx", "smith_separable", "eevee", "gauss_legendre"), nov, alpha, eta, DEFAULT_SAMPLES["gauss_legendre"], 0
     )[0]
     np.testing.assert_allclose(
         e, ref.energies(float(nov[0]), float(alpha[0]), float(eta[0]), fresnel="eevee"), rtol=0, atol=REFERENCE_ATOL
@@ -105,11 +108,11 @@ def test_smooth_limit_is_fresnel_including_total_internal_reflection():
     assert worst <= SMOOTH_ATOL, where
     # the TIR branch explicitly: inside glass (eta = 1/1.5), views past the critical angle reflect everything
     mu = np.array([0.1, 0.3, 0.6], np.float32)  # cos theta_c = 0.745
-    e = kd.integrate(
+    e = integrate(
         ("ggx", "smith_separable", "exact", "gauss_legendre"),
         mu,
         *f32([ALPHA_MIN] * 3, [1 / 1.5] * 3),
-        kd.DEFAULT_SAMPLES["gauss_legendre"],
+        DEFAULT_SAMPLES["gauss_legendre"],
         0,
     )
     np.testing.assert_allclose(e[:, :2], np.tile([1.0, 0.0], (3, 1)), rtol=0, atol=SMOOTH_ATOL)
@@ -118,7 +121,7 @@ def test_smooth_limit_is_fresnel_including_total_internal_reflection():
     eta = np.array([1.5, 1.5, 1 / 1.5, 1 / 1.5], np.float32)
     F = vd.fresnel_np(eta, mu)
     for est in ("gauss_legendre", "sobol_vndf"):
-        e = kd.integrate(("ggx", "smith_separable", "exact", est), mu, np.zeros(4, np.float32), eta)
+        e = integrate(("ggx", "smith_separable", "exact", est), mu, np.zeros(4, np.float32), eta)
         want_t = np.where(mu < np.sqrt(np.maximum(1 - eta**2.0, 0.0)), 0.0, 1 - F)
         np.testing.assert_allclose(e, np.stack([F, want_t, F + want_t], 1), rtol=0, atol=1e-6, err_msg=est)
 
@@ -132,21 +135,21 @@ def test_index_matched_interface_has_no_reflection_and_the_smith_transmittance()
     mu, alpha = f32([0.2, 0.5, 0.9], [0.3, 0.3, 0.3])
     at = {}
     for eta in (1.0 - 1e-6, 1.0, 1.0 + 1e-6):
-        at[eta] = kd.integrate(
+        at[eta] = integrate(
             ("ggx", "smith_separable", "exact", "gauss_legendre"),
             mu,
             alpha,
             *f32([eta] * 3),
-            kd.DEFAULT_SAMPLES["gauss_legendre"],
+            DEFAULT_SAMPLES["gauss_legendre"],
             0,
         )
     np.testing.assert_allclose(at[1.0 - 1e-6][:, 2], at[1.0][:, 2], atol=1e-3)
     np.testing.assert_allclose(at[1.0 + 1e-6][:, 2], at[1.0][:, 2], atol=1e-3)
-    smooth = kd.integrate(
+    smooth = integrate(
         ("ggx", "smith_separable", "exact", "gauss_legendre"),
         mu,
         *f32([ALPHA_MIN] * 3, [1.0] * 3),
-        kd.DEFAULT_SAMPLES["gauss_legendre"],
+        DEFAULT_SAMPLES["gauss_legendre"],
         0,
     )
     np.testing.assert_allclose(smooth[:, 1], 1.0, atol=1e-6)
@@ -293,12 +296,12 @@ def test_openpbr_reflection_ratio_closed_form_reproduces_the_shipped_array():
     """Fed OpenPBR's own (shipped) averages, the Kulla-Conty split reproduces OpenPBR_IdealDielectricReflectionRatio
     to its UNORM16 rounding at every texel of every eta != 1 row (alpha > 0), in the module and in an independent
     scalar transcription."""
-    from lutbake.kinds.dielectric_ratio import reflection_ratio
+    from lutbake.integrands.dielectric_ratio import reflection_ratio
 
     shipped = np.load("tests/data/openpbr_energy_tables.npz")
     x = shipped["ideal_dielectric_reflection_ratio"] / 65535.0
     ec = shipped["ideal_dielectric_avg_energy_complement"] / 65535.0
-    etas = kd.ior_values(32, 0.4, 2.5, "endpoint", "symmetric")
+    etas = ior_values(32, 0.4, 2.5, "endpoint", "symmetric")
     rows = [z for z in range(32) if z not in OPENPBR_ETA_ONE_ROWS]
     got = reflection_ratio(ec[rows], ec[[31 - z for z in rows]], etas[rows, None])
     scalar = np.array([[kulla_conty_ratio(ec[z, a], ec[31 - z, a], etas[z]) for a in range(8, 32)] for z in rows])
@@ -459,7 +462,7 @@ def honesty_ratio(err: np.ndarray, est: np.ndarray) -> float:
 @pytest.mark.parametrize("tol", HONESTY_TOLERANCES)
 def test_adaptive_estimate_bounds_the_error_against_a_high_order(tol):
     nov, alpha, eta = (np.asarray(c, np.float32) for c in zip(*HONESTY_TEXELS))
-    high = kd.integrate(("ggx", "smith_separable", "exact", "gauss_legendre"), nov, alpha, eta, 3 * HIGH_ORDER**2)
+    high = integrate(("ggx", "smith_separable", "exact", "gauss_legendre"), nov, alpha, eta, 3 * HIGH_ORDER**2)
     values, est = adaptive_at(tol)
     np.testing.assert_array_less(np.abs(values - high), est)  # every estimate bounds its error
     np.testing.assert_array_less(est, tol + TERMS_FLOOR * np.abs(values))  # and reached the tolerance (+ the floor)
@@ -489,10 +492,10 @@ def test_adaptive_estimate_of_eevee_btdf_grazing_row_bounds_the_error():
     integrand = dielectric_integrand("ggx", "smith_separable", "eevee", 1)
     inputs = {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": eta}
     tol = 1.0e-6
-    values, est = DielectricAdaptive(*kd.kernel_tolerance("eevee_btdf", Tolerance(tol, 0.0))).evaluate_with_error(
-        integrand, inputs, "cpu"
-    )
-    high = kd.integrate(("ggx", "smith_separable", "eevee", "gauss_legendre"), nov, alpha, eta, 3 * HIGH_ORDER**2)
+    values, est = DielectricAdaptive(
+        *kernel_tolerance(lookup_layout("dielectric", "eevee_btdf"), Tolerance(tol, 0.0))
+    ).evaluate_with_error(integrand, inputs, "cpu")
+    high = integrate(("ggx", "smith_separable", "eevee", "gauss_legendre"), nov, alpha, eta, 3 * HIGH_ORDER**2)
     err = np.abs(values[:, 2] - high[:, 2])
     np.testing.assert_array_less(err, est[:, 2])
     np.testing.assert_array_less(est[:, 2], tol + TERMS_FLOOR * np.abs(values[:, 2]))
@@ -517,9 +520,7 @@ def test_adaptive_first_pair_is_the_merged_fixed_rules():
     quadrature = est - TERMS_FLOOR * np.abs(values)
     assert np.all(quadrature >= np.abs(q16 - q8) * (1.0 - 1e-9))  # (rounding of est - floor |v|)
     # the merge drops some texel's NDF-peak breakpoints (a fixed-order table keeps them all)
-    assert np.any(
-        q16 != kd.integrate(("ggx", "smith_separable", "exact", "gauss_legendre"), nov, alpha, eta, 3 * 16**2)
-    )
+    assert np.any(q16 != integrate(("ggx", "smith_separable", "exact", "gauss_legendre"), nov, alpha, eta, 3 * 16**2))
 
 
 @pytest.mark.parametrize(
@@ -535,7 +536,7 @@ def test_small_eta_and_critical_angle_match_numpy(texel):
     """v.h and the refraction in float64 (lutbake.integrands.dielectric g64): float32's v.h, amplified by 1/eta^2
     next to total internal reflection, and v's float32 components (unit to ~1e-8) left these 1e-6 to 4e-5 off."""
     nov, alpha, eta = (np.atleast_1d(x) for x in f32(*texel))
-    e = kd.integrate(("ggx", "smith_separable", "eevee", "gauss_legendre"), nov, alpha, eta, 3 * HIGH_ORDER**2)[0]
+    e = integrate(("ggx", "smith_separable", "eevee", "gauss_legendre"), nov, alpha, eta, 3 * HIGH_ORDER**2)[0]
     want = ref.energies(float(nov[0]), float(alpha[0]), float(eta[0]), fresnel="eevee")
     np.testing.assert_allclose(e, want, rtol=0, atol=NUMPY_ACCURACY)  # measured: within 5.9e-8 (float32 D, G)
 
@@ -546,9 +547,9 @@ def test_avg_mu_starts_grade_towards_the_critical_angle():
     eta, alpha = 0.6, 0.01
     c = np.sqrt(1 - eta * eta)
     graded = [c + s * alpha * 4.0**k for k in range(3) for s in (-1, 1)]  # 0.01, 0.04, 0.16
-    np.testing.assert_allclose(kd.mu_starts(eta, alpha), np.sort([0.0, 0.2, eta, c, 1.0, *graded]), rtol=1e-12)
-    np.testing.assert_allclose(kd.mu_starts(eta, 0.0), [0.0, 0.2, eta, c, 1.0], rtol=1e-12)
-    np.testing.assert_array_equal(kd.mu_starts(1.5, alpha), [0.0, 0.2, 1.0])
+    np.testing.assert_allclose(mu_starts(eta, alpha), np.sort([0.0, 0.2, eta, c, 1.0, *graded]), rtol=1e-12)
+    np.testing.assert_allclose(mu_starts(eta, 0.0), [0.0, 0.2, eta, c, 1.0], rtol=1e-12)
+    np.testing.assert_array_equal(mu_starts(1.5, alpha), [0.0, 0.2, 1.0])
 
 
 def test_avg_mu_rule_reaches_the_tolerance():
@@ -577,11 +578,11 @@ def test_avg_mu_rule_reaches_the_tolerance():
     wt = (np.diff(edges)[:, None] * w / 2).ravel()
     key = ("ggx", "smith_separable", "exact_metal", "gauss_legendre")  # the kind's defaults
     for k in range(len(alpha)):
-        e = kd.integrate(key, mu, np.full(len(mu), alpha[k]), np.full(len(mu), eta[k]), samples=432)
+        e = integrate(key, mu, np.full(len(mu), alpha[k]), np.full(len(mu), eta[k]), samples=432)
         ref = 2 * (wt * mu) @ e
         err = np.abs(values[k, :2] - ref[:2])
         assert np.all(err <= mu_err[k, :2] + 2e-7), (k, alpha[k], eta[k], err, mu_err[k])
-        e = kd.integrate(key, mu, np.full(len(mu), alpha[k]), np.full(len(mu), eta[k]), samples=1200)
+        e = integrate(key, mu, np.full(len(mu), alpha[k]), np.full(len(mu), eta[k]), samples=1200)
         ref = 2 * (wt * mu) @ e
         err = np.abs(values[k] - [ref[0], ref[1], ref[0] + ref[1]])  # layout energy: E_R, E_T, E_R + E_T
         assert np.all(err <= float(table.attributes["error_estimate"])), (k, alpha[k], eta[k], err)
@@ -615,7 +616,7 @@ def test_avg_inner_order_climbs_to_a_tight_tolerance():
     wt = (np.diff(edges)[:, None] * w / 2).ravel()
     key = ("ggx", "smith_separable", "exact_metal", "gauss_legendre")
     for k in range(0, len(alpha), 2):  # three of the six texels, both etas
-        e = kd.integrate(key, mu, np.full(len(mu), alpha[k]), np.full(len(mu), eta[k]), samples=3 * 28**2)
+        e = integrate(key, mu, np.full(len(mu), alpha[k]), np.full(len(mu), eta[k]), samples=3 * 28**2)
         ref = 2 * (wt * mu) @ e
         err = np.abs(values[k] - [ref[0], ref[1], ref[0] + ref[1]])
         # float32 storage rounds a value ~0.5 by up to 3e-8 on top of the estimate

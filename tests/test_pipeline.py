@@ -186,11 +186,12 @@ def test_api_bake_skips_up_to_date_outputs_unless_forced(spec, tmp_path):
 # ---- import layers: no circle, no module imports upward ----------------------------------------------------------
 # lowest first; a module may import its own layer's siblings and any lower layer, never a higher one
 LAYERS = [
-    {"errors", "edge", "axes", "table", "textsafe", "tolerance", "warp_runtime", "catalog", "metals", "memo"},
+    {"errors", "edge", "axes", "table", "textsafe", "limits", "tolerance", "warp_runtime", "catalog", "metals", "memo"},
     {"io"},
     {"terms"},
     {"sampling"},
     {"integrands", "ltc"},
+    {"layouts"},
     {"kinds", "value_bounds"},
     {"config", "preflight"},
     # cluster: the executor's Dask counterpart

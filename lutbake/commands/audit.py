@@ -35,7 +35,6 @@ from pathlib import Path
 import numpy as np
 
 from ..axes import Axis
-from ..catalog import SHEEN_LAYOUTS
 from ..edge import NOV_MIN
 from ..io.lut_files import LutFile, read_lut
 from ..tolerance import Tolerance
@@ -65,11 +64,12 @@ def srgb_oetf(v):
     return np.where(v <= 0.0031308, 12.92 * v, 1.055 * v ** (1 / 2.4) - 0.055)
 
 
-def other_layout(pred: np.ndarray, layout: str) -> np.ndarray:
-    """The same table written in the other split-sum layout (channels R, G; a third channel is kept)."""
+def other_layout(pred: np.ndarray, split_sum: str | None) -> np.ndarray:
+    """The same table written in the other split-sum layout (channels R, G; a third channel is kept); ``split_sum``:
+    the declared layout's pair (lutbake.layouts.base.Layout.split_sum)."""
     out = pred.copy()
     r, g = pred[..., 0], pred[..., 1]
-    if layout.startswith("multiscatter"):  # (Fc, E) -> (scale, bias) = (E - Fc, Fc)
+    if split_sum == "multiscatter":  # (Fc, E) -> (scale, bias) = (E - Fc, Fc)
         out[..., 0], out[..., 1] = g - r, r
     else:  # (scale, bias) -> (Fc, E) = (bias, scale + bias)
         out[..., 0], out[..., 1] = g, r + g
@@ -110,6 +110,13 @@ class Conventions:
     @property
     def layout(self) -> str:
         return self.options["layout"]
+
+    @property
+    def record(self):
+        """The declared layout's record (lutbake.layouts)."""
+        from ..layouts import lookup_layout
+
+        return lookup_layout("dfg", self.layout)
 
 
 def conventions(config=None, preset=None, overrides=(), shape=None) -> Conventions:
@@ -238,13 +245,15 @@ def hypotheses(conv: Conventions) -> list[Hypothesis]:
             lambda p: np.concatenate([p[..., 1:2], p[..., 0:1], p[..., 2:]], axis=-1),
         )
     )
-    other = "scale_bias" if conv.layout.startswith("multiscatter") else "multiscatter"
+    if "other_split_sum" not in conv.record.audit:
+        return hs
+    other = "scale_bias" if conv.record.split_sum == "multiscatter" else "multiscatter"
     hs.append(
         Hypothesis(
             "layout_" + other,
             f"the file is in the {other} layout, declared {conv.layout} (multiscatter (R, G) = (bias, scale + bias))",
             nominal,
-            lambda p: other_layout(p, conv.layout),
+            lambda p: other_layout(p, conv.record.split_sum),
         )
     )
     return hs
@@ -254,16 +263,15 @@ class Integrator:
     """Converged (and, for the noise estimate, Hammersley) integrals at arbitrary (NoV, alpha), cached."""
 
     def __init__(self, conv: Conventions, workers: int | None = None):
-        from ..integrands import engine_diffuse, specular
+        from ..integrands import specular
         from ..kinds.dfg import terms_of
-        from ..kinds.engine_layouts import BASE_LAYOUT
 
         self.specular = specular
-        self.engine_diffuse = engine_diffuse
         o = conv.options
         self.form, self.ndf, self.masking = terms_of(o)
         self.layout = o["layout"]
-        self.base = BASE_LAYOUT.get(self.layout, self.layout)  # the specular integrand's layout
+        self.record = conv.record
+        self.base = self.record.integrand  # the specular integrand's channel set
         self.nch = specular.N_CHANNELS[self.base]
         self.workers = workers
         self._cache: dict[bytes, np.ndarray] = {}
@@ -302,17 +310,17 @@ class Integrator:
         key = b"".join(a.astype(np.float32).tobytes() for a in (nov, alpha, rough))
         if key not in self._cache:
             tol = Tolerance(REFERENCE_TOLERANCE, 0.0)
-            out = self._run(self.base, "gauss_legendre", None, self.nch, nov, alpha, tol)
-            if self.base != self.layout:
-                out = self.engine_diffuse.engine_channels(self.layout, out, nov, rough)
+            out = self.record.stored(self._run(self.base, "gauss_legendre", None, self.nch, nov, alpha, tol))
+            if self.record.engine_channel is not None:
+                out = self.record.engine_channel.compute(out, nov, rough)
             self._cache[key] = out
         return self._cache[key]
 
     def hammersley(self, nov, alpha, samples: int) -> np.ndarray | None:
         """The engines' usual estimator (R, G of the split-sum layout), or None for the sheen layouts."""
-        if self.base in SHEEN_LAYOUTS or self.form != "microfacet":
+        if self.record.terms.ndf is not None or self.form != "microfacet":
             return None
-        base = "multiscatter" if self.base.startswith("multiscatter") else "scale_bias"
+        base = "multiscatter" if self.record.split_sum == "multiscatter" else "scale_bias"
         return self._run(base, "hammersley_ndf", samples, 2, nov, alpha)
 
 
@@ -483,9 +491,7 @@ def audit(
         )
     conv = conventions(**(conv_args or {}), shape=(rows, cols))
     integ = Integrator(conv, workers)
-    from ..kinds.dfg import CHANNELS
-
-    names = list(CHANNELS[conv.layout])
+    names = list(conv.record.channels)
     nch = min(fch, len(names))
     # the sheen layouts keep their value in B only (charlie) or R, G: compare what the layout fills
     compared = [c for c in range(nch) if not names[c].startswith("zero")]

@@ -18,15 +18,14 @@ within the tolerance and ``fit_ratio`` <= FIT_RATIO_MAX.
 OpenPBR (adobe/openpbr-bsdf ``impl/data/openpbr_*_data.h``, UNORM16): each energy array against lutbake's bake
 under the ``openpbr`` preset's conventions (its [ior][alpha][cos] grid, separable Smith, exact Fresnel), at a
 strided subset of IOR slices and roughness rows; the reflection ratio against lutbake's (its Kulla-Conty split of
-the two sides' averages, lutbake.kinds.dielectric_ratio) where OpenPBR reads it (alpha index >= 2, eta != 1; the rest
-reported apart), and against the reciprocity identity of OpenPBR's multiple-scattering lobe (1 - x(eta)) E_avg(eta) =
-(1 - x(1/eta)) E_avg(1/eta). The cos = 0 column is reported apart: lutbake evaluates
+the two sides' averages, lutbake.integrands.dielectric_ratio) where OpenPBR reads it (alpha index >= 2, eta != 1;
+the rest reported apart), and against the reciprocity identity of OpenPBR's multiple-scattering lobe
+(1 - x(eta)) E_avg(eta) = (1 - x(1/eta)) E_avg(1/eta). The cos = 0 column is reported apart: lutbake evaluates
 NoV >= NOV_MIN there (lutbake.edge), a limit the shipped Monte Carlo estimator does not take.
 """
 
 from __future__ import annotations
 
-import gzip
 import math
 import re
 from dataclasses import dataclass, field
@@ -93,8 +92,10 @@ class TableAuditReport:
 
 
 def _read_text(path: Path) -> str:
-    raw = path.read_bytes()
-    return (gzip.decompress(raw) if path.suffix == ".gz" else raw).decode("utf-8", "replace")
+    from ..io import bounded  # size caps: a text table or its gzip at most bounded.MAX_TEXT_BYTES
+
+    raw = bounded.read_bytes(path, bounded.MAX_TEXT_BYTES, "a text table")
+    return (bounded.gunzip(raw) if path.suffix == ".gz" else raw).decode("utf-8", "replace")
 
 
 # --------------------------------------------------------------------------------------------------- LTC
@@ -109,7 +110,9 @@ def read_ltc_pair(path: Path) -> tuple[np.ndarray, np.ndarray]:
     path = Path(path)
     if path.name.endswith("_1.dds"):
         second = path.with_name(path.name.replace("_1.dds", "_2.dds"))
-        return tuple(dds.decode(p.read_bytes())[0].astype(np.float64) for p in (path, second))
+        from ..io.bounded import read_bytes
+
+        return tuple(dds.decode(read_bytes(p))[0].astype(np.float64) for p in (path, second))
     text = _read_text(path)
     num = re.compile(r"-?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
     arrays = []
@@ -312,11 +315,12 @@ def audit_ltc(
 
 def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> TableAuditReport:
     from ..kinds import lookup_kind
-    from ..kinds.dielectric import OPENPBR_SIZE
+    from ..layouts.openpbr import OPENPBR_SIZE
 
     n = OPENPBR_SIZE
-    with np.load(Path(path)) as z:
-        shipped = {k: z[k].astype(np.float64) / 65535.0 for k in z.files}
+    from ..io.bounded import load_npz_all
+
+    shipped = {k: v.astype(np.float64) / 65535.0 for k, v in load_npz_all(Path(path)).items()}
     missing = [k for k, _, _ in OPENPBR_KEYS if k not in shipped]
     if missing:
         raise ValueError(f"{path}: missing OpenPBR arrays {missing} (keys: {sorted(shipped)})")
@@ -345,8 +349,8 @@ def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> 
             s = _stats(got - ours)
             errors[key] = s
             judged.append((got - ours).ravel())
-    # the reflection ratio (lutbake.kinds.dielectric_ratio): judged where OpenPBR reads it (alpha index >= 2, eta != 1);
-    # at alpha index 0-1 and on the eta = 1 row the averages are ~0 and their rounding decides the ratio
+    # the reflection ratio (lutbake.integrands.dielectric_ratio): judged where OpenPBR reads it (alpha index >= 2,
+    # eta != 1); at alpha index 0-1 and on the eta = 1 row the averages are ~0 and their rounding decides the ratio
     x = shipped["ideal_dielectric_reflection_ratio"]
     diff = x[iz] - ours_avg[..., RATIO_CHANNEL]
     body = np.zeros(diff.shape, bool)
@@ -396,6 +400,7 @@ def dispatch(
     """The LTC / OpenPBR audit when the declared conventions are one (a preset or config of kind ltc, or layout
     openpbr); None for the dfg family (lutbake.commands.audit)."""
     from ..config import load_config, parse_overrides, preset_path
+    from ..layouts import REGISTRY
 
     conv_args = conv_args or {}
     cfg = conv_args.get("config")
@@ -403,7 +408,8 @@ def dispatch(
     specs = load_config(p, parse_overrides(conv_args.get("overrides") or ()))
     if specs[0].kind == "ltc":
         return audit_ltc(path, specs[0], tolerance, metric, max_side, error_map=error_map)
-    if specs[0].options.get("layout") == "openpbr":
+    record = REGISTRY.get((specs[0].kind, specs[0].options.get("layout")))
+    if record is not None and "openpbr_arrays" in record.audit:  # the layout's record names its audit
         if error_map is not None:
             raise ValueError("--error-map: not drawn for OpenPBR's 3D arrays (the report names where each maximum is)")
         return audit_openpbr(path, specs, tolerance, metric, max_side)

@@ -26,7 +26,9 @@ from pathlib import Path
 import numpy as np
 
 from ..axes import Axis
+from ..errors import LutbakeError
 from ..io.readers import TableView, read_table
+from ..textsafe import bounded, shorten
 
 N_SPHERES = 5
 MAX_SLICES = 6  # columns of a 3D slice grid
@@ -90,6 +92,15 @@ def lookup(data: np.ndarray, axes: list[Axis], coords: dict[str, np.ndarray | fl
     return out
 
 
+def split_sum_form(layout: str) -> str | None:
+    """How a file's R, G (B) rebuild E, from its layout's record (lutbake.layouts.base.Layout.split_sum): scale_bias,
+    multiscatter, sheen or None (also for a layout this lutbake does not know)."""
+    from ..layouts import REGISTRY
+
+    lay = REGISTRY.get(("dfg", layout))
+    return lay.split_sum if lay is not None else None
+
+
 def split_sum(view: TableView):
     """(how the spheres are shaded, E(nov, roughness value) -> RGB, broad) from the file's own
     reconstruction, or None where the kind has none. ``roughness value`` is in the units of the table's
@@ -99,7 +110,7 @@ def split_sum(view: TableView):
     rough = next((n for n in names if n in ROUGHNESS_AXES), None)
     if view.kind is None or "NoV" not in names or rough is None or view.data.ndim != 3 + (len(axes) == 3):
         return None
-    layout = view.terms.get("layout", "scale_bias")
+    form = split_sum_form(view.terms.get("layout", "scale_bias"))
     z = axes[0] if len(axes) == 3 else None
     nch = view.data.shape[-1]
 
@@ -112,21 +123,21 @@ def split_sum(view: TableView):
     if view.kind in ("dfg", "specular_aniso") and nch >= 2:
         zmid = float(z.values()[z.count // 2]) if z is not None else None
         where = f", {_short(z, zmid)}" if z is not None else ""
-        if layout in ("scale_bias", "scale_bias_f82"):  # Karis 2013: E = f0 * scale + bias
+        if form == "scale_bias":  # Karis 2013: E = f0 * scale + bias
 
             def E_scale_bias(nov, r):
                 t = at(nov, r, zmid)
                 return SPHERE_F0 * t[..., 0:1] + t[..., 1:2]
 
             return f"E = f0 R + G, f0 = gold{where}", E_scale_bias, False
-        if layout in ("multiscatter", "multiscatter_cloth"):  # Filament: E = mix(R, G, f0)
+        if form == "multiscatter":  # Filament: E = mix(R, G, f0)
 
             def E_multiscatter(nov, r):
                 t = at(nov, r, zmid)
                 return (1 - SPHERE_F0) * t[..., 0:1] + SPHERE_F0 * t[..., 1:2]
 
             return f"E = (1 - f0) R + f0 G, f0 = gold{where}", E_multiscatter, False
-        if layout in ("charlie", "charlie_clamped") and nch >= 3:
+        if form == "sheen" and nch >= 3:
             # the sheen lobe is broad: its prefiltered (Charlie) environment is close to the mean radiance
             return (
                 "sheen = prefiltered_charlie sheenColor B, sheenColor = white",
@@ -210,10 +221,11 @@ def _channel_title(view: TableView, c: int) -> str:
 
 
 def _suptitle(view: TableView, path: Path, width_chars: int) -> str:
-    head = f"{path.name}: {view.kind} table '{view.name}'" if view.kind else f"{path.name}: no lutbake metadata"
+    name = shorten(path.name)
+    head = f"{name}: {view.kind} table '{view.name}'" if view.kind else f"{name}: no lutbake metadata"
     terms = ", ".join(f"{k} {v}" for k, v in view.terms.items())
     attrs = view.attrs
-    extra = ", ".join(f"{k} {attrs[k]}" for k in ("estimator", "samples") if k in attrs)
+    extra = ", ".join(f"{k} {bounded(attrs[k], 60)}" for k in ("estimator", "samples") if k in attrs)
     body = "; ".join(x for x in (terms, extra + (" per texel" if "samples" in attrs else "")) if x)
     return "\n".join([head] + textwrap.wrap(body, max(width_chars, 40)))
 
@@ -344,30 +356,39 @@ def figure(path):
     view = read_table(path)
     spheres = split_sum(view)
     dims = {a.dim for a in view.axes}
-    if "y_block" in dims:
-        fig, inches = _fig_btf(plt, view)
-    elif view.axes and dims == {"x"}:
-        fig, inches = _fig_1d(plt, view)
-    elif view.data.ndim == 4:
-        fig, inches = _fig_3d(plt, view, spheres)
-    else:
-        fig, inches = _fig_2d(plt, view, spheres)
-    note = "" if spheres or not view.kind else f"\n(no sphere row: {view.kind} has no split-sum reconstruction)"
-    fig.suptitle(_suptitle(view, path, int(inches * CHARS_PER_INCH)) + note, fontsize=9)
+    with matplotlib.rc_context({"text.parse_math": False}):  # names from the file are text: "$x$" is no formula
+        if "y_block" in dims:
+            fig, inches = _fig_btf(plt, view)
+        elif view.axes and dims == {"x"}:
+            fig, inches = _fig_1d(plt, view)
+        elif view.data.ndim == 4:
+            fig, inches = _fig_3d(plt, view, spheres)
+        else:
+            fig, inches = _fig_2d(plt, view, spheres)
+        note = "" if spheres or not view.kind else f"\n(no sphere row: {view.kind} has no split-sum reconstruction)"
+        fig.suptitle(_suptitle(view, path, int(inches * CHARS_PER_INCH)) + note, fontsize=9)
     return fig
 
 
-def render(path, out=None, dpi: int = 100) -> Path:
-    """Write the preview PNG of the table at ``path`` (default: <path stem>.preview.png beside it)."""
+def render(path, out=None, dpi: int = 100, force: bool = False) -> Path:
+    """Write the preview PNG of the table at ``path`` (default: <path stem>.preview.png beside it). ``out`` is
+    checked before anything is read (lutbake.preflight.check_image_output): never the table, its sidecar or a
+    config, a ``.png`` unless ``force``, in a directory that takes files."""
     import matplotlib.pyplot as plt
 
     from ..io.atomic import atomic_write
+    from ..io.oserror import os_error_text
+    from ..preflight import check_image_output, input_files
 
     path = Path(path)
-    fig = figure(path)
     out = Path(out) if out else path.with_name(path.stem + ".preview.png")
+    check_image_output(out, input_files(path), force, "--out")
+    fig = figure(path)
     try:
         atomic_write(out, lambda tmp: fig.savefig(tmp, format="png", dpi=dpi))
+    except OSError as e:  # the directory changed since the check: name the PNG, not the temporary file
+        e.filename = None
+        raise LutbakeError(f"cannot write {shorten(str(out))}: {os_error_text(e, out.parent)}") from None
     finally:
         plt.close(fig)
     return out

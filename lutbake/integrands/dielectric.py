@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import functools
 
+import numpy as np
 import warp as wp
 
 from ..catalog import DIELECTRIC_MASKINGS
@@ -172,3 +173,18 @@ def dielectric_integrand(ndf_name: str, masking_name: str, mode: str, nch: int =
         g64=g64,
         g64_parts=(facet64, lobes64),
     )
+
+
+def integrate(key: tuple, nov, alpha, eta, samples: int | None = None, seed: int = 0, device: str = "cpu"):
+    """Host helper (checks, tests, benchmarks): float64 (len, 3) integrals of the (ndf, masking, Fresnel mode)
+    integrand by ``estimator`` at texels (nov, alpha, eta); alpha through the edge policy as in a table."""
+    from ..sampling.dielectric_layout import estimator_for
+
+    ndf_name, masking_name, mode, estimator = key
+    integrand = dielectric_integrand(ndf_name, masking_name, mode)
+    inputs = {
+        "nov": np.asarray(nov, np.float32),
+        "alpha": integrand.alpha_input(np.asarray(alpha, np.float32)),
+        "param": np.asarray(eta, np.float32),
+    }
+    return estimator_for(estimator, samples, seed).evaluate(integrand, inputs, device)

@@ -2,6 +2,13 @@
 rule) -> float64`` (closed forms ignore alpha and the GL arrays; the microfacet model of Gotanda 2014, Eq. 4, is
 integrated over m by lutbake.sampling.facets and ignores sigma).
 
+The microfacet diffuse BRDF (Gotanda 2014, course notes, Eq. 4; every facet Lambertian, rho = 1):
+    f(l, v) = 1 / (pi (n.l)(n.v)) ∫_Ω (m.l)+ (m.v)+ D(m) F_facet(m.l, m.v) G2(m, l, v) dω_m
+GGX D, height-correlated Smith G2 = χ+(m.l) χ+(m.v) / (1 + Λ(n.v) + Λ(n.l)) (Heitz 2014, Eq. 99): apart from
+the χ+ (the clamps), G2 does not depend on m and leaves the integral:
+    f = G2(l, v) / (pi (n.l)(n.v)) ∫ (m.l)+ (m.v)+ F_facet D(m) dω_m.
+At sigma -> 0, D -> delta(m - n) / (n.m) and f -> F_facet(n.l, n.v) / pi: Lambert x Eq. 6 for the Eq. 6 facet form.
+
 The record ``DiffuseIntegrand`` also carries, for the microfacet model, its facet transmission split
 F_facet = c(f0) T(m.l) T(m.v) (``transmission`` = T, ``f0_scale`` = c), which the swapped-integral albedo
 (lutbake.sampling.swapped) needs. alpha -> 0 has no closed form here: alpha is clamped to ALPHA_MIN (lutbake.edge).

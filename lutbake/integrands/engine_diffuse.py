@@ -18,7 +18,7 @@ in mu = n.l in (0, 1) and phi in (0, pi) (the integrand is even in phi), with th
     (1/pi) ∫ g (n.l) dω = (2/pi) ∫_0^pi ∫_0^1 g(mu, phi) mu dmu dphi.
 The integrand is a polynomial in mu and cos(phi) times sqrt(1 - mu^2) (through l.v): DIFFUSE_ORDER nodes per
 dimension reach 1e-9 (tested against scipy's adaptive quadrature).
-The layouts' names, channels and reconstruction text are declared in lutbake.kinds.engine_layouts.
+The layouts' names, channels and reconstruction text are declared in lutbake.layouts.hdrp.
 """
 
 from __future__ import annotations
@@ -105,19 +105,22 @@ def fabric_lambert(perceptual_roughness: np.ndarray, device: str = "cpu") -> np.
     return out.numpy()
 
 
-def engine_channels(layout: str, base: np.ndarray, nov: np.ndarray, rough: np.ndarray, device: str = "cpu"):
-    """The layout's table from its base layout's channels (n, nch) at texels (nov, perceptual roughness)."""
-    if layout == "charlie_fabric":
-        b = fabric_lambert(rough, device)
-        return np.concatenate([base / HDRP_UNIFORM_SCALE, b[:, None]], axis=1)
+def fabric_channel(base: np.ndarray, nov: np.ndarray, rough: np.ndarray, device: str = "cpu") -> np.ndarray:
+    """charlie_fabric's table from the sheen pair (n, 2) at texels (nov, perceptual roughness): R, G / 2 pi and
+    B = FabricLambertNoPI."""
+    b = fabric_lambert(rough, device)
+    return np.concatenate([base / HDRP_UNIFORM_SCALE, b[:, None]], axis=1)
+
+
+def disney_channel(base: np.ndarray, nov: np.ndarray, rough: np.ndarray, device: str = "cpu") -> np.ndarray:
+    """multiscatter_disney's table from the multiscatter pair (n, 2): B = the Disney FGD - 0.5."""
     b = disney_fgd(nov, rough, device) - HDRP_DIFFUSE_OFFSET
     return np.concatenate([base, b[:, None]], axis=1)
 
 
-def with_diffuse_channel(
-    plan: TexelPlan, nov: np.ndarray, perceptual_roughness: np.ndarray, layout: str = "multiscatter_disney"
-) -> TexelPlan:
-    """The plan of the base layout turned into ``layout``'s (engine_channels: channel B appended, same tiles)."""
+def with_diffuse_channel(plan: TexelPlan, nov: np.ndarray, perceptual_roughness: np.ndarray, channel) -> TexelPlan:
+    """The plan of the base layout turned into the engine layout's (``channel``, lutbake.layouts.base.EngineChannel:
+    channel B appended by channel.compute, same tiles)."""
     base_tile = plan.run_tile
     nch = plan.n_channels
 
@@ -125,21 +128,20 @@ def with_diffuse_channel(
         """The layout's channels from the base tile's, then the base tile's aux columns (TexelPlan.aux_channels)."""
         s = slice(start, stop)
         base = base_tile(start, stop, device)
-        table = engine_channels(layout, base[:, :nch], nov[s], perceptual_roughness[s], device)
+        table = channel.compute(base[:, :nch], nov[s], perceptual_roughness[s], device)
         return np.concatenate([table, base[:, nch:]], axis=1)
 
     base_prepare = plan.prepare
 
     def prepare(device: str) -> None:
         base_prepare(device)
-        load_module((fabric_kernel() if layout == "charlie_fabric" else diffuse_kernel()).module, device=device)
+        load_module(channel.kernel().module, device=device)
 
     base_estimate = plan.error_estimate
-    scale = HDRP_UNIFORM_SCALE if layout == "charlie_fabric" else 1.0
 
     def base_data(data: np.ndarray) -> np.ndarray:
         """The base layout's tile data: its channels (rescaled) and aux columns, without channel B."""
-        return np.concatenate([data[:, :nch] * scale, data[:, nch + 1 :]], axis=1)
+        return np.concatenate([data[:, :nch] * channel.scale, data[:, nch + 1 :]], axis=1)
 
     if base_estimate is not None:  # the specular channels' estimate, on the base layout's values; B: the tests
         plan.error_estimate = lambda data, device: base_estimate(base_data(data), device)

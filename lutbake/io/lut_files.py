@@ -17,12 +17,13 @@ Row 0 of the result is the first row stored in the file (no flip). A JSON sideca
 
 from __future__ import annotations
 
-import json
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from . import bounded
 
 TEXT_EXTENSIONS = (".h", ".hpp", ".inc", ".js", ".mjs", ".ts", ".wgsl", ".rs")
 READABLE = (".exr", ".png", ".dds", ".ktx2", ".npy", ".npz") + TEXT_EXTENSIONS
@@ -58,6 +59,7 @@ def _read_png(path: Path) -> tuple[np.ndarray, str]:
         raise ValueError(f"{path}: cannot open PNG: {oiio.geterror()}")
     try:
         spec = inp.spec()
+        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header")
         native = oiio.UINT16 if spec.format.size() == 2 else oiio.UINT8
         codes = inp.read_image(native)  # raw codes: OIIO applies no transfer function on read
     finally:
@@ -70,10 +72,16 @@ def _read_png(path: Path) -> tuple[np.ndarray, str]:
 def _text_shape(text: str, shape) -> tuple[int, ...]:
     if shape is not None:
         return tuple(int(s) for s in shape)
-    m = re.search(r"lutbake:shape\s*[=:]\s*\[?\s*(\d+)\s*,\s*(\d+)\s*,\s*(\d+)", text)
+    m = re.search(
+        r"lutbake:shape[ \t]{0,8}[=:][ \t]{0,8}\[?[ \t]{0,8}(\d{1,9})\s{0,8},\s{0,8}(\d{1,9})\s{0,8},\s{0,8}(\d{1,9})",
+        text,
+    )
     if m:
         return tuple(int(g) for g in m.groups())
-    dims = {k: int(v) for k, v in re.findall(r"#define\s+\w+?_(HEIGHT|WIDTH|CHANNELS)\s+(\d+)", text)}
+    dims = {
+        k: int(v)
+        for k, v in re.findall(r"#define[ \t]{1,64}\w{0,128}?_(HEIGHT|WIDTH|CHANNELS)[ \t]{1,64}(\d{1,9})", text)
+    }
     if len(dims) == 3:
         return dims["HEIGHT"], dims["WIDTH"], dims["CHANNELS"]
     raise ValueError(
@@ -83,8 +91,30 @@ def _text_shape(text: str, shape) -> tuple[int, ...]:
 
 
 def strip_comments(text: str) -> str:
-    """Source text without its /* ... */ and // comments."""
-    return re.sub(r"//[^\n]*", " ", re.sub(r"/\*.*?\*/", " ", text, flags=re.S))
+    """Source text without its /* ... */ and // comments, in one pass (linear time: an unclosed ``/*`` ends the
+    text, it is never searched for again from each later ``/*``)."""
+    out, pos, n = [], 0, len(text)
+    block = line = 0  # the next "/*" and "//" at or after pos (-1: none left), each searched for again only once passed
+    while pos < n:
+        if 0 <= block < pos:
+            block = text.find("/*", pos)
+        if 0 <= line < pos:
+            line = text.find("//", pos)
+        if pos == 0:
+            block, line = text.find("/*"), text.find("//")
+        if block < 0 and line < 0:
+            out.append(text[pos:])
+            break
+        start = min(x for x in (block, line) if x >= 0)
+        out.append(text[pos:start])
+        out.append(" ")
+        if start == block:
+            end = text.find("*/", start + 2)
+            pos = n if end < 0 else end + 2
+        else:
+            end = text.find("\n", start)
+            pos = n if end < 0 else end
+    return "".join(out)
 
 
 def literal_values(payload: str, n: int) -> tuple[np.ndarray, str]:
@@ -99,16 +129,43 @@ def literal_values(payload: str, n: int) -> tuple[np.ndarray, str]:
     return np.array([float(x) for x in nums[:n]], dtype=np.float64), "float32"
 
 
+_TOKENS = re.compile(r"[=;({\[]")
+_NUMBER_START = re.compile(r"\s*(?:0x|[-+.\d])")
+
+
+def literal_body(code: str) -> str | None:
+    """The body of the first array literal of ``code`` (comments stripped): from the first number after the first
+    ``{``, ``[`` or ``(`` that follows an ``=`` or a ``(`` in the same statement ("= {", "= [", "( [" in JS,
+    "= array<f32, N>(" in WGSL), up to the next ``;``. One pass over the text (a tokenizer, not a backtracking
+    pattern: 10^6 ``=`` take milliseconds)."""
+    armed = False
+    for m in _TOKENS.finditer(code):
+        c = m.group()
+        if c == ";":
+            armed = False
+        elif c == "=":
+            armed = True
+        else:
+            if armed:
+                num = _NUMBER_START.match(code, m.end())
+                if num:
+                    start = num.end() - len(num.group().lstrip())
+                    end = code.find(";", start)
+                    return code[start : end if end >= 0 else len(code)]
+            armed = c == "("
+    return None
+
+
 def parse_text_array(text: str, shape=None) -> tuple[np.ndarray, str]:
     """The values of the first ``{...}`` / ``[...]`` array literal after its declaration (literal_values);
     comments are skipped."""
-    # "= {", "= [", "( [" (JS), or "= array<f32, N>(" (WGSL): the literal's first number follows
-    m = re.search(r"(?:=|\()\s*[^{\[;(]*?(?:[{\[]|\()\s*((?:0x|[-+.\d])[^;]*)", strip_comments(text))
-    if not m:
+    body = literal_body(strip_comments(text))
+    if body is None:
         raise ValueError("no array literal found")
     shp = _text_shape(text, shape)
+    bounded.check_texels(shp, "the declared shape")
     n = int(np.prod(shp))
-    arr, storage = literal_values(m.group(1), n)
+    arr, storage = literal_values(body, n)
     if arr.size != n:
         raise ValueError(f"the array holds {arr.size} values, the declared shape {shp} needs {n}")
     return arr.reshape(shp), storage
@@ -117,20 +174,34 @@ def parse_text_array(text: str, shape=None) -> tuple[np.ndarray, str]:
 def read_lut(path, shape=None) -> LutFile:
     """Read ``path`` (see the module docstring). ``shape``: (rows, columns, channels) of a text array
     whose file does not declare it."""
-    from .dds import decode as dds_decode
-    from .exr import read_exr
-    from .ktx2 import decode as ktx2_decode
-
     path = Path(path)
     ext = path.suffix.lower()
     if ext not in READABLE:
         raise ValueError(f"{path}: cannot read '{ext}' files; readable: {', '.join(READABLE)}")
-    if not path.is_file():
-        raise ValueError(f"{path}: no such file")
+    problem = bounded.regular_file_problem(path)
+    if problem:
+        raise ValueError(f"{path}: {problem}")
+    try:
+        return _read_lut(path, ext, shape)
+    except ValueError as e:
+        text = str(e)
+        raise ValueError(text if text.startswith(str(path)) else f"{path}: {text}") from None
+
+
+def _read_lut(path: Path, ext: str, shape) -> LutFile:
+    from .dds import decode as dds_decode
+    from .exr import read_exr
+    from .ktx2 import decode as ktx2_decode
+
     attrs, sidecar = {}, {}
     for side in (path.with_name(path.name + ".json"), path.with_suffix(".json")):  # lutbake's, then refs style
-        if side.is_file():
-            sidecar = json.loads(side.read_text())
+        if side.is_file() and side != path:
+            try:
+                sidecar = bounded.load_json(side)
+            except (ValueError, UnicodeDecodeError, OSError) as e:
+                raise ValueError(f"its sidecar {side.name} is not readable JSON: {e}") from None
+            if not isinstance(sidecar, dict) or not isinstance(sidecar.get("lutbake", {}), dict):
+                raise ValueError(f"its sidecar {side.name} is not a JSON object with a 'lutbake' object")
             attrs = sidecar.get("lutbake", {})
             break
     if ext == ".exr":
@@ -139,26 +210,28 @@ def read_lut(path, shape=None) -> LutFile:
     elif ext == ".png":
         data, storage = _read_png(path)
     elif ext == ".dds":
-        arr, _ = dds_decode(path.read_bytes())
+        arr, _ = dds_decode(bounded.read_bytes(path))
         data, storage = arr.astype(np.float64), _float_storage(arr)
     elif ext == ".ktx2":
-        arr, facts = ktx2_decode(path.read_bytes())
+        arr, facts = ktx2_decode(bounded.read_bytes(path))
         kv = facts["key_value"]
         data, storage = arr.astype(np.float64), _float_storage(arr)
         if "lutbake:metadata" in kv:
-            attrs = json.loads(kv["lutbake:metadata"])
+            attrs = bounded.loads_json(kv["lutbake:metadata"])
+            if not isinstance(attrs, dict):
+                raise ValueError("its KTX2 key/value lutbake:metadata is not a JSON object")
     elif ext in (".npy", ".npz"):
-        arr = np.load(path, allow_pickle=False)
         if ext == ".npz":  # one array: named "table" (tests/data), else the only one
-            names = list(arr.files)
-            arr = arr["table" if "table" in names else names[0]]
+            arr, _ = bounded.load_npz(path)
+        else:
+            arr = bounded.load_npy(path)
         if np.issubdtype(arr.dtype, np.unsignedinteger):
             data, storage = _unorm(arr)
         else:
             data, storage = arr.astype(np.float64), _float_storage(arr)
     else:
         try:
-            data, storage = parse_text_array(path.read_text(errors="replace"), shape)
+            data, storage = parse_text_array(bounded.read_text(path, errors="replace"), shape)
         except ValueError as e:
             raise ValueError(f"{path}: {e}") from None
     data = np.asarray(data, dtype=np.float64)

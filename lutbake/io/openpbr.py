@@ -9,7 +9,7 @@
     dielectric_avg -> OpenPBR_IdealDielectricAverageEnergyComplement_Array[32*32], OpenPBR_OpaqueDielectric...[32*32],
                       OpenPBR_IdealMetalAverageEnergyComplement_Array[32],
                       OpenPBR_IdealDielectricReflectionRatio_Array[32*32] (the seventh array:
-                      lutbake.kinds.dielectric_ratio; docs/glass-layouts.md, "The reflection ratio")
+                      lutbake.integrands.dielectric_ratio; docs/glass-layouts.md, "The reflection ratio")
 """
 
 from __future__ import annotations

@@ -4,11 +4,9 @@
 Schlick F makes f0 factor out, so two channels hold the whole table:
     scale_bias   R = ∫ f/F (1 - Fc) (n.l) dω,  G = ∫ f/F Fc (n.l) dω       E = f0 R + G
     multiscatter R = ∫ f/F Fc (n.l) dω,        G = ∫ f/F (n.l) dω          E = mix(R, G, f0); E(F=1) = G
-Two layouts add a third channel B: ``scale_bias_f82`` (Blender EEVEE) B = ∫ f/F (v.h)(1 - v.h)^6 (n.l) dω,
-the F82-tint term; ``multiscatter_cloth`` (Filament) B = ∫ D_charlie V_ashikhmin (n.l) dω, the cloth DV.
-The sheen layouts integrate the KHR_materials_sheen lobe alone (no GGX, F = 1): ``charlie`` B = ∫ D_charlie
-V_ashikhmin (n.l) dω (the glTF Sample Viewer's lut_charlie), ``sheen_albedo`` R = E = ∫ D_charlie V_charlie (n.l) dω
-(the spec's albedo scaling), G = the same with V_ashikhmin; ``*_clamped`` clamp V to [0, 1] as the viewer does.
+The layouts (key ``layout``) are records of lutbake.layouts, one module per engine: the pairs above (plain.py), the
+F82-tint third channel (eevee.py), the cloth DV (filament.py), the sheen lobe alone (gltf.py), HDRP's diffuse channel
+(hdrp.py); each says its channels, the map from the integrand's channels to the stored ones and its shader text.
 Axes, by default: x (columns) = NoV, y (rows) = roughness; image row 0 is the first roughness value
 (smoothest). The engine conventions are explicit keys: ``axis_order`` (which quantity is x),
 ``row_order`` (image row 0 = t near 0 or near 1), ``nov_mapping`` / ``roughness_mapping`` (how t maps to
@@ -19,8 +17,6 @@ integral is derived.
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 
 from ..axes import MAPPINGS, ORDERS, ROUGHNESS_PARAMS, TEXELS, Axis
@@ -28,95 +24,21 @@ from ..catalog import (
     HEMISPHERE_ESTIMATORS,
     MASKINGS,
     NDF_DESCRIPTIONS,
-    SHEEN_LAYOUTS,
     SPECULAR_MODELS,
     VNDF_NDFS,
     masking_allowed,
     model_terms,
 )
 from ..edge import ALPHA_MIN, alpha_policy
-from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..layouts import layouts_of, lookup_layout, summaries
+from ..layouts.base import nov_alpha_grid as texel_grid
+from ..sampling.plan import Grid, TexelPlan, per_texel_plan, with_stored_channels
 from ..tolerance import tolerance_of
-from . import engine_layouts
 from .base import Estimation, Key, declare
 
-LAYOUTS = {
-    "scale_bias": "R = scale, G = bias: E = f0 * R + G (Karis 2013)",
-    "multiscatter": "R = ∫Fc·f, G = ∫f: E = mix(R, G, f0), E(F=1) = G (Filament)",
-    "scale_bias_f82": "scale_bias + B = ∫ f/F (v.h)(1 - v.h)^6 (n.l): the F82-tint term (Blender EEVEE)",
-    "multiscatter_cloth": "multiscatter + B = ∫ D_charlie V_ashikhmin (n.l): cloth DV (Filament --ibl-dfg-cloth)",
-    "charlie": "sheen lobe alone: R = G = 0, B = ∫ D_charlie V_ashikhmin (n.l): the glTF Sample Viewer's lut_charlie "
-    "(KHR_materials_sheen IBL; gauss_legendre only)",
-    "sheen_albedo": "sheen lobe alone: R = E = ∫ D_charlie V_charlie (n.l) (KHR_materials_sheen albedo scaling, "
-    "Charlie visibility), G = the same with V_ashikhmin (gauss_legendre only)",
-    "charlie_clamped": "charlie with V_ashikhmin clamped to [0, 1]: the glTF Sample Viewer's LUT() integrand exactly",
-    "sheen_albedo_clamped": "sheen_albedo with each V clamped to [0, 1], as the glTF Sample Viewer's V_Sheen / "
-    "V_Ashikhmin",
-}
-CHANNELS = {
-    "scale_bias": {
-        "scale": "∫ f/F (1 - (1 - v.h)^5) (n.l) dω_l: multiplies f0",
-        "bias": "∫ f/F (1 - v.h)^5 (n.l) dω_l: added",
-    },
-    "multiscatter": {
-        "fc": "∫ f/F (1 - v.h)^5 (n.l) dω_l: the f90 = 1 weight",
-        "e_ss": "∫ f/F (n.l) dω_l: single-scattering directional albedo with F = 1",
-    },
-}
-CHANNELS["scale_bias_f82"] = {
-    **CHANNELS["scale_bias"],
-    "f82": "∫ f/F (v.h)(1 - v.h)^6 (n.l) dω_l: the F82-tint term (Hoffman 2023 / Blender EEVEE metal_bias)",
-}
-CHANNELS["multiscatter_cloth"] = {
-    **CHANNELS["multiscatter"],
-    "cloth_dv": "∫ D_charlie(h; alpha) V_ashikhmin (n.l) dω_l, no Fresnel: sheen/cloth directional albedo "
-    "(Estevez & Kulla 2017 NDF, Ashikhmin 2007 visibility 1/(4 (n.l + n.v - (n.l)(n.v))))",
-}
-CHANNELS["charlie"] = {
-    "zero_r": "0 (the viewer's lut_charlie leaves R empty)",
-    "zero_g": "0",
-    "charlie_dv": "∫ D_charlie(h; alpha) V_ashikhmin (n.l) dω_l, no Fresnel: the sheen lobe's DFG for IBL "
-    "(Estevez & Kulla 2017 NDF, Ashikhmin & Premoze 2007 visibility 1/(4 (n.l + n.v - (n.l)(n.v))))",
-}
-CHANNELS["sheen_albedo"] = {
-    "sheen_e": "E(n.v) = ∫ D_charlie V_charlie (n.l) dω_l: directional albedo of the KHR_materials_sheen BRDF with its "
-    "Charlie visibility 1/((1 + Lambda(n.v) + Lambda(n.l)) 4 (n.v)(n.l)) (Estevez & Kulla 2017 fit)",
-    "sheen_e_ashikhmin": "∫ D_charlie V_ashikhmin (n.l) dω_l: the same with the spec's cheaper Ashikhmin visibility "
-    "(may exceed 1: not energy conserving, as the spec warns)",
-}
-CHANNELS["charlie_clamped"] = {**CHANNELS["charlie"], "charlie_dv": "∫ D_charlie min(V_ashikhmin, 1) (n.l) dω_l"}
-CHANNELS["sheen_albedo_clamped"] = {
-    "sheen_e": "∫ D_charlie min(V_charlie, 1) (n.l) dω_l",
-    "sheen_e_ashikhmin": "∫ D_charlie min(V_ashikhmin, 1) (n.l) dω_l",
-}
-RECONSTRUCTION = {
-    "scale_bias": "uv = vec2(NoV, roughness) (texel centres per lutbake:axes); t = texture(lut, uv).rg; "
-    "specular = prefiltered * (f0 * t.r + t.g)",
-    "multiscatter": "uv = vec2(NoV, roughness); t = texture(lut, uv).rg; "
-    "E = mix(t.r, t.g, f0) = (1 - f0) t.r + f0 t.g; specular = prefiltered * E; "
-    "energy compensation = 1 + f0 (1 / t.g - 1)",
-}
-RECONSTRUCTION["scale_bias_f82"] = (
-    RECONSTRUCTION["scale_bias"] + "; F82 tint (Blender EEVEE): b = mix(f0, 1, (6/7)^5) * 7/(6/7)^6 * (1 - f82_tint), "
-    "specular = prefiltered * (f0 * t.r + f90 * t.g - b * t.b)"
-)
-RECONSTRUCTION["multiscatter_cloth"] = (
-    RECONSTRUCTION["multiscatter"] + "; cloth/sheen: sheen = prefiltered_charlie * sheen_color * t.b"
-)
-RECONSTRUCTION["charlie"] = (
-    "uv = vec2(NoV, roughness); KHR_materials_sheen IBL (glTF Sample Viewer getIBLRadianceCharlie): "
-    "sheen = prefiltered_charlie * sheenColor * texture(lut, uv).b, at uv = vec2(NdotV, sheenRoughness)"
-)
-RECONSTRUCTION["sheen_albedo"] = (
-    "uv = vec2(NoV, roughness); KHR_materials_sheen albedo scaling: E = texture(lut, uv).r at uv = vec2(NdotV, "
-    "sheenRoughness); sheenAlbedoScaling = 1 - max3(sheenColor) * E (or min over E(NdotV), E(NdotL)); "
-    "f = f_sheen + (f_diffuse + f_specular) * sheenAlbedoScaling; .g is E with Ashikhmin visibility"
-)
-RECONSTRUCTION["charlie_clamped"] = RECONSTRUCTION["charlie"]
-RECONSTRUCTION["sheen_albedo_clamped"] = RECONSTRUCTION["sheen_albedo"]
-LAYOUTS.update(engine_layouts.LAYOUTS)
-CHANNELS.update(engine_layouts.CHANNELS)
-RECONSTRUCTION.update(engine_layouts.RECONSTRUCTION)
+# the layouts (lutbake.layouts: one record per layout, one module per engine): name -> summary, name -> channels
+LAYOUTS = summaries("dfg")
+CHANNELS = {name: lay.channels for name, lay in layouts_of("dfg").items()}
 AXIS_ORDERS = {
     "nov_x": "columns (x) = NoV, rows (y) = roughness: sample at vec2(NoV, roughness) (Filament, glTF, UE4)",
     "roughness_x": "columns (x) = roughness, rows (y) = NoV: sample at vec2(roughness, NoV-coordinate) (Blender EEVEE)",
@@ -188,25 +110,16 @@ def check_spec(spec) -> tuple[str, str] | None:
             f"'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not ndf = {nd!r}"
             + (f" (model {model!r})" if model != "microfacet" else ""),
         )
-    if o.get("layout") == "multiscatter_cloth" and o["estimator"] != "gauss_legendre":
+    lay = lookup_layout("dfg", o.get("layout", "scale_bias"))
+    if lay.gauss_legendre_only and o["estimator"] != "gauss_legendre":
+        return ("estimator", lay.gauss_legendre_only.format(layout=lay.name, estimator=o["estimator"]))
+    if lay.terms.ndf is not None and (
+        model != "microfacet" or (o["ndf"], o["masking"]) != (KEYS["ndf"].default, KEYS["masking"].default)
+    ):
         return (
-            "estimator",
-            "layout 'multiscatter_cloth' needs estimator 'gauss_legendre': the QMC estimators draw "
-            "h from the GGX NDF and miss the Charlie NDF's grazing lobe of the cloth channel",
+            "layout",
+            f"layout {o['layout']!r} integrates the sheen lobe (Charlie NDF) alone: leave model, ndf and masking unset",
         )
-    if engine_layouts.BASE_LAYOUT.get(o.get("layout"), o.get("layout")) in SHEEN_LAYOUTS:
-        if o["estimator"] != "gauss_legendre":
-            return (
-                "estimator",
-                f"layout {o['layout']!r} needs estimator 'gauss_legendre': the QMC estimators draw h "
-                f"from the GGX NDF and miss the Charlie NDF's grazing lobe (got {o['estimator']!r})",
-            )
-        if model != "microfacet" or (o["ndf"], o["masking"]) != (KEYS["ndf"].default, KEYS["masking"].default):
-            return (
-                "layout",
-                f"layout {o['layout']!r} integrates the sheen lobe (Charlie NDF) alone: leave model, ndf "
-                "and masking unset",
-            )
     if o.get("roughness_mapping") == "texel_offset" and o["texel"] != "center":
         return ("roughness_mapping", "'texel_offset' is defined on texel centres (texel = 'center')")
     return None
@@ -262,25 +175,8 @@ def axes_for(o: dict) -> list[Axis]:
 
 
 def reconstruction(layout: str, axes: list[Axis]) -> str:
-    """The layout's shader formula, with the uv of this table's axes written out (lutbake.axes.Axis.uv)."""
-    y_axis, x_axis = axes
-
-    def u(a: Axis) -> str:
-        return re.sub(r"\bx\b", {"NoV": "NoV", "alpha": "alpha"}.get(a.name, "roughness"), a.uv_formula())
-
-    uv = f"uv = vec2({u(x_axis)}, {u(y_axis)})"
-    text = RECONSTRUCTION[layout]
-    return text.replace("uv = vec2(NoV, roughness) (texel centres per lutbake:axes)", uv).replace(
-        "uv = vec2(NoV, roughness)", uv
-    )
-
-
-def texel_grid(axes: list[Axis]) -> tuple[np.ndarray, np.ndarray]:
-    """Per-texel (NoV, alpha) of a [y, x] grid (either axis order), row-major: texel t = iy * nx + ix."""
-    y_axis, x_axis = axes
-    if x_axis.name == "NoV":
-        return np.tile(x_axis.values(), y_axis.count), np.repeat(y_axis.alpha(), x_axis.count)
-    return np.repeat(y_axis.values(), x_axis.count), np.tile(x_axis.alpha(), y_axis.count)
+    """The layout's shader formula, with the uv of this table's axes written out (lutbake.layouts.base.uv_of)."""
+    return lookup_layout("dfg", layout).reconstruction(axes)
 
 
 def grid_for(axes: list[Axis], integrand, param=None, repeat: int = 1) -> Grid:
@@ -305,48 +201,42 @@ def specular_extra(integrand) -> dict[str, str]:
     return {"alpha_policy": alpha_policy(integrand.mirror is not None)}
 
 
+def layout_terms(o: dict, lay) -> dict:
+    """The lutbake:terms record of a spec in layout ``lay``: the layout's own (sheen) or the kind's, plus what the
+    layout adds (the cloth channel, an engine's diffuse term)."""
+    terms = dict(lay.terms_record) if lay.terms_record else {**terms_record(o, "schlick"), "layout": lay.name}
+    terms.update(lay.terms_extra)
+    if lay.engine_channel is not None:
+        terms["diffuse"] = lay.engine_channel.description
+    return terms
+
+
 def plan(spec) -> TexelPlan:
     from ..integrands import engine_diffuse
     from ..integrands.specular import N_CHANNELS, specular_integrand
     from ..sampling.hemisphere import estimator_for
 
     o = spec.options
+    lay = lookup_layout("dfg", o["layout"])
     axes = axes_for(o)
     form, nd, mk = terms_of(o)
-    base = engine_layouts.BASE_LAYOUT.get(o["layout"], o["layout"])  # the specular integrand's layout
-    integrand = specular_integrand(nd, mk, base, form, N_CHANNELS[base])
-    cloth = {"cloth": "D_charlie + V_ashikhmin"} if o["layout"] == "multiscatter_cloth" else {}
-    terms = {**terms_record(o, "schlick"), "layout": o["layout"], **cloth}
-    if base in SHEEN_LAYOUTS:
-        vis = {"charlie": "ashikhmin", "sheen_fgd": "charlie (Estevez-Kulla Lambda fit), R and G"}.get(
-            base.removesuffix("_clamped"), "R: charlie (Estevez-Kulla Lambda fit), G: ashikhmin"
-        )
-        if o["layout"].endswith("_clamped"):
-            vis += " (V clamped to [0, 1], as the glTF Sample Viewer)"
-        terms = {
-            "model": "sheen",
-            "ndf": "charlie (alpha = the roughness axis' alpha)",
-            "masking": vis,
-            "fresnel": "none (F = 1)",
-            "layout": o["layout"],
-            "gauss_legendre_panels": "the GGX CDF in theta_h (panelling only; the integrand is the sheen lobe)",
-        }
-    if base != o["layout"]:
-        terms["diffuse"] = engine_layouts.DIFFUSE_TERMS[o["layout"]]
+    integrand = specular_integrand(nd, mk, lay.integrand, form, N_CHANNELS[lay.integrand])
     plan = per_texel_plan(
         integrand,
         estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
         grid_for(axes, integrand),
-        channels=CHANNELS[o["layout"]],
-        reconstruction=reconstruction(o["layout"], axes),
-        terms=terms,
+        channels=lay.channels,
+        reconstruction=lay.reconstruction(axes),
+        terms=layout_terms(o, lay),
         extra=specular_extra(integrand),
         interpolate=o["interpolation"] == "verified",
     )
-    if base != o["layout"]:
+    if lay.to_stored is not None:
+        plan = with_stored_channels(plan, lay.to_stored, lay.from_stored)
+    if lay.engine_channel is not None:
         nov = texel_grid(axes)[0]
         rough = engine_diffuse.perceptual_roughness_grid(axes)
-        plan = engine_diffuse.with_diffuse_channel(plan, nov, rough, o["layout"])
+        plan = engine_diffuse.with_diffuse_channel(plan, nov, rough, lay.engine_channel)
     return plan
 
 

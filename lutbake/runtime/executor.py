@@ -62,15 +62,18 @@ def execute_tiles(
     each tile, each measured in the thread that ran it (time.thread_time; not for tiles run on a cluster)."""
     from . import cluster
     from .devices import plan_tile_texels
+    from .warp_runtime import defining
 
     remote = cluster.active() if spec is not None else None
     if remote is not None:
         return remote.execute(spec, plan, device, progress=progress, label=label, cancel=cancel)
     workers = workers or default_workers()
     cpu = cpu if cpu is not None else []
-    # tables prepare in parallel: their kernels compile on every core (lutbake.runtime.warp_runtime.load_module)
+    # tables prepare in parallel: one builds its Warp kernels at a time (warp_runtime.defining), their modules
+    # compile on every core (warp_runtime.load_module)
     t0 = time.thread_time()
-    plan.prepare(device)
+    with defining():
+        plan.prepare(device)
     cpu.append(time.thread_time() - t0)
     parts = tiles(plan.n_texels, plan_tile_texels(plan, device))
     out = np.empty((plan.n_texels, plan.tile_width), dtype=np.float64)
@@ -104,13 +107,15 @@ def estimate_error(plan: TexelPlan, data: np.ndarray, device: str = "cpu", spec=
     """``plan.error_estimate`` of baked ``data`` (flat float64, (n_texels, tile_width)), None if the kind has
     none; inside a lutbake.runtime.cluster session it runs on a worker, as the tiles did."""
     from . import cluster
+    from .warp_runtime import defining
 
     if plan.error_estimate is None:
         return None
     remote = cluster.active() if spec is not None else None
     if remote is not None:
         return remote.estimate_error(spec, data, device)
-    return plan.error_estimate(data, device)
+    with defining():  # the refined estimator builds its kernels here
+        return plan.error_estimate(data, device)
 
 
 class Timer:

@@ -94,6 +94,27 @@ def defer_if_busy():
         _DEFER.armed = False
 
 
+_DEFINE = threading.Lock()
+_DEFINING = threading.local()
+
+
+@contextlib.contextmanager
+def defining():
+    """Hold while a thread builds Warp functions and kernels (a table's ``prepare``): Warp's registries of functions
+    and modules are not thread-safe, and two tables building kernels at once could launch each other's variant
+    (two dfg tables differing only in masking baked identical on an empty kernel cache). load_module releases it
+    while it compiles, so modules still compile on every core."""
+    if getattr(_DEFINING, "held", False):
+        yield
+        return
+    with _DEFINE:
+        _DEFINING.held = True
+        try:
+            yield
+        finally:
+            _DEFINING.held = False
+
+
 def load_module(module, device: str = "cpu") -> None:
     """Compile (or load from Warp's kernel cache) a Warp module on ``device`` before worker threads launch its
     kernels. Tables prepare in parallel (lutbake.batch runs two at once on two cores): on a cold kernel cache their
@@ -108,10 +129,17 @@ def load_module(module, device: str = "cpu") -> None:
     _DEFER.armed = False
     if not lock.acquire(blocking=not armed):
         raise ModuleBusy(getattr(module, "name", str(module)))
+    held = getattr(_DEFINING, "held", False)
+    if held:
+        _DEFINING.held = False
+        _DEFINE.release()
     try:
         wp.load_module(module, device=device)
     finally:
         lock.release()
+        if held:
+            _DEFINE.acquire()
+            _DEFINING.held = True
 
 
 # LLVM's inlining budget for lutbake's CPU kernels. Warp's default flags (warp.config.cpu_compiler_flags) raise LLVM's

@@ -1,10 +1,6 @@
-"""The microfacet diffuse BRDF of Gotanda 2014 (course notes, Eq. 4), integrated over the facet normal m.
-
-Microfacet diffuse (every facet Lambertian, rho = 1):
-    f(l, v) = 1 / (pi (n.l)(n.v)) ∫_Ω (m.l)+ (m.v)+ D(m) F_facet(m.l, m.v) G2(m, l, v) dω_m
-GGX D, height-correlated Smith G2 = χ+(m.l) χ+(m.v) / (1 + Λ(n.v) + Λ(n.l)) (Heitz 2014, Eq. 99): apart from
-the χ+ (the clamps), G2 does not depend on m and leaves the integral:
-    f = G2(l, v) / (pi (n.l)(n.v)) ∫ (m.l)+ (m.v)+ F_facet D(m) dω_m.
+"""The quadrature of the microfacet diffuse BRDF's facet-normal integral (the BRDF, Gotanda 2014 course notes, Eq. 4,
+and its G2 reduction are stated in lutbake.integrands.diffuse):
+    I(l, v) = ∫_Ω (m.l)+ (m.v)+ F_facet(m.l, m.v) D(m) dω_m,   f = G2(l, v) I / (pi (n.l)(n.v)).
 Quadrature (``fd_microfacet_for``), deterministic:
 - u = CDF(theta_m) of D(m)(n.m) (GGX: tan^2 theta_m = alpha^2 u / (1 - u)), so D(m) dω_m = du dphi / (2 pi (n.m))
   and the integrand is (m.l)+ (m.v)+ F_facet / (2 pi (n.m)); D, however peaked, is absorbed into u.

@@ -179,7 +179,9 @@ def per_texel_plan(
         nch = integrand.nch
         values, texel_error = full[:, :nch], full[:, nch : 2 * nch]
         target = np.maximum(estimator.absolute, estimator.relative * np.abs(values))
-        ratio = float(np.max(texel_error / target))
+        with np.errstate(divide="ignore", invalid="ignore"):  # tolerance = 0 (allowed): a zero target
+            ratios = np.where(target > 0, texel_error / target, np.where(texel_error > 0, np.inf, 0.0))
+        ratio = float(np.max(ratios))
         # texels whose panels all reached the last order short of the target (the kernel's comparison, with rounding)
         over = int(np.count_nonzero(np.any(texel_error > target * (1.0 + 1e-9), axis=1)))
         err = float(np.max(texel_error))
@@ -233,3 +235,23 @@ def per_texel_plan(
         aux_channels=(integrand.nch + (1 if verified else 0)) if adaptive else 0,
         tile_texels=interpolation.tile_texels(grid.axes) if verified else tile_texels,
     )
+
+
+def with_stored_channels(plan: TexelPlan, to_stored: Callable, from_stored: Callable) -> TexelPlan:
+    """``plan`` with its channels passed through ``to_stored`` (the integrals (n, C) -> the stored values (n, C), a
+    layout's map: lutbake.layouts.base.Layout.to_stored), the tiles' aux columns untouched; the error estimate sees
+    the integrals again through ``from_stored`` (its inverse), as the estimator produced them."""
+    base_tile = plan.run_tile
+    nch = plan.n_channels
+
+    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
+        base = base_tile(start, stop, device)
+        return np.concatenate([to_stored(base[:, :nch]), base[:, nch:]], axis=1)
+
+    base_estimate = plan.error_estimate
+    if base_estimate is not None:
+        plan.error_estimate = lambda data, device: base_estimate(
+            np.concatenate([from_stored(data[:, :nch]), data[:, nch:]], axis=1), device
+        )
+    plan.run_tile = run_tile
+    return plan

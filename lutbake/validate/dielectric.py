@@ -15,7 +15,7 @@
 - ``dielectric_estimators_agree``: panelled Gauss-Legendre vs scrambled-Sobol' VNDF sampling.
 - ``openpbr_reflection_ratio_reciprocity``: the OpenPBR layout's reflection ratio x (kind dielectric_avg) keeps
   OpenPBR's multiple-scattering transmission lobe symmetric: (1 - x(eta)) E_c,avg(eta) = (1 - x(1/eta)) E_c,avg(1/eta)
-  (lutbake.kinds.dielectric_ratio), on mirrored rows of the baked table, and 0 <= x <= 1.
+  (lutbake.integrands.dielectric_ratio), on mirrored rows of the baked table, and 0 <= x <= 1.
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ GL_SAMPLES = 3 * 12**2
 
 
 def _integrate(nov, alpha, eta, masking="smith_separable", estimator="gauss_legendre", samples=GL_SAMPLES):
-    from ..kinds.dielectric import integrate
+    from ..integrands.dielectric import integrate
 
     f = (np.asarray(x, np.float32) for x in np.broadcast_arrays(nov, alpha, eta))
     return integrate(("ggx", masking, "exact", estimator), *f, samples, SEED)
@@ -302,7 +302,7 @@ def openpbr_ratio_rows():
 
 
 def openpbr_reflection_ratio_reciprocity():
-    from ..kinds.dielectric_ratio import reciprocity_residual
+    from ..integrands.dielectric_ratio import reciprocity_residual
 
     rows = openpbr_ratio_rows()
     res = [reciprocity_residual(rows[a][:, 3], rows[a][:, 0], rows[b][:, 3], rows[b][:, 0]) for a, b in RATIO_ROW_PAIRS]

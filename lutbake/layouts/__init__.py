@@ -1,0 +1,73 @@
+"""Engine layouts as data: one ``Layout`` record per layout (lutbake.layouts.base), one module per engine.
+
+Each module declares ``LAYOUTS`` (the layouts it defines: the values of a kind's ``layout`` key) and ``TABLES`` (the
+``EngineTable`` records of the tables its engine loads: the preset that bakes each, the grid and storage keys the
+engine fixes, its shipped table in tests/data). ``lookup_layout(kind, name)`` is the validating lookup (its error
+lists the valid names and the nearest); kinds, value_bounds, preview and audit read the records, never a name.
+Adding an engine: one module here (found by engine_modules), its preset TOMLs, its shipped table in tests/data.
+"""
+
+from __future__ import annotations
+
+import difflib
+import importlib
+import pkgutil
+
+from .base import EngineChannel, EngineTable, Layout, Storage, Terms
+
+NOT_ENGINES = ("base",)
+FIRST = ("plain",)  # lutbake's own layouts lead the ``layout`` keys' lists (their defaults)
+
+
+def engine_modules() -> tuple:
+    """Every engine module of this package: ``plain`` first, then by name (a new module registers by existing)."""
+    names = sorted(m.name for m in pkgutil.iter_modules(__path__) if m.name not in NOT_ENGINES)
+    names = [n for n in FIRST if n in names] + [n for n in names if n not in FIRST]
+    return tuple(importlib.import_module(f"{__name__}.{n}") for n in names)
+
+
+ENGINES = engine_modules()
+REGISTRY: dict[tuple[str, str], Layout] = {(lay.kind, lay.name): lay for m in ENGINES for lay in m.LAYOUTS}
+TABLES: tuple[EngineTable, ...] = tuple(t for m in ENGINES for t in m.TABLES)
+
+
+def layouts_of(kind: str) -> dict[str, Layout]:
+    """The layouts of ``kind``, by name, in registration order."""
+    return {name: lay for (k, name), lay in REGISTRY.items() if k == kind}
+
+
+def lookup_layout(kind: str, name: str) -> Layout:
+    """The record of layout ``name`` of ``kind``; KeyError naming the valid layouts and the nearest."""
+    try:
+        return REGISTRY[(kind, name)]
+    except KeyError:
+        names = sorted(layouts_of(kind))
+        near = difflib.get_close_matches(str(name), names, n=1)
+        hint = f" (did you mean {near[0]!r}?)" if near else ""
+        raise KeyError(f"kind {kind!r} has no layout {name!r}{hint}; layouts: {', '.join(names)}") from None
+
+
+def summaries(kind: str) -> dict[str, str]:
+    """name -> summary of the layouts of ``kind`` (the ``layout`` key's documented values)."""
+    return {name: lay.summary for name, lay in layouts_of(kind).items()}
+
+
+def exclusive_owner(kind: str, fmt: str) -> Layout | None:
+    """The layout of ``kind`` that alone writes format ``fmt`` (OpenPBR's header), or None."""
+    return next((lay for lay in layouts_of(kind).values() if fmt in lay.storage.exclusive), None)
+
+
+__all__ = [
+    "ENGINES",
+    "REGISTRY",
+    "TABLES",
+    "EngineChannel",
+    "EngineTable",
+    "Layout",
+    "Storage",
+    "Terms",
+    "exclusive_owner",
+    "layouts_of",
+    "lookup_layout",
+    "summaries",
+]

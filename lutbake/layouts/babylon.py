@@ -1,0 +1,106 @@
+"""Babylon.js (@babylonjs/core 9.31, Misc/brdfTextureTools.js): the three BRDF lookup tables Babylon ships as base64
+PNGs and loads with ``isRGBD = true`` (decoded by Misc/rgbdTextureTools ExpandRGBDTexture: rgb = pow(png.rgb, 2.2) /
+png.a, Shaders/ShadersInclude/helperFunctions fromRGBD, into a half-float target):
+
+- ``scene.environmentBRDFTexture`` ("MS-BRDF height-correlated", 256², RGBD): Filament's three channels
+  (lutbake.layouts.filament multiscatter_cloth): R = ∫ f/F Fc (n.l), G = ∫ f/F (n.l), B = ∫ D_charlie V_ashikhmin
+  (n.l) (the sheen lookup, getSheenReflectanceFromBRDFLookup); sampled at vec2(NdotV, perceptualRoughness)
+  (pbrBRDFFunctions getBRDFLookup), texel centres, the PNG's first row at v = 0 (invertY = false): roughness 0 first.
+  E = (R90 - R0) x + R0 y (getReflectanceFromBRDFLookup, BRDF_V_HEIGHT_CORRELATED); GGX, height-correlated Smith
+  (smithVisibility_GGXCorrelated).
+- ``scene.openPBREnvironmentBRDFTexture`` ("3-channel F82 LUT", 128²): the layout ``babylon_f82`` below, the F82-tint
+  split sum of Blender EEVEE's brdf_ggx (lutbake.layouts.eevee scale_bias_f82: the same three integrals) stored as
+  x = bias, y = scale + bias and z = 16 x the F82 term (BRDF_Z_SCALE; openpbrIblFunctions: environmentBrdf.z /
+  BRDF_Z_SCALE), read by getF82DirectionalAlbedo: E = (F90 - F0) x + F0 y - b z / 16.
+- ``scene.environmentFuzzBRDFTexture`` (32², RGB): Zeltner, Burley & Chiang 2022's LTC fit of a volumetric sheen
+  (getFuzzBRDFLookup: A in [0.005, 0.88], B in [-0.18, 0.002], R_i in [0, 0.75] at vec2(perceptualRoughness,
+  NdotV)). lutbake does not integrate that model (a microflake volume's multiple scattering, fitted by LTC): its
+  decoded table is kept in tests/data with its provenance, without a preset.
+lutbake's presets write float tables (DDS RGBA16F) Babylon loads with ``isRGBD = false`` and ``invertY = false``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .base import EngineTable, Layout
+from .eevee import SCALE_BIAS_F82
+
+BRDF_Z_SCALE = 16.0  # pbrBRDFFunctions: the F82 term is stored times 16 (its largest value is 1/16 of E's)
+SOURCE = "@babylonjs/core 9.31.3 Misc/brdfTextureTools.js, Shaders/ShadersInclude/pbrBRDFFunctions.js"
+
+
+def f82_stored(e: np.ndarray) -> np.ndarray:
+    """(scale, bias, F82 term) -> (bias, scale + bias, 16 x F82 term): Babylon's x, y, z."""
+    return np.stack([e[:, 1], e[:, 0] + e[:, 1], BRDF_Z_SCALE * e[:, 2]], axis=1)
+
+
+def f82_integrals(t: np.ndarray) -> np.ndarray:
+    """The inverse of f82_stored: (x, y, z) -> (y - x, x, z / 16)."""
+    return np.stack([t[:, 1] - t[:, 0], t[:, 0], t[:, 2] / BRDF_Z_SCALE], axis=1)
+
+
+BABYLON_F82 = Layout(
+    name="babylon_f82",
+    kind="dfg",
+    engine="Babylon.js (scene.openPBREnvironmentBRDFTexture)",
+    summary="multiscatter pair + B = 16 ∫ f/F (v.h)(1 - v.h)^6 (n.l): the F82-tint LUT of Babylon.js's OpenPBR "
+    "material (E = (F90 - F0) R + F0 G - b B / 16)",
+    channels={
+        "fc": "∫ f/F (1 - v.h)^5 (n.l) dω_l: the f90 - f0 weight (Babylon environmentBrdf.x)",
+        "e_ss": "∫ f/F (n.l) dω_l: E with F = 1 (environmentBrdf.y)",
+        "f82_x16": "16 ∫ f/F (v.h)(1 - v.h)^6 (n.l) dω_l: the F82-tint term times BRDF_Z_SCALE (environmentBrdf.z)",
+    },
+    shader="{uv}; t = texture(openPBREnvironmentBRDF, uv).rgb; b = (F0 + (1 - F0) (6/7)^5) (1 - edgeTint) "
+    "17.6512785 (getF82B); E = (F90 - F0) t.x + F0 t.y - b t.z / 16 (getF82DirectionalAlbedo); energy compensation "
+    "= 1 + F_avg (1 / t.y - 1)",
+    integrand=SCALE_BIAS_F82.integrand,
+    source=SOURCE + ", openpbrIblFunctions.js",
+    to_stored=f82_stored,
+    from_stored=f82_integrals,
+    split_sum="multiscatter",
+)
+
+LAYOUTS = (BABYLON_F82,)
+TABLES = (
+    EngineTable(
+        "Babylon.js",
+        "babylon",
+        "babylon_environment_brdf",
+        "dfg",
+        "multiscatter_cloth",
+        {
+            "size": [256, 256],
+            "roughness": "perceptual",
+            "masking": "smith_height_correlated",
+            "layout": "multiscatter_cloth",
+            "texel": "center",
+            "row_order": "lo_first",
+            "dtype": "half",
+            "format": "dds",
+        },
+        SOURCE,
+        "scene.environmentBRDFTexture (isRGBD = false, invertY = false)",
+        shipped="babylon_environment_brdf.npz",
+    ),
+    EngineTable(
+        "Babylon.js",
+        "babylon-openpbr",
+        "babylon_openpbr_brdf",
+        "dfg",
+        "babylon_f82",
+        {
+            "size": [128, 128],
+            "roughness": "perceptual",
+            "masking": "smith_height_correlated",
+            "layout": "babylon_f82",
+            "texel": "center",
+            "row_order": "lo_first",
+            "dtype": "half",
+            "format": "dds",
+        },
+        SOURCE,
+        "scene.openPBREnvironmentBRDFTexture (isRGBD = false, invertY = false)",
+        shipped="babylon_openpbr_brdf.npz",
+    ),
+)
