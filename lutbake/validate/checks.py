@@ -645,7 +645,7 @@ LTC_AREA_REL_MEDIAN = 0.05  # GGX shaded fit, area-light benchmark (16 shading p
 
 
 def ltc_area_benchmark_median() -> CheckResult:
-    """The GGX LTC fit (the ``ltc`` kind's default, lutbake.ltc.shaded) on a small area-light benchmark through the
+    """The shaded GGX LTC fit (``fit = "shaded"``, lutbake.ltc.shaded) on a small area-light benchmark through the
     shader's bilinear lookup (lutbake.validate.ltc_bench: one shading point per roughness x view band, 8 polygon
     lights each, visible-normal ground truth at 256^2): the median relative error."""
     from . import ltc_bench
