@@ -13,6 +13,7 @@ PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-ee
            unity-hdrp unity-hdrp-charlie godot bevy threejs
 WORKERS ?=
 FORCE   ?=
+TEST_WORKERS ?= 2  # pytest-xdist processes for make test; a module's tests stay on one (its fixtures are built once)
 
 .PHONY: lint luts test validate bench clean venv help figures bench-diffuse bench-ltc bench-cluster bench-luts
 
@@ -50,7 +51,7 @@ lint: $(STAMP)
 test: $(STAMP) lint
 	@$(BIN)/python -c "import moderngl; moderngl.create_standalone_context(backend='egl').release()" 2>/dev/null \
 		|| echo "note: no EGL OpenGL here; the GL consumer test will skip (Debian: apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri)"
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadscope
 
 # diffuse kinds against converged references (accuracy and wall time): outputs/bench/diffuse.json
 bench-diffuse: $(STAMP)

@@ -10,6 +10,11 @@
    force, per lobe and roughness, for lutbake's tables and the published GGX table.
 6. Tabulated lobes (gotanda): the interpolated lobe the fit sees against Eq. 4 by direct quadrature (GL order 12),
    relative L3 per texel, next to the fit error of the same texels.
+8. The area-light benchmark through the shader's bilinear lookup (lutbake.validate.ltc_bench): published vs
+   lutbake's L3 fit (the default) vs lutbake's shaded fit (fit = "shaded"), relative error and |error| / albedo
+   (median, p90, max), overall, per roughness band, per view band and per (roughness, view) band, for F = 1 and
+   f0 = 0.04; the ground truth's own error (visible-normal sampling at S^2 against NDF sampling at (2S)^2, views
+   below 80 degrees); and the GGX 64^2 fit time of both fits.
 7. Sharing: the ltc-hdrp preset (alpha_min 1e-3) baked after GGX in the same process (lutbake.ltc.fit.MEMO: texels
    with equal inputs and seeds take GGX's fits), CPU seconds and the ratio to GGX's; and baked alone (memo
    cleared), to check the bits are the same.
@@ -59,10 +64,10 @@ def published():
     )
 
 
-def bake(lobe: str, workers: int, preset: str = "ltc-ggx"):
+def bake(lobe: str, workers: int, preset: str = "ltc-ggx", fit_kind: str = "l3"):
     spec = load_configs(
         [ROOT / "lutbake" / "presets" / f"{preset}.toml"],
-        [f'lobe="{lobe}"', f'name="ltc_{lobe}"', 'format="exr"', 'dtype="float32"'],
+        [f'lobe="{lobe}"', f'name="ltc_{lobe}"', 'format="exr"', 'dtype="float32"', f'fit="{fit_kind}"'],
     )[0]
     cpu0 = time.process_time()
     table, seconds, _ = bake_table(spec, workers=workers)
@@ -83,6 +88,9 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--lobes", default="ggx,beckmann,charlie,lambert")
     ap.add_argument("--port-texels", type=int, default=12, help="texels of the straight-port baseline")
+    ap.add_argument("--bench-cases", type=int, default=8, help="area-light benchmark: shading points per band")
+    ap.add_argument("--bench-lights", type=int, default=16, help="area-light benchmark: lights per shading point")
+    ap.add_argument("--bench-samples", type=int, default=512, help="area-light benchmark: truth's S (S x S samples)")
     args = ap.parse_args(argv)
     wp.config.quiet = True
     OUT.mkdir(parents=True, exist_ok=True)
@@ -171,7 +179,79 @@ def main(argv=None):
     print("straight port:", report["baseline_straight_port"], flush=True)
 
     area_section(report, tables, axes, t1p, t2p, with_published=True)
+    report["area_benchmark"] = benchmark_section(ggx, report["lobes"]["ggx"], workers, t1p, t2p, args)
     finish(report)
+
+
+def benchmark_section(ggx, ggx_row: dict, workers: int, t1p, t2p, args) -> dict:
+    """Section 8: the area-light benchmark (published, L3, shaded) and the two fits' times."""
+    from lutbake.validate import ltc_bench
+
+    fit.MEMO.clear()  # the shaded fit starts from the L3 fit: timed in full, not from the memo
+    new, seconds, cpu = bake("ggx", workers, fit_kind="shaded")
+    times = {
+        "l3_fit_64x64": {"seconds": ggx_row["seconds"], "cpu_seconds": ggx_row["cpu_seconds"]},
+        "shaded_fit_64x64": {"seconds": round(seconds, 2), "cpu_seconds": round(cpu, 2)},
+        "ltc_code_fitLTC": "not built here (no glm in the environment) and no published timing found",
+    }
+    print("fit times:", json.dumps(times), flush=True)
+    t0 = time.perf_counter()
+    cases = ltc_bench.cases(args.bench_cases, args.bench_lights)
+    truths = [ltc_bench.ground_truth(c, args.bench_samples) for c in cases]
+    truth_seconds = time.perf_counter() - t0
+    # the truth's own error: an independent estimator at another count, on views below 80 degrees (NDF sampling
+    # degrades at grazing views) and lights above the relative floor
+    check = [i for i, c in enumerate(cases) if c["theta"] < 80.0][:: max(1, len(cases) // 24)]
+    dev = []
+    for i in check:
+        other = ltc_bench.ground_truth(cases[i], 2 * args.bench_samples, "ndf")
+        g = truths[i]["lobe"]
+        ok = g > ltc_bench.REL_FLOOR * truths[i]["albedo"]
+        dev.append(np.abs(g - other["lobe"])[ok] / g[ok])
+    dev = np.concatenate(dev)
+    tables = {
+        "published": (t1p, t2p),
+        "l3": (ggx.data[0].astype(np.float64), ggx.data[1].astype(np.float64)),
+        "shaded": (new.data[0].astype(np.float64), new.data[1].astype(np.float64)),
+    }
+    out = {
+        "cases": len(cases),
+        "lights": sum(len(c["lights"]) for c in cases),
+        "truth": {
+            "estimator": f"GGX visible-normal sampling, {args.bench_samples}^2 stratified per shading point",
+            "seconds": round(truth_seconds, 1),
+            "vs_ndf_sampling_at_2S": {
+                "lights": int(len(dev)),
+                "relative_difference_median": float(np.median(dev)),
+                "relative_difference_p90": float(np.quantile(dev, 0.9)),
+                "relative_difference_max": float(dev.max()),
+            },
+        },
+        "fit_times": times,
+    }
+    for f0 in (1.0, 0.04):
+        res = {name: ltc_bench.report(ltc_bench.errors(t1, t2, cases, truths, f0)) for name, (t1, t2) in tables.items()}
+        pub, new = res["published"], res["shaded"]
+        worse = [
+            k
+            for k in pub
+            if " / " in k and (new[k]["rel_median"] > pub[k]["rel_median"] or new[k]["abs_p90"] > pub[k]["abs_p90"])
+        ]
+        out[f"f0={f0:g}"] = {
+            "tables": res,
+            "shaded_over_published": {
+                "rel_median": new["all"]["rel_median"] / pub["all"]["rel_median"],
+                "abs_p90": new["all"]["abs_p90"] / pub["all"]["abs_p90"],
+                "bands_worse_in_rel_median_or_abs_p90": worse,
+            },
+        }
+        print(f"area benchmark f0={f0:g}:", json.dumps(out[f"f0={f0:g}"]["shaded_over_published"]), flush=True)
+        for k in ("all", *[k for k in pub if " / " not in k and k != "all"]):
+            row = " | ".join(
+                f"{n} {res[n][k]['rel_median']:.4f} {res[n][k]['rel_p90']:.3f} {res[n][k]['abs_p90']:.4f}" for n in res
+            )
+            print(f"  {k:14s} {row}", flush=True)
+    return out
 
 
 def sharing_section(ggx_cpu: float, workers: int) -> dict:

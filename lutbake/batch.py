@@ -43,7 +43,7 @@ from .provenance import HASH_ATTRIBUTE, content_hash, read_header, sources_diges
 from .runtime.executor import Cancelled, Progress, default_workers
 from .runtime.warp_runtime import ModuleBusy, defer_if_busy
 from .sharing import group_by, values_key
-from .values_cache import ValuesCache
+from .values_cache import ValuesCache, valid_extra
 
 STATUSES = ("baked", "skipped", "failed", "interrupted")
 EXIT_OK, EXIT_FAILED, EXIT_SIGINT, EXIT_SIGTERM = 0, 1, 130, 143
@@ -150,6 +150,9 @@ def _cached(cache: ValuesCache | None, job: Job) -> Computed | None:
     t0 = time.thread_time()
     plan = lookup_kind(job.spec.kind).plan(job.spec)
     if plan.shape != entry[0].shape:
+        return None
+    after = plan.attributes_after(entry[0]) if plan.attributes_after is not None else {}
+    if not valid_extra(entry[1], after):  # only what a bake records, the cheap part recomputed: else a miss
         return None
     return Computed(plan, entry[0], entry[1], 0.0, time.thread_time() - t0)
 

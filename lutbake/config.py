@@ -18,11 +18,12 @@ from typing import Any
 
 from .errors import ConfigError, did_you_mean
 from .kinds import KINDS, Key, lookup_kind
+from .limits import MAX_TEXELS  # noqa: F401  (lutbake.config.MAX_TEXELS, as before)
 from .preflight import config_file_problem, nesting_problem
+from .textsafe import safe_repr
 from .value_bounds import unit_range
 
 NAME_RE = re.compile(r"[A-Za-z0-9_-]{1,128}")  # use fullmatch: "$" would accept a final newline
-MAX_TEXELS = 1 << 26  # 64 Mi texels of any kind (Kind.texels); float64 accumulation of 4 channels = 2 GiB
 BYTES_PER_TEXEL = 32  # float64 x 4 channels while baking
 MAX_LIST = 1024  # entries of a float_list key
 
@@ -82,7 +83,7 @@ def preset_path(name: str) -> Path:
     ps = presets()
     if name not in ps:
         raise ConfigError(
-            "--preset", None, message=f"unknown preset {name!r}{did_you_mean(name, ps)}", allowed=", ".join(ps)
+            "--preset", None, message=f"unknown preset {safe_repr(name)}{did_you_mean(name, ps)}", allowed=", ".join(ps)
         )
     return ps[name]
 
@@ -241,17 +242,29 @@ def parse_overrides(items: tuple[str, ...] | list[str]) -> list[tuple[str | None
         if "=" not in item:
             raise ConfigError("--set", item, message="must look like KEY=VALUE or TABLE.KEY=VALUE")
         lhs, rhs = item.split("=", 1)
-        table, _, key = lhs.strip().rpartition(".")
+        table, dot, key = lhs.strip().rpartition(".")
+        if dot and not table.strip():
+            raise ConfigError(
+                "--set", key.strip(), message="an empty table name before the '.' (KEY=VALUE or TABLE.KEY=VALUE)"
+            )
         problem = nesting_problem(rhs)
         if problem:
             raise ConfigError("--set", key.strip(), message=f"VALUE: {problem}")
         try:
-            value = tomllib.loads(f"v = {rhs.strip()}")["v"]
+            doc = tomllib.loads(f"v = {rhs.strip()}")
         except tomllib.TOMLDecodeError:
-            value = rhs.strip()  # a bare word: a string
+            if "\n" in rhs.strip() or "=" in rhs:
+                raise ConfigError("--set", key.strip(), rhs, message="VALUE is not one TOML value") from None
+            doc = {"v": rhs.strip()}  # a bare word: a string
         except RecursionError:
             raise ConfigError("--set", key.strip(), message="VALUE is nested too deeply") from None
-        out.append((table or None, key, value))
+        except ValueError as e:  # an integer of more than 4300 digits (sys.int_info.str_digits_check_threshold)
+            raise ConfigError("--set", key.strip(), rhs, message=f"VALUE cannot be read: {e}") from None
+        if set(doc) != {"v"}:
+            raise ConfigError(
+                "--set", key.strip(), rhs, message="text after the value (one --set sets one key: give another --set)"
+            )
+        out.append((table or None, key, doc["v"]))
     return out
 
 
@@ -262,7 +275,7 @@ def load_config(path, overrides=()) -> list[TableSpec]:
     if problem:
         raise ConfigError(path, None, message=problem)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8").removeprefix("\ufeff")  # a UTF-8 BOM (Windows editors) is no text
         problem = nesting_problem(text)
         if problem:
             raise ConfigError(path, None, message=f"invalid config: {problem}")

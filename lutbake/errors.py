@@ -6,7 +6,9 @@ from __future__ import annotations
 
 import difflib
 
-from .textsafe import escape_controls, safe_repr
+from .textsafe import safe_repr, shorten
+
+MESSAGE_LIMIT = 2000  # characters of one error line: a 10 000-character name is shown cut in the middle
 
 
 def did_you_mean(value, names) -> str:
@@ -33,7 +35,7 @@ class ConfigError(LutbakeError):
     ):
         self.file, self.key, self.value, self.allowed, self.table = str(file), key, value, allowed, table
         self.message = message
-        where = self.file
+        where = shorten(self.file)
         if table is not None:
             where += f": table {table}"
         parts = [where]
@@ -45,7 +47,7 @@ class ConfigError(LutbakeError):
             text += f": {message}"
         if allowed:
             text += f" (allowed: {allowed})"
-        super().__init__(escape_controls(text))
+        super().__init__(shorten(text, MESSAGE_LIMIT))
 
     def blamed(self, file) -> ConfigError:
         """The same error, naming ``file`` (the --set argument that set the key) as its source."""

@@ -8,9 +8,11 @@ from __future__ import annotations
 import os
 import re
 import stat
+import tempfile
 from pathlib import Path
 
 from .errors import ConfigError
+from .textsafe import shorten
 
 MAX_CONFIG_BYTES = 1 << 20  # a config is a few KiB; a larger file is not one (and is not read into memory)
 _FILE_TYPES = (
@@ -29,6 +31,9 @@ def _what_is(mode: int) -> str:
 def config_file_problem(path) -> str | None:
     """Why ``path`` cannot be read as a config (says what it is), or None for a regular file of sane size."""
     path = Path(path)
+    problem = encoding_problem(path)
+    if problem:
+        return problem
     try:
         st = os.stat(path)
     except FileNotFoundError:
@@ -79,19 +84,114 @@ def _same(a: Path, b: Path) -> bool:
     return os.path.normcase(os.path.realpath(a)) == os.path.normcase(os.path.realpath(b))
 
 
+def encoding_problem(path) -> str | None:
+    """Why ``path`` cannot be handed to the libraries that write and record files (OpenImageIO takes UTF-8 text
+    only; the path is recorded in the file's metadata), or None: a byte that is not UTF-8 (``\\xff``) in it."""
+    try:
+        os.fsencode(str(path)).decode("utf-8")
+    except (UnicodeDecodeError, UnicodeEncodeError):
+        raw = os.fsencode(str(path))
+        bad = next(i for i in range(len(raw)) if not _utf8_prefix_ok(raw[: i + 1]))
+        return f"its name holds the byte {raw[bad : bad + 1]!r} at byte {bad}, which is not UTF-8; rename it"
+    return None
+
+
+def _utf8_prefix_ok(raw: bytes) -> bool:
+    try:
+        raw.decode("utf-8")
+    except UnicodeDecodeError as e:
+        return e.reason == "unexpected end of data"
+    return True
+
+
+def probe_directory(path) -> str | None:
+    """Why no file can be created in directory ``path``, found by trying: create it (mkdir -p), create and remove a
+    temporary file in it, then remove the directories this probe made, or None. Catches what permission bits do not
+    tell (root on /proc or /sys, a read-only bind mount, a full inode table)."""
+    path = Path(path)
+    made = []
+    probe = path
+    while not os.path.lexists(probe) and probe.parent != probe:
+        made.append(probe)
+        probe = probe.parent
+    try:
+        for d in reversed(made):
+            os.mkdir(d)
+        fd, tmp = tempfile.mkstemp(prefix=".lutbake-probe.", dir=path)
+        os.close(fd)
+        os.unlink(tmp)
+    except OSError as e:
+        from .io.oserror import os_error_text
+
+        return f"cannot create files there: {os_error_text(e)}"
+    finally:
+        for d in made:
+            try:
+                os.rmdir(d)
+            except OSError:
+                pass
+    return None
+
+
 def check_out_dir(out_dir) -> None:
-    problem = directory_problem(out_dir)
+    """``--out-dir`` names a directory lutbake can create files in (tried, and left as it was): exit 2 before any
+    kernel runs, not a failed write after the bake."""
+    problem = encoding_problem(out_dir) or directory_problem(out_dir) or probe_directory(out_dir)
     if problem:
-        raise ConfigError("--out-dir", "out-dir", str(out_dir), message=problem)
+        raise ConfigError("--out-dir", "out-dir", shorten(str(out_dir)), message=problem)
+
+
+def planned_files(job) -> list[tuple[Path, str]]:
+    """Every file the bake of ``job`` writes, with what it is: the data file, a second data file (ltc_dds's
+    ``<name>_2.dds``), and the ``.json`` sidecar of each (EXR carries its metadata in its header). The one registry
+    of output paths: collisions, ``--report`` and the preview/error-map guards all read it."""
+    from .io.integrity import sidecar_path
+
+    fmt = job.spec.options.get("format", "exr")
+    files = [(job.path, "output")]
+    if fmt == "ltc_dds":
+        files.append((job.path.with_name(job.path.name.replace("_1.dds", "_2.dds")), "second texture"))
+    # an EXR writes none, but <name>.exr.json is where readers look for one: it is claimed too
+    files += [(sidecar_path(p), f"sidecar of {p.name}") for p, _ in list(files)]
+    return files
+
+
+def path_key(path) -> str:
+    """One key for every spelling of a file: the real parent directory, and the name with case folded (``D.exr``
+    and ``d.exr`` are one file on macOS, Windows and a case-insensitive mount)."""
+    path = Path(path)
+    parent = os.path.realpath(path.parent)
+    return os.path.join(os.path.normcase(parent), path.name.casefold())
+
+
+def check_collisions(jobs) -> None:
+    """No two tables of a batch write one file (data, second texture or sidecar), including names that differ
+    only in case: an ltc_dds table ``foo`` writes ``foo_1.dds``, as a dds table ``foo_1`` does."""
+    owners: dict[str, tuple] = {}
+    for job in jobs:
+        for p, what in planned_files(job):
+            key = path_key(p)
+            if key in owners and owners[key][0] is not job:
+                other, other_path, other_what = owners[key]
+                same = "" if other_path.name == p.name else f" ({other_path.name} and {p.name} differ only in case)"
+                raise ConfigError(
+                    job.spec.source,
+                    "name",
+                    job.name,
+                    table=job.name,
+                    message=f"its {what} {p} is also the {other_what} of table '{other.name}' "
+                    f"({other.spec.source}){same}: the two tables would overwrite each other; rename one",
+                )
+            owners[key] = (job, p, what)
 
 
 def check_outputs(jobs) -> None:
-    """Every output path and sidecar path must be a regular file or absent (a directory or device there fails
-    the rename after the bake); a ``png16`` output must be a 2D table (PNG has no depth: the table's shape comes
-    from its plan, which runs no kernel)."""
-    from .io.integrity import sidecar_path
+    """No two tables write one file (check_collisions). Every file a table writes (planned_files) must be a regular
+    file or absent (a directory or device there fails the rename after the bake); a ``png16`` output must be a 2D
+    table (PNG has no depth: the table's shape comes from its plan, which runs no kernel)."""
     from .kinds import lookup_kind
 
+    check_collisions(jobs)
     for job in jobs:
         if job.status == "pending" and job.spec.options.get("format") == "png16":
             shape = lookup_kind(job.spec.kind).plan(job.spec).shape
@@ -104,8 +204,7 @@ def check_outputs(jobs) -> None:
                     f"png16 holds 2D tables only; this table is {' x '.join(map(str, shape[:-1]))} texels",
                     table=job.name,
                 )
-        paths = (job.path,) if job.path.suffix == ".exr" else (job.path, sidecar_path(job.path))
-        for p in paths:
+        for p, _ in planned_files(job):
             if os.path.lexists(p) and not p.is_symlink() and not p.is_file():
                 raise ConfigError(
                     job.spec.source,
@@ -117,12 +216,14 @@ def check_outputs(jobs) -> None:
 
 
 def check_report(report, jobs, configs=()) -> None:
-    """``--report`` must be creatable and must not be an output, an output's sidecar or a config."""
-    from .io.integrity import sidecar_path
-
+    """``--report`` must be creatable and must not be any file a table writes (planned_files: an output, a second
+    texture, a sidecar) or a config."""
     if report is None:
         return
     report = Path(report)
+    problem = encoding_problem(report)
+    if problem:
+        raise ConfigError("--report", "report", shorten(str(report)), message=problem)
     if os.path.lexists(report) and not report.is_file():
         what = (
             "is a directory"
@@ -133,14 +234,14 @@ def check_report(report, jobs, configs=()) -> None:
         )
         raise ConfigError("--report", "report", str(report), message=what)
     for job in jobs:
-        for p, what in ((job.path, "the output"), (sidecar_path(job.path), "the sidecar")):
-            if _same(report, p):
+        for p, what in planned_files(job):
+            if _same(report, p) or path_key(report) == path_key(p):
                 raise ConfigError(
                     "--report",
                     "report",
                     str(report),
                     table=job.name,
-                    message=f"is {what} of table '{job.name}'; the report would overwrite it",
+                    message=f"is the {what} of table '{job.name}'; the report would overwrite it",
                 )
     for c in configs:
         if _same(report, Path(c)):
@@ -175,3 +276,58 @@ def nesting_problem(text: str) -> str | None:
         if parts > MAX_KEY_PARTS:
             return f"a dotted key of {parts} parts (at most {MAX_KEY_PARTS})"
     return None
+
+
+def input_files(path) -> list[Path]:
+    """The files reading ``path`` touches: itself, its sidecars, the data file a sidecar names, an ltc_dds pair's
+    other texture (what ``preview -o`` / ``audit --error-map`` must never overwrite)."""
+    from .io.readers import sidecar_candidates
+
+    path = Path(path)
+    files = [path, *sidecar_candidates(path)]
+    name = path.name
+    for a, b in (("_1.dds", "_2.dds"), ("_2.dds", "_1.dds")):
+        if name.endswith(a):
+            other = path.with_name(name[: -len(a)] + b)
+            files += [other, *sidecar_candidates(other)]
+    if name.endswith(".json"):
+        files.append(path.with_name(name[: -len(".json")]))
+    return files
+
+
+def check_image_output(out, inputs=(), force: bool = False, option: str = "--out") -> None:
+    """A PNG that ``preview`` / ``audit --error-map`` will write: not one of ``inputs`` (the table, its sidecars, a
+    config: input_files), not a directory or device, ending in ``.png`` unless ``force``, and in a directory that
+    takes files (tried). ConfigError, before any figure is drawn."""
+    if out is None:
+        return
+    out = Path(out)
+    shown = shorten(str(out))
+    problem = encoding_problem(out)
+    if problem:
+        raise ConfigError(option, option.lstrip("-"), shown, message=problem)
+    for p in inputs:
+        if p is not None and (_same(out, p) or path_key(out) == path_key(p)):
+            raise ConfigError(
+                option,
+                option.lstrip("-"),
+                shown,
+                message=f"is an input of this command ({shorten(str(p))}); it would be overwritten with a PNG",
+            )
+    if os.path.lexists(out) and not out.is_file():
+        what = _what_is(os.stat(out).st_mode) if out.exists() else "a dangling symlink"
+        raise ConfigError(option, option.lstrip("-"), shown, message=f"exists and is {what}")
+    if out.suffix.lower() in (".toml", ".json"):  # a config or a sidecar, even with --force
+        raise ConfigError(
+            option, option.lstrip("-"), shown, message="names a config or sidecar; write the PNG elsewhere"
+        )
+    if out.suffix.lower() != ".png" and not force:
+        raise ConfigError(
+            option,
+            option.lstrip("-"),
+            shown,
+            message="does not end in .png; this writes a PNG image (--force writes it under this name anyway)",
+        )
+    problem = directory_problem(out.parent) or probe_directory(out.parent)
+    if problem:
+        raise ConfigError(option, option.lstrip("-"), shown, message=f"{shorten(str(out.parent))} {problem}")

@@ -25,3 +25,26 @@ def safe_repr(value, limit: int = REPR_LIMIT) -> str:
         return f"<a {type(value).__name__} nested too deeply to show>"
     text = escape_controls(text)
     return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+NAME_LIMIT = 160  # characters of a file name or path shown in a message
+TEXT_LIMIT = 4096  # characters of any one string from a file shown in a figure or on the terminal
+
+
+def shorten(text, limit: int = NAME_LIMIT) -> str:
+    """``text`` escaped (escape_controls) and, past ``limit`` characters, cut in the middle with the count said:
+    a 10 000-character name is echoed as its head and tail, never as a 10 KB line."""
+    text = escape_controls(str(text))
+    if len(text) <= limit:
+        return text
+    keep = max(limit - 40, 8)
+    return f"{text[: keep // 2]}…[{len(text) - keep} characters]…{text[-(keep - keep // 2) :]}"
+
+
+def bounded(text, limit: int = TEXT_LIMIT) -> str:
+    """A string read from a file, made safe for matplotlib and the terminal: escaped, at most ``limit`` characters
+    (matplotlib lays text out in time quadratic in its length; a 50 MiB sidecar string took gigabytes)."""
+    text = str(text)
+    if len(text) > limit:
+        text = text[:limit] + f"… [{len(text) - limit} more characters]"
+    return escape_controls(text)

@@ -6,6 +6,7 @@ texels (same uv, same edge-integral fit, float64). Skipped where no GL context e
 from pathlib import Path
 
 import numpy as np
+import pytest
 from test_formats import read_dds_spec
 from test_gl_consumer import ctx  # noqa: F401 - the shared GL context fixture
 
@@ -44,10 +45,11 @@ def random_case(rng):
     return rough, nov, f0, q, quad
 
 
-def test_gl_integrates_a_quad_light_with_the_ltc_tables(ctx, tmp_path):  # noqa: F811
+@pytest.mark.parametrize("fit", ["l3", "shaded"])
+def test_gl_integrates_a_quad_light_with_the_ltc_tables(ctx, tmp_path, fit):  # noqa: F811
     import moderngl
 
-    spec = load_configs([Path("lutbake/presets/ltc-ggx.toml")], [f"size=[{SIZE},{SIZE}]"])[0]
+    spec = load_configs([Path("lutbake/presets/ltc-ggx.toml")], [f"size=[{SIZE},{SIZE}]", f'fit="{fit}"'])[0]
     table = bake_table(spec, workers=2)[0]
     path = write_table(table, tmp_path, "ltc_dds", "half")
     t1 = read_dds_spec(path.read_bytes())[0]

@@ -110,9 +110,13 @@ def small_ltc(tmp_path_factory):
     return api.bake(spec, out_dir=tmp_path_factory.mktemp("ltc"), workers=2)[0].table
 
 
-def test_ltc_bake_magnitude_equals_albedo_table(small_ltc, tmp_path):
+@pytest.mark.parametrize("fit_keys", [['fit="l3"'], ['fit="shaded"', 'magnitude="albedo"']])
+def test_ltc_bake_magnitude_equals_albedo_table(fit_keys, tmp_path):
+    """The magnitude channel is the albedo table with the L3 fit, and with the shaded fit told to keep it (the
+    default shaded fit fits the magnitude with the matrix: tests/test_ltc_shaded.py)."""
     size = SMALL
-    ltc = small_ltc
+    spec = load_configs([Path("lutbake/presets/ltc-ggx.toml")], [f"size=[{SMALL},{SMALL}]", 'format="exr"', *fit_keys])
+    ltc = api.bake(spec, out_dir=tmp_path, workers=2, write=False)[0].table
     cfg = tmp_path / "albedo.toml"
     cfg.write_text(
         '[[table]]\nname = "e"\nkind = "albedo"\n'

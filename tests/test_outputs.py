@@ -18,8 +18,9 @@ from lutbake.kinds import lookup_kind
 ROOT = Path(__file__).resolve().parents[1]
 SMALL = {"size": [8, 6], "roughness_size": 8, "f0_size": 3, "anisotropy_size": 3, "phi_size": 3, "sigma_size": 3}
 # files, conventions and previews are checked here, not accuracy: the glass layouts have fixed sizes (EEVEE
-# 16 x 64^2, OpenPBR 32^3), so they get a low fixed order (their adaptive rule: tests/test_dielectric.py)
-SMALL_GLASS = {"samples": 48, "mu_order": 4}
+# 16 x 64^2, OpenPBR 32^3), so they get a low fixed order and a loose tolerance (their adaptive rules and accuracy:
+# tests/test_dielectric.py; OpenPBR's average at its own 1e-5: 11 s of CPU, at 1e-3: 2 s)
+SMALL_GLASS = {"samples": 48, "mu_order": 4, "tolerance": 1e-3}
 PREVIEW_DPI = 40  # the layout is what is checked here, not the pixels
 
 

@@ -89,13 +89,16 @@ def output_files(out: Path) -> dict[str, bytes]:
 
 @pytest.fixture
 def computed(monkeypatch):
-    """The names of the specs the batch computes (lutbake.batch.compute calls), in order."""
+    """The names of the specs the batch computes (lutbake.batch.compute calls that return), in order of completion: a
+    call that steps back before any tile ran (ModuleBusy, another thread compiling its module) is retried, not a
+    second computation."""
     names = []
     real = batch.compute
 
     def counting(spec, *a, **k):
+        out = real(spec, *a, **k)
         names.append(spec.name)
-        return real(spec, *a, **k)
+        return out
 
     monkeypatch.setattr(batch, "compute", counting)
     return names

@@ -12,6 +12,7 @@ from .options import (
     conventions_of,
     conventions_options,
     fail,
+    force_png_option,
     json_option,
     out_file_option,
     quiet_warp,
@@ -70,7 +71,8 @@ def _shape(text: str | None):
 )
 @json_option("report (for CI)")
 @workers_option
-def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, error_map, as_json, workers):
+@force_png_option("--error-map")
+def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, error_map, as_json, workers, force):
     """Compare the LUT FILE with a converged re-bake under declared conventions and diagnose mistakes.
 
     Reports max/mean/percentile |file - converged| per channel and where the maximum sits, tests each usual
@@ -92,6 +94,9 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
     conventions = conventions_of(preset, config, overrides)
     quiet_warp()
     try:
+        from ..preflight import check_image_output, input_files
+
+        check_image_output(error_map, input_files(file) + ([config] if config else []), force, "--error-map")
         report = run_audit(
             file,
             conventions,

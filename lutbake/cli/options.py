@@ -37,6 +37,11 @@ def out_file_option(what: str):
     )
 
 
+def force_png_option(what: str):
+    """``--force``: write the PNG ``what`` names even under a name that does not end in .png (audit, preview)."""
+    return click.option("--force", is_flag=True, help=f"Write {what} even under a name that does not end in .png.")
+
+
 def set_option(help_text: str):
     """``--set KEY=VALUE`` (repeatable): a config key over every table, or NAME.KEY=VALUE over one."""
     return click.option("--set", "overrides", multiple=True, metavar="KEY=VALUE", help=help_text)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import click
 
-from .options import fail, out_dir_option, out_file_option
+from .options import fail, force_png_option, out_dir_option, out_file_option
 
 
 @click.command("list")
@@ -184,7 +184,8 @@ def validate():
 @click.command()
 @click.argument("file", type=click.Path(path_type=Path))
 @out_file_option("the PNG here (default: FILE's stem + .preview.png beside it)")
-def preview(file, out):
+@force_png_option("the PNG")
+def preview(file, out, force):
     """Render a PNG of a table file (any format lutbake writes; see inspect): 1D tables as curves, 2D
     tables as colour-mapped channels with labelled axes, 3D tables as labelled slice grids, btf tables as
     light x view images per sigma and phi; and, where the table has a split-sum reconstruction, a row of
@@ -198,7 +199,7 @@ def preview(file, out):
     from ..errors import LutbakeError
 
     try:
-        path = render(file, out)
+        path = render(file, out, force=force)
     except ImportError as e:
         fail(f"preview needs matplotlib (pip install 'lutbake[plot]'): {e}")
     except (LutbakeError, OSError) as e:

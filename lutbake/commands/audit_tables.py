@@ -26,7 +26,6 @@ NoV >= NOV_MIN there (lutbake.edge), a limit the shipped Monte Carlo estimator d
 
 from __future__ import annotations
 
-import gzip
 import math
 import re
 from dataclasses import dataclass, field
@@ -86,8 +85,10 @@ class TableAuditReport:
 
 
 def _read_text(path: Path) -> str:
-    raw = path.read_bytes()
-    return (gzip.decompress(raw) if path.suffix == ".gz" else raw).decode("utf-8", "replace")
+    from ..io import bounded  # size caps: a text table or its gzip at most bounded.MAX_TEXT_BYTES
+
+    raw = bounded.read_bytes(path, bounded.MAX_TEXT_BYTES, "a text table")
+    return (bounded.gunzip(raw) if path.suffix == ".gz" else raw).decode("utf-8", "replace")
 
 
 # --------------------------------------------------------------------------------------------------- LTC
@@ -102,7 +103,9 @@ def read_ltc_pair(path: Path) -> tuple[np.ndarray, np.ndarray]:
     path = Path(path)
     if path.name.endswith("_1.dds"):
         second = path.with_name(path.name.replace("_1.dds", "_2.dds"))
-        return tuple(dds.decode(p.read_bytes())[0].astype(np.float64) for p in (path, second))
+        from ..io.bounded import read_bytes
+
+        return tuple(dds.decode(read_bytes(p))[0].astype(np.float64) for p in (path, second))
     text = _read_text(path)
     num = re.compile(r"-?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
     arrays = []
@@ -306,8 +309,9 @@ def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> 
     from ..layouts.openpbr import OPENPBR_SIZE
 
     n = OPENPBR_SIZE
-    with np.load(Path(path)) as z:
-        shipped = {k: z[k].astype(np.float64) / 65535.0 for k in z.files}
+    from ..io.bounded import load_npz_all
+
+    shipped = {k: v.astype(np.float64) / 65535.0 for k, v in load_npz_all(Path(path)).items()}
     missing = [k for k, _, _ in OPENPBR_KEYS if k not in shipped]
     if missing:
         raise ValueError(f"{path}: missing OpenPBR arrays {missing} (keys: {sorted(shipped)})")

@@ -26,7 +26,9 @@ from pathlib import Path
 import numpy as np
 
 from ..axes import Axis
+from ..errors import LutbakeError
 from ..io.readers import TableView, read_table
+from ..textsafe import bounded, shorten
 
 N_SPHERES = 5
 MAX_SLICES = 6  # columns of a 3D slice grid
@@ -219,10 +221,11 @@ def _channel_title(view: TableView, c: int) -> str:
 
 
 def _suptitle(view: TableView, path: Path, width_chars: int) -> str:
-    head = f"{path.name}: {view.kind} table '{view.name}'" if view.kind else f"{path.name}: no lutbake metadata"
+    name = shorten(path.name)
+    head = f"{name}: {view.kind} table '{view.name}'" if view.kind else f"{name}: no lutbake metadata"
     terms = ", ".join(f"{k} {v}" for k, v in view.terms.items())
     attrs = view.attrs
-    extra = ", ".join(f"{k} {attrs[k]}" for k in ("estimator", "samples") if k in attrs)
+    extra = ", ".join(f"{k} {bounded(attrs[k], 60)}" for k in ("estimator", "samples") if k in attrs)
     body = "; ".join(x for x in (terms, extra + (" per texel" if "samples" in attrs else "")) if x)
     return "\n".join([head] + textwrap.wrap(body, max(width_chars, 40)))
 
@@ -353,30 +356,39 @@ def figure(path):
     view = read_table(path)
     spheres = split_sum(view)
     dims = {a.dim for a in view.axes}
-    if "y_block" in dims:
-        fig, inches = _fig_btf(plt, view)
-    elif view.axes and dims == {"x"}:
-        fig, inches = _fig_1d(plt, view)
-    elif view.data.ndim == 4:
-        fig, inches = _fig_3d(plt, view, spheres)
-    else:
-        fig, inches = _fig_2d(plt, view, spheres)
-    note = "" if spheres or not view.kind else f"\n(no sphere row: {view.kind} has no split-sum reconstruction)"
-    fig.suptitle(_suptitle(view, path, int(inches * CHARS_PER_INCH)) + note, fontsize=9)
+    with matplotlib.rc_context({"text.parse_math": False}):  # names from the file are text: "$x$" is no formula
+        if "y_block" in dims:
+            fig, inches = _fig_btf(plt, view)
+        elif view.axes and dims == {"x"}:
+            fig, inches = _fig_1d(plt, view)
+        elif view.data.ndim == 4:
+            fig, inches = _fig_3d(plt, view, spheres)
+        else:
+            fig, inches = _fig_2d(plt, view, spheres)
+        note = "" if spheres or not view.kind else f"\n(no sphere row: {view.kind} has no split-sum reconstruction)"
+        fig.suptitle(_suptitle(view, path, int(inches * CHARS_PER_INCH)) + note, fontsize=9)
     return fig
 
 
-def render(path, out=None, dpi: int = 100) -> Path:
-    """Write the preview PNG of the table at ``path`` (default: <path stem>.preview.png beside it)."""
+def render(path, out=None, dpi: int = 100, force: bool = False) -> Path:
+    """Write the preview PNG of the table at ``path`` (default: <path stem>.preview.png beside it). ``out`` is
+    checked before anything is read (lutbake.preflight.check_image_output): never the table, its sidecar or a
+    config, a ``.png`` unless ``force``, in a directory that takes files."""
     import matplotlib.pyplot as plt
 
     from ..io.atomic import atomic_write
+    from ..io.oserror import os_error_text
+    from ..preflight import check_image_output, input_files
 
     path = Path(path)
-    fig = figure(path)
     out = Path(out) if out else path.with_name(path.stem + ".preview.png")
+    check_image_output(out, input_files(path), force, "--out")
+    fig = figure(path)
     try:
         atomic_write(out, lambda tmp: fig.savefig(tmp, format="png", dpi=dpi))
+    except OSError as e:  # the directory changed since the check: name the PNG, not the temporary file
+        e.filename = None
+        raise LutbakeError(f"cannot write {shorten(str(out))}: {os_error_text(e, out.parent)}") from None
     finally:
         plt.close(fig)
     return out

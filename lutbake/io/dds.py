@@ -88,6 +88,9 @@ def decode(blob: bytes) -> tuple[np.ndarray, dict]:
     dtype, nch = FROM_DXGI[fmt]
     npdt = np.dtype("<f2" if dtype == "half" else "<f4")
     shape = ((depth,) if dim == DIM_TEXTURE3D else ()) + (height, width, nch)
+    from .bounded import check_texels
+
+    check_texels(shape, f"the DDS header ({DXGI_NAMES[fmt]})")
     need = 148 + int(np.prod(shape, dtype=object)) * npdt.itemsize
     if min(shape) < 1 or need > len(blob):
         raise ValueError(

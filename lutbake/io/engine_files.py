@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .bounded import check_texels, read_bytes, read_text
 from .text_arrays import literal_values, parse_text_array, strip_comments
 
 HDRP_CHANNELS = {
@@ -44,7 +45,12 @@ def array_body(text: str, name: str) -> str:
     """The body of the array literal declared as ``name`` (``name[..] = {...}``, ``name = new T([...])``,
     ``name = new T[..] {...}``, ``name: array<f32, N> = array<f32, N>(...)``), comments removed."""
     code = strip_comments(text)
-    m = re.search(rf"\b{re.escape(name)}\b[^=;]*=[^;{{\[(]*?(?:new\s+\w+\s*(?:\[[^\]]*\]\s*)?)?[({{\[]", code)
+    # bounded gaps (linear time on any text): a declaration's type and "new T[..]" are short
+    m = re.search(
+        rf"\b{re.escape(name)}\b[^=;]{{0,256}}=[^;{{\[(]{{0,256}}?(?:new\s{{1,16}}\w{{1,64}}\s{{0,16}}"
+        rf"(?:\[[^\]]{{0,64}}\]\s{{0,16}})?)?[({{\[]",
+        code,
+    )
     if m is None:
         raise ValueError(f"no array {name!r}")
     end = code.find(";", m.end())
@@ -52,6 +58,7 @@ def array_body(text: str, name: str) -> str:
 
 
 def _values(text: str, name: str, shape: tuple[int, ...]) -> np.ndarray:
+    check_texels(shape, f"array {name!r} (the sidecar's axes)", channels=1)
     n = int(np.prod(shape))
     arr, _ = literal_values(array_body(text, name), n)
     if arr.size != n:
@@ -60,7 +67,7 @@ def _values(text: str, name: str, shape: tuple[int, ...]) -> np.ndarray:
 
 
 def _declared(text: str, prefix: str) -> str:
-    m = re.search(rf"\b({re.escape(prefix)}\w*)\s*[\[=]", strip_comments(text))
+    m = re.search(rf"\b({re.escape(prefix)}\w{{0,128}})\s{{0,64}}[\[=]", strip_comments(text))
     if m is None:
         raise ValueError(f"no array named {prefix}*")
     return m.group(1)
@@ -75,18 +82,18 @@ def _ltc_dds(path: Path, doc: dict, dims: dict) -> np.ndarray:
         other = path.with_name(name)
         if not other.is_file():
             raise ValueError(f"its second texture {name} is not beside it")
-        slices.append(dds.decode(other.read_bytes())[0].astype(np.float32))
+        slices.append(dds.decode(read_bytes(other))[0].astype(np.float32))
     return np.stack(slices)
 
 
 def _ltc_js(path: Path, doc: dict, dims: dict) -> np.ndarray:
-    text = path.read_text(encoding="utf-8")
+    text = read_text(path)
     shape = (dims["y"], dims["x"], 4)
     return np.stack([_values(text, "LTC_MAT_1", shape), _values(text, "LTC_MAT_2", shape)])
 
 
 def _ltc_c(path: Path, doc: dict, dims: dict) -> np.ndarray:
-    text = path.read_text(encoding="utf-8")
+    text = read_text(path)
     ny, nx = dims["y"], dims["x"]
     mat = _values(text, _declared(text, "ltc_mat_"), (ny, nx, 4))
     mag = _values(text, _declared(text, "ltc_mag_"), (ny, nx, 2))
@@ -95,7 +102,7 @@ def _ltc_c(path: Path, doc: dict, dims: dict) -> np.ndarray:
 
 
 def _hdrp_cs(path: Path, doc: dict, dims: dict) -> np.ndarray:
-    text = path.read_text(encoding="utf-8")
+    text = read_text(path)
     name = _declared(text, "s_LtcMatrixData_BRDF_")
     bits = _values(text, name, (dims["y"], dims["x"], 4))
     return bits.astype(np.uint16).view(np.float16).astype(np.float32)
@@ -104,7 +111,7 @@ def _hdrp_cs(path: Path, doc: dict, dims: dict) -> np.ndarray:
 def _openpbr_h(path: Path, doc: dict, dims: dict, attrs: dict) -> np.ndarray:
     from .openpbr import UNORM_ONE, camel
 
-    text = path.read_text(encoding="utf-8")
+    text = read_text(path)
     names = json.loads(attrs["channel_names"])
     shape = tuple(dims[d] for d in ("z", "y", "x") if d in dims)
     channels = []
@@ -119,8 +126,8 @@ def _openpbr_h(path: Path, doc: dict, dims: dict, attrs: dict) -> np.ndarray:
 
 
 def _code_array(path: Path, doc: dict, dims: dict) -> np.ndarray:
-    text = path.read_text(encoding="utf-8")
-    m = re.search(r"lutbake:shape\s*=\s*\[([\d,\s]+)\]", text)
+    text = read_text(path)
+    m = re.search(r"lutbake:shape[ \t]{0,8}=[ \t]{0,8}\[([\d, \t]{1,64})\]", text)
     if m is None:
         raise ValueError("no 'lutbake:shape = [...]' line")
     shape = tuple(int(s) for s in m.group(1).split(",") if s.strip())

@@ -20,6 +20,7 @@ import struct
 
 import numpy as np
 
+from .bounded import check_texels, zstd_decompress
 from .dds import PIXEL_FORMATS, gpu_channels, layout_name
 
 IDENTIFIER = bytes([0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A])
@@ -151,14 +152,13 @@ def decode(blob: bytes) -> tuple[np.ndarray, dict]:
     dtype, nch = FROM_VK_FORMAT[vk]
     npdt = np.dtype("<f2" if dtype == "half" else "<f4")
     shape = ((depth,) if depth else (layers,) if layers else ()) + (height, width, nch)
+    check_texels(shape, f"the KTX2 header ({VK_FORMAT_NAMES[vk]})")  # before anything is decompressed
     need = int(np.prod(shape, dtype=object)) * npdt.itemsize
     level = blob[level_off : level_off + level_len]
     if scheme:  # one zstd frame of uncompressedByteLength bytes (KTX 2.0 §3.12.2)
-        import zstandard
-
         if raw_len != need:
             raise ValueError(f"KTX2 uncompressedByteLength {raw_len} != {need} bytes of its header's shape")
-        level = zstandard.ZstdDecompressor().decompress(level, max_output_size=raw_len)
+        level = zstd_decompress(level, raw_len)  # streamed: stops at raw_len whatever the frame says
         level_off, level_len = 0, len(level)
     if min(shape) < 1 or need > level_len or (not scheme and level_off + need > len(blob)):
         raise ValueError(

@@ -18,12 +18,12 @@ Row 0 of the result is the first row stored in the file (no flip). A JSON sideca
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from . import bounded
 from .text_arrays import parse_text_array
 
 TEXT_EXTENSIONS = (".h", ".hpp", ".inc", ".js", ".mjs", ".ts", ".wgsl", ".rs")
@@ -62,6 +62,7 @@ def _read_png(path: Path) -> tuple[np.ndarray, str]:
         raise ValueError(f"{path}: cannot open PNG: {oiio.geterror()}")
     try:
         spec = inp.spec()
+        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header")
         native = oiio.UINT16 if spec.format.size() == 2 else oiio.UINT8
         codes = inp.read_image(native)  # raw codes: OIIO applies no transfer function on read
     finally:
@@ -94,19 +95,33 @@ def _read_exr(path: Path) -> tuple[np.ndarray, dict, str]:
 def read_lut(path, shape=None) -> LutFile:
     """Read ``path`` (see the module docstring). ``shape``: (rows, columns, channels) of a text array
     whose file does not declare it."""
-    from .dds import decode as dds_decode
-    from .ktx2 import decode as ktx2_decode
-
     path = Path(path)
     ext = path.suffix.lower()
     if ext not in READABLE:
         raise ValueError(f"{path}: cannot read '{ext}' files; readable: {', '.join(READABLE)}")
-    if not path.is_file():
-        raise ValueError(f"{path}: no such file")
+    problem = bounded.regular_file_problem(path)
+    if problem:
+        raise ValueError(f"{path}: {problem}")
+    try:
+        return _read_lut(path, ext, shape)
+    except ValueError as e:
+        text = str(e)
+        raise ValueError(text if text.startswith(str(path)) else f"{path}: {text}") from None
+
+
+def _read_lut(path: Path, ext: str, shape) -> LutFile:
+    from .dds import decode as dds_decode
+    from .ktx2 import decode as ktx2_decode
+
     attrs, sidecar = {}, {}
     for side in (path.with_name(path.name + ".json"), path.with_suffix(".json")):  # lutbake's, then refs style
-        if side.is_file():
-            sidecar = json.loads(side.read_text())
+        if side.is_file() and side != path:
+            try:
+                sidecar = bounded.load_json(side)
+            except (ValueError, UnicodeDecodeError, OSError) as e:
+                raise ValueError(f"its sidecar {side.name} is not readable JSON: {e}") from None
+            if not isinstance(sidecar, dict) or not isinstance(sidecar.get("lutbake", {}), dict):
+                raise ValueError(f"its sidecar {side.name} is not a JSON object with a 'lutbake' object")
             attrs = sidecar.get("lutbake", {})
             break
     if ext == ".exr":
@@ -115,26 +130,28 @@ def read_lut(path, shape=None) -> LutFile:
     elif ext == ".png":
         data, storage = _read_png(path)
     elif ext == ".dds":
-        arr, _ = dds_decode(path.read_bytes())
+        arr, _ = dds_decode(bounded.read_bytes(path))
         data, storage = arr.astype(np.float64), _float_storage(arr)
     elif ext == ".ktx2":
-        arr, facts = ktx2_decode(path.read_bytes())
+        arr, facts = ktx2_decode(bounded.read_bytes(path))
         kv = facts["key_value"]
         data, storage = arr.astype(np.float64), _float_storage(arr)
         if "lutbake:metadata" in kv:
-            attrs = json.loads(kv["lutbake:metadata"])
+            attrs = bounded.loads_json(kv["lutbake:metadata"])
+            if not isinstance(attrs, dict):
+                raise ValueError("its KTX2 key/value lutbake:metadata is not a JSON object")
     elif ext in (".npy", ".npz"):
-        arr = np.load(path, allow_pickle=False)
         if ext == ".npz":  # one array: named "table" (tests/data), else the only one
-            names = list(arr.files)
-            arr = arr["table" if "table" in names else names[0]]
+            arr, _ = bounded.load_npz(path)
+        else:
+            arr = bounded.load_npy(path)
         if np.issubdtype(arr.dtype, np.unsignedinteger):
             data, storage = _unorm(arr)
         else:
             data, storage = arr.astype(np.float64), _float_storage(arr)
     else:
         try:
-            data, storage = parse_text_array(path.read_text(errors="replace"), shape)
+            data, storage = parse_text_array(bounded.read_text(path, errors="replace"), shape)
         except ValueError as e:
             raise ValueError(f"{path}: {e}") from None
     data = np.asarray(data, dtype=np.float64)

@@ -31,14 +31,19 @@ from pathlib import Path
 import numpy as np
 
 from ..axes import IMAGE_DIMS, MAPPINGS, ORDERS, TEXELS, Axis
-from ..errors import LutbakeError
+from ..errors import MESSAGE_LIMIT, LutbakeError
 from ..runtime.warp_runtime import stderr_silenced
-from . import dds, ktx2
+from ..textsafe import bounded as bounded_text
+from ..textsafe import shorten
+from . import bounded, dds, ktx2
 
 PREFIX = "lutbake:"
 MAGIC_BYTES = 16  # enough to tell every format apart
 MAX_AXIS_COUNT = 1 << 20  # no lutbake axis is longer (the texel cap is 2^24 in all)
 MAX_FILE_BYTES = 4 << 30  # a table is at most 2^24 texels x 4 channels x 4 bytes = 256 MiB; headers are text
+NAME_CHARS = 120  # characters of a name from a file (kind, table, channel, term) shown by preview and inspect
+MAX_TERMS = 32  # terms shown (lutbake records at most a dozen)
+MAX_EXR_CHANNELS = 64  # channels of one EXR part (a table has 1 to 4; other tools add a few named ones)
 EXR_MAGIC = b"\x76\x2f\x31\x01"
 NPY_MAGIC = b"\x93NUMPY"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -60,7 +65,8 @@ class ReadError(LutbakeError, ValueError):
     """A file lutbake cannot read, or metadata that does not fit the file: one line that names the file."""
 
     def __init__(self, message: str):
-        super().__init__("; ".join(line.strip() for line in str(message).splitlines() if line.strip()))
+        line = "; ".join(part.strip() for part in str(message).splitlines() if part.strip())
+        super().__init__(shorten(line, MESSAGE_LIMIT))
 
 
 @dataclass
@@ -95,10 +101,9 @@ class TableView:
 
 def sniff(path: Path) -> str:
     """The format of ``path`` from its first bytes (FORMAT_NAMES); ReadError for anything else."""
-    if not path.exists():
-        raise ReadError(f"{path}: no such file")
-    if not path.is_file():
-        raise ReadError(f"{path}: not a regular file")
+    problem = bounded.regular_file_problem(path)  # "no such file", "is a FIFO (named pipe), not a file", ...
+    if problem:
+        raise ReadError(f"{path}: {problem}")
     with open(path, "rb") as f:
         head = f.read(MAGIC_BYTES)
     for magic, fmt in (
@@ -131,7 +136,7 @@ def read(path) -> LoadedFile:
         raise ReadError(f"{path}: {size} bytes is larger than any table lutbake writes ({MAX_FILE_BYTES} bytes)")
     try:
         loaded = READERS[fmt](path)
-    except (ValueError, KeyError, TypeError, IndexError, OverflowError, UnicodeDecodeError, EOFError):
+    except (ValueError, KeyError, TypeError, IndexError, OverflowError, UnicodeDecodeError, EOFError, OSError):
         engine = _engine_sidecar(path)
         if engine is None:
             return _read_or_raise(path, fmt)
@@ -213,10 +218,17 @@ def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
         raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
     parts = []
     try:
-        k = 0
+        k, texels = 0, 0
         while inp.seek_subimage(k, 0):
             spec = inp.spec()
             names = list(spec.channelnames)
+            texels += spec.width * spec.height * max(spec.depth, 1)  # every part so far: checked before any read
+            if texels > bounded.MAX_READ_TEXELS or len(names) > MAX_EXR_CHANNELS:
+                raise ValueError(
+                    f"part {k} declares {spec.width} x {spec.height} texels x {len(names)} channels ({texels} texels "
+                    f"in parts 0-{k}); a table lutbake reads is at most {bounded.MAX_READ_TEXELS} texels of "
+                    f"at most {MAX_EXR_CHANNELS} channels: refused before reading"
+                )
             rgba = [c for c in "RGBA" if c in names]
             order = rgba if len(rgba) == len(names) else names
             with stderr_silenced():
@@ -258,8 +270,8 @@ def read_exr(path: Path) -> LoadedFile:
 
 
 def read_npy(path: Path) -> LoadedFile:
-    arr = np.load(path, mmap_mode="r", allow_pickle=False)
-    data = _as_table_array(np.asarray(arr))
+    arr = bounded.load_npy(path)
+    data = _as_table_array(arr)
     return _with_sidecar(LoadedFile(path, "npy", data, {}, None, {"dtype": str(arr.dtype), "shape": list(arr.shape)}))
 
 
@@ -272,6 +284,7 @@ def read_png(path: Path) -> LoadedFile:
         raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
     try:
         spec = inp.spec()
+        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header")
         bits = 16 if str(spec.format) == "uint16" else 8
         with stderr_silenced():
             arr = inp.read_image("uint16" if bits == 16 else "uint8")
@@ -286,19 +299,19 @@ def read_png(path: Path) -> LoadedFile:
 
 
 def read_dds(path: Path) -> LoadedFile:
-    arr, facts = dds.decode(path.read_bytes())
+    arr, facts = dds.decode(bounded.read_bytes(path))
     return _with_sidecar(LoadedFile(path, "dds", _as_table_array(arr), {}, None, facts))
 
 
 def read_ktx2(path: Path) -> LoadedFile:
-    arr, facts = ktx2.decode(path.read_bytes())
+    arr, facts = ktx2.decode(bounded.read_bytes(path))
     kv = facts.pop("key_value")
     facts.update({k: v for k, v in kv.items() if k.startswith("KTX")})
     loaded = LoadedFile(path, "ktx2", _as_table_array(arr), {}, None, facts)
     if "lutbake:metadata" in kv:
         try:
-            meta = json.loads(kv["lutbake:metadata"])
-        except json.JSONDecodeError as e:
+            meta = bounded.loads_json(kv["lutbake:metadata"])
+        except ValueError as e:
             raise ReadError(f"{path}: key/value lutbake:metadata is not valid JSON ({e})") from None
         loaded.attrs = _string_attrs(meta, path, "key/value lutbake:metadata")
         loaded.meta_source = "KTX2 key/value data"
@@ -306,22 +319,31 @@ def read_ktx2(path: Path) -> LoadedFile:
     return _with_sidecar(loaded)
 
 
-_DEFINE = re.compile(r"^#define\s+(\w+?)_(DEPTH|HEIGHT|WIDTH|CHANNELS)\s+(\d+)\s*$", re.M)
-_ARRAY = re.compile(r"static\s+const\s+(uint16_t|float)\s+(\w+)\s*\[[^\]]*\]\s*=\s*\{([^}]*)\}", re.S)
+# Bounded patterns (linear time on any text, issue 38): a declaration's parts are short; the array's body is found
+# with one str.find of its closing brace, never by a pattern that rescans the rest of the file from each candidate.
+_DEFINE = re.compile(r"^#define[ \t]{1,64}(\w{1,128}?)_(DEPTH|HEIGHT|WIDTH|CHANNELS)[ \t]{1,64}(\d{1,12})[ \t]*$", re.M)
+_ARRAY = re.compile(
+    r"static\s{1,64}const\s{1,64}(uint16_t|float)\s{1,64}(\w{1,128})\s{0,64}\[[^\]\n]{0,1024}\]\s{0,64}=\s{0,64}\{"
+)
 
 
 def read_header(path: Path) -> LoadedFile:
     """A C header as lutbake writes it (lutbake.io.formats.header_text): size macros and one flat array
     of floats or binary16 bit patterns."""
-    text = path.read_text(encoding="utf-8")
+    text = bounded.read_text(path, what="a C header")
     m = _ARRAY.search(text)
     if m is None:
         raise ValueError("no 'static const float|uint16_t NAME[...] = {...}' array")
-    ctype, ident, body = m.groups()
+    end = text.find("}", m.end())
+    if end < 0:
+        raise ValueError(f"array {m.group(2)} has no closing brace")
+    ctype, ident = m.groups()
+    body = text[m.end() : end]
     dims = {k: int(v) for macro, k, v in _DEFINE.findall(text) if macro == ident.upper()}
     if not {"HEIGHT", "WIDTH", "CHANNELS"} <= set(dims):
         raise ValueError(f"no {ident.upper()}_HEIGHT / _WIDTH / _CHANNELS macros for array {ident}")
     shape = tuple(dims[k] for k in ("DEPTH", "HEIGHT", "WIDTH", "CHANNELS") if k in dims)
+    bounded.check_texels(shape, f"array {ident}'s macros")
     items = [s for s in (x.strip() for x in body.split(",")) if s]
     if math.prod(shape) != len(items):
         raise ValueError(f"array {ident} has {len(items)} values, its macros say {' x '.join(map(str, shape))}")
@@ -346,9 +368,13 @@ def _is_report(doc) -> bool:
 
 def _load_json(path: Path):
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
+        return bounded.load_json(path)
     except json.JSONDecodeError as e:
         raise ReadError(f"{path}: sidecar is not valid JSON ({e})") from None
+    except (ValueError, UnicodeDecodeError) as e:
+        raise ReadError(f"{path}: not a readable sidecar: {e}") from None
+    except OSError as e:
+        raise ReadError(f"{path}: cannot read: {e.strerror or e}") from None
 
 
 def _load_sidecar(path: Path, doc=None) -> dict:
@@ -475,6 +501,7 @@ def axis_from_meta(d: dict, where: str = "axis") -> Axis:
     name = d.get("name")
     if not isinstance(name, str) or not name:
         bad(f"an axis needs a 'name' string, got {json.dumps(d)[:60]}")
+    name = bounded_text(name, NAME_CHARS)
     where = f"{where} {name!r}"
     count = d.get("count")
     if isinstance(count, float) and count.is_integer():
@@ -561,16 +588,18 @@ def table_view(loaded: LoadedFile) -> TableView:
         raise ReadError(f"{path}: lutbake channel_names lists {len(letters)} channels, the file holds {data.shape[-1]}")
     data = data[..., : len(letters)]  # drop a GPU format's padding (PNG B = 0, DDS/KTX2 A = 1)
     terms = _json_attr(loaded, "terms", dict, {})
+    # every string from the file bounded and escaped here, before any figure or terminal line (textsafe.bounded:
+    # a 50 MiB kind took gigabytes in matplotlib; control characters made it warn about missing glyphs)
     return TableView(
         loaded,
         data,
         axes,
-        [str(names.get(c, f"channel {c}")) for c in letters],
-        [str(meanings.get(c, "")) for c in letters],
-        loaded.attrs["kind"],
-        loaded.attrs.get("table", path.stem),
-        terms,
-        loaded.attrs.get("reconstruction", ""),
+        [bounded_text(names.get(c, f"channel {c}"), NAME_CHARS) for c in letters],
+        [bounded_text(meanings.get(c, "")) for c in letters],
+        bounded_text(loaded.attrs["kind"], NAME_CHARS),
+        bounded_text(loaded.attrs.get("table", path.stem), NAME_CHARS),
+        {bounded_text(k, NAME_CHARS): bounded_text(v, NAME_CHARS) for k, v in list(terms.items())[:MAX_TERMS]},
+        bounded_text(loaded.attrs.get("reconstruction", "")),
     )
 
 

@@ -18,6 +18,8 @@ t = sqrt(1 - cos theta_v) at endpoint texels t/(N - 1), theta_v <= 1.57 rad (NoV
 Shaders sample uv = vec2(roughness, sqrt(1 - NoV)) * (N - 1)/N + 0.5/N. Differences from ltc_code, all recorded
 in the metadata: alpha >= 1e-4 (lutbake.edge; ltc_code 1e-5), magnitude and fresnel integrated exactly
 (ltc_code: 32^2 samples), every texel fitted independently from a coarse pass (ltc_code: chained).
+Key ``fit``: "l3" (default) as above; "shaded" refines the L3 fit's texels to the polygon-light integrals the shader
+computes, magnitude and fresnel included (lutbake.ltc.shaded; docs/ltc_shaded.md).
 The sphere channel's own axes: x = z * 0.5 + 0.5 (z = cos of the form-factor direction's elevation), y =
 len = |form factor|, both endpoint (ltc_code genSphereTab).
 """
@@ -73,10 +75,43 @@ KEYS = {
         minimum=ALPHA_MIN,
         maximum=0.1,
     ),
+    "fit": Key(
+        "fit",
+        "str",
+        "l3",
+        "what the fit minimises",
+        {
+            "l3": "Heitz et al. 2016's L3 distance to the lobe (ltc_code's fit); magnitude and fresnel the exact "
+            "integrals",
+            "shaded": "the l3 fit refined to the polygon-light integrals the shader computes (lutbake.ltc.shaded): "
+            "matrix, magnitude and fresnel fitted to the lobe's integrals over training lights",
+        },
+    ),
+    "fit_f0_weight": Key(
+        "fit_f0_weight",
+        "float",
+        0.7,
+        "shaded fit, lobes with Fresnel: weight of the dielectric (f0 = 0.04) shading errors beside F = 1 (0: F = 1 "
+        "alone; one matrix serves every f0)",
+        minimum=0.0,
+        maximum=1.0,
+    ),
+    "magnitude": Key(
+        "magnitude",
+        "str",
+        "fitted",
+        "the magnitude the shaded fit pairs with its matrix",
+        {
+            "fitted": "fitted with the matrix (ltc_2.x; the shader multiplies by it)",
+            "albedo": "the lobe's albedo, fixed (for shaders that take the magnitude from another table, e.g. Unity "
+            "HDRP's PreIntegratedFGD)",
+        },
+    ),
     "format": Key("format", "str", "exr", "output file format", FORMATS),
 }
 CHANNELS = {
-    "x": "slice 0 (ltc_1): M^-1_00 / M^-1_11; slice 1 (ltc_2): magnitude = ∫ f (n.l) dω_l with F = 1",
+    "x": "slice 0 (ltc_1): M^-1_00 / M^-1_11; slice 1 (ltc_2): magnitude = ∫ f (n.l) dω_l with F = 1 (fit = shaded: "
+    "fitted with the matrix)",
     "y": "slice 0: M^-1_20 / M^-1_11 (glm invM[0][2]); slice 1: fresnel = ∫ f (1 - v.h)^5 (n.l) dω_l "
     "(= magnitude for lobes without Fresnel)",
     "z": "slice 0: M^-1_02 / M^-1_11 (glm invM[2][0]); slice 1: fit_error = (E / ∫ f^3 dω)^(1/3), E = Heitz's L3 "
@@ -108,6 +143,11 @@ def axes_for(o: dict) -> list[Axis]:
         Axis("NoV", "y", n_view, 0.0, 1.0, texel="endpoint", mapping="one_minus_t2", clamp=(NOV_LO, 1.0)),
         Axis(rname, "x", n_rough, 0.0, 1.0, texel="endpoint", alpha_map=amap),
     ]
+
+
+def uses_shaded_fit(o: dict) -> bool:
+    """Whether the table's texels are the shaded fit's (lutbake.ltc.shaded) or the L3 fit's."""
+    return o["fit"] == "shaded" and o["lobe"] != "lambert"  # lambert: the L3 fit is exact
 
 
 def lobe_parameter(rough: Axis) -> np.ndarray:
@@ -212,6 +252,8 @@ class LtcBake:
         self._fits: dict[tuple[int, int], tuple[threading.Lock, list]] = {}
         self.problem = None
         self.coarse = None
+        self.shaded = uses_shaded_fit(o)
+        self.device = "cpu"
         self.sphere = sphere.sphere_table(self.n_rough) if self.n_view == self.n_rough else None
 
     def prepare(self, device: str) -> None:
@@ -225,6 +267,8 @@ class LtcBake:
                     o["lobe"], self.nov, alpha, o["samples"], device, o["estimator"], o["seed"]
                 )
                 self.fresnel = fres
+                self.device = device
+                self.has_fresnel = not np.array_equal(mag, fres)  # lobes without Fresnel store fresnel = magnitude
                 # a tabulated lobe's table is built here on every available core (the executor's default; values do
                 # not depend on the thread count)
                 threads = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
@@ -260,8 +304,24 @@ class LtcBake:
         with lock:
             if not box:
                 texel = np.arange(start, stop)
-                m, err = fit.fit_texels(self.problem, texel, self.n_rough, self.coarse, fit.MEMO)
-                box += [fit.pack_inverse(m), self.problem.relative(texel, err)]
+                p = self.problem
+                m, err = fit.fit_texels(p, texel, self.n_rough, self.coarse, fit.MEMO)
+                packed, mag, fres = fit.pack_inverse(m), p.magnitude[texel], self.fresnel[texel]
+                if self.shaded:
+                    from ..ltc import shaded
+
+                    # texels the L3 fit represents exactly (EON at r = 0: Lambert) keep it: the training lights'
+                    # sampled targets would only add their noise
+                    sel = np.flatnonzero(p.relative(texel, err) >= shaded.EXACT_L3)
+                    free = self.o["magnitude"] == "fitted"
+                    exact_fres = fres[sel] if self.has_fresnel else None
+                    w = self.o["fit_f0_weight"]
+                    packed, mag, fres, err = packed.copy(), mag.copy(), fres.copy(), err.copy()
+                    packed[sel], mag[sel], fres[sel] = shaded.refine(
+                        p, texel[sel], packed[sel], exact_fres, free, self.device, f0_weight=w
+                    )
+                    err[sel] = p.error(texel[sel], np.linalg.inv(fit.unpack_inverse(packed[sel])))
+                box += [packed, p.relative(texel, err), mag, fres]
         return box
 
     def run_tile(self, start: int, stop: int, device: str) -> np.ndarray:
@@ -272,13 +332,13 @@ class LtcBake:
         while pos < stop:  # a tile may straddle the two slices
             z, s = divmod(pos, n)
             e = min(stop - z * n, n)
-            packed, rel = self.fitted(s, e)
+            packed, rel, mag, fres = self.fitted(s, e)
             rows = slice(pos - start, pos - start + e - s)
             if z == 0:
                 out[rows] = packed
             else:
                 sph = self.sphere.ravel()[s:e] if self.sphere is not None else np.zeros(e - s)
-                out[rows] = np.stack([self.problem.magnitude[s:e], self.fresnel[s:e], rel, sph], axis=1)
+                out[rows] = np.stack([mag, fres, rel, sph], axis=1)
             pos += e - s
         return out
 
@@ -301,6 +361,25 @@ def magnitude_record(lb, estimator: str, samples) -> str:
             "f0 = 0): equal to that table at the same texels; fresnel channel = magnitude"
         )
     return f"{estimator}, {samples or 'default'} samples (lutbake albedo / dfg integrands)"
+
+
+def shaded_record(o: dict) -> dict:
+    if not uses_shaded_fit(o):
+        return {"fit": "l3: the matrices minimise the L3 distance; magnitude and fresnel are the exact integrals"}
+    from ..ltc import shaded
+
+    mag = (
+        "magnitude fitted with the matrix, fresnel the least-squares Schlick scale"
+        if o["magnitude"] == "fitted"
+        else "magnitude = the exact albedo (fixed), fresnel the least-squares Schlick scale"
+    )
+    return {
+        "fit": f"shaded: the l3 fit refined by Levenberg-Marquardt ({shaded.ITERATIONS} steps) to minimise the soft-L1 "
+        f"(scale {shaded.ROBUST_SCALE:g}) of (value_j - G_j) / (G_j + {shaded.ABS_WEIGHT:g} albedo) over "
+        f"{shaded.LIGHTS} training lights per texel (lutbake.ltc.lights, seed {shaded.SEED}), G_j from the lobe's "
+        f"{shaded.SAMPLES}^2 importance samples, for F = 1 and (weight {o['fit_f0_weight']:g}) f0 = "
+        f"{shaded.F0_TRAIN:g}; " + mag
+    }
 
 
 def tabulation_record(lb) -> dict:
@@ -373,6 +452,7 @@ def plan(spec) -> TexelPlan:
                 "alpha_min": o["alpha_min"],
                 "theta_max": THETA_MAX,
                 "magnitude": magnitude_record(lb, o["estimator"], m_samples),
+                **shaded_record(o),
                 "roughness_axis": ROUGHNESS_AXES[lb.roughness],
                 **tabulation_record(lb),
             }

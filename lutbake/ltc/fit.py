@@ -312,6 +312,10 @@ class Problem:
         wp.launch(self._values, dim=len(texel), inputs=inputs, device=d)
         return out.numpy()
 
+    def lobe_sample_arrays(self, texel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The lobe's importance samples of ``texel`` (k,): directions (k, N^2, 3), f (n.l) and density (k, N^2)."""
+        return self._ldir.numpy()[texel], self._lf.numpy()[texel], self._lp.numpy()[texel]
+
     def objective(self, texel: np.ndarray, q: np.ndarray) -> np.ndarray:
         return self.error(texel, self.matrices(texel, q))
 

@@ -61,9 +61,16 @@ SCHEDULER_FORMS = (
     "local:N (a LocalCluster of N worker processes here, N >= 1) or a Dask scheduler address such as tcp://HOST:8786"
 )
 LOCAL_RE = re.compile(r"^local:(\d+)$")
-ADDRESS_RE = re.compile(r"^(tcp|tls|ucx|ws|wss)://[^\s/]+$")
+# scheme://host:port: a host name, an IPv4 address or a bracketed IPv6 address; the port 1-65535 (Dask's 8786
+# when left out); checked before anything connects
+ADDRESS_RE = re.compile(
+    r"^(?P<scheme>tcp|tls|ucx|ws|wss)://(?P<host>\[[0-9A-Fa-f:.]{2,45}\]|[A-Za-z0-9](?:[A-Za-z0-9.-]{0,252}))"
+    r"(?::(?P<port>\d{1,5}))?$"
+)
+DEFAULT_PORT = 8786
 MAX_LOCAL_WORKERS = 256
-CONNECT_TIMEOUT_S = 30  # to reach the scheduler, and for its first worker to join
+CONNECT_TIMEOUT_S = 30  # the whole handshake with the scheduler, and for its first worker to join
+REFUSED_HINT = "is a Dask scheduler running there? (dask scheduler --port PORT)"
 POLL_S = 0.2  # how often a waiting table looks at its cancel event
 CLUSTER_TILE_TEXELS = 8192  # CPU tiles of a cluster bake: 16 executor tiles, so Dask's per-task cost stays small
 MAX_TABLE_BYTES = MAX_TEXELS * BYTES_PER_TEXEL  # float64 data of the largest table a config allows
@@ -91,9 +98,71 @@ def parse_scheduler(text: str) -> tuple[str, int | str]:
                 f"a local cluster needs 1 to {MAX_LOCAL_WORKERS} worker processes",
             )
         return "local", n
-    if ADDRESS_RE.match(text):
+    m = ADDRESS_RE.match(text)
+    if m:
+        port = int(m.group("port") or DEFAULT_PORT)
+        if not 1 <= port <= 65535:
+            raise ConfigError("--scheduler", "scheduler", text, SCHEDULER_FORMS, f"port {port} is not 1-65535")
+        if m.group("scheme") == "ucx" and not _ucx_available():
+            raise ConfigError(
+                "--scheduler",
+                "scheduler",
+                text,
+                SCHEDULER_FORMS,
+                "ucx:// needs UCX support for Dask (pip install distributed-ucxx), which is not installed",
+            )
         return "address", text
-    raise ConfigError("--scheduler", "scheduler", text, SCHEDULER_FORMS, "is not a scheduler")
+    problem = "is not a scheduler"
+    if "://" in text and text.rsplit(":", 1)[-1] == "":
+        problem = "has no port after the ':'"
+    raise ConfigError("--scheduler", "scheduler", text, SCHEDULER_FORMS, problem)
+
+
+def _ucx_available() -> bool:
+    import importlib.util
+
+    return any(importlib.util.find_spec(m) is not None for m in ("distributed_ucxx", "ucp", "ucxx"))
+
+
+def probe_scheduler(address: str, timeout: float | None = None) -> None:
+    """Fail fast and bounded before Dask connects: a refused port fails at once, an unreachable host after
+    ``timeout`` seconds, and (tcp://) a port that accepts but does not send the Dask handshake a scheduler sends
+    first (distributed.comm.core: the listener writes its handshake on accept) within ``timeout``. ConfigError."""
+    import socket
+
+    timeout = CONNECT_TIMEOUT_S if timeout is None else timeout
+    m = ADDRESS_RE.match(address)
+    if m is None or m.group("scheme") == "ucx":
+        return
+    host, port = m.group("host").strip("[]"), int(m.group("port") or DEFAULT_PORT)
+    deadline = time.monotonic() + timeout
+
+    def fail(msg):
+        raise ConfigError("--scheduler", "scheduler", address, None, msg)
+
+    try:
+        sock = socket.create_connection((host, port), timeout=timeout)
+    except ConnectionRefusedError:
+        fail(f"cannot connect: connection refused by {host}:{port}; {REFUSED_HINT}")
+    except TimeoutError:
+        fail(f"cannot connect: no answer from {host}:{port} within {timeout:g} s")
+    except OSError as e:
+        fail(f"cannot connect to {host}:{port}: {e.strerror or e}")
+    with sock:
+        if m.group("scheme") != "tcp":  # TLS and websockets: the client speaks first; Dask's timeout bounds them
+            return
+        try:
+            sock.settimeout(max(deadline - time.monotonic(), 0.05))
+            first = sock.recv(1)
+        except TimeoutError:
+            fail(
+                f"{host}:{port} accepted the connection but sent no Dask handshake within {timeout:g} s "
+                f"(not a Dask scheduler?)"
+            )
+        except OSError as e:
+            fail(f"cannot connect to {host}:{port}: {e.strerror or e}")
+        if not first:
+            fail(f"{host}:{port} closed the connection without a Dask handshake; {REFUSED_HINT}")
 
 
 # ---------------------------------------------------------------------------------------------- worker side
@@ -355,6 +424,7 @@ def session(scheduler: str, device: str = "cpu"):
             )
             client = distributed.Client(cluster, set_as_default=False)
         else:
+            probe_scheduler(where)  # refused: at once; silent: CONNECT_TIMEOUT_S, not Dask's unbounded handshake
             client = distributed.Client(where, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
     except (OSError, TimeoutError) as e:
         if cluster is not None:

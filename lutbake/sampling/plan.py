@@ -179,7 +179,9 @@ def per_texel_plan(
         nch = integrand.nch
         values, texel_error = full[:, :nch], full[:, nch : 2 * nch]
         target = np.maximum(estimator.absolute, estimator.relative * np.abs(values))
-        ratio = float(np.max(texel_error / target))
+        with np.errstate(divide="ignore", invalid="ignore"):  # tolerance = 0 (allowed): a zero target
+            ratios = np.where(target > 0, texel_error / target, np.where(texel_error > 0, np.inf, 0.0))
+        ratio = float(np.max(ratios))
         # texels whose panels all reached the last order short of the target (the kernel's comparison, with rounding)
         over = int(np.count_nonzero(np.any(texel_error > target * (1.0 + 1e-9), axis=1)))
         err = float(np.max(texel_error))

@@ -598,6 +598,24 @@ def ltc_eon_r0_is_identity() -> CheckResult:
     )
 
 
+LTC_AREA_REL_MEDIAN = 0.05  # GGX shaded fit, area-light benchmark (16 shading points x 8 lights), F = 1: measured 0.036
+
+
+def ltc_area_benchmark_median() -> CheckResult:
+    """The shaded GGX LTC fit (``fit = "shaded"``, lutbake.ltc.shaded) on a small area-light benchmark through the
+    shader's bilinear lookup (lutbake.validate.ltc_bench: one shading point per roughness x view band, 8 polygon
+    lights each, visible-normal ground truth at 256^2): the median relative error."""
+    from . import ltc_bench
+
+    cases = ltc_bench.cases(1, 8)
+    truths = [ltc_bench.ground_truth(c, 256) for c in cases]
+    t1, t2 = ltc_bench.fitted_texels(ltc_bench.lookup_texels(cases, 64), "shaded")
+    med = ltc_bench.stats(ltc_bench.errors(t1, t2, cases, truths))["rel_median"]
+    return check_result(
+        "ltc_area_benchmark_median", med, LTC_AREA_REL_MEDIAN, "median |LTC - truth| / truth, 128 lights"
+    )
+
+
 # --- registry ------------------------------------------------------------------------------------------
 
 
@@ -631,6 +649,7 @@ def _registry() -> dict:
     checks["ltc_sphere_table_is_snyder"] = ltc_sphere_table_is_snyder
     checks["eon_albedo_is_one"] = eon_albedo_is_one
     checks["ltc_eon_r0_is_identity"] = ltc_eon_r0_is_identity
+    checks["ltc_area_benchmark_median"] = ltc_area_benchmark_median
     return checks
 
 

@@ -1,0 +1,296 @@
+"""Bounded reading of files someone may have sent: every reader of lutbake goes through here, so a hostile file
+costs at most a table's worth of memory and time, and fails with one ValueError line that says what the file
+claims and what the cap is (issue 38).
+
+- **Sizes first.** A header's declared dimensions are checked against ``MAX_READ_TEXELS`` (a LUT is at most
+  lutbake.config.MAX_TEXELS texels, times a few slices for engine layouts) *before* any pixel buffer is allocated
+  (check_texels); compressed data is decompressed in a stream that stops at the size the header declares
+  (zstd_decompress: a frame with no content size, or one that inflates past its claim, is refused).
+- **NumPy.** ``.npy`` headers are parsed with a bounded header size, numeric dtypes only (no object, no
+  structured dtype), their data size checked against the file's; ``.npz`` members are checked by their declared
+  uncompressed size, which zipfile enforces while reading (load_npy, load_npz).
+- **Text.** Text and JSON files are read only up to a size cap (read_text, load_json); JSON nested too deeply is a
+  ValueError, not a RecursionError.
+- **Regular files only.** A FIFO, a device or a directory is named as what it is (regular_file_problem).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import os
+import stat
+import tokenize
+import zipfile
+
+import numpy as np
+
+from ..limits import MAX_TEXELS
+
+MAX_READ_TEXELS = 2 * MAX_TEXELS  # texels of one file (z x y x x): the largest table a config allows, as an ltc pair
+MAX_CHANNELS = 4
+MAX_READ_BYTES = MAX_READ_TEXELS * MAX_CHANNELS * 4  # 2 GiB: float32 RGBA at MAX_READ_TEXELS texels
+MAX_TEXT_BYTES = 64 << 20  # a C/JS/WGSL/Rust array of a 1024^2 RGBA table is about 50 MiB
+MAX_JSON_BYTES = 16 << 20  # a sidecar or a cache entry is a few KiB (a listed axis: tens of KiB)
+MAX_JSON_DEPTH = 64  # lutbake's deepest JSON is 4 levels (sidecar > lutbake > axes > values)
+NPY_HEADER_LIMIT = 10000  # numpy's own default max_header_size
+
+_FILE_TYPES = (
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def what_is(mode: int) -> str:
+    return next((name for test, name in _FILE_TYPES if test(mode)), "a special file")
+
+
+def regular_file_problem(path, follow: bool = True) -> str | None:
+    """Why ``path`` is not a regular file lutbake may open ("no such file", "is a FIFO (named pipe)", ...), or
+    None. ``follow=False``: a symlink is refused too (the values cache opens only its own files)."""
+    try:
+        st = os.stat(path) if follow else os.lstat(path)
+    except FileNotFoundError:
+        return "is a dangling symlink" if os.path.islink(path) else "no such file"
+    except OSError as e:
+        return f"cannot read: {e.strerror or e}"
+    if stat.S_ISLNK(st.st_mode):
+        return "is a symlink"
+    if not stat.S_ISREG(st.st_mode):
+        return f"is {what_is(st.st_mode)}, not a regular file"
+    return None
+
+
+def _open_regular(path, limit: int, what: str):
+    """An open binary file at ``path`` (regular files only: O_NONBLOCK, so a FIFO never blocks the open), and its
+    size, which must be at most ``limit``."""
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            raise ValueError(f"is {what_is(st.st_mode)}, not a regular file")
+        if st.st_size > limit:
+            raise ValueError(f"is {st.st_size} bytes; {what} is at most {limit} bytes")
+        return os.fdopen(fd, "rb"), st.st_size
+    except BaseException:
+        os.close(fd)
+        raise
+
+
+def read_bytes(path, limit: int = MAX_READ_BYTES, what: str = "a table file") -> bytes:
+    """The bytes of the regular file ``path``, at most ``limit`` of them (ValueError otherwise)."""
+    f, size = _open_regular(path, limit, what)
+    with f:
+        data = f.read(size + 1)  # read(n) allocates n bytes up front: the file's size, never the cap
+    if len(data) > size:
+        raise ValueError(f"grew past {size} bytes while being read")
+    return data
+
+
+def read_text(path, limit: int = MAX_TEXT_BYTES, what: str = "a text table", errors: str = "strict") -> str:
+    """The UTF-8 text of ``path`` (a leading BOM dropped), at most ``limit`` bytes."""
+    return read_bytes(path, limit, what).decode("utf-8", errors).removeprefix("\ufeff")
+
+
+def json_depth_problem(text: str, limit: int = MAX_JSON_DEPTH) -> str | None:
+    """Arrays/objects nested deeper than ``limit`` in JSON ``text``, found in one linear pass before parsing."""
+    depth = 0
+    in_string = escaped = False
+    for ch in text:
+        if in_string:
+            if escaped:
+                escaped = False
+            elif ch == "\\":
+                escaped = True
+            elif ch == '"':
+                in_string = False
+        elif ch == '"':
+            in_string = True
+        elif ch in "[{":
+            depth += 1
+            if depth > limit:
+                return f"JSON nested more than {limit} deep"
+        elif ch in "]}":
+            depth -= 1
+    return None
+
+
+def loads_json(text: str, limit: int = MAX_JSON_DEPTH):
+    """json.loads with a nesting bound: ValueError (never RecursionError) for JSON nested past ``limit``."""
+    problem = json_depth_problem(text, limit) if text.count("[") + text.count("{") > limit else None
+    if problem:
+        raise ValueError(problem)
+    try:
+        return json.loads(text)
+    except RecursionError:
+        raise ValueError(f"JSON nested more than {limit} deep") from None
+
+
+def load_json(path, limit: int = MAX_JSON_BYTES):
+    """The JSON document in the regular file ``path`` (at most ``limit`` bytes, MAX_JSON_DEPTH deep)."""
+    return loads_json(read_text(path, limit, "a JSON sidecar"))
+
+
+def check_texels(shape, what: str = "the file", channels: int | None = None) -> None:
+    """ValueError unless ``shape`` (its texels: every dimension but the last, channels, when ``channels`` is None)
+    is a table lutbake may hold: at most MAX_READ_TEXELS texels and MAX_CHANNELS channels, none empty."""
+    dims = [int(d) for d in shape]
+    if channels is None:
+        dims, channels = dims[:-1], dims[-1] if dims else 1
+    texels = math.prod(dims)
+    shown = " x ".join(map(str, dims + [channels]))
+    if any(d < 1 for d in dims) or channels < 1:
+        raise ValueError(f"{what} declares {shown}: an empty table")
+    if texels > MAX_READ_TEXELS:
+        raise ValueError(
+            f"{what} declares {shown} ({texels} texels); a table lutbake reads is at most {MAX_READ_TEXELS} texels "
+            f"(2 x lutbake.config.MAX_TEXELS): refused before reading"
+        )
+    if channels > MAX_CHANNELS:
+        raise ValueError(f"{what} declares {shown}: {channels} channels (a table has 1 to {MAX_CHANNELS})")
+
+
+def zstd_decompress(data: bytes, size: int) -> bytes:
+    """One zstd frame expanded to exactly ``size`` bytes, streamed: never more than ``size`` + 1 bytes are made,
+    whatever the frame declares (or omits) as its content size. ValueError for a truncated or corrupt frame."""
+    import zstandard
+
+    try:
+        with zstandard.ZstdDecompressor().stream_reader(io.BytesIO(data), read_across_frames=False) as reader:
+            out = io.BytesIO()
+            while out.tell() <= size:
+                chunk = reader.read(min(1 << 20, size + 1 - out.tell()))
+                if not chunk:
+                    break
+                out.write(chunk)
+    except zstandard.ZstdError as e:
+        raise ValueError(f"its zstd data cannot be decompressed ({e})") from None
+    got = out.tell()
+    if got != size:
+        more = "more than" if got > size else "only"
+        raise ValueError(
+            f"its zstd data expands to {more} {got} bytes; the header declares {size} (truncated or forged)"
+        )
+    return out.getvalue()
+
+
+# ---------------------------------------------------------------------------------------------- NumPy
+
+
+def _npy_header(f, where: str) -> tuple[tuple[int, ...], np.dtype, bool]:
+    """(shape, dtype, fortran_order) of the .npy stream ``f`` positioned at its start; the stream is left at the
+    data. Only numeric dtypes (bool, integers, floats) are tables; anything else is a ValueError."""
+    from numpy.lib import format as npformat
+
+    try:
+        version = npformat.read_magic(f)
+        if version == (1, 0):
+            shape, fortran, dtype = npformat.read_array_header_1_0(f, max_header_size=NPY_HEADER_LIMIT)
+        elif version in ((2, 0), (3, 0)):
+            shape, fortran, dtype = npformat.read_array_header_2_0(f, max_header_size=NPY_HEADER_LIMIT)
+        else:
+            raise ValueError(f"npy format version {version}")
+    except (ValueError, SyntaxError, TypeError, tokenize.TokenError, MemoryError, RecursionError, EOFError) as e:
+        first = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise ValueError(f"{where}: not a readable .npy header ({first[:120]})") from None
+    if dtype.hasobject or dtype.fields is not None or dtype.subdtype is not None or dtype.kind not in "biuf":
+        raise ValueError(f"{where}: .npy of dtype {str(dtype)[:80]} holds no plain numbers (a table is int or float)")
+    if not isinstance(shape, tuple) or not all(isinstance(d, int) and d >= 0 for d in shape):
+        raise ValueError(f"{where}: .npy shape {str(shape)[:80]} is not a shape")
+    return shape, dtype, fortran
+
+
+def _npy_data(f, shape, dtype, fortran, available: int, where: str, table: bool = True) -> np.ndarray:
+    """The array data after a header; ``table``: (y, x[, C]) or (z, y, x, C), else any array of at most 4
+    dimensions (an engine's arrays, e.g. OpenPBR's 32^3 energy tables) whose values count as texels."""
+    if len(shape) == 2 or not table and 1 <= len(shape) <= 4:
+        check_texels(shape, where, channels=1)
+    elif table and 3 <= len(shape) <= 4:
+        check_texels(shape, where)
+    else:
+        raise ValueError(f"{where}: array of shape {shape} is not a table (2 to 4 dimensions)")
+    nbytes = math.prod(shape) * dtype.itemsize
+    if nbytes > available:
+        raise ValueError(f"{where}: its header declares {shape} {dtype} ({nbytes} bytes), the file holds {available}")
+    data = f.read(nbytes)
+    if len(data) != nbytes:
+        raise ValueError(f"{where}: truncated: {len(data)} of the {nbytes} data bytes its header declares")
+    arr = np.frombuffer(data, dtype=dtype)
+    return arr.reshape(shape[::-1]).transpose() if fortran else arr.reshape(shape)
+
+
+def load_npy(path, limit: int = MAX_READ_BYTES) -> np.ndarray:
+    """The array of the ``.npy`` file ``path``: header bounded and checked (numeric dtype, 2 to 4 dimensions, at most
+    MAX_READ_TEXELS texels) before its data is read; no pickles."""
+    f, size = _open_regular(path, limit, "a .npy table")
+    with f:
+        shape, dtype, fortran = _npy_header(f, "the .npy")
+        return _npy_data(f, shape, dtype, fortran, size - f.tell(), "the .npy")
+
+
+def load_npz(path, member: str | None = None, limit: int = MAX_READ_BYTES) -> tuple[np.ndarray, str]:
+    """(array, member name) of an ``.npz``: ``member``, else ``table``, else its only array. The member's declared
+    uncompressed size is checked against ``limit`` before it is inflated (zipfile stops at that size)."""
+    f, _ = _open_regular(path, limit, "an .npz archive")
+    with f:
+        try:
+            with zipfile.ZipFile(f) as z:
+                names = [n for n in z.namelist() if n.endswith(".npy")]
+                if not names:
+                    raise ValueError("an .npz without arrays")
+                want = (member or "table") + ".npy"
+                name = want if want in names else names[0]
+                if member is None and want not in names and len(names) > 1:
+                    raise ValueError(f"an .npz of {len(names)} arrays and none named 'table'")
+                info = z.getinfo(name)
+                if info.file_size > limit:
+                    raise ValueError(f"member {name} declares {info.file_size} bytes uncompressed; the cap is {limit}")
+                with z.open(info) as m:
+                    shape, dtype, fortran = _npy_header(m, f"member {name}")
+                    arr = _npy_data(m, shape, dtype, fortran, info.file_size, f"member {name}")
+        except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, NotImplementedError, OSError) as e:
+            raise ValueError(f"not a readable .npz ({e})") from None
+    return arr, name[: -len(".npy")]
+
+
+def load_npz_all(path, limit: int = MAX_READ_BYTES, max_members: int = 64) -> dict[str, np.ndarray]:
+    """Every array of an ``.npz`` (at most ``max_members``, their declared sizes together at most ``limit``)."""
+    f, _ = _open_regular(path, limit, "an .npz archive")
+    out = {}
+    with f:
+        try:
+            with zipfile.ZipFile(f) as z:
+                infos = [i for i in z.infolist() if i.filename.endswith(".npy")]
+                total = sum(i.file_size for i in infos)
+                if len(infos) > max_members or total > limit:
+                    raise ValueError(
+                        f"an .npz of {len(infos)} arrays declaring {total} bytes; at most {max_members} arrays and "
+                        f"{limit} bytes are read"
+                    )
+                for info in infos:
+                    with z.open(info) as m:
+                        where = f"member {info.filename}"
+                        shape, dtype, fortran = _npy_header(m, where)
+                        arr = _npy_data(m, shape, dtype, fortran, info.file_size, where, table=False)
+                        out[info.filename[: -len(".npy")]] = arr
+        except (zipfile.BadZipFile, zipfile.LargeZipFile, EOFError, NotImplementedError, OSError) as e:
+            raise ValueError(f"not a readable .npz ({e})") from None
+    return out
+
+
+def gunzip(raw: bytes, limit: int = MAX_TEXT_BYTES) -> bytes:
+    """gzip data expanded, at most ``limit`` bytes (a gzip bomb is refused after ``limit`` bytes, not after all)."""
+    import gzip
+
+    try:
+        with gzip.GzipFile(fileobj=io.BytesIO(raw)) as g:
+            out = g.read(limit + 1)
+    except (OSError, EOFError) as e:
+        raise ValueError(f"not readable gzip data ({e})") from None
+    if len(out) > limit:
+        raise ValueError(f"its gzip data expands past {limit} bytes (the cap of a text table)")
+    return out
