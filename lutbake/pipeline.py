@@ -20,6 +20,7 @@ from .errors import TableError
 from .kinds import lookup_kind
 from .provenance import attributes
 from .runtime.executor import Progress, Timer, estimate_error, execute_tiles
+from .runtime.warp_runtime import defining
 from .sampling.plan import TexelPlan
 from .table import Table
 
@@ -51,7 +52,8 @@ def compute(
     tiles run (lutbake.runtime.cluster.DaskRunner); None: this process' threads."""
     cpu: list[float] = []  # CPU seconds of each part, measured in the thread that ran it (time.thread_time)
     t0 = time.thread_time()
-    plan = lookup_kind(spec.kind).plan(spec)
+    with defining():  # a plan builds Warp functions (kernel factories): one table thread at a time
+        plan = lookup_kind(spec.kind).plan(spec)
     cpu.append(time.thread_time() - t0)
     with Timer() as t:
         full = execute_tiles(
@@ -86,7 +88,8 @@ def compute_at(spec: TableSpec, points: dict[str, np.ndarray], workers: int | No
     written. ``points``: flat per-texel arrays the kind's plan reads ({"nov", "alpha", "rough"} for dfg, whose
     ``plan(spec, points=...)`` takes them). The reference of ``lutbake audit`` and ``lutbake size``
     (lutbake.commands.reference): the bake's own plan and tile executor, at the points those commands need."""
-    plan = lookup_kind(spec.kind).plan(spec, points=points)
+    with defining():
+        plan = lookup_kind(spec.kind).plan(spec, points=points)
     full = execute_tiles(plan, workers=workers, device=device)
     return full[:, : plan.n_channels]
 

@@ -171,7 +171,7 @@ def size(preset, config, overrides, max_error, sizes, nov_min, as_json, workers)
 @click.command()
 @click.argument("family", type=click.Choice(["karis-mobile", "gotanda-eq8"]))
 @click.option("--lang", type=click.Choice(["glsl", "hlsl"]), default="glsl", show_default=True)
-@out_file_option("the shader function here (default: print it after the error table)")
+@out_file_option("the shader function here (default: print it after the error table)", dir_okay=False)
 @json_option("constants and errors")
 def fit(family, lang, out, as_json):
     """Refit a published closed form to lutbake's integral and emit it as GLSL/HLSL with its measured error

@@ -30,10 +30,11 @@ def out_dir_option(default: str, what: str):
     )
 
 
-def out_file_option(what: str):
-    """``-o/--out FILE``: the one file a command writes (preview, fit)."""
+def out_file_option(what: str, dir_okay: bool = True):
+    """``-o/--out FILE``: the one file a command writes (preview, fit); ``dir_okay``: a directory passes the option
+    (the command's own check then says why it is refused)."""
     return click.option(
-        "-o", "--out", type=click.Path(path_type=Path, dir_okay=False), default=None, help=f"Write {what}."
+        "-o", "--out", type=click.Path(path_type=Path, dir_okay=dir_okay), default=None, help=f"Write {what}."
     )
 
 

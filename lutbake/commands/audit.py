@@ -258,10 +258,12 @@ def recorded_attributes(path, shape=None) -> dict:
     try:
         return read_lut(path, shape=shape).attrs
     except (ValueError, OSError):
+        from ..io import bounded
+
         side = Path(path).with_name(Path(path).name + ".json")
-        try:
-            doc = json.loads(side.read_text(encoding="utf-8")) if side.is_file() else {}
-        except (ValueError, OSError):
+        try:  # a sidecar that cannot be read records nothing: the audit then says what is wrong with the file
+            doc = bounded.load_json(side) if side.is_file() else {}
+        except (ValueError, OSError, RecursionError, UnicodeDecodeError):
             return {}
         return doc.get("lutbake", {}) if isinstance(doc, dict) else {}
 
