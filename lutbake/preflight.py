@@ -12,20 +12,10 @@ import tempfile
 from pathlib import Path
 
 from .errors import ConfigError
+from .io.bounded import what_is
 from .textsafe import shorten
 
 MAX_CONFIG_BYTES = 1 << 20  # a config is a few KiB; a larger file is not one (and is not read into memory)
-_FILE_TYPES = (
-    (stat.S_ISDIR, "a directory"),
-    (stat.S_ISFIFO, "a FIFO (named pipe)"),
-    (stat.S_ISCHR, "a character device"),
-    (stat.S_ISBLK, "a block device"),
-    (stat.S_ISSOCK, "a socket"),
-)
-
-
-def _what_is(mode: int) -> str:
-    return next((name for test, name in _FILE_TYPES if test(mode)), "not a regular file")
 
 
 def config_file_problem(path) -> str | None:
@@ -45,7 +35,7 @@ def config_file_problem(path) -> str | None:
     except OSError as e:
         return f"cannot read: {e.strerror or e}"
     if not stat.S_ISREG(st.st_mode):
-        return f"is {_what_is(st.st_mode)}, not a config file"
+        return f"is {what_is(st.st_mode)}, not a config file"
     if st.st_size > MAX_CONFIG_BYTES:
         return f"is {st.st_size} bytes; a config is at most {MAX_CONFIG_BYTES} bytes (is it a config file?)"
     return None
@@ -211,7 +201,7 @@ def check_outputs(jobs) -> None:
                     "name",
                     job.name,
                     table=job.name,
-                    message=f"its output {p} exists and is {_what_is(os.lstat(p).st_mode)}",
+                    message=f"its output {p} exists and is {what_is(os.lstat(p).st_mode)}",
                 )
 
 
@@ -229,7 +219,7 @@ def check_report(report, jobs, configs=()) -> None:
             "is a directory"
             if report.is_dir()
             else (
-                "is a dangling symlink" if not report.exists() else f"exists and is {_what_is(os.stat(report).st_mode)}"
+                "is a dangling symlink" if not report.exists() else f"exists and is {what_is(os.stat(report).st_mode)}"
             )
         )
         raise ConfigError("--report", "report", str(report), message=what)
@@ -315,7 +305,7 @@ def check_image_output(out, inputs=(), force: bool = False, option: str = "--out
                 message=f"is an input of this command ({shorten(str(p))}); it would be overwritten with a PNG",
             )
     if os.path.lexists(out) and not out.is_file():
-        what = _what_is(os.stat(out).st_mode) if out.exists() else "a dangling symlink"
+        what = what_is(os.stat(out).st_mode) if out.exists() else "a dangling symlink"
         raise ConfigError(option, option.lstrip("-"), shown, message=f"exists and is {what}")
     if out.suffix.lower() in (".toml", ".json"):  # a config or a sidecar, even with --force
         raise ConfigError(

@@ -28,6 +28,7 @@ import functools
 import numpy as np
 import warp as wp
 
+from ..layouts.hdrp import HDRP_UNIFORM_SCALE
 from ..runtime.warp_runtime import MODULE_OPTIONS, load_module
 from ..sampling.plan import TexelPlan
 from ..terms.engine_diffuse import Fd_disney_hdrp, Fd_fabric_lambert_hdrp
@@ -36,7 +37,6 @@ wp.set_module_options(MODULE_OPTIONS)
 
 DIFFUSE_ORDER = 24  # Gauss-Legendre nodes per dimension (mu, phi)
 HDRP_DIFFUSE_OFFSET = 0.5  # HDRP stores the Disney FGD minus 0.5 (range [0.5, 1.5] -> [0, 1] for its UNORM target)
-HDRP_UNIFORM_SCALE = 2.0 * np.pi  # HDRP's Charlie R, G are the integrals / 2 pi (its runtime multiplies by 2 pi)
 
 
 @functools.lru_cache(maxsize=None)
@@ -118,24 +118,29 @@ def disney_channel(base: np.ndarray, nov: np.ndarray, rough: np.ndarray, device:
     return np.concatenate([base, b[:, None]], axis=1)
 
 
+# lutbake.layouts.base.EngineChannel.name -> (the layout's table from the base channels, the Warp kernel it launches)
+CHANNELS = {"disney": (disney_channel, diffuse_kernel), "fabric": (fabric_channel, fabric_kernel)}
+
+
 def with_diffuse_channel(plan: TexelPlan, nov: np.ndarray, perceptual_roughness: np.ndarray, channel) -> TexelPlan:
     """The plan of the base layout turned into the engine layout's (``channel``, lutbake.layouts.base.EngineChannel:
-    channel B appended by channel.compute, same tiles)."""
+    channel B appended by its CHANNELS function, same tiles)."""
     base_tile = plan.run_tile
     nch = plan.n_channels
+    compute, kernel = CHANNELS[channel.name]
 
     def run_tile(start: int, stop: int, device: str) -> np.ndarray:
         """The layout's channels from the base tile's, then the base tile's aux columns (TexelPlan.aux_channels)."""
         s = slice(start, stop)
         base = base_tile(start, stop, device)
-        table = channel.compute(base[:, :nch], nov[s], perceptual_roughness[s], device)
+        table = compute(base[:, :nch], nov[s], perceptual_roughness[s], device)
         return np.concatenate([table, base[:, nch:]], axis=1)
 
     base_prepare = plan.prepare
 
     def prepare(device: str) -> None:
         base_prepare(device)
-        load_module(channel.kernel().module, device=device)
+        load_module(kernel().module, device=device)
 
     base_estimate = plan.error_estimate
 

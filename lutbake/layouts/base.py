@@ -31,13 +31,12 @@ class Terms:
 
 @dataclass(frozen=True)
 class EngineChannel:
-    """A channel an engine adds to a base layout's (Unity HDRP's pre-integrated diffuse as channel B):
-    ``compute(base, nov, perceptual_roughness, device)`` -> the (n, nch + 1) table from the base channels,
-    ``kernel()`` the warp kernel to load at prepare, ``scale`` the base channels' divisor as stored,
-    ``description`` the lutbake:terms ``diffuse`` entry."""
+    """A channel an engine adds to a base layout's (Unity HDRP's pre-integrated diffuse as channel B): ``name``
+    its entry in lutbake.integrands.engine_diffuse.CHANNELS (the function that computes the (n, nch + 1) table
+    from the base channels and the Warp kernel it loads; named, so that reading the records imports no Warp),
+    ``scale`` the base channels' divisor as stored, ``description`` the lutbake:terms ``diffuse`` entry."""
 
-    compute: Callable
-    kernel: Callable
+    name: str
     scale: float
     description: str
 

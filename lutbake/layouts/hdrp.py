@@ -10,16 +10,12 @@ the integrals), and LtcData.BRDF_GGX.cs.
 
 from __future__ import annotations
 
-from ..integrands.engine_diffuse import (
-    HDRP_UNIFORM_SCALE,
-    diffuse_kernel,
-    disney_channel,
-    fabric_channel,
-    fabric_kernel,
-)
+import math
+
 from .base import EngineChannel, EngineTable, Layout, Terms
 from .gltf import SHEEN_GL_ONLY, sheen_terms
 
+HDRP_UNIFORM_SCALE = 2.0 * math.pi  # HDRP's Charlie R, G are the integrals / 2 pi (its runtime multiplies by 2 pi)
 SOURCE = "HDRP Runtime/Material/PreIntegratedFGD (PreIntegratedFGD.hlsl, preIntegratedFGD_*.shader)"
 DISNEY = "disney (Burley 2012, HDRP DisneyDiffuseNoPI / 1.03571), minus 0.5"
 FABRIC = "fabric lambert (HDRP FabricLambertNoPI = lerp(1, 0.5, alpha)); R, G divided by 2 pi"
@@ -39,7 +35,7 @@ MULTISCATTER_DISNEY = Layout(
     "uv).rgb; specularFGD = mix(t.r, t.g, f0); diffuseFGD = t.b + 0.5; reflectivity = t.g",
     integrand="multiscatter",
     source=SOURCE,
-    engine_channel=EngineChannel(disney_channel, diffuse_kernel, 1.0, DISNEY),
+    engine_channel=EngineChannel("disney", 1.0, DISNEY),
     unit_range=False,
     above_one="B = Disney FGD - 0.5 spans [-0.028, 1.0036] on endpoint texels (NoV = 0 rows)",
     split_sum="multiscatter",
@@ -64,7 +60,7 @@ CHARLIE_FABRIC = Layout(
     terms=Terms(ndf="charlie", masking="charlie", fresnel="none"),
     terms_record=sheen_terms("charlie_fabric", "charlie (Estevez-Kulla Lambda fit), R and G"),
     gauss_legendre_only=SHEEN_GL_ONLY,
-    engine_channel=EngineChannel(fabric_channel, fabric_kernel, HDRP_UNIFORM_SCALE, FABRIC),
+    engine_channel=EngineChannel("fabric", HDRP_UNIFORM_SCALE, FABRIC),
     split_sum=None,
 )
 
