@@ -459,3 +459,42 @@ def test_every_lutbake_kernel_module_compiles_with_lutbakes_options():
     for name, mod in ours.items():
         for key, value in warp_runtime.MODULE_OPTIONS.items():
             assert mod.options[key] == value, (name, key)
+
+
+def test_kernels_are_built_one_thread_at_a_time_but_modules_compile_in_parallel(monkeypatch):
+    """warp_runtime.defining: Warp's registries of functions and modules are not thread-safe (on an empty kernel cache,
+    two tables of one batch that differed only in masking came out identical), so one table thread at a time builds
+    kernels; load_module releases the lock while it compiles, so two modules still compile at the same time."""
+    import threading
+
+    import warp as wp
+
+    from lutbake.runtime import warp_runtime
+
+    spans = {"build": [], "load": []}
+
+    def slow_load(module, device=None):
+        t0 = time.perf_counter()
+        time.sleep(0.3)
+        spans["load"].append((t0, time.perf_counter()))
+
+    def prepare(module):
+        with warp_runtime.defining():
+            t0 = time.perf_counter()
+            time.sleep(0.1)  # building the kernel: under the lock
+            spans["build"].append((t0, time.perf_counter()))
+            warp_runtime.load_module(module, "cpu")  # compiling: lock released
+            with warp_runtime.defining():  # nested use (the error estimate inside a bake) does not deadlock
+                pass
+
+    monkeypatch.setattr(wp, "load_module", slow_load)
+    monkeypatch.setattr(warp_runtime, "_MODULE_LOCKS", {})
+    threads = [threading.Thread(target=prepare, args=(m,)) for m in (object(), object())]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    (b0, b1), (l0, l1) = sorted(spans["build"]), sorted(spans["load"])
+    assert b1[0] >= b0[1]  # the builds never overlap
+    assert l1[0] < l0[1]  # the compiles do
+    assert not getattr(warp_runtime._DEFINING, "held", False)
