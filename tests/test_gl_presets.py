@@ -202,6 +202,10 @@ RECONSTRUCTION = {
         f"vec2(mix(t.r, t.g, f0) * {TWO_PI!r}, t.b)",
         lambda t, u, f0: (((1 - f0) * t[:, 0] + f0 * t[:, 1]) * TWO_PI, t[:, 2]),
     ),
+    "babylon_f82": (  # getF82DirectionalAlbedo with F90 = 1: (1 - F0) x + F0 y, and the F82 term z / BRDF_Z_SCALE
+        "vec2(mix(t.r, t.g, f0), t.b / 16.0)",
+        lambda t, u, f0: ((1 - f0) * t[:, 0] + f0 * t[:, 1], t[:, 2] / 16.0),
+    ),
     "charlie": ("vec2(f0 * t.b, 0.0)", lambda t, u, f0: (f0 * t[:, 2], 0 * f0)),
     "sheen_albedo": ("vec2(1.0 - f0 * t.r, 0.0)", lambda t, u, f0: (1 - f0 * t[:, 0], 0 * f0)),
     "energy": ("vec2(1.0 / t.b, t.r)", lambda t, u, f0: (1 / t[:, 2], t[:, 0])),  # f / E_sum (Turquin), E_R
