@@ -498,3 +498,41 @@ def test_kernels_are_built_one_thread_at_a_time_but_modules_compile_in_parallel(
     assert b1[0] >= b0[1]  # the builds never overlap
     assert l1[0] < l0[1]  # the compiles do
     assert not getattr(warp_runtime._DEFINING, "held", False)
+
+
+def test_a_thread_waiting_for_anothers_compile_lets_others_build_kernels(monkeypatch):
+    """load_module releases warp_runtime.defining while it waits for a module another thread is compiling (not only
+    while it compiles): a third thread may build its kernels meanwhile."""
+    import threading
+
+    import warp as wp
+
+    from lutbake.runtime import warp_runtime
+
+    compiling, release = threading.Event(), threading.Event()
+
+    def held_load(module, device=None):
+        if not compiling.is_set():
+            compiling.set()
+            release.wait(5)
+
+    def prepare():
+        with warp_runtime.defining():
+            warp_runtime.load_module("a", "cpu")
+
+    monkeypatch.setattr(wp, "load_module", held_load)
+    monkeypatch.setattr(warp_runtime, "_MODULE_LOCKS", {})
+    threads = [threading.Thread(target=prepare) for _ in range(2)]  # the first compiles a, the second waits for it
+    threads[0].start()
+    assert compiling.wait(5)
+    threads[1].start()
+    time.sleep(0.2)
+    try:
+        free = warp_runtime._DEFINE.acquire(timeout=1.0)  # a third table's kernel build
+        if free:
+            warp_runtime._DEFINE.release()
+    finally:
+        release.set()
+        for th in threads:
+            th.join(5)
+    assert free

@@ -127,16 +127,18 @@ def load_module(module, device: str = "cpu") -> None:
         lock = _MODULE_LOCKS.setdefault(key, threading.Lock())
     armed = getattr(_DEFER, "armed", False)
     _DEFER.armed = False
-    if not lock.acquire(blocking=not armed):
-        raise ModuleBusy(getattr(module, "name", str(module)))
     held = getattr(_DEFINING, "held", False)
-    if held:
+    if held:  # other threads build kernels while this one compiles or waits for another's compile
         _DEFINING.held = False
         _DEFINE.release()
     try:
-        wp.load_module(module, device=device)
+        if not lock.acquire(blocking=not armed):
+            raise ModuleBusy(getattr(module, "name", str(module)))
+        try:
+            wp.load_module(module, device=device)
+        finally:
+            lock.release()
     finally:
-        lock.release()
         if held:
             _DEFINE.acquire()
             _DEFINING.held = True
