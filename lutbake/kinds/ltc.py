@@ -35,6 +35,7 @@ import numpy as np
 from ..axes import Axis
 from ..catalog import LTC_FIT_GRID, LTC_LOBES
 from ..edge import ALPHA_MIN
+from ..layouts.base import uv_of
 from ..sampling.plan import TexelPlan
 from .base import Estimation, Key, declare
 
@@ -109,6 +110,14 @@ KEYS = {
     ),
     "format": Key("format", "str", "exr", "output file format", FORMATS),
 }
+RECONSTRUCTION = (  # {uv}: lutbake.layouts.base.uv_of of the table's [NoV, roughness] axes
+    "{uv}; t1 = texture(ltc_1, uv); t2 = texture(ltc_2, uv); "
+    "Minv = mat3(vec3(t1.x, 0, t1.y), vec3(0, 1, 0), vec3(t1.z, 0, t1.w)); in the frame (T1, T2, N), "
+    "T1 = normalize(V - N NoV): polygon integral I = 1/(2 pi) Σ edges acos(v_i.v_j) normalize(v_i x v_j).z of the "
+    "clipped, normalised vertices Minv p_i; specular = light * I * (f0 * t2.x + (1 - f0) * t2.y); "
+    "sphere/disk: I = len * texture(ltc_2, vec2(z * 0.5 + 0.5, len) * (N - 1)/N + 0.5/N).w for the vector "
+    "form factor F (len = |F|, z = F.z / len)"
+)
 CHANNELS = {
     "x": "slice 0 (ltc_1): M^-1_00 / M^-1_11; slice 1 (ltc_2): magnitude = ∫ f (n.l) dω_l with F = 1 (fit = shaded: "
     "fitted with the matrix)",
@@ -119,14 +128,6 @@ CHANNELS = {
     "w": "slice 0: M^-1_22 / M^-1_11; slice 1: sphere = horizon-clipped / unclipped form factor of a spherical cap, "
     "at x = z * 0.5 + 0.5, y = len (own axes, endpoint texels)",
 }
-RECONSTRUCTION = (
-    "uv = vec2(roughness, sqrt(1 - NoV)) * (N - 1)/N + 0.5/N; t1 = texture(ltc_1, uv); t2 = texture(ltc_2, uv); "
-    "Minv = mat3(vec3(t1.x, 0, t1.y), vec3(0, 1, 0), vec3(t1.z, 0, t1.w)); in the frame (T1, T2, N), "
-    "T1 = normalize(V - N NoV): polygon integral I = 1/(2 pi) Σ edges acos(v_i.v_j) normalize(v_i x v_j).z of the "
-    "clipped, normalised vertices Minv p_i; specular = light * I * (f0 * t2.x + (1 - f0) * t2.y); "
-    "sphere/disk: I = len * texture(ltc_2, vec2(z * 0.5 + 0.5, len) * (N - 1)/N + 0.5/N).w for the vector "
-    "form factor F (len = |F|, z = F.z / len)"
-)
 
 
 def axes_for(o: dict) -> list[Axis]:
@@ -463,7 +464,7 @@ def plan(spec) -> TexelPlan:
     return TexelPlan(
         axes=axes,
         channels=CHANNELS,
-        reconstruction=RECONSTRUCTION,
+        reconstruction=RECONSTRUCTION.format(uv=uv_of(axes[1:])),  # uv of the (NoV, roughness) axes
         n_texels=2 * n,
         n_channels=4,
         run_tile=state.run_tile,

@@ -56,6 +56,25 @@ COARSE_NODES = 8  # coarse-pass texels per axis (including both ends)
 M_MIN = 1.0e-7  # ltc_code FitLTC::update: m11, m22 >= 1e-7
 
 
+@wp.struct
+class Texels:
+    """What the lobe is at every texel: view v, alpha, and a tabulated lobe's table (lutbake.ltc.tabulated; a
+    1-element placeholder for analytic lobes)."""
+
+    v: wp.array(dtype=wp.vec3)
+    alpha: wp.array(dtype=float)
+    tab: wp.array3d(dtype=float)
+
+
+@wp.struct
+class LobeSamples:
+    """The lobe's importance samples per (texel, grid point): direction, f (n.l) and its density."""
+
+    dirs: wp.array2d(dtype=wp.vec3d)
+    f: wp.array2d(dtype=wp.float64)
+    p: wp.array2d(dtype=wp.float64)
+
+
 @wp.func
 def ltc_eval(m_inv: wp.mat33d, det_inv: wp.float64, l: wp.vec3d):
     """D(l) = max(0, z_o)/pi |det M^-1| / |M^-1 l|^3, z_o = (M^-1 l).z / |M^-1 l| (Heitz et al. 2016, Eq. 3)."""
@@ -90,37 +109,25 @@ def kernels(lobe_name: str):
             return f_pdf0(v, l, a)
 
     @wp.kernel(enable_backward=False)
-    def lobe_samples(
-        v: wp.array(dtype=wp.vec3),
-        alpha: wp.array(dtype=float),
-        grid: wp.array(dtype=wp.vec2),
-        tab: wp.array3d(dtype=float),
-        dirs: wp.array2d(dtype=wp.vec3d),
-        f: wp.array2d(dtype=wp.float64),
-        p: wp.array2d(dtype=wp.float64),
-    ):
+    def lobe_samples(x: Texels, grid: wp.array(dtype=wp.vec2), out: LobeSamples):
         """The lobe-sampled half of the metric does not depend on M: its directions, f (n.l) and density, once."""
         i, s = wp.tid()
-        vi = v[i]
-        a = alpha[i]
+        vi = x.v[i]
+        a = x.alpha[i]
         u = grid[s]
         l = sample(vi, a, u[0], u[1])
-        dirs[i, s] = wp.vec3d(wp.float64(l[0]), wp.float64(l[1]), wp.float64(l[2]))
-        f[i, s] = wp.float64(f_cos(vi, l, a, tab, i))
-        p[i, s] = wp.float64(pdf(vi, l, a, tab, i))
+        out.dirs[i, s] = wp.vec3d(wp.float64(l[0]), wp.float64(l[1]), wp.float64(l[2]))
+        out.f[i, s] = wp.float64(f_cos(vi, l, a, x.tab, i))
+        out.p[i, s] = wp.float64(pdf(vi, l, a, x.tab, i))
 
     @wp.kernel(enable_backward=False)
     def heitz_error(
         texel: wp.array(dtype=int),
         m: wp.array(dtype=wp.mat33d),
-        v: wp.array(dtype=wp.vec3),
-        alpha: wp.array(dtype=float),
+        x: Texels,
         magnitude: wp.array(dtype=wp.float64),
-        tab: wp.array3d(dtype=float),
         cos_dirs: wp.array(dtype=wp.vec3d),
-        lobe_dirs: wp.array2d(dtype=wp.vec3d),
-        lobe_f: wp.array2d(dtype=wp.float64),
-        lobe_p: wp.array2d(dtype=wp.float64),
+        lobe: LobeSamples,
         err: wp.array(dtype=wp.float64),
     ):
         """ltc_code computeError: 1/N^2 Σ over LTC samples and lobe samples of |f - mag D|^3 / (p_ltc + p_brdf)."""
@@ -129,8 +136,8 @@ def kernels(lobe_name: str):
         mi = m[i]
         m_inv = wp.inverse(mi)
         det_inv = wp.abs(wp.determinant(m_inv))
-        vi = v[t]
-        a = alpha[t]
+        vi = x.v[t]
+        a = x.alpha[t]
         mag = magnitude[t]
         acc = wp.float64(0.0)
         for s in range(cos_dirs.shape[0]):
@@ -142,32 +149,25 @@ def kernels(lobe_name: str):
             ld = mw / r
             l = wp.vec3(float(ld[0]), float(ld[1]), float(ld[2]))
             d = wo[2] * wp.float64(0.3183098861837907) * det_inv * r * r * r
-            fp = f_pdf(vi, l, a, tab, t)
+            fp = f_pdf(vi, l, a, x.tab, t)
             e = wp.abs(wp.float64(fp[0]) - mag * d)
             q = d + wp.float64(fp[1])
             if q > wp.float64(0.0):
                 acc += e * e * e / q
             # lobe sample (precomputed by lobe_samples)
-            d2 = ltc_eval(m_inv, det_inv, lobe_dirs[t, s])
-            e2 = wp.abs(lobe_f[t, s] - mag * d2)
-            q2 = d2 + lobe_p[t, s]
+            d2 = ltc_eval(m_inv, det_inv, lobe.dirs[t, s])
+            e2 = wp.abs(lobe.f[t, s] - mag * d2)
+            q2 = d2 + lobe.p[t, s]
             if q2 > wp.float64(0.0):
                 acc += e2 * e2 * e2 / q2
         err[i] = acc / wp.float64(cos_dirs.shape[0])
 
     @wp.kernel(enable_backward=False)
-    def lobe_values(
-        texel: wp.array(dtype=int),
-        l: wp.array(dtype=wp.vec3),
-        v: wp.array(dtype=wp.vec3),
-        alpha: wp.array(dtype=float),
-        tab: wp.array3d(dtype=float),
-        out: wp.array(dtype=wp.float64),
-    ):
+    def lobe_values(texel: wp.array(dtype=int), l: wp.array(dtype=wp.vec3), x: Texels, out: wp.array(dtype=wp.float64)):
         """f (n.l) of texel[i] at direction l[i], as the fit sees it (a tabulated lobe: interpolated)."""
         i = wp.tid()
         t = texel[i]
-        out[i] = wp.float64(f_cos(v[t], l[i], alpha[t], tab, t))
+        out[i] = wp.float64(f_cos(x.v[t], l[i], x.alpha[t], x.tab, t))
 
     return lobe_samples, heitz_error, lobe_values
 
@@ -216,27 +216,24 @@ class Problem:
         lb = lobe(lobe_name)
         # a tabulated lobe's per-texel table (lutbake.ltc.tabulated, ``workers`` threads), else a 1-element placeholder
         tab = lb.tabulate(self.v, self.alpha, d, workers) if lb.tabulate else np.zeros((1, 1, 1), np.float32)
-        self._tab = wp.array(tab, dtype=float, device=d)
-        self._grid = wp.array(grid, dtype=wp.vec2, device=d)
+        self._texels = Texels()
+        self._texels.v = wp.array(self.v, dtype=wp.vec3, device=d)
+        self._texels.alpha = wp.array(self.alpha, dtype=float, device=d)
+        self._texels.tab = wp.array(tab, dtype=float, device=d)
         self._cos = wp.array(cosine_dirs(grid), dtype=wp.vec3d, device=d)
-        self._v = wp.array(self.v, dtype=wp.vec3, device=d)
-        self._alpha = wp.array(self.alpha, dtype=float, device=d)
         self._mag = wp.array(self.magnitude, dtype=wp.float64, device=d)
         s = len(grid)
-        self._ldir = wp.zeros((self.n, s), dtype=wp.vec3d, device=d)
-        self._lf = wp.zeros((self.n, s), dtype=wp.float64, device=d)
-        self._lp = wp.zeros((self.n, s), dtype=wp.float64, device=d)
-        wp.launch(
-            lobe_samples,
-            dim=(self.n, s),
-            inputs=[self._v, self._alpha, self._grid, self._tab, self._ldir, self._lf, self._lp],
-            device=d,
-        )
+        self._lobe = LobeSamples()
+        self._lobe.dirs = wp.zeros((self.n, s), dtype=wp.vec3d, device=d)
+        self._lobe.f = wp.zeros((self.n, s), dtype=wp.float64, device=d)
+        self._lobe.p = wp.zeros((self.n, s), dtype=wp.float64, device=d)
+        grid_d = wp.array(grid, dtype=wp.vec2, device=d)
+        wp.launch(lobe_samples, dim=(self.n, s), inputs=[self._texels, grid_d, self._lobe], device=d)
         # from the lobe's samples: its average direction Σ (f / p) l (ltc_code computeAvgTerms) and ∫ f^3 ≈ Σ f^3 / p
-        f, p = self._lf.numpy(), self._lp.numpy()
+        dirs, f, p = self.lobe_sample_arrays(slice(None))
         w = np.where(p > 0.0, f / np.where(p > 0.0, p, 1.0), 0.0)
         self.f3 = np.sum(f * f * w, axis=1) / s
-        self.frame_z = self._frames(np.einsum("ts,tsk->tk", w, self._ldir.numpy()))
+        self.frame_z = self._frames(np.einsum("ts,tsk->tk", w, dirs))
         self.evaluations = 0
         self.dof = 4 if lb.free_frame else 3  # q's length (matrices)
 
@@ -288,14 +285,10 @@ class Problem:
             inputs=[
                 wp.array(np.asarray(texel, np.int32), dtype=int, device=d),
                 wp.array(np.ascontiguousarray(m, np.float64), dtype=wp.mat33d, device=d),
-                self._v,
-                self._alpha,
+                self._texels,
                 self._mag,
-                self._tab,
                 self._cos,
-                self._ldir,
-                self._lf,
-                self._lp,
+                self._lobe,
                 out,
             ],
             device=d,
@@ -308,13 +301,13 @@ class Problem:
         d = self.device
         out = wp.zeros(len(texel), dtype=wp.float64, device=d)
         inputs = [wp.array(np.asarray(texel, np.int32), dtype=int, device=d)]
-        inputs += [wp.array(np.asarray(l, np.float32), dtype=wp.vec3, device=d), self._v, self._alpha, self._tab, out]
+        inputs += [wp.array(np.asarray(l, np.float32), dtype=wp.vec3, device=d), self._texels, out]
         wp.launch(self._values, dim=len(texel), inputs=inputs, device=d)
         return out.numpy()
 
     def lobe_sample_arrays(self, texel: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The lobe's importance samples of ``texel`` (k,): directions (k, N^2, 3), f (n.l) and density (k, N^2)."""
-        return self._ldir.numpy()[texel], self._lf.numpy()[texel], self._lp.numpy()[texel]
+        return self._lobe.dirs.numpy()[texel], self._lobe.f.numpy()[texel], self._lobe.p.numpy()[texel]
 
     def objective(self, texel: np.ndarray, q: np.ndarray) -> np.ndarray:
         return self.error(texel, self.matrices(texel, q))

@@ -32,6 +32,7 @@ import warp as wp
 
 from ..runtime.warp_runtime import MODULE_OPTIONS, load_module
 from . import lights as ltc_lights
+from .fit import unpack_inverse
 
 wp.set_module_options(MODULE_OPTIONS)
 
@@ -177,15 +178,6 @@ def robust_weight(z: np.ndarray) -> np.ndarray:
     return 1.0 / np.sqrt(1.0 + z * z / (ROBUST_SCALE * ROBUST_SCALE))
 
 
-def unpack(theta: np.ndarray) -> np.ndarray:
-    """Packed (k, 4) -> M^-1 (k, 3, 3) (rows (x, 0, z), (0, 1, 0), (y, 0, w); lutbake.ltc.fit.unpack_inverse)."""
-    k = len(theta)
-    inv = np.zeros((k, 3, 3))
-    inv[:, 0, 0], inv[:, 2, 0], inv[:, 0, 2], inv[:, 2, 2] = theta[:, 0], theta[:, 1], theta[:, 2], theta[:, 3]
-    inv[:, 1, 1] = 1.0
-    return inv
-
-
 def texel_lights(nov: np.ndarray, alpha: np.ndarray, count: int = LIGHTS, seed: int = SEED) -> np.ndarray:
     """Training lights (k, count, 4, 3) per texel: one fixed set of uniform numbers (``seed``) mapped through each
     texel's own (n.v, alpha) (lutbake.ltc.lights.from_uniforms), so a texel's lights depend on its inputs alone."""
@@ -294,7 +286,7 @@ def refine(
     npar = 4 + len(lin)
 
     def evaluate(theta):
-        return np.tile(integrals(unpack(theta), local, polys, device), (1, len(f0s)))
+        return np.tile(integrals(unpack_inverse(theta), local, polys, device), (1, len(f0s)))
 
     def residual(I, m, f):
         return ((coef_m * m[:, None] + coef_f * f[:, None]) * I - target) * sw
@@ -314,7 +306,7 @@ def refine(
         h = FD_STEP * np.maximum(np.abs(theta), 1.0)
         trials = np.repeat(theta[:, None, :], 4, axis=1)
         trials[:, np.arange(4), np.arange(4)] += h
-        It = integrals(unpack(trials.reshape(-1, 4)), np.repeat(local, 4), polys, device).reshape(k, 4, -1)
+        It = integrals(unpack_inverse(trials.reshape(-1, 4)), np.repeat(local, 4), polys, device).reshape(k, 4, -1)
         dI = np.tile((It - I[:, None, : G.shape[1]]) / h[:, :, None], (1, 1, len(f0s)))  # (k, 4, R)
         scale = (coef_m * m[:, None] + coef_f * f[:, None]) * sw
         J = np.empty((k, target.shape[1], npar))

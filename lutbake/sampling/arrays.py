@@ -4,6 +4,7 @@ import warp as wp
 
 Floats = wp.array(dtype=float)  # one float32 per texel
 Vec3s = wp.array(dtype=wp.vec3)  # one direction per texel
+LightView = wp.array2d(dtype=wp.vec3)  # (l, v) per texel: row i = (l_i, v_i), unit directions in the shading frame
 Points2 = wp.array2d(dtype=float)  # QMC points, one row each (float32)
 Rule = wp.array(dtype=wp.vec2d)  # a Gauss-Legendre rule on [0, 1]: (node, weight) pairs, float64
 Levels = wp.array(dtype=wp.vec2i)  # a ladder of rules: (offset, order) into concatenated Rules (hemisphere.gl_levels)

@@ -219,19 +219,7 @@ def dielectric_texel(t: wp.vec3, merge: wp.float64):
             t_lo = half
         n_panels += 1
         edges[n_panels] = t_lo
-    x = DielectricTexel()
-    x.v = v
-    x.a = a
-    x.eta = eta_f
-    x.a64 = a64
-    x.cos_v = cos_v
-    x.sin_v = sin_v
-    x.eps_l = eps_l
-    x.cos_c = cos_c
-    x.theta_peak = theta_peak
-    x.n_panels = n_panels
-    x.edges = edges
-    return x
+    return DielectricTexel(v, a, eta_f, a64, cos_v, sin_v, eps_l, cos_c, theta_peak, n_panels, edges)  # field order
 
 
 @functools.lru_cache(maxsize=None)

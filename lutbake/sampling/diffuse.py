@@ -27,7 +27,7 @@ import warp as wp
 from ..runtime.warp_runtime import load_module, unique_kernel
 from ..terms.frame import view_dir
 from . import points
-from .arrays import Floats, Levels, Points2, Rows64, Rule, Values64
+from .arrays import Floats, Levels, LightView, Points2, Rows64, Rule, Values64
 from .facets import (
     FACET_ORDERS,
     MAX_U_PANELS,
@@ -80,9 +80,7 @@ def brdf_kernel(brdf):
     """Kernel: f(l, v) at direction pairs lv[i] = (l, v) with sa[i] = (sigma, alpha) (tests, plots, BTF slices)."""
 
     @unique_kernel
-    def brdf_point_kernel(
-        lv: wp.array2d(dtype=wp.vec3), sa: wp.array(dtype=wp.vec2), f0: float, rule: Rule, out: Values64
-    ):
+    def brdf_point_kernel(lv: LightView, sa: wp.array(dtype=wp.vec2), f0: float, rule: Rule, out: Values64):
         i = wp.tid()
         out[i] = brdf(lv[i, 0], lv[i, 1], sa[i][0], sa[i][1], f0, rule)
 
@@ -247,7 +245,7 @@ def sobol_point_kernel(facet):
     f = fd_microfacet_sobol_for(facet)
 
     @unique_kernel
-    def brdf_sobol_kernel(lv: wp.array2d(dtype=wp.vec3), alpha: Floats, f0: float, pts: Points2, out: Values64):
+    def brdf_sobol_kernel(lv: LightView, alpha: Floats, f0: float, pts: Points2, out: Values64):
         i = wp.tid()
         out[i] = f(lv[i, 0], lv[i, 1], alpha[i], f0, pts)
 
@@ -284,7 +282,7 @@ def adaptive_point_kernel(facet):
 
     @unique_kernel
     def brdf_adaptive_kernel(
-        lv: wp.array2d(dtype=wp.vec3), alpha: Floats, f0: float, tol: wp.vec2d, rules: Rule, levels: Levels, out: Rows64
+        lv: LightView, alpha: Floats, f0: float, tol: wp.vec2d, rules: Rule, levels: Levels, out: Rows64
     ):
         i = wp.tid()
         fe = f(lv[i, 0], lv[i, 1], alpha[i], f0, rules, levels, tol)
@@ -303,7 +301,7 @@ def adaptive_azimuths_kernel(facet):
 
     @unique_kernel
     def brdf_adaptive_azimuths_kernel(
-        lv: wp.array2d(dtype=wp.vec3),
+        lv: LightView,
         alpha: Floats,
         f0: float,
         tol: wp.vec2d,

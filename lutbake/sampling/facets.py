@@ -32,7 +32,7 @@ import warp as wp
 from ..edge import COS_EPS
 from ..terms import masking
 from ..terms.distributions import GGX
-from .arrays import Floats, Levels, Rows64, Rule
+from .arrays import Floats, Levels, LightView, Rows64, Rule
 from .ladder import greedy_ladder_for
 from .panels import (
     MAX_TAIL_CUTS,
@@ -387,7 +387,7 @@ def facet_panel_azimuths_for(F_facet):
     @wp.func
     def facet_panel_azimuths(
         p: FacetPair,
-        lv: wp.array2d(dtype=wp.vec3),
+        lv: LightView,
         azl: Azimuths,
         first: int,
         end: int,
@@ -483,7 +483,7 @@ def fd_microfacet_adaptive_azimuths_for(F_facet):
 
     @wp.func
     def fd_microfacet_adaptive_azimuths(
-        lv: wp.array2d(dtype=wp.vec3),
+        lv: LightView,
         alpha: Floats,
         f0: float,
         rules: Rule,

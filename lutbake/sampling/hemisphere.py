@@ -269,19 +269,7 @@ def panel_texel(
             t_lo = theta_b
         n_panels += 1
         edges[n_panels] = t_lo
-    t = PanelTexel()
-    t.v = v
-    t.a = a
-    t.prm = prm
-    t.theta_a = theta_a
-    t.theta_peak = theta_peak
-    t.eps_l = eps_l
-    t.edges = edges
-    t.phi_a = phi_a
-    t.kink = kink
-    t.theta_klo = band[0]
-    t.theta_khi = band[1]
-    return t, n_panels
+    return PanelTexel(v, a, prm, theta_a, theta_peak, eps_l, edges, phi_a, kink, band[0], band[1]), n_panels
 
 
 @wp.func
