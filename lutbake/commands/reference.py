@@ -19,9 +19,29 @@ from ..axes import Axis
 from ..config import TableSpec, load_config, parse_overrides, preset_path, validate_table
 from ..errors import ConfigError
 from ..pipeline import compute_at
+from ..runtime.memo import RowMemo
 
 REFERENCE_TOLERANCE = 1e-7  # the re-bake: adaptive Gauss-Legendre to 1e-7 per value (its estimates bound the error:
 # docs/validation.md); a fixed order 12 leaves ~1e-5 at NoV = 1e-4 and would flag a correct table
+POINTS = ("nov", "alpha", "rough")
+# the reference integrals per (spec, texel), shared by every audit of a process: audits of one engine's files (or of
+# one file under several hypotheses) ask for the same conventions at the same texels; a texel's value is a function
+# of its spec and point alone (lutbake.pipeline.compute_at: the same for any tiling or worker count)
+REFERENCES = RowMemo()
+
+
+def computed_at(spec: TableSpec, points: dict, workers: int | None) -> np.ndarray:
+    """``compute_at(spec, points, workers)``, its rows memoised per texel in REFERENCES."""
+    cols = [np.asarray(points[k], np.float64) for k in POINTS]
+    base = repr(sorted(spec.options.items())).encode()
+    keys = [base + b"".join(c[i].tobytes() for c in cols) for i in range(len(cols[0]))]
+    if not keys:
+        return compute_at(spec, points, workers)
+
+    def compute(idx):
+        return (compute_at(spec, {k: c[idx] for k, c in zip(POINTS, cols)}, workers),)
+
+    return REFERENCES.run(keys, compute)[0]
 
 
 def recorded_specs(config_text: str, where: str, overrides=()) -> list[TableSpec]:
@@ -101,7 +121,7 @@ def _with(spec: TableSpec, **options) -> TableSpec:
 
 class Reference:
     """Converged (and, for the noise estimate, Hammersley) integrals of a dfg spec at arbitrary (NoV, alpha),
-    through lutbake.pipeline.compute_at; cached by the points."""
+    through lutbake.pipeline.compute_at, memoised per texel (computed_at)."""
 
     def __init__(self, conv: Conventions, workers: int | None = None):
         from ..kinds.dfg import terms_of
@@ -118,17 +138,12 @@ class Reference:
             interpolation="off",
         )
         self.workers = workers
-        self._cache: dict[bytes, np.ndarray] = {}
 
     def converged(self, nov: np.ndarray, alpha: np.ndarray, rough: np.ndarray | None = None) -> np.ndarray:
         """Every channel of the layout at (NoV, alpha); ``rough`` (perceptual) feeds an engine diffuse channel
         (default sqrt(alpha))."""
         rough = np.sqrt(alpha) if rough is None else rough
-        key = b"".join(np.asarray(a, np.float32).tobytes() for a in (nov, alpha, rough))
-        if key not in self._cache:
-            points = {"nov": nov, "alpha": alpha, "rough": rough}
-            self._cache[key] = compute_at(self.converged_spec, points, self.workers)
-        return self._cache[key]
+        return computed_at(self.converged_spec, {"nov": nov, "alpha": alpha, "rough": rough}, self.workers)
 
     def hammersley(self, nov, alpha, samples: int) -> np.ndarray | None:
         """The engines' usual estimator (R, G of the split-sum layout), or None for the sheen layouts."""
@@ -144,4 +159,4 @@ class Reference:
             tolerance=None,
             relative_tolerance=None,
         )
-        return compute_at(spec, {"nov": nov, "alpha": alpha, "rough": np.sqrt(alpha)}, self.workers)[:, :2]
+        return computed_at(spec, {"nov": nov, "alpha": alpha, "rough": np.sqrt(alpha)}, self.workers)[:, :2]
