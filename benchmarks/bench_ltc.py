@@ -213,6 +213,8 @@ def benchmark_section(ggx, ggx_row: dict, workers: int, t1p, t2p, args) -> dict:
         "published": (t1p, t2p),
         "l3": (ggx.data[0].astype(np.float64), ggx.data[1].astype(np.float64)),
         "shaded": (new.data[0].astype(np.float64), new.data[1].astype(np.float64)),
+        # the smallest shader change: a second LTC for the Schlick part (only the texels the lookups read are fitted)
+        "two_lobe": ltc_bench.fitted_texels(ltc_bench.lookup_texels(cases, N), "two_lobe", N),
     }
     out = {
         "cases": len(cases),
@@ -230,28 +232,34 @@ def benchmark_section(ggx, ggx_row: dict, workers: int, t1p, t2p, args) -> dict:
         "fit_times": times,
     }
     for f0 in (1.0, 0.04):
-        res = {name: ltc_bench.report(ltc_bench.errors(t1, t2, cases, truths, f0)) for name, (t1, t2) in tables.items()}
-        pub, new = res["published"], res["shaded"]
-        worse = [
-            k
-            for k in pub
-            if " / " in k and (new[k]["rel_median"] > pub[k]["rel_median"] or new[k]["abs_p90"] > pub[k]["abs_p90"])
-        ]
-        out[f"f0={f0:g}"] = {
-            "tables": res,
-            "shaded_over_published": {
-                "rel_median": new["all"]["rel_median"] / pub["all"]["rel_median"],
-                "abs_p90": new["all"]["abs_p90"] / pub["all"]["abs_p90"],
-                "bands_worse_in_rel_median_or_abs_p90": worse,
-            },
+        res = {n: ltc_bench.report(ltc_bench.errors(t[0], t[1], cases, truths, f0, *t[2:])) for n, t in tables.items()}
+        pub = res["published"]
+        out[f"f0={f0:g}"] = {"tables": res} | {
+            f"{name}_over_published": over_published(res[name], pub) for name in ("shaded", "two_lobe")
         }
-        print(f"area benchmark f0={f0:g}:", json.dumps(out[f"f0={f0:g}"]["shaded_over_published"]), flush=True)
+        for name in ("shaded", "two_lobe"):
+            ratios = out[f"f0={f0:g}"][f"{name}_over_published"]
+            print(f"area benchmark f0={f0:g} {name}:", json.dumps(ratios), flush=True)
         for k in ("all", *[k for k in pub if " / " not in k and k != "all"]):
             row = " | ".join(
                 f"{n} {res[n][k]['rel_median']:.4f} {res[n][k]['rel_p90']:.3f} {res[n][k]['abs_p90']:.4f}" for n in res
             )
             print(f"  {k:14s} {row}", flush=True)
     return out
+
+
+def over_published(new: dict, pub: dict) -> dict:
+    """The goals' ratios (median relative error, |error| / albedo p90) and the bands worse than the published table."""
+    worse = [
+        k
+        for k in pub
+        if " / " in k and (new[k]["rel_median"] > pub[k]["rel_median"] or new[k]["abs_p90"] > pub[k]["abs_p90"])
+    ]
+    return {
+        "rel_median": new["all"]["rel_median"] / pub["all"]["rel_median"],
+        "abs_p90": new["all"]["abs_p90"] / pub["all"]["abs_p90"],
+        "bands_worse_in_rel_median_or_abs_p90": worse,
+    }
 
 
 def sharing_section(ggx_cpu: float, workers: int) -> dict:

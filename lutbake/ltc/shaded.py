@@ -250,6 +250,7 @@ def refine(
     lights: int = LIGHTS,
     samples: int = SAMPLES,
     f0_weight: float = F0_WEIGHT,
+    schlick_lobe: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Levenberg-Marquardt from ``packed`` (k, 4) at ``texel``: (packed (k, 4), magnitude (k,), fresnel (k,)).
 
@@ -258,7 +259,10 @@ def refine(
     those of F = 1 and of f0 = ``F0_TRAIN`` (value (f0 magnitude + (1 - f0) fresnel) I against f0 G + (1 - f0) H,
     relative to the same mix of the albedos), so the one matrix serves metals and dielectrics.
     ``fit_magnitude`` False keeps magnitude = the albedo and fresnel = the exact channel and fits the matrix alone
-    (for shaders that take the magnitude from another table, e.g. HDRP's PreIntegratedFGD)."""
+    (for shaders that take the magnitude from another table, e.g. HDRP's PreIntegratedFGD).
+    ``schlick_lobe``: fit the matrix and the fresnel channel to the Schlick part H alone (f0 = 0), the magnitude kept:
+    the second LTC of a two-lobe shader, value = f0 magnitude I(M1) + (1 - f0) fresnel I(M2) (lutbake.validate.
+    ltc_bench.fitted_texels "two_lobe")."""
     from .fit import Problem
 
     k = len(texel)
@@ -266,12 +270,15 @@ def refine(
     sp = Problem(problem.lobe, problem.nov[texel], problem.alpha[texel], problem.magnitude[texel], samples, device)
     G, H = targets(sp, np.arange(k), polys, device)
     A = problem.magnitude[texel]
-    f0s = (1.0,) if fresnel is None or f0_weight == 0.0 else (1.0, F0_TRAIN)
+    if schlick_lobe:
+        f0s = (0.0,)
+    else:
+        f0s = (1.0,) if fresnel is None or f0_weight == 0.0 else (1.0, F0_TRAIN)
     AH = A if fresnel is None else np.asarray(fresnel, np.float64)
     # per reflectance: target (k, L), sqrt weight (k, L), d value / d (magnitude, fresnel) per unit I
     tg = [f0 * G + (1.0 - f0) * H for f0 in f0s]
     sw = [
-        (1.0 if f0 == 1.0 else f0_weight) / np.maximum(t + ABS_WEIGHT * (f0 * A + (1.0 - f0) * AH)[:, None], TINY)
+        (1.0 if f0 == f0s[0] else f0_weight) / np.maximum(t + ABS_WEIGHT * (f0 * A + (1.0 - f0) * AH)[:, None], TINY)
         for f0, t in zip(f0s, tg)
     ]
     target = np.concatenate(tg, axis=1)
@@ -282,7 +289,7 @@ def refine(
     iso = problem.isotropic[texel]
     free = np.ones((k, 4), bool)
     free[iso, :3] = False  # normal incidence: (1, 0, 0, w)
-    lin = (["m"] if fit_magnitude else []) + (["f"] if fit_magnitude and len(f0s) > 1 else [])
+    lin = [name for name, used in (("m", max(f0s) > 0.0), ("f", min(f0s) < 1.0)) if fit_magnitude and used]
     npar = 4 + len(lin)
 
     def evaluate(theta):
@@ -334,6 +341,6 @@ def refine(
         lam = np.where(ok, lam / 3.0, lam * 4.0)
     if fresnel is None:
         f = m.copy()
-    elif fit_magnitude and len(f0s) == 1:  # F = 1 alone: the Schlick channel is the exact integral
+    elif fit_magnitude and f0s == (1.0,):  # F = 1 alone: the Schlick channel is the exact integral
         f = AH.copy()
     return theta, m, f

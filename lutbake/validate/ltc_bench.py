@@ -119,20 +119,28 @@ def ground_truth(case: dict, s: int, sampler: str = "vndf") -> dict:
     }
 
 
-def shade(ltc_1: np.ndarray, ltc_2: np.ndarray, case: dict) -> np.ndarray:
-    """(2, k): the shader's value per light for F = 1 (row 0: t2.x I) and the Schlick part (row 1: t2.y I)."""
+def shade(ltc_1: np.ndarray, ltc_2: np.ndarray, case: dict, ltc_3: np.ndarray | None = None) -> np.ndarray:
+    """(2, k): the shader's value per light for F = 1 (row 0: t2.x I) and the Schlick part (row 1: t2.y I); with
+    ``ltc_3`` (a two-lobe shader) the Schlick part's polygon integral goes through ltc_3's matrix."""
     out = np.empty((2, len(case["lights"])))
     for k, p in enumerate(case["lights"]):
         out[0, k] = polygon.shade(ltc_1, ltc_2, case["r"], case["nov"], p, f0=1.0)
-        out[1, k] = polygon.shade(ltc_1, ltc_2, case["r"], case["nov"], p, f0=0.0)
+        out[1, k] = polygon.shade(ltc_1 if ltc_3 is None else ltc_3, ltc_2, case["r"], case["nov"], p, f0=0.0)
     return out
 
 
-def errors(ltc_1: np.ndarray, ltc_2: np.ndarray, cs: list[dict], truths: list[dict], f0: float = 1.0) -> dict:
+def errors(
+    ltc_1: np.ndarray,
+    ltc_2: np.ndarray,
+    cs: list[dict],
+    truths: list[dict],
+    f0: float = 1.0,
+    ltc_3: np.ndarray | None = None,
+) -> dict:
     """Per light of every case (flat arrays): rel (NaN where the truth is below the floor), abs (/ albedo), bands."""
     rel, ab, rb, vb = [], [], [], []
     for c, g in zip(cs, truths):
-        val = shade(ltc_1, ltc_2, c)
+        val = shade(ltc_1, ltc_2, c, ltc_3)
         got = f0 * val[0] + (1.0 - f0) * val[1]
         want = f0 * g["lobe"] + (1.0 - f0) * g["schlick"]
         alb = max(f0 * g["albedo"] + (1.0 - f0) * g["schlick_albedo"], 1e-12)
@@ -204,10 +212,13 @@ def lookup_texels(cs: list[dict], n: int) -> list[tuple[int, int]]:
 
 def fitted_texels(
     texels: list[tuple[int, int]], fit_kind: str = "shaded", n: int = 64, f0_weight: float | None = None
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, ...]:
     """A GGX n x n table (ltc_1, ltc_2) with only ``texels`` filled, fitted as the ``ltc`` kind fits them (its
     magnitude, its coarse pass and seeding, and for ``fit_kind`` "shaded" its refinement; the sphere and fit-error
-    channels are left 0): enough for the cases whose lookups read only these texels, at a fraction of a table's cost."""
+    channels are left 0): enough for the cases whose lookups read only these texels, at a fraction of a table's cost.
+    ``fit_kind`` "two_lobe": (ltc_1, ltc_2, ltc_3) of a two-lobe shader, ltc_1 the shaded fit of F = 1 alone and
+    ltc_3 the matrix of the Schlick part's own shaded fit (lutbake.ltc.shaded.refine ``schlick_lobe``), t2.y its
+    fresnel channel."""
     from ..kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
     from ..ltc import fit, shaded
 
@@ -218,9 +229,13 @@ def fitted_texels(
     idx = np.array([t * n + a for t, a in texels])
     m, _ = fit.fit_texels(prob, idx, n, fit.coarse_pass(prob, n, n))
     packed, mg, fr = fit.pack_inverse(m), mag[idx], fres[idx]
-    if fit_kind == "shaded":
+    t1, t2, t3 = np.zeros((n * n, 4)), np.zeros((n * n, 4)), np.zeros((n * n, 4))
+    if fit_kind == "two_lobe":
+        t3[idx], _, fr = shaded.refine(prob, idx, packed, fres[idx], schlick_lobe=True)
+        packed, mg, _ = shaded.refine(prob, idx, packed, fres[idx], f0_weight=0.0)
+    elif fit_kind == "shaded":
         w = shaded.F0_WEIGHT if f0_weight is None else f0_weight
         packed, mg, fr = shaded.refine(prob, idx, packed, fres[idx], f0_weight=w)
-    t1, t2 = np.zeros((n * n, 4)), np.zeros((n * n, 4))
     t1[idx], t2[idx, 0], t2[idx, 1] = packed, mg, fr
-    return t1.reshape(n, n, 4), t2.reshape(n, n, 4)
+    tables = (t1.reshape(n, n, 4), t2.reshape(n, n, 4), t3.reshape(n, n, 4))
+    return tables if fit_kind == "two_lobe" else tables[:2]
