@@ -211,6 +211,51 @@ def section_ltc(docs: dict[str, dict]) -> list[str]:
             f"texels; median relative L3 error {fmt(med.get('lutbake'))} (ltc_code {fmt(med.get('ltc_code'))}).",
             "",
         ]
+    return out + section_area(main.get("area_benchmark"))
+
+
+def section_area(doc: dict | None) -> list[str]:
+    """The area-light benchmark (bench_ltc section 8): every table through the shader's bilinear lookup, per band."""
+    if not doc:
+        return []
+    out = [
+        f"### Area lights through the shader (GGX, {doc['cases']} shading points, {doc['lights']} polygon lights)",
+        "",
+        "Relative error median / p90 and |error| / albedo p90 of the shaded polygon integral against "
+        f"{doc['truth']['estimator']} (lutbake.validate.ltc_bench); `two_lobe`: a second LTC for the Schlick part "
+        "(a shader change).",
+        "",
+    ]
+    times = doc.get("fit_times", {})
+    fit_line = ", ".join(
+        f"{k} {fmt(v['seconds'])} s" if isinstance(v, dict) and "seconds" in v else f"{k}: {v}"
+        for k, v in times.items()
+    )
+    out += [f"GGX 64² fit times: {fit_line}.", ""]
+    for f0 in ("f0=1", "f0=0.04"):
+        res = doc.get(f0)
+        if not res:
+            continue
+        names = list(res["tables"])
+        rows = [
+            [band]
+            + [
+                f"{fmt(r[band]['rel_median'])} / {fmt(r[band]['rel_p90'])} / {fmt(r[band]['abs_p90'])}"
+                for r in (res["tables"][n] for n in names)
+            ]
+            for band in res["tables"][names[0]]
+            if " / " not in band
+        ]
+        out += [f"{f0}:", ""] + table(["band"] + names, rows) + [""]
+        for fit in ("shaded", "two_lobe"):
+            ratio = res.get(f"{fit}_over_published")
+            if ratio:
+                out += [
+                    f"- {fit} over published: median relative {fmt(ratio['rel_median'])}, |error| / albedo p90 "
+                    f"{fmt(ratio['abs_p90'])}, roughness × view bands worse: "
+                    f"{len(ratio['bands_worse_in_rel_median_or_abs_p90'])} of 16"
+                ]
+        out += [""]
     return out
 
 
