@@ -145,5 +145,8 @@ LTC_LOBES = {
     "GGX alpha = sigma; f tabulated per texel by lutbake's quadrature and interpolated",
     "eon": "energy-preserving Oren-Nayar (Portsmouth et al. 2024; OpenPBR's diffuse), rho = 1, exact albedo "
     "(E = 1); x = base_diffuse_roughness",
+    "zeltner": "Zeltner, Burley & Chiang 2022's analytic volumetric sheen (an SGGX fiber slab: exact single "
+    "scattering + their multiple-scattering fit), sigma = alpha^2; M^-1 = [[a, 0, b], [0, a, 0], [0, 0, 1]] in the "
+    "normal's frame",
 }
 LTC_FIT_GRID = 32  # ltc_code Nsample: the metric's grid is N x N per sampling technique

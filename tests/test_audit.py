@@ -223,8 +223,10 @@ SHIPPED = {
 }
 # tables of tests/data no preset bakes: the model they hold is not one lutbake integrates
 UNAUDITED = {
-    "babylon_environment_fuzz_brdf.npz": "Zeltner, Burley & Chiang 2022's LTC fit of a volumetric sheen "
-    "(lutbake.layouts.babylon)",
+    "babylon_environment_fuzz_brdf.npz": "Zeltner, Burley & Chiang 2022's LTC fit of their random-walk volume "
+    "(identified in tests/test_sheen_volume.py; lutbake integrates their analytic approximation, no preset yet)",
+    "ltc_sheen_tables.npz": "Zeltner et al.'s two published LTC tables (volume, approx): the references of "
+    "tests/test_sheen_volume.py, no engine loads them",
 }
 FAST_SIDE = 6  # the loop's subset (its own tests above use MAX_SIDE)
 OPENPBR_RATIO_MEAN = 2e-3  # the ratio re-baked: its averages' noise divided by them (measured mean 6.1e-4, all slices)

@@ -198,6 +198,11 @@ def magnitude_fresnel(
     if lb.magnitude == "lambert":
         one = np.ones(len(nov))
         return one, one.copy()
+    if lb.magnitude == "lobe":  # no other integrator has the lobe: lutbake.ltc.fit's quadrature of f_cos
+        from ..ltc import fit
+
+        m = fit.lobe_albedo(fit.Problem(lobe_name, nov, alpha, np.zeros(len(nov)), device=device))
+        return m, m.copy()
     if lb.magnitude.startswith("diffuse:"):
         m = diffuse_magnitude(lb.magnitude.split(":")[1], nov, alpha, samples, device)
         return m, m.copy()
@@ -344,6 +349,10 @@ class LtcBake:
         return out
 
 
+NORMAL_FRAME = (
+    "M^-1 = [[a, 0, b], [0, a, 0], [0, 0, 1]] in the normal's frame (Zeltner, Burley & Chiang 2022; tizian/ltc-sheen), "
+    "2 parameters (log(1 / a), b)"
+)
 FREE_FRAME = " turned about y by a fitted angle d (4 parameters: every LTC of a lobe symmetric about the xz-plane)"
 ROUGHNESS_AXES = {
     "perceptual": "x = perceptual roughness r, NDF alpha = r^2 (ltc_code)",
@@ -355,6 +364,10 @@ ROUGHNESS_AXES = {
 
 
 def magnitude_record(lb, estimator: str, samples) -> str:
+    if lb.magnitude == "lobe":
+        from ..ltc import fit
+
+        return f"lutbake.ltc.fit.lobe_albedo: midpoint rule, {fit.ALBEDO_NODES}^2 (theta graded to the horizon, phi)"
     if lb.magnitude.startswith("diffuse:"):
         model = lb.magnitude.split(":")[1]
         return (
@@ -425,7 +438,7 @@ def plan(spec) -> TexelPlan:
     state = LtcBake(o, axes)
     n = axes[1].count * axes[2].count
     lb = LOBES[o["lobe"]]
-    m_samples = 0 if lb.magnitude == "lambert" else o["samples"]
+    m_samples = 0 if lb.magnitude in ("lambert", "lobe") else o["samples"]
     if o["estimator"] == "gauss_legendre" and not m_samples:
         m_samples = MAGNITUDE_SAMPLES.get(o["lobe"])
     terms = {
@@ -436,17 +449,19 @@ def plan(spec) -> TexelPlan:
         else "none (fresnel channel = magnitude)",
         "layout": "ltc_code (selfshadow/ltc_code fit/fitLTC.cpp packTab)",
     }
-    q_tail = ", d" if lb.free_frame else ""
+    q_text = "log(1 / a), b" if lb.normal_frame else "log m11, log m22, m13/m11" + (", d" if lb.free_frame else "")
     extra = {
         "ltc_fit": json.dumps(
             {
-                "parametrisation": "M = [X Y Z] [[m11, 0, m13], [0, m22, 0], [0, 0, 1]], Z = lobe's average direction"
+                "parametrisation": NORMAL_FRAME
+                if lb.normal_frame
+                else "M = [X Y Z] [[m11, 0, m13], [0, m22, 0], [0, 0, 1]], Z = lobe's average direction"
                 + (FREE_FRAME if lb.free_frame else " (ltc_code's 3 parameters)"),
                 "metric": "Heitz et al. 2016 L3 distance, MIS over lobe and LTC samples (ltc_code computeError)",
                 "fit_samples": f"{o['fit_samples']} x {o['fit_samples']} per technique",
                 "optimiser": f"Nelder-Mead (ltc_code nelder_mead.h), tol {fit.NELDER_MEAD_TOL}, "
                 f"<= {fit.NELDER_MEAD_ITERS} iterations per restart, simplex sizes {list(fit.COARSE_STEPS)} "
-                f"(coarse pass), {list(fit.FINE_STEPS)} (texels) in (log m11, log m22, m13/m11{q_tail})",
+                f"(coarse pass), {list(fit.FINE_STEPS)} (texels) in ({q_text})",
                 "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses, at the lobe's alpha "
                 f"(>= {ALPHA_MIN:g}, unclamped by alpha_min); each texel starts "
                 "from the best of the analytic guesses and the surrounding coarse fits (no chaining)",

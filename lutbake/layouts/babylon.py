@@ -12,10 +12,14 @@ png.a, Shaders/ShadersInclude/helperFunctions fromRGBD, into a half-float target
   split sum of Blender EEVEE's brdf_ggx (lutbake.layouts.eevee scale_bias_f82: the same three integrals) stored as
   x = bias, y = scale + bias and z = 16 x the F82 term (BRDF_Z_SCALE; openpbrIblFunctions: environmentBrdf.z /
   BRDF_Z_SCALE), read by getF82DirectionalAlbedo: E = (F90 - F0) x + F0 y - b z / 16.
-- ``scene.environmentFuzzBRDFTexture`` (32², RGB): Zeltner, Burley & Chiang 2022's LTC fit of a volumetric sheen
-  (getFuzzBRDFLookup: A in [0.005, 0.88], B in [-0.18, 0.002], R_i in [0, 0.75] at vec2(perceptualRoughness,
-  NdotV)). lutbake does not integrate that model (a microflake volume's multiple scattering, fitted by LTC): its
-  decoded table is kept in tests/data with its provenance, without a preset.
+- ``scene.environmentFuzzBRDFTexture`` (32², RGB): Zeltner, Burley & Chiang 2022's published LTC fit of their
+  random-walk volume (tizian/ltc-sheen ltc_table_sheen_volume: M^-1 = [[A, 0, B], [0, A, 0], [0, 0, 1]] in the
+  normal's frame, R_i the volume's reflectance), rows = NdotV = max(0.01, j/31), columns = alpha = max(0.01, i/31)
+  (endpoints), each channel coded linearly between its extremes; getFuzzBRDFLookup reads it at
+  vec2(sqrt(fuzz_roughness), NdotV) as A = mix(0.005, 0.88, r), B = mix(-0.18, 0.002, g), R_i = mix(0, 0.75, b), but
+  after the RGBD decode's pow(x, 2.2) (up to 0.25 off in A; tests/test_sheen_volume.py, docs/presets.md). lutbake
+  integrates the paper's analytic approximation (LTC lobe ``zeltner``, lutbake.terms.sheen_volume), not the random
+  walk; no preset writes Babylon's (A, B, R_i) layout yet.
 lutbake's presets write float tables (DDS RGBA16F) Babylon loads with ``isRGBD = false`` and ``invertY = false``.
 """
 

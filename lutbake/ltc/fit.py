@@ -54,6 +54,7 @@ FINE_STEPS = (0.1,)
 ATOL_RELATIVE = 1.0e-6
 COARSE_NODES = 8  # coarse-pass texels per axis (including both ends)
 M_MIN = 1.0e-7  # ltc_code FitLTC::update: m11, m22 >= 1e-7
+ALBEDO_NODES = 256  # lobe_albedo's nodes per angle: Zeltner's sheen albedo converged to 1e-9 (512 changes it by 1e-11)
 
 
 @wp.struct
@@ -235,7 +236,8 @@ class Problem:
         self.f3 = np.sum(f * f * w, axis=1) / s
         self.frame_z = self._frames(np.einsum("ts,tsk->tk", w, dirs))
         self.evaluations = 0
-        self.dof = 4 if lb.free_frame else 3  # q's length (matrices)
+        self.normal_frame = lb.normal_frame
+        self.dof = 2 if lb.normal_frame else 4 if lb.free_frame else 3  # q's length (matrices)
 
     def _frames(self, avg: np.ndarray) -> np.ndarray:
         """Z = normalize(average direction with y cleared); (0, 0, 1) at normal incidence (ltc_code fitTab)."""
@@ -251,7 +253,10 @@ class Problem:
     def matrices(self, texel: np.ndarray, q: np.ndarray) -> np.ndarray:
         """M = [X Y Z] * [[m11, 0, m13], [0, m22, 0], [0, 0, 1]] for q = (log m11, log m22, m13 / m11) (``dof`` 3,
         ltc_code's); with ``dof`` 4, q[:, 3] = d, the frame Z turned by d radians about y from the lobe's average
-        direction (every M of a lobe symmetric about the xz-plane, up to scale, is of this form)."""
+        direction (every M of a lobe symmetric about the xz-plane, up to scale, is of this form); with
+        ``normal_frame`` (``dof`` 2) normal_frame_matrices."""
+        if self.normal_frame:
+            return normal_frame_matrices(q, self.isotropic[texel])
         m11 = np.maximum(np.exp(q[:, 0]), M_MIN)
         m22 = np.maximum(np.exp(q[:, 1]), M_MIN)
         m13 = q[:, 2] * m11
@@ -319,6 +324,37 @@ class Problem:
         falls below that provable bound and the floor keeps e finite and meaningful (0 for a zero lobe)."""
         f3 = np.maximum(self.f3[texel], self.magnitude[texel] ** 3 / (4.0 * np.pi**2))
         return np.cbrt(np.where(f3 > 0.0, err / np.where(f3 > 0.0, f3, 1.0), 0.0))
+
+
+def lobe_albedo(problem: Problem, n: int = ALBEDO_NODES) -> np.ndarray:
+    """∫ f (n.l) dω_l per texel of ``problem`` (the magnitude of a lobe no other integrator has: Lobe.magnitude
+    "lobe") by the product midpoint rule in (theta_l, phi_l), phi over [0, pi] doubled (the lobes are symmetric
+    about the xz-plane), theta = pi/2 (1 - (1 - t)^2): nodes graded towards the horizon, where sheen lobes peak.
+    float64 sums of the lobe's float32 values."""
+    t = (np.arange(n) + 0.5) / n
+    theta = 0.5 * np.pi * (1.0 - (1.0 - t) ** 2)
+    w_theta = np.pi * (1.0 - t) / n * np.sin(theta)  # d theta / dt / n x the solid angle's sin theta
+    phi = t * np.pi
+    th, ph = np.meshgrid(theta, phi, indexing="ij")
+    dirs = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], axis=-1).reshape(-1, 3)
+    w = np.repeat(w_theta, n) * (2.0 * np.pi / n)
+    out = np.empty(problem.n)
+    for i in range(problem.n):
+        out[i] = problem.f_cos(np.full(len(dirs), i), dirs) @ w
+    return out
+
+
+def normal_frame_matrices(q: np.ndarray, isotropic: np.ndarray) -> np.ndarray:
+    """Zeltner, Burley & Chiang 2022's LTC (tizian/ltc-sheen fit_ltc_sheen_*.py; pbrt-v3 sheenltc.cpp evalLTC): in
+    the normal's frame, M^-1 = [[a, 0, b], [0, a, 0], [0, 0, 1]]; q = (log(1 / a), b) (the first as ltc_code's
+    log m11: M scales x and y by 1 / a), b = 0 at normal incidence. Returns M (k, 3, 3)."""
+    a = 1.0 / np.maximum(np.exp(q[:, 0]), M_MIN)
+    b = np.where(isotropic, 0.0, q[:, 1])
+    m = np.zeros((len(q), 3, 3))
+    m[:, 0, 0] = m[:, 1, 1] = 1.0 / a
+    m[:, 0, 2] = -b / a
+    m[:, 2, 2] = 1.0
+    return m
 
 
 def nelder_mead(
@@ -399,7 +435,8 @@ def analytic_guesses(problem: Problem, texel: np.ndarray) -> np.ndarray:
     a = np.maximum(problem.alpha[texel].astype(np.float64), 1e-4)
     cands = [np.log(2.0 * a), np.log(a), np.zeros_like(a)]
     z = np.zeros_like(a)
-    return np.stack([np.stack([c, c, *[z] * (problem.dof - 2)], axis=1) for c in cands], axis=1)
+    scales = 1 if problem.normal_frame else 2  # (log m11, b) or (log m11, log m22, ...)
+    return np.stack([np.stack([c] * scales + [z] * (problem.dof - scales), axis=1) for c in cands], axis=1)
 
 
 def best_of(problem: Problem, texel: np.ndarray, cands: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -15,6 +15,7 @@ ltc_code's agree sample for sample on GGX.
 | lambert | (n.l) / pi (the identity LTC: a check) | cosine |
 | gotanda | Gotanda 2014 Eq. 4 (GGX alpha = sigma, Eq. 6 facets, f0 = 0), tabulated per texel | cosine |
 | eon | energy-preserving Oren-Nayar (Portsmouth et al. 2024; OpenPBR), rho = 1, exact albedo | cosine |
+| zeltner | Zeltner et al. 2022's analytic volumetric sheen (lutbake.terms.sheen_volume), sigma = alpha^2 | cosine |
 
 A tabulated lobe (``Lobe.tabulate``: gotanda) takes two more arguments, its per-texel table and the texel index:
 f_cos(v, l, alpha, tab, t) (lutbake.ltc.tabulated); lutbake.ltc.fit adapts the others.
@@ -29,7 +30,7 @@ import warp as wp
 
 from ..catalog import LTC_LOBES
 from ..edge import COS_EPS
-from ..terms import diffuse, masking, ndf
+from ..terms import diffuse, masking, ndf, sheen_volume
 from ..terms.frame import reflect
 from .tabulated import gotanda_f_cos, tabulate_gotanda
 
@@ -178,6 +179,11 @@ def eon_f_pdf(v: wp.vec3, l: wp.vec3, r: float):
 
 
 @wp.func
+def zeltner_f_pdf(v: wp.vec3, l: wp.vec3, alpha: float):
+    return wp.vec2(sheen_volume.f_cos_sheen_approx(v, l, alpha), cosine_pdf(v, l, alpha))
+
+
+@wp.func
 def gotanda_pdf(v: wp.vec3, l: wp.vec3, alpha: float, tab: wp.array3d(dtype=float), t: int):
     return cosine_pdf(v, l, alpha)
 
@@ -201,6 +207,8 @@ class Lobe:
     tabulate: object = None  # host (v (n, 3), alpha (n,), device, workers) -> per-texel table, or None (closed form)
     free_frame: bool = False  # fit the frame angle too (4 parameters, lutbake.ltc.fit.Problem.matrices), not only
     # ltc_code's 3 with Z = the lobe's average direction
+    normal_frame: bool = False  # fit Zeltner et al. 2022's M^-1 = [[a, 0, b], [0, a, 0], [0, 0, 1]] in the normal's
+    # frame (2 parameters, lutbake.ltc.fit.Problem.matrices) instead of ltc_code's lobe-average frame
 
 
 LOBES = {
@@ -259,6 +267,17 @@ LOBES = {
         eon_f_pdf,
         "diffuse:eon",
         "diffuse_roughness",
+    ),
+    "zeltner": Lobe(
+        "zeltner",
+        LTC_LOBES["zeltner"],
+        sheen_volume.f_cos_sheen_approx,
+        cosine_sample,
+        cosine_pdf,
+        zeltner_f_pdf,
+        "lobe",
+        "alpha",
+        normal_frame=True,
     ),
 }
 
