@@ -54,30 +54,36 @@ def test_normal_frame_matrices_are_zeltners():
 
 
 def test_lobe_albedo_matches_the_ports_quadrature():
-    """lutbake.ltc.fit.lobe_albedo (the ltc kind's magnitude of the lobe) against the port's own quadrature."""
+    """lutbake.ltc.fit.lobe_albedo (the ltc kind's magnitude of the lobe, Gauss-Legendre) against the port's own
+    quadrature, a midpoint rule, at 1024^2 (at 256^2 its own error reaches 1e-5 relative)."""
     idx = [(0, 0), (3, 2), (16, 16), (5, 25), (31, 31)]
     nov = np.float32([MUS[i] for i, _ in idx])
     alpha = np.float32([ALPHAS[j] for _, j in idx])
     got = fit.lobe_albedo(fit.Problem("zeltner", nov, alpha, np.zeros(len(idx))))
-    want = [ref.albedo(float(m), float(a)) for m, a in zip(nov, alpha)]
+    want = [ref.albedo(float(m), float(a), n=1024) for m, a in zip(nov, alpha)]
     np.testing.assert_allclose(got, want, rtol=1e-5)
 
 
 def test_fit_on_the_papers_grid_is_close_to_the_published_approx_table(published):
-    """lutbake's L3 fit (magnitude = albedo) of the approx lobe against the paper's L2 fit (R free) of the same lobe:
-    rows mu >= 0.03: |dA| median 7.4e-3, p95 2.8e-2, max 5.6e-2; |dB| median 3.1e-3, max 1.7e-2; |R - albedo| median
-    6.1e-3 relative, max 3.6e-2. Row mu = 0.01 (grazing view) is left out: both fits' relative L3 error there is ~1
-    (no LTC of this form fits it) and they differ by up to 0.95 in A."""
+    """lutbake's L3 fit (magnitude = albedo) of the approx lobe against the paper's L2 fit (R free) of the same lobe,
+    every other texel of rows mu >= 0.03: |dA| median 7.3e-3, p95 3.0e-2, max 5.5e-2; |dB| median 2.9e-3, max 1.2e-2;
+    |R - albedo| median 5.9e-3 relative, max 3.4e-2. Row mu = 0.01 (grazing view) is left out: both fits' relative L3
+    error there is ~1 (no LTC of this form fits it) and they differ by up to 0.95 in A."""
     nov, alpha = np.repeat(np.float32(MUS), N), np.tile(np.float32(ALPHAS), N)
     p = fit.Problem("zeltner", nov, alpha, np.zeros(N * N))
     p = fit.Problem("zeltner", nov, alpha, fit.lobe_albedo(p))
-    m, _ = fit.fit_texels(p, np.arange(N * N), N, fit.coarse_pass(p, N, N))
+    rows, cols = np.arange(1, N, 2), np.arange(0, N, 2)  # every other texel (each is fitted independently)
+    idx = (rows[:, None] * N + cols[None, :]).ravel()
+    m, _ = fit.fit_texels(p, idx, N, fit.coarse_pass(p, N, N))
     inv = np.linalg.inv(m)
-    ours = np.stack([inv[:, 0, 0] / inv[:, 2, 2], inv[:, 0, 2] / inv[:, 2, 2], p.magnitude], axis=1).reshape(N, N, 3)
-    d = np.abs(ours - published["approx"])[1:]
+    ours = np.stack([inv[:, 0, 0] / inv[:, 2, 2], inv[:, 0, 2] / inv[:, 2, 2], p.magnitude[idx]], axis=1)
+    d = np.abs(ours - published["approx"].reshape(-1, 3)[idx]).reshape(len(rows), len(cols), 3)
+    print("|dA| median, p95, max", np.median(d[..., 0]), np.quantile(d[..., 0], 0.95), d[..., 0].max())
+    print("|dB| median, max", np.median(d[..., 1]), d[..., 1].max())
     assert np.median(d[..., 0]) < 0.01 and np.quantile(d[..., 0], 0.95) < 0.04 and d[..., 0].max() < 0.08
     assert np.median(d[..., 1]) < 0.005 and d[..., 1].max() < 0.03
-    rel = d[..., 2] / np.maximum(published["approx"][1:, :, 2], 1e-3)
+    rel = d[..., 2] / np.maximum(published["approx"][1::2, ::2, 2], 1e-3)
+    print("R relative median, max abs", np.median(rel), d[..., 2].max())
     assert np.median(rel) < 0.01 and d[..., 2].max() < 0.05
 
 

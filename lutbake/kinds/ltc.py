@@ -367,7 +367,10 @@ def magnitude_record(lb, estimator: str, samples) -> str:
     if lb.magnitude == "lobe":
         from ..ltc import fit
 
-        return f"lutbake.ltc.fit.lobe_albedo: midpoint rule, {fit.ALBEDO_NODES}^2 (theta graded to the horizon, phi)"
+        return (
+            f"lutbake.ltc.fit.lobe_albedo: Gauss-Legendre {fit.ALBEDO_ORDER} x {fit.ALBEDO_ORDER // 2} (theta graded "
+            "to the horizon, phi)"
+        )
     if lb.magnitude.startswith("diffuse:"):
         model = lb.magnitude.split(":")[1]
         return (
