@@ -74,12 +74,15 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_interpolation.py
 	$(BIN)/python benchmarks/bench_dielectric.py
 	$(BIN)/python benchmarks/bench_ltc.py
+	$(BIN)/python benchmarks/bench_ltc.py --lobes eon,gotanda
 	$(BIN)/python benchmarks/bench_cluster.py
 	$(BIN)/python benchmarks/write_benchmarks_md.py
 
-# LTC fits (kind ltc): fit time per lobe at 64^2, the straight-port baseline, area-light errors: outputs/bench/ltc.json
+# LTC fits (kind ltc): fit time per lobe at 64^2, the straight-port baseline, area-light errors (L3 and shaded fits):
+# outputs/bench/ltc.json (ggx, beckmann, charlie, lambert) and ltc_eon_gotanda.json
 bench-ltc: $(STAMP)
 	$(BIN)/python benchmarks/bench_ltc.py
+	$(BIN)/python benchmarks/bench_ltc.py --lobes eon,gotanda
 
 bench-luts: $(STAMP)
 	$(BIN)/python benchmarks/bench_luts.py

@@ -81,7 +81,8 @@ def area(lobe: str, t1, t2, axes) -> dict:
     s = AREA_SAMPLES.get(lobe, 512)
     rows = ltc_area.compare(lobe, t1, t2, axes[1].values(), lobe_parameter(axes[2]), AREA_TEXELS, s=s)
     by_rough = ltc_area.summarise(rows, "a")
-    return {f"r={a / (N - 1):.3f}": v for a, v in by_rough.items()}
+    overall = ltc_area.summarise([{**r, "all": "all"} for r in rows], "all")
+    return {f"r={a / (N - 1):.3f}": v for a, v in by_rough.items()} | overall
 
 
 def main(argv=None):
@@ -91,6 +92,12 @@ def main(argv=None):
     ap.add_argument("--bench-cases", type=int, default=8, help="area-light benchmark: shading points per band")
     ap.add_argument("--bench-lights", type=int, default=16, help="area-light benchmark: lights per shading point")
     ap.add_argument("--bench-samples", type=int, default=512, help="area-light benchmark: truth's S (S x S samples)")
+    ap.add_argument(
+        "--shaded",
+        default=None,
+        help="lobes also fitted with fit = shaded and compared at the area-light texels (default: those of --lobes but "
+        "ggx, benchmarked through the shader in section 8, and lambert, an exact LTC)",
+    )
     args = ap.parse_args(argv)
     wp.config.quiet = True
     OUT.mkdir(parents=True, exist_ok=True)
@@ -121,7 +128,7 @@ def main(argv=None):
             print(f"interpolation {lobe}:", json.dumps(report["interpolation"][lobe]), flush=True)
     axes = axes_for({"lobe": "ggx", "size": [N, N]})
     if "ggx" not in tables:
-        area_section(report, tables, axes, None, None, with_published=False)
+        area_section(report, tables, axes, None, None, with_published=False, shaded=shaded_lobes(args, tables))
         return finish(report)
     nov, alpha = texel_params(axes)
     ggx = tables["ggx"]
@@ -178,7 +185,7 @@ def main(argv=None):
     }
     print("straight port:", report["baseline_straight_port"], flush=True)
 
-    area_section(report, tables, axes, t1p, t2p, with_published=True)
+    area_section(report, tables, axes, t1p, t2p, with_published=True, shaded=shaded_lobes(args, tables))
     report["area_benchmark"] = benchmark_section(ggx, report["lobes"]["ggx"], workers, t1p, t2p, args)
     finish(report)
 
@@ -279,7 +286,11 @@ def sharing_section(ggx_cpu: float, workers: int) -> dict:
     return row
 
 
-def area_section(report, tables, axes, t1p, t2p, with_published: bool) -> None:
+def shaded_lobes(args, tables: dict) -> list[str]:
+    return args.shaded.split(",") if args.shaded else [lb for lb in tables if lb not in ("ggx", "lambert")]
+
+
+def area_section(report, tables, axes, t1p, t2p, with_published: bool, shaded: list[str]) -> None:
     report["area_lights"] = {"lights": [name for name, _ in ltc_area.light_set()], "texels": AREA_TEXELS}
     if with_published:
         report["area_lights"]["published_ggx"] = area("ggx", t1p, t2p, axes)
@@ -288,6 +299,12 @@ def area_section(report, tables, axes, t1p, t2p, with_published: bool) -> None:
         ax = axes_for({"lobe": lobe, "size": [N, N]})
         report["area_lights"][lobe] = area(lobe, table.data[0].astype(np.float64), table.data[1].astype(np.float64), ax)
         print(f"area lights {lobe}:", json.dumps(report["area_lights"][lobe]), flush=True)
+    for lobe in shaded:  # the shaded fit of the other lobes, at the same texels (texel centres, no bilinear lookup)
+        table, seconds, cpu = bake(lobe, default_workers(), fit_kind="shaded")
+        ax = axes_for({"lobe": lobe, "size": [N, N]})
+        row = area(lobe, table.data[0].astype(np.float64), table.data[1].astype(np.float64), ax)
+        report.setdefault("area_lights_shaded", {})[lobe] = row | {"seconds": seconds, "cpu_seconds": cpu}
+        print(f"area lights {lobe} (fit = shaded):", json.dumps(row["all"]), "L3:", report["area_lights"][lobe]["all"])
 
 
 def finish(report) -> None:

@@ -194,6 +194,23 @@ def section_ltc(docs: dict[str, dict]) -> list[str]:
                 ]
             )
     out += table(["lobe", "size", "wall s", "CPU s", "fit error median", "p95", "max"], rows) + [""]
+    shaded = [
+        [lobe]
+        + [r[fit]["all"][k] for fit in ("l3", "shaded") for k in ("rel_median", "rel_p90", "abs_max")]
+        + [r["shaded"].get("cpu_seconds")]
+        for doc in docs.values()
+        for lobe, s in doc.get("area_lights_shaded", {}).items()
+        if "all" in doc.get("area_lights", {}).get(lobe, {})
+        for r in [{"l3": doc["area_lights"][lobe], "shaded": s}]
+    ]
+    if shaded:
+        out += [
+            'The other lobes fitted with `fit = "shaded"`, at the area-light texels (texel centres; relative error of '
+            "magnitude × polygon integral against the brute force, and the largest |error| / magnitude):",
+            "",
+        ]
+        header = ["lobe"] + [f"{fit} {k}" for fit in ("L3", "shaded") for k in ("rel median", "rel p90", "abs max")]
+        out += table(header + ["shaded CPU s"], shaded) + [""]
     main = docs.get("ltc.json", {})
     port = main.get("baseline_straight_port")
     if port:
