@@ -244,3 +244,28 @@ def test_benchmarks_page_is_rendered_from_the_json(tmp_path):
     make = (ROOT / "Makefile").read_text()
     bench = make.split("\nbench:", 1)[1].split("\n\n", 1)[0]
     assert bench.rstrip().endswith("benchmarks/write_benchmarks_md.py"), "make bench renders the page last"
+
+
+def test_benchmarks_page_renders_the_ltc_area_benchmark_and_the_shaded_fits(tmp_path):
+    """bench_ltc's area-light benchmark (every table through the shader, per band, both reflectances) and the other
+    lobes' shaded fits reach the page (shapes as bench_ltc and lutbake.validate.ltc_bench.report write them)."""
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import write_benchmarks_md
+
+    def band(x):
+        return {"rel_median": x, "rel_p90": 2 * x, "abs_p90": x / 10}
+
+    tables = {
+        n: {"all": band(x), "r 0.05-0.3 / θ 0-30°": band(x)} for n, x in (("published", 0.05), ("two_lobe", 0.02))
+    }
+    ratio = {"rel_median": 0.4, "abs_p90": 0.2, "bands_worse_in_rel_median_or_abs_p90": []}
+    area = {"cases": 4, "lights": 64, "truth": {"estimator": "GGX VNDF"}, "fit_times": {"l3_fit_64x64": {"seconds": 9}}}
+    area |= {"f0=1": {"tables": tables, "two_lobe_over_published": ratio}}
+    summary = {"all": {"rel_median": 0.1, "rel_p90": 0.3, "abs_max": 0.05}}
+    doc = {"lobes": {}, "area_benchmark": area, "area_lights": {"eon": summary}}
+    doc["area_lights_shaded"] = {"eon": summary | {"cpu_seconds": 40.0}}
+    (tmp_path / "ltc.json").write_text(json.dumps(doc))
+    text = write_benchmarks_md.render(tmp_path)
+    assert "| all | 0.05 / 0.1 / 0.005 | 0.02 / 0.04 / 0.002 |" in text, text
+    assert "two_lobe over published: median relative 0.4, |error| / albedo p90 0.2" in text
+    assert "| eon | 0.1 | 0.3 | 0.05 | 0.1 | 0.3 | 0.05 | 40 |" in text, text
