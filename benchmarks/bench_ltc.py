@@ -14,7 +14,7 @@
    lutbake's L3 fit (the default) vs lutbake's shaded fit (fit = "shaded"), relative error and |error| / albedo
    (median, p90, max), overall, per roughness band, per view band and per (roughness, view) band, for F = 1 and
    f0 = 0.04; the ground truth's own error (visible-normal sampling at S^2 against NDF sampling at (2S)^2, views
-   below 80 degrees); and the GGX 64^2 fit time of both fits.
+   below 80 degrees); and the GGX 64^2 fit time of both fits, beside ltc_code's C++ fitLTC (benchmarks/fitltc.py).
 7. Sharing: the ltc-hdrp preset (alpha_min 1e-3) baked after GGX in the same process (lutbake.ltc.fit.MEMO: texels
    with equal inputs and seeds take GGX's fits), CPU seconds and the ratio to GGX's; and baked alone (memo
    cleared), to check the bits are the same.
@@ -38,6 +38,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests"))
 
+import fitltc  # noqa: E402
 import ltc_port  # noqa: E402
 import warp as wp  # noqa: E402
 
@@ -199,8 +200,13 @@ def benchmark_section(ggx, ggx_row: dict, workers: int, t1p, t2p, args) -> dict:
     times = {
         "l3_fit_64x64": {"seconds": ggx_row["seconds"], "cpu_seconds": ggx_row["cpu_seconds"]},
         "shaded_fit_64x64": {"seconds": round(seconds, 2), "cpu_seconds": round(cpu, 2)},
-        "ltc_code_fitLTC": "not built here (no glm in the environment) and no published timing found",
+        "ltc_code_fitLTC": fitltc.time_fitltc(),
     }
+    c = times["ltc_code_fitLTC"]
+    c_seconds = c.get("seconds", c.get("last_measured", {}).get("seconds"))
+    if c_seconds:  # fitLTC runs one thread; lutbake's l3 fit runs `workers`
+        times["fitLTC_seconds_over_lutbake_l3"] = round(c_seconds / ggx_row["seconds"], 1)
+        times["fitLTC_seconds_over_lutbake_l3_cpu"] = round(c_seconds / ggx_row["cpu_seconds"], 1)
     print("fit times:", json.dumps(times), flush=True)
     t0 = time.perf_counter()
     cases = ltc_bench.cases(args.bench_cases, args.bench_lights)
