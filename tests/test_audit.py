@@ -224,7 +224,8 @@ SHIPPED = {
 # tables of tests/data no preset bakes: the model they hold is not one lutbake integrates
 UNAUDITED = {
     "babylon_environment_fuzz_brdf.npz": "Zeltner, Burley & Chiang 2022's LTC fit of their random-walk volume "
-    "(identified in tests/test_sheen_volume.py; lutbake integrates their analytic approximation, no preset yet)",
+    "(identified in tests/test_sheen_volume.py; lutbake integrates their analytic approximation: preset babylon-fuzz, "
+    "compared in tests/test_babylon.py; audit_ltc reads ltc_code pairs, not this (A, B, R_i) coding)",
     "ltc_sheen_tables.npz": "Zeltner et al.'s two published LTC tables (volume, approx): the references of "
     "tests/test_sheen_volume.py, no engine loads them",
 }

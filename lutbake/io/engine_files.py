@@ -7,6 +7,7 @@ the table's axes, channels and conventions), so ``lutbake inspect`` and ``previe
 | ``js`` (kind ltc) | three.js module | ``LTC_MAT_1``, ``LTC_MAT_2`` | (2, N, N, 4) |
 | ``c`` | Blender EEVEE .cc | ``ltc_mat_<lobe>``, ``ltc_mag_<lobe>``, ``ltc_disk_integral`` | (2, N, N, 4) |
 | ``cs`` | Unity HDRP .cs | ``s_LtcMatrixData_BRDF_<LOBE>`` (FP16 bits) | (N, N, 4): HDRP's texel, its own channels |
+| ``babylon_fuzz`` | one DDS | r, g, b through Babylon's mix() (lutbake.layouts.babylon) | (N, N, 3): A, B, R_i |
 | ``openpbr_h`` | OpenPBR header | ``OpenPBR_*_Array`` (UNORM16 codes / 65535) | the table's (metal: tiled over IOR) |
 | ``js``, ``wgsl``, ``rs`` | code arrays | the one array, shape from its ``lutbake:shape`` line | the table's |
 
@@ -134,7 +135,44 @@ def _code_array(path: Path, doc: dict, dims: dict) -> np.ndarray:
     return parse_text_array(text, shape)[0]
 
 
-READERS = {"ltc_dds": _ltc_dds, "c": _ltc_c, "cs": _hdrp_cs, "wgsl": _code_array, "rs": _code_array}
+def _babylon_fuzz(path: Path, doc: dict, dims: dict) -> np.ndarray:
+    from ..layouts.babylon import BABYLON_FUZZ
+    from . import dds
+
+    stored = dds.decode(read_bytes(path))[0].astype(np.float64)
+    if stored.shape[:2] != (dims["y"], dims["x"]) or stored.shape[-1] < 3:
+        raise ValueError(f"its texture is {stored.shape}, the sidecar's axes need ({dims['y']}, {dims['x']}, 4)")
+    return BABYLON_FUZZ.decode(stored)
+
+
+def _babylon_fuzz_attrs(attrs: dict, doc: dict) -> str:
+    """Babylon's channels and shader line in place of ltc_code's (the texture axis dropped); the note: the decode
+    and the values outside the mix() ranges the writer reported."""
+    from ..layouts.babylon import BABYLON_FUZZ
+
+    attrs["axes"] = json.dumps([a for a in json.loads(attrs["axes"]) if a["dim"] != "z"])
+    attrs["channel_names"] = json.dumps({k: c.name for k, c in zip("RGB", BABYLON_FUZZ.channels)})
+    attrs["channels"] = json.dumps({k: f"{c.name}: {c.meaning}" for k, c in zip("RGB", BABYLON_FUZZ.channels)})
+    attrs["reconstruction"] = str(doc.get("shader", BABYLON_FUZZ.shader))
+    outside = doc.get("outside_mix_ranges") or "none"
+    if isinstance(outside, dict):
+        outside = "; ".join(
+            f"{name}: {v.get('texels')} texels, values [{v.get('min', 0):.4g}, {v.get('max', 0):.4g}] vs mix range "
+            f"{v.get('range')}"
+            for name, v in outside.items()
+            if isinstance(v, dict)
+        )
+    return f"Babylon's r, g, b decoded by getFuzzBRDFLookup's mix() as (A, B, R_i); outside the mix ranges: {outside}"
+
+
+READERS = {
+    "babylon_fuzz": _babylon_fuzz,
+    "ltc_dds": _ltc_dds,
+    "c": _ltc_c,
+    "cs": _hdrp_cs,
+    "wgsl": _code_array,
+    "rs": _code_array,
+}
 
 
 def read_engine(path: Path, doc: dict) -> tuple[np.ndarray, dict[str, str], str]:
@@ -161,6 +199,8 @@ def read_engine(path: Path, doc: dict) -> tuple[np.ndarray, dict[str, str], str]
         attrs["axes"] = json.dumps([a for a in json.loads(attrs["axes"]) if a["dim"] != "z"])
         attrs["channel_names"] = json.dumps({k: v[0] for k, v in HDRP_CHANNELS.items()})
         attrs["channels"] = json.dumps({k: v[1] for k, v in HDRP_CHANNELS.items()})
-    if attrs.get("kind") == "ltc" and fmt != "cs":
+    if fmt == "babylon_fuzz":
+        note = _babylon_fuzz_attrs(attrs, doc)
+    if attrs.get("kind") == "ltc" and fmt not in ("cs", "babylon_fuzz"):
         note += "; ltc_2.z (the fit error) is 0 in engine layouts (lutbake:fit_error_* hold its statistics)"
     return np.ascontiguousarray(data, dtype=np.float32), attrs, note

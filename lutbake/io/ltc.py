@@ -11,6 +11,8 @@ formats ``ltc_dds``, ``js``, ``c`` and ``cs`` of lutbake.io.formats.
 |  |  | ltc_disk_integral[N][N][1] (rows = sqrt(1 - NoV), columns = roughness) |
 | ``cs`` | <name>.cs (+ .json) | Unity HDRP LtcData.BRDF_<lobe>.cs: ushort[N * N * 4] of FP16 bits, one slice of its |
 |  |  | Texture2DArray _LtcData (R16G16B16A16_SFloat); (M^-1_00, M^-1_20, M^-1_11, M^-1_02) / M^-1_22 |
+| ``babylon_fuzz`` | <name>.dds (+ .json) | Babylon.js scene.environmentFuzzBRDFTexture: one RGBA16F (or 32F) DDS, |
+|  |  | (A, B, R_i) of a normal-frame fit coded by getFuzzBRDFLookup's mix() (lutbake.layouts.babylon) |
 Every array is row 0 first (row = view index t, column = roughness index a: element a + t N, as ltc_code's
 tab[a + t*N]); ltc_2's .z (lutbake's fit_error) is written as 0 as in ltc_code.
 """
@@ -25,11 +27,13 @@ from ..table import Table
 from .conventions import write_conventions
 
 FP16_MAX = 65504.0
-EXTENSIONS = {"ltc_dds": "_1.dds", "js": ".js", "c": ".cc", "cs": ".cs"}
+EXTENSIONS = {"ltc_dds": "_1.dds", "js": ".js", "c": ".cc", "cs": ".cs", "babylon_fuzz": ".dds"}
 FORMATS = {  # js: lutbake.io.code_arrays' format, which writes an ltc table as three.js' module (write_js)
     "ltc_dds": "ltc_code's two files <name>_1.dds, <name>_2.dds: RGBA16F (dtype half) or RGBA32F (kind ltc)",
     "c": "Blender EEVEE C arrays ltc_mat_<lobe>, ltc_mag_<lobe>, ltc_disk_integral (kind ltc)",
     "cs": "Unity HDRP C# table s_LtcMatrixData_BRDF_<LOBE>, FP16 bits of one RGBA16F slice (kind ltc)",
+    "babylon_fuzz": "Babylon.js environmentFuzzBRDFTexture: one DDS, RGBA16F (half) or RGBA32F, (A, B, R_i) coded by "
+    "getFuzzBRDFLookup's mix() ranges (kind ltc, normal-frame lobes: zeltner)",
 }
 
 
@@ -192,4 +196,56 @@ def write_cs(table: Table, path, dtype: str = "half") -> Path:
     return path
 
 
-WRITERS = {"ltc_dds": write_ltc_dds, "js": write_js, "c": write_c, "cs": write_cs}
+def babylon_fuzz_pixels(table: Table) -> tuple[np.ndarray, dict]:
+    """Babylon's stored RGBA (ny, nx, 4) float64 of a normal-frame ``ltc`` table (lutbake.layouts.babylon
+    BABYLON_FUZZ: r, g, b = (A, B, R_i) coded by the shader's mix() ranges, a = 1) and the values outside those ranges
+    (channel -> texels, extent, range; empty when none). Unclamped: a float texture holds them and mix() reads them
+    back exactly; the writer reports them."""
+    from ..layouts.babylon import BABYLON_FUZZ
+
+    if table.kind != "ltc":
+        raise ValueError(f"table {table.name!r}: babylon_fuzz holds kind 'ltc' tables only, not {table.kind!r}")
+    t1 = np.asarray(table.data[0], np.float64)
+    if np.abs(t1[..., 1]).max() > 0 or np.abs(t1[..., 0] - 1.0).max() > 1e-6:
+        raise ValueError(
+            f"table {table.name!r}: babylon_fuzz stores an LTC fitted in the normal's frame, M^-1 = [[A, 0, B], "
+            "[0, A, 0], [0, 0, 1]] (ltc_1 = (1, 0, B/A, 1/A)): fit a normal-frame lobe (zeltner)"
+        )
+    values = BABYLON_FUZZ.values(table.data)
+    return BABYLON_FUZZ.encode(values), BABYLON_FUZZ.outside(values)
+
+
+def write_babylon_fuzz(table: Table, path, dtype: str = "half") -> Path:
+    """One DDS Babylon loads as scene.environmentFuzzBRDFTexture (isRGBD = false, invertY = false: row 0 at v = 0).
+    Values outside the mix() ranges are not clamped (the float texture holds them and mix() extrapolates, so the
+    shader reads the fitted values): the sidecar lists them (``outside_mix_ranges``: per channel the texel count, the
+    extent and the range) and ``lutbake inspect`` / ``preview`` say so (lutbake.io.engine_files)."""
+    from ..layouts.babylon import BABYLON_FUZZ
+    from ..layouts.base import uv_of
+    from . import dds
+    from .atomic import atomic_write_bytes
+
+    stored, outside = babylon_fuzz_pixels(table)
+    np_dtype = np.float16 if dtype == "half" else np.float32
+    path = Path(path)
+    atomic_write_bytes(path, dds.encode(stored.astype(np_dtype)))
+    write_conventions(
+        table,
+        path,
+        "babylon_fuzz",
+        {
+            "dxgi_format": "R16G16B16A16_FLOAT" if dtype == "half" else "R32G32B32A32_FLOAT",
+            "engine": BABYLON_FUZZ.engine,
+            "coding": {
+                c.name: {"channel": ch, "mix": [c.lo, c.hi], "meaning": c.meaning}
+                for ch, c in zip("rgb", BABYLON_FUZZ.channels)
+            },
+            "alpha_channel": "1",
+            "shader": BABYLON_FUZZ.shader.format(uv=uv_of(table.axes[1:])),
+            "outside_mix_ranges": outside or "none",
+        },
+    )
+    return path
+
+
+WRITERS = {"ltc_dds": write_ltc_dds, "js": write_js, "c": write_c, "cs": write_cs, "babylon_fuzz": write_babylon_fuzz}

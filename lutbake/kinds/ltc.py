@@ -18,6 +18,9 @@ t = sqrt(1 - cos theta_v) at endpoint texels t/(N - 1), theta_v <= 1.57 rad (NoV
 Shaders sample uv = vec2(roughness, sqrt(1 - NoV)) * (N - 1)/N + 0.5/N. Differences from ltc_code, all recorded
 in the metadata: alpha >= 1e-4 (lutbake.edge; ltc_code 1e-5), magnitude and fresnel integrated exactly
 (ltc_code: 32^2 samples), every texel fitted independently from a coarse pass (ltc_code: chained).
+Keys ``nov_mapping`` ("one_minus_t2", default: ltc_code's rows; "linear": NoV = t) and ``texel`` ("endpoint", default;
+"center") change both axes' grid (Zeltner et al.'s sheen tables are linear in NoV; Babylon.js samples its fuzz table
+at texel centres: preset ``babylon-fuzz``, format ``babylon_fuzz``, lutbake.layouts.babylon).
 Key ``fit``: "l3" (default) as above; "shaded" refines the L3 fit's texels to the polygon-light integrals the shader
 computes, magnitude and fresnel included (lutbake.ltc.shaded; docs/ltc_shaded.md).
 The sphere channel's own axes: x = z * 0.5 + 0.5 (z = cos of the form-factor direction's elevation), y =
@@ -32,7 +35,7 @@ import threading
 
 import numpy as np
 
-from ..axes import Axis
+from ..axes import MAPPINGS, TEXELS, Axis
 from ..catalog import LTC_FIT_GRID, LTC_LOBES
 from ..edge import ALPHA_MIN
 from ..layouts.base import uv_of
@@ -50,6 +53,8 @@ FORMATS = {
     "c": "Blender EEVEE C arrays ltc_mat_<lobe>[N][N][4], ltc_mag_<lobe>[N][N][2], ltc_disk_integral[N][N][1]",
     "cs": "Unity HDRP C# table s_LtcMatrixData_BRDF_<LOBE> (ushort FP16 bits, one RGBA16F slice of _LtcData): "
     "(M^-1_00, M^-1_20, M^-1_11, M^-1_02) / M^-1_22",
+    "babylon_fuzz": "Babylon.js scene.environmentFuzzBRDFTexture: one DDS, RGBA16F (half) or RGBA32F, (A, B, R_i) of "
+    "a normal-frame fit (lobe zeltner) coded by getFuzzBRDFLookup's mix() ranges (lutbake.layouts.babylon)",
 }
 ESTIMATORS = {
     "gauss_legendre": "the fit (Heitz's L3 metric, Nelder-Mead per texel: lutbake.ltc.fit) with magnitude and fresnel "
@@ -108,6 +113,23 @@ KEYS = {
             "HDRP's PreIntegratedFGD)",
         },
     ),
+    "nov_mapping": Key(
+        "nov_mapping",
+        "str",
+        "one_minus_t2",
+        "how t maps to NoV on the rows (y)",
+        {
+            "one_minus_t2": MAPPINGS["one_minus_t2"] + "; ltc_code's t = sqrt(1 - cos theta_v) (default)",
+            "linear": MAPPINGS["linear"] + " (Zeltner et al.'s sheen tables, Babylon.js's fuzz table)",
+        },
+    ),
+    "texel": Key(
+        "texel",
+        "str",
+        "endpoint",
+        "texel convention of both axes (the NoV rows and the roughness columns)",
+        {"endpoint": TEXELS["endpoint"] + " (ltc_code; default)", "center": TEXELS["center"] + " (Babylon.js)"},
+    ),
     "format": Key("format", "str", "exr", "output file format", FORMATS),
 }
 RECONSTRUCTION = (  # {uv}: lutbake.layouts.base.uv_of of the table's [NoV, roughness] axes
@@ -139,10 +161,13 @@ def axes_for(o: dict) -> list[Axis]:
         lb.roughness, "perceptual_roughness"
     )
     amap = "sigma" if lb.roughness == "sigma" else None  # Gotanda's sigma: GGX alpha = sigma (docs/diffuse.md)
+    texel = o.get("texel", "endpoint")
     return [
         Axis("texture", "z", 2, 1.0, 2.0, texel="endpoint", mapping="listed", listed=(1.0, 2.0)),
-        Axis("NoV", "y", n_view, 0.0, 1.0, texel="endpoint", mapping="one_minus_t2", clamp=(NOV_LO, 1.0)),
-        Axis(rname, "x", n_rough, 0.0, 1.0, texel="endpoint", alpha_map=amap),
+        Axis(
+            "NoV", "y", n_view, 0.0, 1.0, texel=texel, mapping=o.get("nov_mapping", "one_minus_t2"), clamp=(NOV_LO, 1.0)
+        ),
+        Axis(rname, "x", n_rough, 0.0, 1.0, texel=texel, alpha_map=amap),
     ]
 
 
@@ -507,8 +532,15 @@ def check_spec(spec):
         )
     if LOBES[o["lobe"]].magnitude.startswith("diffuse:") and o["samples"] is not None and o["samples"] > 64:
         return ("samples", f"lobe {o['lobe']!r}: samples is the diffuse kind's Gauss-Legendre order, at most 64")
-    if o["format"] == "ltc_dds" and o["dtype"] not in ("half", "float32"):
-        return ("dtype", "ltc_dds writes RGBA16F (half) or RGBA32F (float32)")
+    if o["format"] in ("ltc_dds", "babylon_fuzz") and o["dtype"] not in ("half", "float32"):
+        return ("dtype", f"{o['format']} writes RGBA16F (half) or RGBA32F (float32)")
+    if o["format"] == "babylon_fuzz" and not LOBES[o["lobe"]].normal_frame:
+        normal = ", ".join(n for n, lb in LOBES.items() if lb.normal_frame)
+        return (
+            "format",
+            f"babylon_fuzz stores M^-1 = [[A, 0, B], [0, A, 0], [0, 0, 1]] in the normal's frame: lobe {o['lobe']!r} "
+            f"is not fitted so (normal-frame lobes: {normal})",
+        )
     return None
 
 

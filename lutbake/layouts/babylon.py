@@ -19,11 +19,15 @@ png.a, Shaders/ShadersInclude/helperFunctions fromRGBD, into a half-float target
   vec2(sqrt(fuzz_roughness), NdotV) as A = mix(0.005, 0.88, r), B = mix(-0.18, 0.002, g), R_i = mix(0, 0.75, b), but
   after the RGBD decode's pow(x, 2.2) (up to 0.25 off in A; tests/test_sheen_volume.py, docs/presets.md). lutbake
   integrates the paper's analytic approximation (LTC lobe ``zeltner``, lutbake.terms.sheen_volume), not the random
-  walk; no preset writes Babylon's (A, B, R_i) layout yet.
+  walk. The preset ``babylon-fuzz`` writes Babylon's (A, B, R_i) layout from that fit (``BABYLON_FUZZ`` below: the
+  mix() ranges, the channels, the shader line, as data; lutbake.io.ltc writes and reads it as format
+  ``babylon_fuzz``), sampled where Babylon samples: linear NoV and alpha axes at texel centres.
 lutbake's presets write float tables (DDS RGBA16F) Babylon loads with ``isRGBD = false`` and ``invertY = false``.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -63,6 +67,86 @@ BABYLON_F82 = Layout(
     to_stored=f82_stored,
     from_stored=f82_integrals,
     split_sum="multiscatter",
+)
+
+
+@dataclass(frozen=True)
+class CodedChannel:
+    """One channel of a texture a shader reads as value = mix(lo, hi, stored): stored = (value - lo) / (hi - lo)."""
+
+    name: str
+    lo: float
+    hi: float
+    meaning: str
+
+    def encode(self, value: np.ndarray) -> np.ndarray:
+        return (np.asarray(value, np.float64) - self.lo) / (self.hi - self.lo)
+
+    def decode(self, stored: np.ndarray) -> np.ndarray:
+        return self.lo + (self.hi - self.lo) * np.asarray(stored, np.float64)
+
+
+@dataclass(frozen=True)
+class LtcCoding:
+    """An engine texture of an ``ltc`` table fitted in the normal's frame (M^-1 = [[A, 0, B], [0, A, 0], [0, 0, 1]],
+    lutbake.ltc.fit normal_frame_matrices): (A, B, magnitude) each coded linearly into [0, 1] (``channels``, in
+    texture order r, g, b; a = 1). ``values`` reads (A, B, R) from the table's ltc_code packing (slice 0 = M^-1 /
+    M^-1_11 as (m00, m20, m02, m22): A = 1 / m22, B = m02 / m22; slice 1 x = magnitude)."""
+
+    name: str
+    engine: str
+    channels: tuple[CodedChannel, ...]
+    shader: str
+    source: str
+
+    @staticmethod
+    def values(data: np.ndarray) -> np.ndarray:
+        """(2, ny, nx, 4) ltc table -> (ny, nx, 3) float64 (A, B, R)."""
+        t1, t2 = np.asarray(data[0], np.float64), np.asarray(data[1], np.float64)
+        return np.stack([1.0 / t1[..., 3], t1[..., 2] / t1[..., 3], t2[..., 0]], axis=-1)
+
+    def encode(self, values: np.ndarray) -> np.ndarray:
+        """(.., 3) (A, B, R) -> (.., 4) stored RGBA (a = 1), unclamped."""
+        coded = [c.encode(values[..., k]) for k, c in enumerate(self.channels)]
+        return np.stack(coded + [np.ones(values.shape[:-1])], axis=-1)
+
+    def decode(self, stored: np.ndarray) -> np.ndarray:
+        """(.., >= 3) stored -> (.., 3) (A, B, R): the shader's mix()."""
+        return np.stack([c.decode(stored[..., k]) for k, c in enumerate(self.channels)], axis=-1)
+
+    def outside(self, values: np.ndarray) -> dict[str, dict]:
+        """Per channel whose values leave [lo, hi]: the texel count, the values' extent and the range (the shader's
+        mix() extrapolates a float texture's stored value outside [0, 1] linearly, so the values read back exactly;
+        an 8-bit or UNORM copy would clamp them)."""
+        out = {}
+        for k, c in enumerate(self.channels):
+            v = values[..., k]
+            bad = (v < c.lo) | (v > c.hi)
+            if bad.any():
+                out[c.name] = {
+                    "texels": int(bad.sum()),
+                    "min": float(v.min()),
+                    "max": float(v.max()),
+                    "range": [c.lo, c.hi],
+                }
+        return out
+
+
+BABYLON_FUZZ = LtcCoding(
+    name="babylon_fuzz",
+    engine="Babylon.js (scene.environmentFuzzBRDFTexture)",
+    channels=(  # pbrBRDFFunctions getFuzzBRDFLookup: ARange, BRange, RiRange
+        CodedChannel("A", 0.005, 0.88, "M^-1_00 = M^-1_11 of the normal-frame LTC (r: A = mix(0.005, 0.88, r))"),
+        CodedChannel("B", -0.18, 0.002, "M^-1_02 of the normal-frame LTC (g: B = mix(-0.18, 0.002, g))"),
+        CodedChannel(
+            "R", 0.0, 0.75, "the lobe's directional albedo R_i, the LTC's magnitude (b: R_i = mix(0, 0.75, b))"
+        ),
+    ),
+    shader="vec2 UV = vec2(perceptualRoughness, NdotV) (getFuzzBRDFLookup(NdotV, sqrt(fuzz_roughness)): the column "
+    "coordinate is the table's alpha); {uv}; t = texture2D(environmentFuzzBrdfSampler, uv); A = mix(0.005, 0.88, t.r); "
+    "B = mix(-0.18, 0.002, t.g); R_i = mix(0.0, 0.75, t.b); M^-1 = [[A, 0, B], [0, A, 0], [0, 0, 1]] in the normal's "
+    "frame",
+    source=SOURCE,
 )
 
 LAYOUTS = (BABYLON_F82,)
@@ -106,5 +190,23 @@ TABLES = (
         SOURCE,
         "scene.openPBREnvironmentBRDFTexture (isRGBD = false, invertY = false)",
         shipped="babylon_openpbr_brdf.npz",
+    ),
+    EngineTable(
+        "Babylon.js",
+        "babylon-fuzz",
+        "babylon_fuzz_brdf",
+        "ltc",
+        None,
+        {
+            "lobe": "zeltner",
+            "size": [32, 32],
+            "nov_mapping": "linear",
+            "texel": "center",
+            "dtype": "half",
+            "format": "babylon_fuzz",
+        },
+        SOURCE,
+        "scene.environmentFuzzBRDFTexture (isRGBD = false, invertY = false)",
+        shipped="babylon_environment_fuzz_brdf.npz",
     ),
 )
