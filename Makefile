@@ -10,7 +10,7 @@ OUT    ?= outputs
 CONFIGS := $(wildcard configs/*.toml)
 PRESETS ?= filament filament-corrected gltf gltf-charlie gltf-sheen-e blender-eevee unreal blender-eevee-btdf blender-eevee-bsdf \
            openpbr turquin ltc-ggx ltc-threejs ltc-eevee ltc-hdrp \
-           unity-hdrp unity-hdrp-charlie godot bevy threejs babylon babylon-openpbr
+           unity-hdrp unity-hdrp-charlie godot bevy threejs babylon babylon-openpbr babylon-fuzz
 WORKERS ?=
 FORCE   ?=
 TEST_WORKERS ?= 2  # pytest-xdist processes for make test; a module's tests stay on one (its fixtures are built once)

@@ -191,8 +191,19 @@ UV_PRESETS = [
     "bevy",
     "threejs",
     "ltc-ggx",
+    "babylon",
+    "babylon-openpbr",
+    "babylon-fuzz",
 ]
-ROUGHNESS_NAMES = ("r", "roughness", "Roughness", "perceptual_roughness", "sheenRoughness")
+ROUGHNESS_NAMES = (
+    "r",
+    "roughness",
+    "Roughness",
+    "perceptual_roughness",
+    "sheenRoughness",
+    "perceptualRoughness",
+    "alpha",
+)
 NOV_NAMES = ("NoV", "NdotV", "dotNV")
 
 
