@@ -23,7 +23,8 @@ SMALL_LTC = {"kind": "ltc", "lobe": "ggx", "size": [6, 6], "fit_samples": 4}
 # (dielectric_avg declares none since its mu rule reaches the tolerance that format / dtype set)
 SMALL = {"ltc": SMALL_LTC}
 # layout values a kind's own cross-key check refuses with these small specs (they pair with other keys)
-REFUSED: set = set()
+# (babylon_fuzz: a normal-frame lobe's only, refused for ggx; tests/test_babylon.py checks the refusal)
+REFUSED: set = {("ltc", "format", "babylon_fuzz")}
 
 
 def plan_records(plan) -> dict:
