@@ -66,9 +66,10 @@ def reference(name: str, kw: dict):
     path = OUT / f"ref_dielectric_{key}.npz"
     if path.exists():
         return np.load(path)["idx"], np.load(path)["ref"]
-    k = (*kd.terms_of(o), kd.MODE[o["layout"]], "gauss_legendre")
+    layout = lookup_layout("dielectric", o["layout"])
+    k = (*kd.terms_of(o), layout.integrand, "gauss_legendre")  # the layout's Fresnel mode
     f = [np.asarray(a[idx], np.float32) for a in (nov, alpha, eta)]
-    ref = lookup_layout("dielectric", o["layout"]).stored(integrate(k, *f, 3 * REF_ORDER**2, 0))
+    ref = layout.stored(integrate(k, *f, 3 * REF_ORDER**2, 0))
     OUT.mkdir(parents=True, exist_ok=True)
     np.savez(path, idx=idx, ref=ref)
     return idx, ref
