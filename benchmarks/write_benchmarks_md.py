@@ -133,7 +133,7 @@ def section_interpolation(doc: dict | None) -> list[str]:
     out += note(doc)
     rows = [
         [
-            t["name"],
+            t["table"],
             t.get("texels"),
             100 * t.get("interpolated", 0),
             t.get("cpu_s"),
