@@ -36,6 +36,15 @@ def specs():
                 yield spec
 
 
+def stored_error(spec):
+    """A dfg layout's map from integral error bounds to stored-channel bounds (the identity otherwise: the dielectric
+    kinds' tiles carry stored bounds already, lutbake.sampling.dielectric_layout)."""
+    from lutbake.layouts import lookup_layout
+
+    layout = spec.options.get("layout")
+    return lookup_layout("dfg", layout).stored_error if spec.kind == "dfg" and layout else (lambda err: err)
+
+
 def tiles(spec, **overrides):
     """(data (n, tile width), CPU seconds of the tiles, wall seconds, the plan's channel count) of spec with
     ``overrides``."""
@@ -72,7 +81,10 @@ def main() -> None:
         nch = data.shape[1] - width - 1
         v, e, flag = data[:, :nch], data[:, width : width + nch], data[:, -1]
         err = np.abs(v - ref[:, :nch])
-        bound = e + ref[:, width : width + nch]
+        # the estimates are the integrals' (the tiles' aux columns); a layout that stores other combinations maps
+        # them to its stored channels' bounds (Layout.stored_error; Babylon's F82: bias, scale + bias, 16 F82)
+        to_stored = stored_error(spec)
+        bound = to_stored(e) + to_stored(ref[:, width : width + nch])
         interp = flag == INTERPOLATED
         ratio = np.where(bound > 0, err / np.maximum(bound, 1e-300), 0.0)
         row = {

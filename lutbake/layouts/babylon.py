@@ -43,6 +43,11 @@ def f82_stored(e: np.ndarray) -> np.ndarray:
     return np.stack([e[:, 1], e[:, 0] + e[:, 1], BRDF_Z_SCALE * e[:, 2]], axis=1)
 
 
+def f82_errors(err: np.ndarray) -> np.ndarray:
+    """Bounds of f82_stored's channels from those of (scale, bias, F82 term): (err_b, err_s + err_b, 16 err_F82)."""
+    return np.stack([err[:, 1], err[:, 0] + err[:, 1], BRDF_Z_SCALE * err[:, 2]], axis=1)
+
+
 def f82_integrals(t: np.ndarray) -> np.ndarray:
     """The inverse of f82_stored: (x, y, z) -> (y - x, x, z / 16)."""
     return np.stack([t[:, 1] - t[:, 0], t[:, 0], t[:, 2] / BRDF_Z_SCALE], axis=1)
@@ -66,6 +71,7 @@ BABYLON_F82 = Layout(
     source=SOURCE + ", openpbrIblFunctions.js",
     to_stored=f82_stored,
     from_stored=f82_integrals,
+    error_to_stored=f82_errors,
     split_sum="multiscatter",
 )
 
