@@ -254,12 +254,14 @@ def audit_ltc(
     if area_texels:
         pick = np.unique(np.linspace(0, len(idx) - 1, area_texels).round().astype(int))
         ours_t1 = fit.pack_inverse(m_ours)
+        references: dict = {}  # the brute force at a texel, the same for the file and lutbake's fit
         for label, m1 in (("file", packed_file), ("lutbake fit", ours_t1)):
             t2_sub = np.stack([mag, fres, np.zeros_like(mag), np.zeros_like(mag)], 1) if label != "file" else f_t2
             rows = []
             for i in pick:  # one texel at a time: compare() indexes NoV by row and alpha by column
+                m1_i, t2_i = m1[[i]][:, None], t2_sub[[i]][:, None]
                 rows += ltc_area.compare(
-                    o["lobe"], m1[[i]][:, None], t2_sub[[i]][:, None], nov[[i]], a_fit[[i]], [(0, 0)], AREA_SAMPLES
+                    o["lobe"], m1_i, t2_i, nov[[i]], a_fit[[i]], [(0, 0)], AREA_SAMPLES, references=references
                 )
             rel = np.array([r["rel_error"] for r in rows if r["rel_error"] is not None])
             area[label] = {"median": float(np.median(rel)), "p90": float(np.quantile(rel, 0.9)), "cases": len(rel)}

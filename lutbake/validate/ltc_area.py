@@ -170,14 +170,22 @@ def compare(
     alpha_values: np.ndarray,
     texels: list[tuple[int, int]],
     s: int = 512,
+    references: dict | None = None,
 ) -> list[dict]:
-    """Per (view row t, roughness column a) texel and light: the LTC value, the brute force, their errors."""
+    """Per (view row t, roughness column a) texel and light: the LTC value, the brute force, their errors.
+    ``references``: a dict the brute-force integrals are kept in per (lobe, NoV, alpha, s), for calls that compare
+    several tables at the same texels (they do not depend on the table)."""
     lights = light_set()
     polys = [p for _, p in lights]
     rows = []
     for t, a in texels:
         nov, alpha = float(nov_values[t]), float(alpha_values[a])
-        gt = brute_force(lobe, nov, alpha, polys, s)
+        key = (lobe, nov, alpha, s)
+        gt = references.get(key) if references is not None else None
+        if gt is None:
+            gt = brute_force(lobe, nov, alpha, polys, s)
+            if references is not None:
+                references[key] = gt
         mag = float(ltc_2[t, a, 0])
         for (name, p), g in zip(lights, gt):
             val = ltc_value(ltc_1[t, a], ltc_2[t, a], nov, p)
