@@ -29,7 +29,7 @@ ENV_SHEEN_RTOL_MEDIAN = 1e-2  # measured 4.6e-3
 # OpenPBR F82 LUT (128², 8-bit): measured RMS R 3.4e-3, G 5.8e-3, B 4.3e-3
 F82_RMS = {0: 4.5e-3, 1: 7.5e-3, 2: 6.0e-3}
 F82_MAX = 2.0e-2  # measured 1.4e-2 (every channel, every texel)
-AUDIT_SIDE = 64
+AUDIT_SIDE = 16  # the F82 table's nominal RMS is 0.81x / 0.80x / 0.79x the best alternative's at sides 6 / 32 / 64
 # fuzz table (32², Zeltner et al.'s random-walk *volume* fit, read linearly through the mix() ranges) vs the
 # babylon-fuzz bake (their analytic approximation, lutbake's L3 fit) bilinearly at the shipped grid, rows mu >= 0.03:
 # measured median |diff| A 2.3e-2, B 1.8e-2, R_i 7.1e-3; p95 0.25, 8.3e-2, 4.4e-2 (the paper's own approx table vs
@@ -108,12 +108,11 @@ def test_babylon_openpbr_f82_lut_matches_the_shipped_table(bake_preset):
     assert d.max() < F82_MAX
 
 
-@pytest.mark.parametrize(
-    "name, preset", [("babylon_environment_brdf", "babylon"), ("babylon_openpbr_brdf", "babylon-openpbr")]
-)
+@pytest.mark.parametrize("name, preset", [("babylon_openpbr_brdf", "babylon-openpbr")])
 def test_audit_finds_babylons_declared_conventions_best(name, preset):
     """``lutbake audit`` under the preset: the declared conventions fit best (no flipped rows, texel offset or other
-    split-sum layout), on a 64 x 64 subset (smaller ones are dominated by the sheen channel's grazing corner)."""
+    split-sum layout). The environment table (babylon) is audited so, on the 64 x 64 subset its sheen channel's grazing
+    corner needs, by tests/test_audit.py's test_audit_runs_on_every_shipped_table."""
     r = audit(DATA / f"{name}.npz", {"preset": preset}, max_side=AUDIT_SIDE)
     assert r.extra["chosen"] == "nominal", r.diagnosis
 
