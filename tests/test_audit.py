@@ -64,6 +64,40 @@ def test_filament_preset_conventions_fit_the_shipped_table():
     assert nominal["rms"] < 0.1 * min(others)
 
 
+# lutbake's own filament file: the conventions and texels of the filament audit above (its references reused)
+
+
+@pytest.fixture(scope="module")
+def own_filament(tmp_path_factory):
+    """lutbake's own `filament` bake as `make luts` writes it (128 x 128 half RGBA16F DDS + sidecar; the cloth
+    channel reaches ~18 at the smoothest row)."""
+    from lutbake import api
+    from lutbake.config import preset_path
+
+    out = tmp_path_factory.mktemp("own")
+    (r,) = api.bake([preset_path("filament")], out_dir=out)
+    return r.path
+
+
+def test_lutbakes_own_half_dds_passes_under_its_preset(own_filament):
+    """`lutbake audit outputs/filament_dfg.dds --preset filament` failed: the cloth channel reaches 18, where half
+    rounding alone is ~0.008 > the 1e-3 tolerance; the judged error is the one beyond a rounding step."""
+    r = audit(own_filament, {"preset": "filament"}, max_side=MAX_SIDE)
+    assert r.passed and r.extra["chosen"] == "nominal", r.text()
+    assert r.quantisation["kind"] == "half"
+    assert r.extra["raw_error"]["max"] > 1e-3  # the raw |file - converged| is above the tolerance ...
+    assert r.extra["raw_error"]["max"] <= r.extra["raw_error"]["step_at_max"]  # ... and within one half step
+
+
+def test_lutbakes_own_file_is_audited_against_its_recorded_conventions(own_filament):
+    """Without --preset, the file's sidecar conventions are used (not `default`, which gave 'layout mismatch')."""
+    r = audit(own_filament, {}, max_side=MAX_SIDE)
+    assert r.passed and r.extra["chosen"] == "nominal", r.text()
+    assert "recorded config" in r.conventions and "multiscatter_cloth" in r.conventions
+    res = CliRunner().invoke(main, ["audit", str(own_filament), "--max-side", "16"])
+    assert res.exit_code == 0 and "PASS" in res.output, res.output
+
+
 def test_gltf_lut_ggx_8bit_quantisation_and_sample_noise_found():
     r = run(DATA / "khronos_lut_ggx_u8.npz", preset="gltf")
     assert r.extra["chosen"] == "nominal"
@@ -206,7 +240,113 @@ def test_cli_rejects_non_finite_values_and_undeclared_text_layouts(clean, tmp_pa
     assert res.exit_code == 2 and "--shape" in res.output
 
 
+@pytest.fixture
+def no_area_lights(monkeypatch):
+    """audit() of an LTC table without the area-light comparison (the tests using this do not read it;
+    test_audit_runs_on_every_shipped_table does)."""
+    from functools import partial
+
+    from lutbake.commands import audit_tables
+
+    monkeypatch.setattr(audit_tables, "audit_ltc", partial(audit_tables.audit_ltc, area_texels=0))
+
+
+def write_ltc_js(path, t1, t2):
+    path.write_text(
+        "var g_ltc_1 = [" + ", ".join(f"{v:.6g}" for v in t1.ravel()) + "];\n"
+        "var g_ltc_2 = [" + ", ".join(f"{v:.6g}" for v in t2.ravel()) + "];\n"
+    )
+    return path
+
+
+def test_ltc_audit_fails_a_table_whose_matrices_are_packed_in_the_wrong_order(tmp_path, no_area_lights):
+    """ltc_code's table with ltc_1's (y, z) coefficients exchanged (glm's column-major invM read row-major, a
+    classic port mistake): the magnitudes are intact, so only the fit-quality check can catch it -- and does."""
+    from lutbake.commands.audit_tables import FIT_RATIO_MAX, read_ltc_pair
+
+    t1, t2 = read_ltc_pair(DATA / "ltc_code_ltc.js.gz")
+    path = write_ltc_js(tmp_path / "ltc_swapped.js", t1[..., [0, 2, 1, 3]], t2)
+    r = audit(path, {"preset": "ltc-ggx"}, max_side=FAST_SIDE, tolerance=1.0)
+    assert r.extra["chosen"] == "nominal"
+    assert r.extra["fit_ratio"] > FIT_RATIO_MAX
+    assert not r.passed
+
+
+def test_ltc_audit_names_flipped_view_rows(tmp_path, no_area_lights):
+    """ltc_code's table with its view rows in reverse order (both textures): the magnitude hypotheses name it."""
+    from lutbake.commands.audit_tables import read_ltc_pair
+
+    t1, t2 = read_ltc_pair(DATA / "ltc_code_ltc.js.gz")
+    r = audit(write_ltc_js(tmp_path / "ltc_flipped.js", t1[::-1], t2[::-1]), {"preset": "ltc-ggx"}, max_side=FAST_SIDE)
+    assert r.extra["chosen"] == "rows_flipped", r.findings
+    assert not r.passed
+
+
+def test_ltc_audit_passes_lutbakes_own_table(tmp_path, no_area_lights):
+    """A lutbake LTC table (ltc-threejs preset, JS floats, 4^2: what is checked holds at any size) audited under its
+    own preset: magnitudes and Fresnel within float rounding, the conventions fit, the matrices are lutbake's fit
+    (per-texel ratio 1)."""
+    from lutbake import api
+    from lutbake.config import load_configs
+
+    spec = load_configs([Path("lutbake/presets/ltc-threejs.toml")], ["size=[4, 4]"])
+    path = api.bake(spec, out_dir=tmp_path, workers=2)[0].path
+    r = audit(path, {"preset": "ltc-threejs"}, max_side=4, tolerance=CLEAN_TOL)
+    assert r.passed, r.text()
+    assert r.extra["chosen"] == "nominal"
+    np.testing.assert_allclose(r.extra["fit_ratio"], 1.0, rtol=CLEAN_TOL)
+
+
+# ---- other tools' files are read -------------------------------------------------------------------------------------
+
+
+def _write_oiio(path, pixels, names, pixel_type):
+    import OpenImageIO as oiio
+
+    h, w, n = pixels.shape
+    spec = oiio.ImageSpec(w, h, n, pixel_type)
+    spec.channelnames = tuple(names)
+    spec.attribute("oiio:UnassociatedAlpha", 1)  # the codes as given (OIIO would un-premultiply them otherwise)
+    out = oiio.ImageOutput.create(str(path))
+    assert out.open(str(path), spec), oiio.geterror()
+    assert out.write_image(np.ascontiguousarray(pixels))
+    out.close()
+
+
+@pytest.mark.parametrize(
+    "name, names, pixel_type",
+    [
+        ("float_rg.exr", ["R", "G"], "float"),
+        ("half_rgb.exr", ["R", "G", "B"], "half"),
+        ("layer_rgba.exr", ["dfg.R", "dfg.G", "dfg.B", "dfg.A"], "float"),
+        ("u16_rgb.png", ["R", "G", "B"], "uint16"),
+        ("u16_grey_alpha.png", ["Y", "A"], "uint16"),
+        ("u8_rgb.png", ["R", "G", "B"], "uint8"),
+    ],
+)
+def test_other_tools_exr_and_png_files_are_read_and_pass_when_right(clean, tmp_path, name, names, pixel_type):
+    """EXR (float/half, RG/RGB/RGBA, layer-prefixed channel names, no lutbake attribute) and PNG (8/16-bit, RGB and
+    grey+alpha) as another tool writes them: read, and a correct table passes at a tolerance far below the 8-bit
+    step (the storage rounding is not counted against it)."""
+    n = len(names)
+    values = np.concatenate([clean, np.zeros(clean.shape[:2] + (max(0, n - 2),))], axis=-1)[..., :n]
+    if n == 4:
+        values[..., 3] = 1.0
+    if pixel_type.startswith("uint"):
+        top = 255 if pixel_type == "uint8" else 65535
+        pixels = np.round(values * top).astype(np.uint8 if top == 255 else np.uint16)
+    else:
+        pixels = values.astype(np.float16 if pixel_type == "half" else np.float32)
+    path = tmp_path / name
+    _write_oiio(path, pixels, names, pixel_type)
+    r = run(path, tolerance=CLEAN_TOL)
+    assert r.passed and r.extra["chosen"] == "nominal", (name, r.text())
+    expect = {"uint8": "unorm8", "uint16": "unorm16", "half": "half", "float": "float"}[pixel_type]
+    assert r.quantisation["kind"] == expect
+
+
 # ------------------------------------------------------------------------- every shipped table in tests/data
+# (last in the file: babylon's 64-side audit alone fills the reference memo, lutbake.commands.reference.REFERENCES)
 
 # file -> (preset, audit keyword arguments); every table file of tests/data must be listed (the test below checks)
 SHIPPED = {
@@ -268,139 +408,3 @@ def test_audit_runs_on_every_shipped_table(name):
         assert r.extra["area"]["file"]["median"] < 2 * r.extra["area"]["lutbake fit"]["median"]
     else:
         assert r.extra["chosen"] == "nominal", r.diagnosis
-
-
-@pytest.fixture
-def no_area_lights(monkeypatch):
-    """audit() of an LTC table without the area-light comparison (the tests using this do not read it;
-    test_audit_runs_on_every_shipped_table does)."""
-    from functools import partial
-
-    from lutbake.commands import audit_tables
-
-    monkeypatch.setattr(audit_tables, "audit_ltc", partial(audit_tables.audit_ltc, area_texels=0))
-
-
-def write_ltc_js(path, t1, t2):
-    path.write_text(
-        "var g_ltc_1 = [" + ", ".join(f"{v:.6g}" for v in t1.ravel()) + "];\n"
-        "var g_ltc_2 = [" + ", ".join(f"{v:.6g}" for v in t2.ravel()) + "];\n"
-    )
-    return path
-
-
-def test_ltc_audit_fails_a_table_whose_matrices_are_packed_in_the_wrong_order(tmp_path, no_area_lights):
-    """ltc_code's table with ltc_1's (y, z) coefficients exchanged (glm's column-major invM read row-major, a
-    classic port mistake): the magnitudes are intact, so only the fit-quality check can catch it -- and does."""
-    from lutbake.commands.audit_tables import FIT_RATIO_MAX, read_ltc_pair
-
-    t1, t2 = read_ltc_pair(DATA / "ltc_code_ltc.js.gz")
-    path = write_ltc_js(tmp_path / "ltc_swapped.js", t1[..., [0, 2, 1, 3]], t2)
-    r = audit(path, {"preset": "ltc-ggx"}, max_side=FAST_SIDE, tolerance=1.0)
-    assert r.extra["chosen"] == "nominal"
-    assert r.extra["fit_ratio"] > FIT_RATIO_MAX
-    assert not r.passed
-
-
-def test_ltc_audit_names_flipped_view_rows(tmp_path, no_area_lights):
-    """ltc_code's table with its view rows in reverse order (both textures): the magnitude hypotheses name it."""
-    from lutbake.commands.audit_tables import read_ltc_pair
-
-    t1, t2 = read_ltc_pair(DATA / "ltc_code_ltc.js.gz")
-    r = audit(write_ltc_js(tmp_path / "ltc_flipped.js", t1[::-1], t2[::-1]), {"preset": "ltc-ggx"}, max_side=FAST_SIDE)
-    assert r.extra["chosen"] == "rows_flipped", r.findings
-    assert not r.passed
-
-
-def test_ltc_audit_passes_lutbakes_own_table(tmp_path, no_area_lights):
-    """A lutbake LTC table (ltc-threejs preset, JS floats, 4^2: what is checked holds at any size) audited under its
-    own preset: magnitudes and Fresnel within float rounding, the conventions fit, the matrices are lutbake's fit
-    (per-texel ratio 1)."""
-    from lutbake import api
-    from lutbake.config import load_configs
-
-    spec = load_configs([Path("lutbake/presets/ltc-threejs.toml")], ["size=[4, 4]"])
-    path = api.bake(spec, out_dir=tmp_path, workers=2)[0].path
-    r = audit(path, {"preset": "ltc-threejs"}, max_side=4, tolerance=CLEAN_TOL)
-    assert r.passed, r.text()
-    assert r.extra["chosen"] == "nominal"
-    np.testing.assert_allclose(r.extra["fit_ratio"], 1.0, rtol=CLEAN_TOL)
-
-
-# ---- issue 39: lutbake's own files pass; other tools' files are read ------------------------------------------------
-
-
-@pytest.fixture(scope="module")
-def own_filament(tmp_path_factory):
-    """lutbake's own `filament` bake as `make luts` writes it (128 x 128 half RGBA16F DDS + sidecar; the cloth
-    channel reaches ~18 at the smoothest row)."""
-    from lutbake import api
-    from lutbake.config import preset_path
-
-    out = tmp_path_factory.mktemp("own")
-    (r,) = api.bake([preset_path("filament")], out_dir=out)
-    return r.path
-
-
-def test_lutbakes_own_half_dds_passes_under_its_preset(own_filament):
-    """`lutbake audit outputs/filament_dfg.dds --preset filament` failed: the cloth channel reaches 18, where half
-    rounding alone is ~0.008 > the 1e-3 tolerance; the judged error is the one beyond a rounding step."""
-    r = audit(own_filament, {"preset": "filament"}, max_side=MAX_SIDE)
-    assert r.passed and r.extra["chosen"] == "nominal", r.text()
-    assert r.quantisation["kind"] == "half"
-    assert r.extra["raw_error"]["max"] > 1e-3  # the raw |file - converged| is above the tolerance ...
-    assert r.extra["raw_error"]["max"] <= r.extra["raw_error"]["step_at_max"]  # ... and within one half step
-
-
-def test_lutbakes_own_file_is_audited_against_its_recorded_conventions(own_filament):
-    """Without --preset, the file's sidecar conventions are used (not `default`, which gave 'layout mismatch')."""
-    r = audit(own_filament, {}, max_side=MAX_SIDE)
-    assert r.passed and r.extra["chosen"] == "nominal", r.text()
-    assert "recorded config" in r.conventions and "multiscatter_cloth" in r.conventions
-    res = CliRunner().invoke(main, ["audit", str(own_filament), "--max-side", "16"])
-    assert res.exit_code == 0 and "PASS" in res.output, res.output
-
-
-def _write_oiio(path, pixels, names, pixel_type):
-    import OpenImageIO as oiio
-
-    h, w, n = pixels.shape
-    spec = oiio.ImageSpec(w, h, n, pixel_type)
-    spec.channelnames = tuple(names)
-    spec.attribute("oiio:UnassociatedAlpha", 1)  # the codes as given (OIIO would un-premultiply them otherwise)
-    out = oiio.ImageOutput.create(str(path))
-    assert out.open(str(path), spec), oiio.geterror()
-    assert out.write_image(np.ascontiguousarray(pixels))
-    out.close()
-
-
-@pytest.mark.parametrize(
-    "name, names, pixel_type",
-    [
-        ("float_rg.exr", ["R", "G"], "float"),
-        ("half_rgb.exr", ["R", "G", "B"], "half"),
-        ("layer_rgba.exr", ["dfg.R", "dfg.G", "dfg.B", "dfg.A"], "float"),
-        ("u16_rgb.png", ["R", "G", "B"], "uint16"),
-        ("u16_grey_alpha.png", ["Y", "A"], "uint16"),
-        ("u8_rgb.png", ["R", "G", "B"], "uint8"),
-    ],
-)
-def test_other_tools_exr_and_png_files_are_read_and_pass_when_right(clean, tmp_path, name, names, pixel_type):
-    """EXR (float/half, RG/RGB/RGBA, layer-prefixed channel names, no lutbake attribute) and PNG (8/16-bit, RGB and
-    grey+alpha) as another tool writes them: read, and a correct table passes at a tolerance far below the 8-bit
-    step (the storage rounding is not counted against it)."""
-    n = len(names)
-    values = np.concatenate([clean, np.zeros(clean.shape[:2] + (max(0, n - 2),))], axis=-1)[..., :n]
-    if n == 4:
-        values[..., 3] = 1.0
-    if pixel_type.startswith("uint"):
-        top = 255 if pixel_type == "uint8" else 65535
-        pixels = np.round(values * top).astype(np.uint8 if top == 255 else np.uint16)
-    else:
-        pixels = values.astype(np.float16 if pixel_type == "half" else np.float32)
-    path = tmp_path / name
-    _write_oiio(path, pixels, names, pixel_type)
-    r = run(path, tolerance=CLEAN_TOL)
-    assert r.passed and r.extra["chosen"] == "nominal", (name, r.text())
-    expect = {"uint8": "unorm8", "uint16": "unorm16", "half": "half", "float": "float"}[pixel_type]
-    assert r.quantisation["kind"] == expect
