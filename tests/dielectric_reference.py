@@ -26,6 +26,7 @@ from test_reference_dfg import NDF
 GL_NODES = 12
 PANEL_RATIO = 3.0
 FIRST = 1.0e-5  # first panel width next to an anchor (rad)
+CHUNK = 4096  # phi panels per vectorised evaluation
 
 
 def fresnel_np(eta, c):
@@ -56,9 +57,8 @@ def eevee_s(eta, c):
     return schlick_weight(np.sqrt(np.maximum(ct2, 0.0)))
 
 
-def bsdf(v, o, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exact"):
-    """(f_r, f_t) at direction arrays o (..., 3); each is 0 on the other side. ``fresnel = "eevee"`` returns the
-    Fresnel-free lobes weighted as EEVEE's tables: ((1 - s) f_r/F, s f_r/F, (1 - s) f_t/(1 - F)) (eevee_s)."""
+def _lobes(v, o, alpha, eta, ndf, masking, fresnel, side):
+    """The lobes of bsdf on one side (side "r": f_r, or EEVEE's two reflection lobes; "t": f_t, or EEVEE's one)."""
     D, Lam = NDF[ndf]
     nov = v[2]
     noo = o[..., 2]
@@ -66,11 +66,16 @@ def bsdf(v, o, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exact"
     with np.errstate(divide="ignore", invalid="ignore"):
         lam_o = Lam(np.abs(noo), alpha)
         g2 = G2_np(masking, lam_v, lam_o)
-        hr = v + o
-        hr = hr / np.linalg.norm(hr, axis=-1, keepdims=True)
-        vhr = hr @ v
-        fr = fresnel_np(eta, vhr) * D(hr[..., 2], alpha) * g2 / (4.0 * nov * noo)
-        fr = np.where((noo > 0) & (vhr > 0), fr, 0.0)
+        if side == "r":
+            hr = v + o
+            hr = hr / np.linalg.norm(hr, axis=-1, keepdims=True)
+            vhr = hr @ v
+            if fresnel == "eevee":
+                fr0 = np.where((noo > 0) & (vhr > 0), D(hr[..., 2], alpha) * g2 / (4.0 * nov * noo), 0.0)
+                sr = eevee_s(eta, vhr)
+                return np.nan_to_num((1 - sr) * fr0), np.nan_to_num(sr * fr0)
+            fr = fresnel_np(eta, vhr) * D(hr[..., 2], alpha) * g2 / (4.0 * nov * noo)
+            return (np.nan_to_num(np.where((noo > 0) & (vhr > 0), fr, 0.0)),)
         ht = -(v + eta * o)
         ht = ht / np.linalg.norm(ht, axis=-1, keepdims=True)
         ht = np.where(ht[..., 2:3] < 0, -ht, ht)
@@ -87,36 +92,37 @@ def bsdf(v, o, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exact"
         )
         ft = np.where((noo < 0) & (vh > 0) & (oh < 0), ft, 0.0)
         if fresnel == "eevee":
-            fr0 = np.where((noo > 0) & (vhr > 0), D(hr[..., 2], alpha) * g2 / (4.0 * nov * noo), 0.0)
-            sr, st = eevee_s(eta, vhr), eevee_s(eta, vh)
-            ft0 = ft / (1.0 - fresnel_np(eta, vh))
-            return tuple(np.nan_to_num(x) for x in ((1 - sr) * fr0, sr * fr0, (1 - st) * ft0))
-    return np.nan_to_num(fr), np.nan_to_num(ft)
+            ft = (1 - eevee_s(eta, vh)) * (ft / (1.0 - fresnel_np(eta, vh)))
+    return (np.nan_to_num(ft),)
 
 
-def _graded(lo, hi, anchors):
-    """Panel edges on [lo, hi] graded geometrically away from each anchor (first width FIRST, ratio PANEL_RATIO):
-    a panel is never wider than its distance to the nearest anchor (x PANEL_RATIO)."""
-    edges = {lo, hi}
-    for a in anchors:
-        if not (lo <= a <= hi):
-            continue
-        edges.add(a)
-        for sgn in (-1.0, 1.0):
-            d = FIRST
-            while True:
-                x = a + sgn * d
-                if not (lo < x < hi):
-                    break
-                edges.add(x)
-                d = d * PANEL_RATIO
-    return np.array(sorted(edges))
+def bsdf(v, o, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exact"):
+    """(f_r, f_t) at direction arrays o (..., 3); each is 0 on the other side. ``fresnel = "eevee"`` returns the
+    Fresnel-free lobes weighted as EEVEE's tables: ((1 - s) f_r/F, s f_r/F, (1 - s) f_t/(1 - F)) (eevee_s)."""
+    return _lobes(v, o, alpha, eta, ndf, masking, fresnel, "r") + _lobes(v, o, alpha, eta, ndf, masking, fresnel, "t")
 
 
-def _gl(edges):
+def _edges(lo, hi, anchors):
+    """Panel edges on [lo, hi] graded geometrically away from each anchor (first width FIRST, ratio PANEL_RATIO; a
+    panel is never wider than its distance to the nearest anchor x PANEL_RATIO), one row per row of ``anchors``
+    (n, m): sorted, each edge once, NaN-padded (an anchor outside [lo, hi], or NaN, adds nothing)."""
+    d = [FIRST]
+    while d[-1] * PANEL_RATIO < hi - lo:
+        d.append(d[-1] * PANEL_RATIO)
+    a = np.asarray(anchors, np.float64)[..., None]
+    near = np.concatenate([a + np.array(d), a - np.array(d)], axis=-1)
+    near = np.where((lo <= a) & (a <= hi) & (lo < near) & (near < hi), near, np.nan)
+    a = np.where((lo <= a) & (a <= hi), a, np.nan)
+    rows = [np.full((len(a), 1), lo), np.full((len(a), 1), hi), a[..., 0], near.reshape(len(a), -1)]
+    e = np.sort(np.concatenate(rows, axis=1), axis=1)
+    return np.sort(np.where(np.diff(e, axis=1, prepend=-np.inf) > 0, e, np.nan), axis=1)  # repeats dropped
+
+
+def _gl(lo, hi):
+    """Gauss-Legendre nodes and weights (GL_NODES per panel) of panels [lo, hi] (arrays), rows = panels."""
     x, w = np.polynomial.legendre.leggauss(GL_NODES)
-    lo, hi = edges[:-1, None], edges[1:, None]
-    return (lo + (hi - lo) * (x + 1) / 2).ravel(), ((hi - lo) * w / 2).ravel()
+    lo, hi = lo[:, None], hi[:, None]
+    return lo + (hi - lo) * (x + 1) / 2, (hi - lo) * w / 2
 
 
 def _cone_thetas(cos_v, sin_v, k, lo, hi):
@@ -134,23 +140,10 @@ def _phi_cut(cos_v, sin_v, k, theta):
     return np.arccos(np.clip(cp, -1.0, 1.0))
 
 
-def _phi_rule(cos_v, sin_v, cuts, theta):
-    """Per-theta graded phi panels (padded to one shape): nodes and weights, arrays (len(theta), m)."""
-    rows = []
-    for t in theta:
-        anchors = [np.pi, 0.0] + ([float(_phi_cut(cos_v, sin_v, k, t)) for k in cuts] if sin_v > 0 else [])
-        rows.append(_graded(0.0, np.pi, anchors))
-    m = max(len(r) for r in rows)
-    edges = np.array([np.concatenate([r, np.full(m - len(r), np.pi)]) for r in rows])
-    x, w = np.polynomial.legendre.leggauss(GL_NODES)
-    lo, hi = edges[:, :-1, None], edges[:, 1:, None]
-    n = len(theta)
-    return (lo + (hi - lo) * (x + 1) / 2).reshape(n, -1), ((hi - lo) * w / 2).reshape(n, -1)
-
-
 def energies(nov, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exact"):
     """(E_R, E_T) of the texel by the graded product rule (module docstring); fresnel = "eevee": EEVEE's (scale, bias,
-    transmission_factor). eta = 1 makes f_t a delta: excluded."""
+    transmission_factor). eta = 1 makes f_t a delta: excluded. Vectorised over every (theta, phi) node of a hemisphere,
+    a phi panel per row (the phi edges graded per theta node), in chunks of CHUNK nodes."""
     nov = float(nov)
     sin_v = np.sqrt(max(1.0 - nov * nov, 0.0))
     v = np.array([sin_v, 0.0, nov])
@@ -167,15 +160,22 @@ def energies(nov, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exa
             anchors += _cone_thetas(nov, sin_v, k, lo, hi)
         if lo == half and nov < eta:  # n.h_t = 0: the half vector flips, D(h) jumps from D(pi/2) to 0
             anchors.append(np.arccos(-nov / eta))
-        th, wt = _gl(_graded(lo, hi, anchors))
-        total = 0.0
-        for c in range(0, len(th), 64):
-            t, w = th[c : c + 64], wt[c : c + 64]
-            ph, wp_ = _phi_rule(nov, sin_v, cuts, t)
-            st = np.sin(t)[:, None]
-            o = np.stack([st * np.cos(ph), st * np.sin(ph), np.broadcast_to(np.cos(t)[:, None], ph.shape)], axis=-1)
-            fs = bsdf(v, o, alpha, eta, ndf, masking, fresnel)
-            fs = fs[:-1] if lo == 0.0 else fs[-1:]
-            total = total + np.array([np.sum(w * np.sin(t) * np.abs(np.cos(t)) * np.sum(wp_ * f, axis=1)) for f in fs])
+        e = _edges(lo, hi, [anchors])[0]
+        e = e[~np.isnan(e)]
+        th, wt = (x.ravel() for x in _gl(e[:-1], e[1:]))
+        # phi panels per theta node: graded from 0, pi (the lobe peaks) and each cut's breakpoint at that theta
+        cut_phi = [_phi_cut(nov, sin_v, k, th) for k in cuts] if sin_v > 0 else []
+        pe = _edges(0.0, np.pi, np.column_stack([np.full_like(th, np.pi), np.zeros_like(th), *cut_phi]))
+        row, col = np.nonzero(~np.isnan(pe[:, 1:]) & ~np.isnan(pe[:, :-1]))
+        ph, wp = _gl(pe[row, col], pe[row, col + 1])
+        total = np.zeros(2 if lo == 0.0 and fresnel == "eevee" else 1)
+        for c in range(0, len(row), CHUNK):
+            r = row[c : c + CHUNK]
+            st, ct = np.sin(th[r])[:, None], np.cos(th[r])[:, None]
+            p = ph[c : c + CHUNK]
+            o = np.stack([st * np.cos(p), st * np.sin(p), np.broadcast_to(ct, p.shape)], axis=-1)
+            fs = _lobes(v, o, alpha, eta, ndf, masking, fresnel, "r" if lo == 0.0 else "t")
+            wo = (wt[r] * np.sin(th[r]) * np.abs(np.cos(th[r])))[:, None] * wp[c : c + CHUNK]
+            total = total + np.array([np.sum(wo * f) for f in fs])
         out += list(2.0 * total)
     return tuple(out)
