@@ -88,7 +88,8 @@ AGREEMENT = [
         "sobol_ndf",
         AGREEMENT_TOL_ANISO,
     ),
-    # the dielectric kinds: panelled GL split at every kink vs GGX visible-normal Sobol' (16384 points), eta both sides
+    # the dielectric kinds: panelled GL split at every kink vs GGX visible-normal Sobol' (16384 points; the averages
+    # 4096, AGREEMENT_TOL_QMC's count: measured 9.0e-5 over three seeds), eta both sides
     (
         "dielectric",
         {"size": [4, 3], "ior_size": 2, "ior_range": [0.7, 1.5], "roughness_range": [0.3, 1.0]},
@@ -98,7 +99,14 @@ AGREEMENT = [
     ),
     (
         "dielectric_avg",
-        {"roughness_size": 3, "ior_size": 2, "ior_range": [0.7, 1.5], "roughness_range": [0.3, 1.0], "mu_order": 6},
+        {
+            "roughness_size": 3,
+            "ior_size": 2,
+            "ior_range": [0.7, 1.5],
+            "roughness_range": [0.3, 1.0],
+            "mu_order": 6,
+            "samples": 4096,
+        },
         "gauss_legendre",
         "sobol_vndf",
         AGREEMENT_TOL_QMC,
