@@ -58,12 +58,21 @@ def eevee_s(eta, c):
 
 
 def _lobes(v, o, alpha, eta, ndf, masking, fresnel, side):
-    """The lobes of bsdf on one side (side "r": f_r, or EEVEE's two reflection lobes; "t": f_t, or EEVEE's one)."""
+    """The lobes of bsdf on one side at directions o (n, 3) (side "r": f_r, or EEVEE's two reflection lobes; "t":
+    f_t, or EEVEE's one, evaluated only where it is not 0: below the surface with v.h > 0 > o.h)."""
     D, Lam = NDF[ndf]
     nov = v[2]
-    noo = o[..., 2]
     lam_v = Lam(np.float64(nov), alpha)
     with np.errstate(divide="ignore", invalid="ignore"):
+        if side == "t":
+            ht = -(v + eta * o)
+            ht = ht / np.linalg.norm(ht, axis=-1, keepdims=True)
+            ht = np.where(ht[..., 2:3] < 0, -ht, ht)
+            vh = ht @ v
+            oh = np.sum(ht * o, axis=-1)
+            out, keep = np.zeros(len(o)), np.flatnonzero((o[:, 2] < 0) & (vh > 0) & (oh < 0))
+            o, ht, vh, oh = o[keep], ht[keep], vh[keep], oh[keep]
+        noo = o[..., 2]
         lam_o = Lam(np.abs(noo), alpha)
         g2 = G2_np(masking, lam_v, lam_o)
         if side == "r":
@@ -76,11 +85,6 @@ def _lobes(v, o, alpha, eta, ndf, masking, fresnel, side):
                 return np.nan_to_num((1 - sr) * fr0), np.nan_to_num(sr * fr0)
             fr = fresnel_np(eta, vhr) * D(hr[..., 2], alpha) * g2 / (4.0 * nov * noo)
             return (np.nan_to_num(np.where((noo > 0) & (vhr > 0), fr, 0.0)),)
-        ht = -(v + eta * o)
-        ht = ht / np.linalg.norm(ht, axis=-1, keepdims=True)
-        ht = np.where(ht[..., 2:3] < 0, -ht, ht)
-        vh = ht @ v
-        oh = np.sum(ht * o, axis=-1)
         ft = (
             np.abs(vh * oh)
             * eta
@@ -90,16 +94,19 @@ def _lobes(v, o, alpha, eta, ndf, masking, fresnel, side):
             * g2
             / (nov * np.abs(noo) * (vh + eta * oh) ** 2)
         )
-        ft = np.where((noo < 0) & (vh > 0) & (oh < 0), ft, 0.0)
         if fresnel == "eevee":
             ft = (1 - eevee_s(eta, vh)) * (ft / (1.0 - fresnel_np(eta, vh)))
-    return (np.nan_to_num(ft),)
+        out[keep] = np.nan_to_num(ft)
+    return (out,)
 
 
 def bsdf(v, o, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exact"):
     """(f_r, f_t) at direction arrays o (..., 3); each is 0 on the other side. ``fresnel = "eevee"`` returns the
     Fresnel-free lobes weighted as EEVEE's tables: ((1 - s) f_r/F, s f_r/F, (1 - s) f_t/(1 - F)) (eevee_s)."""
-    return _lobes(v, o, alpha, eta, ndf, masking, fresnel, "r") + _lobes(v, o, alpha, eta, ndf, masking, fresnel, "t")
+    o = np.asarray(o, np.float64)
+    flat = o.reshape(-1, 3)
+    lobes = [_lobes(v, flat, alpha, eta, ndf, masking, fresnel, side) for side in ("r", "t")]
+    return tuple(f.reshape(o.shape[:-1]) for f in lobes[0] + lobes[1])
 
 
 def _edges(lo, hi, anchors):
@@ -173,9 +180,9 @@ def energies(nov, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exa
             r = row[c : c + CHUNK]
             st, ct = np.sin(th[r])[:, None], np.cos(th[r])[:, None]
             p = ph[c : c + CHUNK]
-            o = np.stack([st * np.cos(p), st * np.sin(p), np.broadcast_to(ct, p.shape)], axis=-1)
+            o = np.stack([st * np.cos(p), st * np.sin(p), np.broadcast_to(ct, p.shape)], axis=-1).reshape(-1, 3)
             fs = _lobes(v, o, alpha, eta, ndf, masking, fresnel, "r" if lo == 0.0 else "t")
-            wo = (wt[r] * np.sin(th[r]) * np.abs(np.cos(th[r])))[:, None] * wp[c : c + CHUNK]
+            wo = ((wt[r] * np.sin(th[r]) * np.abs(np.cos(th[r])))[:, None] * wp[c : c + CHUNK]).ravel()
             total = total + np.array([np.sum(wo * f) for f in fs])
         out += list(2.0 * total)
     return tuple(out)
