@@ -53,6 +53,12 @@ def f32(*xs):
     return (np.asarray(x, np.float32) for x in xs)
 
 
+@functools.cache
+def ref_energies(nov: float, alpha: float, eta: float) -> tuple:
+    """The reference (E_R, E_T) of a texel, computed once per texel (the honesty test below asks for these too)."""
+    return ref.energies(nov, alpha, eta)
+
+
 @pytest.mark.parametrize("texel", RANDOM + EDGES)
 def test_energies_match_numpy_integral_over_the_outgoing_sphere(texel):
     nov, alpha, eta = f32(*texel)
@@ -62,7 +68,7 @@ def test_energies_match_numpy_integral_over_the_outgoing_sphere(texel):
         DEFAULT_SAMPLES["gauss_legendre"],
         0,
     )[0]
-    er, et = ref.energies(float(nov), float(alpha), float(eta))
+    er, et = ref_energies(float(nov), float(alpha), float(eta))
     np.testing.assert_allclose(e, [er, et, er + et], rtol=0, atol=REFERENCE_ATOL)
 
 
@@ -471,7 +477,9 @@ def test_adaptive_estimate_bounds_the_error_against_a_high_order(tol):
 
 @functools.lru_cache(maxsize=None)
 def numpy_energies():
-    return np.array([ref.energies(*map(float, t)) for t in HONESTY_TEXELS])
+    """At the float32 texels the kernel integrates (adaptive_at): the float64 ones moved the integral by up to
+    3.9e-7, 0.91 of NUMPY_ACCURACY on top of the estimate at tolerance 1e-6; none is above its estimate at these."""
+    return np.array([ref_energies(*(float(np.float32(x)) for x in t)) for t in HONESTY_TEXELS])
 
 
 @pytest.mark.parametrize("tol", NUMPY_TOLERANCES)
