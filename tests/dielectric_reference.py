@@ -57,6 +57,11 @@ def eevee_s(eta, c):
     return schlick_weight(np.sqrt(np.maximum(ct2, 0.0)))
 
 
+def _norm(x):
+    """|x| of rows x (n, 3), as a column."""
+    return np.sqrt(x[:, 0] * x[:, 0] + x[:, 1] * x[:, 1] + x[:, 2] * x[:, 2])[:, None]
+
+
 def _lobes(v, o, alpha, eta, ndf, masking, fresnel, side):
     """The lobes of bsdf on one side at directions o (n, 3) (side "r": f_r, or EEVEE's two reflection lobes; "t":
     f_t, or EEVEE's one, evaluated only where it is not 0: below the surface with v.h > 0 > o.h)."""
@@ -66,10 +71,10 @@ def _lobes(v, o, alpha, eta, ndf, masking, fresnel, side):
     with np.errstate(divide="ignore", invalid="ignore"):
         if side == "t":
             ht = -(v + eta * o)
-            ht = ht / np.linalg.norm(ht, axis=-1, keepdims=True)
+            ht = ht / _norm(ht)
             ht = np.where(ht[..., 2:3] < 0, -ht, ht)
             vh = ht @ v
-            oh = np.sum(ht * o, axis=-1)
+            oh = ht[:, 0] * o[:, 0] + ht[:, 1] * o[:, 1] + ht[:, 2] * o[:, 2]
             out, keep = np.zeros(len(o)), np.flatnonzero((o[:, 2] < 0) & (vh > 0) & (oh < 0))
             o, ht, vh, oh = o[keep], ht[keep], vh[keep], oh[keep]
         noo = o[..., 2]
@@ -77,7 +82,7 @@ def _lobes(v, o, alpha, eta, ndf, masking, fresnel, side):
         g2 = G2_np(masking, lam_v, lam_o)
         if side == "r":
             hr = v + o
-            hr = hr / np.linalg.norm(hr, axis=-1, keepdims=True)
+            hr = hr / _norm(hr)
             vhr = hr @ v
             if fresnel == "eevee":
                 fr0 = np.where((noo > 0) & (vhr > 0), D(hr[..., 2], alpha) * g2 / (4.0 * nov * noo), 0.0)
@@ -150,7 +155,7 @@ def _phi_cut(cos_v, sin_v, k, theta):
 def energies(nov, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exact"):
     """(E_R, E_T) of the texel by the graded product rule (module docstring); fresnel = "eevee": EEVEE's (scale, bias,
     transmission_factor). eta = 1 makes f_t a delta: excluded. Vectorised over every (theta, phi) node of a hemisphere,
-    a phi panel per row (the phi edges graded per theta node), in chunks of CHUNK nodes."""
+    a phi panel per row (the phi edges graded per theta node), CHUNK panels at a time."""
     nov = float(nov)
     sin_v = np.sqrt(max(1.0 - nov * nov, 0.0))
     v = np.array([sin_v, 0.0, nov])
@@ -176,13 +181,15 @@ def energies(nov, alpha, eta, ndf="ggx", masking="smith_separable", fresnel="exa
         row, col = np.nonzero(~np.isnan(pe[:, 1:]) & ~np.isnan(pe[:, :-1]))
         ph, wp = _gl(pe[row, col], pe[row, col + 1])
         total = np.zeros(2 if lo == 0.0 and fresnel == "eevee" else 1)
+        sin_t, cos_t = np.sin(th), np.cos(th)
+        w_t = wt * sin_t * np.abs(cos_t)
         for c in range(0, len(row), CHUNK):
             r = row[c : c + CHUNK]
-            st, ct = np.sin(th[r])[:, None], np.cos(th[r])[:, None]
+            st, ct = sin_t[r][:, None], cos_t[r][:, None]
             p = ph[c : c + CHUNK]
             o = np.stack([st * np.cos(p), st * np.sin(p), np.broadcast_to(ct, p.shape)], axis=-1).reshape(-1, 3)
             fs = _lobes(v, o, alpha, eta, ndf, masking, fresnel, "r" if lo == 0.0 else "t")
-            wo = ((wt[r] * np.sin(th[r]) * np.abs(np.cos(th[r])))[:, None] * wp[c : c + CHUNK]).ravel()
+            wo = (w_t[r][:, None] * wp[c : c + CHUNK]).ravel()
             total = total + np.array([np.sum(wo * f) for f in fs])
         out += list(2.0 * total)
     return tuple(out)
