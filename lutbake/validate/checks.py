@@ -113,7 +113,10 @@ def _composite_gl(edges: np.ndarray, n: int = GL_NODES) -> tuple[np.ndarray, np.
 
 def _h(theta: np.ndarray, phi: np.ndarray | float = 0.0) -> np.ndarray:
     st = np.sin(theta)
-    return np.stack(np.broadcast_arrays(st * np.cos(phi), st * np.sin(phi), np.cos(theta)), axis=-1)
+    xyz = st * np.cos(phi), st * np.sin(phi), np.cos(theta)
+    h = np.empty(np.broadcast_shapes(*(np.shape(c) for c in xyz)) + (3,), np.result_type(*xyz))
+    h[..., 0], h[..., 1], h[..., 2] = xyz
+    return h
 
 
 # --- NDF normalisation -----------------------------------------------------------------------------
