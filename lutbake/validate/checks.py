@@ -272,9 +272,8 @@ def weak_white_furnace_aniso() -> CheckResult:
                 v = np.array([sin_v * np.cos(phi_v), sin_v * np.sin(phi_v), nov])
                 psi = psimax[:, None] * s[None, :]
                 h = _h(theta[:, None], phi_v + psi)
-                terms = evaluate_terms(h=h, v=v, alpha=ax, alpha_y=ay, names=["D_ggx_aniso", "Lambda_ggx_aniso"])
-                D = terms["D_ggx_aniso"].astype(np.float64)
-                lam = float(terms["Lambda_ggx_aniso"].ravel()[0])
+                D = evaluate_terms(h=h, alpha=ax, alpha_y=ay, names=["D_ggx_aniso"])["D_ggx_aniso"].astype(np.float64)
+                lam = float(evaluate_terms(v=v, alpha=ax, alpha_y=ay, names=["Lambda_ggx_aniso"])["Lambda_ggx_aniso"])
                 vom = np.maximum(h.astype(np.float32).astype(np.float64) @ v, 0.0)
                 inner = np.sum(psimax[:, None] * ws[None, :] * vom * D, axis=1)
                 integral = np.sum(wt * np.sin(theta) * inner) / (1.0 + lam)
