@@ -48,8 +48,17 @@ ABOVE = (
 )
 
 
+# the adaptive estimators' error target: the bounds hold or fail by far more (PNG_SLACK = 1e-3; every "above one"
+# table leaves [-PNG_SLACK, 1 + PNG_SLACK] by more than 0.02), and min/max move by < 1e-4 from the default tolerance
+TOL = 1.0e-4
+# the microfacet diffuse model's fixed GL order (default 12): at 8 its tables' min/max move by < 4e-6, at 5x less cost
+DIFFUSE_MICROFACET = {"samples": 8}
+
+
 def spec(kind, opts):
-    return validate_table({"name": "t", "kind": kind, **SMALL[kind], **opts}, "<test>", 0)
+    coarse = DIFFUSE_MICROFACET if kind in vb.DIFFUSE_KINDS and opts.get("model") == "microfacet" else {}
+    raw = {"name": "t", "kind": kind, **SMALL[kind], "tolerance": TOL, **coarse, **opts}
+    return validate_table(raw, "<test>", 0)
 
 
 def test_every_kind_layout_and_model_is_declared():

@@ -113,7 +113,10 @@ def _composite_gl(edges: np.ndarray, n: int = GL_NODES) -> tuple[np.ndarray, np.
 
 def _h(theta: np.ndarray, phi: np.ndarray | float = 0.0) -> np.ndarray:
     st = np.sin(theta)
-    return np.stack(np.broadcast_arrays(st * np.cos(phi), st * np.sin(phi), np.cos(theta)), axis=-1)
+    xyz = st * np.cos(phi), st * np.sin(phi), np.cos(theta)
+    h = np.empty(np.broadcast_shapes(*(np.shape(c) for c in xyz)) + (3,), np.result_type(*xyz))
+    h[..., 0], h[..., 1], h[..., 2] = xyz
+    return h
 
 
 # --- NDF normalisation -----------------------------------------------------------------------------
@@ -132,7 +135,7 @@ def _projected_area(term: str, grade_at) -> tuple[float, str]:
     errors = []
     for alpha in PROJECTED_AREA_ALPHAS:
         theta, w = _composite_gl(_graded_edges(0.0, np.pi / 2, [grade_at(alpha)]))
-        D = evaluate_terms(h=_h(theta), alpha=alpha)[term].astype(np.float64)
+        D = evaluate_terms(h=_h(theta), alpha=alpha, names=[term])[term].astype(np.float64)
         errors.append(abs(2.0 * np.pi * np.sum(w * D * np.cos(theta) * np.sin(theta)) - 1.0))
     k = int(np.argmax(errors))
     where = f"worst at alpha={PROJECTED_AREA_ALPHAS[k]}"
@@ -170,7 +173,7 @@ def weak_white_furnace(ndf_name: str) -> CheckResult:
             phi = phimax[:, None] * s
             wphi = phimax[:, None] * ws
             h = _h(theta[:, None], phi)
-            terms = evaluate_terms(h=h, alpha=alpha, nov=nov)
+            terms = evaluate_terms(h=h, alpha=alpha, nov=nov, names=[f"D_{ndf_name}", f"G1_smith_{ndf_name}"])
             D = terms[f"D_{ndf_name}"].astype(np.float64)
             G1 = float(terms[f"G1_smith_{ndf_name}"].ravel()[0])
             vom = sin_v * h[..., 0].astype(np.float64) + nov * h[..., 2].astype(np.float64)
@@ -213,7 +216,7 @@ def _aniso_measure(term: str, weight, horizon: bool = False) -> tuple[float, tup
     for alpha, a, ax, ay in _aniso_pairs():
         theta, wt = _sphere_quadrature(min(ax, ay), horizon=horizon)
         h = _h(theta[:, None], phi[None, :])
-        D = evaluate_terms(h=h, alpha=ax, alpha_y=ay)[term].astype(np.float64)
+        D = evaluate_terms(h=h, alpha=ax, alpha_y=ay, names=[term])[term].astype(np.float64)
         val = 4.0 * np.sum((wt * weight(theta))[:, None] * wphi[None, :] * D)
         errors.append(abs(val - 1.0))
         where.append((alpha, a))
@@ -269,9 +272,8 @@ def weak_white_furnace_aniso() -> CheckResult:
                 v = np.array([sin_v * np.cos(phi_v), sin_v * np.sin(phi_v), nov])
                 psi = psimax[:, None] * s[None, :]
                 h = _h(theta[:, None], phi_v + psi)
-                terms = evaluate_terms(h=h, v=v, alpha=ax, alpha_y=ay)
-                D = terms["D_ggx_aniso"].astype(np.float64)
-                lam = float(terms["Lambda_ggx_aniso"].ravel()[0])
+                D = evaluate_terms(h=h, alpha=ax, alpha_y=ay, names=["D_ggx_aniso"])["D_ggx_aniso"].astype(np.float64)
+                lam = float(evaluate_terms(v=v, alpha=ax, alpha_y=ay, names=["Lambda_ggx_aniso"])["Lambda_ggx_aniso"])
                 vom = np.maximum(h.astype(np.float32).astype(np.float64) @ v, 0.0)
                 inner = np.sum(psimax[:, None] * ws[None, :] * vom * D, axis=1)
                 integral = np.sum(wt * np.sin(theta) * inner) / (1.0 + lam)
@@ -438,8 +440,10 @@ def fresnel_eq2_is_exact_dielectric() -> CheckResult:
     f0 = np.linspace(0.0, 0.95, 96)[:, None]
     c = np.linspace(0.0, 1.0, 101)[None, :]
     s = np.sqrt(f0.astype(np.float32).astype(np.float64))
-    eq2 = evaluate_terms(f0=f0, cos_theta=c)["F_dielectric_f0"].astype(np.float64)
-    exact = evaluate_terms(eta=(1.0 + s) / (1.0 - s), cos_theta=c)["F_dielectric"].astype(np.float64)
+    eq2 = evaluate_terms(f0=f0, cos_theta=c, names=["F_dielectric_f0"])["F_dielectric_f0"].astype(np.float64)
+    exact = evaluate_terms(eta=(1.0 + s) / (1.0 - s), cos_theta=c, names=["F_dielectric"])["F_dielectric"].astype(
+        np.float64
+    )
     err = np.abs(eq2 - exact)
     i, j = np.unravel_index(np.argmax(err), err.shape)
     return check_result(
@@ -454,8 +458,8 @@ def fresnel_eq2_is_exact_dielectric() -> CheckResult:
 def schlick_endpoints() -> CheckResult:
     """F_schlick(f0, 1) = f0 and F_schlick(f0, 0) = 1 for f0 in [0, 1]."""
     f0 = np.linspace(0.0, 1.0, 101)
-    at_normal = evaluate_terms(f0=f0, cos_theta=1.0)["F_schlick"].astype(np.float64)
-    at_grazing = evaluate_terms(f0=f0, cos_theta=0.0)["F_schlick"].astype(np.float64)
+    at_normal = evaluate_terms(f0=f0, cos_theta=1.0, names=["F_schlick"])["F_schlick"].astype(np.float64)
+    at_grazing = evaluate_terms(f0=f0, cos_theta=0.0, names=["F_schlick"])["F_schlick"].astype(np.float64)
     err_n = np.max(np.abs(at_normal - f0.astype(np.float32)))
     err_g = np.max(np.abs(at_grazing - 1.0))
     return check_result(

@@ -7,8 +7,8 @@ what is measured is the Warp code, not a host re-implementation.
 
 Host API (inputs broadcast against each other; ``h``, ``l``, ``v`` carry a trailing axis of 3):
 
-    evaluate_terms(h=..., alpha=..., nov=..., nol=..., voh=..., loh=..., f0=..., eta=..., cos_theta=...)
-        -> {term name: array}, names in ``TERM_NAMES``:
+    evaluate_terms(h=..., alpha=..., nov=..., nol=..., voh=..., loh=..., f0=..., eta=..., cos_theta=..., names=...)
+        -> {term name: array}, names in ``TERM_NAMES`` (all of them, or those in ``names``):
         D_<ndf>            D(h, alpha)                                  for every NDF in distributions.NDFS
         Lambda_<ndf>       Lambda(nov, alpha)
         G1_smith_<ndf>     G1_smith(Lambda(nov, alpha))
@@ -173,8 +173,13 @@ SCALARS = ("alpha", "alpha_y", "nov", "nol", "voh", "loh", "f0", "eta", "cos_the
 
 
 @wp.kernel
-def _terms_kernel(hv: wp.array2d(dtype=wp.vec3), s: wp.array2d(dtype=float), out: wp.array2d(dtype=float)):
-    """hv[i] = (h, v); s[i] = SCALARS in order."""
+def _terms_kernel(
+    hv: wp.array2d(dtype=wp.vec3),
+    s: wp.array2d(dtype=float),
+    column: wp.array(dtype=int),
+    out: wp.array2d(dtype=float),
+):
+    """hv[i] = (h, v); s[i] = SCALARS in order; term k goes to out[i, column[k]], skipped where column[k] < 0."""
     i = wp.tid()
     x = TermInputs()
     x.h = hv[i, 0]
@@ -189,7 +194,8 @@ def _terms_kernel(hv: wp.array2d(dtype=wp.vec3), s: wp.array2d(dtype=float), out
     x.eta = s[i, 7]
     x.cos_theta = s[i, 8]
     for k in range(wp.static(len(_PROBE_FUNCS))):
-        out[i, k] = wp.static(_PROBE_FUNCS[k])(x)
+        if column[k] >= 0:
+            out[i, column[k]] = wp.static(_PROBE_FUNCS[k])(x)
 
 
 # --- full specular BRDFs ------------------------------------------------------------------------
@@ -233,17 +239,23 @@ def _brdf_kernel(lv: wp.array2d(dtype=wp.vec3), alpha_f0: wp.array(dtype=wp.vec2
 # --- host side ------------------------------------------------------------------------------------
 
 
-def _vec_and_scalars(vecs: dict, scalars: dict) -> tuple[tuple, dict]:
-    """Broadcast (..., 3) vectors and (...) scalars to one shape; return it and flat float32 arrays."""
+def _vec_and_scalars(vecs: dict, scalars: dict) -> tuple[tuple, np.ndarray, np.ndarray]:
+    """Broadcast (..., 3) vectors and (...) scalars to one shape; return it, the vectors packed (n, len(vecs), 3)
+    and the scalars (n, len(scalars)), float32, in the dicts' order."""
     vecs = {k: np.asarray(a, dtype=np.float32) for k, a in vecs.items()}
-    scalars = {k: np.asarray(a, dtype=np.float32) for k, a in scalars.items()}
+    scalars = [np.asarray(a, dtype=np.float32) for a in scalars.values()]
     for k, a in vecs.items():
         if a.shape[-1:] != (3,):
             raise ValueError(f"{k} must have a trailing axis of 3, got shape {a.shape}")
-    shape = np.broadcast_shapes(*(a.shape[:-1] for a in vecs.values()), *(a.shape for a in scalars.values()))
-    flat = {k: np.ascontiguousarray(np.broadcast_to(a, shape + (3,)).reshape(-1, 3)) for k, a in vecs.items()}
-    flat.update({k: np.ascontiguousarray(np.broadcast_to(a, shape).reshape(-1)) for k, a in scalars.items()})
-    return shape, flat
+    shape = np.broadcast_shapes(*(a.shape[:-1] for a in vecs.values()), *(a.shape for a in scalars))
+    vec = np.empty(shape + (len(vecs), 3), dtype=np.float32)
+    for j, a in enumerate(vecs.values()):
+        vec[..., j, :] = a
+    sca = np.empty(shape + (len(scalars),), dtype=np.float32)
+    for j, a in enumerate(scalars):
+        sca[..., j] = a
+    n = int(np.prod(shape, dtype=np.int64))
+    return shape, vec.reshape(n, len(vecs), 3), sca.reshape(n, len(scalars))
 
 
 def evaluate_terms(
@@ -259,46 +271,42 @@ def evaluate_terms(
     f0=0.04,
     eta=1.5,
     cos_theta=1.0,
+    names=None,
     device: str = "cpu",
 ) -> dict[str, np.ndarray]:
-    """Every term of ``TERM_NAMES`` at the broadcast inputs (module docstring) -> {name: float32 array}.
+    """Every term of ``TERM_NAMES`` (or only those in ``names``: the others are not evaluated) at the broadcast
+    inputs (module docstring) -> {name: float32 array}.
     ``h`` is in the shading frame (n = +z) and is used as given (not normalised); n.h for G2 is h.z.
     The anisotropic terms read ``alpha`` as alpha_x (tangent, +x), ``alpha_y`` (default: alpha) and the
     direction ``v``; D_ashikhmin_shirley has exponents nu, nv = max(2/alpha^2 - 2, 0) of alpha, alpha_y."""
     alpha_y = alpha if alpha_y is None else alpha_y
-    shape, x = _vec_and_scalars(
-        {"h": h, "v": v},
-        {
-            "alpha": alpha,
-            "alpha_y": alpha_y,
-            "nov": nov,
-            "nol": nol,
-            "voh": voh,
-            "loh": loh,
-            "f0": f0,
-            "eta": eta,
-            "cos_theta": cos_theta,
-        },
+    scalars = dict(
+        alpha=alpha, alpha_y=alpha_y, nov=nov, nol=nol, voh=voh, loh=loh, f0=f0, eta=eta, cos_theta=cos_theta
     )
-    n = int(np.prod(shape, dtype=np.int64))
-    out = wp.zeros((n, len(TERM_NAMES)), dtype=float, device=device)
-    hv = np.ascontiguousarray(np.stack([x["h"], x["v"]], axis=1), dtype=np.float32)
-    sc = np.ascontiguousarray(np.stack([x[k] for k in SCALARS], axis=1), dtype=np.float32)
+    shape, hv, sc = _vec_and_scalars({"h": h, "v": v}, {k: scalars[k] for k in SCALARS})
+    names = TERM_NAMES if names is None else tuple(dict.fromkeys(names))
+    unknown = set(names) - set(TERM_NAMES)
+    if unknown:
+        raise KeyError(f"unknown term(s) {sorted(unknown)}; valid: {', '.join(TERM_NAMES)}")
+    column = np.full(len(TERM_NAMES), -1, dtype=np.int32)
+    column[[TERM_NAMES.index(name) for name in names]] = np.arange(len(names))
+    n = len(hv)
+    out = wp.empty((n, len(names)), dtype=float, device=device)  # the kernel writes every element
     inputs = [wp.array(hv, dtype=wp.vec3, device=device), wp.array(sc, dtype=float, device=device)]
     if n:
-        wp.launch(_terms_kernel, dim=n, inputs=inputs + [out], device=device)
+        wp.launch(
+            _terms_kernel, dim=n, inputs=inputs + [wp.array(column, dtype=int, device=device), out], device=device
+        )
     res = out.numpy()
-    return {name: res[:, k].reshape(shape) for k, name in enumerate(TERM_NAMES)}
+    return {name: res[:, k].reshape(shape) for k, name in enumerate(names)}
 
 
 def evaluate_brdfs(l, v, alpha, f0=0.04, device: str = "cpu") -> dict[tuple[str, str], np.ndarray]:
     """f(l, v) of every (NDF, masking) pair in ``BRDF_PAIRS`` -> {(ndf, masking): float32 array}.
     ``l`` and ``v`` are unit vectors in the shading frame (n = +z)."""
-    shape, x = _vec_and_scalars({"l": l, "v": v}, {"alpha": alpha, "f0": f0})
-    n = int(np.prod(shape, dtype=np.int64))
+    shape, lv, af = _vec_and_scalars({"l": l, "v": v}, {"alpha": alpha, "f0": f0})
+    n = len(lv)
     out = wp.zeros((n, len(BRDF_PAIRS)), dtype=float, device=device)
-    lv = np.ascontiguousarray(np.stack([x["l"], x["v"]], axis=1), dtype=np.float32)
-    af = np.ascontiguousarray(np.stack([x["alpha"], x["f0"]], axis=1), dtype=np.float32)
     inputs = [wp.array(lv, dtype=wp.vec3, device=device), wp.array(af, dtype=wp.vec2, device=device)]
     if n:
         wp.launch(_brdf_kernel, dim=n, inputs=inputs + [out], device=device)
