@@ -22,8 +22,10 @@ ROOT = Path(__file__).resolve().parents[1]
 SMALL = {"size": [8, 6], "roughness_size": 8, "f0_size": 3, "anisotropy_size": 3, "phi_size": 3, "sigma_size": 3}
 SMALL |= {"ior_size": 4, "fit_samples": 8}
 # the glass layouts have fixed sizes (EEVEE 16 x 64^2, OpenPBR 32^3), so they get the lowest order and a loose
-# tolerance (their adaptive rules and accuracy: tests/test_dielectric.py). Baking the small set: 4.9 s of CPU
+# tolerance (their adaptive rules and accuracy: tests/test_dielectric.py); the diffuse tables a GL order of 4, not 12
 SMALL_GLASS = {"samples": 4, "mu_order": 2, "tolerance": 1e-1}
+SMALL_KIND = {"dielectric": SMALL_GLASS, "dielectric_avg": SMALL_GLASS, "diffuse": {"samples": 4}}
+SMALL_KIND["diffuse_3d"] = SMALL_KIND["diffuse"]
 PREVIEW_DPI = 40  # the layout is what is checked here, not the pixels
 RENDERED = (  # one file per kind of picture, drawn to a PNG
     "dfg.exr",
@@ -51,8 +53,7 @@ def luts(tmp_path_factory) -> Path:
         for i, raw in enumerate(tomllib.loads(src.read_text())["table"]):
             keys = lookup_kind(raw["kind"]).keys
             raw.update({k: v for k, v in SMALL.items() if k in keys})
-            if raw["kind"].startswith("dielectric"):
-                raw.update({k: v for k, v in SMALL_GLASS.items() if k in keys})
+            raw.update({k: v for k, v in SMALL_KIND.get(raw["kind"], {}).items() if k in keys})
             spec = validate_table(raw, src, i)
             table = bake_table(spec, workers=1)[0]
             write_table(table, out, spec.options.get("format", "exr"), spec.options.get("dtype", "float32"))
