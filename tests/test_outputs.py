@@ -66,9 +66,11 @@ def luts(tmp_path_factory) -> Path:
 def test_the_small_set_has_every_kind_and_format(luts):
     from lutbake.io.readers import read
 
-    kinds = {read(p).attrs.get("kind") for p in luts.glob("*") if p.is_file() and not p.name.endswith(".json")}
+    loaded = {p: read(p) for p in luts.rglob("*.*")}  # each file read once for both checks
+    top = [p for p in luts.glob("*") if p.is_file() and not p.name.endswith(".json")]
+    kinds = {(loaded[p] if p in loaded else read(p)).attrs.get("kind") for p in top}
     assert {"dfg", "albedo", "albedo_avg", "specular_3d", "specular_aniso", "diffuse", "diffuse_3d", "btf"} <= kinds
-    formats = {read(p).format for p in luts.rglob("*.*")}
+    formats = {f.format for f in loaded.values()}
     assert {"exr", "npy", "png", "dds", "ktx2", "h", "sidecar"} <= formats
 
 
