@@ -235,7 +235,8 @@ def write_killed(table, out: Path, fmt: str, kill_at: int, tmp: Path) -> subproc
 @pytest.mark.parametrize("fmt", ["npy", "exr", "ktx2"])
 def test_a_writer_killed_at_every_step_leaves_nothing_a_rerun_trusts(pristine, tmp_path, fmt):
     """B's writer is SIGKILLed after each step of writing over A's output; then A's next run, and B's,
-    must each end with their own exact bytes, skipping only where the unit on disk is theirs."""
+    must each end with their own exact bytes, skipping only where the unit on disk is theirs. One writer is killed
+    per step; each rerun starts from a copy of what it left."""
     a, b, dir_a, dir_b = pristine[fmt]
     name = f"t{EXTENSIONS[fmt]}"
     table_b, _, _ = api.bake_table(b, workers=1)
@@ -244,11 +245,13 @@ def test_a_writer_killed_at_every_step_leaves_nothing_a_rerun_trusts(pristine, t
     steps = full.stdout.strip().split("|")
     assert len(steps) == (2 if fmt == "exr" else 4), steps
     for kill_at in range(1, len(steps) + 1):
+        killed = tmp_path / f"killed{kill_at}"  # A's output, B's writer killed over it: each rerun gets a copy
+        shutil.copytree(dir_a, killed)
+        p = write_killed(table_b, killed, fmt, kill_at, tmp_path)
+        assert p.returncode == -signal.SIGKILL, (kill_at, p.stdout, p.stderr)
         for rerun, theirs in ((a, dir_a), (b, dir_b)):
             out = tmp_path / f"k{kill_at}_{rerun.options['samples']}"
-            shutil.copytree(dir_a, out)
-            p = write_killed(table_b, out, fmt, kill_at, tmp_path)
-            assert p.returncode == -signal.SIGKILL, (kill_at, p.stdout, p.stderr)
+            shutil.copytree(killed, out)
             (job,) = batch.schedule([rerun], out)
             if job.status == "skipped":  # a skip is right only if the output on disk is this config's
                 assert same_output(out / name, theirs / name), f"{fmt}: killed after '{steps[kill_at - 1]}'"
@@ -258,10 +261,7 @@ def test_a_writer_killed_at_every_step_leaves_nothing_a_rerun_trusts(pristine, t
             assert not [f for f in out.iterdir() if atomic.TEMP_RE.fullmatch(f.name)], "stale temp files left"
         if fmt != "exr" and steps[kill_at - 1].startswith("renamed t."):
             # the decisive instant: B's data renamed, A's sidecar still there: A's rerun must not skip
-            out = tmp_path / f"decisive{kill_at}"
-            shutil.copytree(dir_a, out)
-            write_killed(table_b, out, fmt, kill_at, tmp_path)
-            assert batch.schedule([a], out)[0].status == "pending"
+            assert batch.schedule([a], killed)[0].status == "pending"
 
 
 def test_a_full_disk_between_data_and_sidecar_makes_the_next_run_rebake(pristine, tmp_path, monkeypatch):

@@ -16,6 +16,7 @@ from lutbake.io.formats import write_table
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = '[[table]]\nname = "small"\nkind = "dfg"\nsize = [8, 4]\nsamples = 48\n'
 HEAVY = ("warp", "scipy", "OpenImageIO", "matplotlib")
+MARK = "heavy modules: "  # starts the line loaded_after prints after each run
 
 
 def python(code: str, env_extra=None, cwd=None) -> subprocess.CompletedProcess:
@@ -24,28 +25,29 @@ def python(code: str, env_extra=None, cwd=None) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=cwd or ROOT)
 
 
-def loaded_after(args: list[str]) -> list[str]:
-    """Which heavy modules a `lutbake ARGS` run (in a fresh interpreter) imported."""
+def loaded_after(*runs: list[str]) -> list[list[str]]:
+    """Which heavy modules were imported after each `lutbake ARGS` run, the runs made in this order in one fresh
+    interpreter: each list holds what that run and the runs before it imported, so where the lists before it are
+    empty, it is what that run imports alone (one interpreter start for several runs, not one each)."""
     code = (
-        f"import json, sys\nfrom lutbake.cli import main\ntry:\n    main({args!r})\nexcept SystemExit:\n    pass\n"
-        f"print(json.dumps([m for m in {HEAVY!r} if m in sys.modules]))"
+        "import json, sys\nfrom lutbake.cli import main\n"
+        f"for args in {list(runs)!r}:\n    try:\n        main(args)\n    except SystemExit:\n        pass\n"
+        f"    print('\\n' + {MARK!r} + json.dumps([m for m in {HEAVY!r} if m in sys.modules]))"
     )
     r = python(code)
     assert r.returncode == 0, r.stderr
-    return json.loads(r.stdout.strip().splitlines()[-1])
+    return [json.loads(line[len(MARK) :]) for line in r.stdout.splitlines() if line.startswith(MARK)]
 
 
 def test_help_and_version_import_nothing_heavy():
-    assert loaded_after(["--help"]) == []
-    assert loaded_after(["bake", "--help"]) == []
-    assert loaded_after(["--version"]) == []
+    assert loaded_after(["--help"], ["bake", "--help"], ["--version"]) == [[], [], []]
 
 
 def test_list_and_every_commands_help_import_nothing_heavy():
     """`lutbake list` prints every kind, NDF, model and estimator from warp-free declarations (lutbake.catalog)."""
-    assert loaded_after(["list"]) == []
-    for command in ("validate", "audit", "inspect", "preview", "size", "fit", "plot"):
-        assert loaded_after([command, "--help"]) == [], command
+    commands = ("validate", "audit", "inspect", "preview", "size", "fit", "plot")
+    loaded = loaded_after(["list"], *([command, "--help"] for command in commands))
+    assert dict(zip(("list",) + commands, loaded)) == dict.fromkeys(("list",) + commands, [])
 
 
 def test_the_kind_registry_and_config_checks_import_no_warp(tmp_path):
@@ -63,15 +65,13 @@ def test_the_kind_registry_and_config_checks_import_no_warp(tmp_path):
 def test_inspect_imports_only_what_the_format_needs(tmp_path):
     dds = write_table(table2d(2), tmp_path, "dds")
     exr = write_table(table2d(2), tmp_path / "e", "exr")
-    assert loaded_after(["inspect", str(dds)]) == []
     js = write_table(table2d(2), tmp_path / "j", "js")  # an engine layout: values read back with its sidecar
-    assert loaded_after(["inspect", str(js)]) == []
-    assert loaded_after(["inspect", str(exr)]) == ["OpenImageIO"]
+    assert loaded_after(["inspect", str(dds)], ["inspect", str(js)], ["inspect", str(exr)]) == [[], [], ["OpenImageIO"]]
 
 
 def test_preview_imports_no_warp_or_scipy(tmp_path):
     npy = write_table(table2d(2), tmp_path, "npy")
-    assert loaded_after(["preview", str(npy), "-o", str(tmp_path / "p.png")]) == ["matplotlib"]
+    assert loaded_after(["preview", str(npy), "-o", str(tmp_path / "p.png")]) == [["matplotlib"]]
 
 
 def test_import_lutbake_is_lazy():
