@@ -31,16 +31,28 @@ def test_gotanda_eq8_numpy_equals_lutbake_fitted_term():
     np.testing.assert_allclose(got, ref, rtol=EQ8_RTOL, atol=1e-7)
 
 
-def test_karis_refit_lowers_the_rms_and_emits_both_languages():
-    r = fit_karis(n=16)
+@pytest.fixture(scope="module")
+def karis16():
+    """The Karis refit on a 16^2 grid, shared by the tests that read it."""
+    return fit_karis(n=16)
+
+
+@pytest.fixture(scope="module")
+def gotanda_small():
+    """The Gotanda refit on a 6 x 4 x 5 grid (40 evaluations at most), shared by both languages' test."""
+    return fit_gotanda(6, 4, 5, max_nfev=40)
+
+
+def test_karis_refit_lowers_the_rms_and_emits_both_languages(karis16):
+    r = karis16
     for key in ("max |E - E_exact| (f0 = 0.04)", "max |E - E_exact| (f0 = 1)", "mean |A - scale|"):
         assert r.errors["refit"][key] < r.errors["published"][key], key
     assert "EnvBRDFApprox_lutbake" in r.code["glsl"] and "float2" in r.code["hlsl"]
 
 
 @pytest.mark.parametrize("lang", ["glsl", "hlsl"])
-def test_gotanda_refit_lowers_the_floored_max_relative_error(lang):
-    r = fit_gotanda(6, 4, 5, max_nfev=40)
+def test_gotanda_refit_lowers_the_floored_max_relative_error(gotanda_small, lang):
+    r = gotanda_small
     key = "max relative, floored at 0.02/pi"
     assert r.errors["refit"][key] < r.errors["published"][key]
     assert "Fd_gotanda_refit" in r.code[lang]
@@ -53,14 +65,14 @@ def test_cli_fit_writes_the_shader(tmp_path):
     assert "published" in res.output and "float2 EnvBRDFApprox_lutbake" in out.read_text()
 
 
-def test_emitted_glsl_compiles_and_matches_numpy():
+def test_emitted_glsl_compiles_and_matches_numpy(karis16):
     """The emitted Karis GLSL, run on a real OpenGL (moderngl, EGL), returns what the numpy form returns."""
     moderngl = pytest.importorskip("moderngl")
     try:
         ctx = moderngl.create_standalone_context(backend="egl")
     except Exception as e:  # no EGL / GL driver here
         pytest.skip(f"no OpenGL context: {e}")
-    r = fit_karis(n=16)
+    r = karis16
     pts = np.array([[0.1, 0.2], [0.5, 0.5], [0.9, 0.95], [0.02, 0.7]], np.float32)
     got = _render(ctx, r.code["glsl"], "vec4(EnvBRDFApprox_lutbake(q.x, q.y), 0.0, 1.0)", pts)[:, :2]
     np.testing.assert_allclose(

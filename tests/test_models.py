@@ -3,6 +3,7 @@ isotropic Ashikhmin-Shirley; and the config rules that keep a model's terms fixe
 
 import numpy as np
 import pytest
+from scipy import integrate
 
 from lutbake.errors import ConfigError
 
@@ -70,11 +71,33 @@ def test_model_config_rules(kw, match, spec):
         spec(kind="dfg", **kw)
 
 
+def ashikhmin_shirley_albedo(s: float, n_v: float) -> float:
+    """E = ∫ f (n.l) dω_l of the isotropic Ashikhmin-Shirley lobe of exponent s at n.v (v = (sqrt(1 - n.v²), 0, n.v)),
+    independent of lutbake: scipy's cubature (adaptive Gauss-Kronrod, vectorised) over (theta_l, phi) in
+    [0, pi/2] x [0, pi], doubled (f is even in phi), theta_l split at theta_v, the max(n.l, n.v) kink (u in [0, 1]
+    and [1, 2]); the tolerances of the dblquad in (n.l, phi) it replaces (hemisphere_reference), which it matches to
+    6e-11 on this test's texels at 1/40 of the time."""
+    sv, tv = np.sqrt(1.0 - n_v * n_v), np.arccos(n_v)
+
+    def f(x):
+        u, phi = x[:, 0], x[:, 1]
+        lo = u < 1.0
+        th = np.where(lo, u * tv, tv + (u - 1.0) * (np.pi / 2 - tv))
+        mu, sl = np.cos(th), np.sin(th)
+        jac = np.where(lo, tv, np.pi / 2 - tv) * sl
+        hx, hy, hz = sv + sl * np.cos(phi), sl * np.sin(phi), n_v + mu
+        norm = np.sqrt(hx * hx + hy * hy + hz * hz)
+        nh, vh = hz / norm, (sv * hx + n_v * hz) / norm
+        return jac * (s + 1.0) / (8.0 * np.pi) * nh**s / (vh * np.maximum(mu, n_v)) * mu
+
+    res = integrate.cubature(f, [0.0, 0.0], [2.0, np.pi], rtol=1e-8, atol=1e-10)
+    assert res.status == "converged"
+    return 2.0 * float(res.estimate)
+
+
 def test_ashikhmin_shirley_reaches_its_tolerance_against_scipy(bake):
     """Its max(n.l, n.v) kink is a panel boundary (the level line n.l = n.v, per texel): the default gauss_legendre
-    meets 1e-6 with an estimate that bounds its error against scipy's dblquad over l (hemisphere_reference)."""
-    from hemisphere_reference import hemisphere_integral
-
+    meets 1e-6 with an estimate that bounds its error against scipy's cubature over l (ashikhmin_shirley_albedo)."""
     t = bake(
         kind="albedo",
         model="ashikhmin_shirley",
@@ -86,13 +109,8 @@ def test_ashikhmin_shirley_reaches_its_tolerance_against_scipy(bake):
     rough, nov = t.axes[0].values().astype(np.float64), t.axes[1].values().astype(np.float64)
     worst = 0.0
     for i, r in enumerate(rough):
-        s = 2.0 / r**4 - 2.0  # alpha = r^2
-
-        def f_cos(mu, nh, vh, n_v=None, s=s):
-            return (s + 1.0) / (8.0 * np.pi) * nh**s / (vh * max(mu, n_v)) * mu
-
         for j, n_v in enumerate(nov):
-            want = hemisphere_integral(lambda mu, nh, vh, n_v=n_v: f_cos(mu, nh, vh, n_v), n_v)
+            want = ashikhmin_shirley_albedo(2.0 / r**4 - 2.0, n_v)  # alpha = r^2
             worst = max(worst, abs(float(t.data[i, j, 0]) - want))
     print(f"\nAshikhmin-Shirley E vs scipy: max error {worst:.2e}, estimate {t.attributes['error_estimate']}")
     assert worst <= float(t.attributes["error_estimate"]) <= 1e-6

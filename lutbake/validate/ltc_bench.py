@@ -210,17 +210,12 @@ def lookup_texels(cs: list[dict], n: int) -> list[tuple[int, int]]:
     return sorted(out)
 
 
-def fitted_texels(
-    texels: list[tuple[int, int]], fit_kind: str = "shaded", n: int = 64, f0_weight: float | None = None
-) -> tuple[np.ndarray, ...]:
-    """A GGX n x n table (ltc_1, ltc_2) with only ``texels`` filled, fitted as the ``ltc`` kind fits them (its
-    magnitude, its coarse pass and seeding, and for ``fit_kind`` "shaded" its refinement; the sphere and fit-error
-    channels are left 0): enough for the cases whose lookups read only these texels, at a fraction of a table's cost.
-    ``fit_kind`` "two_lobe": (ltc_1, ltc_2, ltc_3) of a two-lobe shader, ltc_1 the shaded fit of F = 1 alone and
-    ltc_3 the matrix of the Schlick part's own shaded fit (lutbake.ltc.shaded.refine ``schlick_lobe``), t2.y its
-    fresnel channel."""
+def l3_texels(texels: list[tuple[int, int]], n: int = 64) -> tuple:
+    """The L3 fit of ``texels`` of a GGX n x n table as the ``ltc`` kind fits them (its magnitude, its coarse pass
+    and seeding): (problem, flat texel indices, packed ltc_1 (k, 4), magnitude (n^2,), fresnel (n^2,)), what
+    fitted_texels refines (pass it as ``l3`` to refine one fit several ways)."""
     from ..kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
-    from ..ltc import fit, shaded
+    from ..ltc import fit
 
     axes = axes_for({"lobe": "ggx", "size": [n, n]})
     nov, alpha = texel_params(axes)
@@ -228,7 +223,26 @@ def fitted_texels(
     prob = fit.Problem("ggx", nov, alpha, mag)
     idx = np.array([t * n + a for t, a in texels])
     m, _ = fit.fit_texels(prob, idx, n, fit.coarse_pass(prob, n, n))
-    packed, mg, fr = fit.pack_inverse(m), mag[idx], fres[idx]
+    return prob, idx, fit.pack_inverse(m), mag, fres
+
+
+def fitted_texels(
+    texels: list[tuple[int, int]],
+    fit_kind: str = "shaded",
+    n: int = 64,
+    f0_weight: float | None = None,
+    l3: tuple | None = None,
+) -> tuple[np.ndarray, ...]:
+    """A GGX n x n table (ltc_1, ltc_2) with only ``texels`` filled, fitted as the ``ltc`` kind fits them (its
+    magnitude, its coarse pass and seeding, and for ``fit_kind`` "shaded" its refinement; the sphere and fit-error
+    channels are left 0): enough for the cases whose lookups read only these texels, at a fraction of a table's cost.
+    ``fit_kind`` "two_lobe": (ltc_1, ltc_2, ltc_3) of a two-lobe shader, ltc_1 the shaded fit of F = 1 alone and
+    ltc_3 the matrix of the Schlick part's own shaded fit (lutbake.ltc.shaded.refine ``schlick_lobe``), t2.y its
+    fresnel channel. ``l3``: l3_texels(texels, n) where the caller has it (the same bits, not fitted again)."""
+    from ..ltc import shaded
+
+    prob, idx, packed, mag, fres = l3_texels(texels, n) if l3 is None else l3
+    mg, fr = mag[idx], fres[idx]
     t1, t2, t3 = np.zeros((n * n, 4)), np.zeros((n * n, 4)), np.zeros((n * n, 4))
     if fit_kind == "two_lobe":
         t3[idx], _, fr = shaded.refine(prob, idx, packed, fres[idx], schlick_lobe=True)
