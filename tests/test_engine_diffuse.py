@@ -93,8 +93,8 @@ def test_unity_hdrp_preset_layout_and_channel_b():
 
 
 # --- unity-hdrp-charlie: PreIntegratedFGD_CharlieFabricLambert -------------------------------------------------------
-# converged Gauss-Legendre (lutbake) vs the graded cubature (tests/hemisphere_reference.py; converged to 5e-12 on these
-# texels, scipy dblquad at epsabs 1e-10 agrees to 3e-10) on the stored (/ 2 pi) scale
+# converged Gauss-Legendre (lutbake) vs the graded cubature (tests/hemisphere_reference.py: a finer rule changes it by
+# < 1e-14 on these texels, scipy dblquad at epsabs 1e-10 agrees to 3e-10) on the stored (/ 2 pi) scale
 CHARLIE_ATOL = 2e-6
 CHARLIE_TEXELS = [(2, 0), (2, 5), (4, 1), (5, 7), (7, 0), (7, 3)]  # (row = roughness, column = NoV) of an 8 x 8 bake
 

@@ -52,8 +52,8 @@ def test_engine_preset_conventions(preset, expected):
     assert {k: spec.options[k] for k in expected} == expected
 
 
-# converged lutbake vs the graded cubature (tests/hemisphere_reference.py; converged to 5e-12 on these texels, scipy
-# dblquad at epsabs 1e-10 agrees to 6e-10), float32 storage of the 8 x 8 bake
+# converged lutbake vs the graded cubature (tests/hemisphere_reference.py: a finer rule changes it by < 6e-12 on these
+# texels, scipy dblquad at epsabs 1e-10 agrees to 6e-10), float32 storage of the 8 x 8 bake
 GODOT_ATOL = 2e-6
 GODOT_TEXELS = [(0, 0), (1, 3), (3, 6), (5, 2), (7, 7)]  # (image row, column); row 0 = the roughest (hi_first)
 
