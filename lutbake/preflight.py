@@ -245,19 +245,20 @@ MAX_NESTING = 32  # arrays / inline tables inside each other; lutbake's deepest 
 MAX_KEY_PARTS = 32  # parts of one dotted key; tomllib takes quadratic time on long ones (20 000 parts: ~45 s)
 _STRINGS = re.compile(r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'|"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'')
 _COMMENT = re.compile(r"#[^\n]*")
+_NOT_BRACKET = re.compile(r"[^\[\]{}]")
 
 
 def nesting_problem(text: str) -> str | None:
     """Why ``text`` (TOML) is too deeply nested to be a config, found in one linear pass before parsing it
     (a RecursionError or minutes of parsing otherwise), or None."""
+    import numpy as np
+
     bare = _COMMENT.sub("", _STRINGS.sub('""', text))
-    depth = deepest = 0
-    for ch in bare:
-        if ch in "[{":
-            depth += 1
-            deepest = max(deepest, depth)
-        elif ch in "]}":
-            depth = max(depth - 1, 0)
+    # the depth after each bracket, an unmatched closing one ignored (depth >= 0): the walk of +-1 steps reflected at
+    # 0 is its running sum minus the running sum's lowest value so far below 0
+    brackets = np.frombuffer(_NOT_BRACKET.sub("", bare).encode(), np.uint8)
+    walk = np.cumsum(np.where((brackets == ord("[")) | (brackets == ord("{")), 1, -1))
+    deepest = int(np.max(walk - np.minimum(np.minimum.accumulate(walk), 0), initial=0))
     if deepest > MAX_NESTING:
         return f"arrays or inline tables nested {deepest} deep (at most {MAX_NESTING})"
     for line in bare.splitlines():

@@ -19,6 +19,9 @@ from lutbake.integrands.specular import hemisphere_integral
 DATA = Path(__file__).parent / "data"
 N = 32  # side of the lutbake tables the broken copies are made of
 MAX_SIDE = 32  # audit subset in these tests (speed)
+# the filament audits' subset of the 128² tables (17 x 17 texels, first and last rows and columns included): the
+# findings are those at MAX_SIDE (offset / nominal RMS 0.044 vs 0.042 at 32, estimated samples 1025 at both)
+FILAMENT_SIDE = 16
 CLEAN_TOL = 1e-5  # a lutbake table re-audited under its own conventions: GL 432 vs GL 432 at the same points
 FILAMENT_SAMPLES = 1024  # cmgen's DFG sample count (filament_dfg.json)
 GLTF_SAMPLES = 1024  # glTF IBL sampler's lut_ggx sample count (khronos_lut_ggx_u8.json)
@@ -43,12 +46,12 @@ def srgb_decode(v):
     return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
 
 
-def run(path, **kw):
-    return audit(path, {"preset": kw.pop("preset", "default")}, max_side=MAX_SIDE, **kw)
+def run(path, max_side=MAX_SIDE, **kw):
+    return audit(path, {"preset": kw.pop("preset", "default")}, max_side=max_side, **kw)
 
 
 def test_filament_shipped_table_one_texel_roughness_offset_found():
-    r = run(DATA / "filament_dfg.npz", preset="filament-corrected")
+    r = run(DATA / "filament_dfg.npz", preset="filament-corrected", max_side=FILAMENT_SIDE)
     assert r.extra["chosen"] == "roughness_offset_+1"
     assert "convention mismatch" in r.diagnosis[0]
     assert r.quantisation["kind"] == "half"
@@ -57,7 +60,7 @@ def test_filament_shipped_table_one_texel_roughness_offset_found():
 
 
 def test_filament_preset_conventions_fit_the_shipped_table():
-    r = run(DATA / "filament_dfg.npz", preset="filament")
+    r = run(DATA / "filament_dfg.npz", preset="filament", max_side=FILAMENT_SIDE)
     assert r.extra["chosen"] == "nominal"
     nominal = next(h for h in r.hypotheses if h["name"] == "nominal")
     others = [h["rms"] for h in r.hypotheses if h["name"] != "nominal"]
@@ -82,7 +85,7 @@ def own_filament(tmp_path_factory):
 def test_lutbakes_own_half_dds_passes_under_its_preset(own_filament):
     """`lutbake audit outputs/filament_dfg.dds --preset filament` failed: the cloth channel reaches 18, where half
     rounding alone is ~0.008 > the 1e-3 tolerance; the judged error is the one beyond a rounding step."""
-    r = audit(own_filament, {"preset": "filament"}, max_side=MAX_SIDE)
+    r = audit(own_filament, {"preset": "filament"}, max_side=FILAMENT_SIDE)
     assert r.passed and r.extra["chosen"] == "nominal", r.text()
     assert r.quantisation["kind"] == "half"
     assert r.extra["raw_error"]["max"] > 1e-3  # the raw |file - converged| is above the tolerance ...
@@ -91,7 +94,7 @@ def test_lutbakes_own_half_dds_passes_under_its_preset(own_filament):
 
 def test_lutbakes_own_file_is_audited_against_its_recorded_conventions(own_filament):
     """Without --preset, the file's sidecar conventions are used (not `default`, which gave 'layout mismatch')."""
-    r = audit(own_filament, {}, max_side=MAX_SIDE)
+    r = audit(own_filament, {}, max_side=FILAMENT_SIDE)
     assert r.passed and r.extra["chosen"] == "nominal", r.text()
     assert "recorded config" in r.conventions and "multiscatter_cloth" in r.conventions
     res = CliRunner().invoke(main, ["audit", str(own_filament), "--max-side", "16"])
@@ -206,8 +209,11 @@ def test_bevy_shipped_ktx2_fits_the_bevy_preset():
 
 
 def test_bevy_shipped_table_is_height_correlated_not_separable():
-    hc = run(DATA / "bevy_dfg.ktx2", preset="bevy")
-    sep = audit(DATA / "bevy_dfg.ktx2", {"preset": "bevy", "overrides": ["masking=smith_separable"]}, max_side=MAX_SIDE)
+    """On a 7 x 7 subset (first and last rows and columns): RMS ratio 0.022 there, 0.017 on 33 x 33."""
+    hc = run(DATA / "bevy_dfg.ktx2", preset="bevy", max_side=FAST_SIDE)
+    sep = audit(
+        DATA / "bevy_dfg.ktx2", {"preset": "bevy", "overrides": ["masking=smith_separable"]}, max_side=FAST_SIDE
+    )
     assert hc.hypotheses[0]["rms"] < 0.1 * sep.hypotheses[0]["rms"]
 
 

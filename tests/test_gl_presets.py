@@ -35,9 +35,13 @@ ROOT = Path(__file__).resolve().parents[1]
 TEXTURE_FORMATS = ("exr", "dds", "ktx2", "ktx2zst", "png16", "ltc_dds")
 SMALL_SIDE = 16  # the longest side of a reduced 2D bake (the preset's aspect ratio kept, >= MIN_SIDE)
 MIN_SIDE = 4
-LTC_SIDE = 8  # LTC fits take ~0.3 s per texel row
+# the costly bakes smaller still (what GL samples is the same at any size): an LTC fit (8² 1.2 s, 4² 0.3 s), the 3D
+# dielectric table's adaptive quadrature (16² x 4 IOR slices 0.9 s, 8² x 4 0.1 s), the averages' (8 x 4 0.8 s, 4 x 4
+# 0.35 s)
+LTC_SIDE = 4
+DIELECTRIC_SIDE = 8
 IOR_SIZE = 4
-ROUGHNESS_SIZE = 8
+ROUGHNESS_SIZE = 4
 N_POINTS = 256
 # GL vs the CPU filter of the same texels: GPUs weight texels with a few fractional bits (Direct3D 11 requires 8),
 # so the bound is 2^-8 of the largest difference between the texels a point filters, plus float32 rounding. Mesa
@@ -68,6 +72,8 @@ def small_overrides(spec) -> list[str]:
     if "size" in o:
         if spec.kind == "ltc":
             w = h = LTC_SIDE
+        elif "ior_size" in o:
+            w = h = DIELECTRIC_SIDE
         else:
             f = SMALL_SIDE / max(o["size"])
             w, h = (max(MIN_SIDE, round(s * f)) for s in o["size"])

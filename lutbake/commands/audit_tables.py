@@ -225,8 +225,9 @@ def audit_ltc(
     sub_ny, sub_nx = len(iy), len(ix)
     problem = fit.Problem(o["lobe"], nov, a_fit, mag, o["fit_samples"])
     idx = np.arange(len(texel))
-    coarse = fit.coarse_pass(problem, sub_ny, sub_nx)
-    m_ours, e_ours = fit.fit_texels(problem, idx, sub_nx, coarse)
+    # lutbake.ltc.fit.MEMO: audits of one table size (or the bake of its preset) share their texels' fits, same bits
+    coarse = fit.coarse_pass(problem, sub_ny, sub_nx, fit.MEMO)
+    m_ours, e_ours = fit.fit_texels(problem, idx, sub_nx, coarse, fit.MEMO)
     packed_file = t1.reshape(-1, 4)[texel]
     e_file = fit.heitz_error_of_packed(problem, idx, packed_file)
     rel_file, rel_ours = problem.relative(idx, e_file), problem.relative(idx, e_ours)

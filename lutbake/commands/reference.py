@@ -34,7 +34,9 @@ def computed_at(spec: TableSpec, points: dict, workers: int | None) -> np.ndarra
     """``compute_at(spec, points, workers)``, its rows memoised per texel in REFERENCES."""
     cols = [np.asarray(points[k], np.float64) for k in POINTS]
     base = repr(sorted(spec.options.items())).encode()
-    keys = [base + b"".join(c[i].tobytes() for c in cols) for i in range(len(cols[0]))]
+    # a texel's key: base + its nov, alpha, rough float64 bytes (one row of the stacked points)
+    raw, width = np.stack(cols, axis=1).tobytes(), 8 * len(POINTS)
+    keys = [base + raw[i : i + width] for i in range(0, len(raw), width)]
     if not keys:
         return compute_at(spec, points, workers)
 
