@@ -51,7 +51,7 @@ lint: $(STAMP)
 test: $(STAMP) lint
 	@$(BIN)/python -c "import moderngl; moderngl.create_standalone_context(backend='egl').release()" 2>/dev/null \
 		|| echo "note: no EGL OpenGL here; the GL consumer test will skip (Debian: apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri)"
-	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadscope
+	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadscope --no-loadscope-reorder
 
 # diffuse kinds against converged references (accuracy and wall time): outputs/bench/diffuse.json
 bench-diffuse: $(STAMP)

@@ -25,6 +25,21 @@ from lutbake.config import load_config, parse_overrides, preset_path, validate_t
 DATA = Path(__file__).resolve().parent / "data"
 
 
+# The modules with the most test time, longest first. `make test` runs whole modules per xdist worker in
+# collection order (--dist loadscope --no-loadscope-reorder), so the long ones start first and both workers
+# finish together (longest-processing-time-first); every other module keeps its file order after them.
+SLOW_FIRST = (
+    "test_outputs", "test_audit", "test_validate", "test_dielectric", "test_cluster", "test_integrity",
+    "test_value_bounds", "test_quiet_lazy", "test_ltc", "test_ltc_shaded", "test_babylon", "test_pipeline",
+    "test_hostile", "test_interpolation",
+)  # fmt: skip
+
+
+def pytest_collection_modifyitems(items):
+    rank = {name: i for i, name in enumerate(SLOW_FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.stem, len(SLOW_FIRST)))
+
+
 @pytest.fixture(scope="session", autouse=True)
 def warp_quiet():
     wp.config.quiet = True
