@@ -94,32 +94,44 @@ def _utf8_prefix_ok(raw: bytes) -> bool:
     return True
 
 
-def probe_directory(path) -> str | None:
+def probe_directory(path, attempts=3) -> str | None:
     """Why no file can be created in directory ``path``, found by trying: create it (mkdir -p), create and remove a
     temporary file in it, then remove the directories this probe made, or None. Catches what permission bits do not
-    tell (root on /proc or /sys, a read-only bind mount, a full inode table)."""
+    tell (root on /proc or /sys, a read-only bind mount, a full inode table). Two runs probing one new directory at
+    once race: a directory the other made first is used, not an error, and a directory it removed under this probe
+    is tried again (``attempts`` times)."""
     path = Path(path)
-    made = []
-    probe = path
-    while not os.path.lexists(probe) and probe.parent != probe:
-        made.append(probe)
-        probe = probe.parent
-    try:
-        for d in reversed(made):
-            os.mkdir(d)
-        fd, tmp = tempfile.mkstemp(prefix=".lutbake-probe.", dir=path)
-        os.close(fd)
-        os.unlink(tmp)
-    except OSError as e:
-        from .io.oserror import os_error_text
+    for attempt in range(attempts):
+        made = []
+        try:
+            missing = []
+            probe = path
+            while not os.path.lexists(probe) and probe.parent != probe:
+                missing.append(probe)
+                probe = probe.parent
+            for d in reversed(missing):
+                try:
+                    os.mkdir(d)
+                    made.append(d)
+                except FileExistsError:
+                    if not os.path.isdir(d):
+                        raise
+            fd, tmp = tempfile.mkstemp(prefix=".lutbake-probe.", dir=path)
+            os.close(fd)
+            os.unlink(tmp)
+            return None
+        except OSError as e:
+            if isinstance(e, FileNotFoundError) and attempt < attempts - 1:
+                continue
+            from .io.oserror import os_error_text
 
-        return f"cannot create files there: {os_error_text(e)}"
-    finally:
-        for d in made:
-            try:
-                os.rmdir(d)
-            except OSError:
-                pass
+            return f"cannot create files there: {os_error_text(e)}"
+        finally:
+            for d in reversed(made):
+                try:
+                    os.rmdir(d)
+                except OSError:
+                    pass
     return None
 
 

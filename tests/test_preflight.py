@@ -347,3 +347,29 @@ def test_entry_point_ends_with_the_atexit_hooks_the_flushes_and_the_threads_of_a
     assert "thread finished" in lines[:-1], r.stdout
     r = run("-", "--version", capture_output=False, stderr=subprocess.PIPE, preexec_fn=lambda: os.close(1))
     assert r.returncode == 0 and r.stderr == "", r.stderr  # no stdout at all (sys.stdout is None)
+
+
+def test_probe_directory_survives_a_concurrent_run_making_and_removing_the_directory(tmp_path, monkeypatch):
+    """Two runs probing one new --out-dir: the other run's mkdir wins the race (FileExistsError here), then its
+    rmdir removes the directory under this probe (FileNotFoundError at mkstemp): both are retried, not errors."""
+    import tempfile
+
+    from lutbake import preflight
+
+    out = tmp_path / "out"
+    real_mkdir, real_mkstemp, calls = os.mkdir, tempfile.mkstemp, []
+
+    def other_run_first(d, *a):
+        real_mkdir(d)  # the other run made it a moment before
+        real_mkdir(d, *a)
+
+    def other_run_removes(*a, **k):
+        calls.append(1)
+        if len(calls) == 1:
+            os.rmdir(out)  # the other run's probe cleans up
+        return real_mkstemp(*a, **k)
+
+    monkeypatch.setattr(preflight.os, "mkdir", other_run_first)
+    monkeypatch.setattr(preflight.tempfile, "mkstemp", other_run_removes)
+    assert preflight.probe_directory(out) is None
+    assert len(calls) == 2
