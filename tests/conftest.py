@@ -29,9 +29,9 @@ DATA = Path(__file__).resolve().parent / "data"
 # collection order (--dist loadscope --no-loadscope-reorder), so the long ones start first and both workers
 # finish together (longest-processing-time-first); every other module keeps its file order after them.
 SLOW_FIRST = (
-    "test_outputs", "test_audit", "test_validate", "test_dielectric", "test_cluster", "test_integrity",
-    "test_value_bounds", "test_quiet_lazy", "test_ltc", "test_ltc_shaded", "test_babylon", "test_pipeline",
-    "test_hostile", "test_interpolation",
+    "test_dielectric", "test_audit", "test_outputs", "test_cluster", "test_validate", "test_ltc", "test_quiet_lazy",
+    "test_pipeline", "test_ltc_shaded", "test_babylon", "test_interpolation", "test_batch", "test_integrity",
+    "test_preflight", "test_hostile",
 )  # fmt: skip
 
 
