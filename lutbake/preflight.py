@@ -5,6 +5,7 @@ written. A config path that is not a regular file says what it is."""
 
 from __future__ import annotations
 
+import errno
 import os
 import re
 import stat
@@ -41,25 +42,40 @@ def config_file_problem(path) -> str | None:
     return None
 
 
-def directory_problem(path) -> str | None:
+def directory_problem(path, attempts: int = 3) -> str | None:
     """Why lutbake cannot create files in directory ``path`` (made if missing, as mkdir -p would), or None:
-    a dangling symlink, a file on the way, a read-only file system, no write permission."""
+    a dangling symlink, a symlink loop, a file on the way, a read-only file system, no write permission. A directory
+    another run's probe made and removed while this one looked is looked at again (``attempts`` times)."""
     path = Path(path)
+    for _ in range(attempts):
+        problem = _directory_problem_once(path)
+        if problem != _VANISHED:
+            return problem
+    return None  # made and removed under us every time: the probe (probe_directory) tries it for real
+
+
+_VANISHED = "vanished"  # the directory looked at was removed meanwhile (another run's probe): look again
+
+
+def _directory_problem_once(path: Path) -> str | None:
     probe = path
     while not probe.exists():
         if os.path.islink(probe):
+            where = "" if probe == path else f"{probe} "
             target = os.readlink(probe)
-            return (
-                f"is a dangling symlink (to {target!r})"
-                if probe == path
-                else f"{probe} is a dangling symlink (to {target!r})"
-            )
+            if _stat_errno(probe) == errno.ELOOP:
+                return f"{where}is a symlink loop (to {target!r})"
+            return f"{where}is a dangling symlink (to {target!r})"
         if probe.parent == probe:
             break
         probe = probe.parent
     if not probe.is_dir():
+        if not os.path.lexists(probe):
+            return _VANISHED
         return "exists and is not a directory" if probe == path else f"{probe} is a file, not a directory"
     if not os.access(probe, os.W_OK | os.X_OK):
+        if not os.path.lexists(probe):
+            return _VANISHED
         where = "" if probe == path else f" ({probe})"
         try:
             if os.statvfs(probe).f_flag & os.ST_RDONLY:
@@ -68,6 +84,14 @@ def directory_problem(path) -> str | None:
             pass
         return f"is not writable{where} (permission denied)"
     return None
+
+
+def _stat_errno(path) -> int:
+    try:
+        os.stat(path)
+    except OSError as e:
+        return e.errno or 0
+    return 0
 
 
 def _same(a: Path, b: Path) -> bool:
@@ -114,6 +138,8 @@ def probe_directory(path, attempts=3) -> str | None:
                     os.mkdir(d)
                     made.append(d)
                 except FileExistsError:
+                    if not os.path.lexists(d):  # another run's probe made it and removed it since: try again
+                        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), str(d)) from None
                     if not os.path.isdir(d):
                         raise
             fd, tmp = tempfile.mkstemp(prefix=".lutbake-probe.", dir=path)

@@ -373,3 +373,34 @@ def test_probe_directory_survives_a_concurrent_run_making_and_removing_the_direc
     monkeypatch.setattr(preflight.tempfile, "mkstemp", other_run_removes)
     assert preflight.probe_directory(out) is None
     assert len(calls) == 2
+
+
+def test_a_directory_another_run_made_and_removed_meanwhile_is_no_error(tmp_path, monkeypatch):
+    """Issue 46, item 1 (concurrent runs into one new --out-dir): the other run's probe makes the directory and removes
+    it again while this run looks at it: between its exists() and access() ('is not writable (permission denied)'),
+    and between its mkdir and ours ('File exists' for a directory gone again). Both are looked at again, not errors."""
+    from lutbake import preflight
+
+    out = tmp_path / "out"
+    out.mkdir()  # the other run's probe made it
+    real_access, real_mkdir, seen = os.access, os.mkdir, []
+
+    def removed_meanwhile(path, mode):
+        if not seen:
+            seen.append(path)
+            os.rmdir(out)  # ... and removes it now
+        return real_access(path, mode)
+
+    monkeypatch.setattr(preflight.os, "access", removed_meanwhile)
+    assert preflight.directory_problem(out) is None
+    monkeypatch.setattr(preflight.os, "access", real_access)
+
+    def made_and_removed(d, *a):
+        if not seen[1:]:
+            seen.append(d)
+            raise FileExistsError(17, "File exists", str(d))  # it was there an instant ago, gone by now
+        real_mkdir(d, *a)
+
+    monkeypatch.setattr(preflight.os, "mkdir", made_and_removed)
+    assert preflight.probe_directory(out) is None
+    assert len(seen) == 2 and not out.exists()
