@@ -152,8 +152,9 @@ def bake(
     preflight.check_out_dir(out_dir)
     jobs = batch.schedule(specs, out_dir, force=force)
     preflight.check_outputs(jobs)
+    preflight.check_inputs(jobs, paths, cache_dir)
     if report is not None:
-        preflight.check_report(report, jobs, paths)
+        preflight.check_report(report, jobs, paths, cache_dir)
     if on_schedule:
         on_schedule([_result(j) for j in jobs])
     done: dict[int, BakeResult] = {}

@@ -243,9 +243,45 @@ def check_outputs(jobs) -> None:
                 )
 
 
-def check_report(report, jobs, configs=()) -> None:
+def _is(a, b) -> bool:
+    """``a`` and ``b`` name one file: the same real path, or one name in one real directory (case folded)."""
+    return _same(a, b) or path_key(a) == path_key(b)
+
+
+def input_claims(jobs, configs=(), cache_dir=None) -> list[tuple[Path, str]]:
+    """Every path a run reads or keeps that no table may write, with what it is: each config (a preset's file too),
+    the --cache directory and the cache entries this run may write (one per pending values key,
+    lutbake.values_cache)."""
+    claims = [(Path(c), f"the config {c}") for c in configs]
+    if cache_dir is not None:
+        cache_dir = Path(cache_dir)
+        claims.append((cache_dir, f"the --cache directory {cache_dir}"))
+        for key in sorted({j.values_key for j in jobs if j.status == "pending" and j.values_key}):
+            claims += [(cache_dir / f"{key}{ext}", f"a --cache entry in {cache_dir}") for ext in (".npy", ".json")]
+    return claims
+
+
+def check_inputs(jobs, configs=(), cache_dir=None) -> None:
+    """No file a table writes (planned_files: an output, a second texture, a sidecar) is a config, the --cache
+    directory or a cache entry (input_claims): the bake would overwrite its own input. ConfigError naming both."""
+    claims = input_claims(jobs, configs, cache_dir)
+    for job in jobs:
+        for p, what in planned_files(job):
+            for c, claim in claims:
+                if _is(p, c):
+                    raise ConfigError(
+                        job.spec.source,
+                        "name",
+                        job.name,
+                        table=job.name,
+                        message=f"its {what} ({shorten(str(p))}) is {shorten(claim)}; the bake would overwrite it: "
+                        "rename the table or that file, or choose another --out-dir",
+                    )
+
+
+def check_report(report, jobs, configs=(), cache_dir=None) -> None:
     """``--report`` must be creatable and must not be any file a table writes (planned_files: an output, a second
-    texture, a sidecar) or a config."""
+    texture, a sidecar), a config, the --cache directory or a cache entry (input_claims)."""
     if report is None:
         return
     report = Path(report)
@@ -271,9 +307,9 @@ def check_report(report, jobs, configs=()) -> None:
                     table=job.name,
                     message=f"is the {what} of table '{job.name}'; the report would overwrite it",
                 )
-    for c in configs:
-        if _same(report, Path(c)):
-            raise ConfigError("--report", "report", str(report), message=f"is the config {c}; it would be overwritten")
+    for c, claim in input_claims(jobs, configs, cache_dir):
+        if _is(report, c):
+            raise ConfigError("--report", "report", str(report), message=f"is {claim}; it would be overwritten")
     problem = directory_problem(report.parent)
     if problem:
         raise ConfigError("--report", "report", str(report), message=f"cannot be written: {report.parent}: {problem}")

@@ -404,3 +404,27 @@ def test_a_directory_another_run_made_and_removed_meanwhile_is_no_error(tmp_path
     monkeypatch.setattr(preflight.os, "mkdir", made_and_removed)
     assert preflight.probe_directory(out) is None
     assert len(seen) == 2 and not out.exists()
+
+
+@pytest.mark.parametrize(
+    "config_name, table, fmt, claimed",
+    [("u.exr", "u", "exr", "its output"), ("t.npy.json", "t", "npy", "its sidecar of t.npy"), ("t.h", "t", "h", "")],
+)
+def test_a_config_that_a_table_would_overwrite_is_refused(tmp_path, no_kernel, config_name, table, fmt, claimed):
+    """Issue 46, item 4: a config saved as ``u.exr`` (table u's output) or ``t.npy.json`` (table t's sidecar) was
+    replaced by its own bake, exit 0. Every input is in the registry's check: exit 2, the file named, nothing
+    written."""
+    cfg = tmp_path / config_name
+    text = f'[[table]]\nname = "{table}"\nkind = "dfg"\nsize = [4, 4]\nsamples = 48\nformat = "{fmt}"\n'
+    cfg.write_text(text)
+    refused(bake(cfg, "--out-dir", tmp_path), claimed, f"is the config {cfg}", "would overwrite it")
+    refused(bake(cfg, "--out-dir", tmp_path / "x" / ".."), f"is the config {cfg}")
+    assert cfg.read_text() == text and sorted(f.name for f in tmp_path.iterdir()) == [config_name]
+
+
+def test_an_output_or_report_that_is_the_cache_directory_is_refused(cfg, tmp_path, no_kernel):
+    """Issue 46, item 4: the --cache directory is an input too (its entries as well)."""
+    out = tmp_path / "o"
+    refused(bake(cfg, "--out-dir", out, "--cache", out / "t.exr"), "its output", "is the --cache directory")
+    refused(bake(cfg, "--out-dir", out, "--cache", out / "c", "--report", out / "c"), "is the --cache directory")
+    assert not out.exists()
