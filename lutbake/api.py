@@ -37,6 +37,7 @@ class BakeResult:
     message: str = ""
     values_from: str | None = None
     shape: str = ""
+    cache_error: str = ""  # why its values could not be written into the --cache (the table is baked all the same)
 
     @property
     def name(self) -> str:
@@ -88,6 +89,7 @@ def _result(job: batch.Job) -> BakeResult:
         job.message,
         job.values_from,
         job.shape,
+        job.cache_error,
     )
 
 
@@ -150,9 +152,11 @@ def bake(
                 on_result(results[-1])
         return results
     preflight.check_out_dir(out_dir)
+    preflight.check_cache(cache_dir)
     jobs = batch.schedule(specs, out_dir, force=force)
     preflight.check_outputs(jobs)
     preflight.check_inputs(jobs, paths, cache_dir)
+    preflight.check_path_lengths(jobs, cache_dir, report)
     if report is not None:
         preflight.check_report(report, jobs, paths, cache_dir)
     if on_schedule:

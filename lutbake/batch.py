@@ -74,6 +74,7 @@ class Job:
     message: str = ""
     shape: str = ""
     table: object = None  # the baked lutbake.table.Table, once baked
+    cache_error: str = ""  # why its values could not be written into the --cache (the table itself is baked)
 
     @property
     def name(self) -> str:
@@ -165,7 +166,10 @@ def _store(cache: ValuesCache | None, job: Job, computed: Computed) -> None:
     try:
         cache.store(job.values_key, computed.data, computed.extra)
     except OSError as e:
-        job.message = f"values cache not written: {os_error_text(e, cache.directory, computed.data.nbytes)}"
+        job.cache_error = f"values cache {cache.directory} not written: " + os_error_text(
+            e, cache.directory, computed.data.nbytes
+        )
+        job.message = job.cache_error
 
 
 def _bake_group(

@@ -164,9 +164,99 @@ def probe_directory(path, attempts=3) -> str | None:
 def check_out_dir(out_dir) -> None:
     """``--out-dir`` names a directory lutbake can create files in (tried, and left as it was): exit 2 before any
     kernel runs, not a failed write after the bake."""
-    problem = encoding_problem(out_dir) or directory_problem(out_dir) or probe_directory(out_dir)
+    _check_directory("--out-dir", out_dir)
+
+
+def check_cache(cache_dir) -> None:
+    """``--cache DIR`` is checked as ``--out-dir`` is (a read-only file system, below a file, a dangling symlink or a
+    symlink loop, too long): exit 2 before any kernel, not every entry silently unwritten."""
+    if cache_dir is not None:
+        _check_directory("--cache", cache_dir)
+
+
+def _check_directory(option: str, directory) -> None:
+    try:
+        problem = (
+            encoding_problem(directory)
+            or length_problem([Path(directory) / PROBE_NAME])
+            or directory_problem(directory)
+            or probe_directory(directory)
+        )
+    except OSError as e:  # whatever the checks above did not foresee: one line, not a traceback
+        from .io.oserror import os_error_text
+
+        problem = f"cannot be used: {os_error_text(e)}"
     if problem:
-        raise ConfigError("--out-dir", "out-dir", shorten(str(out_dir)), message=problem)
+        raise ConfigError(option, option.lstrip("-"), shorten(str(directory)), message=problem)
+
+
+PROBE_NAME = ".lutbake-probe.XXXXXXXX"  # as long as probe_directory's temporary file (mkstemp: 8 random characters)
+DEFAULT_PATH_MAX, DEFAULT_NAME_MAX = 4096, 255  # Linux's, where os.pathconf tells none
+
+
+def path_limits(path) -> tuple[int, int]:
+    """(PATH_MAX, NAME_MAX) in bytes (PATH_MAX counts the final NUL) of the file system ``path`` is or will be on:
+    os.pathconf of its nearest existing ancestor."""
+    probe = Path(path)
+    while not os.path.isdir(probe) and probe.parent != probe:  # isdir: False, not an error, for a too-long path
+        probe = probe.parent
+    limits = []
+    for name, default in (("PC_PATH_MAX", DEFAULT_PATH_MAX), ("PC_NAME_MAX", DEFAULT_NAME_MAX)):
+        try:
+            value = os.pathconf(probe, name)
+        except (OSError, ValueError, AttributeError):  # no such limit, no os.pathconf (Windows)
+            value = None
+        limits.append(value if value and value > 0 else default)
+    return limits[0], limits[1]
+
+
+def length_problem(paths) -> str | None:
+    """Why one of ``paths`` (files a run will create, as it will spell them) cannot be created: a name over NAME_MAX
+    or a path over PATH_MAX (os.pathconf, path_limits), or None."""
+    for p in paths:
+        path_max, name_max = path_limits(Path(p).parent)
+        raw = os.fsencode(str(p))
+        if len(raw) + 1 > path_max:
+            return (
+                f"the path {shorten(str(p))} this run would create is {len(raw)} bytes long; the file system takes "
+                f"at most {path_max - 1} (PATH_MAX): choose a shorter path"
+            )
+        for part in Path(p).parts:
+            if len(os.fsencode(part)) > name_max:
+                return (
+                    f"the file name {shorten(part)} this run would create is {len(os.fsencode(part))} bytes long; "
+                    f"the file system takes at most {name_max} (NAME_MAX)"
+                )
+    return None
+
+
+def created_paths(jobs, cache_dir=None, report=None) -> list[tuple[str, object, list[Path]]]:
+    """(option, its value, the paths it makes this run create): every planned file of the pending tables (data,
+    second texture, sidecar) and the temporary sibling each is written to first (lutbake.io.atomic.temp_name), the
+    cache entries and their temporary files, the report and its temporary file."""
+    from .io.atomic import temp_name
+
+    def with_temps(paths):
+        return [q for p in paths for q in (p, p.with_name(temp_name(p.name)))]
+
+    groups = []
+    pending = [j for j in jobs if j.status == "pending"]
+    for job in pending:
+        groups.append(("--out-dir", job.path.parent, with_temps([p for p, _ in planned_files(job)])))
+    if cache_dir is not None:
+        groups.append(("--cache", cache_dir, with_temps(cache_entries(pending, cache_dir))))
+    if report is not None:
+        groups.append(("--report", report, with_temps([Path(report)])))
+    return groups
+
+
+def check_path_lengths(jobs, cache_dir=None, report=None) -> None:
+    """The longest path this run will create (created_paths: temporary names, sidecars, cache entries, the report)
+    within the OS limits (length_problem): exit 2 before any kernel, not a failed rename after the bake."""
+    for option, value, paths in created_paths(jobs, cache_dir, report):
+        problem = length_problem(sorted(paths, key=lambda p: -len(os.fsencode(str(p)))))
+        if problem:
+            raise ConfigError(option, option.lstrip("-"), shorten(str(value)), message=problem)
 
 
 def planned_files(job) -> list[tuple[Path, str]]:
@@ -192,6 +282,11 @@ def path_key(path) -> str:
     return os.path.join(os.path.normcase(parent), path.name.casefold())
 
 
+def _name_error(job, message: str) -> ConfigError:
+    """A ConfigError blaming table ``job``'s name (the file it writes) in its config."""
+    return ConfigError(job.spec.source, "name", job.name, table=job.name, message=message)
+
+
 def check_collisions(jobs) -> None:
     """No two tables of a batch write one file (data, second texture or sidecar), including names that differ
     only in case: an ltc_dds table ``foo`` writes ``foo_1.dds``, as a dds table ``foo_1`` does."""
@@ -202,12 +297,9 @@ def check_collisions(jobs) -> None:
             if key in owners and owners[key][0] is not job:
                 other, other_path, other_what = owners[key]
                 same = "" if other_path.name == p.name else f" ({other_path.name} and {p.name} differ only in case)"
-                raise ConfigError(
-                    job.spec.source,
-                    "name",
-                    job.name,
-                    table=job.name,
-                    message=f"its {what} {p} is also the {other_what} of table '{other.name}' "
+                raise _name_error(
+                    job,
+                    f"its {what} {p} is also the {other_what} of table '{other.name}' "
                     f"({other.spec.source}){same}: the two tables would overwrite each other; rename one",
                 )
             owners[key] = (job, p, what)
@@ -254,11 +346,16 @@ def input_claims(jobs, configs=(), cache_dir=None) -> list[tuple[Path, str]]:
     lutbake.values_cache)."""
     claims = [(Path(c), f"the config {c}") for c in configs]
     if cache_dir is not None:
-        cache_dir = Path(cache_dir)
-        claims.append((cache_dir, f"the --cache directory {cache_dir}"))
-        for key in sorted({j.values_key for j in jobs if j.status == "pending" and j.values_key}):
-            claims += [(cache_dir / f"{key}{ext}", f"a --cache entry in {cache_dir}") for ext in (".npy", ".json")]
+        claims.append((Path(cache_dir), f"the --cache directory {cache_dir}"))
+        claims += [(e, f"a --cache entry in {cache_dir}") for e in cache_entries(jobs, cache_dir)]
     return claims
+
+
+def cache_entries(jobs, cache_dir) -> list[Path]:
+    """The files of the cache entries this run may write in ``cache_dir``: one .npy and one .json per values key of
+    the pending tables (lutbake.values_cache.ValuesCache.paths)."""
+    keys = sorted({j.values_key for j in jobs if j.status == "pending" and j.values_key})
+    return [Path(cache_dir) / f"{key}{ext}" for key in keys for ext in (".npy", ".json")]
 
 
 def check_inputs(jobs, configs=(), cache_dir=None) -> None:
@@ -269,12 +366,9 @@ def check_inputs(jobs, configs=(), cache_dir=None) -> None:
         for p, what in planned_files(job):
             for c, claim in claims:
                 if _is(p, c):
-                    raise ConfigError(
-                        job.spec.source,
-                        "name",
-                        job.name,
-                        table=job.name,
-                        message=f"its {what} ({shorten(str(p))}) is {shorten(claim)}; the bake would overwrite it: "
+                    raise _name_error(
+                        job,
+                        f"its {what} ({shorten(str(p))}) is {shorten(claim)}; the bake would overwrite it: "
                         "rename the table or that file, or choose another --out-dir",
                     )
 

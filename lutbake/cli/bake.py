@@ -161,6 +161,7 @@ class BatchProgress:
         self.total = self.finished = self.pending = 0
         self.running: list[str] = []
         self.shown = False
+        self.cache_warned = False  # a --cache that cannot be written is said once, not once per table
 
     def scheduled(self, results) -> None:
         self.total = len(results)
@@ -212,6 +213,11 @@ class BatchProgress:
         elif r.status == "failed":
             self.done_pending += 1
             click.echo(f"{count}FAILED {r.name}: {escape_controls(r.message)}", err=True)
+        if r.cache_error and not self.cache_warned:
+            self.cache_warned = True
+            click.echo(
+                f"warning: {escape_controls(r.cache_error)}; the tables are baked, their values not kept", err=True
+            )
         self.draw()
 
     def line(self) -> str:
