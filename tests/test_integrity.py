@@ -424,32 +424,71 @@ def check_no_wrong_skip(configs: dict[int, Path], out: Path, refs: dict[int, Pat
     assert all(len(v) == 1 for v in skippers.values()), f"a pair of two writers left on disk: {skippers}"
 
 
+def wrong_vouchers(out: Path, expected: dict[str, bytes]) -> list[str]:
+    """The npy outputs whose sidecar, read at this instant, vouches for the data file's bytes (its ``data_sha256``
+    is their sha256) while those bytes are not the table of the config its ``content_hash`` names (``expected``:
+    content hash -> that table's bytes): a file the next run of that config would skip, holding another's table.
+    One read of each file: what a concurrent run scheduling at this moment would see."""
+    from lutbake.io.integrity import sha256_bytes
+
+    wrong = []
+    for name in RACE_NAMES:
+        data = out / f"{name}.npy"
+        try:
+            doc = json.loads(sidecar_path(data).read_bytes())
+            blob = data.read_bytes()
+        except (OSError, ValueError):
+            continue
+        claimed = doc.get("lutbake", {}).get("content_hash")
+        if doc.get("data_sha256") == sha256_bytes(blob) and blob != expected.get(claimed):
+            wrong.append(name)
+    return wrong
+
+
 @pytest.mark.parametrize("fmt", ["npy", "exr"])
 def test_concurrent_bakes_into_one_out_dir_never_leave_a_wrong_file_up_to_date(tmp_path, monkeypatch, fmt):
-    """Issue 46, item 1: 12 bakes at once (threads, 4 rounds) of two configs with the same table names into one
+    """Issue 46, item 1: 12 bakes at once (threads, 3 rounds; EXR 2) of two configs with the same table names into one
     out-dir. A sidecar hashed from the file after its rename named the other run's bytes: the next run of the config
-    skipped a file holding the other config's table. (An EXR is sealed before its rename: checked the same way.)"""
+    skipped a file holding the other config's table. Checked while the bakes run (wrong_vouchers, npy) and after
+    each round (check_no_wrong_skip). (An EXR is sealed before its rename: checked the same way after each round.)"""
     import threading
 
     configs = race_configs(tmp_path, fmt)
     refs = {s: tmp_path / f"ref{s}" for s in configs}
     for s, cfg in configs.items():
         api.bake([cfg], refs[s], workers=1)
+    expected = {
+        batch.content_hash(spec): (refs[s] / f"{spec.name}.npy").read_bytes()
+        for s, cfg in configs.items()
+        for spec in load_configs([cfg])
+        if fmt == "npy"
+    }
     widen_the_window(monkeypatch)
     out = tmp_path / "out"
-    for _ in range(4):
-        failures = []
+    wrong: list[str] = []
+    for _ in range(3 if fmt == "npy" else 2):
+        failures, running = [], threading.Event()
 
         def one(cfg):
             r = api.bake([cfg], out, workers=1, force=True, check=False)
             failures.extend(x.message for x in r if x.status != "baked")
 
+        def watch():  # what a run scheduling at any instant meanwhile would see
+            while running.is_set():
+                wrong.extend(wrong_vouchers(out, expected) if expected else [])
+
         threads = [threading.Thread(target=one, args=(configs[RACE_SAMPLES[i % 2]],)) for i in range(12)]
+        running.set()
+        watcher = threading.Thread(target=watch)
+        watcher.start()
         for t in threads:
             t.start()
         for t in threads:
             t.join()
+        running.clear()
+        watcher.join()
         assert not failures, failures
+        assert not wrong, f"a sidecar vouched for another config's bytes: {sorted(set(wrong))} ({len(wrong)} times)"
         check_no_wrong_skip(configs, out, refs)
 
 
@@ -472,12 +511,12 @@ RACER = textwrap.dedent("""
         for table in tables:
             write_table(table, out_dir, "npy")
 """)
-RACE_ROUNDS = 8
+RACE_ROUNDS = 6
 
 
 def test_concurrent_processes_writing_one_out_dir_leave_each_pair_whole(tmp_path):
     """Issue 46, item 1, across processes (two `lutbake bake` at once): 6 writer processes, 3 per config, writing both
-    tables in 8 rounds started together into one out-dir; after each round every skip is right and every pair on disk
+    tables in 6 rounds started together into one out-dir; after each round every skip is right and every pair on disk
     is one writer's (the out-dir's flock, lutbake.io.atomic.unit_lock)."""
     import time
 
