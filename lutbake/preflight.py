@@ -94,8 +94,12 @@ def _stat_errno(path) -> int:
     return 0
 
 
+def _real_key(path) -> str:
+    return "real:" + os.path.normcase(os.path.realpath(path))
+
+
 def _same(a: Path, b: Path) -> bool:
-    return os.path.normcase(os.path.realpath(a)) == os.path.normcase(os.path.realpath(b))
+    return _real_key(a) == _real_key(b)
 
 
 def encoding_problem(path) -> str | None:
@@ -361,16 +365,19 @@ def cache_entries(jobs, cache_dir) -> list[Path]:
 def check_inputs(jobs, configs=(), cache_dir=None) -> None:
     """No file a table writes (planned_files: an output, a second texture, a sidecar) is a config, the --cache
     directory or a cache entry (input_claims): the bake would overwrite its own input. ConfigError naming both."""
-    claims = input_claims(jobs, configs, cache_dir)
+    claims = {}
+    for c, claim in input_claims(jobs, configs, cache_dir):  # each spelling of the file: _is, looked up in one step
+        claims.setdefault(_real_key(c), claim)
+        claims.setdefault(path_key(c), claim)
     for job in jobs:
         for p, what in planned_files(job):
-            for c, claim in claims:
-                if _is(p, c):
-                    raise _name_error(
-                        job,
-                        f"its {what} ({shorten(str(p))}) is {shorten(claim)}; the bake would overwrite it: "
-                        "rename the table or that file, or choose another --out-dir",
-                    )
+            claim = claims.get(_real_key(p)) or claims.get(path_key(p))
+            if claim is not None:
+                raise _name_error(
+                    job,
+                    f"its {what} ({shorten(str(p))}) is {shorten(claim)}; the bake would overwrite it: "
+                    "rename the table or that file, or choose another --out-dir",
+                )
 
 
 def check_report(report, jobs, configs=(), cache_dir=None) -> None:
