@@ -506,7 +506,10 @@ RACER = textwrap.dedent("""
         tables = pickle.load(f)
     for k in range(int(rounds)):
         open(f"{go}.{k}.{os.getpid()}", "w").close()  # ready for round k
+        deadline = time.monotonic() + 120  # the test died: never outlive it
         while not os.path.exists(f"{go}.{k}"):  # every writer starts the round at once
+            if time.monotonic() > deadline or os.getppid() == 1:
+                sys.exit("no go signal: the test has gone")
             time.sleep(0.001)
         for table in tables:
             write_table(table, out_dir, "npy")
@@ -530,15 +533,20 @@ def test_concurrent_processes_writing_one_out_dir_leave_each_pair_whole(tmp_path
         tf.write_bytes(pickle.dumps([x.table for x in r]))
         args = [sys.executable, "-c", RACER, str(tf), str(out), str(RACE_ROUNDS), str(WINDOW_S), str(go)]
         procs += [subprocess.Popen(args, env=env) for _ in range(3)]
-    for k in range(RACE_ROUNDS + 1):
-        while k < RACE_ROUNDS and len(list(tmp_path.glob(f"go.{k}.*"))) < len(procs):
-            assert all(p.poll() is None for p in procs), "a writer died"
-            time.sleep(0.005)
-        if k:  # every writer has finished round k - 1 (and waits for round k)
-            if k == RACE_ROUNDS:
-                assert [p.wait(timeout=120) for p in procs] == [0] * len(procs)
-            check_no_wrong_skip(configs, out, refs)
-        (tmp_path / f"go.{k}").touch()
+    try:
+        for k in range(RACE_ROUNDS + 1):
+            while k < RACE_ROUNDS and len(list(tmp_path.glob(f"go.{k}.*"))) < len(procs):
+                assert all(p.poll() is None for p in procs), "a writer died"
+                time.sleep(0.005)
+            if k:  # every writer has finished round k - 1 (and waits for round k)
+                if k == RACE_ROUNDS:
+                    assert [p.wait(timeout=120) for p in procs] == [0] * len(procs)
+                check_no_wrong_skip(configs, out, refs)
+            (tmp_path / f"go.{k}").touch()
+    finally:  # a failed round leaves no writer behind, waiting for a go that never comes
+        for p in procs:
+            p.kill()
+            p.wait()
 
 
 # ------------------------------------------------------------------------------- counts, by hand
