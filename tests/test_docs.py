@@ -280,3 +280,33 @@ def test_benchmarks_page_renders_the_ltc_area_benchmark_and_the_shaded_fits(tmp_
     assert "| all | 0.05 / 0.1 / 0.005 | 0.02 / 0.04 / 0.002 |" in text, text
     assert "two_lobe over published: median relative 0.4, |error| / albedo p90 0.2" in text
     assert "| eon | 0.1 | 0.3 | 0.05 | 0.1 | 0.3 | 0.05 | 40 |" in text, text
+
+
+CHECK_NAME = re.compile(r"`([a-z_0-9]+\[[a-z_0-9,]+\])`")
+
+
+def test_every_check_the_docs_name_is_a_registered_check():
+    """A parametrised check cited in a page (`weak_white_furnace[ggx]`) is one ``lutbake validate`` runs."""
+    from lutbake.validate.checks import CHECKS
+
+    for page in [ROOT / "README.md", *PAGES]:
+        for name in CHECK_NAME.findall(page.read_text()):
+            if name.split("[", 1)[0] in {n.split("[", 1)[0] for n in CHECKS}:
+                assert name in CHECKS, f"{page.name} cites check {name}: lutbake validate has no such check"
+
+
+def test_models_page_says_what_the_loader_does_with_blinn_phong_and_smith(tmp_path):
+    """docs/models.md: Blinn–Phong with a Smith masking is refused at load, and v_cavity is the masking it takes."""
+    from lutbake.config import load_config
+    from lutbake.errors import ConfigError
+
+    doc = " ".join((DOCS / "models.md").read_text().split())
+    assert 'pairing `ndf = "blinn_phong"` with a Smith `masking` is refused at load' in doc
+    cfg = tmp_path / "bp.toml"
+    for masking, refused in (("smith_height_correlated", True), ("smith_separable", True), ("v_cavity", False)):
+        cfg.write_text(f'[[table]]\nname = "bp"\nkind = "dfg"\nndf = "blinn_phong"\nmasking = "{masking}"\n')
+        if refused:
+            with pytest.raises(ConfigError, match="v_cavity"):
+                load_config(cfg)
+        else:
+            assert load_config(cfg)[0].options["masking"] == "v_cavity"
