@@ -310,3 +310,109 @@ def test_models_page_says_what_the_loader_does_with_blinn_phong_and_smith(tmp_pa
                 load_config(cfg)
         else:
             assert load_config(cfg)[0].options["masking"] == "v_cavity"
+
+
+# a code span that is shader code: a texture read, or arithmetic on what one returned
+SHADER_CODE = re.compile(r"texture\w*\(|SampleLevel\(|\b(?:t|AB|fab|t1|t2)\.[xyzwrgb]{1,4}\b|\b(?:mix|lerp)\([xR],")
+CODE_SPAN = re.compile(r"`([^`\n]+)`")
+
+
+def shader_spans(text: str) -> list[str]:
+    return [span for span in CODE_SPAN.findall(text) if SHADER_CODE.search(span)]
+
+
+def engine_lines(presets) -> list[str]:
+    """The engine tables' own shader lines (lutbake.layouts EngineTable.shader) of ``presets``, in record order."""
+    from lutbake.layouts import TABLES
+
+    return [t.shader for t in TABLES if t.preset in presets and t.shader]
+
+
+@pytest.fixture(scope="module")
+def rendered() -> dict[str, str]:
+    """Preset -> the reconstruction text of each of its tables, as the bake records it (lutbake.pipeline.assemble:
+    the engine's line first, then the layout's), joined by newlines."""
+    from lutbake.config import load_config, presets
+    from lutbake.kinds import lookup_kind
+    from lutbake.pipeline import Computed, assemble
+
+    out = {}
+    for name, path in presets().items():
+        texts = []
+        for spec in load_config(path):
+            plan = lookup_kind(spec.kind).plan(spec)
+            texts.append(assemble(spec, Computed(plan, np.zeros(plan.shape), {}, 0.0, 0.0)).reconstruction)
+        out[name] = "\n".join(texts)
+    return out
+
+
+def test_readme_shader_lines_are_the_engine_records(rendered):
+    """README's engine table: each row's shader cell holds, as code, every line its presets' engine records declare
+    and no other shader code; each such line is the first line of that table's reconstruction (what `lutbake inspect`
+    prints first)."""
+    seen = set()
+    for line in set(readme_rows().values()):
+        presets = re.findall(r"`([a-z0-9-]+)`", line.split(" | ")[1])
+        cell = line.split(" | ")[3]
+        want = engine_lines(presets)
+        spans = CODE_SPAN.findall(cell)
+        assert all(shader in spans for shader in want), f"README row {presets}: {spans} lacks one of {want}"
+        assert set(shader_spans(cell)) <= set(want), f"README row {presets}: {shader_spans(cell)} != records {want}"
+        for preset in presets:
+            for shader in engine_lines([preset]):
+                assert f": {shader}\n" in rendered[preset], (preset, shader)
+        seen.update(presets)
+    assert seen >= set(UV_PRESETS)
+
+
+def preset_page_rows() -> dict[str, str]:
+    """docs/presets.md's first table (preset, engine, file, how to load it): preset -> its row."""
+    rows = {}
+    table = (DOCS / "presets.md").read_text().split("| preset | engine | file | how to load it |", 1)[1]
+    for line in table.split("\n\n", 1)[0].splitlines():
+        m = re.match(r"\| `([a-z0-9-]+)` \| ", line)
+        if m and m.group(1) not in rows:
+            rows[m.group(1)] = line
+    return rows
+
+
+def test_presets_page_quotes_each_presets_own_reconstruction(rendered):
+    """docs/presets.md: a preset row holds its engine record's line, and every piece of shader code in it is part of
+    that preset's recorded reconstruction."""
+    rows = preset_page_rows()
+    for preset, row in rows.items():
+        for shader in engine_lines([preset]):
+            assert f"`{shader}`" in row, f"docs/presets.md row {preset}: no `{shader}`"
+        for span in shader_spans(row):
+            assert span in rendered[preset], f"docs/presets.md row {preset}: `{span}` is not in its reconstruction"
+
+
+def test_engines_page_shader_code_is_a_recorded_reconstruction(rendered):
+    """docs/engines.md: every piece of shader code it quotes is part of some preset's recorded reconstruction."""
+    text = re.sub(r"```.*?```", "", (DOCS / "engines.md").read_text(), flags=re.S)
+    everything = "\n".join(rendered.values())
+    wrong = [span for span in shader_spans(text) if span not in everything]
+    assert not wrong, f"docs/engines.md quotes shader code no layout record holds: {wrong}"
+
+
+@pytest.mark.parametrize("preset, fmt", [("unreal", "dds"), ("godot", "exr"), ("blender-eevee", "h")])
+def test_inspect_prints_the_engine_line_first(tmp_path, capsys, preset, fmt):
+    """`lutbake inspect` of a preset's file (any format: the EXR header, a DDS's or header's sidecar) prints the
+    engine record's shader line as the first line of the reconstruction: the README's line for that preset."""
+    from lutbake.cli import main
+    from lutbake.config import load_config, preset_path
+    from lutbake.io.formats import write_table
+    from lutbake.kinds import lookup_kind
+    from lutbake.pipeline import Computed, assemble
+
+    spec = load_config(preset_path(preset))[0]
+    plan = lookup_kind(spec.kind).plan(spec)
+    table = assemble(spec, Computed(plan, np.full(plan.shape, 0.5), {}, 0.0, 0.0))
+    path = write_table(table, tmp_path, fmt, "half" if fmt == "dds" else "float32")
+    with pytest.raises(SystemExit) as ended:
+        main(["inspect", str(path)])
+    assert ended.value.code == 0
+    out = capsys.readouterr().out.splitlines()
+    (shader,) = engine_lines([preset])
+    assert out[out.index("reconstruction:") + 1].endswith(f": {shader}"), out[out.index("reconstruction:") + 1]
+    assert f"`{shader}`" in readme_rows()[preset]
