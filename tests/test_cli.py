@@ -57,11 +57,47 @@ def test_unknown_preset_and_bad_set_exit_2(tmp_path):
     assert not any(tmp_path.iterdir())
 
 
-def test_list_shows_kinds_terms_and_presets():
+LIST_SUMMARY_MAX_LINES = 40  # the default `lutbake list`: a summary of a few dozen lines
+
+
+def test_list_is_a_short_summary_that_says_how_to_ask_for_more():
+    """`lutbake list` names every kind, preset and format in a few dozen lines and the commands that list each in
+    full; the topics hold the rest (the unfiltered list was 616 lines, 53 KB)."""
+    from lutbake.config import presets
+    from lutbake.io.formats import ALL_FORMATS
+    from lutbake.kinds import KINDS
+
     r = run("list")
-    assert r.exit_code == 0
-    for word in ("dfg", "ggx", "beckmann", "smith_height_correlated", "v_cavity", "schlick", "default"):
-        assert word in r.output
+    assert r.exit_code == 0, r.output
+    assert len(r.output.splitlines()) <= LIST_SUMMARY_MAX_LINES, r.output
+    words = set(re.findall(r"[A-Za-z0-9_-]+", r.output))
+    assert set(KINDS) | set(presets()) | set(ALL_FORMATS) <= words
+    for more in ("lutbake list kinds", "lutbake list presets", "lutbake list formats", "lutbake list keys", "terms"):
+        assert more in r.output, more
+
+
+def test_list_topics_show_kinds_terms_keys_and_formats():
+    kinds, terms, keys, formats = (run("list", *t) for t in (["kinds"], ["terms"], ["keys", "dfg"], ["formats"]))
+    assert all(r.exit_code == 0 for r in (kinds, terms, keys, formats))
+    assert "split_sum" in kinds.output and "ltc" in kinds.output
+    for word in ("ggx", "beckmann", "smith_height_correlated", "v_cavity", "schlick", "sobol_vndf"):
+        assert word in terms.output
+    for word in ("size", "masking", "smith_joint_approx", "layout", "multiscatter_cloth", 'default "exr"'):
+        assert word in keys.output, word
+    assert "ktx2zst" in formats.output and "babylon_fuzz" in formats.output
+
+
+def test_list_keys_refuses_a_missing_or_unknown_kind_by_name():
+    missing, unknown, extra = run("list", "keys"), run("list", "keys", "dgf"), run("list", "kinds", "dfg")
+    assert missing.exit_code == 2 and "lutbake list keys dfg" in missing.output
+    assert unknown.exit_code == 2 and "'dgf'" in unknown.output and "dfg" in unknown.output
+    assert extra.exit_code == 2 and "keys KIND" in extra.output
+    assert "Traceback" not in missing.output + unknown.output + extra.output
+
+
+def test_list_help_has_examples():
+    r = run("list", "--help")
+    assert r.exit_code == 0 and "Examples" in r.output and "lutbake list keys dfg" in r.output
 
 
 def test_inspect_missing_file_is_a_clear_error(tmp_path):
@@ -104,7 +140,7 @@ def test_list_prints_whole_preset_descriptions_and_the_files_each_writes():
     from lutbake.config import presets
     from lutbake.io.formats import written_files
 
-    out = " ".join(run("list").output.split())  # the wrapping undone
+    out = " ".join(run("list", "presets").output.split())  # the wrapping undone
     for name, path in presets().items():
         text = path.read_text(encoding="utf-8")
         comment = " ".join(ln.lstrip("#").strip() for ln in text.splitlines()[: _leading_comments(text)])

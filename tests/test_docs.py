@@ -25,7 +25,8 @@ MEASURED_PAGE = DOCS / "benchmarks.md"
 
 
 def test_every_kind_key_and_value_is_documented():
-    doc = (DOCS / "config.md").read_text()
+    """In the config pages (docs/config.md, docs/config-<kind>.md) or the key pages rendered from the declarations."""
+    doc = "".join(p.read_text() for p in [DOCS / "config.md", *DOCS.glob("config-*.md"), *DOCS.glob("keys/*.md")])
     for kind in KINDS.values():
         assert f"`{kind.name}`" in doc, kind.name
         for key in kind.keys.values():
@@ -416,3 +417,86 @@ def test_inspect_prints_the_engine_line_first(tmp_path, capsys, preset, fmt):
     (shader,) = engine_lines([preset])
     assert out[out.index("reconstruction:") + 1].endswith(f": {shader}"), out[out.index("reconstruction:") + 1]
     assert f"`{shader}`" in readme_rows()[preset]
+
+
+CONFIG_PAGES = [DOCS / "config.md", *sorted(DOCS.glob("config-*.md"))]
+KEY_PAGES = DOCS / "keys"
+
+
+def config_sections() -> dict[str, str]:
+    """'common' -> the keys of every kind; kind name -> that kind's section, from the config pages."""
+    text = "\n".join(p.read_text() for p in CONFIG_PAGES)
+    sections = {}
+    for part in re.split(r"^#+ ", text, flags=re.M):
+        m = re.match(r"Kind `([a-z_0-9]+)`", part)
+        if m:
+            sections[m.group(1)] = part
+        elif part.startswith("Keys of every kind"):
+            sections["common"] = part
+    return sections
+
+
+def key_rows(section: str) -> dict[str, list[list[str]]]:
+    """A section's one-key table rows: key -> the rows naming it alone (cells: key, type, default, allowed, meaning)."""
+    rows: dict[str, list[list[str]]] = {}
+    for line in section.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split(" | ")]
+        m = re.fullmatch(r"`([a-z_0-9]+)`", cells[0]) if line.startswith("| `") and len(cells) == 5 else None
+        if m:
+            rows.setdefault(m.group(1), []).append(cells)
+    return rows
+
+
+def test_config_pages_agree_with_the_key_declarations():
+    """Each key row of docs/config*.md (a kind's section, or the keys of every kind, which are `dfg`'s) appears once
+    and lists exactly the key's declared values and its declared default: the prose reference cannot drift."""
+    import tomllib
+
+    sections = config_sections()
+    assert set(KINDS) <= set(sections), set(KINDS) - set(sections)
+    for where, section in sections.items():
+        kind = KINDS["dfg" if where == "common" else where]
+        for name, found in key_rows(section).items():
+            assert len(found) == 1, f"config: {where} lists key {name} {len(found)} times"
+            key = kind.keys.get(name)
+            assert key is not None, f"config: {where} documents key {name}, which kind {kind.name} does not declare"
+            _, _, default, allowed, _ = found[0]
+            if key.choices and not allowed.startswith("as "):
+                values = set(re.findall(r"`([^`]+)`", allowed))
+                assert values == set(key.choices), (where, name, sorted(values ^ set(key.choices)))
+            try:
+                written = tomllib.loads(f"x = {default.strip('`')}")["x"]
+            except tomllib.TOMLDecodeError:
+                continue  # prose ("required", "from the storage")
+            declared = list(key.default) if isinstance(key.default, tuple) else key.default
+            assert written == declared, (where, name, default, key.default)
+
+
+def test_key_pages_are_rendered_from_the_declarations():
+    """docs/keys/<kind>.md is lutbake.kinds.reference.markdown(kind) (`python -m lutbake.kinds.reference docs/keys`),
+    one page per kind, and names every key and value (what `lutbake list keys KIND` prints)."""
+    from lutbake.kinds.reference import markdown
+
+    assert {p.stem for p in KEY_PAGES.glob("*.md")} == set(KINDS)
+    for kind in KINDS.values():
+        page = (KEY_PAGES / f"{kind.name}.md").read_text()
+        assert page == markdown(kind), f"docs/keys/{kind.name}.md is stale: python -m lutbake.kinds.reference docs/keys"
+        for key in kind.keys.values():
+            assert f"| `{key.name}` |" in page
+            assert all(f"`{value}`" in page for value in key.choices or ())
+
+
+def test_every_entry_lutbake_list_prints_is_documented():
+    """Each preset (`lutbake list presets`) has its row in docs/presets.md or a page of its own family, each format
+    (`lutbake list formats`) is in docs/formats.md, each kind (`lutbake list kinds`) in docs/kinds.md and has its key
+    page."""
+    from lutbake.config import presets
+    from lutbake.io.formats import ALL_FORMATS
+
+    pages = {name: (DOCS / name).read_text() for name in ("presets.md", "formats.md", "kinds.md", "ltc.md")}
+    for preset in presets():
+        assert f"`{preset}`" in pages["presets.md"] + pages["ltc.md"], preset
+    for fmt in ALL_FORMATS:
+        assert f"`{fmt}`" in pages["formats.md"], fmt
+    for kind in KINDS:
+        assert f"`{kind}`" in pages["kinds.md"] and (KEY_PAGES / f"{kind}.md").is_file(), kind
