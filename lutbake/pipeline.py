@@ -18,6 +18,7 @@ import numpy as np
 from .config import TableSpec
 from .errors import TableError
 from .kinds import lookup_kind
+from .layouts import reconstruction_with_engine_line
 from .provenance import attributes
 from .runtime.executor import Progress, Timer, estimate_error, execute_tiles
 from .runtime.warp_runtime import defining
@@ -104,7 +105,7 @@ def assemble(spec: TableSpec, computed: Computed) -> Table:
         computed.data.astype(np.float32),
         plan.axes,
         plan.channels,
-        plan.reconstruction,
+        reconstruction_with_engine_line(spec.kind, spec.name, spec.options, plan.reconstruction),
         attributes(spec, plan, computed.extra),
     )
 

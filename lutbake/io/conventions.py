@@ -77,7 +77,7 @@ def convention_lines(table: Table, pixels: np.ndarray, dtype: str, ident: str, v
             f"    sample at {d['uv_formula']}",
         ]
     lines += ["channels:"] + [f"  {c} = {n}: {m}" for c, (n, m) in zip("RGBA", table.channels.items())]
-    lines += ["reconstruction:", f"  {table.reconstruction}", "", "provenance:"]
+    lines += ["reconstruction:", *(f"  {line}" for line in table.reconstruction.splitlines()), "", "provenance:"]
     for k in ("terms", "estimator", "samples", "seed", "version", "warp_version"):
         if k in table.attributes:
             lines.append(f"  {k}: {table.attributes[k]}")
