@@ -206,7 +206,7 @@ def fake_result(name, status="baked", kind="dfg", size=(10, 10)):
     spec = SimpleNamespace(name=name, kind=kind, options={"size": list(size), "samples": None})
     return SimpleNamespace(
         name=name, spec=spec, status=status, path=f"out/{name}.exr", shape="10x10x2", seconds=1.0, samples=48,
-        values_from=None, message="",
+        values_from=None, message="", cache_error=None,
     )  # fmt: skip
 
 
