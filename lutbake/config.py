@@ -112,6 +112,10 @@ def _check_value(key: Key, value, file, table) -> Any:
         if key.maximum is not None and value > key.maximum:
             fail(f"must be <= {_num(key.maximum)}")
         return value
+    if key.type == "bool":
+        if not isinstance(value, bool):
+            fail("must be true or false", "true, false")
+        return value
     if key.type == "int_pair":
         if (
             not isinstance(value, list)

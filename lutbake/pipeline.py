@@ -25,6 +25,8 @@ from .runtime.warp_runtime import defining
 from .sampling.plan import TexelPlan
 from .table import Table
 
+OVER_TOLERANCE = "over_tolerance"  # the lutbake:* attribute of a table whose texels end over their tolerance
+
 
 @dataclass
 class Computed:
@@ -76,8 +78,10 @@ def compute(
     extra = {}
     estimate = estimate_error(plan, full, device, spec, runner)
     if estimate is not None:
-        err, how = estimate
+        err, how, *over = estimate
         extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)
+        if over and over[0]:  # texels that ended over the tolerance (lutbake.tolerance.over_tolerance)
+            extra[OVER_TOLERANCE] = over[0]
     if plan.attributes_after is not None:
         extra.update(plan.attributes_after(data))
     cpu.append(time.thread_time() - t0)

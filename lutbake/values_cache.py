@@ -43,7 +43,8 @@ from .io.atomic import atomic_write_bytes, atomic_write_hashed, remove_stale_tem
 from .io.integrity import sha256_bytes
 
 FORMAT = "lutbake-values-cache-v2"  # v2: "bytes" and "entry_sha256" (v1 entries are misses, then rewritten)
-ESTIMATE_KEYS = ("error_estimate", "error_estimate_method")  # what lutbake.pipeline.compute records besides
+# what lutbake.pipeline.compute records besides
+ESTIMATE_KEYS = ("error_estimate", "error_estimate_method", "over_tolerance")
 MAX_EXTRA_CHARS = 4096  # characters of one extra value (lutbake's are numbers and short descriptions)
 
 

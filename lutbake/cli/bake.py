@@ -13,6 +13,7 @@ import click
 from ..io.formats import ALL_FORMATS
 from .options import fail, out_dir_option, set_option, workers_option
 
+ACCEPT = "accept_over_tolerance"  # the config key that accepts a table over its tolerance (exit 0)
 PROGRESS_MIN_EVALS = 1.5e7  # about a second of work on two busy cores: a single table shows a bar above it
 DRAW_INTERVAL = 0.5  # seconds between redraws of the progress line as tiles finish
 
@@ -74,8 +75,11 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     in parallel; each prints one line: path, shape, seconds, samples per texel; on a terminal a progress line
     shows tables done / total, the running table, elapsed time and an estimate. The last line sums up the batch
     ("40 tables: 12 baked, 28 up to date, 0 failed, 64 s"). A table that fails does not stop the others; the exit
-    status is then 1. Outputs are replaced atomically: Ctrl-C (exit 130) or SIGTERM (exit 143) keeps finished
-    tables, writes no unfinished one, and lists the tables that did not finish; the next run bakes only those.
+    status is then 1. A table whose texels end over their tolerance is written and prints "OVER TOLERANCE name: ..."
+    (how many texels, their rows / columns, the worst estimate / tolerance); the exit status is then 1 unless its
+    config sets accept_over_tolerance = true. Outputs are replaced atomically: Ctrl-C (exit 130) or SIGTERM
+    (exit 143) keeps finished tables, writes no unfinished one, and lists the tables that did not finish; the next
+    run bakes only those.
 
     \b
     Examples:
@@ -132,6 +136,18 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     unfinished = [r.name for r in results if r.status in ("interrupted", "pending")]
     if failed:
         click.echo(f"{len(failed)} of {len(results)} tables failed: {', '.join(failed)}", err=True)
+    over = [r.name for r in results if r.status == "over_tolerance"]
+    if over:
+        refused = [r.name for r in results if r.status == "over_tolerance" and not r.spec.options.get(ACCEPT)]
+        click.echo(
+            f"{len(over)} of {len(results)} tables over their tolerance: {', '.join(over)}"
+            + (
+                f" (exit 1; {ACCEPT} = true in a table's config accepts it)"
+                if refused
+                else f" (accepted: {ACCEPT} = true)"
+            ),
+            err=True,
+        )
     if results.interrupted_by is not None:
         click.echo(
             f"interrupted ({batch.signal_name(results.interrupted_by)}): {len(unfinished)} of {len(results)} tables "
@@ -143,12 +159,17 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
 
 
 def summary(results, seconds: float) -> str:
-    """The closing line: "40 tables: 12 baked, 28 up to date, 0 failed, 64 s" (and how many were interrupted)."""
-    n = {s: sum(r.status == s for r in results) for s in ("baked", "skipped", "failed", "interrupted", "pending")}
+    """The closing line: "40 tables: 12 baked, 28 up to date, 0 failed, 64 s" (and how many ended over their
+    tolerance, how many were interrupted)."""
+    statuses = ("baked", "skipped", "over_tolerance", "failed", "interrupted", "pending")
+    n = {s: sum(r.status == s for r in results) for s in statuses}
     stopped = n["interrupted"] + n["pending"]
     return (
         f"{len(results)} table{'s' if len(results) != 1 else ''}: {n['baked']} baked, {n['skipped']} up to date, "
-        f"{n['failed']} failed" + (f", {stopped} interrupted" if stopped else "") + f", {seconds:.0f} s"
+        + (f"{n['over_tolerance']} over tolerance, " if n["over_tolerance"] else "")
+        + f"{n['failed']} failed"
+        + (f", {stopped} interrupted" if stopped else "")
+        + f", {seconds:.0f} s"
     )
 
 
@@ -280,7 +301,10 @@ class BatchProgress:
         count = f"[{self.finished}/{self.total}] "
         if r.status == "skipped":
             self._write(f"{count}skipped {escape_controls(str(r.path))} (up to date)")
-        elif r.status == "baked":
+        elif r.status == "over_tolerance" and r.table is None:  # up to date, as its file records
+            self._write(f"{count}skipped {escape_controls(str(r.path))} (up to date)")
+            self._write(f"OVER TOLERANCE {r.name}: {escape_controls(r.message)}", err=True)
+        elif r.status in ("baked", "over_tolerance"):
             note = samples_note(r.spec, r.samples)
             if r.values_from is not None:
                 note = "; ".join(filter(None, (note, f"values computed once with {r.values_from}")))
@@ -288,6 +312,8 @@ class BatchProgress:
                 f"{count}{escape_controls(str(r.path))}  {r.shape}  {r.seconds:.2f} s  {r.samples} samples/texel"
                 + (f" ({note})" if note else "")
             )
+            if r.status == "over_tolerance":
+                self._write(f"OVER TOLERANCE {r.name}: {escape_controls(r.message)}", err=True)
         elif r.status == "failed":
             self._write(f"{count}FAILED {r.name}: {escape_controls(r.message)}", err=True)
         if r.cache_error and not self.cache_warned:

@@ -386,7 +386,7 @@ def facet_rules_for(spec, members: int = 0):
     member's param, each member's sum taking the same float operations, in the same order, as its own rule's."""
     facet_weight = facet_weight_for(spec.g, spec.distribution.pdf_ndf)
     pdf = spec.distribution.pdf_ndf
-    over_pdf, g64 = over_pdf_for(pdf), spec.g64
+    over_pdf, g64, g_sin2 = over_pdf_for(pdf), spec.g64, spec.g_sin2
     part, rest = spec.g64_parts if members > 0 else (None, None)
     nch = spec.vec._length_
 
@@ -400,7 +400,7 @@ def facet_rules_for(spec, members: int = 0):
     @wp.func
     def add_facet(acc: Any, f: OuterNode, cos_phi: wp.float64, sin_phi: wp.float64, w: wp.float64):
         """acc plus w g / p at the facet (theta_h of the outer node f, phi); an integrand with g64 gets v.h from
-        facet_voh."""
+        facet_voh, one with g_sin2 (a Charlie lobe) sin^2(theta_h) from the node's float64 sin(theta_h)."""
         h = wp.vec3(float(f.sin_h * cos_phi), float(f.sin_h * sin_phi), float(f.cos_h))
         if wp.static(members > 0):
             # the param-free part and the density once a node (over_pdf's operations, in two steps)
@@ -420,6 +420,8 @@ def facet_rules_for(spec, members: int = 0):
         else:
             if wp.static(g64 is not None):
                 gw = over_pdf(g64(f.v, h, f.a, f.prm, facet_voh(f, cos_phi, sin_phi)), f.v, h, f.a, f.in_u)
+            elif wp.static(g_sin2 is not None):  # a Charlie lobe: sin^(1/alpha) of the node's float64 sin(theta_h)
+                gw = over_pdf(g_sin2(f.v, h, f.a, f.prm, f.sin_h * f.sin_h), f.v, h, f.a, f.in_u)
             else:
                 gw = facet_weight(f.v, h, f.a, f.prm, f.in_u)
             for c in range(wp.static(nch)):
@@ -611,10 +613,6 @@ def make_gauss_legendre(spec):
         # the texel's target, in units of the panel sums (I = sum / pi): the estimate, TERMS_ROUNDING included, within
         # the tolerance
         rounding = TERMS_ROUNDING
-        if wp.static(spec.grazing_peak):
-            # D_charlie = sin(theta_h)^(1/alpha) of a float32 h: pow multiplies sin^2's rounding by 1 / (2 alpha)
-            # (measured: 9.5e-7 relative at alpha = 0.023, n.v = 1/128, at every order)
-            rounding = TERMS_ROUNDING * (wp.float64(1.0) + wp.float64(0.5) / wp.float64(t.a))
         total, e = integrate(t, n_panels, rules, levels, Sums(tol[0] * PI64), Sums(tol[1]), rounding)
         for c in range(wp.static(nch)):
             out[i, c] = total[c] / PI64
