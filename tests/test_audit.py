@@ -159,6 +159,24 @@ def test_audit_reads_png16_exr_ktx2_and_a_c_header(clean, tmp_path):
         assert r.passed and r.extra["chosen"] == "nominal", (fmt, r.text())
 
 
+def test_audit_and_inspect_recognise_a_file_by_its_content_never_its_name(clean, tmp_path):
+    """docs/formats.md: files are recognised by content. An npy saved as lut.bin and an EXR saved as lut.npy: inspect
+    reads both, and audit reads them the same way (lutbake.io.readers.sniff) and passes them."""
+    from lutbake.axes import Axis
+    from lutbake.io.formats import write_table
+    from lutbake.table import Table
+
+    np.save(tmp_path / "t.npy", clean.astype(np.float32))
+    axes = [Axis("perceptual_roughness", "y", N), Axis("NoV", "x", N)]
+    exr = write_table(Table("t", "dfg", clean.astype(np.float32), axes, {"scale": "", "bias": ""}, ""), tmp_path, "exr")
+    for src, name in ((tmp_path / "t.npy", "lut.bin"), (exr, "lut.npy")):
+        (tmp_path / name).write_bytes(Path(src).read_bytes())
+        for args in (["inspect", name], ["audit", name, "--max-side", "16", "--tolerance", "1e-5"]):
+            res = CliRunner().invoke(main, [args[0], str(tmp_path / args[1]), *args[2:]])
+            assert res.exit_code == 0, (args, res.output)
+        assert "PASS" in res.output
+
+
 def test_cli_json_exit_codes_and_error_map(clean, tmp_path):
     p = tmp_path / "flipped.npy"
     np.save(p, clean[::-1].astype(np.float32))
