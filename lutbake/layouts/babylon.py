@@ -176,6 +176,7 @@ TABLES = (
         SOURCE,
         "scene.environmentBRDFTexture (isRGBD = false, invertY = false)",
         shipped="babylon_environment_brdf.npz",
+        encoding="rgbd",  # the shipped PNG (Misc/brdfTextureTools.js loadBRDFTexture: isRGBD = true)
     ),
     EngineTable(
         "Babylon.js",
@@ -196,6 +197,7 @@ TABLES = (
         SOURCE,
         "scene.openPBREnvironmentBRDFTexture (isRGBD = false, invertY = false)",
         shipped="babylon_openpbr_brdf.npz",
+        encoding="rgbd",
     ),
     EngineTable(
         "Babylon.js",
@@ -214,5 +216,6 @@ TABLES = (
         SOURCE,
         "scene.environmentFuzzBRDFTexture (isRGBD = false, invertY = false)",
         shipped="babylon_environment_fuzz_brdf.npz",
+        encoding="rgbd",
     ),
 )

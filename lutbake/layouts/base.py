@@ -114,7 +114,10 @@ class Layout:
 class EngineTable:
     """One table an engine loads, baked by a preset: the layout it is written in, the grid and storage keys the engine
     fixes (the preset's options must hold them: tests/test_layouts.py), the engine's source, what the engine loads
-    and, where tests/data holds the shipped table, its name there."""
+    and, where tests/data holds the shipped table, its name there. ``encoding``: how the engine's shipped file stores
+    a value (a name of lutbake.commands.audit_search.ENCODINGS: ``plain`` UNORM codes or floats as read, ``rgbd``
+    Babylon's RGBD, ``rgbm``, ``srgb_encoded``, ``half_bits``); ``audit --preset`` decodes a file so when its storage
+    can hold that encoding (an 8-bit RGBA PNG for RGBD), and tries every other encoding as a hypothesis."""
 
     engine: str
     preset: str
@@ -125,6 +128,7 @@ class EngineTable:
     source: str
     loads: str
     shipped: str | None = None
+    encoding: str = "plain"
 
 
 def uv_of(axes: list[Axis]) -> str:
