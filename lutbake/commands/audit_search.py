@@ -401,9 +401,10 @@ def choose(cands: list[Candidate]) -> Candidate:
 
 
 def listed(cands: list[Candidate]) -> list[Candidate]:
-    """The report's hypotheses: the declared conventions, every single mistake, the best few combinations."""
-    singles = [c for c in cands if c.mistakes <= 1]
-    return singles + [c for c in cands if c.mistakes > 1][:LISTED_COMBINATIONS]
+    """The report's hypotheses: the declared conventions first, then every single mistake and the best few
+    combinations, each best first."""
+    singles = [c for c in cands if c.mistakes == 1]
+    return [c for c in cands if c.mistakes == 0] + singles + [c for c in cands if c.mistakes > 1][:LISTED_COMBINATIONS]
 
 
 def roughness(res: np.ndarray) -> float | None:
