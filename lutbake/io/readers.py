@@ -10,6 +10,7 @@ file's first bytes (its magic number), never by its extension.
 | KTX2 | ``«KTX 20»\\r\\n\\x1a\\n`` | lutbake.io.ktx2.decode | ``lutbake:metadata`` key/value, else sidecar |
 | C header | text from ``/*``, ``//`` or ``#`` | its ``static const`` array and size macros | the ``.json`` sidecar |
 | sidecar | text from ``{`` | the data file it names (``"file"``) | its ``"lutbake"`` object |
+| npz, text array | ``PK\\x03\\x04``; other text | ``audit`` reads them (lutbake.io.lut_files), not ``read`` | sidecar |
 | engine layout | DDS or text | lutbake.io.engine_files, by the sidecar's ``format`` (LTC, OpenPBR, JS) | the sidecar |
 
 ``read(path)`` returns a :class:`LoadedFile` (pixels as stored, including a GPU format's padding
@@ -47,6 +48,8 @@ MAX_EXR_CHANNELS = 64  # channels of one EXR part (a table has 1 to 4; other too
 EXR_MAGIC = b"\x76\x2f\x31\x01"
 NPY_MAGIC = b"\x93NUMPY"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+ZIP_MAGIC = b"PK\x03\x04"  # a NumPy .npz archive
+TEXT_CONTROLS = b"\t\n\r\f"  # the control bytes a text array may hold
 GENERIC_FORMATS = ("exr", "npy", "png16", "dds", "ktx2", "ktx2zst", "h")  # sidecar "format"s whose pixels lutbake reads
 FORMAT_NAMES = {
     "engine": "engine-specific file",
@@ -56,6 +59,8 @@ FORMAT_NAMES = {
     "dds": "DDS",
     "ktx2": "KTX 2.0",
     "h": "C header",
+    "npz": "NumPy .npz archive",
+    "text": "text array (JS, TS, WGSL, Rust or C source)",
     "sidecar": "lutbake .json sidecar",
     "report": "lutbake bake report (--report)",
 }
@@ -100,7 +105,8 @@ class TableView:
 
 
 def sniff(path: Path) -> str:
-    """The format of ``path`` from its first bytes (FORMAT_NAMES); ReadError for anything else."""
+    """The format of ``path`` from its first bytes (FORMAT_NAMES), never its name: the one recognition ``inspect``,
+    ``preview`` and ``audit`` (lutbake.io.lut_files) share; ReadError for anything else."""
     problem = bounded.regular_file_problem(path)  # "no such file", "is a FIFO (named pipe), not a file", ...
     if problem:
         raise ReadError(f"{path}: {problem}")
@@ -112,6 +118,7 @@ def sniff(path: Path) -> str:
         (PNG_MAGIC, "png"),
         (dds.MAGIC, "dds"),
         (ktx2.IDENTIFIER, "ktx2"),
+        (ZIP_MAGIC, "npz"),
     ):
         if head.startswith(magic):
             return fmt
@@ -120,6 +127,8 @@ def sniff(path: Path) -> str:
         return "sidecar"
     if text.startswith((b"/*", b"//", b"#")):
         return "h"
+    if text and all(b >= 0x20 or b in TEXT_CONTROLS for b in text):  # bytes >= 0x80: UTF-8
+        return "text"
     shown = head[:8].hex(" ") if head else "nothing (an empty file)"
     raise ReadError(
         f"{path}: not a format lutbake reads (EXR, npy, PNG, DDS, KTX2, C header, .json sidecar): "
@@ -134,6 +143,11 @@ def read(path) -> LoadedFile:
     size = path.stat().st_size
     if size > MAX_FILE_BYTES:
         raise ReadError(f"{path}: {size} bytes is larger than any table lutbake writes ({MAX_FILE_BYTES} bytes)")
+    if fmt not in READERS:  # recognised, but only audit reads its values (lutbake.io.lut_files)
+        engine = _engine_sidecar(path)
+        if engine is None:
+            raise ReadError(f"{path}: a {FORMAT_NAMES[fmt]}: inspect and preview do not read it (lutbake audit does)")
+        return engine
     try:
         loaded = READERS[fmt](path)
     except (ValueError, KeyError, TypeError, IndexError, OverflowError, UnicodeDecodeError, EOFError, OSError):

@@ -177,6 +177,7 @@ TABLES = (
         "scene.environmentBRDFTexture (isRGBD = false, invertY = false)",
         shipped="babylon_environment_brdf.npz",
         shader="t = texture(environmentBrdfSampler, vec2(NdotV, perceptualRoughness)).rgb; (R90 - R0) * t.x + R0 * t.y",
+        encoding="rgbd",  # the shipped PNG (Misc/brdfTextureTools.js loadBRDFTexture: isRGBD = true)
     ),
     EngineTable(
         "Babylon.js",
@@ -201,6 +202,7 @@ TABLES = (
             "t = texture(openPBREnvironmentBRDF, vec2(NdotV, perceptualRoughness)).rgb; "
             "(F90 - F0) * t.x + F0 * t.y - b * t.z / 16"
         ),
+        encoding="rgbd",
     ),
     EngineTable(
         "Babylon.js",
@@ -223,5 +225,6 @@ TABLES = (
             "t = texture(environmentFuzzBrdfSampler, vec2(alpha, NdotV)).rgb; A = mix(0.005, 0.88, t.r); "
             "B = mix(-0.18, 0.002, t.g); R = mix(0.0, 0.75, t.b)"
         ),
+        encoding="rgbd",
     ),
 )

@@ -117,7 +117,10 @@ class EngineTable:
     and, where tests/data holds the shipped table, its name there. ``shader``: the engine's own line that samples
     the table and rebuilds its value, in the engine's names and uv (the first line of the file's reconstruction,
     ``lutbake inspect``, and the README's engine table; "" where the engine reads the table through its own array
-    code, as the LTC arrays)."""
+    code, as the LTC arrays). ``encoding``: how the engine's shipped file stores a value (a name of
+    lutbake.commands.audit_search.ENCODINGS: ``plain`` UNORM codes or floats as read, ``rgbd`` Babylon's RGBD,
+    ``rgbm``, ``srgb_encoded``, ``half_bits``); ``audit --preset`` decodes a file so when its storage can hold that
+    encoding (an 8-bit RGBA PNG for RGBD), and tries every other encoding as a hypothesis."""
 
     engine: str
     preset: str
@@ -129,6 +132,7 @@ class EngineTable:
     loads: str
     shipped: str | None = None
     shader: str = ""
+    encoding: str = "plain"
 
     def holds(self, kind: str, name: str, options: dict) -> bool:
         """Whether a table ``name`` of ``kind`` with ``options`` is this engine table: its name, and every key the
