@@ -440,12 +440,16 @@ def test_a_scheduler_port_that_accepts_and_never_answers_is_bounded(tmp_path, mo
 
 
 def test_tolerance_zero_leaks_no_numpy_warning(tmp_path):
+    """A tolerance of 0 no estimate meets (but an exact one): every texel over it, said as such (the ratio inf), with
+    no numpy warning on the way; exit 1, or 0 where the config accepts it."""
     cfg = tmp_path / "c.toml"
-    cfg.write_text(SMALL.format(name="t").replace("samples = 48", "tolerance = 0"))
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", RuntimeWarning)
-        r = bake(cfg, "--out-dir", tmp_path / "o")
-    assert r.exit_code == 0 and "RuntimeWarning" not in r.output, r.output
+    for accept, code in (("", 1), ("accept_over_tolerance = true\n", 0)):
+        cfg.write_text(SMALL.format(name="t").replace("samples = 48", accept + "tolerance = 0"))
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", RuntimeWarning)
+            r = bake(cfg, "--out-dir", tmp_path / "o", "--force")
+        assert r.exit_code == code and "RuntimeWarning" not in r.output, r.output
+        assert "OVER TOLERANCE t:" in r.output and "worst estimate / tolerance inf" in r.output, r.output
 
 
 def test_a_config_with_a_utf8_bom_is_read(tmp_path):
