@@ -474,3 +474,76 @@ def test_audit_says_what_a_fifo_or_a_directory_is(tmp_path, make):
 def test_set_refuses_trailing_text_and_an_empty_table_name(tmp_path, item):
     line = one_line_error(bake("--preset", "default", "--set", item, "--out-dir", tmp_path / "o"))
     assert "--set" in line
+
+
+# ------------------------------------------------------ readers again: EXR headers, text arrays, sidecars, memory
+
+
+def _exr_end_of_header(blob: bytes) -> int:
+    pos = 8
+    while blob[pos] != 0:
+        type_end = blob.index(b"\0", blob.index(b"\0", pos) + 1)
+        pos = type_end + 5 + struct.unpack_from("<i", blob, type_end + 1)[0]
+    return pos
+
+
+def _exr_with_attributes(path: Path, count: int) -> Path:
+    """A 4 x 4 RG EXR (no compression: one scanline per chunk) whose header gains ``count`` int attributes; the
+    offset table after the header is moved by the bytes inserted."""
+    oiio = pytest.importorskip("OpenImageIO")
+    spec = oiio.ImageSpec(4, 4, 2, "float")
+    spec.channelnames = ("R", "G")
+    spec.attribute("compression", "none")
+    out = oiio.ImageOutput.create(str(path))
+    assert out.open(str(path), spec) and out.write_image(np.zeros((4, 4, 2), np.float32)) and out.close()
+    blob = bytearray(path.read_bytes())
+    end = _exr_end_of_header(blob)
+    extra = b"".join(b"a%05d\0int\0" % k + struct.pack("<ii", 4, k) for k in range(count))
+    offsets = struct.unpack_from("<4Q", blob, end + 1)
+    struct.pack_into("<4Q", blob, end + 1, *(o + len(extra) for o in offsets))
+    blob[end:end] = extra
+    path.write_bytes(bytes(blob))
+    return path
+
+
+def _commands(path: Path, out: Path):
+    return (["inspect", path], ["preview", path, "-o", out], ["audit", path, "--preset", "default"])
+
+
+def test_an_exr_header_of_40000_attributes_is_refused_before_openimageio_parses_it(tmp_path):
+    assert read(_exr_with_attributes(tmp_path / "ok.exr", 100)).data.shape == (4, 4, 2)  # a long header still reads
+    path = _exr_with_attributes(tmp_path / "a.exr", 40_000)  # 760 KB; OpenImageIO: 8 s (10 000: 0.7 s)
+    for args in _commands(path, tmp_path / "p.png"):
+        t0 = time.perf_counter()
+        line = one_line_error(CliRunner().invoke(main, list(map(str, args))))
+        assert time.perf_counter() - t0 < LINEAR_S, args[0]  # preview: importing matplotlib too
+        assert f"more than {bounded.MAX_EXR_ATTRIBUTES} attributes" in line and "a.exr" in line, line
+
+
+def _header(path: Path, body: str, shape=(2, 2, 1), ctype="float") -> Path:
+    h, w, c = shape
+    path.write_text(
+        f"// t\n#define T_HEIGHT {h}\n#define T_WIDTH {w}\n#define T_CHANNELS {c}\n"
+        f"static const {ctype} t[{h * w * c}] = {{ {body} }};\n"
+    )
+    return path
+
+
+def test_c99_hex_floats_are_read_as_floats_by_inspect_and_audit(tmp_path):
+    from lutbake.io.lut_files import read_lut
+
+    path = _header(tmp_path / "t.h", "0x1.0p-1, 0x1.8p+0, -0x1p-2, 0x0p+0")  # printf("%a")
+    want = [0.5, 1.5, -0.25, 0.0]
+    assert read(path).data.ravel().tolist() == want  # inspect refused the file
+    lut = read_lut(path)
+    assert lut.data.ravel().tolist() == want and lut.storage == "float32"  # audit: half bits 0x1, 0x1, ... (6e-8)
+    bits = read_lut(_header(tmp_path / "b.h", "0x3c00, 0x3800, 0xb400, 0x0000", ctype="uint16_t"))
+    assert bits.data.ravel().tolist() == [1.0, 0.5, -0.25, 0.0] and bits.storage == "half"
+
+
+@pytest.mark.parametrize("values", [4 + 1000, 3], ids=["1000_more", "one_fewer"])
+def test_a_text_array_with_other_than_its_declared_count_is_refused(tmp_path, values):
+    path = _header(tmp_path / "t.h", ", ".join(["0.5"] * min(values, 4) + ["9.0"] * (values - 4)))
+    for args in (["inspect", path], ["audit", path, "--preset", "default"]):
+        line = one_line_error(CliRunner().invoke(main, list(map(str, args))))
+        assert f"holds {values} values" in line and "needs 4" in line, line

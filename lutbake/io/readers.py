@@ -36,6 +36,7 @@ from ..runtime.warp_runtime import stderr_silenced
 from ..textsafe import bounded as bounded_text
 from ..textsafe import shorten
 from . import bounded, dds, ktx2
+from .text_arrays import parse_numbers
 
 PREFIX = "lutbake:"
 MAGIC_BYTES = 16  # enough to tell every format apart
@@ -212,6 +213,9 @@ def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
     come in that order; any other channel names are kept in file order."""
     import OpenImageIO as oiio  # imported here: only EXR and PNG need it
 
+    problem = bounded.exr_header_problem(path)  # before OpenImageIO parses the attributes (super-linear in their count)
+    if problem:
+        raise ValueError(problem)
     with stderr_silenced():  # libpng / OpenEXR print their own complaints; the ReadError says it once
         inp = oiio.ImageInput.open(str(path))
     if inp is None:
@@ -344,13 +348,10 @@ def read_header(path: Path) -> LoadedFile:
         raise ValueError(f"no {ident.upper()}_HEIGHT / _WIDTH / _CHANNELS macros for array {ident}")
     shape = tuple(dims[k] for k in ("DEPTH", "HEIGHT", "WIDTH", "CHANNELS") if k in dims)
     bounded.check_texels(shape, f"array {ident}'s macros")
-    items = [s for s in (x.strip() for x in body.split(",")) if s]
-    if math.prod(shape) != len(items):
-        raise ValueError(f"array {ident} has {len(items)} values, its macros say {' x '.join(map(str, shape))}")
-    if ctype == "uint16_t":
-        data = np.array([int(s, 0) for s in items], dtype=np.uint16).view(np.float16)
-    else:
-        data = np.array([s.rstrip("fF") for s in items], dtype=np.float64)
+    try:
+        data, _ = parse_numbers(body, math.prod(shape), bits=ctype == "uint16_t")
+    except ValueError as e:
+        raise ValueError(f"array {ident} (its macros say {' x '.join(map(str, shape))}): {e}") from None
     loaded = LoadedFile(
         path,
         "h",
