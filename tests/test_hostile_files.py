@@ -547,3 +547,70 @@ def test_a_text_array_with_other_than_its_declared_count_is_refused(tmp_path, va
     for args in (["inspect", path], ["audit", path, "--preset", "default"]):
         line = one_line_error(CliRunner().invoke(main, list(map(str, args))))
         assert f"holds {values} values" in line and "needs 4" in line, line
+
+
+def _edit_sidecar(path: Path, edit) -> None:
+    side = path.with_name(path.name + ".json")
+    doc = json.loads(side.read_text())
+    edit(doc["lutbake"])
+    side.write_text(json.dumps(doc))  # "\ud800" is written as the JSON escape \\ud800: valid JSON, no text
+
+
+def _set_json(attrs, key, edit):
+    value = json.loads(attrs[key])
+    edit(value)
+    attrs[key] = json.dumps(value)
+
+
+SIDECAR_EDITS = {
+    "kind": lambda a: a.update(kind="\ud800"),
+    "table": lambda a: a.update(table="t\ud800"),
+    "axis_name": lambda a: _set_json(a, "axes", lambda axes: axes[0].update(name="\ud800")),
+    "channel_name": lambda a: _set_json(a, "channel_names", lambda c: c.update(R="\udfff")),
+    "range_10e400": lambda a: _set_json(a, "axes", lambda axes: axes[0].update(range=[0, 10**400])),
+    "count_5001_digits": lambda a: a.update(axes=a["axes"].replace('"count": 4', '"count": ' + "9" * 5001, 1)),
+}
+
+
+@pytest.mark.parametrize("edit", SIDECAR_EDITS, ids=list(SIDECAR_EDITS))
+def test_a_valid_json_sidecar_with_no_text_or_no_number_is_one_line(tmp_path, edit):
+    path = _npy_with_sidecar(tmp_path)
+    _edit_sidecar(path, SIDECAR_EDITS[edit])
+    for args in _commands(path, tmp_path / "p.png")[:2]:
+        line = one_line_error(CliRunner().invoke(main, list(map(str, args))))
+        assert "t.npy" in line and ("surrogate" in line or "range" in line or "4300 digits" in line), line
+
+
+def test_preview_of_an_rgba_z_exr_draws_rgba_and_says_so(tmp_path):
+    oiio = pytest.importorskip("OpenImageIO")
+    pytest.importorskip("matplotlib")
+    path = tmp_path / "render.exr"
+    spec = oiio.ImageSpec(8, 4, 5, "float")
+    spec.channelnames = ("R", "G", "B", "A", "Z")
+    out = oiio.ImageOutput.create(str(path))
+    pixels = np.arange(8 * 4 * 5, dtype=np.float32).reshape(4, 8, 5)
+    assert out.open(str(path), spec) and out.write_image(pixels) and out.close()
+    loaded = read(path)
+    assert loaded.facts["channels"] == ["R", "G", "B", "A", "Z"]
+    np.testing.assert_array_equal(loaded.data, pixels)
+    r = CliRunner().invoke(main, ["preview", str(path), "-o", str(tmp_path / "p.png")])
+    assert r.exit_code == 0 and r.exception is None, r.output  # was IndexError
+    from lutbake.commands.preview import figure
+
+    fig = figure(path)
+    assert "5 channels: the first 4 are drawn, not channel Z" in fig._suptitle.get_text()
+
+
+def test_preview_of_a_table_holding_nan_and_inf_masks_them_without_warnings(tmp_path):
+    pytest.importorskip("matplotlib")
+    from lutbake.commands.preview import figure
+
+    path = _npy_with_sidecar(tmp_path)
+    data = np.full((4, 4, 2), 0.5, np.float32)
+    data[0, 0, 0], data[1, 2, 1], data[3, 3, 0] = np.nan, np.inf, -np.inf
+    np.save(path, data)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # numpy's RuntimeWarnings (invalid value, All-NaN slice) named library paths
+        fig = figure(path)
+        fig.savefig(tmp_path / "p.png")
+    assert "3 non-finite values (NaN/Inf) of 32 masked" in fig._suptitle.get_text()

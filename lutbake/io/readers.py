@@ -234,7 +234,7 @@ def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
                     f"at most {MAX_EXR_CHANNELS} channels: refused before reading"
                 )
             rgba = [c for c in "RGBA" if c in names]
-            order = rgba if len(rgba) == len(names) else names
+            order = rgba + [c for c in names if c not in rgba] if rgba else names  # RGBA first (RGBA + Z: 5)
             with stderr_silenced():
                 arr = inp.read_image(k, 0, 0, len(names), "float")
             if arr is None:
@@ -262,6 +262,9 @@ def read_exr(path: Path) -> LoadedFile:
     if len(shapes) != 1:
         raise ValueError(f"its parts have different shapes {sorted(shapes)}")
     attrs = {k: v for k, v in parts[0][1].items() if k not in ("slice_index", "slice_value")}
+    problem = _text_problem(attrs)
+    if problem:
+        raise ValueError(f"its lutbake attributes: {problem}")
     facts = {**parts[0][2], "parts": [(f["part"], a.get("slice_value")) for _, a, f in parts]}
     if len(parts) == 1 and "slice_index" not in parts[0][1]:
         data = parts[0][0]
@@ -397,7 +400,28 @@ def _string_attrs(meta, where: Path, what: str) -> dict[str, str]:
     bad = [k for k, v in meta.items() if not isinstance(v, str)]
     if bad:
         raise ReadError(f"{where}: {what}: attribute {bad[0]!r} must be a string, got {type(meta[bad[0]]).__name__}")
+    problem = _text_problem(meta)
+    if problem:
+        raise ReadError(f"{where}: {what}: {problem}")
     return dict(meta)
+
+
+_SURROGATE = re.compile("[\ud800-\udfff]")  # valid in JSON ("\\ud800"), never text: no terminal or font takes it
+
+
+def _text_problem(value, where: str = "") -> str | None:
+    """Where a JSON value (its keys and strings, at any depth) holds a lone UTF-16 surrogate, or None."""
+    if isinstance(value, str):
+        m = _SURROGATE.search(value)
+        return f"{where or 'a string'} holds a lone surrogate (U+{ord(m.group()):04X}): not text" if m else None
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for key, item in items:
+        name = f"{where}[{key}]" if isinstance(key, int) else f"{where}.{key}" if where else f"{key}"
+        name = bounded_text(_SURROGATE.sub("?", str(name)), NAME_CHARS)
+        problem = (_text_problem(key, f"key {name!r}") if isinstance(key, str) else None) or _text_problem(item, name)
+        if problem:
+            return problem
+    return None
 
 
 def sidecar_candidates(path: Path) -> list[Path]:
@@ -479,16 +503,25 @@ def _json_attr(loaded: LoadedFile, key: str, kind: type, default):
             raise ReadError(f"{where} is missing (every lutbake table records it)")
         return default
     try:
-        value = json.loads(loaded.attrs[key])
-    except json.JSONDecodeError as e:
-        raise ReadError(f"{where} is not valid JSON ({e})") from None
+        value = bounded.loads_json(loaded.attrs[key])
+    except ValueError as e:  # JSONDecodeError, nesting, an integer of more than 4300 digits
+        raise ReadError(f"{where} is not valid JSON ({shorten(str(e), 200)})") from None
     if not isinstance(value, kind):
         raise ReadError(f"{where} must be a JSON {'list' if kind is list else 'object'}, got {loaded.attrs[key][:60]}")
+    problem = _text_problem(value)
+    if problem:
+        raise ReadError(f"{where}: {problem}")
     return value
 
 
 def _number(x) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+    """A finite JSON number (an integer too large for a float, 10^400, is not one)."""
+    if not isinstance(x, (int, float)) or isinstance(x, bool):
+        return False
+    try:
+        return math.isfinite(float(x))
+    except OverflowError:
+        return False
 
 
 def axis_from_meta(d: dict, where: str = "axis") -> Axis:
@@ -575,7 +608,10 @@ def table_view(loaded: LoadedFile) -> TableView:
     data, path = loaded.data, loaded.path
     if not loaded.attrs:
         nch = data.shape[-1]
-        return TableView(loaded, data, [], [f"channel {c}" for c in "RGBA"[:nch]], [""] * nch, None, path.stem, {}, "")
+        letters = [str(c) for c in loaded.facts.get("channels") or ()][:nch] or list("RGBA"[:nch])
+        letters += [f"#{c}" for c in range(len(letters), nch)]
+        names = [f"channel {bounded_text(c, NAME_CHARS)}" for c in letters]
+        return TableView(loaded, data, [], names, [""] * nch, None, path.stem, {}, "")
     if "kind" not in loaded.attrs:
         raise ReadError(f"{path}: lutbake metadata ({loaded.meta_source}) without 'kind'")
     axes_meta = _json_attr(loaded, "axes", list, None)
