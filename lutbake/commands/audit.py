@@ -36,6 +36,7 @@ import numpy as np
 
 from ..axes import Axis
 from ..edge import NOV_MIN
+from ..io.bounded import reading_for
 from ..io.lut_files import LutFile, read_lut
 from .audit_report import (
     METRICS,
@@ -399,11 +400,12 @@ def audit(
     neither a preset nor a config, the conventions the file records; see the module docstring)."""
     if metric not in METRICS:
         raise ValueError(f"metric {metric!r}: allowed {', '.join(METRICS)}")
-    recorded, lut = recorded_attributes(path, shape)
-    other = dispatch(path, conv_args, tolerance, metric, max_side, error_map, recorded)  # LTC and OpenPBR
-    if other is not None:
-        return other
-    lut = lut or read_lut(path, shape=shape)  # read again only to raise what is wrong with it
+    with reading_for("audit"):  # the read's memory budget counts the audit's work on the values
+        recorded, lut = recorded_attributes(path, shape)
+        other = dispatch(path, conv_args, tolerance, metric, max_side, error_map, recorded)  # LTC and OpenPBR
+        if other is not None:
+            return other
+        lut = lut or read_lut(path, shape=shape)  # read again only to raise what is wrong with it
     rows, cols, fch = lut.data.shape
     bad = ~np.isfinite(lut.data)
     if bad.any():

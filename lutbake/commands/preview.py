@@ -28,6 +28,7 @@ import numpy as np
 
 from ..axes import Axis
 from ..errors import LutbakeError
+from ..io.bounded import reading_for
 from ..io.readers import TableView, read_table
 from ..textsafe import bounded, shorten
 
@@ -381,7 +382,8 @@ def figure(path):
     import matplotlib.pyplot as plt
 
     path = Path(path)
-    view, notes = _drawable(read_table(path))
+    with reading_for("preview"):  # the read's memory budget counts what drawing takes
+        view, notes = _drawable(read_table(path))
     spheres = split_sum(view) if not notes else None
     dims = {a.dim for a in view.axes}
     with matplotlib.rc_context({"text.parse_math": False}):  # names from the file are text: "$x$" is no formula

@@ -16,6 +16,8 @@ claims and what the cap is (issue 38).
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import io
 import json
 import math
@@ -35,6 +37,18 @@ MAX_TEXT_BYTES = 64 << 20  # a C/JS/WGSL/Rust array of a 1024^2 RGBA table is ab
 MAX_JSON_BYTES = 16 << 20  # a sidecar or a cache entry is a few KiB (a listed axis: tens of KiB)
 MAX_JSON_DEPTH = 64  # lutbake's deepest JSON is 4 levels (sidecar > lutbake > axes > values)
 NPY_HEADER_LIMIT = 10000  # numpy's own default max_header_size
+# Memory: one budget for what a read and its command's work on the values take together, computed from the shape and
+# the stored dtype before anything is allocated (check_memory). Bytes per value, measured as max RSS over the values
+# of a 2048 x 2048 RGBA float32 file (KTX2, npy, EXR, PNG16; lutbake 1 GiB files alike): the reader holds the stored
+# values plus a float32 table (READ_BYTES + the stored item size); the command adds PROCESSING_BYTES.
+MAX_READ_MEMORY = 2 << 30  # 2 GiB: a 2^26-texel RGBA float32 table (the largest a config bakes) for inspect
+READ_BYTES = 4  # the float32 table beside the stored values (an EXR: OpenImageIO's float buffer is the stored copy)
+PROCESSING_BYTES = {
+    "inspect": 0,
+    "preview": 16,
+    "audit": 100,
+}  # measured totals: inspect 4-8, preview 20-22, audit 99-102
+_COMMAND = contextvars.ContextVar("lutbake_read_command", default="inspect")
 
 _FILE_TYPES = (
     (stat.S_ISDIR, "a directory"),
@@ -135,9 +149,10 @@ def load_json(path, limit: int = MAX_JSON_BYTES):
     return loads_json(read_text(path, limit, "a JSON sidecar"))
 
 
-def check_texels(shape, what: str = "the file", channels: int | None = None) -> None:
+def check_texels(shape, what: str = "the file", channels: int | None = None, itemsize: int = 4) -> None:
     """ValueError unless ``shape`` (its texels: every dimension but the last, channels, when ``channels`` is None)
-    is a table lutbake may hold: at most MAX_READ_TEXELS texels and MAX_CHANNELS channels, none empty."""
+    is a table lutbake may hold: at most MAX_READ_TEXELS texels and MAX_CHANNELS channels, none empty, and its
+    values stored as ``itemsize`` bytes fit the memory budget (check_memory)."""
     dims = [int(d) for d in shape]
     if channels is None:
         dims, channels = dims[:-1], dims[-1] if dims else 1
@@ -152,6 +167,32 @@ def check_texels(shape, what: str = "the file", channels: int | None = None) -> 
         )
     if channels > MAX_CHANNELS:
         raise ValueError(f"{what} declares {shown}: {channels} channels (a table has 1 to {MAX_CHANNELS})")
+    check_memory(dims + [channels], itemsize, what)
+
+
+@contextlib.contextmanager
+def reading_for(command: str):
+    """Reads inside are budgeted for ``command`` ("inspect", "preview", "audit"): its PROCESSING_BYTES per value."""
+    token = _COMMAND.set(command)
+    try:
+        yield
+    finally:
+        _COMMAND.reset(token)
+
+
+def check_memory(shape, itemsize: int, what: str = "the file") -> None:
+    """ValueError unless reading ``shape`` values stored as ``itemsize`` bytes each, and the current command's work on
+    them (reading_for), fits MAX_READ_MEMORY: refused before anything is allocated, naming the shape and the bytes."""
+    values = math.prod(int(d) for d in shape)
+    command = _COMMAND.get()
+    per_value = itemsize + READ_BYTES + PROCESSING_BYTES[command]
+    need = values * per_value
+    if need > MAX_READ_MEMORY:
+        raise ValueError(
+            f"{what} declares {' x '.join(map(str, shape))} ({values} values of {itemsize} bytes): {command} would "
+            f"need about {need / (1 << 30):.1f} GiB ({per_value} bytes a value, measured), more than the "
+            f"{MAX_READ_MEMORY >> 30} GiB a read may take: refused before reading"
+        )
 
 
 def zstd_decompress(data: bytes, size: int) -> bytes:
@@ -159,23 +200,26 @@ def zstd_decompress(data: bytes, size: int) -> bytes:
     whatever the frame declares (or omits) as its content size. ValueError for a truncated or corrupt frame."""
     import zstandard
 
+    out = bytearray(size + 1)  # filled in place: the declared size once (BytesIO + getvalue held it twice)
+    view, got = memoryview(out), 0
     try:
         with zstandard.ZstdDecompressor().stream_reader(io.BytesIO(data), read_across_frames=False) as reader:
-            out = io.BytesIO()
-            while out.tell() <= size:
-                chunk = reader.read(min(1 << 20, size + 1 - out.tell()))
-                if not chunk:
+            while got <= size:
+                n = reader.readinto(view[got : min(got + (1 << 20), size + 1)])
+                if not n:
                     break
-                out.write(chunk)
+                got += n
     except zstandard.ZstdError as e:
         raise ValueError(f"its zstd data cannot be decompressed ({e})") from None
-    got = out.tell()
+    finally:
+        view.release()
     if got != size:
         more = "more than" if got > size else "only"
         raise ValueError(
             f"its zstd data expands to {more} {got} bytes; the header declares {size} (truncated or forged)"
         )
-    return out.getvalue()
+    del out[size:]  # the one byte of slack: bytearray shrinks in place
+    return out
 
 
 # ------------------------------------------------------------------------------------------------ EXR
@@ -261,9 +305,9 @@ def _npy_data(f, shape, dtype, fortran, available: int, where: str, table: bool 
     """The array data after a header; ``table``: (y, x[, C]) or (z, y, x, C), else any array of at most 4
     dimensions (an engine's arrays, e.g. OpenPBR's 32^3 energy tables) whose values count as texels."""
     if len(shape) == 2 or not table and 1 <= len(shape) <= 4:
-        check_texels(shape, where, channels=1)
+        check_texels(shape, where, channels=1, itemsize=dtype.itemsize)
     elif table and 3 <= len(shape) <= 4:
-        check_texels(shape, where)
+        check_texels(shape, where, itemsize=dtype.itemsize)
     else:
         raise ValueError(f"{where}: array of shape {shape} is not a table (2 to 4 dimensions)")
     nbytes = math.prod(shape) * dtype.itemsize

@@ -233,6 +233,7 @@ def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
                     f"in parts 0-{k}); a table lutbake reads is at most {bounded.MAX_READ_TEXELS} texels of "
                     f"at most {MAX_EXR_CHANNELS} channels: refused before reading"
                 )
+            bounded.check_memory((texels, len(names)), 4, f"the EXR (parts 0-{k}: texels x channels)")
             rgba = [c for c in "RGBA" if c in names]
             order = rgba + [c for c in names if c not in rgba] if rgba else names  # RGBA first (RGBA + Z: 5)
             with stderr_silenced():
@@ -240,7 +241,8 @@ def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
             if arr is None:
                 raise ValueError(f"cannot read the pixels of part {k}: {inp.geterror()}")
             arr = np.asarray(arr, dtype=np.float32).reshape(spec.height, spec.width, len(names))
-            arr = np.ascontiguousarray(arr[..., [names.index(c) for c in order]])
+            if order != names:  # a copy only where the channels move (RGBA first)
+                arr = np.ascontiguousarray(arr[..., [names.index(c) for c in order]])
             facts = {
                 "pixel_type": str(spec.format),
                 "compression": spec.getattribute("compression"),
@@ -291,7 +293,7 @@ def read_png(path: Path) -> LoadedFile:
         raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
     try:
         spec = inp.spec()
-        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header")
+        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header", itemsize=spec.format.size())
         bits = 16 if str(spec.format) == "uint16" else 8
         with stderr_silenced():
             arr = inp.read_image("uint16" if bits == 16 else "uint8")
@@ -300,9 +302,20 @@ def read_png(path: Path) -> LoadedFile:
         codes = np.asarray(arr).reshape(spec.height, spec.width, spec.nchannels)
     finally:
         inp.close()
-    data = _as_table_array(codes.astype(np.float64) / float((1 << bits) - 1))
+    data = _unorm_float32(codes, (1 << bits) - 1)
     facts = {"bit_depth": bits, "channels": list(spec.channelnames), "encoding": f"code / {(1 << bits) - 1}"}
     return _with_sidecar(LoadedFile(path, "png", data, {}, None, facts))
+
+
+UNORM_ROWS = 256  # rows converted at a time from UNORM codes (float64 division, rounded to float32)
+
+
+def _unorm_float32(codes: np.ndarray, one: int) -> np.ndarray:
+    """float32 code / one, as the float64 division rounds it, a block of rows at a time (no float64 image)."""
+    out = np.empty(codes.shape, np.float32)
+    for r in range(0, codes.shape[0], UNORM_ROWS):
+        out[r : r + UNORM_ROWS] = codes[r : r + UNORM_ROWS] / float(one)
+    return _as_table_array(out)
 
 
 def read_dds(path: Path) -> LoadedFile:
@@ -350,7 +363,7 @@ def read_header(path: Path) -> LoadedFile:
     if not {"HEIGHT", "WIDTH", "CHANNELS"} <= set(dims):
         raise ValueError(f"no {ident.upper()}_HEIGHT / _WIDTH / _CHANNELS macros for array {ident}")
     shape = tuple(dims[k] for k in ("DEPTH", "HEIGHT", "WIDTH", "CHANNELS") if k in dims)
-    bounded.check_texels(shape, f"array {ident}'s macros")
+    bounded.check_texels(shape, f"array {ident}'s macros", itemsize=8)  # parsed as float64
     try:
         data, _ = parse_numbers(body, math.prod(shape), bits=ctype == "uint16_t")
     except ValueError as e:

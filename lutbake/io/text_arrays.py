@@ -210,7 +210,7 @@ def parse_text_array(text: str, shape=None) -> tuple[np.ndarray, str]:
     if body is None:
         raise ValueError("no array literal found")
     shp = _text_shape(text, shape)
-    bounded.check_texels(shp, "the declared shape")
+    bounded.check_texels(shp, "the declared shape", itemsize=8)  # parsed as float64
     n = int(np.prod(shp))
     arr, storage = parse_numbers(body, n)
     return arr.reshape(shp), storage
