@@ -42,6 +42,7 @@ import numpy as np
 
 from ..axes import Axis
 from ..edge import NOV_MIN
+from ..io.bounded import reading_for
 from ..io.lut_files import LutFile, read_lut
 from .audit_report import (
     METRICS,
@@ -182,11 +183,12 @@ def rounding_step(values: np.ndarray, quant: dict) -> np.ndarray:
     return np.spacing(np.abs(np.asarray(values)).astype(dtype)).astype(np.float64)
 
 
-def recorded_attributes(path, shape=None) -> dict:
-    """The lutbake attributes the file records (EXR header, KTX2 key/value data, or its ``<file>.json`` sidecar);
-    {} for another tool's file."""
+def recorded_attributes(path, shape=None) -> tuple[dict, LutFile | None]:
+    """The lutbake attributes the file records (EXR header, KTX2 key/value data, or its ``<file>.json`` sidecar),
+    {} for another tool's file; and the file read (None where read_lut cannot read it), so it is read once."""
     try:
-        return read_lut(path, shape=shape).attrs
+        lut = read_lut(path, shape=shape)
+        return lut.attrs, lut
     except (ValueError, OSError):
         from ..io import bounded
 
@@ -194,8 +196,8 @@ def recorded_attributes(path, shape=None) -> dict:
         try:  # a sidecar that cannot be read records nothing: the audit then says what is wrong with the file
             doc = bounded.load_json(side) if side.is_file() else {}
         except (ValueError, OSError, RecursionError, UnicodeDecodeError):
-            return {}
-        return doc.get("lutbake", {}) if isinstance(doc, dict) else {}
+            return {}, None
+        return (doc.get("lutbake", {}) if isinstance(doc, dict) else {}), None
 
 
 def quantise(values: np.ndarray, quant: dict) -> np.ndarray:
@@ -392,11 +394,12 @@ def audit(
     neither a preset nor a config, the conventions the file records; see the module docstring)."""
     if metric not in METRICS:
         raise ValueError(f"metric {metric!r}: allowed {', '.join(METRICS)}")
-    recorded = recorded_attributes(path, shape)
-    other = dispatch(path, conv_args, tolerance, metric, max_side, error_map, recorded)  # LTC and OpenPBR
-    if other is not None:
-        return other
-    lut: LutFile = read_lut(path, shape=shape)
+    with reading_for("audit"):  # the read's memory budget counts the audit's work on the values
+        recorded, lut = recorded_attributes(path, shape)
+        other = dispatch(path, conv_args, tolerance, metric, max_side, error_map, recorded)  # LTC and OpenPBR
+        if other is not None:
+            return other
+        lut = lut or read_lut(path, shape=shape)  # read again only to raise what is wrong with it
     rows, cols, fch = lut.data.shape
     bad = ~np.isfinite(lut.data)
     if bad.any():

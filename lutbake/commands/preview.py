@@ -22,16 +22,19 @@ from __future__ import annotations
 
 import re
 import textwrap
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from ..axes import Axis
 from ..errors import LutbakeError
+from ..io.bounded import reading_for
 from ..io.readers import TableView, read_table
 from ..textsafe import bounded, shorten
 
 N_SPHERES = 5
+MAX_CHANNELS = 4  # channels drawn (a table has 1 to 4; a renderer's EXR may add Z and others)
 MAX_SLICES = 6  # columns of a 3D slice grid
 MAX_BTF_SIGMAS, MAX_BTF_PHIS = 4, 5
 SPHERE_F0 = np.array([1.0, 0.71, 0.29])  # a gold-like conductor's f0 (RGB)
@@ -213,7 +216,11 @@ def _image(fig, ax, img, y_axis, x_axis, vmin=None, vmax=None, labels=(True, Tru
 
 def _color_range(values: np.ndarray) -> tuple[float, float, str]:
     """(vmin, vmax, note): the full range, or up to the CLIP_PERCENTILE when a few texels (a grazing corner)
-    are far above the rest, so the rest stays readable; the note says so and gives the true maximum."""
+    are far above the rest, so the rest stays readable; the note says so and gives the true maximum. Non-finite
+    values (masked as NaN by _drawable) are left out."""
+    values = values[np.isfinite(values)]
+    if not values.size:
+        return 0.0, 1.0, "\nno finite value"
     lo, hi = float(values.min()), float(values.max())
     top = float(np.percentile(values, CLIP_PERCENTILE))
     if hi - lo > CLIP_RATIO * (top - lo) > 0:
@@ -229,7 +236,7 @@ def _channel_title(view: TableView, c: int) -> str:
         lines = lines[: MEANING_LINES - 1] + [textwrap.shorten(" ".join(lines[MEANING_LINES - 1 :]), MEANING_WIDTH)]
     col = view.data[..., c]
     const = f"  (constant {float(col.flat[0]):.3g})" if col.size and col.min() == col.max() else ""
-    return "\n".join([f"{'RGBA'[c]} = {name}{const}"] + lines)
+    return "\n".join([f"{'RGBA'[c]} = {name}{const}" if c < len("RGBA") else f"{name}{const}"] + lines)
 
 
 def _suptitle(view: TableView, path: Path, width_chars: int) -> str:
@@ -423,7 +430,7 @@ def _fig_btf(plt, view):
     sig = _pick(data.shape[0], MAX_BTF_SIGMAS)
     phis = _pick(block.count, MAX_BTF_PHIS)
     ny = y_axis.count
-    vmin, vmax = float(data[..., 0].min()), float(data[..., 0].max())
+    vmin, vmax, _ = _color_range(data[..., 0])
     fig = plt.figure(figsize=(2.6 * len(phis) + 1.4, 2.6 * len(sig) + 1.4), dpi=100, layout="constrained")
     zvals, pvals = (z_axis.values() if z_axis is not None else None), block.values()
     for i, k in enumerate(sig):
@@ -452,6 +459,28 @@ def _sphere_row(canvas, view, spheres):
         ax.axis("off")
 
 
+def _drawable(view: TableView) -> tuple[TableView, list[str]]:
+    """The view as drawn, and what was left out, each in one line: channels past MAX_CHANNELS (an EXR's RGBA + Z: the
+    RGBA channels are drawn), and non-finite values, masked (NaN: not coloured; no sphere row is shaded from them)."""
+    notes = []
+    nch = view.data.shape[-1]
+    if nch > MAX_CHANNELS:
+        left = ", ".join(view.channel_names[MAX_CHANNELS:])
+        notes.append(f"{nch} channels: the first {MAX_CHANNELS} are drawn, not {bounded(left, 200)}")
+        view = replace(
+            view,
+            data=view.data[..., :MAX_CHANNELS],
+            channel_names=view.channel_names[:MAX_CHANNELS],
+            meanings=view.meanings[:MAX_CHANNELS],
+        )
+    bad = ~np.isfinite(view.data)
+    count = int(bad.sum())
+    if count:
+        notes.append(f"{count} non-finite values (NaN/Inf) of {view.data.size} masked: drawn uncoloured")
+        view = replace(view, data=np.where(bad, np.float32(np.nan), view.data))
+    return view, notes
+
+
 def figure(path):
     """The preview of the table file at ``path`` as a matplotlib Figure (Agg; close it when done)."""
     import matplotlib
@@ -460,8 +489,9 @@ def figure(path):
     import matplotlib.pyplot as plt
 
     path = Path(path)
-    view = read_table(path)
-    spheres = split_sum(view)
+    with reading_for("preview"):  # the read's memory budget counts what drawing takes
+        view, notes = _drawable(read_table(path))
+    spheres = split_sum(view) if not notes else None
     dims = {a.dim for a in view.axes}
     with matplotlib.rc_context({"text.parse_math": False}):  # names from the file are text: "$x$" is no formula
         if "y_block" in dims:
@@ -474,7 +504,12 @@ def figure(path):
             fig, inches = _fig_3d(plt, view, spheres)
         else:
             fig, inches = _fig_2d(plt, view, spheres)
-        note = "" if spheres or not view.kind else f"\n(no sphere row: {view.kind} has no split-sum reconstruction)"
+        note = (
+            ""
+            if spheres or not view.kind or notes
+            else f"\n(no sphere row: {view.kind} has no split-sum reconstruction)"
+        )
+        note += "".join(f"\n({n})" for n in notes)
         fig.suptitle(_suptitle(view, path, int(inches * CHARS_PER_INCH)) + note, fontsize=9)
     return fig
 

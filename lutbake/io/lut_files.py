@@ -45,7 +45,9 @@ class LutFile:
 
 def _unorm(codes: np.ndarray) -> tuple[np.ndarray, str]:
     bits = codes.dtype.itemsize * 8
-    return codes.astype(np.float64) / float((1 << bits) - 1), f"unorm{bits}"
+    values = codes.astype(np.float64)
+    values /= float((1 << bits) - 1)  # in place: one float64 image, not two
+    return values, f"unorm{bits}"
 
 
 def _float_storage(arr: np.ndarray) -> str:
@@ -62,7 +64,7 @@ def _read_png(path: Path) -> tuple[np.ndarray, str]:
         raise ValueError(f"{path}: cannot open PNG: {oiio.geterror()}")
     try:
         spec = inp.spec()
-        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header")
+        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header", itemsize=spec.format.size())
         native = oiio.UINT16 if spec.format.size() == 2 else oiio.UINT8
         codes = inp.read_image(native)  # raw codes: OIIO applies no transfer function on read
     finally:

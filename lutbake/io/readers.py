@@ -37,6 +37,7 @@ from ..runtime.warp_runtime import stderr_silenced
 from ..textsafe import bounded as bounded_text
 from ..textsafe import shorten
 from . import bounded, dds, ktx2
+from .text_arrays import parse_numbers
 
 PREFIX = "lutbake:"
 MAGIC_BYTES = 16  # enough to tell every format apart
@@ -226,6 +227,9 @@ def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
     come in that order; any other channel names are kept in file order."""
     import OpenImageIO as oiio  # imported here: only EXR and PNG need it
 
+    problem = bounded.exr_header_problem(path)  # before OpenImageIO parses the attributes (super-linear in their count)
+    if problem:
+        raise ValueError(problem)
     with stderr_silenced():  # libpng / OpenEXR print their own complaints; the ReadError says it once
         inp = oiio.ImageInput.open(str(path))
     if inp is None:
@@ -243,14 +247,16 @@ def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
                     f"in parts 0-{k}); a table lutbake reads is at most {bounded.MAX_READ_TEXELS} texels of "
                     f"at most {MAX_EXR_CHANNELS} channels: refused before reading"
                 )
+            bounded.check_memory((texels, len(names)), 4, f"the EXR (parts 0-{k}: texels x channels)")
             rgba = [c for c in "RGBA" if c in names]
-            order = rgba if len(rgba) == len(names) else names
+            order = rgba + [c for c in names if c not in rgba] if rgba else names  # RGBA first (RGBA + Z: 5)
             with stderr_silenced():
                 arr = inp.read_image(k, 0, 0, len(names), "float")
             if arr is None:
                 raise ValueError(f"cannot read the pixels of part {k}: {inp.geterror()}")
             arr = np.asarray(arr, dtype=np.float32).reshape(spec.height, spec.width, len(names))
-            arr = np.ascontiguousarray(arr[..., [names.index(c) for c in order]])
+            if order != names:  # a copy only where the channels move (RGBA first)
+                arr = np.ascontiguousarray(arr[..., [names.index(c) for c in order]])
             facts = {
                 "pixel_type": str(spec.format),
                 "compression": spec.getattribute("compression"),
@@ -272,6 +278,9 @@ def read_exr(path: Path) -> LoadedFile:
     if len(shapes) != 1:
         raise ValueError(f"its parts have different shapes {sorted(shapes)}")
     attrs = {k: v for k, v in parts[0][1].items() if k not in ("slice_index", "slice_value")}
+    problem = _text_problem(attrs)
+    if problem:
+        raise ValueError(f"its lutbake attributes: {problem}")
     facts = {**parts[0][2], "parts": [(f["part"], a.get("slice_value")) for _, a, f in parts]}
     if len(parts) == 1 and "slice_index" not in parts[0][1]:
         data = parts[0][0]
@@ -298,7 +307,7 @@ def read_png(path: Path) -> LoadedFile:
         raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
     try:
         spec = inp.spec()
-        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header")
+        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header", itemsize=spec.format.size())
         bits = 16 if str(spec.format) == "uint16" else 8
         with stderr_silenced():
             arr = inp.read_image("uint16" if bits == 16 else "uint8")
@@ -307,9 +316,20 @@ def read_png(path: Path) -> LoadedFile:
         codes = np.asarray(arr).reshape(spec.height, spec.width, spec.nchannels)
     finally:
         inp.close()
-    data = _as_table_array(codes.astype(np.float64) / float((1 << bits) - 1))
+    data = _unorm_float32(codes, (1 << bits) - 1)
     facts = {"bit_depth": bits, "channels": list(spec.channelnames), "encoding": f"code / {(1 << bits) - 1}"}
     return _with_sidecar(LoadedFile(path, "png", data, {}, None, facts))
+
+
+UNORM_ROWS = 256  # rows converted at a time from UNORM codes (float64 division, rounded to float32)
+
+
+def _unorm_float32(codes: np.ndarray, one: int) -> np.ndarray:
+    """float32 code / one, as the float64 division rounds it, a block of rows at a time (no float64 image)."""
+    out = np.empty(codes.shape, np.float32)
+    for r in range(0, codes.shape[0], UNORM_ROWS):
+        out[r : r + UNORM_ROWS] = codes[r : r + UNORM_ROWS] / float(one)
+    return _as_table_array(out)
 
 
 def read_dds(path: Path) -> LoadedFile:
@@ -357,14 +377,11 @@ def read_header(path: Path) -> LoadedFile:
     if not {"HEIGHT", "WIDTH", "CHANNELS"} <= set(dims):
         raise ValueError(f"no {ident.upper()}_HEIGHT / _WIDTH / _CHANNELS macros for array {ident}")
     shape = tuple(dims[k] for k in ("DEPTH", "HEIGHT", "WIDTH", "CHANNELS") if k in dims)
-    bounded.check_texels(shape, f"array {ident}'s macros")
-    items = [s for s in (x.strip() for x in body.split(",")) if s]
-    if math.prod(shape) != len(items):
-        raise ValueError(f"array {ident} has {len(items)} values, its macros say {' x '.join(map(str, shape))}")
-    if ctype == "uint16_t":
-        data = np.array([int(s, 0) for s in items], dtype=np.uint16).view(np.float16)
-    else:
-        data = np.array([s.rstrip("fF") for s in items], dtype=np.float64)
+    bounded.check_texels(shape, f"array {ident}'s macros", itemsize=8)  # parsed as float64
+    try:
+        data, _ = parse_numbers(body, math.prod(shape), bits=ctype == "uint16_t")
+    except ValueError as e:
+        raise ValueError(f"array {ident} (its macros say {' x '.join(map(str, shape))}): {e}") from None
     loaded = LoadedFile(
         path,
         "h",
@@ -410,7 +427,28 @@ def _string_attrs(meta, where: Path, what: str) -> dict[str, str]:
     bad = [k for k, v in meta.items() if not isinstance(v, str)]
     if bad:
         raise ReadError(f"{where}: {what}: attribute {bad[0]!r} must be a string, got {type(meta[bad[0]]).__name__}")
+    problem = _text_problem(meta)
+    if problem:
+        raise ReadError(f"{where}: {what}: {problem}")
     return dict(meta)
+
+
+_SURROGATE = re.compile("[\ud800-\udfff]")  # valid in JSON ("\\ud800"), never text: no terminal or font takes it
+
+
+def _text_problem(value, where: str = "") -> str | None:
+    """Where a JSON value (its keys and strings, at any depth) holds a lone UTF-16 surrogate, or None."""
+    if isinstance(value, str):
+        m = _SURROGATE.search(value)
+        return f"{where or 'a string'} holds a lone surrogate (U+{ord(m.group()):04X}): not text" if m else None
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for key, item in items:
+        name = f"{where}[{key}]" if isinstance(key, int) else f"{where}.{key}" if where else f"{key}"
+        name = bounded_text(_SURROGATE.sub("?", str(name)), NAME_CHARS)
+        problem = (_text_problem(key, f"key {name!r}") if isinstance(key, str) else None) or _text_problem(item, name)
+        if problem:
+            return problem
+    return None
 
 
 def sidecar_candidates(path: Path) -> list[Path]:
@@ -492,16 +530,25 @@ def _json_attr(loaded: LoadedFile, key: str, kind: type, default):
             raise ReadError(f"{where} is missing (every lutbake table records it)")
         return default
     try:
-        value = json.loads(loaded.attrs[key])
-    except json.JSONDecodeError as e:
-        raise ReadError(f"{where} is not valid JSON ({e})") from None
+        value = bounded.loads_json(loaded.attrs[key])
+    except ValueError as e:  # JSONDecodeError, nesting, an integer of more than 4300 digits
+        raise ReadError(f"{where} is not valid JSON ({shorten(str(e), 200)})") from None
     if not isinstance(value, kind):
         raise ReadError(f"{where} must be a JSON {'list' if kind is list else 'object'}, got {loaded.attrs[key][:60]}")
+    problem = _text_problem(value)
+    if problem:
+        raise ReadError(f"{where}: {problem}")
     return value
 
 
 def _number(x) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+    """A finite JSON number (an integer too large for a float, 10^400, is not one)."""
+    if not isinstance(x, (int, float)) or isinstance(x, bool):
+        return False
+    try:
+        return math.isfinite(float(x))
+    except OverflowError:
+        return False
 
 
 def axis_from_meta(d: dict, where: str = "axis") -> Axis:
@@ -588,7 +635,10 @@ def table_view(loaded: LoadedFile) -> TableView:
     data, path = loaded.data, loaded.path
     if not loaded.attrs:
         nch = data.shape[-1]
-        return TableView(loaded, data, [], [f"channel {c}" for c in "RGBA"[:nch]], [""] * nch, None, path.stem, {}, "")
+        letters = [str(c) for c in loaded.facts.get("channels") or ()][:nch] or list("RGBA"[:nch])
+        letters += [f"#{c}" for c in range(len(letters), nch)]
+        names = [f"channel {bounded_text(c, NAME_CHARS)}" for c in letters]
+        return TableView(loaded, data, [], names, [""] * nch, None, path.stem, {}, "")
     if "kind" not in loaded.attrs:
         raise ReadError(f"{path}: lutbake metadata ({loaded.meta_source}) without 'kind'")
     axes_meta = _json_attr(loaded, "axes", list, None)
