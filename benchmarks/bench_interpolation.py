@@ -5,6 +5,7 @@ Per table: the share of texels interpolated / coarse / integrated, the CPU secon
 without (same run, same tolerance: the ratio), and the honesty of its estimates: every texel's |v - reference| against
 its own recorded estimate plus the reference's, the reference being every texel integrated to a tenth of the table's
 tolerance (``interpolation = "off"``). Writes outputs/bench/interpolation.json and prints a summary.
+``--tables NAME ...``: only those tables; ``--texels FILE.npz``: every texel's worst error / bound per table.
 """
 
 from __future__ import annotations
