@@ -97,4 +97,4 @@ def over_tolerance(ratios, axes) -> str:
             )
         where = ", ".join(parts)
     worst = float(np.max(np.where(np.isnan(r), np.inf, r)))
-    return f"{len(over)} of {len(r)} texels over tolerance: {where}; worst estimate / tolerance {worst:.3g}"
+    return f"{len(over)} of {len(r)} texels over tolerance: {where}; worst estimate / tolerance {worst:.4g}"

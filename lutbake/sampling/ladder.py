@@ -49,21 +49,29 @@ def channel(x: wp.vec4d, c: int):  # noqa: F811 (a Warp overload)
     return x[c]
 
 
+# the least share of the floor a quadrature target keeps, where the floor eats the tolerance: a half let a texel whose
+# floor was 0.67 of the tolerance (HDRP's Charlie G channel: 6.69 x 1e-7 against 1e-6) stop at 1.0007 x its
+# tolerance; a tenth leaves such a texel the tolerance minus its floor, and stops climbing only where the floor alone
+# is over 0.91 of the tolerance (no order helps there)
+FLOOR_SHARE = wp.constant(wp.float64(0.1))
+
+
 @functools.lru_cache(maxsize=None)
 def furthest_over_for(nch: int):
     """``furthest_over(total, err, target_abs, target_rel, floor)``: the channel c whose estimate err_c is furthest
-    over its target max(target_abs_c, target_rel_c |total_c|) - floor |total_c| (at least floor |total_c| / 2), -1
-    when every channel meets its target (float64 vectors of nch)."""
+    over its target max(target_abs_c, target_rel_c |total_c|) - floor |total_c| (at least FLOOR_SHARE floor
+    |total_c|), -1 when every channel meets its target (float64 vectors of nch)."""
 
     @wp.func
     def furthest_over(total: Any, err: Any, target_abs: Any, target_rel: Any, floor: wp.float64):
         worst_c = wp.int32(-1)
         over = wp.float64(1.0)
         for c in range(wp.static(nch)):
-            # a floor over the tolerance (float32 noise) leaves the quadrature half of it: beyond, no order helps
+            # a floor near or over the tolerance (float32 noise) leaves the quadrature FLOOR_SHARE of it: beyond, no
+            # order helps (the texel ends over its tolerance, and says so)
             target = wp.max(
                 wp.max(target_abs[c], target_rel[c] * wp.abs(total[c])) - floor * wp.abs(total[c]),
-                wp.float64(0.5) * floor * wp.abs(total[c]),
+                FLOOR_SHARE * floor * wp.abs(total[c]),
             )
             if err[c] > target * over:
                 worst_c = c
@@ -94,17 +102,16 @@ def totals_for(Sums, nch: int):
 @functools.lru_cache(maxsize=None)
 def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None):
     """``(integrate, climb, Panels, Sums, Orders)``: ``integrate(ctx, n_panels, rules, levels, target_abs, target_rel,
-    floor) -> (total, err)`` (``Sums``: float64 vectors of nch, the targets per channel too): every panel at the first
-    two levels, then refined until err_c = sum_p d_(p,c) <= max(target_abs_c, target_rel_c |total_c|) - floor
-    |total_c| (but at least floor |total_c| / 2) for every channel c (floor: a relative error the caller adds to the
-    estimate, e.g. the terms' rounding;
-    an unreachable target, e.g. 1e300, never refines) or every panel is at the last order (module docstring);
-    n_panels <= max_panels. ``climb(ctx, n_panels, rules, levels, target_abs, target_rel, floor, fine0, coarse0,
-    lev)``: the same from each panel's first two levels' values given (``Panels``: float64 matrices max_panels x nch;
-    fine0 at levels[lev[j]], coarse0 at levels[lev[j] - 1]; ``Orders``: int32 vectors of max_panels), e.g. computed
-    for several texels that share per-node work: the same float operations, so the same result.
-    ``first_level(ctx, j) -> k`` (optional): panel j starts at levels k and k + 1 instead of the first two (a panel
-    class known to converge fast; clamped to the ladder)."""
+    floor) -> (total, err)`` (``Sums``: float64 vectors of nch, the targets per channel too): every panel at the
+    first two levels, then refined until err_c = sum_p d_(p,c) <= max(target_abs_c, target_rel_c |total_c|) - floor
+    |total_c| (but at least FLOOR_SHARE floor |total_c|) for every channel c (floor: a relative error the caller
+    adds to the estimate, e.g. the terms' rounding; an unreachable target, e.g. 1e300, never refines) or every panel
+    is at the last order (module docstring); n_panels <= max_panels. ``climb(ctx, n_panels, rules, levels,
+    target_abs, target_rel, floor, fine0, coarse0, lev)``: the same from each panel's first two levels' values given
+    (``Panels``: float64 matrices max_panels x nch; fine0 at levels[lev[j]], coarse0 at levels[lev[j] - 1];
+    ``Orders``: int32 vectors of max_panels), e.g. computed for several texels that share per-node work: the same
+    float operations, so the same result. ``first_level(ctx, j) -> k`` (optional): panel j starts at levels k and k
+    + 1 instead of the first two (a panel class known to converge fast; clamped to the ladder)."""
     Panels = wp.types.matrix(shape=(max_panels, nch), dtype=wp.float64)
     Sums = wp.types.vector(length=nch, dtype=wp.float64)
     Orders = wp.types.vector(length=max_panels, dtype=wp.int32)  # a panel's level
