@@ -16,6 +16,9 @@ _EXPORTS = {
     "load_config": "config",
     "load_configs": "config",
     "Table": "table",
+    "ConfigError": "errors",  # every wrong input of the API (docs/batch.md)
+    "LutbakeError": "errors",
+    "TableError": "errors",
 }
 
 
@@ -30,3 +33,4 @@ def __getattr__(name: str):
 
 
 __all__ = ["bake", "bake_table", "BakeResult", "load_config", "load_configs", "TableSpec", "Table", "__version__"]
+__all__ += ["ConfigError", "LutbakeError", "TableError"]
