@@ -370,25 +370,28 @@ FOREIGN = {
 
 
 @contextlib.contextmanager
-def loopback_server(first: bytes, close: bool = False, tls=None):
-    """A server on 127.0.0.1 only, one thread, gone after the block: each connection gets ``first`` (through TLS
-    when ``tls``, a server SSLContext), then stays open (``close``: is closed)."""
+def loopback_server(first: bytes, close: bool = False, tls=None, later: bytes | None = None):
+    """A server on 127.0.0.1 only, one thread, gone after the block: each connection gets ``first`` (``later``:
+    every connection after the first gets that; through TLS when ``tls``, a server SSLContext), then stays open
+    (``close``: is closed)."""
     srv = socket.create_server(("127.0.0.1", 0))
     srv.settimeout(0.1)
     stop, conns = threading.Event(), []
 
     def serve():
+        accepted = 0
         while not stop.is_set():
             try:
                 c, _ = srv.accept()
             except OSError:
                 continue
             conns.append(c)
+            accepted += 1
             try:
                 c.settimeout(2)
                 c = tls.wrap_socket(c, server_side=True) if tls else c
                 conns.append(c)
-                c.sendall(first)
+                c.sendall(first if later is None or accepted == 1 else later)
                 if close:
                     c.close()
             except OSError:
@@ -429,9 +432,11 @@ def test_a_port_whose_service_is_not_dask_is_refused_in_one_line(tmp_path, monke
         assert "SSH-2.0-OpenSSH_9.6p1" in line and "an SSH server" in line
 
 
-def test_an_ssh_banner_ends_the_process_with_exit_2(tmp_path):
-    """The process never exited after Dask's traceback (a Client half made: its __del__ waits on a dead loop)."""
-    with loopback_server(FOREIGN["ssh"]) as port:
+@pytest.mark.parametrize("later", [None, FOREIGN["ssh"]], ids=["ssh", "dask_handshake_then_ssh"])
+def test_a_foreign_service_ends_the_process_with_exit_2(tmp_path, later):
+    """The process never exited after Dask's traceback (a Client half made: its __del__ waits on a dead loop). The
+    second server passes the probe, then sends Dask's own connection an SSH banner: Dask fails, the process ends."""
+    with loopback_server(FOREIGN["ssh"] if later is None else GOOD_HANDSHAKE, later=later) as port:
         t0 = time.perf_counter()
         p = subprocess.run(
             [sys.executable, "-m", "lutbake", "bake", "--preset", "default", "--out-dir", str(tmp_path / "o")]
@@ -442,7 +447,8 @@ def test_an_ssh_banner_ends_the_process_with_exit_2(tmp_path):
             timeout=20,
         )
     assert p.returncode == 2 and p.stdout == "" and len(p.stderr.splitlines()) == 1, p.stderr
-    assert "not a Dask scheduler" in p.stderr and time.perf_counter() - t0 < 2 * PROBE_BOUND_S
+    assert f"127.0.0.1:{port}" in p.stderr and time.perf_counter() - t0 < 2 * PROBE_BOUND_S
+    assert ("not a Dask scheduler" if later is None else "cannot connect: MemoryError") in p.stderr
 
 
 def test_the_probe_passes_a_dask_scheduler_and_its_handshake(client):

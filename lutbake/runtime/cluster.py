@@ -72,6 +72,7 @@ ADDRESS_RE = re.compile(
 DEFAULT_PORT = 8786
 MAX_LOCAL_WORKERS = 256
 CONNECT_TIMEOUT_S = 30  # the whole handshake with the scheduler, and for its first worker to join
+HALF_MADE_CLOSE_S = 2  # closing a Client whose connection failed (it has nothing open: 0.5 ms measured)
 REFUSED_HINT = "is a Dask scheduler running there? (dask scheduler --port PORT)"
 U64 = struct.Struct("<Q")  # Dask's "Q": the byte counts, frame counts and frame lengths of its TCP framing
 HANDSHAKE_MAX_BYTES = 1 << 16  # a Dask handshake is ~60 bytes (three short keys in msgpack); larger is not one
@@ -515,6 +516,34 @@ def _distributed():
     return distributed
 
 
+def _half_made_clients(error: BaseException, client_type) -> list:
+    """The Clients whose constructor raised ``error``: the ``self`` of its traceback's frames."""
+    import traceback
+
+    found: list = []
+    for frame, _ in traceback.walk_tb(error.__traceback__):
+        obj = frame.f_locals.get("self")
+        if isinstance(obj, client_type) and not any(obj is f for f in found):
+            found.append(obj)
+    return found
+
+
+def _connect(distributed, address: str):
+    """distributed.Client(address); when Dask fails past the probe, the Client it half made is closed here, while
+    its event loop runs: left to its __del__ at exit, it waited forever on a loop already gone (the process printed
+    its error and never ended)."""
+    try:
+        return distributed.Client(address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
+    except Exception as e:
+        for client in _half_made_clients(e, distributed.Client):
+            with contextlib.suppress(Exception):
+                client.close(timeout=HALF_MADE_CLOSE_S)
+            client.status = "closed"  # its __del__ closes nothing more
+            with contextlib.suppress(Exception):
+                client._loop_runner.stop()  # distributed.utils.LoopRunner: the client's IO-loop thread
+        raise
+
+
 @contextlib.contextmanager
 def session(scheduler: str, device: str = "cpu"):
     """Connect to ``scheduler`` (``local:N`` starts a LocalCluster), check its workers, and yield the DaskRunner
@@ -536,7 +565,7 @@ def session(scheduler: str, device: str = "cpu"):
             client = distributed.Client(cluster, set_as_default=False)
         else:
             probe_scheduler(where)  # refused: at once; silent: CONNECT_TIMEOUT_S, not Dask's unbounded handshake
-            client = distributed.Client(where, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
+            client = _connect(distributed, where)
     except ConfigError:
         raise
     except Exception as e:  # OSError, TimeoutError, or what Dask raises on a handshake the probe passed
