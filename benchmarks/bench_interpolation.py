@@ -5,6 +5,7 @@ Per table: the share of texels interpolated / coarse / integrated, the CPU secon
 without (same run, same tolerance: the ratio), and the honesty of its estimates: every texel's |v - reference| against
 its own recorded estimate plus the reference's, the reference being every texel integrated to a tenth of the table's
 tolerance (``interpolation = "off"``). Writes outputs/bench/interpolation.json and prints a summary.
+``--tables NAME ...``: only those tables; ``--texels FILE.npz``: every texel's worst error / bound per table.
 """
 
 from __future__ import annotations
@@ -68,10 +69,14 @@ def main() -> None:
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=OUT / "interpolation.json")
+    ap.add_argument("--tables", nargs="+", metavar="NAME", help="only these tables (default: every one)")
+    ap.add_argument("--texels", type=Path, help="also write every texel's error / bound of each table here (.npz)")
     args = ap.parse_args()
     wp.config.quiet = True
-    rows = []
+    rows, per_texel = [], {}
     for spec in specs():
+        if args.tables and spec.name not in args.tables:
+            continue
         tol = tolerance_of(spec.options)
         data, cpu, wall, width = tiles(spec)
         off, cpu_off, wall_off, _ = tiles(spec, interpolation="off")
@@ -105,6 +110,7 @@ def main() -> None:
             "texels_over_bound": int(np.count_nonzero(np.any(err > bound, axis=1))),
         }
         rows.append(row)
+        per_texel[spec.name] = ratio.max(axis=1)
         print(
             f"{spec.name:<40} {row['texels']:>8} texels, {100 * row['interpolated']:5.1f} % interpolated: "
             f"{cpu:6.2f} s CPU vs {cpu_off:6.2f} s without ({cpu_off / max(cpu, 1e-9):4.1f}x); max error "
@@ -116,6 +122,8 @@ def main() -> None:
     print(f"all {len(rows)} tables: {total:.1f} s CPU vs {total_off:.1f} s without ({total_off / total:.2f}x)")
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps({"tables": rows, "cpu_s": total, "cpu_s_without": total_off}, indent=2) + "\n")
+    if args.texels:
+        np.savez_compressed(args.texels, **per_texel)
     print(f"wrote {args.out.relative_to(ROOT) if args.out.is_relative_to(ROOT) else args.out}")
 
 

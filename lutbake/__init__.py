@@ -1,7 +1,7 @@
 """lutbake: bake pre-integrated BRDF tables with Warp kernels on the CPU.
 
 import lutbake
-results = lutbake.bake(["configs/dfg.toml"], out_dir="outputs")
+results = lutbake.bake(["configs/dfg.toml"], out_dir="outputs", overrides=["samples=2048", "dfg.dtype=half"])
 """
 
 __version__ = "0.1.0"
@@ -30,6 +30,11 @@ def __getattr__(name: str):
         globals()[name] = value
         return value
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    """The module's names and the public API still to be imported (PEP 562), so ``dir(lutbake)`` lists it."""
+    return sorted(set(globals()) | set(__all__))
 
 
 __all__ = ["bake", "bake_table", "BakeResult", "load_config", "load_configs", "TableSpec", "Table", "__version__"]

@@ -14,6 +14,7 @@ from pathlib import Path
 from . import arguments, batch, pipeline, preflight
 from .config import TableSpec, load_configs, validate_spec
 from .errors import ConfigError, TableError
+from .pipeline import OVER_TOLERANCE
 from .runtime.executor import Progress
 from .table import Table
 from .values_cache import open_cache
@@ -24,8 +25,9 @@ __all__ = ["BakeResult", "BakeResults", "bake", "bake_table"]
 @dataclass
 class BakeResult:
     """One table of ``bake``: its spec, the baked Table (None unless ``baked``), the written path, seconds, samples
-    per texel, the status (lutbake.batch.STATUSES: baked, skipped (its output was up to date), failed,
-    interrupted), why (``message``), and the table whose computation its values came from (``values_from``)."""
+    per texel, the status (lutbake.batch.STATUSES: baked, skipped (its output was up to date), over_tolerance
+    (written, or up to date, with texels over their tolerance: ``message`` names them), failed, interrupted), why
+    (``message``), and the table whose computation its values came from (``values_from``)."""
 
     spec: TableSpec
     table: Table | None
@@ -36,6 +38,7 @@ class BakeResult:
     message: str = ""
     values_from: str | None = None
     shape: str = ""
+    cache_error: str = ""  # why its values could not be written into the --cache (the table is baked all the same)
 
     @property
     def name(self) -> str:
@@ -44,7 +47,8 @@ class BakeResult:
 
 class BakeResults(list):
     """``bake``'s results, one per table in config order, with the run's outcome: ``interrupted_by`` (the signal
-    number, or None), ``exit_status`` (0, 1 if a table failed, 130 / 143 after SIGINT / SIGTERM) and
+    number, or None), ``exit_status`` (0, 1 if a table failed or ended over its tolerance without
+    accept_over_tolerance = true, 130 / 143 after SIGINT / SIGTERM) and
     ``report_error`` (why ``report`` could not be written, or None)."""
 
     interrupted_by: int | None = None
@@ -87,6 +91,7 @@ def _result(job: batch.Job) -> BakeResult:
         job.message,
         job.values_from,
         job.shape,
+        job.cache_error,
     )
 
 
@@ -169,8 +174,9 @@ def bake(
     ``cache_dir``: the values cache of ``lutbake bake --cache`` (lutbake.values_cache; ``force`` reads no entry).
     ``scheduler``: run the tiles on a Dask cluster (lutbake.runtime.cluster: ``local:N`` or ``tcp://HOST:PORT``),
     started only when a table is to be baked. ``report``: write the JSON summary there (lutbake.batch.write_report).
-    ``check``: raise TableError when a table failed and KeyboardInterrupt when the run was interrupted (after the
-    others finished); False: return every result, with the outcome on the BakeResults.
+    ``check``: raise TableError when a table failed or ended over its tolerance (unless its config sets
+    accept_over_tolerance = true; the file is written either way) and KeyboardInterrupt when the run was
+    interrupted (after the others finished); False: return every result, with the outcome on the BakeResults.
     """
     _check_arguments(
         out_dir,
@@ -189,15 +195,19 @@ def bake(
     if not write:
         for spec in specs:
             table, seconds, samples = pipeline.bake_table(spec, workers, device, progress)
-            results.append(BakeResult(spec, table, None, seconds, samples))
+            over = table.attributes.get(OVER_TOLERANCE, "")
+            results.append(BakeResult(spec, table, None, seconds, samples, "over_tolerance" if over else "baked", over))
             if on_result:
                 on_result(results[-1])
         return results
     preflight.check_out_dir(out_dir)
+    preflight.check_cache(cache_dir)
     jobs = batch.schedule(specs, out_dir, force=force)
     preflight.check_outputs(jobs)
+    preflight.check_inputs(jobs, paths, cache_dir)
+    preflight.check_path_lengths(jobs, cache_dir, report)
     if report is not None:
-        preflight.check_report(report, jobs, paths)
+        preflight.check_report(report, jobs, paths, cache_dir)
     if on_schedule:
         on_schedule([_result(j) for j in jobs])
     done: dict[int, BakeResult] = {}
@@ -208,7 +218,7 @@ def bake(
             on_result(done[id(job)])
 
     for job in jobs:
-        if job.status == "skipped":
+        if job.status in ("skipped", "over_tolerance"):  # up to date (over_tolerance: as its file records)
             finished(job)
     pending = sum(j.status == "pending" for j in jobs)
     signum = None
@@ -246,7 +256,7 @@ def bake(
     if check:
         if signum is not None:
             raise KeyboardInterrupt(batch.signal_name(signum))
-        failed = [j for j in jobs if j.status == "failed"]
+        failed = [j for j in jobs if j.status == "failed" or (j.status == "over_tolerance" and not j.accepted)]
         if failed:
             raise TableError("; ".join(j.message for j in failed))
     return results

@@ -11,6 +11,10 @@
 - **Compute once, write many.** Pending tables with the same values key (lutbake.sharing: same kind and options
   but for name and the kind's layout keys, e.g. one LTC fit written as DDS, JS and C) are computed once and
   written each in its own layout; the files are those each table gets baked alone.
+- **Over tolerance.** A table whose texels end over their tolerance (the adaptive rule's last order reached; the
+  plan says where: lutbake.tolerance.over_tolerance, lutbake:over_tolerance in the file) is written and marked
+  ``over_tolerance``, with a message naming its texels and the worst estimate / tolerance, also when it is up to
+  date; the run exits 1 unless its config sets ``accept_over_tolerance = true``.
 - **Interrupts.** A KeyboardInterrupt (SIGINT) or ``Interrupted`` (raised by the SIGTERM handler of
   ``signal_handlers()``) while the main thread waits cancels every table that has not written its
   file: those are marked ``interrupted``; finished files stay. Writes are atomic (io.exr.write_exr),
@@ -38,14 +42,16 @@ from .io.atomic import atomic_write_bytes, remove_stale_temps
 from .io.formats import output_path, write_table
 from .io.oserror import os_error_text
 from .kinds import lookup_kind
-from .pipeline import Computed, assemble, compute
+from .pipeline import OVER_TOLERANCE, Computed, assemble, compute
 from .provenance import HASH_ATTRIBUTE, content_hash, read_header, sources_digest
 from .runtime.executor import Cancelled, Progress, default_workers
 from .runtime.warp_runtime import ModuleBusy, defer_if_busy
 from .sharing import group_by, values_key
 from .values_cache import ValuesCache, valid_extra
 
-STATUSES = ("baked", "skipped", "failed", "interrupted")
+# over_tolerance: written (baked now, or up to date from an earlier run), but texels ended over their tolerance
+# (lutbake.tolerance.over_tolerance): the run exits 1 unless the table's config sets accept_over_tolerance = true
+STATUSES = ("baked", "skipped", "over_tolerance", "failed", "interrupted")
 EXIT_OK, EXIT_FAILED, EXIT_SIGINT, EXIT_SIGTERM = 0, 1, 130, 143
 
 
@@ -74,10 +80,29 @@ class Job:
     message: str = ""
     shape: str = ""
     table: object = None  # the baked lutbake.table.Table, once baked
+    cache_error: str = ""  # why its values could not be written into the --cache (the table itself is baked)
 
     @property
     def name(self) -> str:
         return self.spec.name
+
+    @property
+    def accepted(self) -> bool:
+        """Its config accepts an over_tolerance outcome (accept_over_tolerance = true): no exit status 1 for it."""
+        return self.spec.options.get("accept_over_tolerance") is True
+
+    def check_tolerance(self, attributes: dict[str, str], up_to_date: bool = False) -> None:
+        """Status over_tolerance, and a message that names the texels, where ``attributes`` (its file's lutbake:*)
+        say texels ended over the tolerance (lutbake.pipeline.OVER_TOLERANCE)."""
+        over = attributes.get(OVER_TOLERANCE)
+        if not over:
+            return
+        self.status = "over_tolerance"
+        policy = "accepted (accept_over_tolerance = true)" if self.accepted else "exit status 1"
+        self.message = (
+            f"{self.spec.source}: table '{self.name}': {over}; {'up to date in' if up_to_date else 'written to'} "
+            f"{self.path}; {policy}"
+        )
 
     def report(self) -> dict:
         return {
@@ -116,6 +141,7 @@ def schedule(specs: list[TableSpec], out_dir, force: bool = False) -> list[Job]:
             job.samples = int(header["samples"]) if header.get("samples", "").isdigit() else None
             job.error_estimate = _float_or_none(header.get("error_estimate"))
             job.message = "up to date"
+            job.check_tolerance(header, up_to_date=True)
         jobs.append(job)
     return jobs
 
@@ -165,7 +191,10 @@ def _store(cache: ValuesCache | None, job: Job, computed: Computed) -> None:
     try:
         cache.store(job.values_key, computed.data, computed.extra)
     except OSError as e:
-        job.message = f"values cache not written: {os_error_text(e, cache.directory, computed.data.nbytes)}"
+        job.cache_error = f"values cache {cache.directory} not written: " + os_error_text(
+            e, cache.directory, computed.data.nbytes
+        )
+        job.message = job.cache_error
 
 
 def _bake_group(
@@ -235,6 +264,7 @@ def _write_one(job: Job, computed: Computed, values_from: str | None, cancel: th
     job.values_from = values_from
     job.error_estimate = _float_or_none(table.attributes.get("error_estimate"))
     job.shape = "x".join(str(a.count) for a in table.axes) + f"x{len(table.channels)}"
+    job.check_tolerance(table.attributes)
 
 
 def run(
@@ -332,10 +362,13 @@ def signal_name(signum: int) -> str:
 
 
 def exit_status(jobs: list[Job], signum: int | None) -> int:
-    """130 after SIGINT, 143 after SIGTERM, 1 if any table failed, else 0."""
+    """130 after SIGINT, 143 after SIGTERM, 1 if any table failed or ended over its tolerance unaccepted
+    (Job.accepted), else 0."""
     if signum is not None:
         return EXIT_SIGTERM if signum == signal.SIGTERM else EXIT_SIGINT
-    return EXIT_FAILED if any(j.status == "failed" for j in jobs) else EXIT_OK
+    if any(j.status == "failed" or (j.status == "over_tolerance" and not j.accepted) for j in jobs):
+        return EXIT_FAILED
+    return EXIT_OK
 
 
 def write_report(path, jobs: list[Job], status: int, signum: int | None = None) -> Path:

@@ -20,7 +20,7 @@ from typing import Any
 from . import arguments
 from .errors import ArgumentError, ConfigError, did_you_mean
 from .kinds import KINDS, Key, lookup_kind
-from .limits import MAX_TEXELS  # noqa: F401  (lutbake.config.MAX_TEXELS, as before)
+from .limits import BAKE_PEAK_BYTES_PER_TEXEL, MAX_TEXELS  # noqa: F401  (lutbake.config.MAX_TEXELS, as before)
 from .preflight import config_file_problem, nesting_problem
 from .textsafe import safe_repr
 from .value_bounds import unit_range
@@ -170,6 +170,10 @@ def _check_value(key: Key, value, file, table) -> Any:
         if key.maximum is not None and value > key.maximum:
             fail(f"must be <= {_num(key.maximum)}")
         return value
+    if key.type == "bool":
+        if not isinstance(value, bool):
+            fail("must be true or false", "true, false")
+        return value
     if key.type == "int_pair":
         if (
             not isinstance(value, (list, tuple))
@@ -267,9 +271,10 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
             file,
             size_key,
             options.get(size_key),
-            f"at most {MAX_TEXELS} texels = {human_bytes(MAX_TEXELS * BYTES_PER_TEXEL)}",
-            f"{kind.texels_doc} = {texels} texels would need {human_bytes(texels * BYTES_PER_TEXEL)} "
-            "of memory while baking",
+            f"at most {MAX_TEXELS} texels (a bake's peak: about {human_bytes(MAX_TEXELS * BAKE_PEAK_BYTES_PER_TEXEL)})",
+            f"{kind.texels_doc} = {texels} texels would need about "
+            f"{human_bytes(texels * BAKE_PEAK_BYTES_PER_TEXEL)} of memory at the bake's peak "
+            f"({BAKE_PEAK_BYTES_PER_TEXEL} bytes a texel, measured)",
             label,
         )
     if options.get("format") == "png16":

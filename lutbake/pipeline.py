@@ -18,11 +18,14 @@ import numpy as np
 from .config import TableSpec
 from .errors import TableError
 from .kinds import lookup_kind
+from .layouts import reconstruction_with_engine_line
 from .provenance import attributes
 from .runtime.executor import Progress, Timer, estimate_error, execute_tiles
 from .runtime.warp_runtime import defining
 from .sampling.plan import TexelPlan
 from .table import Table
+
+OVER_TOLERANCE = "over_tolerance"  # the lutbake:* attribute of a table whose texels end over their tolerance
 
 
 @dataclass
@@ -75,8 +78,10 @@ def compute(
     extra = {}
     estimate = estimate_error(plan, full, device, spec, runner)
     if estimate is not None:
-        err, how = estimate
+        err, how, *over = estimate
         extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)
+        if over and over[0]:  # texels that ended over the tolerance (lutbake.tolerance.over_tolerance)
+            extra[OVER_TOLERANCE] = over[0]
     if plan.attributes_after is not None:
         extra.update(plan.attributes_after(data))
     cpu.append(time.thread_time() - t0)
@@ -104,7 +109,7 @@ def assemble(spec: TableSpec, computed: Computed) -> Table:
         computed.data.astype(np.float32),
         plan.axes,
         plan.channels,
-        plan.reconstruction,
+        reconstruction_with_engine_line(spec.kind, spec.name, spec.options, plan.reconstruction),
         attributes(spec, plan, computed.extra),
     )
 

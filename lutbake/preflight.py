@@ -5,6 +5,7 @@ written. A config path that is not a regular file says what it is."""
 
 from __future__ import annotations
 
+import errno
 import os
 import re
 import stat
@@ -41,25 +42,40 @@ def config_file_problem(path) -> str | None:
     return None
 
 
-def directory_problem(path) -> str | None:
+def directory_problem(path, attempts: int = 3) -> str | None:
     """Why lutbake cannot create files in directory ``path`` (made if missing, as mkdir -p would), or None:
-    a dangling symlink, a file on the way, a read-only file system, no write permission."""
+    a dangling symlink, a symlink loop, a file on the way, a read-only file system, no write permission. A directory
+    another run's probe made and removed while this one looked is looked at again (``attempts`` times)."""
     path = Path(path)
+    for _ in range(attempts):
+        problem = _directory_problem_once(path)
+        if problem != _VANISHED:
+            return problem
+    return None  # made and removed under us every time: the probe (probe_directory) tries it for real
+
+
+_VANISHED = "vanished"  # the directory looked at was removed meanwhile (another run's probe): look again
+
+
+def _directory_problem_once(path: Path) -> str | None:
     probe = path
     while not probe.exists():
         if os.path.islink(probe):
+            where = "" if probe == path else f"{probe} "
             target = os.readlink(probe)
-            return (
-                f"is a dangling symlink (to {target!r})"
-                if probe == path
-                else f"{probe} is a dangling symlink (to {target!r})"
-            )
+            if _stat_errno(probe) == errno.ELOOP:
+                return f"{where}is a symlink loop (to {target!r})"
+            return f"{where}is a dangling symlink (to {target!r})"
         if probe.parent == probe:
             break
         probe = probe.parent
     if not probe.is_dir():
+        if not os.path.lexists(probe):
+            return _VANISHED
         return "exists and is not a directory" if probe == path else f"{probe} is a file, not a directory"
     if not os.access(probe, os.W_OK | os.X_OK):
+        if not os.path.lexists(probe):
+            return _VANISHED
         where = "" if probe == path else f" ({probe})"
         try:
             if os.statvfs(probe).f_flag & os.ST_RDONLY:
@@ -70,8 +86,20 @@ def directory_problem(path) -> str | None:
     return None
 
 
+def _stat_errno(path) -> int:
+    try:
+        os.stat(path)
+    except OSError as e:
+        return e.errno or 0
+    return 0
+
+
+def _real_key(path) -> str:
+    return "real:" + os.path.normcase(os.path.realpath(path))
+
+
 def _same(a: Path, b: Path) -> bool:
-    return os.path.normcase(os.path.realpath(a)) == os.path.normcase(os.path.realpath(b))
+    return _real_key(a) == _real_key(b)
 
 
 def encoding_problem(path) -> str | None:
@@ -114,6 +142,8 @@ def probe_directory(path, attempts=3) -> str | None:
                     os.mkdir(d)
                     made.append(d)
                 except FileExistsError:
+                    if not os.path.lexists(d):  # another run's probe made it and removed it since: try again
+                        raise FileNotFoundError(errno.ENOENT, os.strerror(errno.ENOENT), str(d)) from None
                     if not os.path.isdir(d):
                         raise
             fd, tmp = tempfile.mkstemp(prefix=".lutbake-probe.", dir=path)
@@ -138,9 +168,99 @@ def probe_directory(path, attempts=3) -> str | None:
 def check_out_dir(out_dir) -> None:
     """``--out-dir`` names a directory lutbake can create files in (tried, and left as it was): exit 2 before any
     kernel runs, not a failed write after the bake."""
-    problem = encoding_problem(out_dir) or directory_problem(out_dir) or probe_directory(out_dir)
+    _check_directory("--out-dir", out_dir)
+
+
+def check_cache(cache_dir) -> None:
+    """``--cache DIR`` is checked as ``--out-dir`` is (a read-only file system, below a file, a dangling symlink or a
+    symlink loop, too long): exit 2 before any kernel, not every entry silently unwritten."""
+    if cache_dir is not None:
+        _check_directory("--cache", cache_dir)
+
+
+def _check_directory(option: str, directory) -> None:
+    try:
+        problem = (
+            encoding_problem(directory)
+            or length_problem([Path(directory) / PROBE_NAME])
+            or directory_problem(directory)
+            or probe_directory(directory)
+        )
+    except OSError as e:  # whatever the checks above did not foresee: one line, not a traceback
+        from .io.oserror import os_error_text
+
+        problem = f"cannot be used: {os_error_text(e)}"
     if problem:
-        raise ConfigError("--out-dir", "out-dir", shorten(str(out_dir)), message=problem)
+        raise ConfigError(option, option.lstrip("-"), shorten(str(directory)), message=problem)
+
+
+PROBE_NAME = ".lutbake-probe.XXXXXXXX"  # as long as probe_directory's temporary file (mkstemp: 8 random characters)
+DEFAULT_PATH_MAX, DEFAULT_NAME_MAX = 4096, 255  # Linux's, where os.pathconf tells none
+
+
+def path_limits(path) -> tuple[int, int]:
+    """(PATH_MAX, NAME_MAX) in bytes (PATH_MAX counts the final NUL) of the file system ``path`` is or will be on:
+    os.pathconf of its nearest existing ancestor."""
+    probe = Path(path)
+    while not os.path.isdir(probe) and probe.parent != probe:  # isdir: False, not an error, for a too-long path
+        probe = probe.parent
+    limits = []
+    for name, default in (("PC_PATH_MAX", DEFAULT_PATH_MAX), ("PC_NAME_MAX", DEFAULT_NAME_MAX)):
+        try:
+            value = os.pathconf(probe, name)
+        except (OSError, ValueError, AttributeError):  # no such limit, no os.pathconf (Windows)
+            value = None
+        limits.append(value if value and value > 0 else default)
+    return limits[0], limits[1]
+
+
+def length_problem(paths) -> str | None:
+    """Why one of ``paths`` (files a run will create, as it will spell them) cannot be created: a name over NAME_MAX
+    or a path over PATH_MAX (os.pathconf, path_limits), or None."""
+    for p in paths:
+        path_max, name_max = path_limits(Path(p).parent)
+        raw = os.fsencode(str(p))
+        if len(raw) + 1 > path_max:
+            return (
+                f"the path {shorten(str(p))} this run would create is {len(raw)} bytes long; the file system takes "
+                f"at most {path_max - 1} (PATH_MAX): choose a shorter path"
+            )
+        for part in Path(p).parts:
+            if len(os.fsencode(part)) > name_max:
+                return (
+                    f"the file name {shorten(part)} this run would create is {len(os.fsencode(part))} bytes long; "
+                    f"the file system takes at most {name_max} (NAME_MAX)"
+                )
+    return None
+
+
+def created_paths(jobs, cache_dir=None, report=None) -> list[tuple[str, object, list[Path]]]:
+    """(option, its value, the paths it makes this run create): every planned file of the pending tables (data,
+    second texture, sidecar) and the temporary sibling each is written to first (lutbake.io.atomic.temp_name), the
+    cache entries and their temporary files, the report and its temporary file."""
+    from .io.atomic import temp_name
+
+    def with_temps(paths):
+        return [q for p in paths for q in (p, p.with_name(temp_name(p.name)))]
+
+    groups = []
+    pending = [j for j in jobs if j.status == "pending"]
+    for job in pending:
+        groups.append(("--out-dir", job.path.parent, with_temps([p for p, _ in planned_files(job)])))
+    if cache_dir is not None:
+        groups.append(("--cache", cache_dir, with_temps(cache_entries(pending, cache_dir))))
+    if report is not None:
+        groups.append(("--report", report, with_temps([Path(report)])))
+    return groups
+
+
+def check_path_lengths(jobs, cache_dir=None, report=None) -> None:
+    """The longest path this run will create (created_paths: temporary names, sidecars, cache entries, the report)
+    within the OS limits (length_problem): exit 2 before any kernel, not a failed rename after the bake."""
+    for option, value, paths in created_paths(jobs, cache_dir, report):
+        problem = length_problem(sorted(paths, key=lambda p: -len(os.fsencode(str(p)))))
+        if problem:
+            raise ConfigError(option, option.lstrip("-"), shorten(str(value)), message=problem)
 
 
 def planned_files(job) -> list[tuple[Path, str]]:
@@ -166,6 +286,11 @@ def path_key(path) -> str:
     return os.path.join(os.path.normcase(parent), path.name.casefold())
 
 
+def _name_error(job, message: str) -> ConfigError:
+    """A ConfigError blaming table ``job``'s name (the file it writes) in its config."""
+    return ConfigError(job.spec.source, "name", job.name, table=job.name, message=message)
+
+
 def check_collisions(jobs) -> None:
     """No two tables of a batch write one file (data, second texture or sidecar), including names that differ
     only in case: an ltc_dds table ``foo`` writes ``foo_1.dds``, as a dds table ``foo_1`` does."""
@@ -176,12 +301,9 @@ def check_collisions(jobs) -> None:
             if key in owners and owners[key][0] is not job:
                 other, other_path, other_what = owners[key]
                 same = "" if other_path.name == p.name else f" ({other_path.name} and {p.name} differ only in case)"
-                raise ConfigError(
-                    job.spec.source,
-                    "name",
-                    job.name,
-                    table=job.name,
-                    message=f"its {what} {p} is also the {other_what} of table '{other.name}' "
+                raise _name_error(
+                    job,
+                    f"its {what} {p} is also the {other_what} of table '{other.name}' "
                     f"({other.spec.source}){same}: the two tables would overwrite each other; rename one",
                 )
             owners[key] = (job, p, what)
@@ -217,9 +339,50 @@ def check_outputs(jobs) -> None:
                 )
 
 
-def check_report(report, jobs, configs=()) -> None:
+def _is(a, b) -> bool:
+    """``a`` and ``b`` name one file: the same real path, or one name in one real directory (case folded)."""
+    return _same(a, b) or path_key(a) == path_key(b)
+
+
+def input_claims(jobs, configs=(), cache_dir=None) -> list[tuple[Path, str]]:
+    """Every path a run reads or keeps that no table may write, with what it is: each config (a preset's file too),
+    the --cache directory and the cache entries this run may write (one per pending values key,
+    lutbake.values_cache)."""
+    claims = [(Path(c), f"the config {c}") for c in configs]
+    if cache_dir is not None:
+        claims.append((Path(cache_dir), f"the --cache directory {cache_dir}"))
+        claims += [(e, f"a --cache entry in {cache_dir}") for e in cache_entries(jobs, cache_dir)]
+    return claims
+
+
+def cache_entries(jobs, cache_dir) -> list[Path]:
+    """The files of the cache entries this run may write in ``cache_dir``: one .npy and one .json per values key of
+    the pending tables (lutbake.values_cache.ValuesCache.paths)."""
+    keys = sorted({j.values_key for j in jobs if j.status == "pending" and j.values_key})
+    return [Path(cache_dir) / f"{key}{ext}" for key in keys for ext in (".npy", ".json")]
+
+
+def check_inputs(jobs, configs=(), cache_dir=None) -> None:
+    """No file a table writes (planned_files: an output, a second texture, a sidecar) is a config, the --cache
+    directory or a cache entry (input_claims): the bake would overwrite its own input. ConfigError naming both."""
+    claims = {}
+    for c, claim in input_claims(jobs, configs, cache_dir):  # each spelling of the file: _is, looked up in one step
+        claims.setdefault(_real_key(c), claim)
+        claims.setdefault(path_key(c), claim)
+    for job in jobs:
+        for p, what in planned_files(job):
+            claim = claims.get(_real_key(p)) or claims.get(path_key(p))
+            if claim is not None:
+                raise _name_error(
+                    job,
+                    f"its {what} ({shorten(str(p))}) is {shorten(claim)}; the bake would overwrite it: "
+                    "rename the table or that file, or choose another --out-dir",
+                )
+
+
+def check_report(report, jobs, configs=(), cache_dir=None) -> None:
     """``--report`` must be creatable and must not be any file a table writes (planned_files: an output, a second
-    texture, a sidecar) or a config."""
+    texture, a sidecar), a config, the --cache directory or a cache entry (input_claims)."""
     if report is None:
         return
     report = Path(report)
@@ -245,9 +408,9 @@ def check_report(report, jobs, configs=()) -> None:
                     table=job.name,
                     message=f"is the {what} of table '{job.name}'; the report would overwrite it",
                 )
-    for c in configs:
-        if _same(report, Path(c)):
-            raise ConfigError("--report", "report", str(report), message=f"is the config {c}; it would be overwritten")
+    for c, claim in input_claims(jobs, configs, cache_dir):
+        if _is(report, c):
+            raise ConfigError("--report", "report", str(report), message=f"is {claim}; it would be overwritten")
     problem = directory_problem(report.parent)
     if problem:
         raise ConfigError("--report", "report", str(report), message=f"cannot be written: {report.parent}: {problem}")

@@ -23,7 +23,7 @@ from . import __version__
 from .config import TableSpec
 from .kinds import lookup_kind
 
-ALWAYS_LAYOUT = ("name",)  # the output stem: never part of the values
+ALWAYS_LAYOUT = ("name", "accept_over_tolerance")  # the output stem, the exit-status policy: never the values
 
 
 def layout_keys(kind: str) -> tuple[str, ...]:

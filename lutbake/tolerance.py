@@ -66,3 +66,35 @@ def tolerance_of(options, float32: Tolerance | None = None) -> Tolerance:
     if tol is None and rel is None:
         return default_tolerance(options, float32)
     return Tolerance(float(tol or 0.0), float(rel or 0.0))
+
+
+# a texel is over its tolerance when its estimate exceeds the target by more than float rounding (the kernels compare
+# in float64 after a division by pi)
+OVER_SLACK = 1.0e-9
+AXIS_WORDS = {"x": "columns", "y": "rows", "z": "slices", "y_block": "row blocks"}
+
+
+def over_tolerance(ratios, axes) -> str:
+    """Where a table ends over its tolerance: ``ratios`` per texel (estimate / target, the worst channel; row-major,
+    the slowest axis first), ``axes`` the table's (lutbake.axes.Axis, slowest first). One line: "143 of 4096 texels
+    over tolerance: perceptual_roughness rows 0..16 (0.0078..0.27), NoV columns 0..12 (0.0078..0.2); worst
+    estimate / tolerance 3.65e+03" (the bounding box of those texels, indices and axis values); "" when none."""
+    import numpy as np
+
+    r = np.asarray(ratios, np.float64).ravel()
+    over = np.flatnonzero(~(r <= 1.0 + OVER_SLACK))  # NaN counts as over
+    if len(over) == 0:
+        return ""
+    shape = tuple(a.count for a in axes)
+    where = f"texels {over.min()}..{over.max()}"
+    if int(np.prod(shape)) == len(r):
+        parts = []
+        for a, idx in zip(axes, np.unravel_index(over, shape)):
+            lo, hi = int(idx.min()), int(idx.max())
+            values = a.values()
+            parts.append(
+                f"{a.name} {AXIS_WORDS.get(a.dim, a.dim)} {lo}..{hi} ({float(values[lo]):.3g}..{float(values[hi]):.3g})"
+            )
+        where = ", ".join(parts)
+    worst = float(np.max(np.where(np.isnan(r), np.inf, r)))
+    return f"{len(over)} of {len(r)} texels over tolerance: {where}; worst estimate / tolerance {worst:.3g}"

@@ -39,11 +39,12 @@ from pathlib import Path
 import numpy as np
 
 from .io import bounded
-from .io.atomic import atomic_write, atomic_write_bytes, remove_stale_temps
+from .io.atomic import atomic_write_bytes, atomic_write_hashed, remove_stale_temps
 from .io.integrity import sha256_bytes
 
 FORMAT = "lutbake-values-cache-v2"  # v2: "bytes" and "entry_sha256" (v1 entries are misses, then rewritten)
-ESTIMATE_KEYS = ("error_estimate", "error_estimate_method")  # what lutbake.pipeline.compute records besides
+# what lutbake.pipeline.compute records besides
+ESTIMATE_KEYS = ("error_estimate", "error_estimate_method", "over_tolerance")
 MAX_EXTRA_CHARS = 4096  # characters of one extra value (lutbake's are numbers and short descriptions)
 
 
@@ -132,15 +133,22 @@ class ValuesCache:
         """Write entry ``key`` (the .npy, then the JSON naming its sha256), both atomically."""
         data_path, meta_path = self.paths(key)
         data = np.ascontiguousarray(data, dtype=np.float64)
-        atomic_write(data_path, lambda tmp: np.save(tmp, data, allow_pickle=False))
-        blob = data_path.read_bytes()
+        size: list[int] = []
+
+        def write(tmp: Path) -> None:
+            np.save(tmp, data, allow_pickle=False)
+            size.append(os.path.getsize(tmp))
+
+        # the size and sha256 of the bytes this run wrote, not of the file after the rename (another run may have
+        # replaced it in between): from its own temporary file (lutbake.io.atomic.atomic_write_hashed)
+        digest = atomic_write_hashed(data_path, write)
         meta = {
             "format": FORMAT,
             "values_key": key,
             "sources": self.sources,
             "shape": list(data.shape),
-            "bytes": len(blob),
-            "sha256": sha256_bytes(blob),
+            "bytes": size[0],
+            "sha256": digest,
             "extra": {str(k): str(v) for k, v in extra.items()},
             "written": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         }

@@ -136,6 +136,70 @@ def test_broken_copy_is_diagnosed(clean, tmp_path, name, make, expected):
     assert not r.passed
 
 
+def srgb_encode(v):
+    """IEC 61966-2-1 OETF (the inverse of srgb_decode), written out here."""
+    return np.where(v <= 0.0031308, 12.92 * v, 1.055 * np.maximum(v, 0) ** (1 / 2.4) - 0.055)
+
+
+def test_two_stacked_mistakes_rows_flipped_and_srgb_encoded_are_both_named(clean, tmp_path):
+    """Rows flipped *and* sRGB-encoded: each mistake alone explains little (rows_flipped RMS 0.148, srgb_encoded 0.206,
+    declared 0.269), so a one-mistake audit called it 'the declared conventions fit ... Monte-Carlo noise'. The
+    combination explains it exactly, and what is left is the storage rounding, not noise."""
+    p = tmp_path / "flipped_srgb.npy"
+    np.save(p, srgb_encode(clean[::-1]).astype(np.float32))
+    r = run(p)
+    assert r.extra["chosen"] == "rows_flipped+srgb_encoded", r.text()
+    assert r.diagnosis[0].startswith("convention mismatch: rows flipped + sRGB-encoded"), r.diagnosis
+    chosen = next(h for h in r.hypotheses if h["name"] == r.extra["chosen"])
+    assert chosen["rms"] < CLEAN_TOL and chosen["mistakes"] == 2
+    assert r.extra["explained"] == "rounding" and not r.noise["detected"]
+    assert not any("Monte-Carlo" in d or "conventions fit" in d for d in r.diagnosis)
+
+
+def test_a_smooth_perturbation_no_hypothesis_explains_is_said_so(clean, tmp_path):
+    """A noise-free table plus a smooth random field (RMS ~5e-3): no combination explains it, and the residual is
+    smooth where sampling noise of the same RMS is rough -- no noise, no sample count, no 'conventions fit'."""
+    rng = np.random.default_rng(7)
+    t = (np.arange(N) + 0.5) / N
+    y, x = np.meshgrid(t, t, indexing="ij")
+    field = sum(
+        rng.normal() * np.cos(np.pi * kx * x + rng.uniform(0, 6)) * np.cos(np.pi * ky * y + rng.uniform(0, 6))
+        for kx in range(3)
+        for ky in range(3)
+    )
+    p = tmp_path / "perturbed.npy"
+    np.save(p, (clean + 5e-3 * field[..., None] / field.std()).astype(np.float32))
+    r = run(p)
+    assert r.extra["explained"] == "smooth", r.text()
+    assert r.diagnosis[0].startswith("no hypothesis explains the data: the best"), r.diagnosis
+    assert not r.noise["detected"] and r.noise.get("samples") is None
+    assert not any("Monte-Carlo" in d or "conventions fit" in d for d in r.diagnosis)
+
+
+def _rgbd_codes(v):
+    """Babylon's toRGBD written out here: D = floor(255 / max(rgb)) / 255 (at most 1), rgb = (v D)^(1/2.2), 8 bits."""
+    rgb = np.concatenate([v, np.zeros(v.shape[:-1] + (3 - v.shape[-1],))], axis=-1)
+    d = np.minimum(np.floor(255 / np.maximum(rgb.max(axis=-1, keepdims=True), 1e-9)), 255) / 255
+    return np.round(np.concatenate([(rgb * d) ** (1 / 2.2), d], axis=-1) * 255).astype(np.uint8)
+
+
+@pytest.mark.parametrize(
+    "name, make, expected",
+    [
+        ("rgbd", _rgbd_codes, "rgbd"),
+        ("half_bits", lambda t: t.astype(np.float16).view(np.uint16), "half_bits"),
+        ("flipped_half_bits", lambda t: t[:, ::-1].astype(np.float16).view(np.uint16), "columns_flipped+half_bits"),
+    ],
+)
+def test_a_storage_encoding_the_preset_does_not_declare_is_found(clean, tmp_path, name, make, expected):
+    """Storage encodings are hypotheses: an RGBD-packed 8-bit RGBA array and half floats saved as 16-bit codes, read
+    as plain UNORM under the default preset, are decoded by the hypothesis that names them."""
+    p = tmp_path / f"{name}.npy"
+    np.save(p, make(clean))
+    r = run(p)
+    assert r.extra["chosen"] == expected, r.text()
+
+
 @pytest.mark.parametrize("shift", [-0.5, 0.5])
 def test_half_texel_shifted_copy_is_diagnosed(tmp_path, shift):
     c = (np.arange(N) + 0.5) / N
@@ -157,6 +221,24 @@ def test_audit_reads_png16_exr_ktx2_and_a_c_header(clean, tmp_path):
         path = write_table(table, tmp_path, fmt, "half" if fmt in ("ktx2", "h") else "float32")
         r = run(path, tolerance=tol)
         assert r.passed and r.extra["chosen"] == "nominal", (fmt, r.text())
+
+
+def test_audit_and_inspect_recognise_a_file_by_its_content_never_its_name(clean, tmp_path):
+    """docs/formats.md: files are recognised by content. An npy saved as lut.bin and an EXR saved as lut.npy: inspect
+    reads both, and audit reads them the same way (lutbake.io.readers.sniff) and passes them."""
+    from lutbake.axes import Axis
+    from lutbake.io.formats import write_table
+    from lutbake.table import Table
+
+    np.save(tmp_path / "t.npy", clean.astype(np.float32))
+    axes = [Axis("perceptual_roughness", "y", N), Axis("NoV", "x", N)]
+    exr = write_table(Table("t", "dfg", clean.astype(np.float32), axes, {"scale": "", "bias": ""}, ""), tmp_path, "exr")
+    for src, name in ((tmp_path / "t.npy", "lut.bin"), (exr, "lut.npy")):
+        (tmp_path / name).write_bytes(Path(src).read_bytes())
+        for args in (["inspect", name], ["audit", name, "--max-side", "16", "--tolerance", "1e-5"]):
+            res = CliRunner().invoke(main, [args[0], str(tmp_path / args[1]), *args[2:]])
+            assert res.exit_code == 0, (args, res.output)
+        assert "PASS" in res.output
 
 
 def test_cli_json_exit_codes_and_error_map(clean, tmp_path):

@@ -38,6 +38,7 @@ FUZZ_MEDIAN = np.array([0.03, 0.025, 0.01])
 FUZZ_P95 = np.array([0.3, 0.1, 0.06])
 FUZZ_MODEL_GAP = 1.5  # the bake's median |diff| at most this times the published approx table's (measured <= 1.3)
 FUZZ_GRID = np.maximum(0.01, np.arange(32) / 31)  # the shipped table's mu rows and alpha columns (endpoints)
+RGBD_SIDE = 8  # the RGBD PNG's audit subset (its errors are compared with the decoded table's at the same texels)
 
 
 def load(name):
@@ -192,3 +193,33 @@ def test_babylon_fuzz_preset_matches_the_shipped_table_as_closely_as_the_papers_
     with np.load(DATA / "ltc_sheen_tables.npz") as z:
         paper = np.median(np.abs(z["approx"] - shipped)[1:], axis=(0, 1))
     assert np.all(np.median(d, axis=(0, 1)) < FUZZ_MODEL_GAP * paper), (np.median(d, axis=(0, 1)), paper)
+
+
+def test_every_engine_table_names_a_storage_encoding_audit_knows():
+    from lutbake.commands.audit_search import ENCODINGS
+
+    assert {t.encoding for t in TABLES} <= set(ENCODINGS)
+    assert {t.encoding for t in TABLES if t.engine == "Babylon.js"} == {"rgbd"}
+
+
+def test_audit_of_babylons_shipped_rgbd_png_decodes_rgbd_and_reports_the_real_error(tmp_path):
+    """The shipped PNG (its 8-bit RGBA codes, tests/data) under --preset babylon: read as plain UNORM it was called
+    'srgb_encoded' and failed by 25.7; the preset's engine table declares RGBD, so the audit decodes it as Babylon
+    does and its errors are exactly those of the decoded table (the .npz's ``table``) against the converged bake."""
+    import OpenImageIO as oiio
+
+    codes = load("babylon_environment_brdf")[1]
+    png = tmp_path / "shipped.png"
+    spec = oiio.ImageSpec(codes.shape[1], codes.shape[0], 4, "uint8")
+    spec.attribute("oiio:UnassociatedAlpha", 1)
+    out = oiio.ImageOutput.create(str(png))
+    assert out.open(str(png), spec) and out.write_image(np.ascontiguousarray(codes))
+    out.close()
+    r = audit(png, {"preset": "babylon"}, max_side=RGBD_SIDE)
+    decoded = audit(DATA / "babylon_environment_brdf.npz", {"preset": "babylon"}, max_side=RGBD_SIDE)
+    assert r.extra["encoding"] == "rgbd" and r.quantisation["kind"] == "unorm8", r.text()
+    assert "storage rgbd" in r.conventions and any("RGBD-packed" in d for d in r.diagnosis)
+    assert "srgb" not in r.extra["chosen"]
+    for channel, s in decoded.errors.items():
+        np.testing.assert_allclose([r.errors[channel][k] for k in ("max", "mean")], [s["max"], s["mean"]], rtol=1e-5)
+    assert r.extra["raw_error"]["max"] == pytest.approx(decoded.extra["raw_error"]["max"], rel=1e-5)

@@ -189,7 +189,7 @@ def test_report_has_every_field(three):
     r = bake(cfg, cfg2, "--out-dir", out, "--set", "c.estimator=sobol_ndf", "--report", rep)
     assert r.exit_code == 0
     doc = json.loads(rep.read_text())
-    assert doc["counts"] == {"baked": 1, "skipped": 3, "failed": 0, "interrupted": 0}
+    assert doc["counts"] == {"baked": 1, "skipped": 3, "over_tolerance": 0, "failed": 0, "interrupted": 0}
     keys = {"name", "status", "path", "content_hash", "seconds", "cpu_seconds", "values_from", "samples"}
     keys |= {"error_estimate", "message"}
     for t in doc["tables"]:

@@ -25,7 +25,8 @@ MEASURED_PAGE = DOCS / "benchmarks.md"
 
 
 def test_every_kind_key_and_value_is_documented():
-    doc = (DOCS / "config.md").read_text()
+    """In the config pages (docs/config.md, docs/config-<kind>.md) or the key pages rendered from the declarations."""
+    doc = "".join(p.read_text() for p in [DOCS / "config.md", *DOCS.glob("config-*.md"), *DOCS.glob("keys/*.md")])
     for kind in KINDS.values():
         assert f"`{kind.name}`" in doc, kind.name
         for key in kind.keys.values():
@@ -280,3 +281,222 @@ def test_benchmarks_page_renders_the_ltc_area_benchmark_and_the_shaded_fits(tmp_
     assert "| all | 0.05 / 0.1 / 0.005 | 0.02 / 0.04 / 0.002 |" in text, text
     assert "two_lobe over published: median relative 0.4, |error| / albedo p90 0.2" in text
     assert "| eon | 0.1 | 0.3 | 0.05 | 0.1 | 0.3 | 0.05 | 40 |" in text, text
+
+
+CHECK_NAME = re.compile(r"`([a-z_0-9]+\[[a-z_0-9,]+\])`")
+
+
+def test_every_check_the_docs_name_is_a_registered_check():
+    """A parametrised check cited in a page (`weak_white_furnace[ggx]`) is one ``lutbake validate`` runs."""
+    from lutbake.validate.checks import CHECKS
+
+    for page in [ROOT / "README.md", *PAGES]:
+        for name in CHECK_NAME.findall(page.read_text()):
+            if name.split("[", 1)[0] in {n.split("[", 1)[0] for n in CHECKS}:
+                assert name in CHECKS, f"{page.name} cites check {name}: lutbake validate has no such check"
+
+
+def test_models_page_says_what_the_loader_does_with_blinn_phong_and_smith(tmp_path):
+    """docs/models.md: Blinn–Phong with a Smith masking is refused at load, and v_cavity is the masking it takes."""
+    from lutbake.config import load_config
+    from lutbake.errors import ConfigError
+
+    doc = " ".join((DOCS / "models.md").read_text().split())
+    assert 'pairing `ndf = "blinn_phong"` with a Smith `masking` is refused at load' in doc
+    cfg = tmp_path / "bp.toml"
+    for masking, refused in (("smith_height_correlated", True), ("smith_separable", True), ("v_cavity", False)):
+        cfg.write_text(f'[[table]]\nname = "bp"\nkind = "dfg"\nndf = "blinn_phong"\nmasking = "{masking}"\n')
+        if refused:
+            with pytest.raises(ConfigError, match="v_cavity"):
+                load_config(cfg)
+        else:
+            assert load_config(cfg)[0].options["masking"] == "v_cavity"
+
+
+# a code span that is shader code: a texture read, or arithmetic on what one returned
+SHADER_CODE = re.compile(r"texture\w*\(|SampleLevel\(|\b(?:t|AB|fab|t1|t2)\.[xyzwrgb]{1,4}\b|\b(?:mix|lerp)\([xR],")
+CODE_SPAN = re.compile(r"`([^`\n]+)`")
+
+
+def shader_spans(text: str) -> list[str]:
+    return [span for span in CODE_SPAN.findall(text) if SHADER_CODE.search(span)]
+
+
+def engine_lines(presets) -> list[str]:
+    """The engine tables' own shader lines (lutbake.layouts EngineTable.shader) of ``presets``, in record order."""
+    from lutbake.layouts import TABLES
+
+    return [t.shader for t in TABLES if t.preset in presets and t.shader]
+
+
+@pytest.fixture(scope="module")
+def rendered() -> dict[str, str]:
+    """Preset -> the reconstruction text of each of its tables, as the bake records it (lutbake.pipeline.assemble:
+    the engine's line first, then the layout's), joined by newlines."""
+    from lutbake.config import load_config, presets
+    from lutbake.kinds import lookup_kind
+    from lutbake.pipeline import Computed, assemble
+
+    out = {}
+    for name, path in presets().items():
+        texts = []
+        for spec in load_config(path):
+            plan = lookup_kind(spec.kind).plan(spec)
+            texts.append(assemble(spec, Computed(plan, np.zeros(plan.shape), {}, 0.0, 0.0)).reconstruction)
+        out[name] = "\n".join(texts)
+    return out
+
+
+def test_readme_shader_lines_are_the_engine_records(rendered):
+    """README's engine table: each row's shader cell holds, as code, every line its presets' engine records declare
+    and no other shader code; each such line is the first line of that table's reconstruction (what `lutbake inspect`
+    prints first)."""
+    seen = set()
+    for line in set(readme_rows().values()):
+        presets = re.findall(r"`([a-z0-9-]+)`", line.split(" | ")[1])
+        cell = line.split(" | ")[3]
+        want = engine_lines(presets)
+        spans = CODE_SPAN.findall(cell)
+        assert all(shader in spans for shader in want), f"README row {presets}: {spans} lacks one of {want}"
+        assert set(shader_spans(cell)) <= set(want), f"README row {presets}: {shader_spans(cell)} != records {want}"
+        for preset in presets:
+            for shader in engine_lines([preset]):
+                assert f": {shader}\n" in rendered[preset], (preset, shader)
+        seen.update(presets)
+    assert seen >= set(UV_PRESETS)
+
+
+def preset_page_rows() -> dict[str, str]:
+    """docs/presets.md's first table (preset, engine, file, how to load it): preset -> its row."""
+    rows = {}
+    table = (DOCS / "presets.md").read_text().split("| preset | engine | file | how to load it |", 1)[1]
+    for line in table.split("\n\n", 1)[0].splitlines():
+        m = re.match(r"\| `([a-z0-9-]+)` \| ", line)
+        if m and m.group(1) not in rows:
+            rows[m.group(1)] = line
+    return rows
+
+
+def test_presets_page_quotes_each_presets_own_reconstruction(rendered):
+    """docs/presets.md: a preset row holds its engine record's line, and every piece of shader code in it is part of
+    that preset's recorded reconstruction."""
+    rows = preset_page_rows()
+    for preset, row in rows.items():
+        for shader in engine_lines([preset]):
+            assert f"`{shader}`" in row, f"docs/presets.md row {preset}: no `{shader}`"
+        for span in shader_spans(row):
+            assert span in rendered[preset], f"docs/presets.md row {preset}: `{span}` is not in its reconstruction"
+
+
+def test_engines_page_shader_code_is_a_recorded_reconstruction(rendered):
+    """docs/engines.md: every piece of shader code it quotes is part of some preset's recorded reconstruction."""
+    text = re.sub(r"```.*?```", "", (DOCS / "engines.md").read_text(), flags=re.S)
+    everything = "\n".join(rendered.values())
+    wrong = [span for span in shader_spans(text) if span not in everything]
+    assert not wrong, f"docs/engines.md quotes shader code no layout record holds: {wrong}"
+
+
+@pytest.mark.parametrize("preset, fmt", [("unreal", "dds"), ("godot", "exr"), ("blender-eevee", "h")])
+def test_inspect_prints_the_engine_line_first(tmp_path, capsys, preset, fmt):
+    """`lutbake inspect` of a preset's file (any format: the EXR header, a DDS's or header's sidecar) prints the
+    engine record's shader line as the first line of the reconstruction: the README's line for that preset."""
+    from lutbake.cli import main
+    from lutbake.config import load_config, preset_path
+    from lutbake.io.formats import write_table
+    from lutbake.kinds import lookup_kind
+    from lutbake.pipeline import Computed, assemble
+
+    spec = load_config(preset_path(preset))[0]
+    plan = lookup_kind(spec.kind).plan(spec)
+    table = assemble(spec, Computed(plan, np.full(plan.shape, 0.5), {}, 0.0, 0.0))
+    path = write_table(table, tmp_path, fmt, "half" if fmt == "dds" else "float32")
+    with pytest.raises(SystemExit) as ended:
+        main(["inspect", str(path)])
+    assert ended.value.code == 0
+    out = capsys.readouterr().out.splitlines()
+    (shader,) = engine_lines([preset])
+    assert out[out.index("reconstruction:") + 1].endswith(f": {shader}"), out[out.index("reconstruction:") + 1]
+    assert f"`{shader}`" in readme_rows()[preset]
+
+
+CONFIG_PAGES = [DOCS / "config.md", *sorted(DOCS.glob("config-*.md"))]
+KEY_PAGES = DOCS / "keys"
+
+
+def config_sections() -> dict[str, str]:
+    """'common' -> the keys of every kind; kind name -> that kind's section, from the config pages."""
+    text = "\n".join(p.read_text() for p in CONFIG_PAGES)
+    sections = {}
+    for part in re.split(r"^#+ ", text, flags=re.M):
+        m = re.match(r"Kind `([a-z_0-9]+)`", part)
+        if m:
+            sections[m.group(1)] = part
+        elif part.startswith("Keys of every kind"):
+            sections["common"] = part
+    return sections
+
+
+def key_rows(section: str) -> dict[str, list[list[str]]]:
+    """A section's one-key table rows: key -> the rows naming it alone (cells: key, type, default, allowed, meaning)."""
+    rows: dict[str, list[list[str]]] = {}
+    for line in section.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split(" | ")]
+        m = re.fullmatch(r"`([a-z_0-9]+)`", cells[0]) if line.startswith("| `") and len(cells) == 5 else None
+        if m:
+            rows.setdefault(m.group(1), []).append(cells)
+    return rows
+
+
+def test_config_pages_agree_with_the_key_declarations():
+    """Each key row of docs/config*.md (a kind's section, or the keys of every kind, which are `dfg`'s) appears once
+    and lists exactly the key's declared values and its declared default: the prose reference cannot drift."""
+    import tomllib
+
+    sections = config_sections()
+    assert set(KINDS) <= set(sections), set(KINDS) - set(sections)
+    for where, section in sections.items():
+        kind = KINDS["dfg" if where == "common" else where]
+        for name, found in key_rows(section).items():
+            assert len(found) == 1, f"config: {where} lists key {name} {len(found)} times"
+            key = kind.keys.get(name)
+            assert key is not None, f"config: {where} documents key {name}, which kind {kind.name} does not declare"
+            _, _, default, allowed, _ = found[0]
+            if key.choices and not allowed.startswith("as "):
+                values = set(re.findall(r"`([^`]+)`", allowed))
+                assert values == set(key.choices), (where, name, sorted(values ^ set(key.choices)))
+            try:
+                written = tomllib.loads(f"x = {default.strip('`')}")["x"]
+            except tomllib.TOMLDecodeError:
+                continue  # prose ("required", "from the storage")
+            declared = list(key.default) if isinstance(key.default, tuple) else key.default
+            assert written == declared, (where, name, default, key.default)
+
+
+def test_key_pages_are_rendered_from_the_declarations():
+    """docs/keys/<kind>.md is lutbake.kinds.reference.markdown(kind) (`python -m lutbake.kinds.reference docs/keys`),
+    one page per kind, and names every key and value (what `lutbake list keys KIND` prints)."""
+    from lutbake.kinds.reference import markdown
+
+    assert {p.stem for p in KEY_PAGES.glob("*.md")} == set(KINDS)
+    for kind in KINDS.values():
+        page = (KEY_PAGES / f"{kind.name}.md").read_text()
+        assert page == markdown(kind), f"docs/keys/{kind.name}.md is stale: python -m lutbake.kinds.reference docs/keys"
+        for key in kind.keys.values():
+            assert f"| `{key.name}` |" in page
+            assert all(f"`{value}`" in page for value in key.choices or ())
+
+
+def test_every_entry_lutbake_list_prints_is_documented():
+    """Each preset (`lutbake list presets`) has its row in docs/presets.md or a page of its own family, each format
+    (`lutbake list formats`) is in docs/formats.md, each kind (`lutbake list kinds`) in docs/kinds.md and has its key
+    page."""
+    from lutbake.config import presets
+    from lutbake.io.formats import ALL_FORMATS
+
+    pages = {name: (DOCS / name).read_text() for name in ("presets.md", "formats.md", "kinds.md", "ltc.md")}
+    for preset in presets():
+        assert f"`{preset}`" in pages["presets.md"] + pages["ltc.md"], preset
+    for fmt in ALL_FORMATS:
+        assert f"`{fmt}`" in pages["formats.md"], fmt
+    for kind in KINDS:
+        assert f"`{kind}`" in pages["kinds.md"] and (KEY_PAGES / f"{kind}.md").is_file(), kind

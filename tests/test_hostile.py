@@ -165,6 +165,8 @@ def bad_for(key):
             st.tuples(unit, st.floats(min_value=1.0000001, allow_nan=False, allow_infinity=False)).map(list),
             st.tuples(unit, st.text(max_size=3)).map(list),
         )
+    if k.type == "bool":  # TOML's true / false only: 0, 1, "true" are not booleans
+        return st.one_of(st.integers(), st.floats(), st.text(max_size=6), st.lists(scalars, max_size=3))
     if k.type == "float":
         return st.one_of(
             st.text(max_size=6),

@@ -184,7 +184,8 @@ def test_every_file_of_a_multi_file_output_is_verified(tmp_path):
     first, second = tmp_path / "t_1.dds", tmp_path / "t_2.dds"
     second.write_bytes(b"second texture")
     first.write_bytes(b"first texture")
-    write_sidecar(first, "ltc_dds", {"content_hash": "h"}, {"files": [first.name, second.name]})
+    digests = {f.name: sha256_file(f) for f in (first, second)}
+    write_sidecar(first, "ltc_dds", {"content_hash": "h"}, digests, {"files": [first.name, second.name]})
     assert read_sidecar(first)["files_sha256"] == {second.name: sha256_file(second)}
     second.write_bytes(b"second textur!")
     assert read_sidecar(first) is None
@@ -369,6 +370,183 @@ def test_a_legacy_shared_sidecar_is_replaced(pristine, tmp_path):
     (job,) = batch.schedule([a], out, force=True)
     batch.run([job], workers=1, progress=None)
     assert not legacy.exists() and sidecar_path(out / "t.npy").is_file()
+
+
+# ------------------------------------------------------------------- concurrent runs into one out-dir
+
+RACE_NAMES = ("t", "u")
+RACE_SAMPLES = (48, 75)
+WINDOW_S = 0.002  # test-only widening of every write's instant between a rename and what follows it
+
+
+def race_configs(tmp: Path, fmt: str) -> dict[int, Path]:
+    """Two configs with the same table names (RACE_NAMES) and different samples: samples -> config path."""
+    made = {}
+    for s in RACE_SAMPLES:
+        p = tmp / f"race_{fmt}_{s}.toml"
+        p.write_text(
+            "".join(
+                f'[[table]]\nname = "{n}"\nkind = "dfg"\nsize = [4, 4]\nsamples = {s}\nformat = "{fmt}"\n'
+                for n in RACE_NAMES
+            )
+        )
+        made[s] = p
+    return made
+
+
+def widen_the_window(monkeypatch) -> None:
+    """Sleep after each rename's directory fsync: on a writer that hashes the file after its rename, another run's
+    rename then lands in between (the old bug) on almost every write, not once in a while."""
+    import time
+
+    real = atomic._fsync_dir
+
+    def slow(path):
+        real(path)
+        time.sleep(WINDOW_S)
+
+    monkeypatch.setattr(atomic, "_fsync_dir", slow)
+
+
+def check_no_wrong_skip(configs: dict[int, Path], out: Path, refs: dict[int, Path]) -> None:
+    """Every file a config would skip holds that config's bytes, and every table's pair on disk is one writer's
+    (one of the two configs skips it: never a data file of one run beside the sidecar of the other)."""
+    skippers = {n: [] for n in RACE_NAMES}
+    for s, cfg in configs.items():
+        for job in batch.schedule(load_configs([cfg]), out):
+            if job.status != "skipped":
+                continue
+            skippers[job.name].append(s)
+            assert same_output(job.path, refs[s] / job.path.name), f"samples = {s}: {job.path.name} is not its table"
+            if job.path.suffix != ".exr":
+                doc = json.loads(sidecar_path(job.path).read_text())
+                assert doc["data_sha256"] == sha256_file(refs[s] / job.path.name)
+    assert all(len(v) == 1 for v in skippers.values()), f"a pair of two writers left on disk: {skippers}"
+
+
+def wrong_vouchers(out: Path, expected: dict[str, bytes]) -> list[str]:
+    """The npy outputs whose sidecar, read at this instant, vouches for the data file's bytes (its ``data_sha256``
+    is their sha256) while those bytes are not the table of the config its ``content_hash`` names (``expected``:
+    content hash -> that table's bytes): a file the next run of that config would skip, holding another's table.
+    One read of each file: what a concurrent run scheduling at this moment would see."""
+    from lutbake.io.integrity import sha256_bytes
+
+    wrong = []
+    for name in RACE_NAMES:
+        data = out / f"{name}.npy"
+        try:
+            doc = json.loads(sidecar_path(data).read_bytes())
+            blob = data.read_bytes()
+        except (OSError, ValueError):
+            continue
+        claimed = doc.get("lutbake", {}).get("content_hash")
+        if doc.get("data_sha256") == sha256_bytes(blob) and blob != expected.get(claimed):
+            wrong.append(name)
+    return wrong
+
+
+@pytest.mark.parametrize("fmt", ["npy", "exr"])
+def test_concurrent_bakes_into_one_out_dir_never_leave_a_wrong_file_up_to_date(tmp_path, monkeypatch, fmt):
+    """Issue 46, item 1: 12 bakes at once (threads, 3 rounds; EXR 1) of two configs with the same table names into one
+    out-dir. A sidecar hashed from the file after its rename named the other run's bytes: the next run of the config
+    skipped a file holding the other config's table. Checked while the bakes run (wrong_vouchers, npy) and after
+    each round (check_no_wrong_skip). (An EXR is sealed before its rename: checked the same way after each round.)"""
+    import threading
+
+    configs = race_configs(tmp_path, fmt)
+    refs = {s: tmp_path / f"ref{s}" for s in configs}
+    for s, cfg in configs.items():
+        api.bake([cfg], refs[s], workers=1)
+    expected = {
+        batch.content_hash(spec): (refs[s] / f"{spec.name}.npy").read_bytes()
+        for s, cfg in configs.items()
+        for spec in load_configs([cfg])
+        if fmt == "npy"
+    }
+    widen_the_window(monkeypatch)
+    out = tmp_path / "out"
+    wrong: list[str] = []
+    for _ in range(3 if fmt == "npy" else 1):
+        failures, running = [], threading.Event()
+
+        def one(cfg):
+            r = api.bake([cfg], out, workers=1, force=True, check=False)
+            failures.extend(x.message for x in r if x.status != "baked")
+
+        def watch():  # what a run scheduling at any instant meanwhile would see
+            while running.is_set():
+                wrong.extend(wrong_vouchers(out, expected) if expected else [])
+
+        threads = [threading.Thread(target=one, args=(configs[RACE_SAMPLES[i % 2]],)) for i in range(12)]
+        running.set()
+        watcher = threading.Thread(target=watch)
+        watcher.start()
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        running.clear()
+        watcher.join()
+        assert not failures, failures
+        assert not wrong, f"a sidecar vouched for another config's bytes: {sorted(set(wrong))} ({len(wrong)} times)"
+        check_no_wrong_skip(configs, out, refs)
+
+
+RACER = textwrap.dedent("""
+    import os, pickle, sys, time
+    from lutbake.io import atomic
+    from lutbake.io.formats import write_table
+    tables_file, out_dir, rounds, window, go = sys.argv[1:]
+    real = atomic._fsync_dir
+    def slow(path):
+        real(path)
+        time.sleep(float(window))
+    atomic._fsync_dir = slow
+    with open(tables_file, "rb") as f:
+        tables = pickle.load(f)
+    for k in range(int(rounds)):
+        open(f"{go}.{k}.{os.getpid()}", "w").close()  # ready for round k
+        deadline = time.monotonic() + 120  # the test died: never outlive it
+        while not os.path.exists(f"{go}.{k}"):  # every writer starts the round at once
+            if time.monotonic() > deadline or os.getppid() == 1:
+                sys.exit("no go signal: the test has gone")
+            time.sleep(0.001)
+        for table in tables:
+            write_table(table, out_dir, "npy")
+""")
+RACE_ROUNDS = 6
+
+
+def test_concurrent_processes_writing_one_out_dir_leave_each_pair_whole(tmp_path):
+    """Issue 46, item 1, across processes (two `lutbake bake` at once): 6 writer processes, 3 per config, writing both
+    tables in 6 rounds started together into one out-dir; after each round every skip is right and every pair on disk
+    is one writer's (the out-dir's flock, lutbake.io.atomic.unit_lock)."""
+    import time
+
+    configs = race_configs(tmp_path, "npy")
+    refs = {s: tmp_path / f"ref{s}" for s in configs}
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    go, out, procs = tmp_path / "go", tmp_path / "out", []
+    for s, cfg in configs.items():
+        r = api.bake([cfg], refs[s], workers=1)
+        tf = tmp_path / f"tables{s}.pkl"
+        tf.write_bytes(pickle.dumps([x.table for x in r]))
+        args = [sys.executable, "-c", RACER, str(tf), str(out), str(RACE_ROUNDS), str(WINDOW_S), str(go)]
+        procs += [subprocess.Popen(args, env=env) for _ in range(3)]
+    try:
+        for k in range(RACE_ROUNDS + 1):
+            while k < RACE_ROUNDS and len(list(tmp_path.glob(f"go.{k}.*"))) < len(procs):
+                assert all(p.poll() is None for p in procs), "a writer died"
+                time.sleep(0.005)
+            if k:  # every writer has finished round k - 1 (and waits for round k)
+                if k == RACE_ROUNDS:
+                    assert [p.wait(timeout=120) for p in procs] == [0] * len(procs)
+                check_no_wrong_skip(configs, out, refs)
+            (tmp_path / f"go.{k}").touch()
+    finally:  # a failed round leaves no writer behind, waiting for a go that never comes
+        for p in procs:
+            p.kill()
+            p.wait()
 
 
 # ------------------------------------------------------------------------------- counts, by hand

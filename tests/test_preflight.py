@@ -373,3 +373,126 @@ def test_probe_directory_survives_a_concurrent_run_making_and_removing_the_direc
     monkeypatch.setattr(preflight.tempfile, "mkstemp", other_run_removes)
     assert preflight.probe_directory(out) is None
     assert len(calls) == 2
+
+
+def test_a_directory_another_run_made_and_removed_meanwhile_is_no_error(tmp_path, monkeypatch):
+    """Issue 46, item 1 (concurrent runs into one new --out-dir): the other run's probe makes the directory and removes
+    it again while this run looks at it: between its exists() and access() ('is not writable (permission denied)'),
+    and between its mkdir and ours ('File exists' for a directory gone again). Both are looked at again, not errors."""
+    from lutbake import preflight
+
+    out = tmp_path / "out"
+    out.mkdir()  # the other run's probe made it
+    real_access, real_mkdir, seen = os.access, os.mkdir, []
+
+    def removed_meanwhile(path, mode):
+        if not seen:
+            seen.append(path)
+            os.rmdir(out)  # ... and removes it now
+        return real_access(path, mode)
+
+    monkeypatch.setattr(preflight.os, "access", removed_meanwhile)
+    assert preflight.directory_problem(out) is None
+    monkeypatch.setattr(preflight.os, "access", real_access)
+
+    def made_and_removed(d, *a):
+        if not seen[1:]:
+            seen.append(d)
+            raise FileExistsError(17, "File exists", str(d))  # it was there an instant ago, gone by now
+        real_mkdir(d, *a)
+
+    monkeypatch.setattr(preflight.os, "mkdir", made_and_removed)
+    assert preflight.probe_directory(out) is None
+    assert len(seen) == 2 and not out.exists()
+
+
+@pytest.mark.parametrize(
+    "config_name, table, fmt, claimed",
+    [("u.exr", "u", "exr", "its output"), ("t.npy.json", "t", "npy", "its sidecar of t.npy"), ("t.h", "t", "h", "")],
+)
+def test_a_config_that_a_table_would_overwrite_is_refused(tmp_path, no_kernel, config_name, table, fmt, claimed):
+    """Issue 46, item 4: a config saved as ``u.exr`` (table u's output) or ``t.npy.json`` (table t's sidecar) was
+    replaced by its own bake, exit 0. Every input is in the registry's check: exit 2, the file named, nothing
+    written."""
+    cfg = tmp_path / config_name
+    text = f'[[table]]\nname = "{table}"\nkind = "dfg"\nsize = [4, 4]\nsamples = 48\nformat = "{fmt}"\n'
+    cfg.write_text(text)
+    refused(bake(cfg, "--out-dir", tmp_path), claimed, f"is the config {cfg}", "would overwrite it")
+    refused(bake(cfg, "--out-dir", tmp_path / "x" / ".."), f"is the config {cfg}")
+    assert cfg.read_text() == text and sorted(f.name for f in tmp_path.iterdir()) == [config_name]
+
+
+def test_an_output_or_report_that_is_the_cache_directory_is_refused(cfg, tmp_path, no_kernel):
+    """Issue 46, item 4: the --cache directory is an input too (its entries as well)."""
+    out = tmp_path / "o"
+    refused(bake(cfg, "--out-dir", out, "--cache", out / "t.exr"), "its output", "is the --cache directory")
+    refused(bake(cfg, "--out-dir", out, "--cache", out / "c", "--report", out / "c"), "is the --cache directory")
+    assert not out.exists()
+
+
+# ------------------------------------------------------------ issue 46, item 6: --cache and the OS path limits
+
+
+def test_a_cache_that_cannot_be_written_is_refused_like_the_out_dir(cfg, tmp_path, mount, no_kernel):
+    """Issue 46, item 6: a --cache below a file, a dangling symlink, a symlink loop or on a read-only file system
+    was accepted and every entry silently unwritten; now exit 2, one line, before any kernel."""
+    out = tmp_path / "o"
+    (tmp_path / "f").write_text("")
+    (tmp_path / "dangling").symlink_to(tmp_path / "gone")
+    (tmp_path / "loop").symlink_to(tmp_path / "loop")
+    refused(bake(cfg, "--out-dir", out, "--cache", tmp_path / "f" / "c"), "--cache", "is a file, not a directory")
+    refused(bake(cfg, "--out-dir", out, "--cache", tmp_path / "dangling"), "--cache", "dangling symlink")
+    refused(bake(cfg, "--out-dir", out, "--cache", tmp_path / "loop"), "--cache", "symlink loop")
+    refused(bake(cfg, "--out-dir", tmp_path / "loop"), "--out-dir", "symlink loop")
+    ro = mount(tmp_path / "ro", "ro,size=64k")
+    refused(bake(cfg, "--out-dir", out, "--cache", ro / "c"), "--cache", "read-only file system")
+    assert not out.exists()
+
+
+def test_a_cache_write_that_fails_anyway_is_said_once(tmp_path, monkeypatch):
+    """Issue 46, item 6: a cache write that fails during the run (the disk fills, the mount turns read-only) is said
+    once on the terminal, however many entries fail; the tables are baked (exit 0)."""
+    import errno
+
+    from lutbake import values_cache
+
+    def read_only(self, key, data, extra):
+        raise OSError(errno.EROFS, os.strerror(errno.EROFS), str(self.directory / f"{key}.npy"))
+
+    monkeypatch.setattr(values_cache.ValuesCache, "store", read_only)
+    p = tmp_path / "c.toml"
+    p.write_text(DFG + DFG.replace('"t"', '"u"').replace("48", "75"))  # two values keys: two failed entries
+    r = bake(p, "--out-dir", tmp_path / "o", "--cache", tmp_path / "cache")
+    assert r.exit_code == 0, r.output
+    assert r.output.count("values cache") == 1 and "read-only file system" in r.output, r.output
+
+
+def long_dir(base: Path, length: int) -> Path:
+    """A directory path below ``base`` exactly ``length`` characters long (components of at most 200)."""
+    path = str(base)
+    while len(path) < length:
+        room = length - len(path) - 1
+        path += "/" + "d" * (min(200, room) if room - min(200, room) != 1 else 199)
+    assert len(path) == length
+    return Path(path)
+
+
+def test_an_out_dir_near_path_max_is_refused_before_any_kernel(cfg, tmp_path, no_kernel):
+    """Issue 46, item 6: an --out-dir whose outputs fit PATH_MAX but not the temporary name of a sidecar
+    (.t.npy.json.<pid>.<8 hex>.tmp.json) passed preflight and failed after the bake (exit 1); a longer one gave an
+    OSError traceback in preflight. Both: exit 2, one line, no traceback."""
+    path_max = os.pathconf(tmp_path, "PC_PATH_MAX")
+    temp = len(f"/.t.npy.json.{os.getpid()}.01234567.tmp.json")
+    near = long_dir(tmp_path, path_max - temp)  # + the temporary sidecar name + NUL: one byte over
+    assert len(str(near / "t.npy.json")) + 1 < path_max
+    refused(bake(cfg, "--out-dir", near, "--format", "npy"), "PATH_MAX", ".tmp.json")
+    refused(bake(cfg, "--out-dir", long_dir(tmp_path, path_max + 150)), "PATH_MAX")
+    refused(bake(cfg, "--out-dir", tmp_path / "o", "--cache", long_dir(tmp_path, path_max + 10)), "--cache", "PATH_MAX")
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["c.toml"]
+
+
+def test_an_out_dir_name_over_name_max_is_refused_without_a_traceback(cfg, tmp_path, no_kernel):
+    """A directory name longer than NAME_MAX: an OSError traceback in preflight (ENAMETOOLONG), now exit 2."""
+    name_max = os.pathconf(tmp_path, "PC_NAME_MAX")
+    refused(bake(cfg, "--out-dir", tmp_path / ("n" * (name_max + 1)) / "o"), "NAME_MAX")
+    refused(bake(cfg, "--out-dir", tmp_path / "o", "--cache", tmp_path / ("n" * (name_max + 1))), "--cache", "NAME_MAX")

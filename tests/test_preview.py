@@ -168,3 +168,87 @@ def test_a_table_without_lutbake_metadata_is_drawn_by_index(tmp_path):
     fig = figure(p)
     assert "no lutbake metadata" in fig.get_suptitle() and fig.axes[0].get_xlabel() == "x index"
     plt.close(fig)
+
+
+LTC_MEANINGS = {
+    "x": "slice 0 (ltc_1): M^-1_00 / M^-1_11; slice 1 (ltc_2): magnitude = ∫ f (n.l) dω_l with F = 1 (fit = shaded: "
+    "fitted with the matrix)",
+    "y": "slice 0: M^-1_20 / M^-1_11 (glm invM[0][2]); slice 1: fresnel = ∫ f (1 - v.h)^5 (n.l) dω_l (= magnitude for "
+    "lobes without Fresnel)",
+    "z": "slice 0: M^-1_02 / M^-1_11 (glm invM[2][0]); slice 1: fit_error = (E / ∫ f^3 dω)^(1/3), E = Heitz's L3 "
+    "metric of the fit (0 in engine layouts)",
+    "w": "slice 0: M^-1_22 / M^-1_11; slice 1: sphere = horizon-clipped / unclipped form factor of a spherical cap, at "
+    "x = z * 0.5 + 0.5, y = len (own axes, endpoint texels)",
+}
+
+
+def ltc_table(tmp_path, n=16):
+    """An LTC table as the engine layouts hold one: matrix entries from about 1 up to FP16's 65504 (HDRP's smooth
+    grazing texels), and ltc_2's channels in [0, 1]."""
+    rng = np.random.default_rng(3)
+    data = rng.random((2, n, n, 4))
+    data[0] = 10.0 ** (rng.random((n, n, 4)) * 4.8)  # 1 ... 65504: decades
+    data[0, -1, 0, :] = 65504.0
+    axes = [
+        Axis("texture", "z", 2, 1.0, 2.0, texel="endpoint"),
+        Axis("NoV", "y", n, texel="endpoint", mapping="one_minus_t2"),
+        Axis("perceptual_roughness", "x", n, texel="endpoint"),
+    ]
+    return make(tmp_path, "ltc", data, axes, LTC_MEANINGS, {"lobe": "ggx"}, name="ltc")
+
+
+@pytest.fixture(scope="module")
+def ltc_figure(tmp_path_factory):
+    """The preview of ltc_table, laid out once (drawn) for the three tests below."""
+    fig = figure(ltc_table(tmp_path_factory.mktemp("ltc"), n=8))
+    fig.canvas.draw()
+    yield fig
+    plt.close(fig)
+
+
+def panel(fig, start):
+    """The Axes whose (left) title starts with ``start``, and its image."""
+    (ax,) = [a for a in fig.axes if a.get_title(loc="left").startswith(start) and a.get_images()]
+    return ax, ax.get_images()[0]
+
+
+def test_ltc_matrix_entries_spanning_decades_get_a_log_colour_scale(ltc_figure):
+    """Matrix entries from 1 to 65504 on a linear scale were one flat colour; on the symmetric log scale the
+    texels keep their order and most of them a colour of their own."""
+    from matplotlib.colors import SymLogNorm
+
+    fig = ltc_figure
+    ax, im = panel(fig, "R (.x): M^-1_00")
+    values = np.asarray(im.get_array())
+    assert isinstance(im.norm, SymLogNorm) and "log colour scale" in ax.get_title(loc="left")
+    colours = np.unique(np.round(im.norm(values.ravel()) * 255))
+    assert len(colours) >= 0.5 * min(values.size, 256), len(colours)
+    _, magnitude = panel(fig, "R (.x): magnitude")
+    assert not isinstance(magnitude.norm, SymLogNorm)  # ltc_2 in [0, 1]: linear
+
+
+def test_ltc_titles_do_not_overlap(ltc_figure):
+    """No title (panel titles, the textures' row titles) overlaps another title or another panel."""
+    fig = ltc_figure
+    renderer = fig.canvas.get_renderer()
+    texts = [t for ax in fig.axes for t in (ax.title, ax._left_title) if t.get_text()]
+    texts += [sf._suptitle for sf in getattr(fig, "subfigs", []) if sf._suptitle is not None]
+    boxes = [t.get_window_extent(renderer) for t in texts]
+    for i, a in enumerate(boxes):
+        for j in range(i + 1, len(boxes)):
+            assert not a.overlaps(boxes[j]), (texts[i].get_text()[:40], texts[j].get_text()[:40])
+    panels = [ax.get_window_extent(renderer) for ax in fig.axes if ax.get_images()]
+    for t, box in zip(texts, boxes):
+        assert not any(box.overlaps(p) for p in panels), t.get_text()[:40]
+
+
+def test_ltc_sphere_channel_is_drawn_on_its_own_axes(ltc_figure):
+    """ltc_2's sphere channel is indexed by (z * 0.5 + 0.5, len), not by (roughness, NoV): its panel's ticks run over
+    z in [-1, 1] and len in [0, 1], the other panels' over the table's axes."""
+    fig = ltc_figure
+    ax, _ = panel(fig, "A (.w): sphere")
+    assert ax.get_xlabel().startswith("z = cos elevation") and ax.get_ylabel().startswith("len = |F|")
+    assert [t.get_text() for t in ax.get_xticklabels()][::3] == ["-1", "1"]
+    assert [t.get_text() for t in ax.get_yticklabels()][::3] == ["0", "1"]
+    other, _ = panel(fig, "R (.x): magnitude")
+    assert other.get_xlabel().startswith("perceptual roughness")

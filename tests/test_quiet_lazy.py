@@ -46,8 +46,17 @@ def test_help_and_version_import_nothing_heavy():
 def test_list_and_every_commands_help_import_nothing_heavy():
     """`lutbake list` prints every kind, NDF, model and estimator from warp-free declarations (lutbake.catalog)."""
     commands = ("validate", "audit", "inspect", "preview", "size", "fit", "plot")
-    loaded = loaded_after(["list"], *([command, "--help"] for command in commands))
-    assert dict(zip(("list",) + commands, loaded)) == dict.fromkeys(("list",) + commands, [])
+    lists = (
+        ["list"],
+        ["list", "kinds"],
+        ["list", "presets"],
+        ["list", "formats"],
+        ["list", "keys", "ltc"],
+        ["list", "terms"],
+    )
+    loaded = loaded_after(*lists, *([command, "--help"] for command in commands))
+    names = [" ".join(a) for a in lists] + list(commands)
+    assert dict(zip(names, loaded)) == dict.fromkeys(names, [])
 
 
 def test_the_kind_registry_and_config_checks_import_no_warp(tmp_path):
@@ -152,3 +161,32 @@ def test_make_figures_writes_under_outputs_and_leaves_tracked_figures_alone(tmp_
     assert all(p.read_bytes() == b for p, b in tracked.items())
     written = sorted((tmp_path / "figures").glob("*.png"))
     assert len(written) == 3 and all(p.read_bytes()[:4] == b"\x89PNG" for p in written)
+
+
+def test_dir_lists_the_public_api_without_importing_it():
+    """``dir(lutbake)`` names every entry of ``__all__`` (module ``__dir__``, PEP 562) while the package stays lazy:
+    listing it imports neither the API modules nor Warp."""
+    code = (
+        "import json, sys, lutbake\n"
+        "loaded = ['lutbake.api' in sys.modules, 'warp' in sys.modules]\n"
+        "print(json.dumps([sorted(lutbake.__all__), dir(lutbake), *loaded]))"
+    )
+    r = python(code)
+    assert r.returncode == 0, r.stderr
+    public, listed, api_loaded, warp_loaded = json.loads(r.stdout)
+    assert set(public) <= set(listed), set(public) - set(listed)
+    assert not api_loaded and not warp_loaded
+
+
+def test_the_api_docs_example_shows_overrides_and_they_load():
+    """docs/batch.md's Python example passes ``overrides=`` (the --set texts), accepted as written."""
+    import ast
+    import re
+
+    from lutbake.config import load_configs
+
+    doc = (ROOT / "docs" / "batch.md").read_text()
+    m = re.search(r"overrides=(\[[^\]]*\])", doc.split("## Python API", 1)[1])
+    assert m, "docs/batch.md's API example does not show overrides="
+    spec = load_configs([ROOT / "configs" / "dfg.toml"], ast.literal_eval(m.group(1)))[0]
+    assert (spec.options["samples"], spec.options["dtype"]) == (2048, "half")

@@ -88,3 +88,30 @@ def test_fixed_samples_keep_the_fixed_order(bake):
     attrs = bake(kind="dfg", size=[8, 8], samples=432).attributes
     assert "tolerance" not in attrs
     assert "order 12 - order 16" in attrs["error_estimate_method"]
+
+
+# texels of make luts' tables where a panel's 6 x 6 product rule was accurate by a cancellation of its outer rule's
+# error against its inner rule's (specular_3d_dielectric_f0, metal_silver, godot_dfg) or its inner 4-point rule by
+# chance (albedo's coarse texels, at a quarter of 1e-6): (channels, nch, n.v, alpha, param, absolute, relative)
+CANCELLING_TEXELS = {
+    "dielectric_f0": ("F:dielectric_f0", 1, 0.03515625, 0.06056213, 0.15625, 1.0e-6, 0.0),
+    "dielectric_f0_grazing_rough": ("F:dielectric_f0", 1, 0.37890625, 0.18798828, 0.96875, 1.0e-6, 0.0),
+    "metal_silver": ("metal", 3, 0.06640625, 0.10510254, 2.0, 1.0e-6, 0.0),
+    "albedo_coarse": ("albedo", 1, 0.53515625, 0.43580627, 0.0, 0.25e-6, 0.0),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CANCELLING_TEXELS))
+def test_error_estimate_bounds_error_where_a_product_rule_cancels(case):
+    from lutbake.integrands.specular import metal_param
+
+    channels, nch, nov, alpha, param, tol_abs, tol_rel = CANCELLING_TEXELS[case]
+    if channels == "metal":
+        param = metal_param("silver")
+    integrand = specular_integrand("ggx", "smith_height_correlated", channels, "microfacet", nch)
+    inputs = {"nov": np.float32([nov]), "alpha": np.float32([alpha]), "param": np.float32([param])}
+    got, est = gl_launch(integrand, inputs, ADAPTIVE_ORDERS, (tol_abs, tol_rel), "cpu")
+    ref = gl_launch(integrand, inputs, (CONVERGED_ORDER,), (0.0, 0.0), "cpu")[0]
+    err = np.abs(got - ref)[:, :nch]
+    print(f"{case}: error {err.max():.3e}, estimate {est[:, :nch].min():.3e}")
+    assert np.all(err <= est[:, :nch])

@@ -4,6 +4,7 @@ summary."""
 from __future__ import annotations
 
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -12,7 +13,9 @@ import click
 from ..io.formats import ALL_FORMATS
 from .options import fail, out_dir_option, set_option, workers_option
 
+ACCEPT = "accept_over_tolerance"  # the config key that accepts a table over its tolerance (exit 0)
 PROGRESS_MIN_EVALS = 1.5e7  # about a second of work on two busy cores: a single table shows a bar above it
+DRAW_INTERVAL = 0.5  # seconds between redraws of the progress line as tiles finish
 
 
 @click.command()
@@ -72,8 +75,11 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     in parallel; each prints one line: path, shape, seconds, samples per texel; on a terminal a progress line
     shows tables done / total, the running table, elapsed time and an estimate. The last line sums up the batch
     ("40 tables: 12 baked, 28 up to date, 0 failed, 64 s"). A table that fails does not stop the others; the exit
-    status is then 1. Outputs are replaced atomically: Ctrl-C (exit 130) or SIGTERM (exit 143) keeps finished
-    tables, writes no unfinished one, and lists the tables that did not finish; the next run bakes only those.
+    status is then 1. A table whose texels end over their tolerance is written and prints "OVER TOLERANCE name: ..."
+    (how many texels, their rows / columns, the worst estimate / tolerance); the exit status is then 1 unless its
+    config sets accept_over_tolerance = true. Outputs are replaced atomically: Ctrl-C (exit 130) or SIGTERM
+    (exit 143) keeps finished tables, writes no unfinished one, and lists the tables that did not finish; the next
+    run bakes only those.
 
     \b
     Examples:
@@ -130,6 +136,18 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
     unfinished = [r.name for r in results if r.status in ("interrupted", "pending")]
     if failed:
         click.echo(f"{len(failed)} of {len(results)} tables failed: {', '.join(failed)}", err=True)
+    over = [r.name for r in results if r.status == "over_tolerance"]
+    if over:
+        refused = [r.name for r in results if r.status == "over_tolerance" and not r.spec.options.get(ACCEPT)]
+        click.echo(
+            f"{len(over)} of {len(results)} tables over their tolerance: {', '.join(over)}"
+            + (
+                f" (exit 1; {ACCEPT} = true in a table's config accepts it)"
+                if refused
+                else f" (accepted: {ACCEPT} = true)"
+            ),
+            err=True,
+        )
     if results.interrupted_by is not None:
         click.echo(
             f"interrupted ({batch.signal_name(results.interrupted_by)}): {len(unfinished)} of {len(results)} tables "
@@ -141,39 +159,115 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
 
 
 def summary(results, seconds: float) -> str:
-    """The closing line: "40 tables: 12 baked, 28 up to date, 0 failed, 64 s" (and how many were interrupted)."""
-    n = {s: sum(r.status == s for r in results) for s in ("baked", "skipped", "failed", "interrupted", "pending")}
+    """The closing line: "40 tables: 12 baked, 28 up to date, 0 failed, 64 s" (and how many ended over their
+    tolerance, how many were interrupted)."""
+    statuses = ("baked", "skipped", "over_tolerance", "failed", "interrupted", "pending")
+    n = {s: sum(r.status == s for r in results) for s in statuses}
     stopped = n["interrupted"] + n["pending"]
     return (
         f"{len(results)} table{'s' if len(results) != 1 else ''}: {n['baked']} baked, {n['skipped']} up to date, "
-        f"{n['failed']} failed" + (f", {stopped} interrupted" if stopped else "") + f", {seconds:.0f} s"
+        + (f"{n['over_tolerance']} over tolerance, " if n["over_tolerance"] else "")
+        + f"{n['failed']} failed"
+        + (f", {stopped} interrupted" if stopped else "")
+        + f", {seconds:.0f} s"
     )
+
+
+class WorkClock:
+    """The time left of a batch, from the work done rather than the tables done.
+
+    Each pending table is planned with its texel count; once it starts (after its kernels are built) its cost, the
+    integrand evaluations of its plan, is known, and each tile adds its texels. A table not started yet is weighed
+    by its texels at the mean cost per texel of those started. The rate is the work done over the time since the
+    first tile began, so the kernels' first compile (before any tile) does not count as baking:
+
+        left = (now - first tile) * (work planned - work done) / work done
+
+    (counting tables instead overestimates the time left when the large tables finish last, and counting the
+    compile overestimates it by the compile's share). Times are whatever clock the caller passes."""
+
+    def __init__(self):
+        self.texels: dict[str, int] = {}
+        self.cost: dict[str, float] = {}
+        self.done: dict[str, int] = {}
+        self.first: float | None = None
+
+    def plan(self, name: str, texels: int) -> None:
+        self.texels[name] = max(int(texels), 1)
+
+    def start(self, name: str, texels: int, cost: float, now: float) -> None:
+        self.texels[name] = max(int(texels), 1)
+        self.cost[name] = float(cost)
+        self.first = now if self.first is None else self.first
+
+    def advance(self, name: str, n: int) -> None:
+        self.done[name] = min(self.done.get(name, 0) + n, self.texels.get(name, n))
+
+    def finish(self, name: str) -> None:
+        if name in self.texels:
+            self.done[name] = self.texels[name]
+
+    def left(self, now: float) -> float | None:
+        """Seconds left, or None before any work is done."""
+        started = [n for n in self.texels if n in self.cost]
+        if self.first is None or not started or now <= self.first:
+            return None
+        per_texel = sum(self.cost[n] for n in started) / sum(self.texels[n] for n in started)
+        work = {n: self.cost.get(n, t * per_texel) for n, t in self.texels.items()}
+        done = sum(w * self.done.get(n, 0) / self.texels[n] for n, w in work.items())
+        if done <= 0:
+            return None
+        return (now - self.first) * (sum(work.values()) - done) / done
 
 
 class BatchProgress:
     """What ``lutbake bake`` prints while the batch runs: one line per table as it ends ("[done/total] ...", stdout:
     plain lines wherever the output goes) and, on a terminal,
     a progress line on stderr redrawn in place: tables done / total, the running tables, elapsed, an estimate of
-    the time left (from the finished tables' share of the work); a single long table gets a texel bar instead."""
+    the time left (WorkClock: the work done, weighed by each table's cost); a single long table gets a texel bar
+    instead. Tables finish on the batch's threads while their tiles report from others: every write to the terminal
+    goes through ``_write`` under one lock, and the status line is cleared before any other line is printed, so no
+    line is ever glued to another."""
 
     def __init__(self, terminal: bool, t0: float):
         self.terminal, self.t0 = terminal, t0
         self.total = self.finished = self.pending = 0
         self.running: list[str] = []
         self.shown = False
+        self.cache_warned = False  # a --cache that cannot be written is said once, not once per table
+        self.clock = WorkClock()
+        self.lock = threading.RLock()
+        self.last_draw = 0.0
+
+    def _write(self, text: str, nl: bool = True, err: bool = False) -> None:
+        with self.lock:
+            click.echo(text, nl=nl, err=err)
 
     def scheduled(self, results) -> None:
+        from ..kinds import lookup_kind
+
         self.total = len(results)
         self.pending = sum(r.status == "pending" for r in results)
-        self.done_pending = 0
+        for r in results:
+            if r.status == "pending":
+                self.clock.plan(r.name, lookup_kind(r.spec.kind).texels(r.spec.options))
 
     def texels(self, label: str, n_texels: int, cost: float):
         """lutbake.runtime.executor.Progress: a table starts (its tiles are about to run)."""
-        self.running.append(label)
-        self.draw()
-        if self.terminal and self.pending == 1 and cost > PROGRESS_MIN_EVALS:
-            return self._texel_bar(label, n_texels)
-        return None
+        with self.lock:
+            self.running.append(label)
+            self.clock.start(label, n_texels, cost, time.perf_counter())
+            self.draw()
+            if self.terminal and self.pending == 1 and cost > PROGRESS_MIN_EVALS:
+                return self._texel_bar(label, n_texels)
+        return lambda n: self._advance(label, n)
+
+    def _advance(self, label: str, n: int) -> None:
+        """A tile of ``label`` is done: count its texels, and redraw at most every DRAW_INTERVAL seconds."""
+        with self.lock:
+            self.clock.advance(label, n)
+            if time.perf_counter() - self.last_draw >= DRAW_INTERVAL:
+                self.draw()
 
     def _texel_bar(self, label: str, n_texels: int):
         self.clear()
@@ -182,57 +276,75 @@ class BatchProgress:
         left = [n_texels]
 
         def update(n: int) -> None:
-            bar.update(n)
-            left[0] -= n
-            if left[0] <= 0:
-                bar.__exit__(None, None, None)
+            with self.lock:
+                self.clock.advance(label, n)
+                bar.update(n)
+                left[0] -= n
+                if left[0] <= 0:
+                    bar.__exit__(None, None, None)
 
         return update
 
     def done(self, r) -> None:
+        with self.lock:
+            self._done(r)
+
+    def _done(self, r) -> None:
         from ..api import samples_note
         from ..textsafe import escape_controls
 
         if r.name in self.running:
             self.running.remove(r.name)
         self.finished += 1
+        self.clock.finish(r.name)
         self.clear()
         count = f"[{self.finished}/{self.total}] "
         if r.status == "skipped":
-            click.echo(f"{count}skipped {escape_controls(str(r.path))} (up to date)")
-        elif r.status == "baked":
-            self.done_pending += 1
+            self._write(f"{count}skipped {escape_controls(str(r.path))} (up to date)")
+        elif r.status == "over_tolerance" and r.table is None:  # up to date, as its file records
+            self._write(f"{count}skipped {escape_controls(str(r.path))} (up to date)")
+            self._write(f"OVER TOLERANCE {r.name}: {escape_controls(r.message)}", err=True)
+        elif r.status in ("baked", "over_tolerance"):
             note = samples_note(r.spec, r.samples)
             if r.values_from is not None:
                 note = "; ".join(filter(None, (note, f"values computed once with {r.values_from}")))
-            click.echo(
+            self._write(
                 f"{count}{escape_controls(str(r.path))}  {r.shape}  {r.seconds:.2f} s  {r.samples} samples/texel"
                 + (f" ({note})" if note else "")
             )
+            if r.status == "over_tolerance":
+                self._write(f"OVER TOLERANCE {r.name}: {escape_controls(r.message)}", err=True)
         elif r.status == "failed":
-            self.done_pending += 1
-            click.echo(f"{count}FAILED {r.name}: {escape_controls(r.message)}", err=True)
+            self._write(f"{count}FAILED {r.name}: {escape_controls(r.message)}", err=True)
+        if r.cache_error and not self.cache_warned:
+            self.cache_warned = True
+            self._write(
+                f"warning: {escape_controls(r.cache_error)}; the tables are baked, their values not kept", err=True
+            )
         self.draw()
 
     def line(self) -> str:
-        elapsed = time.perf_counter() - self.t0
-        left = ""
-        if 0 < self.done_pending < self.pending:
-            left = f", ~{elapsed / self.done_pending * (self.pending - self.done_pending):.0f} s left"
+        now = time.perf_counter()
+        left = self.clock.left(now) if self.finished < self.total else None
         running = ""
         if self.running:
             running = f"  running {self.running[0]}" + (f" +{len(self.running) - 1}" if len(self.running) > 1 else "")
-        return f"[{self.finished}/{self.total}]{running}  {elapsed:.0f} s{left}"
+        return f"[{self.finished}/{self.total}]{running}  {now - self.t0:.0f} s" + (
+            f", ~{left:.0f} s left" if left is not None else ""
+        )
 
     def draw(self) -> None:
-        if self.terminal and self.total and self.finished < self.total and self.pending > 1:
-            click.echo("\r\x1b[2K" + self.line(), nl=False, err=True)
-            self.shown = True
+        with self.lock:
+            if self.terminal and self.total and self.finished < self.total and self.pending > 1:
+                self._write("\r\x1b[2K" + self.line(), nl=False, err=True)
+                self.shown = True
+                self.last_draw = time.perf_counter()
 
     def clear(self) -> None:
-        if self.shown:
-            click.echo("\r\x1b[2K", nl=False, err=True)
-            self.shown = False
+        with self.lock:
+            if self.shown:
+                self._write("\r\x1b[2K", nl=False, err=True)
+                self.shown = False
 
     def close(self) -> None:
         self.clear()

@@ -11,10 +11,109 @@ import click
 
 from .options import fail, force_png_option, out_dir_option, out_file_option
 
+LIST_TOPICS = ("kinds", "presets", "formats", "keys", "terms")
+LIST_EXAMPLES = """
+\b
+Examples:
+  lutbake list                 # a summary, and how to ask for more
+  lutbake list kinds           # every table kind, its aliases and what it holds
+  lutbake list presets         # every engine preset: what it is, the files it writes
+  lutbake list formats         # every output format (format = ... / --format)
+  lutbake list keys dfg        # every key of kind dfg: type, default, allowed values and their meaning
+  lutbake list terms           # NDFs, masking, models, Fresnel, metals, layouts, estimators, texel conventions
+"""
 
-@click.command("list")
-def list_():
-    """List table kinds, selectable terms, estimators and presets."""
+
+@click.command("list", epilog=LIST_EXAMPLES)
+@click.argument("topic", required=False, type=click.Choice(LIST_TOPICS))
+@click.argument("kind", required=False)
+def list_(topic, kind):
+    """List what lutbake offers: a short summary, or one TOPIC in full (kinds, presets, formats, keys KIND, terms)."""
+    width = max(60, min(shutil.get_terminal_size((100, 24)).columns, 120))
+    if kind is not None and topic != "keys":
+        fail(f"only 'lutbake list keys KIND' takes a second argument (got {kind!r} after {topic or 'list'!r})")
+    if topic == "keys":
+        _list_keys(kind, width)
+    else:
+        {None: _list_summary, "kinds": _list_kinds, "presets": _list_presets, "formats": _list_formats}.get(
+            topic, _list_terms
+        )(width)
+
+
+def _section(width: int, title: str, items: dict[str, str]) -> None:
+    """A bold title, then one entry a line: its name, and its description wrapped under its column."""
+    click.echo(click.style(title, bold=True))
+    for k, v in items.items():
+        lines = textwrap.wrap(v, width - 29, break_on_hyphens=False, break_long_words=False) or [""]
+        click.echo(f"  {k:<26} {lines[0]}" + "".join(f"\n{'':29}{line}" for line in lines[1:]))
+    click.echo()
+
+
+def _names(width: int, title: str, names, more: str) -> None:
+    """A bold title, the names wrapped into a paragraph, and the command that lists them in full."""
+    click.echo(click.style(title, bold=True))
+    text = ", ".join(names)
+    click.echo(textwrap.fill(text, width, initial_indent="  ", subsequent_indent="  ", break_on_hyphens=False))
+    click.echo(f"  ({more})")
+    click.echo()
+
+
+def _kind_entries() -> dict[str, str]:
+    from ..kinds import KINDS
+
+    return {k.name + (f" ({', '.join(k.aliases)})" if k.aliases else ""): k.description for k in KINDS.values()}
+
+
+def _list_summary(width: int) -> None:
+    from ..config import presets
+    from ..io.formats import ALL_FORMATS
+    from ..kinds import KINDS
+
+    _names(width, "Table kinds (kind = ...)", KINDS, "lutbake list kinds; a kind's keys: lutbake list keys KIND")
+    _names(width, "Presets (--preset NAME)", presets(), "lutbake list presets: what each is, the files it writes")
+    _names(width, "Output formats (format = ... / --format)", ALL_FORMATS, "lutbake list formats")
+    _names(width, "Terms", dict.fromkeys(title.split(" (")[0] for title in _terms()), "lutbake list terms")
+    click.echo("Every key of a kind with its type, default and allowed values: lutbake list keys dfg")
+
+
+def _list_kinds(width: int) -> None:
+    _section(width, "Table kinds (kind = ...)", _kind_entries())
+
+
+def _list_presets(width: int) -> None:
+    from ..config import presets
+
+    _section(
+        width,
+        "Presets (--preset NAME): what each is, and the files it writes",
+        {k: preset_text(p) for k, p in presets().items()},
+    )
+
+
+def _list_formats(width: int) -> None:
+    from ..io.formats import ALL_FORMATS
+
+    _section(width, "Output formats (format = ... / --format)", ALL_FORMATS)
+
+
+def _list_keys(kind: str | None, width: int) -> None:
+    from ..kinds import KINDS, lookup_kind
+    from ..kinds.reference import text
+
+    if kind is None:
+        fail(f"'lutbake list keys' needs a kind, e.g. 'lutbake list keys dfg'; kinds: {', '.join(KINDS)}")
+    try:
+        found = lookup_kind(kind)
+    except KeyError as e:
+        fail(e.args[0])
+    for line in text(found):
+        indent = len(line) - len(line.lstrip())
+        hang = indent + (29 if indent else 2)
+        click.echo(textwrap.fill(line, width, subsequent_indent=" " * hang, break_on_hyphens=False) if line else "")
+
+
+def _terms() -> dict[str, dict[str, str]]:
+    """The selectable terms, by section title (warp-free declarations: lutbake.catalog and the kinds)."""
     from ..axes import TEXELS
     from ..catalog import (
         ANISO_ESTIMATORS,
@@ -26,50 +125,31 @@ def list_():
         NDF_DESCRIPTIONS,
         SPECULAR_MODELS,
     )
-    from ..config import presets
-    from ..io.formats import ALL_FORMATS
-    from ..kinds import KINDS
     from ..kinds.dfg import LAYOUTS
     from ..kinds.diffuse import DIFFUSE_ESTIMATORS
     from ..kinds.specular_aniso import VIEW_AZIMUTHS
     from ..metals import METALS
 
-    width = max(60, min(shutil.get_terminal_size((100, 24)).columns, 120))
+    return {
+        "NDFs (ndf = ...)": NDF_DESCRIPTIONS,
+        "Masking-shadowing (masking = ...)": MASKINGS,
+        "Models (dfg, albedo, albedo_avg, specular_3d: model = ...)": SPECULAR_MODELS,
+        "Anisotropic models (specular_aniso: model = ...)": ANISO_MODELS,
+        "View azimuth (specular_aniso: view_azimuth = ...)": VIEW_AZIMUTHS,
+        "Fresnel (specular_3d: fresnel = ...; dfg factors Schlick out)": FRESNELS,
+        "Metals (specular_3d: metal = ...)": {k: f"n+ik R,G,B = {m.n} + i{m.k}; {m.source}" for k, m in METALS.items()},
+        "DFG layouts (layout = ...)": LAYOUTS,
+        "Estimators (dfg, albedo, albedo_avg, specular_3d: estimator = ...)": HEMISPHERE_ESTIMATORS,
+        "Diffuse models (kind = diffuse, model = ...)": DIFFUSE_MODELS,
+        "Estimators (diffuse, diffuse_3d: estimator = ...)": DIFFUSE_ESTIMATORS,
+        "Estimators (specular_aniso: estimator = ...)": ANISO_ESTIMATORS,
+        "Texel conventions (texel = ...)": TEXELS,
+    }
 
-    def section(title, items):
-        click.echo(click.style(title, bold=True))
-        for k, v in items.items():
-            lines = textwrap.wrap(v, width - 29, break_on_hyphens=False, break_long_words=False) or [
-                ""
-            ]  # whole descriptions, wrapped under their column
-            click.echo(f"  {k:<26} {lines[0]}" + "".join(f"\n{'':29}{line}" for line in lines[1:]))
-        click.echo()
 
-    section(
-        "Table kinds (kind = ...)",
-        {k.name + (f" ({', '.join(k.aliases)})" if k.aliases else ""): k.description for k in KINDS.values()},
-    )
-    section("NDFs (ndf = ...)", NDF_DESCRIPTIONS)
-    section("Masking-shadowing (masking = ...)", MASKINGS)
-    section("Models (dfg, albedo, albedo_avg, specular_3d: model = ...)", SPECULAR_MODELS)
-    section("Anisotropic models (specular_aniso: model = ...)", ANISO_MODELS)
-    section("View azimuth (specular_aniso: view_azimuth = ...)", VIEW_AZIMUTHS)
-
-    section("Fresnel (specular_3d: fresnel = ...; dfg factors Schlick out)", FRESNELS)
-    section(
-        "Metals (specular_3d: metal = ...)", {k: f"n+ik R,G,B = {m.n} + i{m.k}; {m.source}" for k, m in METALS.items()}
-    )
-    section("DFG layouts (layout = ...)", LAYOUTS)
-    section("Estimators (dfg, albedo, albedo_avg, specular_3d: estimator = ...)", HEMISPHERE_ESTIMATORS)
-    section("Diffuse models (kind = diffuse, model = ...)", DIFFUSE_MODELS)
-    section("Estimators (diffuse, diffuse_3d: estimator = ...)", DIFFUSE_ESTIMATORS)
-    section("Estimators (specular_aniso: estimator = ...)", ANISO_ESTIMATORS)
-    section("Texel conventions (texel = ...)", TEXELS)
-    section("Output formats (format = ... / --format)", ALL_FORMATS)
-    section(
-        "Presets (--preset NAME): what each is, and the files it writes",
-        {k: preset_text(p) for k, p in presets().items()},
-    )
+def _list_terms(width: int) -> None:
+    for title, items in _terms().items():
+        _section(width, title, items)
 
 
 def preset_text(path: Path) -> str:

@@ -7,28 +7,34 @@ Every file texel (row y, column x) then has a declared (NoV, alpha) (lutbake.kin
 reference is lutbake's Gauss-Legendre integral at those points (error ~4e-7), on a strided subset of at most
 ``max_side`` x ``max_side`` texels (the last row and column always included).
 
-Hypotheses (each one a prediction of the whole file, compared with the data by RMS over the channels the
-declared layout and the file share; the nominal one is the declared conventions):
-- positions: rows or columns flipped, axes swapped (square tables), the roughness or NoV axis shifted by
-  +-1/2 or +-1 texel (t -> t + s/N before the mapping), the roughness axis read as alpha (alpha = value) or
-  squared twice (alpha = value^4) -- each re-integrated at its own points;
-- values: sRGB-decoded (file = EOTF(truth), what a linear LUT loaded as sRGB and saved back holds) or
-  sRGB-encoded (file = OETF(truth)), R and G swapped, the other split-sum layout (scale/bias <-> multiscatter:
-  multiscatter (R, G) = (bias, scale + bias)).
-A hypothesis is reported as the diagnosis when its RMS is below MISMATCH_RATIO x the nominal RMS.
-Then, with the best conventions:
+Hypotheses: every combination of four factors (lutbake.commands.audit_search), each a prediction of the whole
+file, compared with the decoded file by RMS over the channels the declared layout and the file share; the nominal one
+is the declared conventions, with the storage encoding the preset's engine table declares (``EngineTable.encoding``:
+Babylon's RGBD PNG) when the file's storage can hold it:
+- points: the roughness or NoV axis shifted by +-1/2 or +-1 texel (t -> t + s/N before the mapping), the roughness
+  axis read as alpha (alpha = value) or squared twice (alpha = value^4) -- each re-integrated once at its own points;
+- channels: R and G swapped, the other split-sum layout (scale/bias <-> multiscatter: (R, G) = (bias, scale + bias));
+- order: rows or columns flipped, axes swapped (square tables) and their compositions -- undone on the file;
+- encoding: sRGB-encoded (file = OETF(truth)) or sRGB-decoded (file = EOTF(truth), a linear LUT loaded as sRGB and
+  saved back), RGBD, RGBM, half floats in 16-bit codes, or the values as stored -- undone by decoding the file.
+A combination is the diagnosis when its RMS is below MISMATCH_RATIO x that of the best with fewer mistakes. Its
+residual then says whether anything explains the data: the storage rounding alone, sampling noise (as rough from
+texel to texel as the engines' estimator's error of the same RMS), or neither ("no hypothesis explains the data").
+Then, with the chosen conventions:
 - quantisation: the smallest UNORM bit depth (8, 10, 12, 16) on whose code grid every value lies, or half
-  floats (every value exactly representable); the rounding error it alone explains, q / sqrt(12);
-- Monte-Carlo noise: the residual against the converged integral, compared with lutbake's own estimate by
-  the engines' usual generator (Hammersley points, NDF importance sampling: Filament cmgen, the glTF IBL
-  sampler, UE4) at N = 64 ... 16384 samples, quantised the same way; the N whose residual matches the file's
-  (log-log interpolation) is the estimated sample count.
+  floats (every value exactly representable); the rounding it alone leaves (the converged table encoded, rounded and
+  decoded as the file is);
+- Monte-Carlo noise, when the residual is noise: the residual against the converged integral, compared with
+  lutbake's own estimate by the engines' usual generator (Hammersley points, NDF importance sampling: Filament
+  cmgen, the glTF IBL sampler, UE4) at N = 64 ... 16384 samples, stored the same way; the N whose residual matches
+  the file's (log-log interpolation) is the estimated sample count.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -36,16 +42,35 @@ import numpy as np
 
 from ..axes import Axis
 from ..edge import NOV_MIN
+from ..io.bounded import reading_for
 from ..io.lut_files import LutFile, read_lut
 from .audit_report import (
     METRICS,
-    MISMATCH_RATIO,
     PERCENTILES,
     metric_value,
     stats,
     subset,
     verdict,
     write_error_map,
+)
+from .audit_search import (
+    DECLARED,
+    ENCODINGS,
+    EXACT_RMS,
+    MISMATCH_RATIO,
+    NOISE_ROUGHNESS_MIN,
+    Candidate,
+    Encoding,
+    Factor,
+    Search,
+    at_rounding,
+    channel_ops,
+    choose,
+    explain,
+    listed,
+    rms,
+    roughness,
+    round_trip,
 )
 from .audit_tables import dispatch
 from .reference import Conventions, Reference, conventions
@@ -54,32 +79,9 @@ MAX_SIDE = 128  # default subset: at most this many rows and columns are re-inte
 QUANT_TOL = 1e-3  # a value is on a UNORM code grid when |v (2^b - 1) - round| <= this (in codes)
 UNORM_BITS = (8, 10, 12, 16)
 NOISE_SAMPLES = (64, 256, 1024, 4096, 16384)  # the calibration bakes of the noise estimate
-NOISE_TEXELS = 1024  # texels of the subset used for the noise calibration (fixed, evenly spread)
-NOISE_FLOOR_RATIO = 1.5  # noise is reported when the residual exceeds this x what the quantisation explains
-
-
-def srgb_eotf(v):
-    """sRGB decoding (IEC 61966-2-1): what a sampler returns for a texture stored as sRGB."""
-    v = np.clip(v, 0.0, None)
-    return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
-
-
-def srgb_oetf(v):
-    """sRGB encoding (IEC 61966-2-1), the inverse of srgb_eotf."""
-    v = np.clip(v, 0.0, None)
-    return np.where(v <= 0.0031308, 12.92 * v, 1.055 * v ** (1 / 2.4) - 0.055)
-
-
-def other_layout(pred: np.ndarray, split_sum: str | None) -> np.ndarray:
-    """The same table written in the other split-sum layout (channels R, G; a third channel is kept); ``split_sum``:
-    the declared layout's pair (lutbake.layouts.base.Layout.split_sum)."""
-    out = pred.copy()
-    r, g = pred[..., 0], pred[..., 1]
-    if split_sum == "multiscatter":  # (Fc, E) -> (scale, bias) = (E - Fc, Fc)
-        out[..., 0], out[..., 1] = g - r, r
-    else:  # (scale, bias) -> (Fc, E) = (bias, scale + bias)
-        out[..., 0], out[..., 1] = g, r + g
-    return out
+NOISE_SIDE = (
+    32  # the noise calibration's grid: NOISE_SIDE + 1 evenly spread rows and columns of the subset (1089 texels)
+)
 
 
 @dataclass
@@ -93,16 +95,6 @@ class Positions:
     def map(self, fn) -> Positions:
         """The same index operation (flip, transpose, subset) applied to every field."""
         return Positions(fn(self.nov), fn(self.alpha), fn(self.rough))
-
-
-@dataclass
-class Hypothesis:
-    name: str
-    description: str
-    positions: Positions
-    transform: object = None  # values: callable(pred) -> pred, or None
-    rms: float = math.nan
-    max: float = math.nan
 
 
 def _axis_values(axis: Axis, shift: float) -> np.ndarray:
@@ -134,97 +126,36 @@ def positions(
     return Positions(nov, alpha, rough)
 
 
-def hypotheses(conv: Conventions) -> list[Hypothesis]:
-    nominal = positions(conv)
+def point_sets(conv: Conventions) -> list[tuple[Factor, Positions]]:
+    """The declared texel positions and the positional mistakes, each a set of points integrated once (the search's
+    first factor, lutbake.commands.audit_search)."""
     rname = next(a.name for a in conv.axes if a.name != "NoV")
-    declared_power = 2.0 if rname == "perceptual_roughness" else 1.0
-    hs = [Hypothesis("nominal", f"the declared conventions ({conv.source})", nominal)]
-    row_axis = conv.axes[0].name
-    hs.append(
-        Hypothesis(
-            "rows_flipped",
-            f"rows in reverse order (the {row_axis} axis flipped: row 0 at the other end)",
-            nominal.map(lambda a: a[::-1]),
-        )
-    )
-    hs.append(
-        Hypothesis(
-            "columns_flipped",
-            f"columns in reverse order (the {conv.axes[1].name} axis flipped)",
-            nominal.map(lambda a: a[:, ::-1]),
-        )
-    )
-    if nominal.nov.shape[0] == nominal.nov.shape[1]:
-        hs.append(
-            Hypothesis(
-                "axes_swapped", "rows and columns swapped (NoV and roughness exchanged)", nominal.map(lambda a: a.T)
-            )
-        )
+    out = [(DECLARED, positions(conv))]
     for axis, key in (("roughness", "shift_rough"), ("NoV", "shift_nov")):
         for s in (-1.0, -0.5, 0.5, 1.0):
             what = "one texel" if abs(s) == 1 else "half a texel"
             toward = "toward t = 1 (rougher)" if axis == "roughness" else "toward t = 1 (larger NoV)"
             if s < 0:
                 toward = toward.replace("t = 1", "t = 0").replace("rougher", "smoother").replace("larger", "smaller")
-            hs.append(
-                Hypothesis(
-                    f"{axis.lower()}_offset_{s:+g}",
-                    f"the {axis} axis offset by {what} {toward}: every texel holds t {s:+g}/N",
-                    positions(conv, **{key: s}),
-                )
-            )
-    if declared_power == 2.0:
-        hs.append(
-            Hypothesis(
-                "roughness_is_alpha",
-                "the roughness axis holds alpha (alpha = t), not perceptual roughness (alpha = t^2)",
-                positions(conv, alpha_power=1.0),
-            )
-        )
-        hs.append(
-            Hypothesis(
+            name = f"{axis.lower()}_offset_{s:+g}"
+            desc = f"the {axis} axis offset by {what} {toward}: every texel holds t {s:+g}/N"
+            out.append((Factor(name, f"{axis} axis offset {s:+g} texel", desc), positions(conv, **{key: s})))
+    powers = (
+        [
+            ("roughness_is_alpha", "roughness read as alpha", "alpha = t, not perceptual roughness (alpha = t^2)", 1.0),
+            (
                 "roughness_squared_twice",
+                "roughness squared twice",
                 "alpha = t^4: perceptual roughness squared twice",
-                positions(conv, alpha_power=4.0),
-            )
-        )
-    else:
-        hs.append(
-            Hypothesis(
-                "roughness_is_perceptual",
-                "the roughness axis holds perceptual roughness (alpha = t^2), not alpha",
-                positions(conv, alpha_power=2.0),
-            )
-        )
-    hs.append(
-        Hypothesis(
-            "srgb_decoded",
-            "values sRGB-decoded (file = sRGB EOTF(truth): a linear LUT read or converted as sRGB)",
-            nominal,
-            srgb_eotf,
-        )
+                4.0,
+            ),
+        ]
+        if rname == "perceptual_roughness"
+        else [("roughness_is_perceptual", "roughness read as perceptual", "alpha = t^2, not alpha", 2.0)]
     )
-    hs.append(Hypothesis("srgb_encoded", "values sRGB-encoded (file = sRGB OETF(truth))", nominal, srgb_oetf))
-    hs.append(
-        Hypothesis(
-            "channels_swapped",
-            "R and G swapped",
-            nominal,
-            lambda p: np.concatenate([p[..., 1:2], p[..., 0:1], p[..., 2:]], axis=-1),
-        )
-    )
-    if "other_split_sum" not in conv.record.audit:
-        return hs
-    other = "scale_bias" if conv.record.split_sum == "multiscatter" else "multiscatter"
-    hs.append(
-        Hypothesis(
-            "layout_" + other,
-            f"the file is in the {other} layout, declared {conv.layout} (multiscatter (R, G) = (bias, scale + bias))",
-            nominal,
-            lambda p: other_layout(p, conv.record.split_sum),
-        )
-    )
-    return hs
+    for name, label, desc, power in powers:
+        out.append((Factor(name, label, f"the roughness axis: {desc}"), positions(conv, alpha_power=power)))
+    return out
 
 
 def detect_quantisation(values: np.ndarray, storage: str) -> dict:
@@ -252,11 +183,12 @@ def rounding_step(values: np.ndarray, quant: dict) -> np.ndarray:
     return np.spacing(np.abs(np.asarray(values)).astype(dtype)).astype(np.float64)
 
 
-def recorded_attributes(path, shape=None) -> dict:
-    """The lutbake attributes the file records (EXR header, KTX2 key/value data, or its ``<file>.json`` sidecar);
-    {} for another tool's file."""
+def recorded_attributes(path, shape=None) -> tuple[dict, LutFile | None]:
+    """The lutbake attributes the file records (EXR header, KTX2 key/value data, or its ``<file>.json`` sidecar),
+    {} for another tool's file; and the file read (None where read_lut cannot read it), so it is read once."""
     try:
-        return read_lut(path, shape=shape).attrs
+        lut = read_lut(path, shape=shape)
+        return lut.attrs, lut
     except (ValueError, OSError):
         from ..io import bounded
 
@@ -264,8 +196,8 @@ def recorded_attributes(path, shape=None) -> dict:
         try:  # a sidecar that cannot be read records nothing: the audit then says what is wrong with the file
             doc = bounded.load_json(side) if side.is_file() else {}
         except (ValueError, OSError, RecursionError, UnicodeDecodeError):
-            return {}
-        return doc.get("lutbake", {}) if isinstance(doc, dict) else {}
+            return {}, None
+        return (doc.get("lutbake", {}) if isinstance(doc, dict) else {}), None
 
 
 def quantise(values: np.ndarray, quant: dict) -> np.ndarray:
@@ -334,53 +266,117 @@ class AuditReport:
         return "\n".join(lines)
 
 
-def _noise_estimate(integ: Reference, pos_sub: Positions, data: np.ndarray, ref: np.ndarray, quant: dict) -> dict:
-    """Estimated Monte-Carlo sample count of the file's generator (see the module docstring)."""
-    flat = np.arange(pos_sub.nov.size)
-    pick = flat[np.linspace(0, flat.size - 1, min(NOISE_TEXELS, flat.size)).round().astype(int)]
-    nov, alpha = pos_sub.nov.ravel()[pick], pos_sub.alpha.ravel()[pick]
-    ref2 = ref.reshape(-1, ref.shape[-1])[pick, :2]
-    obs = data.reshape(-1, data.shape[-1])[pick, :2]
-    rms_obs = float(np.sqrt(np.mean((obs - ref2) ** 2)))
-    rms_quant = float(np.sqrt(np.mean((quantise(ref2, quant) - ref2) ** 2)))
-    out = {"rms_residual": rms_obs, "rms_quantisation_alone": rms_quant, "texels": int(len(pick))}
-    if rms_obs <= max(NOISE_FLOOR_RATIO * rms_quant, 1e-6):
-        out.update(
-            detected=False,
-            samples=None,
-            description=f"no sampling noise above the storage rounding (residual RMS {rms_obs:.3g}, rounding "
-            f"alone {rms_quant:.3g})",
-        )
-        return out
+def _calibration(integ: Reference, chosen: Chosen, quant: dict, gy, gx) -> list[dict] | None:
+    """The engines' estimator (Hammersley points, NDF importance sampling) at NOISE_SAMPLES samples, at the chosen
+    points of the (gy, gx) grid of the subset, with the chosen channel mistake, stored in the chosen encoding and
+    rounded as the file is: per N, the RMS (R, G) of its error against the converged table and its roughness rho
+    (lutbake.commands.audit_search.roughness); None for a layout the estimator does not compute (the sheen ones)."""
+    grid = chosen.positions.map(lambda a: a[np.ix_(gy, gx)])
+    points = chosen.points_prediction[np.ix_(gy, gx)]
+    ref = chosen.prediction[np.ix_(gy, gx)][..., :2]
+
+    def stored(values):  # the chosen channel mistake, then the chosen encoding's rounding
+        return round_trip(chosen.candidate.channels.apply(values), chosen.encoding, lambda v: quantise(v, quant))
+
     curve = []
     for n in NOISE_SAMPLES:
-        est = integ.hammersley(nov, alpha, n)
+        est = integ.hammersley(grid.nov.ravel(), grid.alpha.ravel(), n)
         if est is None:
-            out.update(
-                detected=True,
-                samples=None,
-                description=f"residual RMS {rms_obs:.3g} above the rounding "
-                f"({rms_quant:.3g}); no sample-count calibration for layout {integ.layout}",
-            )
-            return out
-        curve.append((n, float(np.sqrt(np.mean((quantise(est, quant) - ref2) ** 2)))))
-    out["calibration"] = [{"samples": n, "rms": e} for n, e in curve]
-    ns, es = np.log([c[0] for c in curve]), np.log([c[1] for c in curve])
+            return None
+        full = points.copy()
+        full[..., :2] = est.reshape(points.shape[:2] + (2,))
+        err = stored(full)[..., :2] - ref
+        curve.append({"samples": n, "rms": rms(err), "roughness": roughness(err)})
+    return curve
+
+
+def _noise(curve: list[dict] | None, rms_obs: float, rms_quant: float, layout: str) -> dict:
+    """The estimated sample count of the file's generator: the N whose estimator error (``curve``) matches the file's
+    residual RMS, interpolated in log-log (see the module docstring)."""
+    out = {"detected": True, "rms_residual": rms_obs, "rms_quantisation_alone": rms_quant, "samples": None}
+    if curve is None:
+        out["description"] = (
+            f"sampling noise: residual RMS {rms_obs:.3g} above the rounding ({rms_quant:.3g}) and rough as noise; "
+            f"no sample-count calibration for layout {layout}"
+        )
+        return out
+    out["calibration"] = curve
+    ns, es = np.log([c["samples"] for c in curve]), np.log([c["rms"] for c in curve])
     order = np.argsort(es)  # np.interp needs increasing x: the error falls with N
-    if rms_obs >= curve[0][1]:
-        n_est, bound = None, f"<= {curve[0][0]}"
-    elif rms_obs <= curve[-1][1]:
-        n_est, bound = None, f">= {curve[-1][0]}"
+    if rms_obs >= curve[0]["rms"]:
+        bound = f"<= {curve[0]['samples']}"
+    elif rms_obs <= curve[-1]["rms"]:
+        bound = f">= {curve[-1]['samples']}"
     else:
-        n_est = float(np.exp(np.interp(np.log(rms_obs), es[order], ns[order])))
-        bound = f"~{n_est:.0f}"
-    out.update(
-        detected=True,
-        samples=n_est,
-        samples_bound=bound,
-        description=f"Monte-Carlo noise: residual RMS {rms_obs:.3g} vs {rms_quant:.3g} from rounding alone; "
-        f"matches a Hammersley NDF-sampled estimate with {bound} samples per texel",
+        out["samples"] = float(np.exp(np.interp(np.log(rms_obs), es[order], ns[order])))
+        bound = f"~{out['samples']:.0f}"
+    out["samples_bound"] = bound
+    out["description"] = (
+        f"Monte-Carlo noise: residual RMS {rms_obs:.3g} vs {rms_quant:.3g} from rounding alone; matches a "
+        f"Hammersley NDF-sampled estimate with {bound} samples per texel"
     )
+    return out
+
+
+def _nearest_roughness(curve: list[dict] | None, rms_obs: float) -> float | None:
+    """rho of the calibration point whose RMS is nearest the file's (in log)."""
+    if not curve:
+        return None
+    near = min(curve, key=lambda c: abs(math.log(max(c["rms"], 1e-300)) - math.log(max(rms_obs, 1e-300))))
+    return near["roughness"]
+
+
+@dataclass
+class Chosen:
+    """The chosen combination at the subset: its candidate, encoding, the decoded re-ordered file (``data``), the
+    prediction (``prediction``; before the channel mistake: ``points_prediction``) and the points' positions."""
+
+    candidate: Candidate
+    encoding: Encoding
+    data: np.ndarray
+    prediction: np.ndarray
+    points_prediction: np.ndarray
+    positions: Positions
+
+
+def declared_encoding(conv_args: dict | None, lut: LutFile) -> tuple[Encoding, str]:
+    """The storage encoding of the preset's engine table (lutbake.layouts.base.EngineTable.encoding) when this file's
+    storage can hold it (RGBD: four 8-bit channels), else ``plain``; and the words for the conventions line."""
+    from ..layouts import TABLES
+
+    preset = (conv_args or {}).get("preset")
+    name = next((t.encoding for t in TABLES if preset and t.preset == preset), "plain")
+    enc = ENCODINGS[name]
+    if enc.applies(lut.data, lut.storage):
+        return enc, f"storage {name}"
+    return ENCODINGS["plain"], (
+        f"storage plain (the engine ships {name}, which a {lut.storage} file of {lut.data.shape[-1]} channel(s) "
+        "does not hold)"
+    )
+
+
+def _diagnosis(nominal: Candidate, chosen: Candidate, cands: list[Candidate], why: str, rho, rounding: float) -> list:
+    out = []
+    if chosen is not nominal:
+        out.append(
+            f"convention mismatch: {chosen.label} ({chosen.name}: {chosen.description}): RMS {nominal.rms:.3g} -> "
+            f"{chosen.rms:.3g}, max {nominal.max:.3g} -> {chosen.max:.3g}"
+        )
+    elif why != "smooth":
+        alt = next(c for c in cands if c is not nominal)
+        out.append(
+            f"the declared conventions fit: no combination of the usual mistakes explains the data better by "
+            f"{1 / MISMATCH_RATIO:g}x (nominal RMS {nominal.rms:.3g}; best alternative {alt.name}, {alt.rms:.3g})"
+        )
+    if why == "smooth":
+        out.append(
+            f"no hypothesis explains the data: the best, {chosen.label}, leaves RMS {chosen.rms:.3g} (declared "
+            f"conventions {nominal.rms:.3g}) as a smooth residual (Laplacian energy share {rho:.2g} < "
+            f"{NOISE_ROUGHNESS_MIN:g}): neither sampling noise nor the storage rounding (RMS {rounding:.2g}) -- a "
+            "model, term or convention the audit does not try"
+        )
+    elif why == "unknown":
+        out.append("too few texels (under 3 x 3) to tell sampling noise from a systematic residual")
     return out
 
 
@@ -398,11 +394,12 @@ def audit(
     neither a preset nor a config, the conventions the file records; see the module docstring)."""
     if metric not in METRICS:
         raise ValueError(f"metric {metric!r}: allowed {', '.join(METRICS)}")
-    recorded = recorded_attributes(path, shape)
-    other = dispatch(path, conv_args, tolerance, metric, max_side, error_map, recorded)  # LTC and OpenPBR
-    if other is not None:
-        return other
-    lut: LutFile = read_lut(path, shape=shape)
+    with reading_for("audit"):  # the read's memory budget counts the audit's work on the values
+        recorded, lut = recorded_attributes(path, shape)
+        other = dispatch(path, conv_args, tolerance, metric, max_side, error_map, recorded)  # LTC and OpenPBR
+        if other is not None:
+            return other
+        lut = lut or read_lut(path, shape=shape)  # read again only to raise what is wrong with it
     rows, cols, fch = lut.data.shape
     bad = ~np.isfinite(lut.data)
     if bad.any():
@@ -414,49 +411,76 @@ def audit(
     conv = conventions(**(conv_args or {}), shape=(rows, cols), recorded=lut.attrs, path=path)
     integ = Reference(conv, workers)
     names = list(conv.record.channels)
-    nch = min(fch, len(names))
+    declared, storage_words = declared_encoding(conv_args, lut)
+    nch = min(declared.channels(fch), len(names))
     # the sheen layouts keep their value in B only (charlie) or R, G: compare what the layout fills
     compared = [c for c in range(nch) if not names[c].startswith("zero")]
+    encodings = [declared] + [
+        e
+        for e in ENCODINGS.values()
+        if e is not declared and e.applies(lut.data, lut.storage) and e.channels(fch) >= nch
+    ]
     iy, ix = subset(rows, max_side), subset(cols, max_side)
-    data = lut.data[np.ix_(iy, ix)][..., :nch]
-    hs = hypotheses(conv)
-    preds = {}
-    for h in hs:
-        sub = h.positions.map(lambda a: a[np.ix_(iy, ix)])
-        pred = integ.converged(sub.nov.ravel(), sub.alpha.ravel(), sub.rough.ravel()).reshape(len(iy), len(ix), -1)[
-            ..., :nch
-        ]
-        if h.transform is not None:
-            pred = h.transform(pred)
-        d = (data - pred)[..., compared]
-        h.rms, h.max = float(np.sqrt(np.mean(d**2))), float(np.max(np.abs(d)))
-        preds[h.name] = (pred, sub)
-    nominal = hs[0]
-    best = min(hs, key=lambda h: h.rms)
-    diagnosis = []
-    if best is not nominal and best.rms < MISMATCH_RATIO * nominal.rms:
-        diagnosis.append(
-            f"convention mismatch: {best.name}: {best.description} (RMS {nominal.rms:.3g} -> "
-            f"{best.rms:.3g}, max {nominal.max:.3g} -> {best.max:.3g})"
-        )
-        chosen = best
-    else:
-        alt = min((h for h in hs if h is not nominal), key=lambda h: h.rms)
-        diagnosis.append(
-            f"the declared conventions fit: no alternative explains the data better by {1 / MISMATCH_RATIO:g}x "
-            f"(nominal RMS {nominal.rms:.3g}; best alternative {alt.name}, {alt.rms:.3g})"
-        )
-        chosen = nominal
+    ops = channel_ops(conv.record, conv.layout)
+    preds, points = {}, {}
+    for pts, pos in point_sets(conv):  # the search's one cost: each point set integrated once
+        sub = pos.map(lambda a: a[np.ix_(iy, ix)])
+        pred = integ.converged(sub.nov.ravel(), sub.alpha.ravel(), sub.rough.ravel())
+        points[pts] = (sub, pred.reshape(len(iy), len(ix), -1)[..., :nch])
+        for op in ops:
+            preds[(pts, op)] = op.apply(points[pts][1])
+    t_search = time.perf_counter()
+    search = Search(lut.data, lut.storage, iy, ix, compared, nch, encodings, preds)
+    cands = search.run()
+    t_search = time.perf_counter() - t_search
+    nominal = next(c for c in cands if c.mistakes == 0)
+    chosen = choose(cands)
+    enc_c = declared if chosen.encoding is DECLARED else ENCODINGS[chosen.encoding.name]
+    pick = Chosen(
+        chosen,
+        enc_c,
+        search.decoded(enc_c, chosen.order),
+        preds[(chosen.points, chosen.channels)],
+        points[chosen.points][1],
+        points[chosen.points][0],
+    )
     quant = detect_quantisation(lut.data[..., [c for c in compared if c < fch]], lut.storage)
-    ref_nominal, sub_nominal = preds["nominal"]
-    pred_c, sub_c = preds[chosen.name]
-    noise = {"detected": False, "description": "not estimated (values were transformed)"}
-    if chosen.transform is None:
-        noise = _noise_estimate(integ, sub_c, data, pred_c, quant)
-    if quant["kind"] != "float":
-        diagnosis.append(f"stored as {quant['description']}")
-    diagnosis.append(noise["description"])
-    err = data - ref_nominal
+    rounding = rms(
+        round_trip(pick.prediction, enc_c, lambda v: quantise(v, quant))[..., compared] - pick.prediction[..., compared]
+    )
+    res = pick.data - pick.prediction
+    why, rho, noise = "rounding", None, {"detected": False}
+    if at_rounding(res[..., compared], rounding):
+        noise["description"] = (
+            f"no sampling noise above the storage rounding (residual RMS {chosen.rms:.3g}, rounding alone "
+            f"{rounding:.3g}, the reference's own error {EXACT_RMS:g})"
+        )
+    else:  # noise or a smooth residual: held against the engines' estimator on a grid of the subset
+        gy, gx = (np.unique(np.linspace(0, n - 1, min(n, NOISE_SIDE + 1)).round().astype(int)) for n in res.shape[:2])
+        curve = _calibration(integ, pick, quant, gy, gx)
+        rg = [c for c in compared if c < 2] if curve is not None else compared
+        grid_res = res[np.ix_(gy, gx)][..., rg]
+        why, rho = explain(grid_res, _nearest_roughness(curve, rms(grid_res)))
+        if why == "noise":
+            rms_quant = rms(
+                round_trip(pick.prediction, enc_c, lambda v: quantise(v, quant))[np.ix_(gy, gx)][..., rg]
+                - pick.prediction[np.ix_(gy, gx)][..., rg]
+            )
+            noise = _noise(curve, rms(grid_res), rms_quant, integ.layout)
+        else:
+            noise["description"] = f"not estimated: the residual is not noise-like ({why})"
+        if curve is not None:
+            noise["calibration"] = curve
+    diagnosis = _diagnosis(nominal, chosen, cands, why, rho, rounding)
+    if quant["kind"] != "float" or declared.name != "plain":
+        diagnosis.append(
+            f"stored as {quant['description']}" + (f", {declared.label}" if declared.name != "plain" else "")
+        )
+    if why in ("rounding", "noise"):
+        diagnosis.append(noise["description"])
+    raw_sub = lut.data[np.ix_(iy, ix)]
+    ref_nominal = preds[(nominal.points, nominal.channels)]
+    err = search.decoded(declared, nominal.order) - ref_nominal
     y_vals = conv.axes[0].values()[iy]
     x_vals = conv.axes[1].values()[ix]
     errors = {}
@@ -471,7 +495,7 @@ def audit(
     allerr = np.abs(err[..., compared])
     # judged: what exceeds one rounding step of the storage at each stored value (a table that is exactly a
     # converged bake, rounded to its storage, is within half a step plus its bake tolerance)
-    step = rounding_step(data[..., compared], quant)
+    step = declared.step(raw_sub, rounding_step(raw_sub, quant))[..., :nch][..., compared]
     beyond = np.clip(allerr - step, 0.0, None)
     value = metric_value(beyond, metric)
     k = np.unravel_index(np.argmax(allerr), allerr.shape)
@@ -481,7 +505,7 @@ def audit(
         conventions=f"{conv.source} (layout {conv.layout}, {conv.axes[0].name} rows "
         f"{conv.axes[0].texel}/{conv.axes[0].mapping}/{conv.axes[0].order}, "
         f"{conv.axes[1].name} columns {conv.axes[1].texel}/{conv.axes[1].mapping}/"
-        f"{conv.axes[1].order})",
+        f"{conv.axes[1].order}; {storage_words})",
         channels=["RGBA"[c] for c in compared],
         evaluated={
             "rows": len(iy),
@@ -491,12 +515,21 @@ def audit(
             "stride": int(max(1, math.ceil(max(rows, cols) / max_side))),
         },
         errors=errors,
-        hypotheses=[{"name": h.name, "description": h.description, "rms": h.rms, "max": h.max} for h in hs],
+        hypotheses=[c.as_dict() for c in listed(cands)],
         diagnosis=diagnosis,
         quantisation=quant,
         noise=noise,
         **verdict(metric, tolerance, value),
-        extra={"best": best.name, "chosen": chosen.name, "storage": lut.storage, "raw_error": raw},
+        extra={
+            "best": cands[0].name,
+            "chosen": chosen.name,
+            "explained": why,
+            "roughness": rho,
+            "encoding": declared.name,
+            "storage": lut.storage,
+            "raw_error": raw,
+            "search": {"combinations": len(cands), "seconds": t_search},
+        },
     )
     if error_map is not None:
         report.error_map = str(

@@ -20,17 +20,21 @@ split-sum reconstruction (albedo, diffuse, btf, the sheen albedo-scaling layouts
 
 from __future__ import annotations
 
+import re
 import textwrap
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from ..axes import Axis
 from ..errors import LutbakeError
+from ..io.bounded import reading_for
 from ..io.readers import TableView, read_table
 from ..textsafe import bounded, shorten
 
 N_SPHERES = 5
+MAX_CHANNELS = 4  # channels drawn (a table has 1 to 4; a renderer's EXR may add Z and others)
 MAX_SLICES = 6  # columns of a 3D slice grid
 MAX_BTF_SIGMAS, MAX_BTF_PHIS = 4, 5
 SPHERE_F0 = np.array([1.0, 0.71, 0.29])  # a gold-like conductor's f0 (RGB)
@@ -50,11 +54,21 @@ SYMBOLS = {
     "alpha": "α",
     "perceptual_roughness": "perceptual roughness r",
     "f0": "f0",
+    "sphere_z": "z = cos elevation of F",
+    "sphere_len": "len = |F|",
 }
 ROUGHNESS_AXES = ("perceptual_roughness", "alpha")
 MEANING_WIDTH, MEANING_LINES = 44, 4  # characters per line and lines of a channel's meaning under its name
 CLIP_PERCENTILE, CLIP_RATIO = 99.0, 3.0  # colour scale: see _color_range
 CHARS_PER_INCH = 13  # of 9-point text: where the figure title wraps
+# LTC matrix entries span decades (HDRP's M^-1 / M^-1_22 reaches the FP16 saturation 65504 at smooth grazing texels
+# while most lie near 1): past LOG_SPAN between the largest |value| and the LOG_FLOOR_PERCENTILE of the non-zero
+# ones, a symmetric log colour scale, linear within that floor
+LOG_SPAN, LOG_FLOOR_PERCENTILE = 1.0e2, 5.0
+LOG_TICKS_PER_SIGN = 4  # decades labelled on each side of 0
+LTC_PANEL_INCHES, LTC_TITLE_CHARS, LTC_TITLE_LINES = 3.3, 34, 5
+LTC_TEXTURES = ("ltc_1: the inverse matrix M⁻¹ (normalised)", "ltc_2: magnitude, Fresnel, fit error, sphere")
+SPHERE_MEANING = "sphere"  # the ltc_2 channel on its own axes (lutbake.kinds.ltc: x = z * 0.5 + 0.5, y = len)
 
 
 def _label(axis: Axis) -> str:
@@ -190,8 +204,9 @@ def _ticks(ax, axis: Axis | None, n: int, which: str, label: bool = True) -> Non
         (ax.set_xlabel if which == "x" else ax.set_ylabel)(text, fontsize=8)
 
 
-def _image(fig, ax, img, y_axis, x_axis, vmin=None, vmax=None, labels=(True, True), bar=True):
-    im = ax.imshow(img, origin="lower", cmap="viridis", interpolation="nearest", aspect="auto", vmin=vmin, vmax=vmax)
+def _image(fig, ax, img, y_axis, x_axis, vmin=None, vmax=None, labels=(True, True), bar=True, norm=None):
+    limits = {"norm": norm} if norm is not None else {"vmin": vmin, "vmax": vmax}
+    im = ax.imshow(img, origin="lower", cmap="viridis", interpolation="nearest", aspect="auto", **limits)
     _ticks(ax, x_axis, img.shape[1], "x", labels[0])
     _ticks(ax, y_axis, img.shape[0], "y", labels[1])
     if bar:
@@ -201,7 +216,11 @@ def _image(fig, ax, img, y_axis, x_axis, vmin=None, vmax=None, labels=(True, Tru
 
 def _color_range(values: np.ndarray) -> tuple[float, float, str]:
     """(vmin, vmax, note): the full range, or up to the CLIP_PERCENTILE when a few texels (a grazing corner)
-    are far above the rest, so the rest stays readable; the note says so and gives the true maximum."""
+    are far above the rest, so the rest stays readable; the note says so and gives the true maximum. Non-finite
+    values (masked as NaN by _drawable) are left out."""
+    values = values[np.isfinite(values)]
+    if not values.size:
+        return 0.0, 1.0, "\nno finite value"
     lo, hi = float(values.min()), float(values.max())
     top = float(np.percentile(values, CLIP_PERCENTILE))
     if hi - lo > CLIP_RATIO * (top - lo) > 0:
@@ -217,7 +236,7 @@ def _channel_title(view: TableView, c: int) -> str:
         lines = lines[: MEANING_LINES - 1] + [textwrap.shorten(" ".join(lines[MEANING_LINES - 1 :]), MEANING_WIDTH)]
     col = view.data[..., c]
     const = f"  (constant {float(col.flat[0]):.3g})" if col.size and col.min() == col.max() else ""
-    return "\n".join([f"{'RGBA'[c]} = {name}{const}"] + lines)
+    return "\n".join([f"{'RGBA'[c]} = {name}{const}" if c < len("RGBA") else f"{name}{const}"] + lines)
 
 
 def _suptitle(view: TableView, path: Path, width_chars: int) -> str:
@@ -309,6 +328,101 @@ def _fig_3d(plt, view, spheres):
     return fig, width
 
 
+def _log_norm(values: np.ndarray):
+    """A symmetric log norm when |values| span more than LOG_SPAN (see there), else None (a linear scale)."""
+    from matplotlib.colors import SymLogNorm
+
+    mag = np.abs(values[np.isfinite(values)])
+    nonzero = mag[mag > 0]
+    if nonzero.size == 0:
+        return None
+    floor = float(np.percentile(nonzero, LOG_FLOOR_PERCENTILE))
+    if float(nonzero.max()) <= LOG_SPAN * floor:
+        return None
+    return SymLogNorm(linthresh=floor, vmin=float(np.nanmin(values)), vmax=float(np.nanmax(values)), base=10)
+
+
+def _ltc_meanings(meaning: str) -> tuple[str, str]:
+    """A 3D LTC channel's meaning, "slice 0 (ltc_1): ...; slice 1 (ltc_2): ...", as (ltc_1's, ltc_2's)."""
+    m = re.search(r"slice 0(?: \(ltc_1\))?: (.*?); slice 1(?: \(ltc_2\))?: (.*)", meaning)
+    return (m.group(1), m.group(2)) if m else (meaning, meaning)
+
+
+def _ltc_title(letter: str, text: str, note: str) -> str:
+    lines = textwrap.wrap(f"{letter}: {text}", LTC_TITLE_CHARS)
+    if len(lines) > LTC_TITLE_LINES:
+        lines = lines[: LTC_TITLE_LINES - 1] + [
+            textwrap.shorten(" ".join(lines[LTC_TITLE_LINES - 1 :]), LTC_TITLE_CHARS)
+        ]
+    return "\n".join(lines + ([note] if note else []))
+
+
+def _sphere_axes(n_y: int, n_x: int) -> tuple[Axis, Axis]:
+    """The sphere channel's own (y, x) axes: len = j/(N - 1) up, z = 2 i/(N - 1) - 1 across (endpoint texels)."""
+    return Axis("sphere_len", "y", n_y, 0.0, 1.0, texel="endpoint"), Axis(
+        "sphere_z", "x", n_x, -1.0, 1.0, texel="endpoint"
+    )
+
+
+def _log_ticks(norm) -> list[float]:
+    """Decades of a SymLogNorm's range, at most LOG_TICKS_PER_SIGN a side (every k-th), and 0 where it is inside."""
+
+    def decades(top: float) -> list[float]:
+        if top <= norm.linthresh:
+            return []
+        ks = list(range(int(np.ceil(np.log10(norm.linthresh))), int(np.floor(np.log10(top))) + 1))
+        step = max(1, -(-len(ks) // LOG_TICKS_PER_SIGN))
+        return [10.0**k for k in ks[::-1][::step]]
+
+    ticks = [-v for v in decades(-norm.vmin)] + ([0.0] if norm.vmin < 0 < norm.vmax else []) + decades(norm.vmax)
+    return sorted(ticks)
+
+
+def _ltc_panel(canvas, ax, img, axes, title, matrix: bool) -> None:
+    """One LTC channel: a log colour scale for a matrix entry spanning decades, else the usual range."""
+    from matplotlib.ticker import FuncFormatter
+
+    norm = _log_norm(img) if matrix else None
+    if norm is not None:
+        note = "log colour scale"
+        im = _image(canvas, ax, img, *axes, norm=norm, bar=False)
+        ticks = _log_ticks(norm)
+    else:
+        vmin, vmax, note = _color_range(img)
+        im = _image(canvas, ax, img, *axes, vmin, vmax, bar=False)
+        ticks = None
+    if img.size and img.min() == img.max():
+        note = f"constant {float(img.flat[0]):.3g}"
+    bar = canvas.colorbar(im, ax=ax, fraction=0.046, pad=0.04, ticks=ticks)
+    bar.ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.3g}"))  # plain text: mathtext is off
+    bar.ax.tick_params(labelsize=7)
+    ax.set_title(_ltc_title(*title, note.strip()), fontsize=7, loc="left")
+
+
+def _fig_ltc(plt, view):
+    """An LTC table: one row per texture, ltc_1 (the matrix, log-scaled where it spans decades) and ltc_2, each
+    channel its own panel and colour scale, each row titled once (a subfigure each: no title overlaps another),
+    the sphere channel on its own (z, len) axes. HDRP's .cs holds the matrix alone: one row."""
+    data = view.data if view.data.ndim == 4 else view.data[None]
+    n_tex, nch = data.shape[0], data.shape[-1]
+    table_axes = (_axis_by_dim(view, "y"), _axis_by_dim(view, "x"))
+    width = LTC_PANEL_INCHES * nch
+    fig = plt.figure(figsize=(width, 4.3 * n_tex + 0.8), dpi=100, layout="constrained")
+    rows = fig.subfigures(n_tex, 1) if n_tex > 1 else [fig]
+    for k, row in enumerate(rows):
+        if n_tex > 1:
+            row.suptitle(LTC_TEXTURES[k] + f"  (slice {k})", fontsize=9, x=0.01, ha="left")
+        for c in range(nch):
+            meaning = _ltc_meanings(view.meanings[c])[k] if n_tex > 1 else view.meanings[c]
+            sphere_channel = n_tex > 1 and k == 1 and meaning.startswith(SPHERE_MEANING)
+            img = data[k, ..., c]
+            axes = _sphere_axes(*img.shape) if sphere_channel else table_axes
+            name = view.channel_names[c]
+            letter = f"{'RGBA'[c]} = {name}" if name not in "xyzw" else f"{'RGBA'[c]} (.{name})"
+            _ltc_panel(row, row.add_subplot(1, nch, c + 1), img, axes, (letter, meaning), matrix=k == 0)
+    return fig, width
+
+
 def _fig_btf(plt, view):
     """Light x view images, one row per sigma slice, one column per phi block (a y_block axis)."""
     z_axis, block, y_axis, x_axis = (_axis_by_dim(view, d) for d in ("z", "y_block", "y", "x"))
@@ -316,7 +430,7 @@ def _fig_btf(plt, view):
     sig = _pick(data.shape[0], MAX_BTF_SIGMAS)
     phis = _pick(block.count, MAX_BTF_PHIS)
     ny = y_axis.count
-    vmin, vmax = float(data[..., 0].min()), float(data[..., 0].max())
+    vmin, vmax, _ = _color_range(data[..., 0])
     fig = plt.figure(figsize=(2.6 * len(phis) + 1.4, 2.6 * len(sig) + 1.4), dpi=100, layout="constrained")
     zvals, pvals = (z_axis.values() if z_axis is not None else None), block.values()
     for i, k in enumerate(sig):
@@ -345,6 +459,28 @@ def _sphere_row(canvas, view, spheres):
         ax.axis("off")
 
 
+def _drawable(view: TableView) -> tuple[TableView, list[str]]:
+    """The view as drawn, and what was left out, each in one line: channels past MAX_CHANNELS (an EXR's RGBA + Z: the
+    RGBA channels are drawn), and non-finite values, masked (NaN: not coloured; no sphere row is shaded from them)."""
+    notes = []
+    nch = view.data.shape[-1]
+    if nch > MAX_CHANNELS:
+        left = ", ".join(view.channel_names[MAX_CHANNELS:])
+        notes.append(f"{nch} channels: the first {MAX_CHANNELS} are drawn, not {bounded(left, 200)}")
+        view = replace(
+            view,
+            data=view.data[..., :MAX_CHANNELS],
+            channel_names=view.channel_names[:MAX_CHANNELS],
+            meanings=view.meanings[:MAX_CHANNELS],
+        )
+    bad = ~np.isfinite(view.data)
+    count = int(bad.sum())
+    if count:
+        notes.append(f"{count} non-finite values (NaN/Inf) of {view.data.size} masked: drawn uncoloured")
+        view = replace(view, data=np.where(bad, np.float32(np.nan), view.data))
+    return view, notes
+
+
 def figure(path):
     """The preview of the table file at ``path`` as a matplotlib Figure (Agg; close it when done)."""
     import matplotlib
@@ -353,19 +489,27 @@ def figure(path):
     import matplotlib.pyplot as plt
 
     path = Path(path)
-    view = read_table(path)
-    spheres = split_sum(view)
+    with reading_for("preview"):  # the read's memory budget counts what drawing takes
+        view, notes = _drawable(read_table(path))
+    spheres = split_sum(view) if not notes else None
     dims = {a.dim for a in view.axes}
     with matplotlib.rc_context({"text.parse_math": False}):  # names from the file are text: "$x$" is no formula
         if "y_block" in dims:
             fig, inches = _fig_btf(plt, view)
+        elif view.kind == "ltc" and view.data.ndim in (3, 4) and view.data.shape[-1] == 4:
+            fig, inches = _fig_ltc(plt, view)
         elif view.axes and dims == {"x"}:
             fig, inches = _fig_1d(plt, view)
         elif view.data.ndim == 4:
             fig, inches = _fig_3d(plt, view, spheres)
         else:
             fig, inches = _fig_2d(plt, view, spheres)
-        note = "" if spheres or not view.kind else f"\n(no sphere row: {view.kind} has no split-sum reconstruction)"
+        note = (
+            ""
+            if spheres or not view.kind or notes
+            else f"\n(no sphere row: {view.kind} has no split-sum reconstruction)"
+        )
+        note += "".join(f"\n({n})" for n in notes)
         fig.suptitle(_suptitle(view, path, int(inches * CHARS_PER_INCH)) + note, fontsize=9)
     return fig
 

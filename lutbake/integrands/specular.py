@@ -147,6 +147,28 @@ def half_vector_integrand(lobe, vec, skip_below_horizon_h: bool):
     return integrand
 
 
+def charlie_integrands(lobe, vec):
+    """(g, g_sin2) of a lobe with a Charlie NDF, ``lobe(v, h, l, v.h, alpha, param, D)`` given D's value:
+    ``g(v, h, alpha, param)`` with D = D_charlie of the float32 h (the QMC estimators), ``g_sin2(v, h, alpha,
+    param, sin2)`` with D = D_charlie_sin2 of sin^2(theta_h) in float64 (the gauss_legendre panel rules pass their
+    node's: sin^(1/alpha) multiplies a float32 h's rounding by 1 / (2 alpha), 5e3 at alpha = 1e-4). Both 0 where
+    n.l, v.h or n.v <= COS_EPS (half_vector_integrand's prologue) and where n.h <= 0 (D_charlie = 0 there)."""
+
+    @wp.func
+    def lobe32(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float):
+        return lobe(v, h, l, VoH, alpha, param, ndf.D_charlie(h, alpha))
+
+    @wp.func
+    def g_sin2(v: wp.vec3, h: wp.vec3, alpha: float, param: float, sin2: wp.float64):
+        l = reflect(v, h)
+        VoH = wp.dot(v, h)
+        if l[2] <= COS_EPS or VoH <= COS_EPS or v[2] <= COS_EPS or h[2] <= 0.0:
+            return vec()
+        return lobe(v, h, l, VoH, alpha, param, ndf.D_charlie_sin2(sin2, alpha))
+
+    return half_vector_integrand(lobe32, vec, False), g_sin2
+
+
 @functools.lru_cache(maxsize=None)
 def weight_for(ndf_name: str, masking_name: str, form: str):
     """f (n.l) 4 (v.h) / F of an integrand form (``integrand_for``) at (v, h, l, v.h, alpha)."""
@@ -183,10 +205,9 @@ def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: st
         ashikhmin_shirley  f = (s + 1)/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v)) [x F]:
                                                                       g = (s + 1)/(2 pi) (n.h)^s (n.l) / max(n.l, n.v)
     with s = 2 / alpha^2 - 2 for the last two (ndf_name, masking_name are then unused)."""
-    if channels_name == "multiscatter_cloth":
-        return cloth_integrand_for(ndf_name, masking_name)
-    if channels_name in SHEEN_LAYOUTS:
-        return sheen_integrand_for(channels_name)
+    charlie = charlie_pair_for(ndf_name, masking_name, channels_name)
+    if charlie is not None:
+        return charlie[0]
     ch, vec = channels_for(channels_name)
     weight = weight_for(ndf_name, masking_name, form)
 
@@ -197,18 +218,28 @@ def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: st
     return half_vector_integrand(lobe, vec, True)
 
 
+def charlie_pair_for(ndf_name: str, masking_name: str, channels_name: str):
+    """(g, g_sin2) of the channels with a Charlie lobe (charlie_integrands: the cloth and sheen layouts), else None."""
+    if channels_name == "multiscatter_cloth":
+        return cloth_integrand_for(ndf_name, masking_name)
+    if channels_name in SHEEN_LAYOUTS:
+        return sheen_integrand_for(channels_name)
+    return None
+
+
 @functools.lru_cache(maxsize=None)
 def cloth_integrand_for(ndf_name: str, masking_name: str):
     """(Fc s, s, D_charlie V_ashikhmin (n.l) 4 (v.h)) with s = D G2 (v.h)/(n.v): the multiscatter
-    channels plus Filament's cloth DV (DFV_Charlie_Uniform), 0 where n.l or v.h <= COS_EPS (back-facing)."""
+    channels plus Filament's cloth DV (DFV_Charlie_Uniform), 0 where n.l or v.h <= COS_EPS (back-facing): (g, g_sin2),
+    charlie_integrands."""
     weight = weight_for(ndf_name, masking_name, "microfacet")
 
     @wp.func
-    def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float):
-        cloth = ndf.D_charlie(h, alpha) * masking.V_ashikhmin(v[2], l[2]) * l[2] * 4.0 * VoH
+    def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float, dch: float):
+        cloth = dch * masking.V_ashikhmin(v[2], l[2]) * l[2] * 4.0 * VoH
         return channels_multiscatter3(VoH, param) * weight(v, h, l, VoH, alpha) + wp.vec3(0.0, 0.0, cloth)
 
-    return half_vector_integrand(lobe, wp.vec3, False)
+    return charlie_integrands(lobe, wp.vec3)
 
 
 @functools.lru_cache(maxsize=None)
@@ -219,18 +250,19 @@ def sheen_integrand_for(layout: str):
                       R: E(mu) with the spec's Charlie visibility, G: with Ashikhmin's
         sheen_fgd     (D_charlie V_charlie Fc (n.l) 4 (v.h), D_charlie V_charlie (n.l) 4 (v.h)), Fc = (1 - v.h)^5:
                       the multiscatter pair of the sheen lobe (Unity HDRP PreIntegratedFGD_CharlieFabricLambert)
-    0 where n.l, v.h or n.v <= COS_EPS (back-facing). alpha is the texel's alpha (roughness = "alpha": the
-    sheenRoughness itself, as the KHR spec's D and Lambda fit use it). The ``*_clamped`` layouts clamp each V
-    to [0, 1], as the glTF Sample Viewer's V_Ashikhmin (ibl_filtering.frag) and V_Sheen (brdf.glsl) do."""
+    0 where n.l, v.h or n.v <= COS_EPS (back-facing): (g, g_sin2), charlie_integrands. alpha is the texel's alpha
+    (roughness = "alpha": the sheenRoughness itself, as the KHR spec's D and Lambda fit use it). The ``*_clamped``
+    layouts clamp each V to [0, 1], as the glTF Sample Viewer's V_Ashikhmin (ibl_filtering.frag) and V_Sheen
+    (brdf.glsl) do."""
     clamped = layout.endswith("_clamped")
     vmax = 1.0 if clamped else 1.0e30
     base = layout.removesuffix("_clamped")
 
     @wp.func
-    def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float):
+    def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float, dch: float):
         NoL = l[2]
         NoV = v[2]
-        d = ndf.D_charlie(h, alpha) * NoL * 4.0 * VoH
+        d = dch * NoL * 4.0 * VoH
         ash = d * wp.min(masking.V_ashikhmin(NoV, NoL), wp.static(vmax))
         if wp.static(base == "charlie"):
             return wp.vec3(0.0, 0.0, ash)
@@ -239,7 +271,7 @@ def sheen_integrand_for(layout: str):
             return wp.vec3(dc * fresnel.Fc_schlick(VoH), dc, 0.0)
         return wp.vec3(d * wp.min(masking.V_charlie(NoV, NoL, alpha), wp.static(vmax)), ash, 0.0)
 
-    return half_vector_integrand(lobe, wp.vec3, False)
+    return charlie_integrands(lobe, wp.vec3)
 
 
 # ``masking`` from the config; the others fix them: (integrand form, NDF whose CDF the estimators sample, masking).
@@ -262,7 +294,9 @@ class SpecularIntegrand:
     v.h to float64, where float32's rounding of it matters (the dielectric's refraction near total internal
     reflection); the gauss_legendre panel rules pass it (lutbake.sampling.hemisphere.facet_rules_for), else None.
     ``g64_parts``: (part, rest) with g64(v, h, alpha, param, c) = rest(part(v, h, alpha, c), v, h, alpha, param, c),
-    ``part`` free of the param (texels that differ only in it share it per node), else None.
+    ``part`` free of the param (texels that differ only in it share it per node), else None. ``g_sin2(v, h, alpha,
+    param, sin^2(theta_h) as float64)``: g with its Charlie D from sin^2(theta_h) to float64 (charlie_integrands), which
+    the gauss_legendre panel rules pass where it is set, else None.
     """
 
     key: tuple
@@ -279,6 +313,7 @@ class SpecularIntegrand:
     kink_at_nov: bool = False
     g64: object | None = None
     g64_parts: tuple | None = None
+    g_sin2: object | None = None
 
     def alpha_input(self, alpha) -> np.ndarray:
         """The per-texel alpha the kernels receive (float32): lutbake.edge.effective_alpha."""
@@ -308,7 +343,8 @@ def specular_integrand(
     ``masking_name`` is ignored. The layouts with a Charlie channel (cloth, sheen) have no mirror limit."""
     if form != "microfacet":
         masking_name = "none"
-    charlie = channels_name == "multiscatter_cloth" or channels_name in SHEEN_LAYOUTS
+    pair = charlie_pair_for(ndf_name, masking_name, channels_name)
+    charlie = pair is not None
     vec = wp.vec3 if charlie else channels_for(channels_name)[1]
     k = vec._length_
     mirror = mirror_for(channels_name) if form == "microfacet" and not charlie else None
@@ -327,6 +363,7 @@ def specular_integrand(
         charlie,
         channels_name not in SHEEN_LAYOUTS,
         form == "ashikhmin_shirley",
+        g_sin2=pair[1] if charlie else None,
     )
 
 

@@ -16,6 +16,8 @@ claims and what the cap is (issue 38).
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import io
 import json
 import math
@@ -35,6 +37,18 @@ MAX_TEXT_BYTES = 64 << 20  # a C/JS/WGSL/Rust array of a 1024^2 RGBA table is ab
 MAX_JSON_BYTES = 16 << 20  # a sidecar or a cache entry is a few KiB (a listed axis: tens of KiB)
 MAX_JSON_DEPTH = 64  # lutbake's deepest JSON is 4 levels (sidecar > lutbake > axes > values)
 NPY_HEADER_LIMIT = 10000  # numpy's own default max_header_size
+# Memory: one budget for what a read and its command's work on the values take together, computed from the shape and
+# the stored dtype before anything is allocated (check_memory). Bytes per value, measured as max RSS over the values
+# of a 2048 x 2048 RGBA float32 file (KTX2, npy, EXR, PNG16; lutbake 1 GiB files alike): the reader holds the stored
+# values plus a float32 table (READ_BYTES + the stored item size); the command adds PROCESSING_BYTES.
+MAX_READ_MEMORY = 2 << 30  # 2 GiB: a 2^26-texel RGBA float32 table (the largest a config bakes) for inspect
+READ_BYTES = 4  # the float32 table beside the stored values (an EXR: OpenImageIO's float buffer is the stored copy)
+PROCESSING_BYTES = {
+    "inspect": 0,
+    "preview": 16,
+    "audit": 100,
+}  # measured totals: inspect 4-8, preview 20-22, audit 99-102
+_COMMAND = contextvars.ContextVar("lutbake_read_command", default="inspect")
 
 _FILE_TYPES = (
     (stat.S_ISDIR, "a directory"),
@@ -135,9 +149,10 @@ def load_json(path, limit: int = MAX_JSON_BYTES):
     return loads_json(read_text(path, limit, "a JSON sidecar"))
 
 
-def check_texels(shape, what: str = "the file", channels: int | None = None) -> None:
+def check_texels(shape, what: str = "the file", channels: int | None = None, itemsize: int = 4) -> None:
     """ValueError unless ``shape`` (its texels: every dimension but the last, channels, when ``channels`` is None)
-    is a table lutbake may hold: at most MAX_READ_TEXELS texels and MAX_CHANNELS channels, none empty."""
+    is a table lutbake may hold: at most MAX_READ_TEXELS texels and MAX_CHANNELS channels, none empty, and its
+    values stored as ``itemsize`` bytes fit the memory budget (check_memory)."""
     dims = [int(d) for d in shape]
     if channels is None:
         dims, channels = dims[:-1], dims[-1] if dims else 1
@@ -152,6 +167,32 @@ def check_texels(shape, what: str = "the file", channels: int | None = None) -> 
         )
     if channels > MAX_CHANNELS:
         raise ValueError(f"{what} declares {shown}: {channels} channels (a table has 1 to {MAX_CHANNELS})")
+    check_memory(dims + [channels], itemsize, what)
+
+
+@contextlib.contextmanager
+def reading_for(command: str):
+    """Reads inside are budgeted for ``command`` ("inspect", "preview", "audit"): its PROCESSING_BYTES per value."""
+    token = _COMMAND.set(command)
+    try:
+        yield
+    finally:
+        _COMMAND.reset(token)
+
+
+def check_memory(shape, itemsize: int, what: str = "the file") -> None:
+    """ValueError unless reading ``shape`` values stored as ``itemsize`` bytes each, and the current command's work on
+    them (reading_for), fits MAX_READ_MEMORY: refused before anything is allocated, naming the shape and the bytes."""
+    values = math.prod(int(d) for d in shape)
+    command = _COMMAND.get()
+    per_value = itemsize + READ_BYTES + PROCESSING_BYTES[command]
+    need = values * per_value
+    if need > MAX_READ_MEMORY:
+        raise ValueError(
+            f"{what} declares {' x '.join(map(str, shape))} ({values} values of {itemsize} bytes): {command} would "
+            f"need about {need / (1 << 30):.1f} GiB ({per_value} bytes a value, measured), more than the "
+            f"{MAX_READ_MEMORY >> 30} GiB a read may take: refused before reading"
+        )
 
 
 def zstd_decompress(data: bytes, size: int) -> bytes:
@@ -159,23 +200,79 @@ def zstd_decompress(data: bytes, size: int) -> bytes:
     whatever the frame declares (or omits) as its content size. ValueError for a truncated or corrupt frame."""
     import zstandard
 
+    out = bytearray(size + 1)  # filled in place: the declared size once (BytesIO + getvalue held it twice)
+    view, got = memoryview(out), 0
     try:
         with zstandard.ZstdDecompressor().stream_reader(io.BytesIO(data), read_across_frames=False) as reader:
-            out = io.BytesIO()
-            while out.tell() <= size:
-                chunk = reader.read(min(1 << 20, size + 1 - out.tell()))
-                if not chunk:
+            while got <= size:
+                n = reader.readinto(view[got : min(got + (1 << 20), size + 1)])
+                if not n:
                     break
-                out.write(chunk)
+                got += n
     except zstandard.ZstdError as e:
         raise ValueError(f"its zstd data cannot be decompressed ({e})") from None
-    got = out.tell()
+    finally:
+        view.release()
     if got != size:
         more = "more than" if got > size else "only"
         raise ValueError(
             f"its zstd data expands to {more} {got} bytes; the header declares {size} (truncated or forged)"
         )
-    return out.getvalue()
+    del out[size:]  # the one byte of slack: bytearray shrinks in place
+    return out
+
+
+# ------------------------------------------------------------------------------------------------ EXR
+
+# OpenEXR file layout (openexr.com, "OpenEXR File Layout"): magic 76 2f 31 01, a 4-byte version field (bit 12:
+# multi-part), then per part a header of attributes ``name\0 type\0 int32 size, value``, ended by a NUL; a multi-part
+# file ends its list of headers with an empty header (one more NUL)
+EXR_MULTIPART = 0x1000
+MAX_EXR_ATTRIBUTES = 1024  # of one part (lutbake writes about 20; renderers a few dozen)
+MAX_EXR_HEADER_BYTES = 1 << 20  # of one part's header (lutbake's: a few KiB, its config and axes included)
+MAX_EXR_PARTS = 4096  # a 3D table has a part per z index
+MAX_EXR_ALL_HEADERS = 16 << 20  # the headers of every part together
+EXR_NAME_BYTES = 256  # an attribute's name or type is at most 255 bytes (long names)
+
+
+def exr_header_problem(path) -> str | None:
+    """What is past the caps in the headers of the EXR at ``path`` (attributes and bytes per part, parts), read by a
+    linear walk of the attribute list before OpenImageIO parses them (its header parsing is super-linear: 10 000
+    attributes took 0.7 s, 40 000 took 8 s); None when within them. A malformed list is left to OpenImageIO."""
+    f, size = _open_regular(path, MAX_READ_BYTES, "an EXR")
+    with f:
+        blob = f.read(min(size, 8 + MAX_EXR_ALL_HEADERS + 1))
+    if len(blob) < 8:
+        return None
+    multipart = int.from_bytes(blob[4:8], "little") & EXR_MULTIPART
+    pos, part = 8, 0
+    while pos < len(blob):
+        start, count = pos, 0
+        while pos < len(blob) and blob[pos] != 0:
+            name_end = blob.find(b"\0", pos, pos + EXR_NAME_BYTES)
+            type_end = blob.find(b"\0", name_end + 1, name_end + 1 + EXR_NAME_BYTES) if name_end >= 0 else -1
+            if type_end < 0 or type_end + 5 > len(blob):
+                return None  # malformed or cut: OpenImageIO says what is wrong
+            pos = type_end + 5 + int.from_bytes(blob[type_end + 1 : type_end + 5], "little", signed=True)
+            count += 1
+            if count > MAX_EXR_ATTRIBUTES or pos - start > MAX_EXR_HEADER_BYTES:
+                held = f"more than {MAX_EXR_ATTRIBUTES}" if count > MAX_EXR_ATTRIBUTES else f"{count}"
+                return (
+                    f"part {part}'s header holds {held} attributes in {pos - start} bytes or more; an EXR header "
+                    "lutbake reads holds at most "
+                    f"{MAX_EXR_ATTRIBUTES} attributes in {MAX_EXR_HEADER_BYTES} bytes: refused before parsing it"
+                )
+            if pos <= type_end:
+                return None
+        pos, part = pos + 1, part + 1
+        if not multipart or pos >= len(blob) or blob[pos] == 0:
+            return None
+        if part >= MAX_EXR_PARTS or pos > 8 + MAX_EXR_ALL_HEADERS:
+            return (
+                f"its headers run past {part} parts and {pos - 8} bytes; an EXR lutbake reads has at most "
+                f"{MAX_EXR_PARTS} parts and {MAX_EXR_ALL_HEADERS} bytes of headers: refused before parsing them"
+            )
+    return None
 
 
 # ---------------------------------------------------------------------------------------------- NumPy
@@ -208,9 +305,9 @@ def _npy_data(f, shape, dtype, fortran, available: int, where: str, table: bool 
     """The array data after a header; ``table``: (y, x[, C]) or (z, y, x, C), else any array of at most 4
     dimensions (an engine's arrays, e.g. OpenPBR's 32^3 energy tables) whose values count as texels."""
     if len(shape) == 2 or not table and 1 <= len(shape) <= 4:
-        check_texels(shape, where, channels=1)
+        check_texels(shape, where, channels=1, itemsize=dtype.itemsize)
     elif table and 3 <= len(shape) <= 4:
-        check_texels(shape, where)
+        check_texels(shape, where, itemsize=dtype.itemsize)
     else:
         raise ValueError(f"{where}: array of shape {shape} is not a table (2 to 4 dimensions)")
     nbytes = math.prod(shape) * dtype.itemsize

@@ -22,8 +22,7 @@ import numpy as np
 from ..table import Table, metadata
 from ..table import pixels as checked_pixels
 from . import ktx2
-from .atomic import atomic_write_bytes
-from .conventions import c_ident, convention_lines, write_conventions
+from .conventions import c_ident, convention_lines, write_with_sidecar
 
 PER_LINE = 16
 
@@ -101,9 +100,7 @@ def _writer(fmt: str):
             from .ltc import write_js
 
             return write_js(table, path, dtype)
-        path = atomic_write_bytes(Path(path), source_text(table, fmt, dtype).encode("utf-8"))
-        write_conventions(table, path, fmt)
-        return path
+        return write_with_sidecar(table, path, source_text(table, fmt, dtype).encode("utf-8"), fmt)
 
     return write
 
@@ -113,11 +110,9 @@ def write_ktx2_zstd(table: Table, path, dtype: str = "float32") -> Path:
 
     pixels = checked_pixels(table, dtype)
     path = Path(path)
-    atomic_write_bytes(
-        path, ktx2.encode(pixels, metadata(table), writer=f"lutbake {__version__}", supercompression="zstd")
-    )
-    write_conventions(table, path, "ktx2zst", {"supercompression": "zstd (scheme 2)", "zstd_level": ktx2.ZSTD_LEVEL})
-    return path
+    data = ktx2.encode(pixels, metadata(table), writer=f"lutbake {__version__}", supercompression="zstd")
+    extra = {"supercompression": "zstd (scheme 2)", "zstd_level": ktx2.ZSTD_LEVEL}
+    return write_with_sidecar(table, path, data, "ktx2zst", extra)
 
 
 FORMATS = {

@@ -10,16 +10,27 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table, metadata
+from .atomic import atomic_write_bytes_hashed
 from .integrity import legacy_sidecar, write_sidecar
 
 
-def write_conventions(table: Table, path: Path, fmt: str, extra: dict | None = None) -> None:
-    """The last step of every non-EXR write: ``<file>.json`` naming the data's sha256 (lutbake.io.integrity);
-    a pre-issue-11 ``<stem>.json`` that described this file is removed (it would contradict the new one)."""
-    write_sidecar(path, fmt, metadata(table), extra)
+def write_conventions(
+    table: Table, path: Path, fmt: str, extra: dict | None = None, *, digests: dict[str, str]
+) -> None:
+    """The last step of every non-EXR write: ``<file>.json`` naming the sha256 of the bytes written (``digests``:
+    file name -> sha256, lutbake.io.integrity.sidecar_document); a pre-issue-11 ``<stem>.json`` that described this
+    file is removed (it would contradict the new one)."""
+    write_sidecar(path, fmt, metadata(table), digests, extra)
     old = legacy_sidecar(path)
     if old is not None:
         old.unlink(missing_ok=True)
+
+
+def write_with_sidecar(table: Table, path, data: bytes, fmt: str, extra: dict | None = None) -> Path:
+    """Write ``data`` to ``path`` atomically, then its sidecar naming the sha256 of ``data``: a one-file output."""
+    path = Path(path)
+    write_conventions(table, path, fmt, extra, digests={path.name: atomic_write_bytes_hashed(path, data)})
+    return path
 
 
 def c_ident(name: str) -> str:
@@ -66,7 +77,7 @@ def convention_lines(table: Table, pixels: np.ndarray, dtype: str, ident: str, v
             f"    sample at {d['uv_formula']}",
         ]
     lines += ["channels:"] + [f"  {c} = {n}: {m}" for c, (n, m) in zip("RGBA", table.channels.items())]
-    lines += ["reconstruction:", f"  {table.reconstruction}", "", "provenance:"]
+    lines += ["reconstruction:", *(f"  {line}" for line in table.reconstruction.splitlines()), "", "provenance:"]
     for k in ("terms", "estimator", "samples", "seed", "version", "warp_version"):
         if k in table.attributes:
             lines.append(f"  {k}: {table.attributes[k]}")

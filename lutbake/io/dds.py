@@ -90,7 +90,7 @@ def decode(blob: bytes) -> tuple[np.ndarray, dict]:
     shape = ((depth,) if dim == DIM_TEXTURE3D else ()) + (height, width, nch)
     from .bounded import check_texels
 
-    check_texels(shape, f"the DDS header ({DXGI_NAMES[fmt]})")
+    check_texels(shape, f"the DDS header ({DXGI_NAMES[fmt]})", itemsize=npdt.itemsize)
     need = 148 + int(np.prod(shape, dtype=object)) * npdt.itemsize
     if min(shape) < 1 or need > len(blob):
         raise ValueError(

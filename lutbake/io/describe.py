@@ -51,10 +51,11 @@ def _image_line(data: np.ndarray) -> str:
 
 def _statistics(data: np.ndarray, names: list[str]) -> list[str]:
     lines = ["statistics:"]
-    flat = data.reshape(-1, data.shape[-1]).astype(np.float64)
+    flat = data.reshape(-1, data.shape[-1])  # a view: no float64 copy of the table (it doubled inspect's memory)
     for i, name in enumerate(names):
         col = flat[:, i]
-        lines.append(f"  {name}: min {_fmt(col.min())}  max {_fmt(col.max())}  mean {_fmt(col.mean())}")
+        mean = col.mean(dtype=np.float64)
+        lines.append(f"  {name}: min {_fmt(float(col.min()))}  max {_fmt(float(col.max()))}  mean {_fmt(mean)}")
     return lines
 
 

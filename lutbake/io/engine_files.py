@@ -59,7 +59,7 @@ def array_body(text: str, name: str) -> str:
 
 
 def _values(text: str, name: str, shape: tuple[int, ...]) -> np.ndarray:
-    check_texels(shape, f"array {name!r} (the sidecar's axes)", channels=1)
+    check_texels(shape, f"array {name!r} (the sidecar's axes)", channels=1, itemsize=8)  # parsed as float64
     n = int(np.prod(shape))
     arr, _ = literal_values(array_body(text, name), n)
     if arr.size != n:

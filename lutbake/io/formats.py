@@ -21,8 +21,8 @@ import numpy as np
 from ..table import Table, metadata
 from ..table import pixels as checked_pixels
 from . import code_arrays, dds, ktx2, ltc, openpbr
-from .atomic import atomic_write, atomic_write_bytes
-from .conventions import c_ident, convention_lines, write_conventions
+from .atomic import atomic_write_hashed, unit_lock
+from .conventions import c_ident, convention_lines, write_conventions, write_with_sidecar
 from .exr import write_exr
 
 FORMATS = {
@@ -49,8 +49,9 @@ EXTENSIONS = {
 def write_npy(table: Table, path, dtype: str = "float32") -> Path:
     pixels = checked_pixels(table, dtype)
     path = Path(path)
-    atomic_write(path, lambda tmp: np.save(tmp, pixels, allow_pickle=False))
-    write_conventions(table, path, "npy", {"dtype": str(pixels.dtype), "shape": list(pixels.shape)})
+    digest = atomic_write_hashed(path, lambda tmp: np.save(tmp, pixels, allow_pickle=False))
+    extra = {"dtype": str(pixels.dtype), "shape": list(pixels.shape)}
+    write_conventions(table, path, "npy", extra, digests={path.name: digest})
     return path
 
 
@@ -96,7 +97,7 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
         if not ok:
             raise OSError(f"cannot write {path}: {out.geterror()}")
 
-    atomic_write(path, write)
+    digest = atomic_write_hashed(path, write)
     write_conventions(
         table,
         path,
@@ -105,6 +106,7 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
             "encoding": "uint16 code / 65535, linear (no transfer function)",
             "channels_in_file": "RGB (B = 0)" if len(table.channels) == 2 else "as table",
         },
+        digests={path.name: digest},
     )
     return path
 
@@ -112,12 +114,9 @@ def write_png16(table: Table, path, dtype: str = "float32") -> Path:
 def write_dds(table: Table, path, dtype: str = "float32") -> Path:
     pixels = checked_pixels(table, dtype)
     path = Path(path)
-    atomic_write_bytes(path, dds.encode(pixels))
     fmt = dds.DXGI_NAMES[dds.DXGI[(dtype, 4 if pixels.shape[-1] == 3 else pixels.shape[-1])]]
-    write_conventions(
-        table, path, "dds", {"dxgi_format": fmt, "dimension": "TEXTURE3D" if pixels.ndim == 4 else "TEXTURE2D"}
-    )
-    return path
+    extra = {"dxgi_format": fmt, "dimension": "TEXTURE3D" if pixels.ndim == 4 else "TEXTURE2D"}
+    return write_with_sidecar(table, path, dds.encode(pixels), "dds", extra)
 
 
 def write_ktx2(table: Table, path, dtype: str = "float32", array: bool = False) -> Path:
@@ -125,9 +124,8 @@ def write_ktx2(table: Table, path, dtype: str = "float32", array: bool = False) 
 
     pixels = checked_pixels(table, dtype)
     path = Path(path)
-    atomic_write_bytes(path, ktx2.encode(pixels, metadata(table), array=array, writer=f"lutbake {__version__}"))
-    write_conventions(table, path, "ktx2", {"array": array})
-    return path
+    data = ktx2.encode(pixels, metadata(table), array=array, writer=f"lutbake {__version__}")
+    return write_with_sidecar(table, path, data, "ktx2", {"array": array})
 
 
 def header_text(table: Table, dtype: str = "float32") -> str:
@@ -164,10 +162,7 @@ def header_text(table: Table, dtype: str = "float32") -> str:
 
 
 def write_header(table: Table, path, dtype: str = "float32") -> Path:
-    text = header_text(table, dtype)
-    path = atomic_write_bytes(Path(path), text.encode("utf-8"))
-    write_conventions(table, path, "h")
-    return path
+    return write_with_sidecar(table, path, header_text(table, dtype).encode("utf-8"), "h")
 
 
 def write_openpbr(table: Table, path, dtype: str = "float32") -> Path:
@@ -204,7 +199,11 @@ def written_files(name: str, fmt: str) -> list[str]:
 
 
 def write_table(table: Table, out_dir, fmt: str = "exr", dtype: str = "float32") -> Path:
-    """Write ``table`` to ``out_dir/<name>.<ext>`` in ``fmt`` (FORMATS), atomically. Returns the path."""
+    """Write ``table`` to ``out_dir/<name>.<ext>`` in ``fmt`` (FORMATS), atomically, under the output's unit lock
+    (lutbake.io.atomic.unit_lock: a concurrent writer of the same path never slips between its data and its sidecar).
+    Returns the path."""
     if fmt not in WRITERS:
         raise ValueError(f"table {table.name!r}: unknown format {fmt!r}; valid: {', '.join(WRITERS)}")
-    return WRITERS[fmt](table, output_path(out_dir, table.name, fmt), dtype=dtype)
+    path = output_path(out_dir, table.name, fmt)
+    with unit_lock(path):
+        return WRITERS[fmt](table, path, dtype=dtype)

@@ -12,7 +12,10 @@ the check refuses (then the next run bakes the table again):
   written *last*. The sidecar names the data file (``file``), the sha256 of its bytes (``data_sha256``)
   and a sha256 of the sidecar's own canonical JSON (``sidecar_sha256``, computed with that field absent).
   A crash between the two renames leaves new data beside an old sidecar (``data_sha256`` differs) or no
-  sidecar: never a skip.
+  sidecar: never a skip. The digests are those of the bytes the writer wrote, not of the file on disk after its
+  rename, and the pair is written under lutbake.io.atomic.unit_lock: two runs writing one path (two configs with
+  the same table names, one out-dir) leave one run's data with that run's sidecar, and never a sidecar naming
+  the other run's bytes.
 
 ``verified_attributes(path)`` returns an output's ``lutbake:*`` attributes only if every check passes;
 anything else (missing, truncated, garbled, foreign, half-written unit) returns None: not up to date.
@@ -129,8 +132,13 @@ def _canonical(doc: dict) -> bytes:
     return json.dumps(doc, sort_keys=True, ensure_ascii=False, separators=(",", ":")).encode("utf-8")
 
 
-def sidecar_document(path, fmt: str, attributes: dict[str, str], extra: dict | None = None) -> dict:
-    """The sidecar of the data file ``path`` as it is on disk now (call it after the data's rename)."""
+def sidecar_document(
+    path, fmt: str, attributes: dict[str, str], digests: dict[str, str], extra: dict | None = None
+) -> dict:
+    """The sidecar of the data file ``path``. ``digests``: file name -> sha256 of the bytes this writer wrote, for
+    ``path`` and each other file of the output (``extra["files"]``), taken from the bytes in hand
+    (lutbake.io.atomic.atomic_write_hashed), never from the disk after the rename: another run writing the same path
+    may have replaced the file in between, and this sidecar must not vouch for its bytes."""
     path = Path(path)
     others = [n for n in (extra or {}).get("files", []) if n != path.name]  # e.g. ltc_dds's <name>_2.dds
     doc = {
@@ -139,18 +147,21 @@ def sidecar_document(path, fmt: str, attributes: dict[str, str], extra: dict | N
         "sidecar_version": SIDECAR_VERSION,
         "row_order": "file row 0 = table row 0 (y index 0); column 0 = x index 0",
         **(extra or {}),
-        "data_sha256": sha256_file(path),
+        "data_sha256": digests[path.name],
         "lutbake": dict(attributes),
     }
     if others:
-        doc["files_sha256"] = {n: sha256_file(path.with_name(n)) for n in others}
+        doc["files_sha256"] = {n: digests[n] for n in others}
     doc["sidecar_sha256"] = sha256_bytes(_canonical(doc))
     return doc
 
 
-def write_sidecar(path, fmt: str, attributes: dict[str, str], extra: dict | None = None) -> Path:
-    """Write ``<path>.json`` (atomically) naming the bytes of ``path``: the last step of writing an output."""
-    doc = sidecar_document(path, fmt, attributes, extra)
+def write_sidecar(
+    path, fmt: str, attributes: dict[str, str], digests: dict[str, str], extra: dict | None = None
+) -> Path:
+    """Write ``<path>.json`` (atomically) naming the bytes written to ``path`` (``digests``, sidecar_document): the
+    last step of writing an output, under lutbake.io.atomic.unit_lock."""
+    doc = sidecar_document(path, fmt, attributes, digests, extra)
     return atomic_write_bytes(sidecar_path(path), (json.dumps(doc, indent=1, ensure_ascii=False) + "\n").encode())
 
 

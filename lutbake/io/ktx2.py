@@ -152,7 +152,9 @@ def decode(blob: bytes) -> tuple[np.ndarray, dict]:
     dtype, nch = FROM_VK_FORMAT[vk]
     npdt = np.dtype("<f2" if dtype == "half" else "<f4")
     shape = ((depth,) if depth else (layers,) if layers else ()) + (height, width, nch)
-    check_texels(shape, f"the KTX2 header ({VK_FORMAT_NAMES[vk]})")  # before anything is decompressed
+    check_texels(
+        shape, f"the KTX2 header ({VK_FORMAT_NAMES[vk]})", itemsize=npdt.itemsize
+    )  # before anything is decompressed
     need = int(np.prod(shape, dtype=object)) * npdt.itemsize
     level = blob[level_off : level_off + level_len]
     if scheme:  # one zstd frame of uncompressedByteLength bytes (KTX 2.0 §3.12.2)

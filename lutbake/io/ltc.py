@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from .conventions import write_conventions
+from .conventions import write_conventions, write_with_sidecar
 
 FP16_MAX = 65504.0
 EXTENSIONS = {"ltc_dds": "_1.dds", "js": ".js", "c": ".cc", "cs": ".cs", "babylon_fuzz": ".dds"}
@@ -56,14 +56,14 @@ def _flat(a: np.ndarray, fmt: str = "{:.9g}") -> str:
 
 def write_ltc_dds(table: Table, path, dtype: str = "half") -> Path:
     from . import dds
-    from .atomic import atomic_write_bytes
+    from .atomic import atomic_write_bytes_hashed
 
     t1, t2 = engine_textures(table)
     path = Path(path)
     second = path.with_name(path.name.replace("_1.dds", "_2.dds"))
     np_dtype = np.float16 if dtype == "half" else np.float32
-    atomic_write_bytes(second, dds.encode(t2.astype(np_dtype)))
-    atomic_write_bytes(path, dds.encode(t1.astype(np_dtype)))
+    digests = {second.name: atomic_write_bytes_hashed(second, dds.encode(t2.astype(np_dtype)))}
+    digests[path.name] = atomic_write_bytes_hashed(path, dds.encode(t1.astype(np_dtype)))
     write_conventions(
         table,
         path,
@@ -73,6 +73,7 @@ def write_ltc_dds(table: Table, path, dtype: str = "half") -> Path:
             "dxgi_format": "R16G16B16A16_FLOAT" if dtype == "half" else "R32G32B32A32_FLOAT",
             "ltc_2_z": "0 (lutbake's fit_error is in the EXR only)",
         },
+        digests=digests,
     )
     return path
 
@@ -99,11 +100,8 @@ def js_text(table: Table) -> str:
 
 
 def write_js(table: Table, path, dtype: str = "float32") -> Path:
-    from .atomic import atomic_write_bytes
-
-    path = atomic_write_bytes(Path(path), js_text(table).encode("utf-8"))
-    write_conventions(table, path, "js", {"exports": ["LTC_SIZE", "LTC_MAT_1", "LTC_MAT_2"]})
-    return path
+    extra = {"exports": ["LTC_SIZE", "LTC_MAT_1", "LTC_MAT_2"]}
+    return write_with_sidecar(table, path, js_text(table).encode("utf-8"), "js", extra)
 
 
 def c_text(table: Table) -> str:
@@ -135,11 +133,8 @@ def c_text(table: Table) -> str:
 
 
 def write_c(table: Table, path, dtype: str = "float32") -> Path:
-    from .atomic import atomic_write_bytes
-
-    path = atomic_write_bytes(Path(path), c_text(table).encode("utf-8"))
-    write_conventions(table, path, "c", {"arrays": ["ltc_mat_<lobe>", "ltc_mag_<lobe>", "ltc_disk_integral"]})
-    return path
+    extra = {"arrays": ["ltc_mat_<lobe>", "ltc_mag_<lobe>", "ltc_disk_integral"]}
+    return write_with_sidecar(table, path, c_text(table).encode("utf-8"), "c", extra)
 
 
 def hdrp_pack(ltc_1: np.ndarray) -> np.ndarray:
@@ -187,13 +182,8 @@ def cs_text(table: Table) -> str:
 
 
 def write_cs(table: Table, path, dtype: str = "half") -> Path:
-    from .atomic import atomic_write_bytes
-
-    path = atomic_write_bytes(Path(path), cs_text(table).encode("utf-8"))
-    write_conventions(
-        table, path, "cs", {"array": "s_LtcMatrixData_BRDF_<LOBE>: ushort FP16 bits, RGBA16F slice of _LtcData"}
-    )
-    return path
+    extra = {"array": "s_LtcMatrixData_BRDF_<LOBE>: ushort FP16 bits, RGBA16F slice of _LtcData"}
+    return write_with_sidecar(table, path, cs_text(table).encode("utf-8"), "cs", extra)
 
 
 def babylon_fuzz_pixels(table: Table) -> tuple[np.ndarray, dict]:
@@ -223,29 +213,21 @@ def write_babylon_fuzz(table: Table, path, dtype: str = "half") -> Path:
     from ..layouts.babylon import BABYLON_FUZZ
     from ..layouts.base import uv_of
     from . import dds
-    from .atomic import atomic_write_bytes
 
     stored, outside = babylon_fuzz_pixels(table)
     np_dtype = np.float16 if dtype == "half" else np.float32
-    path = Path(path)
-    atomic_write_bytes(path, dds.encode(stored.astype(np_dtype)))
-    write_conventions(
-        table,
-        path,
-        "babylon_fuzz",
-        {
-            "dxgi_format": "R16G16B16A16_FLOAT" if dtype == "half" else "R32G32B32A32_FLOAT",
-            "engine": BABYLON_FUZZ.engine,
-            "coding": {
-                c.name: {"channel": ch, "mix": [c.lo, c.hi], "meaning": c.meaning}
-                for ch, c in zip("rgb", BABYLON_FUZZ.channels)
-            },
-            "alpha_channel": "1",
-            "shader": BABYLON_FUZZ.shader.format(uv=uv_of(table.axes[1:])),
-            "outside_mix_ranges": outside or "none",
+    extra = {
+        "dxgi_format": "R16G16B16A16_FLOAT" if dtype == "half" else "R32G32B32A32_FLOAT",
+        "engine": BABYLON_FUZZ.engine,
+        "coding": {
+            c.name: {"channel": ch, "mix": [c.lo, c.hi], "meaning": c.meaning}
+            for ch, c in zip("rgb", BABYLON_FUZZ.channels)
         },
-    )
-    return path
+        "alpha_channel": "1",
+        "shader": BABYLON_FUZZ.shader.format(uv=uv_of(table.axes[1:])),
+        "outside_mix_ranges": outside or "none",
+    }
+    return write_with_sidecar(table, path, dds.encode(stored.astype(np_dtype)), "babylon_fuzz", extra)
 
 
 WRITERS = {"ltc_dds": write_ltc_dds, "js": write_js, "c": write_c, "cs": write_cs, "babylon_fuzz": write_babylon_fuzz}

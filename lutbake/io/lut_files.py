@@ -1,14 +1,15 @@
 """Read any LUT file lutbake can audit into a float64 (rows, columns, channels) array.
 
-``read_lut(path, shape=None, encoding=None) -> LutFile``. Formats, by extension:
-- ``.exr``: OpenImageIO (any tool's: float or half, RG/RGB/RGBA, layer-prefixed or other channel names, one part); the
+``read_lut(path, shape=None) -> LutFile``. Formats, recognised by content (lutbake.io.readers.sniff, the recognition
+``inspect`` uses), never by the file's name:
+- EXR: OpenImageIO (any tool's: float or half, RG/RGB/RGBA, layer-prefixed or other channel names, one part); the
   ``lutbake:*`` attributes when present.
-- ``.png``: OpenImageIO, the raw UNORM codes (8 or 16 bit), value = code / (2^bits - 1), **no transfer function**.
-- ``.dds``: DX10 header, R16G16_FLOAT ... RGBA32F (lutbake.io.dds); ``.ktx2``: lutbake.io.ktx2.decode (plain or zstd).
-- ``.npy``, ``.npz``: an integer array is UNORM codes (value = code / dtype max), a float array values (npz: the
+- PNG: OpenImageIO, the raw UNORM codes (8 or 16 bit), value = code / (2^bits - 1), **no transfer function**.
+- DDS: DX10 header, R16G16_FLOAT ... RGBA32F (lutbake.io.dds); KTX2: lutbake.io.ktx2.decode (plain or zstd).
+- NumPy npy, npz: an integer array is UNORM codes (value = code / dtype max), a float array values (npz: the
   array named ``table``, else its only one).
-- ``.h .hpp .inc .js .ts .mjs .wgsl .rs``: the numbers of the first brace/bracket array: hex ``0x....`` literals
-  are IEEE half bits, decimal literals floats.
+- text (``.h .hpp .inc .js .ts .mjs .wgsl .rs`` sources): the numbers of the first brace/bracket array: hex
+  ``0x....`` literals are IEEE half bits, decimal literals floats.
 ``storage`` records how the file stores a value (unorm8/16, half, float32), which the audit's quantisation check uses.
 A text array's layout must be declared: ``#define *_HEIGHT/_WIDTH/_CHANNELS`` (lutbake's C header), the
 ``lutbake:shape`` line of lutbake's JS/WGSL/Rust comment block, or ``shape=(rows, columns, channels)``.
@@ -26,8 +27,7 @@ import numpy as np
 from . import bounded
 from .text_arrays import parse_text_array
 
-TEXT_EXTENSIONS = (".h", ".hpp", ".inc", ".js", ".mjs", ".ts", ".wgsl", ".rs")
-READABLE = (".exr", ".png", ".dds", ".ktx2", ".npy", ".npz") + TEXT_EXTENSIONS
+READABLE = ("exr", "png", "dds", "ktx2", "npy", "npz", "h", "text")  # lutbake.io.readers.sniff's formats audit reads
 
 
 @dataclass
@@ -45,7 +45,9 @@ class LutFile:
 
 def _unorm(codes: np.ndarray) -> tuple[np.ndarray, str]:
     bits = codes.dtype.itemsize * 8
-    return codes.astype(np.float64) / float((1 << bits) - 1), f"unorm{bits}"
+    values = codes.astype(np.float64)
+    values /= float((1 << bits) - 1)  # in place: one float64 image, not two
+    return values, f"unorm{bits}"
 
 
 def _float_storage(arr: np.ndarray) -> str:
@@ -62,7 +64,7 @@ def _read_png(path: Path) -> tuple[np.ndarray, str]:
         raise ValueError(f"{path}: cannot open PNG: {oiio.geterror()}")
     try:
         spec = inp.spec()
-        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header")
+        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header", itemsize=spec.format.size())
         native = oiio.UINT16 if spec.format.size() == 2 else oiio.UINT8
         codes = inp.read_image(native)  # raw codes: OIIO applies no transfer function on read
     finally:
@@ -95,21 +97,24 @@ def _read_exr(path: Path) -> tuple[np.ndarray, dict, str]:
 def read_lut(path, shape=None) -> LutFile:
     """Read ``path`` (see the module docstring). ``shape``: (rows, columns, channels) of a text array
     whose file does not declare it."""
+    from .readers import FORMAT_NAMES, sniff
+
     path = Path(path)
-    ext = path.suffix.lower()
-    if ext not in READABLE:
-        raise ValueError(f"{path}: cannot read '{ext}' files; readable: {', '.join(READABLE)}")
-    problem = bounded.regular_file_problem(path)
-    if problem:
-        raise ValueError(f"{path}: {problem}")
+    fmt = sniff(path)  # ReadError (a ValueError) for a missing file, a FIFO, a directory, an unknown format
+    if fmt not in READABLE:
+        raise ValueError(
+            f"{path}: a {FORMAT_NAMES[fmt]}: audit reads "
+            + ", ".join(FORMAT_NAMES[f] for f in READABLE)
+            + (" (audit the data file the sidecar names)" if fmt == "sidecar" else "")
+        )
     try:
-        return _read_lut(path, ext, shape)
+        return _read_lut(path, fmt, shape)
     except ValueError as e:
         text = str(e)
         raise ValueError(text if text.startswith(str(path)) else f"{path}: {text}") from None
 
 
-def _read_lut(path: Path, ext: str, shape) -> LutFile:
+def _read_lut(path: Path, fmt: str, shape) -> LutFile:
     from .dds import decode as dds_decode
     from .ktx2 import decode as ktx2_decode
 
@@ -124,15 +129,15 @@ def _read_lut(path: Path, ext: str, shape) -> LutFile:
                 raise ValueError(f"its sidecar {side.name} is not a JSON object with a 'lutbake' object")
             attrs = sidecar.get("lutbake", {})
             break
-    if ext == ".exr":
+    if fmt == "exr":
         data, exr_attrs, storage = _read_exr(path)
         attrs = exr_attrs or attrs
-    elif ext == ".png":
+    elif fmt == "png":
         data, storage = _read_png(path)
-    elif ext == ".dds":
+    elif fmt == "dds":
         arr, _ = dds_decode(bounded.read_bytes(path))
         data, storage = arr.astype(np.float64), _float_storage(arr)
-    elif ext == ".ktx2":
+    elif fmt == "ktx2":
         arr, facts = ktx2_decode(bounded.read_bytes(path))
         kv = facts["key_value"]
         data, storage = arr.astype(np.float64), _float_storage(arr)
@@ -140,8 +145,8 @@ def _read_lut(path: Path, ext: str, shape) -> LutFile:
             attrs = bounded.loads_json(kv["lutbake:metadata"])
             if not isinstance(attrs, dict):
                 raise ValueError("its KTX2 key/value lutbake:metadata is not a JSON object")
-    elif ext in (".npy", ".npz"):
-        if ext == ".npz":  # one array: named "table" (tests/data), else the only one
+    elif fmt in ("npy", "npz"):
+        if fmt == "npz":  # one array: named "table" (tests/data), else the only one
             arr, _ = bounded.load_npz(path)
         else:
             arr = bounded.load_npy(path)

@@ -19,8 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from .atomic import atomic_write_bytes
-from .conventions import write_conventions
+from .conventions import write_with_sidecar
 
 METAL_SLICE = 16  # eta = 1 in OpenPBR's IOR axis
 UNORM_ONE = 65535.0
@@ -73,6 +72,4 @@ def header_text(table: Table) -> str:
 
 
 def write_openpbr_header(table: Table, path, dtype: str = "float32") -> Path:
-    path = atomic_write_bytes(Path(path), header_text(table).encode("utf-8"))
-    write_conventions(table, path, "openpbr_h")
-    return path
+    return write_with_sidecar(table, path, header_text(table).encode("utf-8"), "openpbr_h")

@@ -10,6 +10,7 @@ file's first bytes (its magic number), never by its extension.
 | KTX2 | ``«KTX 20»\\r\\n\\x1a\\n`` | lutbake.io.ktx2.decode | ``lutbake:metadata`` key/value, else sidecar |
 | C header | text from ``/*``, ``//`` or ``#`` | its ``static const`` array and size macros | the ``.json`` sidecar |
 | sidecar | text from ``{`` | the data file it names (``"file"``) | its ``"lutbake"`` object |
+| npz, text array | ``PK\\x03\\x04``; other text | ``audit`` reads them (lutbake.io.lut_files), not ``read`` | sidecar |
 | engine layout | DDS or text | lutbake.io.engine_files, by the sidecar's ``format`` (LTC, OpenPBR, JS) | the sidecar |
 
 ``read(path)`` returns a :class:`LoadedFile` (pixels as stored, including a GPU format's padding
@@ -36,6 +37,7 @@ from ..runtime.warp_runtime import stderr_silenced
 from ..textsafe import bounded as bounded_text
 from ..textsafe import shorten
 from . import bounded, dds, ktx2
+from .text_arrays import parse_numbers
 
 PREFIX = "lutbake:"
 MAGIC_BYTES = 16  # enough to tell every format apart
@@ -47,6 +49,8 @@ MAX_EXR_CHANNELS = 64  # channels of one EXR part (a table has 1 to 4; other too
 EXR_MAGIC = b"\x76\x2f\x31\x01"
 NPY_MAGIC = b"\x93NUMPY"
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+ZIP_MAGIC = b"PK\x03\x04"  # a NumPy .npz archive
+TEXT_CONTROLS = b"\t\n\r\f"  # the control bytes a text array may hold
 GENERIC_FORMATS = ("exr", "npy", "png16", "dds", "ktx2", "ktx2zst", "h")  # sidecar "format"s whose pixels lutbake reads
 FORMAT_NAMES = {
     "engine": "engine-specific file",
@@ -56,6 +60,8 @@ FORMAT_NAMES = {
     "dds": "DDS",
     "ktx2": "KTX 2.0",
     "h": "C header",
+    "npz": "NumPy .npz archive",
+    "text": "text array (JS, TS, WGSL, Rust or C source)",
     "sidecar": "lutbake .json sidecar",
     "report": "lutbake bake report (--report)",
 }
@@ -100,7 +106,8 @@ class TableView:
 
 
 def sniff(path: Path) -> str:
-    """The format of ``path`` from its first bytes (FORMAT_NAMES); ReadError for anything else."""
+    """The format of ``path`` from its first bytes (FORMAT_NAMES), never its name: the one recognition ``inspect``,
+    ``preview`` and ``audit`` (lutbake.io.lut_files) share; ReadError for anything else."""
     problem = bounded.regular_file_problem(path)  # "no such file", "is a FIFO (named pipe), not a file", ...
     if problem:
         raise ReadError(f"{path}: {problem}")
@@ -112,6 +119,7 @@ def sniff(path: Path) -> str:
         (PNG_MAGIC, "png"),
         (dds.MAGIC, "dds"),
         (ktx2.IDENTIFIER, "ktx2"),
+        (ZIP_MAGIC, "npz"),
     ):
         if head.startswith(magic):
             return fmt
@@ -120,6 +128,8 @@ def sniff(path: Path) -> str:
         return "sidecar"
     if text.startswith((b"/*", b"//", b"#")):
         return "h"
+    if text and all(b >= 0x20 or b in TEXT_CONTROLS for b in text):  # bytes >= 0x80: UTF-8
+        return "text"
     shown = head[:8].hex(" ") if head else "nothing (an empty file)"
     raise ReadError(
         f"{path}: not a format lutbake reads (EXR, npy, PNG, DDS, KTX2, C header, .json sidecar): "
@@ -134,6 +144,11 @@ def read(path) -> LoadedFile:
     size = path.stat().st_size
     if size > MAX_FILE_BYTES:
         raise ReadError(f"{path}: {size} bytes is larger than any table lutbake writes ({MAX_FILE_BYTES} bytes)")
+    if fmt not in READERS:  # recognised, but only audit reads its values (lutbake.io.lut_files)
+        engine = _engine_sidecar(path)
+        if engine is None:
+            raise ReadError(f"{path}: a {FORMAT_NAMES[fmt]}: inspect and preview do not read it (lutbake audit does)")
+        return engine
     try:
         loaded = READERS[fmt](path)
     except (ValueError, KeyError, TypeError, IndexError, OverflowError, UnicodeDecodeError, EOFError, OSError):
@@ -212,6 +227,9 @@ def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
     come in that order; any other channel names are kept in file order."""
     import OpenImageIO as oiio  # imported here: only EXR and PNG need it
 
+    problem = bounded.exr_header_problem(path)  # before OpenImageIO parses the attributes (super-linear in their count)
+    if problem:
+        raise ValueError(problem)
     with stderr_silenced():  # libpng / OpenEXR print their own complaints; the ReadError says it once
         inp = oiio.ImageInput.open(str(path))
     if inp is None:
@@ -229,14 +247,16 @@ def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
                     f"in parts 0-{k}); a table lutbake reads is at most {bounded.MAX_READ_TEXELS} texels of "
                     f"at most {MAX_EXR_CHANNELS} channels: refused before reading"
                 )
+            bounded.check_memory((texels, len(names)), 4, f"the EXR (parts 0-{k}: texels x channels)")
             rgba = [c for c in "RGBA" if c in names]
-            order = rgba if len(rgba) == len(names) else names
+            order = rgba + [c for c in names if c not in rgba] if rgba else names  # RGBA first (RGBA + Z: 5)
             with stderr_silenced():
                 arr = inp.read_image(k, 0, 0, len(names), "float")
             if arr is None:
                 raise ValueError(f"cannot read the pixels of part {k}: {inp.geterror()}")
             arr = np.asarray(arr, dtype=np.float32).reshape(spec.height, spec.width, len(names))
-            arr = np.ascontiguousarray(arr[..., [names.index(c) for c in order]])
+            if order != names:  # a copy only where the channels move (RGBA first)
+                arr = np.ascontiguousarray(arr[..., [names.index(c) for c in order]])
             facts = {
                 "pixel_type": str(spec.format),
                 "compression": spec.getattribute("compression"),
@@ -258,6 +278,9 @@ def read_exr(path: Path) -> LoadedFile:
     if len(shapes) != 1:
         raise ValueError(f"its parts have different shapes {sorted(shapes)}")
     attrs = {k: v for k, v in parts[0][1].items() if k not in ("slice_index", "slice_value")}
+    problem = _text_problem(attrs)
+    if problem:
+        raise ValueError(f"its lutbake attributes: {problem}")
     facts = {**parts[0][2], "parts": [(f["part"], a.get("slice_value")) for _, a, f in parts]}
     if len(parts) == 1 and "slice_index" not in parts[0][1]:
         data = parts[0][0]
@@ -284,7 +307,7 @@ def read_png(path: Path) -> LoadedFile:
         raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
     try:
         spec = inp.spec()
-        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header")
+        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header", itemsize=spec.format.size())
         bits = 16 if str(spec.format) == "uint16" else 8
         with stderr_silenced():
             arr = inp.read_image("uint16" if bits == 16 else "uint8")
@@ -293,9 +316,20 @@ def read_png(path: Path) -> LoadedFile:
         codes = np.asarray(arr).reshape(spec.height, spec.width, spec.nchannels)
     finally:
         inp.close()
-    data = _as_table_array(codes.astype(np.float64) / float((1 << bits) - 1))
+    data = _unorm_float32(codes, (1 << bits) - 1)
     facts = {"bit_depth": bits, "channels": list(spec.channelnames), "encoding": f"code / {(1 << bits) - 1}"}
     return _with_sidecar(LoadedFile(path, "png", data, {}, None, facts))
+
+
+UNORM_ROWS = 256  # rows converted at a time from UNORM codes (float64 division, rounded to float32)
+
+
+def _unorm_float32(codes: np.ndarray, one: int) -> np.ndarray:
+    """float32 code / one, as the float64 division rounds it, a block of rows at a time (no float64 image)."""
+    out = np.empty(codes.shape, np.float32)
+    for r in range(0, codes.shape[0], UNORM_ROWS):
+        out[r : r + UNORM_ROWS] = codes[r : r + UNORM_ROWS] / float(one)
+    return _as_table_array(out)
 
 
 def read_dds(path: Path) -> LoadedFile:
@@ -343,14 +377,11 @@ def read_header(path: Path) -> LoadedFile:
     if not {"HEIGHT", "WIDTH", "CHANNELS"} <= set(dims):
         raise ValueError(f"no {ident.upper()}_HEIGHT / _WIDTH / _CHANNELS macros for array {ident}")
     shape = tuple(dims[k] for k in ("DEPTH", "HEIGHT", "WIDTH", "CHANNELS") if k in dims)
-    bounded.check_texels(shape, f"array {ident}'s macros")
-    items = [s for s in (x.strip() for x in body.split(",")) if s]
-    if math.prod(shape) != len(items):
-        raise ValueError(f"array {ident} has {len(items)} values, its macros say {' x '.join(map(str, shape))}")
-    if ctype == "uint16_t":
-        data = np.array([int(s, 0) for s in items], dtype=np.uint16).view(np.float16)
-    else:
-        data = np.array([s.rstrip("fF") for s in items], dtype=np.float64)
+    bounded.check_texels(shape, f"array {ident}'s macros", itemsize=8)  # parsed as float64
+    try:
+        data, _ = parse_numbers(body, math.prod(shape), bits=ctype == "uint16_t")
+    except ValueError as e:
+        raise ValueError(f"array {ident} (its macros say {' x '.join(map(str, shape))}): {e}") from None
     loaded = LoadedFile(
         path,
         "h",
@@ -396,7 +427,28 @@ def _string_attrs(meta, where: Path, what: str) -> dict[str, str]:
     bad = [k for k, v in meta.items() if not isinstance(v, str)]
     if bad:
         raise ReadError(f"{where}: {what}: attribute {bad[0]!r} must be a string, got {type(meta[bad[0]]).__name__}")
+    problem = _text_problem(meta)
+    if problem:
+        raise ReadError(f"{where}: {what}: {problem}")
     return dict(meta)
+
+
+_SURROGATE = re.compile("[\ud800-\udfff]")  # valid in JSON ("\\ud800"), never text: no terminal or font takes it
+
+
+def _text_problem(value, where: str = "") -> str | None:
+    """Where a JSON value (its keys and strings, at any depth) holds a lone UTF-16 surrogate, or None."""
+    if isinstance(value, str):
+        m = _SURROGATE.search(value)
+        return f"{where or 'a string'} holds a lone surrogate (U+{ord(m.group()):04X}): not text" if m else None
+    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for key, item in items:
+        name = f"{where}[{key}]" if isinstance(key, int) else f"{where}.{key}" if where else f"{key}"
+        name = bounded_text(_SURROGATE.sub("?", str(name)), NAME_CHARS)
+        problem = (_text_problem(key, f"key {name!r}") if isinstance(key, str) else None) or _text_problem(item, name)
+        if problem:
+            return problem
+    return None
 
 
 def sidecar_candidates(path: Path) -> list[Path]:
@@ -478,16 +530,25 @@ def _json_attr(loaded: LoadedFile, key: str, kind: type, default):
             raise ReadError(f"{where} is missing (every lutbake table records it)")
         return default
     try:
-        value = json.loads(loaded.attrs[key])
-    except json.JSONDecodeError as e:
-        raise ReadError(f"{where} is not valid JSON ({e})") from None
+        value = bounded.loads_json(loaded.attrs[key])
+    except ValueError as e:  # JSONDecodeError, nesting, an integer of more than 4300 digits
+        raise ReadError(f"{where} is not valid JSON ({shorten(str(e), 200)})") from None
     if not isinstance(value, kind):
         raise ReadError(f"{where} must be a JSON {'list' if kind is list else 'object'}, got {loaded.attrs[key][:60]}")
+    problem = _text_problem(value)
+    if problem:
+        raise ReadError(f"{where}: {problem}")
     return value
 
 
 def _number(x) -> bool:
-    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+    """A finite JSON number (an integer too large for a float, 10^400, is not one)."""
+    if not isinstance(x, (int, float)) or isinstance(x, bool):
+        return False
+    try:
+        return math.isfinite(float(x))
+    except OverflowError:
+        return False
 
 
 def axis_from_meta(d: dict, where: str = "axis") -> Axis:
@@ -574,7 +635,10 @@ def table_view(loaded: LoadedFile) -> TableView:
     data, path = loaded.data, loaded.path
     if not loaded.attrs:
         nch = data.shape[-1]
-        return TableView(loaded, data, [], [f"channel {c}" for c in "RGBA"[:nch]], [""] * nch, None, path.stem, {}, "")
+        letters = [str(c) for c in loaded.facts.get("channels") or ()][:nch] or list("RGBA"[:nch])
+        letters += [f"#{c}" for c in range(len(letters), nch)]
+        names = [f"channel {bounded_text(c, NAME_CHARS)}" for c in letters]
+        return TableView(loaded, data, [], names, [""] * nch, None, path.stem, {}, "")
     if "kind" not in loaded.attrs:
         raise ReadError(f"{path}: lutbake metadata ({loaded.meta_source}) without 'kind'")
     axes_meta = _json_attr(loaded, "axes", list, None)

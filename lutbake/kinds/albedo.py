@@ -20,7 +20,7 @@ import numpy as np
 from ..axes import Axis
 from ..sampling.mu_average import mu_averages, mu_target
 from ..sampling.plan import TexelPlan, per_texel_plan
-from ..tolerance import Tolerance, tolerance_of
+from ..tolerance import Tolerance, over_tolerance, tolerance_of
 from . import dfg
 from .base import Key, declare
 
@@ -130,13 +130,16 @@ def plan_albedo_avg(spec) -> TexelPlan:
         )
         return np.concatenate([r.values, r.mu_error + r.inner_error], axis=1)
 
-    def error_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
+    def error_estimate(data: np.ndarray, device: str) -> tuple[float, str, str]:
         full = data.reshape(rough.count, -1)
         values, err = full[:, :nch], full[:, nch:]
-        ratio = float(np.max(err / np.maximum(tol.absolute, tol.relative * np.abs(values))))
-        return float(np.max(err)), (
+        ratios = np.max(err / np.maximum(tol.absolute, tol.relative * np.abs(values)), axis=1)
+        return (
+            float(np.max(err)),
             f"per texel: sum over mu panels of |Q(Kronrod {2 * order + 1}) - Q(Gauss {order})| + 2 sum W mu e(mu) over "
-            f"the Kronrod nodes, e the inner rule's own estimate at each node; max error / tolerance = {ratio:.3g}"
+            f"the Kronrod nodes, e the inner rule's own estimate at each node; max error / tolerance = "
+            f"{float(np.max(ratios)):.3g}",
+            over_tolerance(ratios, [rough]),
         )
 
     per = int(estimator.samples({"nov": [0.0]})[0]) * len(MU_STARTS) * (2 * order + 1)  # nominal: the first panels

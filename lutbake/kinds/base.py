@@ -21,7 +21,7 @@ class Key:
     """One config key: its type, default, allowed values (or a range) and a line of documentation."""
 
     name: str
-    type: str  # "str", "int", "float", "int_pair", "float_range", "float_list", "name"
+    type: str  # "str", "int", "float", "bool", "int_pair", "float_range", "float_list", "name"
     default: Any
     doc: str
     choices: dict[str, str] | None = None  # value -> description
@@ -61,7 +61,8 @@ class Estimation:
 
 
 def common_keys(e: Estimation) -> dict[str, Key]:
-    """The keys every kind has: name, kind, format, dtype, seed, samples, estimator, tolerance, relative_tolerance."""
+    """The keys every kind has: name, kind, format, dtype, seed, samples, estimator, tolerance, relative_tolerance,
+    accept_over_tolerance."""
     return {
         "name": Key(
             "name",
@@ -97,6 +98,13 @@ def common_keys(e: Estimation) -> dict[str, Key]:
             "relative error target per value (see tolerance); unset: from the dtype (float32 0, half 1.2e-4)",
             minimum=0.0,
             maximum=1.0,
+        ),
+        "accept_over_tolerance": Key(
+            "accept_over_tolerance",
+            "bool",
+            None,
+            "true: a table whose texels end over their tolerance (status over_tolerance) does not make the bake exit "
+            "1; unset: false",
         ),
     }
 

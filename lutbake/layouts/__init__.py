@@ -52,6 +52,20 @@ def summaries(kind: str) -> dict[str, str]:
     return {name: lay.summary for name, lay in layouts_of(kind).items()}
 
 
+def engine_table(kind: str, name: str, options: dict) -> EngineTable | None:
+    """The engine table a table ``name`` of ``kind`` with ``options`` is (EngineTable.holds), or None."""
+    return next((t for t in TABLES if t.holds(kind, name, options)), None)
+
+
+def reconstruction_with_engine_line(kind: str, name: str, options: dict, reconstruction: str) -> str:
+    """``reconstruction`` led by the engine's own shader line where the table is an engine's (EngineTable.shader):
+    the line ``lutbake inspect`` prints first and the README's engine table shows."""
+    table = engine_table(kind, name, options)
+    if table is None or not table.shader:
+        return reconstruction
+    return f"{table.engine}: {table.shader}\n{reconstruction}"
+
+
 def exclusive_owner(kind: str, fmt: str) -> Layout | None:
     """The layout of ``kind`` that alone writes format ``fmt`` (OpenPBR's header), or None."""
     return next((lay for lay in layouts_of(kind).values() if fmt in lay.storage.exclusive), None)
@@ -66,8 +80,10 @@ __all__ = [
     "Layout",
     "Storage",
     "Terms",
+    "engine_table",
     "exclusive_owner",
     "layouts_of",
     "lookup_layout",
+    "reconstruction_with_engine_line",
     "summaries",
 ]

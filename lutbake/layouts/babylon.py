@@ -176,6 +176,8 @@ TABLES = (
         SOURCE,
         "scene.environmentBRDFTexture (isRGBD = false, invertY = false)",
         shipped="babylon_environment_brdf.npz",
+        shader="t = texture(environmentBrdfSampler, vec2(NdotV, perceptualRoughness)).rgb; (R90 - R0) * t.x + R0 * t.y",
+        encoding="rgbd",  # the shipped PNG (Misc/brdfTextureTools.js loadBRDFTexture: isRGBD = true)
     ),
     EngineTable(
         "Babylon.js",
@@ -196,6 +198,11 @@ TABLES = (
         SOURCE,
         "scene.openPBREnvironmentBRDFTexture (isRGBD = false, invertY = false)",
         shipped="babylon_openpbr_brdf.npz",
+        shader=(
+            "t = texture(openPBREnvironmentBRDF, vec2(NdotV, perceptualRoughness)).rgb; "
+            "(F90 - F0) * t.x + F0 * t.y - b * t.z / 16"
+        ),
+        encoding="rgbd",
     ),
     EngineTable(
         "Babylon.js",
@@ -214,5 +221,10 @@ TABLES = (
         SOURCE,
         "scene.environmentFuzzBRDFTexture (isRGBD = false, invertY = false)",
         shipped="babylon_environment_fuzz_brdf.npz",
+        shader=(
+            "t = texture(environmentFuzzBrdfSampler, vec2(alpha, NdotV)).rgb; A = mix(0.005, 0.88, t.r); "
+            "B = mix(-0.18, 0.002, t.g); R = mix(0.0, 0.75, t.b)"
+        ),
+        encoding="rgbd",
     ),
 )

@@ -114,7 +114,13 @@ class Layout:
 class EngineTable:
     """One table an engine loads, baked by a preset: the layout it is written in, the grid and storage keys the engine
     fixes (the preset's options must hold them: tests/test_layouts.py), the engine's source, what the engine loads
-    and, where tests/data holds the shipped table, its name there."""
+    and, where tests/data holds the shipped table, its name there. ``shader``: the engine's own line that samples
+    the table and rebuilds its value, in the engine's names and uv (the first line of the file's reconstruction,
+    ``lutbake inspect``, and the README's engine table; "" where the engine reads the table through its own array
+    code, as the LTC arrays). ``encoding``: how the engine's shipped file stores a value (a name of
+    lutbake.commands.audit_search.ENCODINGS: ``plain`` UNORM codes or floats as read, ``rgbd`` Babylon's RGBD,
+    ``rgbm``, ``srgb_encoded``, ``half_bits``); ``audit --preset`` decodes a file so when its storage can hold that
+    encoding (an 8-bit RGBA PNG for RGBD), and tries every other encoding as a hypothesis."""
 
     engine: str
     preset: str
@@ -125,6 +131,24 @@ class EngineTable:
     source: str
     loads: str
     shipped: str | None = None
+    shader: str = ""
+    encoding: str = "plain"
+
+    def holds(self, kind: str, name: str, options: dict) -> bool:
+        """Whether a table ``name`` of ``kind`` with ``options`` is this engine table: its name, and every key the
+        engine fixes except the storage ones (``dtype``, ``format``: they change no shader line)."""
+        if (kind, name) != (self.kind, self.table):
+            return False
+        given = {**options, "kind": kind}
+        return all(_plain(given.get(k)) == v for k, v in self.keys.items() if k not in STORAGE_KEYS)
+
+
+STORAGE_KEYS = ("dtype", "format")
+
+
+def _plain(value):
+    """A config value as the records write it (tuples as lists)."""
+    return [_plain(v) for v in value] if isinstance(value, (list, tuple)) else value
 
 
 def uv_of(axes: list[Axis]) -> str:

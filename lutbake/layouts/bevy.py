@@ -25,5 +25,6 @@ TABLES = (
         "bevy crates/bevy_pbr/src/render/pbr_lighting.wgsl (F_AB), environment_map_light",
         "dfg.ktx2 (RGBA16F, zstd supercompressed)",
         shipped="bevy_dfg.ktx2",
+        shader="textureSampleLevel(dfg_lut, dfg_lut_sampler, vec2<f32>(NdotV, perceptual_roughness), 0.0).rg",
     ),
 )

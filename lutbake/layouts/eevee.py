@@ -188,6 +188,7 @@ TABLES = (
         SOURCE,
         "brdf_ggx[64][64][3] in eevee_lut.cc",
         shipped="blender_eevee_next_brdf_ggx.npz",
+        shader="t = texture(lut, vec2(r, sqrt(1.0 - NoV)) * 63.0/64.0 + 0.5/64.0).rgb; F0 * t.r + F90 * t.g - b * t.b",
     ),
     EngineTable(
         "Blender EEVEE",
@@ -198,6 +199,7 @@ TABLES = (
         {"layout": "eevee_btdf", "format": "h"},
         SOURCE,
         "btdf_ggx[16][64][64][1] in eevee_lut.cc",
+        shader="xy = vec2(sqrt((eta - 1)/(eta + 1)), sqrt(1 - NoV)) * 63/64 + 0.5/64",
     ),
     EngineTable(
         "Blender EEVEE",

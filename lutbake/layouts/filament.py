@@ -57,6 +57,7 @@ TABLES = (
         "filament tools/cmgen (--ibl-dfg), libs/ibl/src/CubemapIBL.cpp",
         "the DFG texture of an IBL (RGBA16F DDS, image row order)",
         shipped="filament_dfg.npz",
+        shader="t = texture(dfg, vec2(NoV, 1.0 - (r - 1.0/128.0))).rgb; E = mix(t.r, t.g, f0); sheen DV = t.b",
     ),
     EngineTable(
         "Filament",
@@ -67,5 +68,6 @@ TABLES = (
         {**GRID, "roughness_mapping": "linear"},
         "filament tools/cmgen, with each row's roughness at its texel centre",
         "the DFG texture of an IBL (RGBA16F DDS)",
+        shader="t = texture(dfg, vec2(NoV, 1.0 - r)).rgb; E = mix(t.r, t.g, f0); sheen DV = t.b",
     ),
 )

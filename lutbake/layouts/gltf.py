@@ -138,6 +138,9 @@ TABLES = (
         VIEWER,
         "assets/images/lut_ggx.png (16-bit linear PNG)",
         shipped="khronos_lut_ggx_u8.npz",
+        shader=(
+            "t = texture(u_GGXLUT, vec2(NdotV, r)).rg; k_S * t.r + t.g, k_S = F0 + (max(1 - r, F0) - F0) (1 - NdotV)^5"
+        ),
     ),
     EngineTable(
         "glTF Sample Viewer",
@@ -148,6 +151,7 @@ TABLES = (
         {"size": [128, 128], "roughness": "alpha", "layout": "charlie", "texel": "center", "format": "exr"},
         VIEWER,
         "assets/images/lut_charlie.png (the viewer's own is 8-bit; the integral exceeds 1: EXR)",
+        shader="texture(u_CharlieLUT, vec2(NdotV, sheenRoughness)).b",
     ),
     EngineTable(
         "glTF Sample Viewer",
@@ -158,5 +162,6 @@ TABLES = (
         {"size": [64, 64], "roughness": "alpha", "layout": "sheen_albedo", "texel": "center", "format": "exr"},
         VIEWER,
         "assets/images/lut_sheen_E.png (the sheen albedo scaling)",
+        shader="texture(u_SheenELUT, vec2(NdotV, sheenRoughness)).r",
     ),
 )

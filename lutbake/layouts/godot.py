@@ -25,5 +25,9 @@ TABLES = (
         },
         "godot servers/rendering/renderer_rd/shaders/environment/integrate_dfg.glsl",
         "the DFG texture integrate_dfg.glsl computes at startup",
+        shader=(
+            "t = textureLod(dfg, vec2(NoV, 1.0 - r), 0.0).rg; "
+            "(f90 - f0) * t.x + f0 * t.y, f90 = clamp(50.0 * f0.g, metallic, 1.0)"
+        ),
     ),
 )

@@ -82,6 +82,10 @@ TABLES = (
         },
         SOURCE,
         "the PreIntegratedFGD render target (64 x 64, built at runtime)",
+        shader=(
+            "t = texture(lut, vec2(sqrt(NoV), r) * 63.0/64.0 + 0.5/64.0).rgb; specularFGD = lerp(t.x, t.y, f0); "
+            "diffuseFGD = t.z + 0.5"
+        ),
     ),
     EngineTable(
         "Unity HDRP",
@@ -92,6 +96,7 @@ TABLES = (
         {"size": [64, 64], "roughness": "perceptual", "layout": "charlie_fabric", "texel": "center"},
         SOURCE,
         "the PreIntegratedFGD render target (64 x 64, built at runtime)",
+        shader="t = texture(lut, vec2(NoV, r)).rgb; specularFGD = lerp(t.x, t.y, f0) * 2π; diffuseFGD = t.z",
     ),
     EngineTable(
         "Unity HDRP",

@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from .base import EngineTable
 
+# ltc_code's webgl/ltc.js lookup (LUT_SIZE 64: LUT_SCALE = 63/64, LUT_BIAS = 0.5/64)
+SHADER = "uv = vec2(r, sqrt(1.0 - NoV)) * 63.0/64.0 + 0.5/64.0; t1 = texture(ltc_1, uv); t2 = texture(ltc_2, uv)"
 SOURCE = "selfshadow/ltc_code fit/fitLTC.cpp (packTab), webgl/ltc_1.dds, ltc_2.dds"
 LAYOUTS = ()
 TABLES = tuple(
@@ -20,6 +22,7 @@ TABLES = tuple(
         SOURCE,
         "ltc_1.dds, ltc_2.dds (RGBA16F)",
         shipped="ltc_code_ltc.js.gz" if lobe == "ggx" else None,
+        shader=SHADER,
     )
     for lobe in ("ggx", "eon", "gotanda")
 )

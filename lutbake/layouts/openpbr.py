@@ -158,6 +158,7 @@ TABLES = (
         SOURCE,
         "openpbr_energy_arrays.h (UNORM16 uint16_t arrays)",
         shipped="openpbr_energy_tables.npz",
+        shader="openpbr_look_up_*_energy_complement(ior, alpha, cos)",
     ),
     EngineTable(
         "OpenPBR",

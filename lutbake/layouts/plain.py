@@ -28,7 +28,8 @@ SCALE_BIAS_SHADER = "{uv}; t = texture(lut, uv).rg; specular = prefiltered * (f0
 KARIS = "Karis 2013, Real Shading in Unreal Engine 4, Eq. 8"
 FILAMENT = "Filament, Physically Based Rendering in Filament, 5.3.4.3 (DFG1, DFG2)"
 MULTISCATTER_SHADER = (
-    "{uv}; t = texture(lut, uv).rg; E = mix(t.r, t.g, f0) = (1 - f0) t.r + f0 t.g; specular = prefiltered * E; "
+    "{uv}; t = texture(lut, uv).rg; E = mix(t.r, t.g, f0) = (1 - f0) t.r + f0 t.g (f90 = 1; an engine's f90: "
+    "E = (f90 - f0) t.r + f0 t.g); specular = prefiltered * E; "
     "energy compensation = 1 + f0 (1 / t.g - 1)"
 )
 
@@ -96,6 +97,7 @@ TABLES = (
         {"size": [128, 128], "roughness": "perceptual", "layout": "scale_bias", "dtype": "float32"},
         "Karis 2013",
         "any engine that samples E = f0 * R + G at vec2(NoV, roughness)",
+        shader="t = texture(dfg, vec2(NoV, r)).rg; specular = prefiltered * (f0 * t.r + t.g)",
     ),
     EngineTable(
         "lutbake",
@@ -106,6 +108,7 @@ TABLES = (
         {**TURQUIN, "size": [32, 32], "masking": "smith_height_correlated"},
         "Turquin 2019, Practical multiple scattering compensation for microfacet models",
         "a 3D texture (NoV, roughness, IOR) of E_R, E_T, E_R + E_T",
+        shader="E = texture(lut3d, vec3(NoV, r, (iorIndex(eta) + 0.5) / 32.0)).rgb; f / E.b",
     ),
     EngineTable(
         "lutbake",

@@ -28,6 +28,7 @@ TABLES = (
         SOURCE,
         "DFGLUTData.js (a 16 x 16 RG half-float DataTexture)",
         shipped="threejs_dfg_lut.js",
+        shader="fab = texture2D(dfgLUT, vec2(roughness, dotNV)).rg; specularColor * fab.x + specularF90 * fab.y",
     ),
     EngineTable(
         "three.js",

@@ -25,5 +25,9 @@ TABLES = (
         },
         "Karis 2013; Engine/Content/EngineMaterials/PreintegratedGF (BRDF.ush EnvBRDF)",
         "PreintegratedGF as R16G16_FLOAT DDS",
+        shader=(
+            "AB = PreIntegratedGF.SampleLevel(s, float2(NoV, Roughness), 0).rg; "
+            "SpecularColor * AB.x + saturate(50 * SpecularColor.g) * AB.y"
+        ),
     ),
 )

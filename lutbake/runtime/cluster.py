@@ -325,7 +325,7 @@ def bake_tile(spec, start: int, stop: int, device: str, token: str) -> tuple[np.
     return data, time.thread_time() - t0
 
 
-def estimate_error_task(spec, data: np.ndarray, device: str, token: str) -> tuple[float, str]:
+def estimate_error_task(spec, data: np.ndarray, device: str, token: str) -> tuple:
     """The Dask task of the plan's error estimate (it runs kernels, so it runs where the tiles ran)."""
     init_warp_quietly()
     _check_token(token)
@@ -493,7 +493,7 @@ class DaskRunner:
                     self.stats.cancelled += len(pending)
         return out
 
-    def estimate_error(self, spec, data: np.ndarray, device: str) -> tuple[float, str]:
+    def estimate_error(self, spec, data: np.ndarray, device: str) -> tuple:
         key = f"lutbake-{spec.name}-{uuid.uuid4().hex[:8]}-{device}-error-estimate"
         import dask
 

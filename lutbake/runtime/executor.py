@@ -102,11 +102,10 @@ def execute_tiles(
     return out
 
 
-def estimate_error(
-    plan: TexelPlan, data: np.ndarray, device: str = "cpu", spec=None, runner=None
-) -> tuple[float, str] | None:
-    """``plan.error_estimate`` of baked ``data`` (flat float64, (n_texels, tile_width)), None if the kind has
-    none; with a ``runner`` (see execute_tiles) it runs on a worker, as the tiles did."""
+def estimate_error(plan: TexelPlan, data: np.ndarray, device: str = "cpu", spec=None, runner=None) -> tuple | None:
+    """``plan.error_estimate`` of baked ``data`` (flat float64, (n_texels, tile_width)): (error, method[, where texels
+    end over the tolerance]), None if the kind has none; with a ``runner`` (see execute_tiles) it runs on a worker, as
+    the tiles did."""
     if plan.error_estimate is None:
         return None
     if runner is not None and spec is not None:

@@ -25,7 +25,7 @@ from ..terms import ndf
 from ..terms.frame import reflect
 from . import points
 from .arrays import Points2, Rows64
-from .hemisphere import AdaptiveGaussLegendre, gl_launch, store_row
+from .hemisphere import PRODUCT_NOTE, AdaptiveGaussLegendre, gl_launch, store_row
 
 DEFAULT_SAMPLES = 16384
 
@@ -146,7 +146,7 @@ class AzimuthAveragedGaussLegendre(AdaptiveGaussLegendre):
     ``azimuth_nodes(alpha_max, alpha_min) -> M`` per texel (the integrand's, in numpy): for the nominal cost only."""
 
     azimuth_nodes: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
-    estimate_note: str = ", plus the view-azimuth rule's |Q_M - Q_(M/2)|"
+    estimate_note: str = PRODUCT_NOTE + ", plus the view-azimuth rule's |Q_M - Q_(M/2)|"
 
     def samples(self, inputs: dict) -> np.ndarray:  # nominal: the lobe evaluations of 3 panels at order 24
         return 3 * 24**2 * self.azimuth_nodes(inputs["param"], inputs["alpha"])

@@ -63,7 +63,7 @@ from ..runtime.warp_runtime import load_module, unique_kernel
 from ..terms.frame import view_dir
 from . import points
 from .arrays import PhiRule, Points2, Rows64, Rule, Values64
-from .ladder import greedy_ladder_for
+from .ladder import product_ladder_for
 
 PI64 = wp.constant(wp.float64(math.pi))
 
@@ -386,7 +386,7 @@ def facet_rules_for(spec, members: int = 0):
     member's param, each member's sum taking the same float operations, in the same order, as its own rule's."""
     facet_weight = facet_weight_for(spec.g, spec.distribution.pdf_ndf)
     pdf = spec.distribution.pdf_ndf
-    over_pdf, g64 = over_pdf_for(pdf), spec.g64
+    over_pdf, g64, g_sin2 = over_pdf_for(pdf), spec.g64, spec.g_sin2
     part, rest = spec.g64_parts if members > 0 else (None, None)
     nch = spec.vec._length_
 
@@ -400,7 +400,7 @@ def facet_rules_for(spec, members: int = 0):
     @wp.func
     def add_facet(acc: Any, f: OuterNode, cos_phi: wp.float64, sin_phi: wp.float64, w: wp.float64):
         """acc plus w g / p at the facet (theta_h of the outer node f, phi); an integrand with g64 gets v.h from
-        facet_voh."""
+        facet_voh, one with g_sin2 (a Charlie lobe) sin^2(theta_h) from the node's float64 sin(theta_h)."""
         h = wp.vec3(float(f.sin_h * cos_phi), float(f.sin_h * sin_phi), float(f.cos_h))
         if wp.static(members > 0):
             # the param-free part and the density once a node (over_pdf's operations, in two steps)
@@ -420,6 +420,8 @@ def facet_rules_for(spec, members: int = 0):
         else:
             if wp.static(g64 is not None):
                 gw = over_pdf(g64(f.v, h, f.a, f.prm, facet_voh(f, cos_phi, sin_phi)), f.v, h, f.a, f.in_u)
+            elif wp.static(g_sin2 is not None):  # a Charlie lobe: sin^(1/alpha) of the node's float64 sin(theta_h)
+                gw = over_pdf(g_sin2(f.v, h, f.a, f.prm, f.sin_h * f.sin_h), f.v, h, f.a, f.in_u)
             else:
                 gw = facet_weight(f.v, h, f.a, f.prm, f.in_u)
             for c in range(wp.static(nch)):
@@ -470,19 +472,22 @@ def facet_rules_for(spec, members: int = 0):
 
 @functools.lru_cache(maxsize=None)
 def panel_rule_for(spec):
-    """``(panel_of, first_level)`` of make_gauss_legendre's ladder for an integrand record: ``panel_of(t, j, rules,
-    off, n)``, the n x n product rule over panel j of texel t (a PanelTexel of panel_texel), and ``first_level(t,
-    j)``, the panel's first level in ADAPTIVE_ORDERS (also used by benchmarks/replay_ladder.py, which integrates
-    every panel at every order)."""
+    """``panel_of(t, j, rules, off, n, off_i, n_i)`` of make_gauss_legendre's ladder for an integrand record: the
+    product of the outer rule rules[off : off + n] and the inner rules[off_i : off_i + n_i] over panel j of texel t
+    (a PanelTexel of panel_texel; also used by benchmarks/replay_ladder.py, which integrates every panel at every
+    order)."""
     acc_type = spec.acc
     outer_range, outer_node = outer_variable_for(spec.distribution.tan2_from_u, spec.distribution.u_from_tan2)
     add_facet, sinh_piece, plain_piece = facet_rules_for(spec)
     kinked = spec.nol_kink is not None or spec.kink_at_nov
 
     @wp.func
-    def panel_sum(t: PanelTexel, t_lo: wp.float64, t_hi: wp.float64, rules: Rule, off: int, n: int):
-        """The n x n product rule (rules[off : off + n]) over the panel [t_lo, t_hi] of texel t: the sum of w g / p.
-        Region A's inner nodes are the same for every texel: ``t.phi_a[off + j]`` holds them (phi_rule_a). Inside
+    def panel_sum(
+        t: PanelTexel, t_lo: wp.float64, t_hi: wp.float64, rules: Rule, off: int, n: int, off_i: int, n_i: int
+    ):
+        """The product of the outer rule rules[off : off + n] and the inner rule rules[off_i : off_i + n_i] over the
+        panel [t_lo, t_hi] of texel t: the sum of w g / p. Region A's inner nodes are the same for every texel:
+        ``t.phi_a[off_i + j]`` holds them (phi_rule_a). Inside
         the kink band (kink_band) the inner domain splits at phi_k (n.l = kink): a plain rule over [0, phi_k], the
         sinh map over [phi_k, phimax]; the band's ends are panel ends, where phi_k has sqrt-like ends as phimax."""
         one = wp.float64(1.0)
@@ -525,38 +530,26 @@ def panel_rule_for(spec):
                 # lies eps_l / slope beyond phimax
                 slope = two * cos_h * sin_v * sin_h * wp.max(s_star, wp.float64(1.0e-12))
                 eps = wp.max(t.eps_l / slope, wp.float64(1.0e-12))
-                acc = sinh_piece(acc, f, c_star, s_star, eps, phimax - phi_k, rules, off, n)
+                acc = sinh_piece(acc, f, c_star, s_star, eps, phimax - phi_k, rules, off_i, n_i)
                 if wp.static(kinked):
                     if in_k:
-                        acc = plain_piece(acc, f, phi_k, rules, off, n)
+                        acc = plain_piece(acc, f, phi_k, rules, off_i, n_i)
             elif in_k:  # region A with the kink: phi_a's map (phimax = eps = pi) over [phi_k, pi], plain below
-                acc = sinh_piece(acc, f, -one, wp.float64(0.0), PI64, PI64 - phi_k, rules, off, n)
-                acc = plain_piece(acc, f, phi_k, rules, off, n)
+                acc = sinh_piece(acc, f, -one, wp.float64(0.0), PI64, PI64 - phi_k, rules, off_i, n_i)
+                acc = plain_piece(acc, f, phi_k, rules, off_i, n_i)
             else:
-                for j in range(n):
-                    r = t.phi_a[off + j]  # (cos phi, sin phi, weight): phi over [0, pi], the same for every texel
+                for j in range(n_i):
+                    r = t.phi_a[off_i + j]  # (cos phi, sin phi, weight): phi over [0, pi], the same for every texel
                     acc = add_facet(acc, f, r[0], r[1], wk * r[2])
         return acc
 
     @wp.func
-    def panel_of(t: PanelTexel, j: int, rules: Rule, off: int, n: int):
-        """Panel j of texel t at the n x n rule rules[off : off + n] (the ladder's panel rule)."""
-        return panel_sum(t, t.edges[j], t.edges[j + 1], rules, off, n)
+    def panel_of(t: PanelTexel, j: int, rules: Rule, off: int, n: int, off_i: int, n_i: int):
+        """Panel j of texel t by the outer rule rules[off : off + n] and the inner rules[off_i : off_i + n_i] (the
+        ladder's panel rule, lutbake.sampling.ladder.product_ladder_for)."""
+        return panel_sum(t, t.edges[j], t.edges[j + 1], rules, off, n, off_i, n_i)
 
-    # the GGX microfacet lobes (a mirror limit: not the Charlie cloth / sheen lobes sampled by GGX's CDF), where (4, 6)
-    # was replayed honest (benchmarks/replay_ladder.py)
-    smooth_peak = spec.distribution.name == "ggx" and spec.mirror is not None
-
-    @wp.func
-    def first_level(t: PanelTexel, j: int):
-        """A panel's coarse level in ADAPTIVE_ORDERS: GGX's region-A NDF-peak panel (u = CDF(theta_h), every phi
-        visible) starts at (4, 6), every other panel at (6, 9)."""
-        if wp.static(smooth_peak):
-            if t.edges[j] < t.theta_a and t.edges[j + 1] <= t.theta_peak:
-                return 0
-        return 1
-
-    return panel_of, first_level
+    return panel_of
 
 
 def make_gauss_legendre(spec):
@@ -566,11 +559,15 @@ def make_gauss_legendre(spec):
       du = 2 pi D cos sin dtheta); a panel in region B has its outer variable smoothstep-mapped;
     - the inner variable phi runs over [0, pi] in region A and [0, acos c*] in region B, through a
       sinh map that resolves G2's pole at n.l = -horizon_scale next to the cut.
-    Adaptivity (lutbake.sampling.ladder, greedy): every panel is integrated by the n_0 x n_0 and the n_1 x n_1
-    product rules (``levels``: the orders, their rules concatenated in ``rules``); a panel keeps Q_(k), the finer,
-    and d = |Q_(k) - Q_(k-1)|, the error of the coarser one: a bound, with exponential convergence, of Q_(k)'s
-    error. While a channel's estimate, sum_p d_p / pi + TERMS_ROUNDING |I_c| (float32 terms), exceeds
-    max(tol_abs, tol_rel |I_c|), its panel with the largest d goes one order up. The estimate is the texel's ``err``.
+    Adaptivity (lutbake.sampling.ladder.product_ladder_for, greedy): the outer and the inner rule each have their
+    own order and error estimate, so that their errors cannot cancel in the estimate (measured: a 6 x 6 rule
+    erring by 5e-7, its outer rule by -3.0e-6 and its inner one by +3.5e-6). Every panel is integrated at (n_0,
+    n_0), (n_1, n_0), (n_1, n_1) (outer, inner; ``levels``: the orders, their rules concatenated in ``rules``, the
+    outer check rule CHECK_ORDER last); a panel keeps the last, d_o = |Q(n_1, n_0) - Q(n_0, n_0)| (at least
+    |Q(n_1, n_0) - Q(CHECK_ORDER, n_0)| and the geometric tail of ladder.outer_bound) and d_i = |Q(n_1, n_1) -
+    Q(n_1, n_0)|. While a channel's estimate, sum_p (d_o + d_i) / pi + TERMS_ROUNDING |I_c| (float32 terms),
+    exceeds max(tol_abs, tol_rel |I_c|), its panel and variable with the largest d goes one order up. The estimate
+    is the texel's ``err``.
     One level: the fixed-order rule, err = 0.
     Kernel inputs: per-texel (n.v, alpha, param); ``levels`` (offset, order) into ``rules``, GL (node, weight)
     pairs on [0, 1]; ``tol`` (tol_abs, tol_rel). ``spec``: an integrand record (g, vec, acc, distribution,
@@ -579,8 +576,8 @@ def make_gauss_legendre(spec):
     nch = spec.vec._length_
     smooth = mirror is not None
     kink = spec.nol_kink or 0.0
-    panel_of, first_level = panel_rule_for(spec)
-    integrate, _, _, Sums, _ = greedy_ladder_for(panel_of, MAX_PANELS, nch, first_level)
+    integrate = product_ladder_for(panel_rule_for(spec), MAX_PANELS, nch, check=True)
+    Sums = wp.types.vector(length=nch, dtype=wp.float64)
 
     @unique_kernel
     def gauss_legendre_kernel(
@@ -611,10 +608,6 @@ def make_gauss_legendre(spec):
         # the texel's target, in units of the panel sums (I = sum / pi): the estimate, TERMS_ROUNDING included, within
         # the tolerance
         rounding = TERMS_ROUNDING
-        if wp.static(spec.grazing_peak):
-            # D_charlie = sin(theta_h)^(1/alpha) of a float32 h: pow multiplies sin^2's rounding by 1 / (2 alpha)
-            # (measured: 9.5e-7 relative at alpha = 0.023, n.v = 1/128, at every order)
-            rounding = TERMS_ROUNDING * (wp.float64(1.0) + wp.float64(0.5) / wp.float64(t.a))
         total, e = integrate(t, n_panels, rules, levels, Sums(tol[0] * PI64), Sums(tol[1]), rounding)
         for c in range(wp.static(nch)):
             out[i, c] = total[c] / PI64
@@ -703,12 +696,18 @@ def _launch(kernel, inputs: dict, point_arrays: list, kernel_channels: int, devi
 
 # the successive product-rule orders of a panel: a ratio of ~1.5 (each level costs ~2.25x the last). Starting lower
 # (4, 6, ...) let coincidental agreements of two coarse rules pass (measured: error 1.9e-6 at an estimate 8e-7 on
-# the 128^2 dfg); from 6 every estimate bounds the error against order 64 (tests/test_tolerance.py). Only GGX's
-# region-A NDF-peak panel (u = CDF(theta_h), every phi visible: the smoothest) starts at (4, 6) (first_level in
-# panel_rule_for; replayed offline, benchmarks/replay_ladder.py: 760 -> 733 evaluations per texel on glTF's grid,
-# every estimate still bounding its error). Gentler climbs (9 -> 11 -> 14 -> 20) replayed 4-7 % cheaper on GGX but
-# let Blinn-Phong's 64^2 table pass an error of 2.7e-6 under an estimate of 2.2e-7: orders 9 and 11 agree by chance
-ADAPTIVE_ORDERS = (4, 6, 9, 12, 16, 24, 32, 48, 64)
+# the 128^2 dfg; GGX's region-A NDF-peak panel from (4, 6): albedo's inner 4- and 6-point rules erred by 2.6e-7 and
+# 3.7e-7, an estimate of 1.1e-7). Gentler climbs (9 -> 11 -> 14 -> 20) replayed 4-7 % cheaper on GGX but let
+# Blinn-Phong's 64^2 table pass an error of 2.7e-6 under an estimate of 2.2e-7: orders 9 and 11 agree by chance.
+# The outer and the inner rule climb on their own (lutbake.sampling.ladder.product_ladder_for)
+ADAPTIVE_ORDERS = (6, 9, 12, 16, 24, 32, 48, 64)
+# the method text's note (lutbake.sampling.plan): what a panel's difference is in the product ladder
+PRODUCT_NOTE = (
+    ", per panel its outer and its inner rule's, each at the other's order (the outer one at least the difference "
+    "to order 8 and its geometric tail: lutbake.sampling.ladder.product_ladder_for)"
+)
+CHECK_ORDER = 8  # the outer check rule of the first pair (lutbake.sampling.ladder.outer_bound: orders 6, 8, 9)
+assert (ADAPTIVE_ORDERS[0], CHECK_ORDER, ADAPTIVE_ORDERS[1]) == (6, 8, 9)  # outer_bound's geometric tail assumes them
 
 
 @functools.lru_cache(maxsize=None)
@@ -755,7 +754,8 @@ def gl_launch(integrand, inputs: dict, orders: tuple[int, ...], tol: tuple[float
     n, texel = _texels(inputs, device)
     out = wp.zeros((n, integrand.kernel_channels), dtype=wp.float64, device=device)
     err = wp.zeros((n, integrand.kernel_channels), dtype=wp.float64, device=device)
-    args = [texel, *gl_rule_arrays(tuple(orders), device), wp.vec2d(*tol), out, err]
+    ladder = tuple(orders) + ((CHECK_ORDER,) if len(orders) > 1 else ())  # the check rule last (product_ladder_for)
+    args = [texel, *gl_rule_arrays(ladder, device), wp.vec2d(*tol), out, err]
     wp.launch(gl_kernel(integrand), dim=n, inputs=args, device=device)
     return out.numpy(), err.numpy()
 
@@ -792,14 +792,16 @@ class GaussLegendre:
 @dataclass(frozen=True)
 class AdaptiveGaussLegendre:
     """``gauss_legendre`` to a tolerance: every panel at the first two orders of ADAPTIVE_ORDERS, then the worst panel
-    one order up until the texel's estimate is within max(absolute, relative |I|) (make_gauss_legendre, the greedy
-    ladder of lutbake.sampling.ladder). ``evaluate_with_error`` also returns each texel's error estimate (the sum over
-    panels of |Q_(k) - Q_(k-1)| plus TERMS_ROUNDING |I|), recorded as the table's lutbake:error_estimate."""
+    rule (outer or inner) one order up until the texel's estimate is within max(absolute, relative |I|)
+    (make_gauss_legendre, the greedy ladder of lutbake.sampling.ladder.product_ladder_for). ``evaluate_with_error``
+    also returns each texel's error estimate (the sum over panels of its outer and inner rules' estimates plus
+    TERMS_ROUNDING |I|), recorded as the table's lutbake:error_estimate."""
 
     absolute: float
     relative: float
     orders: tuple[int, ...] = ADAPTIVE_ORDERS
     name: str = "gauss_legendre"
+    estimate_note: str = PRODUCT_NOTE
 
     def samples(self, inputs: dict) -> np.ndarray:  # nominal: 3 panels at the middle order (the work adapts)
         return np.full(len(inputs["nov"]), 3 * self.orders[(len(self.orders) + 1) // 2] ** 2)  # 24: 1728, as before

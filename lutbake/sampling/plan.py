@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..axes import Axis
+from ..tolerance import over_tolerance
 
 PROBE_STRIDED = 256  # strided probe texels of the error estimate
 PROBE_EXTREME = 64  # ... plus at most this many of the most grazing and of the smallest-alpha texels
@@ -43,7 +44,8 @@ class TexelPlan:
     terms: dict[str, str]
     cost: float  # integrand evaluations in total, for the progress bar
     extra: dict[str, str] = field(default_factory=dict)
-    # (flat float64 tile data (n_texels, tile_width), device) -> (estimated max error, how it was estimated)
+    # (flat float64 tile data (n_texels, tile_width), device) -> (estimated max error, how it was estimated[, where
+    # texels end over the tolerance: lutbake.tolerance.over_tolerance, "" when none])
     error_estimate: Callable[[np.ndarray, str], tuple[float, str]] | None = None
     # (data of plan.shape) -> extra lutbake:* attributes known only after the bake (ltc: fit-error statistics)
     attributes_after: Callable[[np.ndarray], dict[str, str]] | None = None
@@ -172,9 +174,10 @@ def per_texel_plan(
         verified = interpolation.VerifiedInterpolation(grid, estimator, integrate, integrand.nch)
         tolerance_record["interpolation"] = interpolation.METHOD
 
-    def adaptive_estimate(data: np.ndarray, device: str) -> tuple[float, str]:
+    def adaptive_estimate(data: np.ndarray, device: str) -> tuple[float, str, str]:
         """The max over texels of the kernel's own per-texel estimate (the tiles' aux columns); the method names
-        the worst ratio to the tolerance (<= 1: every texel met it)."""
+        the worst ratio to the tolerance (<= 1: every texel met it); the third part, where texels end over it
+        (lutbake.tolerance.over_tolerance, "" when none)."""
         full = data.reshape(grid.n_texels, -1)
         nch = integrand.nch
         values, texel_error = full[:, :nch], full[:, nch : 2 * nch]
@@ -198,7 +201,7 @@ def per_texel_plan(
         how += f" ({met}); max error / tolerance = {ratio:.3g}"
         if relative_error:
             how = "relative (|f| > 1e-6), " + how + f"; max abs {float(np.max(texel_error)):.3e}"
-        return err, how
+        return err, how, over_tolerance(np.max(ratios, axis=1), grid.axes)
 
     def estimate(data: np.ndarray, device: str) -> tuple[float, str]:
         idx = probe_indices(grid)

@@ -81,6 +81,17 @@ def V_ashikhmin(NoV: float, NoL: float):
     return 1.0 / (4.0 * (NoL + NoV - NoL * NoV))
 
 
+# Estevez & Kulla 2017, Table 1: the fit's (a, b, c, d, e) at alpha = 1 and at alpha = 0 (KHR_materials_sheen,
+# "Sheen visibility"). sheen_l interpolates them in t = (1 - alpha)^2; the constants and their slopes are float64
+# (Warp evaluates a literal expression such as 25.3245 - 21.5473 in float32: 1.2e-6 off, which moved Lambda by 1e-6
+# relative and the sheen albedo with it, measured against the KHR formula in numpy)
+SHEEN_FIT_ALPHA_1 = (21.5473, 3.82987, 0.19823, -1.97760, -4.32054)
+SHEEN_FIT_ALPHA_0 = (25.3245, 3.32435, 0.16801, -1.27393, -4.85967)
+SheenFit = wp.types.vector(length=5, dtype=wp.float64)
+SHEEN_FIT_AT_1 = wp.constant(SheenFit(*SHEEN_FIT_ALPHA_1))
+SHEEN_FIT_SLOPE = wp.constant(SheenFit(*(lo - hi for hi, lo in zip(SHEEN_FIT_ALPHA_1, SHEEN_FIT_ALPHA_0))))
+
+
 @wp.func
 def sheen_l(x: wp.float64, alpha: wp.float64):
     """Estevez & Kulla 2017's fit l(x) of the Charlie sheen Lambda (their Table 1, interpolated in
@@ -89,12 +100,8 @@ def sheen_l(x: wp.float64, alpha: wp.float64):
     l times 17 (measured: 9e-7 relative in the sheen albedo at n.v = 0.017)."""
     one = wp.float64(1.0)
     t = (one - alpha) * (one - alpha)
-    a = wp.float64(21.5473) + wp.float64(25.3245 - 21.5473) * t
-    b = wp.float64(3.82987) + wp.float64(3.32435 - 3.82987) * t
-    c = wp.float64(0.19823) + wp.float64(0.16801 - 0.19823) * t
-    d = wp.float64(-1.97760) + wp.float64(-1.27393 + 1.97760) * t
-    e = wp.float64(-4.32054) + wp.float64(-4.85967 + 4.32054) * t
-    return a / (one + b * wp.pow(wp.max(x, wp.float64(0.0)), c)) + d * x + e
+    k = SHEEN_FIT_AT_1 + SHEEN_FIT_SLOPE * t  # (a, b, c, d, e)
+    return k[0] / (one + k[1] * wp.pow(wp.max(x, wp.float64(0.0)), k[2])) + k[3] * x + k[4]
 
 
 # where lambda_sheen switches formula: Lambda is C1 there, its second derivative jumps (the quadratures that integrate

@@ -330,3 +330,14 @@ def D_charlie(h: wp.vec3, alpha: float):
     inv = 1.0 / alpha
     sin2 = h[0] * h[0] + h[1] * h[1]
     return (2.0 + inv) * wp.pow(sin2, 0.5 * inv) * INV_PI * 0.5
+
+
+@wp.func
+def D_charlie_sin2(sin2: wp.float64, alpha: float):
+    """D_charlie from sin^2(theta_h) in float64: (2 + 1/alpha) sin2^(1/(2 alpha)) / (2 pi), the power taken in float64.
+    The power multiplies sin2's relative rounding by 1 / (2 alpha): from a float32 h (D_charlie) 6e-8 becomes 3e-4
+    at alpha = 1e-4, from the quadrature node's float64 angles ~1e-12 (lutbake.sampling.hemisphere.facet_rules_for).
+    The caller checks n.h > 0; sin2 in [0, 1]."""
+    inv = wp.float64(1.0) / wp.float64(alpha)
+    half = wp.float64(0.5)
+    return float((wp.float64(2.0) + inv) * wp.pow(sin2, half * inv) * wp.float64(INV_PI) * half)
