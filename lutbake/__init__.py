@@ -16,6 +16,9 @@ _EXPORTS = {
     "load_config": "config",
     "load_configs": "config",
     "Table": "table",
+    "ConfigError": "errors",  # every wrong input of the API (docs/batch.md)
+    "LutbakeError": "errors",
+    "TableError": "errors",
 }
 
 
@@ -35,3 +38,4 @@ def __dir__() -> list[str]:
 
 
 __all__ = ["bake", "bake_table", "BakeResult", "load_config", "load_configs", "TableSpec", "Table", "__version__"]
+__all__ += ["ConfigError", "LutbakeError", "TableError"]

@@ -11,10 +11,10 @@ import contextlib
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import batch, preflight
-from .config import TableSpec, load_configs
+from . import arguments, batch, pipeline, preflight
+from .config import TableSpec, load_configs, validate_spec
 from .errors import ConfigError, TableError
-from .pipeline import OVER_TOLERANCE, bake_table
+from .pipeline import OVER_TOLERANCE
 from .runtime.executor import Progress
 from .table import Table
 from .values_cache import open_cache
@@ -95,11 +95,47 @@ def _result(job: batch.Job) -> BakeResult:
     )
 
 
+def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu", progress=None, **options):
+    """Bake one spec into a Table, nothing written: (table, seconds, samples per texel) (lutbake.pipeline.bake_table;
+    ``options``: ``cancel``, ``runner``). ``spec`` is checked as its config would be (lutbake.config.validate_spec):
+    ConfigError for a wrong input, before any kernel runs."""
+    spec = validate_spec(spec, "bake_table")
+    arguments.workers_arg("bake_table", workers)
+    arguments.device_arg("bake_table", device)
+    return pipeline.bake_table(spec, workers, device, progress, **options)
+
+
+def _check_arguments(out_dir, workers, device, flags: dict, callbacks: dict, cache_dir, fmt, scheduler, report):
+    """bake()'s arguments other than ``configs`` and ``overrides``: ArgumentError naming the first wrong one."""
+    arguments.path_arg("bake", "out_dir", out_dir)
+    arguments.workers_arg("bake", workers)
+    arguments.device_arg("bake", device)
+    for name, value in flags.items():
+        arguments.flag_arg("bake", name, value)
+    for name, value in callbacks.items():
+        arguments.callback_arg("bake", name, value)
+    arguments.path_arg("bake", "cache_dir", cache_dir, optional=True)
+    arguments.path_arg("bake", "report", report, optional=True)
+    arguments.text_arg("bake", "fmt", fmt, "a format name")
+    arguments.text_arg("bake", "scheduler", scheduler, "'local:N' or a Dask address")
+
+
+def _specs(configs, overrides, fmt) -> tuple[list[TableSpec], list[Path]]:
+    """(every spec of the batch, the config paths): TableSpecs checked as a config's (validate_spec), paths loaded."""
+    items = arguments.configs_arg("bake", "configs", configs, (TableSpec,), f"{arguments.PATH} or a TableSpec")
+    overrides = arguments.overrides_arg("bake", overrides)
+    if fmt is not None:
+        overrides = overrides + [(None, "format", fmt, "--format")]
+    specs = [validate_spec(c) for c in items if isinstance(c, TableSpec)]
+    paths = [c for c in items if not isinstance(c, TableSpec)]
+    return specs + (load_configs(paths, overrides) if paths else []), paths
+
+
 def _check_device(device: str, scheduler: str | None) -> None:
     from .runtime import cluster
 
     if scheduler is not None:
-        cluster.parse_scheduler(scheduler)
+        cluster.check_scheduler(scheduler)
     elif device == "cuda":  # on a cluster the workers' GPUs count (lutbake.runtime.cluster checks them)
         from .runtime.warp_runtime import init_warp
 
@@ -129,10 +165,12 @@ def bake(
     EXR) atomically; a table whose output is up to date (same content hash, lutbake.provenance) is skipped unless
     ``force``. ``write=False`` bakes every table and writes nothing.
 
-    ``configs``: paths to TOML files, or TableSpecs. Nothing runs unless every config is valid and every path the
-    batch writes can be written (ConfigError). ``fmt``: the format of every table (as ``format`` in each; blamed
-    as --format). ``on_schedule(results)``: called once, before anything runs, with every table's BakeResult
-    (status ``pending`` or ``skipped``). ``on_result(BakeResult)`` is called as each ends (skipped ones first).
+    ``configs``: a path to a TOML file (str or Path), a TableSpec, or a list of them; a TableSpec is checked as its
+    config would be. Nothing runs unless every config and argument is valid and every path the batch writes can be
+    written (ConfigError; ArgumentError, a ConfigError, for an argument of the wrong type). ``fmt``: the format of
+    every table (as ``format`` in each; blamed as --format). ``on_schedule(results)``: called once, before anything
+    runs, with every table's BakeResult (status ``pending`` or ``skipped``). ``on_result(BakeResult)`` is called
+    as each ends (skipped ones first).
     ``cache_dir``: the values cache of ``lutbake bake --cache`` (lutbake.values_cache; ``force`` reads no entry).
     ``scheduler``: run the tiles on a Dask cluster (lutbake.runtime.cluster: ``local:N`` or ``tcp://HOST:PORT``),
     started only when a table is to be baked. ``report``: write the JSON summary there (lutbake.batch.write_report).
@@ -140,16 +178,23 @@ def bake(
     accept_over_tolerance = true; the file is written either way) and KeyboardInterrupt when the run was
     interrupted (after the others finished); False: return every result, with the outcome on the BakeResults.
     """
-    specs = [c for c in configs if isinstance(c, TableSpec)]
-    paths = [c for c in configs if not isinstance(c, TableSpec)]
-    if fmt is not None:
-        overrides = list(overrides) + [(None, "format", fmt, "--format")]
-    specs += load_configs(paths, overrides) if paths else []
+    _check_arguments(
+        out_dir,
+        workers,
+        device,
+        {"write": write, "force": force, "check": check},
+        {"progress": progress, "on_result": on_result, "on_schedule": on_schedule},
+        cache_dir,
+        fmt,
+        scheduler,
+        report,
+    )
+    specs, paths = _specs(configs, overrides, fmt)
     _check_device(device, scheduler)
     results = BakeResults()
     if not write:
         for spec in specs:
-            table, seconds, samples = bake_table(spec, workers, device, progress)
+            table, seconds, samples = pipeline.bake_table(spec, workers, device, progress)
             over = table.attributes.get(OVER_TOLERANCE, "")
             results.append(BakeResult(spec, table, None, seconds, samples, "over_tolerance" if over else "baked", over))
             if on_result:

@@ -8,6 +8,7 @@ A config holds one or more ``[[table]]`` entries (docs/config.md lists every key
 from __future__ import annotations
 
 import math
+import os
 import re
 import tomllib
 from collections.abc import Mapping
@@ -16,7 +17,8 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
-from .errors import ConfigError, did_you_mean
+from . import arguments
+from .errors import ArgumentError, ConfigError, did_you_mean
 from .kinds import KINDS, Key, lookup_kind
 from .limits import BAKE_PEAK_BYTES_PER_TEXEL, MAX_TEXELS  # noqa: F401  (lutbake.config.MAX_TEXELS, as before)
 from .preflight import config_file_problem, nesting_problem
@@ -24,6 +26,12 @@ from .textsafe import safe_repr
 from .value_bounds import unit_range
 
 NAME_RE = re.compile(r"[A-Za-z0-9_-]{1,128}")  # use fullmatch: "$" would accept a final newline
+NAME_RULE = "1-128 letters, digits, '-' or '_' (it names the output file)"
+# device names Windows reserves in every directory, whatever the extension ("nul.exr" is the null device):
+# Microsoft, "Naming Files, Paths, and Namespaces" (learn.microsoft.com/windows/win32/fileio/naming-a-file)
+WINDOWS_RESERVED = frozenset(
+    ["CON", "PRN", "AUX", "NUL"] + [f"{port}{i}" for port in ("COM", "LPT") for i in range(10)]
+)
 BYTES_PER_TEXEL = 32  # float64 x 4 channels while baking
 MAX_LIST = 1024  # entries of a float_list key
 
@@ -42,6 +50,30 @@ def human_bytes(n: int) -> str:
 PRESET_DIR = Path(__file__).parent / "presets"
 
 
+def name_problem(name) -> str | None:
+    """Why ``name`` cannot name a table (its output file ``name.<ext>`` on every system), or None. The one check of
+    a name: config keys ``name`` (lutbake.config._check_value) and every TableSpec (its constructor). The letters
+    leave out '.', ' ' and path separators: no name climbs out of the out-dir, none ends in the dot or space
+    Windows strips; a device name Windows reserves is refused with and without an extension."""
+    if not isinstance(name, str):
+        return "must be a string"
+    stem = name.split(".", 1)[0].rstrip(" ")
+    if stem.upper() in WINDOWS_RESERVED:
+        return f"{stem!r} is a device name Windows reserves (CON, PRN, AUX, NUL, COM0-9, LPT0-9): no file can have it"
+    if not NAME_RE.fullmatch(name):
+        return f"must be {NAME_RULE}"
+    return None
+
+
+def _frozen(value):
+    """``value`` immutable all the way down: lists and tuples -> tuples, mappings -> read-only mappings."""
+    if isinstance(value, (list, tuple)):
+        return tuple(_frozen(v) for v in value)
+    if isinstance(value, Mapping):
+        return MappingProxyType({k: _frozen(v) for k, v in value.items()})
+    return value
+
+
 @dataclass(frozen=True)
 class TableSpec:
     """One validated ``[[table]]``: its kind, its options (every key of the kind, defaults filled in),
@@ -52,6 +84,31 @@ class TableSpec:
     options: Mapping[str, Any]
     source: str
     index: int
+
+    def __post_init__(self):
+        """Immutable all the way down (a list option is a tuple: ``spec.options["size"][0] = 16384`` raises
+        TypeError), and the name checked as a config's is (name_problem): a hand-made spec cannot write outside
+        the out-dir. Every other option is checked where a spec enters the API (validate_spec)."""
+        source = self.source if isinstance(self.source, str) else "TableSpec"
+
+        def fail(key, value, message):
+            raise ConfigError(source, key, value, message=f"TableSpec: {message}")
+
+        problem = name_problem(self.name)
+        if problem:
+            fail("name", self.name, f"{problem}")
+        if not isinstance(self.kind, str):
+            fail("kind", self.kind, "must be a string")
+        if not isinstance(self.options, Mapping) or not all(isinstance(k, str) for k in self.options):
+            fail(None, None, f"options must be a mapping of key names to values, not {safe_repr(self.options)}")
+        for key, field in (("name", self.name), ("kind", self.kind)):
+            if key in self.options and self.options[key] != field:
+                fail(key, self.options[key], f"options hold {key} {safe_repr(self.options[key])}, the spec {field!r}")
+        if isinstance(self.source, os.PathLike):
+            object.__setattr__(self, "source", os.fspath(self.source))
+        if not isinstance(self.source, str) or isinstance(self.index, bool) or not isinstance(self.index, int):
+            fail(None, None, "source must be a string (the config's path) and index an integer")
+        object.__setattr__(self, "options", _frozen(self.options))
 
     def toml(self) -> str:
         return "[[table]]\n" + "".join(f"{k} = {_toml_value(v)}\n" for k, v in self.options.items() if v is not None)
@@ -99,8 +156,9 @@ def _check_value(key: Key, value, file, table) -> Any:
     if key.type in ("str", "name"):
         if not isinstance(value, str):
             fail("must be a string", ", ".join(key.choices) if key.choices else None)
-        if key.type == "name" and not NAME_RE.fullmatch(value):
-            fail("must be 1-128 letters, digits, '-' or '_' (it names the output file)")
+        problem = name_problem(value) if key.type == "name" else None
+        if problem:
+            fail(problem)
         if key.choices is not None and value not in key.choices:
             fail("is not a known value" + did_you_mean(value, key.choices), ", ".join(key.choices))
         return value
@@ -118,7 +176,7 @@ def _check_value(key: Key, value, file, table) -> Any:
         return value
     if key.type == "int_pair":
         if (
-            not isinstance(value, list)
+            not isinstance(value, (list, tuple))
             or len(value) != 2
             or any(isinstance(x, bool) or not isinstance(x, int) for x in value)
         ):
@@ -136,7 +194,7 @@ def _check_value(key: Key, value, file, table) -> Any:
         return float(value)
     if key.type == "float_range":
         if (
-            not isinstance(value, list)
+            not isinstance(value, (list, tuple))
             or len(value) != 2
             or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in value)
         ):
@@ -149,7 +207,7 @@ def _check_value(key: Key, value, file, table) -> Any:
         return [lo, hi]
     if key.type == "float_list":
         if (
-            not isinstance(value, list)
+            not isinstance(value, (list, tuple))
             or not 1 <= len(value) <= MAX_LIST
             or any(isinstance(x, bool) or not isinstance(x, (int, float)) for x in value)
         ):
@@ -167,9 +225,9 @@ def _check_value(key: Key, value, file, table) -> Any:
 
 def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
     """Validate one ``[[table]]`` mapping against its kind's keys."""
-    label = f"#{index + 1}" + (f" ({raw['name']!r})" if isinstance(raw.get("name"), str) else "")
     if not isinstance(raw, Mapping):
-        raise ConfigError(file, None, message=f"table {label} must be a TOML table")
+        raise ConfigError(file, None, message=f"table #{index + 1} must be a TOML table")
+    label = f"#{index + 1}" + (f" ({raw['name']!r})" if isinstance(raw.get("name"), str) else "")
     if "kind" not in raw:
         raise ConfigError(file, "kind", message="is missing", allowed=", ".join(KINDS), table=label)
     if not isinstance(raw["kind"], str):
@@ -185,7 +243,7 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
             "is not a known table kind" + did_you_mean(raw["kind"], KINDS),
             label,
         ) from None
-    unknown = sorted(set(raw) - set(kind.keys))
+    unknown = sorted(set(raw) - set(kind.keys), key=str)
     if unknown:
         raise ConfigError(
             file,
@@ -240,6 +298,23 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
     return spec
 
 
+def validate_spec(spec, function: str = "bake") -> TableSpec:
+    """``spec`` checked as its config would be: validate_table of its options (every key, the texel cap, the kind's
+    own checks), so a hand-made TableSpec passes the checks a config's does. Raises ConfigError (ArgumentError
+    when ``spec`` is no TableSpec; ``function`` names the API function it was given to)."""
+    if not isinstance(spec, TableSpec):
+        raise ArgumentError(function, "spec", spec, "a TableSpec (lutbake.load_config(path) returns them)")
+    raw = {k: v for k, v in spec.options.items() if v is not None}  # None: a default left unset
+    raw.update(name=spec.name, kind=spec.kind)
+    return validate_table(raw, spec.source, spec.index)
+
+
+def _overrides(function: str, overrides) -> list[tuple]:
+    """``--set`` texts parsed (parse_overrides), tuples kept: the ``overrides`` of load_config / load_configs."""
+    items = arguments.overrides_arg(function, overrides)
+    return parse_overrides([o for o in items if isinstance(o, str)]) + [o for o in items if not isinstance(o, str)]
+
+
 def parse_overrides(items: tuple[str, ...] | list[str]) -> list[tuple[str | None, str, Any]]:
     """``--set KEY=VALUE`` (every table) or ``--set NAME.KEY=VALUE`` (one table); VALUE is TOML."""
     out = []
@@ -274,8 +349,10 @@ def parse_overrides(items: tuple[str, ...] | list[str]) -> list[tuple[str | None
 
 
 def load_config(path, overrides=()) -> list[TableSpec]:
-    """Read and validate one TOML config; ``overrides`` from parse_overrides() are applied first."""
-    path = Path(path)
+    """Read and validate one TOML config; ``overrides`` (``--set`` texts, or parse_overrides() tuples) are applied
+    first. ConfigError for every wrong input (ArgumentError for an argument of the wrong type)."""
+    path = arguments.path_arg("load_config", "path", path)
+    overrides = _overrides("load_config", overrides)
     problem = config_file_problem(path)
     if problem:
         raise ConfigError(path, None, message=problem)
@@ -317,11 +394,11 @@ def load_config(path, overrides=()) -> list[TableSpec]:
 
 
 def load_configs(paths, overrides=()) -> list[TableSpec]:
-    """Validate every config before anything runs; table names must be unique across the batch. ``overrides``:
-    ``--set`` texts, or (table, key, value, blamed argument) tuples (``--format``)."""
-    ovr = parse_overrides([o for o in overrides if isinstance(o, str)]) + [
-        o for o in overrides if not isinstance(o, str)
-    ]
+    """Validate every config before anything runs; table names must be unique across the batch. ``paths``: one path
+    (str or Path) or a list of them. ``overrides``: ``--set`` texts, or (table, key, value, blamed argument) tuples
+    (``--format``)."""
+    paths = arguments.configs_arg("load_configs", "paths", paths)
+    ovr = _overrides("load_configs", overrides)
     specs: list[TableSpec] = []
     seen: dict[str, str] = {}
     for p in paths:

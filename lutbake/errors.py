@@ -54,5 +54,17 @@ class ConfigError(LutbakeError):
         return ConfigError(file, self.key, self.value, self.allowed, self.message, self.table)
 
 
+class ArgumentError(ConfigError):
+    """A wrong argument of the Python API (``lutbake.bake``, ``bake_table``, ``load_config``, ``load_configs``): the
+    message names the function, the argument, the value and what is accepted. A ConfigError, so one ``except
+    lutbake.ConfigError`` catches every input the API refuses."""
+
+    def __init__(self, function: str, argument: str, value, allowed: str):
+        super().__init__(
+            f"lutbake.{function}()", None, message=f"argument {argument} = {safe_repr(value)}: must be {allowed}"
+        )
+        self.key, self.value, self.allowed = argument, value, allowed
+
+
 class TableError(LutbakeError):
     """A table failed while baking (non-finite values, a kernel error); other tables are unaffected."""

@@ -35,7 +35,8 @@ def values_toml(spec: TableSpec) -> str:
     """The canonical TOML of ``spec`` without its layout keys (kind included)."""
     skip = set(layout_keys(spec.kind))
     kept = sorted((k, v) for k, v in spec.options.items() if k not in skip and v is not None)
-    return f"kind = {spec.kind!r}\n" + "".join(f"{k} = {v!r}\n" for k, v in kept)
+    # a list option is a tuple in a TableSpec: shown as the list it was, so the keys stay those of a list
+    return f"kind = {spec.kind!r}\n" + "".join(f"{k} = {list(v) if isinstance(v, tuple) else v!r}\n" for k, v in kept)
 
 
 def values_key(spec: TableSpec, digest: bytes) -> str:

@@ -10,6 +10,8 @@ import logging
 import os
 import pickle
 import signal
+import socket
+import struct
 import subprocess
 import sys
 import threading
@@ -339,3 +341,173 @@ def test_no_cluster_starts_when_every_table_is_up_to_date(tmp_path, monkeypatch)
     r = CliRunner().invoke(main, ["bake", str(cfg), "--out-dir", str(out), "--scheduler", "local:2"])
     assert r.exit_code == 0, r.output
     assert f"skipped {out / 't.exr'} (up to date)" in r.output
+
+
+# ------------------------------------------------------------------- a port that speaks first but is not Dask
+
+U64 = struct.Struct("<Q")
+PROBE_BOUND_S = 5  # a refusal of a foreign service: at once (the subprocess: its imports, ~1.5 s, included)
+
+
+def dask_handshake(message: dict) -> bytes:
+    """One message in Dask's TCP framing (distributed.comm.tcp): byte count, frame count, frame length, frame."""
+    import msgpack
+
+    frame = msgpack.packb(message)
+    body = U64.pack(1) + U64.pack(len(frame)) + frame
+    return U64.pack(len(body)) + body
+
+
+GOOD_HANDSHAKE = dask_handshake({"compression": None, "python": (3, 11, 7), "pickle-protocol": 5})
+FOREIGN = {
+    "ssh": b"SSH-2.0-OpenSSH_9.6p1 Ubuntu-3ubuntu13\r\n",
+    "garbage": bytes(range(256)) * 4,
+    "huge_length": U64.pack(1 << 40) + b"\0" * 64,
+    "framed_junk": U64.pack(24) + U64.pack(1) + U64.pack(8) + b"notdask!",
+    "framed_other_map": dask_handshake({"op": "hello"}),
+    "short_then_closed": U64.pack(58) + b"\1\0",
+}
+
+
+@contextlib.contextmanager
+def loopback_server(first: bytes, close: bool = False, tls=None, later: bytes | None = None):
+    """A server on 127.0.0.1 only, one thread, gone after the block: each connection gets ``first`` (``later``:
+    every connection after the first gets that; through TLS when ``tls``, a server SSLContext), then stays open
+    (``close``: is closed)."""
+    srv = socket.create_server(("127.0.0.1", 0))
+    srv.settimeout(0.1)
+    stop, conns = threading.Event(), []
+
+    def serve():
+        accepted = 0
+        while not stop.is_set():
+            try:
+                c, _ = srv.accept()
+            except OSError:
+                continue
+            conns.append(c)
+            accepted += 1
+            try:
+                c.settimeout(2)
+                c = tls.wrap_socket(c, server_side=True) if tls else c
+                conns.append(c)
+                c.sendall(first if later is None or accepted == 1 else later)
+                if close:
+                    c.close()
+            except OSError:
+                pass
+
+    t = threading.Thread(target=serve, daemon=True)
+    t.start()
+    try:
+        yield srv.getsockname()[1]
+    finally:
+        stop.set()
+        t.join(2)
+        for c in conns:
+            c.close()
+        srv.close()
+
+
+def cli_error_line(args, seconds=PROBE_BOUND_S) -> str:
+    t0 = time.perf_counter()
+    r = CliRunner().invoke(main, ["bake", *map(str, args)])
+    assert r.exit_code == 2 and (r.exception is None or isinstance(r.exception, SystemExit)), (r.output, r.exception)
+    lines = [x for x in r.output.splitlines() if x.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error:"), r.output
+    assert time.perf_counter() - t0 < seconds
+    return lines[0]
+
+
+@pytest.mark.parametrize("what", FOREIGN)
+def test_a_port_whose_service_is_not_dask_is_refused_in_one_line(tmp_path, monkeypatch, what):
+    """Dask read an SSH banner as a frame length ("Unable to allocate 2.82 EiB"), junk as struct.error: a traceback.
+    The probe checks the first frame's framing and handshake map first; CONNECT_TIMEOUT_S bounds the old code."""
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT_S", 2)
+    with loopback_server(FOREIGN[what], close=what == "short_then_closed") as port:
+        address = f"tcp://127.0.0.1:{port}"
+        line = cli_error_line(["--preset", "default", "--out-dir", tmp_path / "o", "--scheduler", address])
+    assert address in line and "not a Dask scheduler" in line and not (tmp_path / "o").exists()
+    if what == "ssh":
+        assert "SSH-2.0-OpenSSH_9.6p1" in line and "an SSH server" in line
+
+
+@pytest.mark.parametrize("later", [None, FOREIGN["ssh"]], ids=["ssh", "dask_handshake_then_ssh"])
+def test_a_foreign_service_ends_the_process_with_exit_2(tmp_path, later):
+    """The process never exited after Dask's traceback (a Client half made: its __del__ waits on a dead loop). The
+    second server passes the probe, then sends Dask's own connection an SSH banner: Dask fails, the process ends."""
+    with loopback_server(FOREIGN["ssh"] if later is None else GOOD_HANDSHAKE, later=later) as port:
+        t0 = time.perf_counter()
+        p = subprocess.run(
+            [sys.executable, "-m", "lutbake", "bake", "--preset", "default", "--out-dir", str(tmp_path / "o")]
+            + ["--scheduler", f"tcp://127.0.0.1:{port}"],
+            env={**os.environ, "PYTHONPATH": str(ROOT)},
+            capture_output=True,
+            text=True,
+            timeout=20,
+        )
+    assert p.returncode == 2 and p.stdout == "" and len(p.stderr.splitlines()) == 1, p.stderr
+    assert f"127.0.0.1:{port}" in p.stderr and time.perf_counter() - t0 < 2 * PROBE_BOUND_S
+    assert ("not a Dask scheduler" if later is None else "cannot connect: MemoryError") in p.stderr
+
+
+def test_the_probe_passes_a_dask_scheduler_and_its_handshake(client):
+    cluster.probe_scheduler(client.scheduler.address, timeout=5)
+    with loopback_server(GOOD_HANDSHAKE) as port:
+        cluster.probe_scheduler(f"tcp://127.0.0.1:{port}", timeout=5)
+
+
+NO_TLS = {f"distributed.comm.tls.{k}": None for k in ("ca-file", "client.cert", "client.key")}
+
+
+def test_tls_without_dask_tls_settings_is_refused_before_connecting(tmp_path):
+    """tls:// without TLS settings: Dask's TypeError ("TLS expects a `ssl_context` argument"), then a hang."""
+    import dask
+
+    with dask.config.set(NO_TLS), loopback_server(FOREIGN["ssh"]) as port:
+        line = cli_error_line(
+            ["--preset", "default", "--out-dir", tmp_path / "o", "--scheduler", f"tls://127.0.0.1:{port}"]
+        )
+    assert "needs Dask's TLS settings" in line and "ca-file" in line and f"127.0.0.1:{port}" in line
+
+
+@pytest.fixture
+def tls_files(tmp_path):
+    """A self-signed EC certificate for 127.0.0.1 (openssl) and its key: the CA, the server's and the client's."""
+    import shutil
+
+    if shutil.which("openssl") is None:
+        pytest.skip("openssl is needed to make a test certificate")
+    cert, key = tmp_path / "c.pem", tmp_path / "k.pem"
+    subprocess.run(
+        ["openssl", "req", "-x509", "-newkey", "ec", "-pkeyopt", "ec_paramgen_curve:prime256v1", "-nodes"]
+        + ["-keyout", str(key), "-out", str(cert), "-days", "2", "-subj", "/CN=127.0.0.1"],
+        check=True,
+        capture_output=True,
+        timeout=20,
+    )
+    return cert, key
+
+
+def test_tls_with_settings_checks_the_first_frame_through_tls(tls_files):
+    """With Dask's TLS settings the probe speaks TLS: a Dask handshake inside passes, junk inside is refused, and a
+    service that is not TLS at all (an SSH banner) fails the TLS handshake: each one ConfigError, at once."""
+    import ssl
+
+    import dask
+
+    from lutbake.errors import ConfigError
+
+    cert, key = map(str, tls_files)
+    server = ssl.create_default_context(ssl.Purpose.CLIENT_AUTH, cafile=cert)
+    server.load_cert_chain(cert, key)
+    server.verify_mode = ssl.CERT_REQUIRED
+    settings = {"distributed.comm.tls.ca-file": cert, "distributed.comm.tls.client.cert": cert}
+    with dask.config.set({**settings, "distributed.comm.tls.client.key": key}):
+        with loopback_server(GOOD_HANDSHAKE, tls=server) as port:
+            cluster.probe_scheduler(f"tls://127.0.0.1:{port}", timeout=5)
+        for first, tls, why in ((FOREIGN["garbage"], server, "not a Dask scheduler"), (FOREIGN["ssh"], None, "TLS")):
+            t0 = time.perf_counter()
+            with loopback_server(first, tls=tls) as port, pytest.raises(ConfigError, match=why):
+                cluster.probe_scheduler(f"tls://127.0.0.1:{port}", timeout=5)
+            assert time.perf_counter() - t0 < PROBE_BOUND_S

@@ -27,12 +27,12 @@ def test_make_luts_batch_loads_with_unique_names():
     [
         (
             "unity-hdrp",
-            {"size": [64, 64], "texel": "endpoint", "nov_mapping": "square", "layout": "multiscatter_disney"},
+            {"size": (64, 64), "texel": "endpoint", "nov_mapping": "square", "layout": "multiscatter_disney"},
         ),
         (
             "godot",
             {
-                "size": [128, 128],
+                "size": (128, 128),
                 "layout": "multiscatter_cloth",
                 "dtype": "half",
                 "masking": "schlick_ggx_ibl",
@@ -43,13 +43,13 @@ def test_make_luts_batch_loads_with_unique_names():
         ("bevy", {"layout": "scale_bias", "dtype": "half", "format": "ktx2zst"}),
         (
             "threejs",
-            {"size": [16, 16], "axis_order": "roughness_x", "texel": "center", "dtype": "half", "format": "js"},
+            {"size": (16, 16), "axis_order": "roughness_x", "texel": "center", "dtype": "half", "format": "js"},
         ),
     ],
 )
 def test_engine_preset_conventions(preset, expected):
     (spec,) = load_configs([presets()[preset]])
-    assert {k: spec.options[k] for k in expected} == expected
+    assert {k: spec.options[k] for k in expected} == expected  # a list option is a tuple in a TableSpec
 
 
 # converged lutbake vs the graded cubature (tests/hemisphere_reference.py: a finer rule changes it by < 6e-12 on these

@@ -291,7 +291,7 @@ def test_ltc_presets_load_with_their_engine_layouts():
     }
     for preset, (fmt, file) in want.items():
         (spec,) = load_configs([preset_path(preset)])
-        assert spec.kind == "ltc" and spec.options["lobe"] == "ggx" and spec.options["size"] == [64, 64]
+        assert spec.kind == "ltc" and spec.options["lobe"] == "ggx" and spec.options["size"] == (64, 64)
         assert spec.options["format"] == fmt
         assert output_path("out", spec.name, fmt).name == file
     (hdrp,) = load_configs([preset_path("ltc-hdrp")])

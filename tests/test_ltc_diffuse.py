@@ -158,7 +158,7 @@ def test_diffuse_ltc_presets_write_ltc_code_dds():
 
     for preset, lobe, axis in (("ltc-gotanda", "gotanda", "sigma"), ("ltc-eon", "eon", "diffuse_roughness")):
         (spec,) = load_configs([preset_path(preset)])
-        assert spec.kind == "ltc" and spec.options["lobe"] == lobe and spec.options["size"] == [64, 64]
+        assert spec.kind == "ltc" and spec.options["lobe"] == lobe and spec.options["size"] == (64, 64)
         assert spec.options["format"] == "ltc_dds"
         assert output_path("out", spec.name, "ltc_dds").name == f"ltc_{lobe}_1.dds"
         assert axes_for(spec.options)[2].name == axis

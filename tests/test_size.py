@@ -59,3 +59,25 @@ def test_cli_size_json():
     assert doc["smallest"]["f32"] in (8, 16)
     res = CliRunner().invoke(main, ["size", "--max-error", "0", "--sizes", "8"])
     assert res.exit_code == 2
+
+
+@pytest.mark.parametrize(
+    "args, option",
+    [
+        (["size", "--max-error", "nan"], "--max-error"),
+        (["size", "--max-error", "inf"], "--max-error"),
+        (["size", "--max-error", "-1e-3"], "--max-error"),
+        (["size", "--max-error", "1e-3", "--nov-min", "nan"], "--nov-min"),
+        (["size", "--max-error", "1e-3", "--nov-min", "-inf"], "--nov-min"),
+        (["size", "--max-error", "1e-3", "--nov-min", "1.5"], "--nov-min"),
+        (["audit", "missing.exr", "--tolerance", "nan"], "--tolerance"),
+        (["audit", "missing.exr", "--tolerance", "inf"], "--tolerance"),
+        (["audit", "missing.exr", "--tolerance", "-1"], "--tolerance"),
+    ],
+)
+def test_every_float_option_refuses_nan_inf_and_out_of_range(args, option):
+    """`size --max-error nan` was accepted (NaN compares false: never met, never refused); the same for each float
+    option of the CLI: exit 2 naming the option, before any table is measured."""
+    res = CliRunner().invoke(main, args)
+    assert res.exit_code == 2, res.output
+    assert f"Invalid value for '{option}'" in res.output and args[-1] in res.output

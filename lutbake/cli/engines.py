@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 
 from .options import (
+    FiniteFloat,
     conventions_of,
     conventions_options,
     fail,
@@ -37,7 +38,7 @@ def _shape(text: str | None):
 @conventions_options("Override a convention key (texel, row_order, roughness, layout, ...); the size is the file's.")
 @click.option(
     "--tolerance",
-    type=float,
+    type=FiniteFloat(minimum=0.0),
     default=1e-3,
     show_default=True,
     help="Exit 0 when the chosen error metric is within this, 1 otherwise.",
@@ -115,7 +116,12 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
 
 @click.command()
 @conventions_options("Override a convention key.")
-@click.option("--max-error", type=float, required=True, help="Target max |bilinear(table) - integral| between texels.")
+@click.option(
+    "--max-error",
+    type=FiniteFloat(minimum=0.0, open_min=True),
+    required=True,
+    help="Target max |bilinear(table) - integral| between texels.",
+)
 @click.option(
     "--sizes",
     default="8,16,32,64,128,256,512",
@@ -124,7 +130,7 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
 )
 @click.option(
     "--nov-min",
-    type=click.FloatRange(0.0, 1.0),
+    type=FiniteFloat(0.0, 1.0),
     default=0.0,
     show_default=True,
     help="Measure only where NoV >= this (the grazing corner never converges on a linear NoV axis).",
@@ -152,8 +158,6 @@ def size(preset, config, overrides, max_error, sizes, nov_min, as_json, workers)
             raise ValueError
     except ValueError:
         fail(f"--sizes {sizes!r}: a comma-separated list of integers >= 2")
-    if max_error <= 0:
-        fail("--max-error must be > 0")
     quiet_warp()
     try:
         result = smallest_sizes(

@@ -3,6 +3,7 @@ config, and the one way a command reports such an error."""
 
 from __future__ import annotations
 
+import math
 import sys
 from pathlib import Path
 
@@ -17,6 +18,31 @@ def fail(message, status: int = EXIT_CONFIG):
 
     click.echo(f"error: {escape_controls(str(message))}", err=True)
     sys.exit(status)
+
+
+class FiniteFloat(click.ParamType):
+    """A finite number within [``minimum``, ``maximum``] (``open_min``: above ``minimum``), for every float option.
+    click's float and FloatRange let NaN through (every comparison with it is false: ``--max-error nan`` was never
+    met, ``--nov-min nan`` measured nothing) and Inf; both are refused here."""
+
+    name = "number"
+
+    def __init__(self, minimum: float | None = None, maximum: float | None = None, open_min: bool = False):
+        self.minimum, self.maximum, self.open_min = minimum, maximum, open_min
+
+    def convert(self, value, param, ctx):
+        try:
+            x = float(value)
+        except (TypeError, ValueError):
+            self.fail(f"{value!r} is not a number", param, ctx)
+        if not math.isfinite(x):
+            self.fail(f"{value!r}: must be a finite number", param, ctx)
+        lo, hi = self.minimum, self.maximum
+        if lo is not None and (x < lo or (self.open_min and x == lo)):
+            self.fail(f"{value!r}: must be {'>' if self.open_min else '>='} {lo:g}", param, ctx)
+        if hi is not None and x > hi:
+            self.fail(f"{value!r}: must be <= {hi:g}", param, ctx)
+        return x
 
 
 def out_dir_option(default: str, what: str):

@@ -68,7 +68,8 @@ def common_keys(e: Estimation) -> dict[str, Key]:
             "name",
             "name",
             None,
-            "output stem: <out-dir>/<name>.<ext> (ext per format); letters, digits, - and _ only",
+            "output stem: <out-dir>/<name>.<ext> (ext per format); letters, digits, - and _ only; not CON, PRN, AUX, "
+            "NUL, COM0-9, LPT0-9 (Windows reserves them)",
             required=True,
         ),
         "kind": Key("kind", "str", None, "table kind (lutbake list)", required=True),

@@ -45,6 +45,7 @@ import pickle
 import queue
 import re
 import signal
+import struct
 import threading
 import time
 import uuid
@@ -55,6 +56,7 @@ import numpy as np
 
 from ..config import BYTES_PER_TEXEL, MAX_TEXELS
 from ..errors import ConfigError, LutbakeError
+from ..textsafe import safe_repr
 from .worker import identity, identity_token, init_warp_quietly
 
 SCHEDULER_FORMS = (
@@ -70,7 +72,19 @@ ADDRESS_RE = re.compile(
 DEFAULT_PORT = 8786
 MAX_LOCAL_WORKERS = 256
 CONNECT_TIMEOUT_S = 30  # the whole handshake with the scheduler, and for its first worker to join
+HALF_MADE_CLOSE_S = 2  # closing a Client whose connection failed (it has nothing open: 0.5 ms measured)
 REFUSED_HINT = "is a Dask scheduler running there? (dask scheduler --port PORT)"
+U64 = struct.Struct("<Q")  # Dask's "Q": the byte counts, frame counts and frame lengths of its TCP framing
+HANDSHAKE_MAX_BYTES = 1 << 16  # a Dask handshake is ~60 bytes (three short keys in msgpack); larger is not one
+HANDSHAKE_MAX_FRAMES = 16  # it is one frame
+HANDSHAKE_KEYS = ("compression", "python")  # distributed.comm.core.Comm.handshake_info (and pickle-protocol)
+BANNER_SHOWN = 40  # bytes of a foreign service's first message quoted in the refusal
+BANNER_WAIT_S = 0.05  # how long the rest of that message may take to arrive
+KNOWN_BANNERS = ((b"SSH-", "an SSH server"), (b"HTTP/", "a web server"), (b"220", "an FTP or mail server"))
+TLS_SETTINGS = (
+    "distributed.comm.tls.ca-file, .client.cert and .client.key in the Dask config, or the environment variables "
+    "DASK_DISTRIBUTED__COMM__TLS__CA_FILE, ...__CLIENT__CERT and ...__CLIENT__KEY"
+)
 POLL_S = 0.2  # how often a waiting table looks at its cancel event
 CLUSTER_TILE_TEXELS = 8192  # CPU tiles of a cluster bake: 16 executor tiles, so Dask's per-task cost stays small
 MAX_TABLE_BYTES = MAX_TEXELS * BYTES_PER_TEXEL  # float64 data of the largest table a config allows
@@ -118,23 +132,116 @@ def parse_scheduler(text: str) -> tuple[str, int | str]:
     raise ConfigError("--scheduler", "scheduler", text, SCHEDULER_FORMS, problem)
 
 
+def check_scheduler(text: str) -> None:
+    """What can be checked of ``--scheduler`` before any work: its form (parse_scheduler), and for a tls:// address
+    that Dask has TLS settings (tls_context). ConfigError."""
+    if parse_scheduler(text)[0] == "address" and text.startswith("tls://"):
+        tls_context(text)
+
+
 def _ucx_available() -> bool:
     import importlib.util
 
     return any(importlib.util.find_spec(m) is not None for m in ("distributed_ucxx", "ucp", "ucxx"))
 
 
+def tls_context(address: str):
+    """The ssl.SSLContext Dask's TLS settings give a client (distributed.Security), for a ``tls://`` address.
+    ConfigError when none are set (Dask itself fails with a TypeError deep in its connector, then hangs) or when
+    they cannot be loaded."""
+    import ssl
+
+    distributed = _distributed()
+    try:
+        ctx = distributed.Security().get_connection_args("client")["ssl_context"]
+    except (OSError, ssl.SSLError, ValueError, TypeError) as e:
+        raise ConfigError(
+            "--scheduler", "scheduler", address, None, f"Dask's TLS settings cannot be loaded ({type(e).__name__}: {e})"
+        ) from None
+    if ctx is None:
+        raise ConfigError(
+            "--scheduler",
+            "scheduler",
+            address,
+            None,
+            f"tls:// needs Dask's TLS settings, and none are set: {TLS_SETTINGS}",
+        )
+    return ctx
+
+
+def _recv_exactly(sock, n: int, deadline: float) -> bytes:
+    """Up to ``n`` bytes from ``sock`` (fewer when the peer closes); TimeoutError past ``deadline``."""
+    data = b""
+    while len(data) < n:
+        sock.settimeout(max(deadline - time.monotonic(), 0.05))
+        chunk = sock.recv(n - len(data))
+        if not chunk:
+            break
+        data += chunk
+    return data
+
+
+def _rest_of_banner(sock) -> bytes:
+    """What else of a foreign service's first message has already arrived (up to BANNER_SHOWN bytes, no wait)."""
+    try:
+        sock.settimeout(BANNER_WAIT_S)
+        return sock.recv(BANNER_SHOWN)
+    except OSError:  # TimeoutError included: nothing more came
+        return b""
+
+
+def _not_dask(first: bytes, closed: bool = False) -> str:
+    """What a service that sent ``first`` instead of a Dask handshake said, and what it looks like."""
+    looks = next((f" ({what})" for prefix, what in KNOWN_BANNERS if first.startswith(prefix)), "")
+    return f"sent {safe_repr(first[:BANNER_SHOWN])}{looks}{' and closed' if closed else ''}, not a Dask handshake"
+
+
+def handshake_problem(sock, deadline: float) -> str | None:
+    """Why the first message ``sock`` receives is not the handshake a Dask listener writes on accept, or None.
+    The framing (distributed.comm.tcp.TCP.read, distributed.protocol.utils.pack_frames_prelude): a uint64 byte
+    count, then that many bytes: a uint64 frame count, one uint64 length per frame, the frames; the one frame a
+    msgpack map holding HANDSHAKE_KEYS. Checked in bounded memory (HANDSHAKE_MAX_BYTES), where Dask allocates
+    whatever the first 8 bytes say (an SSH banner reads as 2.82 EiB). TimeoutError past ``deadline``."""
+    head = _recv_exactly(sock, U64.size, deadline)
+    if len(head) < U64.size:
+        return _not_dask(head, closed=True) if head else "closed the connection without a Dask handshake"
+    (total,) = U64.unpack(head)
+    if not 2 * U64.size <= total <= HANDSHAKE_MAX_BYTES:
+        return _not_dask(head + _rest_of_banner(sock))
+    body = _recv_exactly(sock, total, deadline)
+    (n_frames,) = U64.unpack_from(body) if len(body) >= U64.size else (0,)
+    prelude = U64.size * (1 + n_frames)
+    if len(body) < total or not 1 <= n_frames <= HANDSHAKE_MAX_FRAMES or prelude > total:
+        return _not_dask(head + body, closed=len(body) < total)
+    lengths = struct.unpack_from(f"<{n_frames}Q", body, U64.size)
+    if prelude + sum(lengths) != total:
+        return _not_dask(head + body)
+    try:
+        import msgpack  # a dependency of distributed
+
+        message = msgpack.unpackb(body[prelude : prelude + lengths[0]])
+    except Exception:  # any malformed msgpack (ExtraData, FormatError, ValueError, ...)
+        return _not_dask(head + body)
+    if not isinstance(message, dict) or not all(k in message for k in HANDSHAKE_KEYS):
+        return _not_dask(head + body)
+    return None
+
+
 def probe_scheduler(address: str, timeout: float | None = None) -> None:
     """Fail fast and bounded before Dask connects: a refused port fails at once, an unreachable host after
-    ``timeout`` seconds, and (tcp://) a port that accepts but does not send the Dask handshake a scheduler sends
-    first (distributed.comm.core: the listener writes its handshake on accept) within ``timeout``. ConfigError."""
+    ``timeout`` seconds, and (tcp://, tls://) a port whose first message is not the handshake a Dask scheduler
+    sends on accept (distributed.comm.core: the listener writes its handshake first; handshake_problem) at once,
+    or after ``timeout`` when it sends nothing. tls:// without Dask's TLS settings is refused before connecting.
+    ConfigError, naming the address."""
     import socket
+    import ssl
 
     timeout = CONNECT_TIMEOUT_S if timeout is None else timeout
     m = ADDRESS_RE.match(address)
     if m is None or m.group("scheme") == "ucx":
         return
-    host, port = m.group("host").strip("[]"), int(m.group("port") or DEFAULT_PORT)
+    scheme, host, port = m.group("scheme"), m.group("host").strip("[]"), int(m.group("port") or DEFAULT_PORT)
+    ctx = tls_context(address) if scheme == "tls" else None
     deadline = time.monotonic() + timeout
 
     def fail(msg):
@@ -148,21 +255,26 @@ def probe_scheduler(address: str, timeout: float | None = None) -> None:
         fail(f"cannot connect: no answer from {host}:{port} within {timeout:g} s")
     except OSError as e:
         fail(f"cannot connect to {host}:{port}: {e.strerror or e}")
-    with sock:
-        if m.group("scheme") != "tcp":  # TLS and websockets: the client speaks first; Dask's timeout bounds them
+    with contextlib.ExitStack() as stack:
+        stack.enter_context(sock)
+        if scheme not in ("tcp", "tls"):  # websockets: the client speaks first; Dask's timeout bounds them
             return
         try:
-            sock.settimeout(max(deadline - time.monotonic(), 0.05))
-            first = sock.recv(1)
+            if ctx is not None:
+                sock.settimeout(max(deadline - time.monotonic(), 0.05))
+                sock = stack.enter_context(ctx.wrap_socket(sock, server_hostname=host))
+            problem = handshake_problem(sock, deadline)
         except TimeoutError:
             fail(
                 f"{host}:{port} accepted the connection but sent no Dask handshake within {timeout:g} s "
                 f"(not a Dask scheduler?)"
             )
+        except ssl.SSLError as e:
+            fail(f"the TLS handshake with {host}:{port} failed ({e.reason or e}): not a Dask TLS scheduler?")
         except OSError as e:
             fail(f"cannot connect to {host}:{port}: {e.strerror or e}")
-        if not first:
-            fail(f"{host}:{port} closed the connection without a Dask handshake; {REFUSED_HINT}")
+        if problem:
+            fail(f"{host}:{port} is not a Dask scheduler: it {problem}; {REFUSED_HINT}")
 
 
 # ---------------------------------------------------------------------------------------------- worker side
@@ -404,6 +516,34 @@ def _distributed():
     return distributed
 
 
+def _half_made_clients(error: BaseException, client_type) -> list:
+    """The Clients whose constructor raised ``error``: the ``self`` of its traceback's frames."""
+    import traceback
+
+    found: list = []
+    for frame, _ in traceback.walk_tb(error.__traceback__):
+        obj = frame.f_locals.get("self")
+        if isinstance(obj, client_type) and not any(obj is f for f in found):
+            found.append(obj)
+    return found
+
+
+def _connect(distributed, address: str):
+    """distributed.Client(address); when Dask fails past the probe, the Client it half made is closed here, while
+    its event loop runs: left to its __del__ at exit, it waited forever on a loop already gone (the process printed
+    its error and never ended)."""
+    try:
+        return distributed.Client(address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
+    except Exception as e:
+        for client in _half_made_clients(e, distributed.Client):
+            with contextlib.suppress(Exception):
+                client.close(timeout=HALF_MADE_CLOSE_S)
+            client.status = "closed"  # its __del__ closes nothing more
+            with contextlib.suppress(Exception):
+                client._loop_runner.stop()  # distributed.utils.LoopRunner: the client's IO-loop thread
+        raise
+
+
 @contextlib.contextmanager
 def session(scheduler: str, device: str = "cpu"):
     """Connect to ``scheduler`` (``local:N`` starts a LocalCluster), check its workers, and yield the DaskRunner
@@ -425,11 +565,15 @@ def session(scheduler: str, device: str = "cpu"):
             client = distributed.Client(cluster, set_as_default=False)
         else:
             probe_scheduler(where)  # refused: at once; silent: CONNECT_TIMEOUT_S, not Dask's unbounded handshake
-            client = distributed.Client(where, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
-    except (OSError, TimeoutError) as e:
+            client = _connect(distributed, where)
+    except ConfigError:
+        raise
+    except Exception as e:  # OSError, TimeoutError, or what Dask raises on a handshake the probe passed
         if cluster is not None:
             cluster.close()
-        raise ConfigError("--scheduler", "scheduler", scheduler, None, f"cannot connect: {e}") from None
+        raise ConfigError(
+            "--scheduler", "scheduler", scheduler, None, f"cannot connect: {type(e).__name__}: {e}"
+        ) from None
     try:
         try:
             client.wait_for_workers(where if form == "local" else 1, timeout=CONNECT_TIMEOUT_S)
