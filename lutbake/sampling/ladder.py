@@ -49,30 +49,32 @@ def channel(x: wp.vec4d, c: int):  # noqa: F811 (a Warp overload)
     return x[c]
 
 
-# the least share of the floor a quadrature target keeps, where the floor eats the tolerance: a half let a texel whose
-# floor was 0.67 of the tolerance (HDRP's Charlie G channel: 6.69 x 1e-7 against 1e-6) stop at 1.0007 x its
-# tolerance; a tenth leaves such a texel the tolerance minus its floor, and stops climbing only where the floor alone
-# is over 0.91 of the tolerance (no order helps there)
-FLOOR_SHARE = wp.constant(wp.float64(0.1))
+# the floor (a relative error the caller adds to the estimate, e.g. float32 terms' rounding, 1e-7 |I|) against the
+# tolerance: where the tolerance less the floor is over FLOOR_REACH floors, the quadrature's target is that rest (the
+# texel meets its tolerance); below, no affordable order helps, and the quadrature stops at half the floor (the texel
+# ends over its tolerance, and says so). A half for both let HDRP's Charlie texel (G = 6.69: floor 6.7e-7 against
+# 1e-6) stop at 1.0007 x its tolerance; a tenth for both cost 6x the time of tight bakes (tolerance 1e-8, where the
+# floor alone is over it: the 256^2 interpolation test 7.8 -> 48 s)
+FLOOR_REACH = wp.constant(wp.float64(0.1))
+FLOOR_GIVE_UP = wp.constant(wp.float64(0.5))
 
 
 @functools.lru_cache(maxsize=None)
 def furthest_over_for(nch: int):
     """``furthest_over(total, err, target_abs, target_rel, floor)``: the channel c whose estimate err_c is furthest
-    over its target max(target_abs_c, target_rel_c |total_c|) - floor |total_c| (at least FLOOR_SHARE floor
-    |total_c|), -1 when every channel meets its target (float64 vectors of nch)."""
+    over its target max(target_abs_c, target_rel_c |total_c|) - floor |total_c| (where that is FLOOR_REACH floors
+    |total_c| or less: FLOOR_GIVE_UP floor |total_c|), -1 when every channel meets its target (float64 vectors of
+    nch)."""
 
     @wp.func
     def furthest_over(total: Any, err: Any, target_abs: Any, target_rel: Any, floor: wp.float64):
         worst_c = wp.int32(-1)
         over = wp.float64(1.0)
         for c in range(wp.static(nch)):
-            # a floor near or over the tolerance (float32 noise) leaves the quadrature FLOOR_SHARE of it: beyond, no
-            # order helps (the texel ends over its tolerance, and says so)
-            target = wp.max(
-                wp.max(target_abs[c], target_rel[c] * wp.abs(total[c])) - floor * wp.abs(total[c]),
-                FLOOR_SHARE * floor * wp.abs(total[c]),
-            )
+            noise = floor * wp.abs(total[c])
+            target = wp.max(target_abs[c], target_rel[c] * wp.abs(total[c])) - noise
+            if target <= FLOOR_REACH * noise:  # the floor eats the tolerance: no order helps
+                target = FLOOR_GIVE_UP * noise
             if err[c] > target * over:
                 worst_c = c
                 over = err[c] / wp.max(target, wp.float64(1.0e-300))
@@ -104,7 +106,7 @@ def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None
     """``(integrate, climb, Panels, Sums, Orders)``: ``integrate(ctx, n_panels, rules, levels, target_abs, target_rel,
     floor) -> (total, err)`` (``Sums``: float64 vectors of nch, the targets per channel too): every panel at the
     first two levels, then refined until err_c = sum_p d_(p,c) <= max(target_abs_c, target_rel_c |total_c|) - floor
-    |total_c| (but at least FLOOR_SHARE floor |total_c|) for every channel c (floor: a relative error the caller
+    |total_c| (furthest_over_for's target) for every channel c (floor: a relative error the caller
     adds to the estimate, e.g. the terms' rounding; an unreachable target, e.g. 1e300, never refines) or every panel
     is at the last order (module docstring); n_panels <= max_panels. ``climb(ctx, n_panels, rules, levels,
     target_abs, target_rel, floor, fine0, coarse0, lev)``: the same from each panel's first two levels' values given
