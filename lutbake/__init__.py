@@ -19,6 +19,12 @@ _EXPORTS = {
     "ConfigError": "errors",  # every wrong input of the API (docs/batch.md)
     "LutbakeError": "errors",
     "TableError": "errors",
+    # your own BRDF terms (docs/plugins.md)
+    "register_fresnel": "plugins",
+    "register_ndf": "plugins",
+    "register_diffuse": "plugins",
+    "register_brdf": "plugins",
+    "load_plugin": "plugins",
 }
 
 
@@ -39,3 +45,4 @@ def __dir__() -> list[str]:
 
 __all__ = ["bake", "bake_table", "BakeResult", "load_config", "load_configs", "TableSpec", "Table", "__version__"]
 __all__ += ["ConfigError", "LutbakeError", "TableError"]
+__all__ += ["register_fresnel", "register_ndf", "register_diffuse", "register_brdf", "load_plugin"]

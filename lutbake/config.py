@@ -12,16 +12,17 @@ import os
 import re
 import tomllib
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
 from typing import Any
 
 from . import arguments
 from .errors import ArgumentError, ConfigError, did_you_mean
-from .kinds import KINDS, Key, lookup_kind
+from .kinds import KINDS, Key, kind_record, lookup_kind
 from .limits import BAKE_PEAK_BYTES_PER_TEXEL, MAX_TEXELS  # noqa: F401  (lutbake.config.MAX_TEXELS, as before)
 from .preflight import config_file_problem, nesting_problem
+from .registry import Choices, Record
 from .textsafe import safe_repr
 from .value_bounds import unit_range
 
@@ -77,13 +78,16 @@ def _frozen(value):
 @dataclass(frozen=True)
 class TableSpec:
     """One validated ``[[table]]``: its kind, its options (every key of the kind, defaults filled in),
-    where it came from, and its canonical TOML text (written into the EXR)."""
+    where it came from, and its canonical TOML text (written into the EXR). ``records``: the record each name-valued
+    option resolved to where the config was read (``kind`` -> the Kind's record, ``ndf`` -> the NDF's, ...,
+    lutbake.registry): below the config, code takes objects from these, never looks a name up again."""
 
     name: str
     kind: str
     options: Mapping[str, Any]
     source: str
     index: int
+    records: Mapping[str, Record] = field(default_factory=dict, compare=False)
 
     def __post_init__(self):
         """Immutable all the way down (a list option is a tuple: ``spec.options["size"][0] = 16384`` raises
@@ -101,24 +105,32 @@ class TableSpec:
             fail("kind", self.kind, "must be a string")
         if not isinstance(self.options, Mapping) or not all(isinstance(k, str) for k in self.options):
             fail(None, None, f"options must be a mapping of key names to values, not {safe_repr(self.options)}")
-        for key, field in (("name", self.name), ("kind", self.kind)):
-            if key in self.options and self.options[key] != field:
-                fail(key, self.options[key], f"options hold {key} {safe_repr(self.options[key])}, the spec {field!r}")
+        for key, given in (("name", self.name), ("kind", self.kind)):
+            if key in self.options and self.options[key] != given:
+                fail(key, self.options[key], f"options hold {key} {safe_repr(self.options[key])}, the spec {given!r}")
         if isinstance(self.source, os.PathLike):
             object.__setattr__(self, "source", os.fspath(self.source))
         if not isinstance(self.source, str) or isinstance(self.index, bool) or not isinstance(self.index, int):
             fail(None, None, "source must be a string (the config's path) and index an integer")
         object.__setattr__(self, "options", _frozen(self.options))
+        if not isinstance(self.records, Mapping) or not all(isinstance(r, Record) for r in self.records.values()):
+            fail(None, None, "records must map option names to lutbake.registry.Record objects")
+        object.__setattr__(self, "records", MappingProxyType(dict(self.records)))
+
+    @property
+    def plugins(self) -> list[Record]:
+        """The plugins' records this table uses (their sources enter its content hash, lutbake.provenance)."""
+        return [r for r in self.records.values() if r.plugin is not None]
 
     def toml(self) -> str:
         return "[[table]]\n" + "".join(f"{k} = {_toml_value(v)}\n" for k, v in self.options.items() if v is not None)
 
     def __reduce__(self):  # a mappingproxy does not pickle; lutbake.runtime.cluster ships specs to Dask workers
-        return (_table_spec, (self.name, self.kind, dict(self.options), self.source, self.index))
+        return (_table_spec, (self.name, self.kind, dict(self.options), self.source, self.index, dict(self.records)))
 
 
-def _table_spec(name: str, kind: str, options: dict, source: str, index: int) -> TableSpec:
-    return TableSpec(name, kind, MappingProxyType(options), source, index)
+def _table_spec(name: str, kind: str, options: dict, source: str, index: int, records: dict) -> TableSpec:
+    return TableSpec(name, kind, MappingProxyType(options), source, index, records)
 
 
 def _toml_value(v) -> str:
@@ -159,6 +171,13 @@ def _check_value(key: Key, value, file, table) -> Any:
         problem = name_problem(value) if key.type == "name" else None
         if problem:
             fail(problem)
+        if isinstance(key.choices, Choices):  # a family's records: the name resolved once, here
+            if value in key.choices:
+                return key.choices.resolve(value).name  # an alias -> the record's name
+            fail(
+                key.choices.why_not(value) or "is not a known value" + did_you_mean(value, key.choices),
+                ", ".join(key.choices),
+            )
         if key.choices is not None and value not in key.choices:
             fail("is not a known value" + did_you_mean(value, key.choices), ", ".join(key.choices))
         return value
@@ -262,7 +281,13 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
         else:
             options[k.name] = list(k.default) if isinstance(k.default, list) else k.default
     options["kind"] = kind.name
-    spec = TableSpec(options["name"], kind.name, MappingProxyType(options), str(file), index)
+    records = {"kind": kind_record(kind.name)}
+    records.update(
+        (k.name, k.choices.resolve(options[k.name]))
+        for k in kind.keys.values()
+        if isinstance(k.choices, Choices) and options[k.name] is not None
+    )
+    spec = TableSpec(options["name"], kind.name, MappingProxyType(options), str(file), index, records)
     texels = kind.texels(options)
     if texels > MAX_TEXELS:
         size_keys = [k for k in options if k == "size" or k.endswith("_size")]  # the key to name: size, else ...
@@ -368,9 +393,10 @@ def load_config(path, overrides=()) -> list[TableSpec]:
         raise ConfigError(path, None, message=f"invalid TOML: {e}") from None
     except OSError as e:
         raise ConfigError(path, None, message=f"cannot read: {e.strerror or e}") from None
-    extra = sorted(set(doc) - {"table"})
+    extra = sorted(set(doc) - {"table", "plugins"})
     if extra:
-        raise ConfigError(path, extra[0], doc[extra[0]], "table", "is not a top-level key")
+        raise ConfigError(path, extra[0], doc[extra[0]], "table, plugins", "is not a top-level key")
+    load_plugins(path, doc.get("plugins", []))
     tables = doc.get("table")
     if not isinstance(tables, list) or not tables:
         raise ConfigError(path, "table", message="a config needs at least one [[table]]")
@@ -391,6 +417,21 @@ def load_config(path, overrides=()) -> list[TableSpec]:
                 raise e.blamed(origin[e.key]) from None
             raise
     return specs
+
+
+def load_plugins(config: Path, paths) -> None:
+    """A config's ``plugins = ["my_brdf.py", ...]`` (relative to the config's folder), and the installed packages'
+    plugins (entry points), loaded before its tables are checked (lutbake.plugins)."""
+    from . import plugins
+
+    plugins.load_entry_points()
+    if not isinstance(paths, list) or not all(isinstance(p, str) and p for p in paths) or len(paths) > MAX_LIST:
+        raise ConfigError(config, "plugins", paths, "a list of Python files", "must be a list of file paths")
+    for p in paths:
+        file = (config.parent / p).resolve()
+        if not file.is_file():
+            raise ConfigError(config, "plugins", p, "a Python file", f"no such file: {file}")
+        plugins.load_plugin(file)
 
 
 def load_configs(paths, overrides=()) -> list[TableSpec]:

@@ -50,13 +50,15 @@ def sources_digest() -> bytes:
 
 
 def content_hash(spec: TableSpec, digest: bytes | None = None) -> str:
-    """The hex sha256 of (spec.toml(), lutbake version, source digest): what makes an output current."""
+    """The hex sha256 of (spec.toml(), lutbake version, source digest, the sources of the plugin records the spec
+    uses: lutbake.registry.Record.sources): what makes an output current."""
     h = hashlib.sha256()
     for part in (
         b"lutbake-content-hash-v1",
         spec.toml().encode(),
         __version__.encode(),
         digest if digest is not None else sources_digest(),
+        *(r.sources() for r in spec.plugins),
     ):
         h.update(str(len(part)).encode() + b"\0" + part)
     return h.hexdigest()
@@ -88,5 +90,6 @@ def attributes(spec: TableSpec, plan, extra: dict[str, str] | None = None) -> di
         "warp_version": warp_version(),
         **plan.extra,
         **(extra or {}),
+        **({"plugins": json.dumps([r.provenance() for r in spec.plugins])} if spec.plugins else {}),
         HASH_ATTRIBUTE: content_hash(spec),  # what makes the file current
     }

@@ -66,7 +66,7 @@ def test_albedo_avg_estimate_bounds_its_error(spec, graded_rule, ndf):
     got, estimate = out[:, 0], out[:, 1]
     mu, w = graded_rule(0.0, 1.0, [0.0, 1.0])
     alpha = plan.axes[0].alpha()
-    integrand = integrand_of(s.options)
+    integrand = integrand_of(s)
     inputs = {
         "nov": np.tile(mu, len(alpha)).astype(np.float32),
         "alpha": integrand.alpha_input(np.repeat(alpha, len(mu))),

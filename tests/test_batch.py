@@ -441,12 +441,13 @@ def test_every_lutbake_kernel_module_compiles_with_lutbakes_options():
     import lutbake
     from lutbake.integrands import fresnel
     from lutbake.ltc import fit
+    from lutbake.records import FRESNEL
     from lutbake.runtime import warp_runtime
 
     for m in pkgutil.walk_packages(lutbake.__path__, "lutbake."):
         if not m.name.endswith("__main__"):
             importlib.import_module(m.name)
-    fresnel._kernel()
+    fresnel._kernel(FRESNEL.lookup("schlick"))
     fit.kernels("ggx")
     from warp._src.context import user_modules
 

@@ -175,11 +175,12 @@ def test_dfg_beckmann_separable_gauss_legendre_matches_reference(references):
 
 def test_dfg_cook_torrance_gauss_legendre_matches_reference(references, spec):
     """The lecture's Cook-Torrance (Beckmann D with 1/pi, V-cavity G, Schlick F): the table kernel of
-    model = "cook_torrance" (lutbake.catalog.model_terms) against the reference with the V-cavity G
+    model = "cook_torrance" (its record in lutbake.records) against the reference with the V-cavity G
     written here."""
     from lutbake.kinds.dfg import terms_of
 
-    form, ndf, masking = terms_of(spec(kind="dfg", model="cook_torrance").options)
+    form, ndf, masking = terms_of(spec(kind="dfg", model="cook_torrance"))
+    ndf = ndf.name
     # the same kinks slow the table's Gauss-Legendre too: measured max error 8.4e-4 at 432 samples (the default),
     # 8.4e-5 at 1152, 4.2e-5 at 4608; scrambled Sobol' NDF sampling with 2^20 points agrees with the reference to 3.5e-7
     got = table(ndf, masking, "gauss_legendre", 4608, form)

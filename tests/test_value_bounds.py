@@ -7,8 +7,9 @@ import pytest
 
 from lutbake import value_bounds as vb
 from lutbake.api import bake_table
-from lutbake.catalog import ANISO_MODELS, DIFFUSE_MODELS
-from lutbake.catalog import SPECULAR_MODELS as MODELS
+from lutbake.records import ANISO_MODEL, DIFFUSE, MODEL
+
+ANISO_MODELS, DIFFUSE_MODELS, MODELS = ANISO_MODEL.names(), DIFFUSE.names(), MODEL.names()
 from lutbake.config import validate_table
 from lutbake.io.formats import PNG_SLACK
 from lutbake.kinds import KINDS

@@ -113,36 +113,40 @@ def _list_keys(kind: str | None, width: int) -> None:
 
 
 def _terms() -> dict[str, dict[str, str]]:
-    """The selectable terms, by section title (warp-free declarations: lutbake.catalog and the kinds)."""
+    """The selectable terms, by section title: the registry's families (lutbake.records, and any plugin's records:
+    lutbake.plugins) and the kinds' own name lists; warp-free."""
     from ..axes import TEXELS
-    from ..catalog import (
-        ANISO_ESTIMATORS,
-        ANISO_MODELS,
-        DIFFUSE_MODELS,
-        FRESNELS,
-        HEMISPHERE_ESTIMATORS,
-        MASKINGS,
-        NDF_DESCRIPTIONS,
-        SPECULAR_MODELS,
-    )
     from ..kinds.dfg import LAYOUTS
     from ..kinds.diffuse import DIFFUSE_ESTIMATORS
     from ..kinds.specular_aniso import VIEW_AZIMUTHS
     from ..metals import METALS
+    from ..records import (
+        ANISO_ESTIMATOR,
+        ANISO_MODEL,
+        DIFFUSE,
+        FRESNEL,
+        HEMISPHERE_ESTIMATOR,
+        LTC_LOBE,
+        MASKING,
+        MODEL,
+        NDF,
+    )
+    from ..registry import choices
 
     return {
-        "NDFs (ndf = ...)": NDF_DESCRIPTIONS,
-        "Masking-shadowing (masking = ...)": MASKINGS,
-        "Models (dfg, albedo, albedo_avg, specular_3d: model = ...)": SPECULAR_MODELS,
-        "Anisotropic models (specular_aniso: model = ...)": ANISO_MODELS,
+        "NDFs (ndf = ...)": choices(NDF),
+        "Masking-shadowing (masking = ...)": choices(MASKING),
+        "Models (dfg, albedo, albedo_avg, specular_3d: model = ...)": choices(MODEL),
+        "Anisotropic models (specular_aniso: model = ...)": choices(ANISO_MODEL),
         "View azimuth (specular_aniso: view_azimuth = ...)": VIEW_AZIMUTHS,
-        "Fresnel (specular_3d: fresnel = ...; dfg factors Schlick out)": FRESNELS,
+        "Fresnel (dfg: those linear in f0; specular_3d: those of f0; fresnel = ...)": choices(FRESNEL),
         "Metals (specular_3d: metal = ...)": {k: f"n+ik R,G,B = {m.n} + i{m.k}; {m.source}" for k, m in METALS.items()},
         "DFG layouts (layout = ...)": LAYOUTS,
-        "Estimators (dfg, albedo, albedo_avg, specular_3d: estimator = ...)": HEMISPHERE_ESTIMATORS,
-        "Diffuse models (kind = diffuse, model = ...)": DIFFUSE_MODELS,
+        "Estimators (dfg, albedo, albedo_avg, specular_3d: estimator = ...)": choices(HEMISPHERE_ESTIMATOR),
+        "Diffuse models (kind = diffuse, model = ...)": choices(DIFFUSE),
         "Estimators (diffuse, diffuse_3d: estimator = ...)": DIFFUSE_ESTIMATORS,
-        "Estimators (specular_aniso: estimator = ...)": ANISO_ESTIMATORS,
+        "Estimators (specular_aniso: estimator = ...)": choices(ANISO_ESTIMATOR),
+        "LTC lobes (kind = ltc, lobe = ...)": choices(LTC_LOBE),
         "Texel conventions (texel = ...)": TEXELS,
     }
 

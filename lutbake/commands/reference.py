@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..axes import Axis
-from ..config import TableSpec, load_config, parse_overrides, preset_path, validate_table
+from ..config import TableSpec, load_config, parse_overrides, preset_path, validate_spec, validate_table
 from ..errors import ConfigError
 from ..pipeline import compute_at
 from ..runtime.memo import RowMemo
@@ -118,7 +118,8 @@ def conventions(config=None, preset=None, overrides=(), shape=None, recorded=Non
 
 
 def _with(spec: TableSpec, **options) -> TableSpec:
-    return TableSpec(spec.name, spec.kind, {**spec.options, **options}, spec.source, spec.index)
+    """``spec`` with ``options`` changed, validated as a config's (its records resolved anew)."""
+    return validate_spec(TableSpec(spec.name, spec.kind, {**spec.options, **options}, spec.source, spec.index))
 
 
 class Reference:
@@ -130,7 +131,7 @@ class Reference:
 
         self.layout = conv.layout
         self.record = conv.record
-        self.form = terms_of(conv.spec.options)[0]
+        self.form = terms_of(conv.spec)[0]
         self.converged_spec = _with(
             conv.spec,
             estimator="gauss_legendre",

@@ -32,8 +32,8 @@ import functools
 import numpy as np
 import warp as wp
 
-from ..catalog import DIELECTRIC_MASKINGS
 from ..edge import COS_EPS
+from ..records import MASKING
 from ..terms import fresnel
 from ..terms.dielectric import F_dielectric64, cos_transmitted, cos_transmitted64
 from ..terms.distributions import NDFS
@@ -65,10 +65,9 @@ def integrand_for(ndf_name: str, masking_name: str, mode: str):
     that differ only in eta share it: lutbake.sampling.dielectric.make_adaptive_members)."""
     if mode not in FRESNEL_MODES:
         raise KeyError(f"unknown Fresnel mode {mode!r}; valid: {', '.join(FRESNEL_MODES)}")
-    if masking_name not in DIELECTRIC_MASKINGS:
-        raise KeyError(
-            f"masking {masking_name!r} is not defined for transmission; valid: {', '.join(DIELECTRIC_MASKINGS)}"
-        )
+    transmission = [r.name for r in MASKING if r.fields["transmission"]]
+    if masking_name not in transmission:
+        raise KeyError(f"masking {masking_name!r} is not defined for transmission; valid: {', '.join(transmission)}")
     D = NDFS[ndf_name].D
     G2 = NDFS[ndf_name].G2(masking_name)
 

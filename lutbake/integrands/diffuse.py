@@ -24,49 +24,43 @@ import warp as wp
 
 from ..axes import sigma_alpha
 from ..edge import COS_EPS, effective_alpha
+from ..records import DIFFUSE, FACET_FRESNEL
 from ..sampling.diffuse import DiffuseGaussLegendre, eval_points
 from ..sampling.facets import fd_microfacet_for
 from ..sampling.swapped import integrate_swapped
 from ..terms import diffuse
 
-FACET_FUNCS = {
-    "eq6": diffuse.F_facet_eq6,
-    "schlick": diffuse.F_facet_schlick,
-    "dielectric_f0": diffuse.F_facet_dielectric_f0,
+# the facet form's f0 factor c(f0) in F_facet = c(f0) T(m.l) T(m.v) (its T: the facet record's ``T``)
+FACET_F0_SCALE = {
+    "eq6": lambda f0: 1.05 * (1.0 - f0),
+    "schlick": lambda f0: (1.0 - f0) ** 2,
+    "dielectric_f0": lambda f0: 1.0,
 }
 
 
-# facet form -> (transmission T(c, f0), the f0 factor c(f0) as a Python function)
-FACET_SPLIT = {
-    "eq6": (diffuse.T_pow5, lambda f0: 1.05 * (1.0 - f0)),
-    "schlick": (diffuse.T_pow5, lambda f0: (1.0 - f0) ** 2),
-    "dielectric_f0": (diffuse.T_dielectric_f0, lambda f0: 1.0),
-}
+def diffuse_record(model):
+    """``model`` itself, or lutbake's diffuse record of that name (host helpers and tests name lutbake's own)."""
+    return DIFFUSE.lookup(model) if isinstance(model, str) else model
 
 
-CLOSED_FORMS = {  # model -> (Fd_ term, whether it takes f0)
-    "oren_nayar": (diffuse.Fd_oren_nayar, False),
-    "oren_nayar_improved": (diffuse.Fd_oren_nayar_improved, False),
-    "oren_nayar_fresnel": (diffuse.Fd_oren_nayar_fresnel, True),
-    "fitted": (diffuse.Fd_gotanda_fitted, True),
-    "fitted_slides": (diffuse.Fd_gotanda_fitted_slides, True),
-    "eon": (diffuse.Fd_eon, False),
-}
+def facet_record(facet_fresnel):
+    return FACET_FRESNEL.lookup(facet_fresnel) if isinstance(facet_fresnel, str) else facet_fresnel
 
 
 @functools.lru_cache(maxsize=None)
-def brdf_for(model: str, facet_fresnel: str = "eq6"):
-    """``brdf(l, v, sigma, alpha, f0, rule) -> float64``: the model's BRDF for rho = 1 (closed forms ignore alpha and
-    the GL rule (node, weight) of the microfacet model's m-integral; the microfacet model ignores sigma)."""
-    if model == "microfacet":
-        fm = fd_microfacet_for(FACET_FUNCS[facet_fresnel])
+def brdf_for(model, facet):
+    """``brdf(l, v, sigma, alpha, f0, rule) -> float64``: the BRDF of a diffuse record for rho = 1 (closed forms,
+    the record's ``Fd(rho, NoL, NoV, LoV, sigma[, f0])``, ignore alpha and the GL rule (node, weight) of the
+    microfacet model's m-integral; the microfacet model, with its ``facet`` record's F_facet, ignores sigma)."""
+    if model.name == "microfacet":
+        fm = fd_microfacet_for(facet["F"])
 
         @wp.func
         def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float, rule: wp.array(dtype=wp.vec2d)):
             return fm(l, v, alpha, f0, rule)
 
         return brdf
-    if model == "lambert":
+    if model.name == "lambert":
 
         @wp.func
         def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float, rule: wp.array(dtype=wp.vec2d)):
@@ -75,8 +69,8 @@ def brdf_for(model: str, facet_fresnel: str = "eq6"):
             return wp.float64(diffuse.Fd_lambert(1.0))
 
         return brdf
-    F, with_f0 = CLOSED_FORMS[model]
-    if with_f0:
+    F = model["Fd"]
+    if model.fields["with_f0"]:
 
         @wp.func
         def closed(l: wp.vec3, v: wp.vec3, sigma: float, f0: float):
@@ -107,12 +101,17 @@ class DiffuseIntegrand:
     nch: int = 1
 
 
+def diffuse_integrand(model, facet_fresnel="eq6") -> DiffuseIntegrand:
+    """The integrand of a diffuse model (a record, or the name of one of lutbake's) and facet form."""
+    return _diffuse_integrand(diffuse_record(model), facet_record(facet_fresnel))
+
+
 @functools.lru_cache(maxsize=None)
-def diffuse_integrand(model: str, facet_fresnel: str = "eq6") -> DiffuseIntegrand:
-    if model != "microfacet":
-        return DiffuseIntegrand(model, facet_fresnel, brdf_for(model, facet_fresnel), None, None)
-    T, c = FACET_SPLIT[facet_fresnel]
-    return DiffuseIntegrand(model, facet_fresnel, brdf_for(model, facet_fresnel), T, c, FACET_FUNCS[facet_fresnel])
+def _diffuse_integrand(model, facet) -> DiffuseIntegrand:
+    if model.name != "microfacet":
+        return DiffuseIntegrand(model.name, facet.name, brdf_for(model, facet), None, None)
+    T, c = facet["T"], FACET_F0_SCALE[facet.name]
+    return DiffuseIntegrand(model.name, facet.name, brdf_for(model, facet), T, c, facet["F"])
 
 
 def _alpha(sigma, sigma_to_alpha: str):

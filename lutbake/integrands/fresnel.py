@@ -14,40 +14,42 @@ import functools
 import numpy as np
 import warp as wp
 
-from ..catalog import FRESNELS
 from ..metals import LAZANYI_ALPHA
+from ..records import FRESNEL
 from ..runtime.warp_runtime import unique_kernel
 from ..sampling.arrays import Floats
-from ..terms import fresnel as fr
-
-COLUMNS = tuple(FRESNELS)
 
 
 @functools.lru_cache(maxsize=None)
-def _kernel():
+def _kernel(fresnel):
+    """out[i] = F(c[i]) of a Fresnel record, reading f0 (param "f0"), n and k ("nk") or n, k and Lazanyi's a ("nka")."""
+    F, param = fresnel["F"], fresnel.fields["param"]
+
     @unique_kernel
-    def eval_fresnel(f0: Floats, n: Floats, k: Floats, a: Floats, c: Floats, out: wp.array2d(dtype=float)):
+    def eval_fresnel(f0: Floats, n: Floats, k: Floats, a: Floats, c: Floats, out: wp.array(dtype=float)):
         i = wp.tid()
-        out[i, 0] = fr.F_schlick(f0[i], c[i])
-        out[i, 1] = fr.F_schlick_sg(f0[i], c[i])
-        out[i, 2] = fr.F_improved_sg(f0[i], c[i])
-        out[i, 3] = fr.F_dielectric_f0(f0[i], c[i])
-        out[i, 4] = fr.F_conductor(n[i], k[i], c[i])
-        out[i, 5] = fr.F_lazanyi(n[i], k[i], a[i], wp.static(LAZANYI_ALPHA), c[i])
+        if wp.static(param == "f0"):
+            out[i] = F(f0[i], c[i])
+        elif wp.static(param == "nk"):
+            out[i] = F(n[i], k[i], c[i])
+        else:
+            out[i] = F(n[i], k[i], a[i], wp.static(LAZANYI_ALPHA), c[i])
 
     return eval_fresnel
 
 
-def evaluate(c, f0=0.04, n=1.5, k=0.0, a=0.0) -> dict[str, np.ndarray]:
-    """Every Fresnel term at cosines ``c`` (broadcast with f0, n, k, a): name -> float64 array.
-    schlick*, improved_sg and dielectric_f0 read f0; conductor and lazanyi read n, k (and a)."""
+def evaluate(c, f0=0.04, n=1.5, k=0.0, a=0.0, fresnels=None) -> dict[str, np.ndarray]:
+    """Fresnel terms at cosines ``c`` (broadcast with f0, n, k, a): name -> float64 array, for the records
+    ``fresnels`` (default: every Fresnel record). Terms of f0 read f0; conductor and lazanyi read n, k (and a)."""
     arrs = np.broadcast_arrays(*(np.asarray(x, dtype=np.float32) for x in (f0, n, k, a, c)))
     shape = arrs[0].shape
     ins = [wp.array(np.ascontiguousarray(x.ravel()), dtype=float, device="cpu") for x in arrs]
-    out = wp.zeros((arrs[0].size, len(COLUMNS)), dtype=float, device="cpu")
-    wp.launch(_kernel(), dim=arrs[0].size, inputs=ins + [out], device="cpu")
-    o = out.numpy().astype(np.float64)
-    return {name: o[:, j].reshape(shape) for j, name in enumerate(COLUMNS)}
+    values = {}
+    for fresnel in FRESNEL if fresnels is None else fresnels:
+        out = wp.zeros(arrs[0].size, dtype=float, device="cpu")
+        wp.launch(_kernel(fresnel), dim=arrs[0].size, inputs=ins + [out], device="cpu")
+        values[fresnel.name] = out.numpy().astype(np.float64).reshape(shape)
+    return values
 
 
 def mu_nodes(order: int = 48) -> tuple[np.ndarray, np.ndarray]:
@@ -61,10 +63,10 @@ def mu_nodes(order: int = 48) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(nodes), np.concatenate(weights)
 
 
-def f_avg(name: str, f0=0.04, n=1.5, k=0.0, a=0.0, order: int = 48) -> float:
-    """F_avg = 2 ∫_0^1 F(mu) mu dmu of the term ``name`` (FRESNELS), by Gauss-Legendre in mu."""
-    if name not in FRESNELS:
-        raise KeyError(f"unknown Fresnel term {name!r}; valid: {', '.join(FRESNELS)}")
+def f_avg(fresnel, f0=0.04, n=1.5, k=0.0, a=0.0, order: int = 48) -> float:
+    """F_avg = 2 ∫_0^1 F(mu) mu dmu of a Fresnel record (or the name of one of lutbake's), by Gauss-Legendre in
+    mu."""
+    fresnel = FRESNEL.lookup(fresnel) if isinstance(fresnel, str) else fresnel
     mu, w = mu_nodes(order)
-    F = evaluate(mu, f0, n, k, a)[name]
+    F = evaluate(mu, f0, n, k, a, [fresnel])[fresnel.name]
     return float(2.0 * np.sum(w * F * mu))

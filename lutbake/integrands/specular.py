@@ -22,22 +22,48 @@ import numpy as np
 import warp as wp
 
 from .. import metals
-from ..catalog import SHEEN_LAYOUTS
 from ..edge import COS_EPS, effective_alpha
-from ..terms import fresnel, masking, ndf
-from ..terms.distributions import NDFS, Distribution
+from ..terms import fresnel as fresnel_terms
+from ..terms import masking, ndf
+from ..terms.distributions import Distribution, distribution
 from ..terms.frame import reflect
 
-
-@wp.func
-def channels_scale_bias(VoH: float, f0: float):
-    Fc = fresnel.Fc_schlick(VoH)
-    return wp.vec2(1.0 - Fc, Fc)
+# the sheen lobe alone: no GGX term (sheen_integrand_for); *_clamped: V clamped to [0, 1] (the viewer's shaders)
+SHEEN_LAYOUTS = ("charlie", "sheen_albedo", "charlie_clamped", "sheen_albedo_clamped", "sheen_fgd")
 
 
-@wp.func
-def channels_multiscatter(VoH: float, f0: float):
-    return wp.vec2(fresnel.Fc_schlick(VoH), 1.0)
+def fc_of(fresnel):
+    """``Fc(c)`` of a Fresnel record linear in f0, F = f0 + (1 - f0) Fc(c) (lutbake.records): its own ``Fc`` where it
+    has one (Schlick's (1 - c)^5), else F(0, c). None: Schlick's."""
+    if fresnel is None:
+        return fresnel_terms.Fc_schlick
+    if fresnel.get("Fc") is not None:
+        return fresnel["Fc"]
+    F = fresnel["F"]
+
+    @wp.func
+    def Fc(c: float):
+        return F(0.0, c)
+
+    return Fc
+
+
+@functools.lru_cache(maxsize=None)
+def split_channels(fresnel=None) -> dict:
+    """The split-sum channel sets of a Fresnel linear in f0, F = f0 (1 - Fc) + Fc (Karis 2013):
+    scale_bias (1 - Fc, Fc) -> E = f0 scale + bias; multiscatter (Fc, 1) -> E = mix(R, G, f0)."""
+    Fc = fc_of(fresnel)
+
+    @wp.func
+    def channels_scale_bias(VoH: float, f0: float):
+        w = Fc(VoH)
+        return wp.vec2(1.0 - w, w)
+
+    @wp.func
+    def channels_multiscatter(VoH: float, f0: float):
+        return wp.vec2(Fc(VoH), 1.0)
+
+    return {"scale_bias": channels_scale_bias, "multiscatter": channels_multiscatter}
 
 
 @wp.func
@@ -45,8 +71,11 @@ def channels_albedo(VoH: float, f0: float):
     return wp.vec2(1.0, 0.0)
 
 
-def fresnel_channels(F):
-    """specular_3d: R = F(f0, v.h) for the texel's f0 (the kernel's per-texel param); G unused (0)."""
+@functools.lru_cache(maxsize=None)
+def fresnel_channels(fresnel):
+    """specular_3d: R = F(f0, v.h) of the Fresnel record for the texel's f0 (the kernel's per-texel param); G unused
+    (0)."""
+    F = fresnel["F"]
 
     @wp.func
     def channels_F(VoH: float, f0: float):
@@ -58,38 +87,42 @@ def fresnel_channels(F):
 # Blender EEVEE's F82-tint layout: (1 - Fc, Fc, (v.h)(1 - v.h)^6)
 @wp.func
 def channels_scale_bias_f82(VoH: float, f0: float):
-    Fc = fresnel.Fc_schlick(VoH)
+    Fc = fresnel_terms.Fc_schlick(VoH)
     return wp.vec3(1.0 - Fc, Fc, VoH * Fc * wp.clamp(1.0 - VoH, 0.0, 1.0))
 
 
 @wp.func
 def channels_multiscatter3(VoH: float, f0: float):
-    return wp.vec3(fresnel.Fc_schlick(VoH), 1.0, 0.0)
+    return wp.vec3(fresnel_terms.Fc_schlick(VoH), 1.0, 0.0)
 
 
-CHANNEL_FUNCS = {
-    "scale_bias": channels_scale_bias,
-    "multiscatter": channels_multiscatter,
-    "albedo": channels_albedo,
-    **{
-        f"F:{name}": fresnel_channels(getattr(fresnel, f"F_{name}"))
-        for name in ("schlick", "schlick_sg", "improved_sg", "dielectric_f0")
-    },
-    "scale_bias_f82": channels_scale_bias_f82,
+@dataclass(frozen=True)
+class ChannelSet:
+    """What a specular table's kernel returns per h: ``length`` channels (the kernel vector), of which a table keeps
+    ``stored`` (lutbake.layouts name them); ``fresnel``: the channels take the config's Fresnel (linear in f0 for the
+    split-sum pairs; any for "F"); ``charlie``: a Charlie lobe with its own integrand (charlie_pair_for)."""
+
+    name: str
+    length: int
+    stored: int
+    fresnel: bool = False
+    charlie: bool = False
+
+
+CHANNEL_SETS = {
+    c.name: c
+    for c in (
+        ChannelSet("scale_bias", 2, 2, fresnel=True),
+        ChannelSet("multiscatter", 2, 2, fresnel=True),
+        ChannelSet("albedo", 2, 2),
+        ChannelSet("F", 2, 1, fresnel=True),
+        ChannelSet("scale_bias_f82", 3, 3),
+        ChannelSet("metal", 3, 3),
+        ChannelSet("multiscatter_cloth", 3, 3, charlie=True),
+        *(ChannelSet(n, 3, 3 if n.startswith("charlie") else 2, charlie=True) for n in SHEEN_LAYOUTS),
+    )
 }
-THREE_CHANNELS = {"scale_bias_f82", "multiscatter_cloth", "charlie", "charlie_clamped"}
-N_CHANNELS = {
-    "scale_bias": 2,
-    "multiscatter": 2,
-    "albedo": 2,
-    "scale_bias_f82": 3,
-    "multiscatter_cloth": 3,
-    "charlie": 3,
-    "sheen_albedo": 2,
-    "charlie_clamped": 3,
-    "sheen_albedo_clamped": 2,
-    "sheen_fgd": 2,
-}
+N_CHANNELS = {name: c.stored for name, c in CHANNEL_SETS.items()}
 
 
 # the metals' complex indices as one constant table, row i = METAL_ORDER[i]: (n_R, n_G, n_B, k_R, k_G, k_B). Every
@@ -114,21 +147,28 @@ def channels_metal(VoH: float, row: float):
     m = METAL_NK
     i = int(row)
     return wp.vec3(
-        fresnel.F_conductor(m[i, 0], m[i, 3], VoH),
-        fresnel.F_conductor(m[i, 1], m[i, 4], VoH),
-        fresnel.F_conductor(m[i, 2], m[i, 5], VoH),
+        fresnel_terms.F_conductor(m[i, 0], m[i, 3], VoH),
+        fresnel_terms.F_conductor(m[i, 1], m[i, 4], VoH),
+        fresnel_terms.F_conductor(m[i, 2], m[i, 5], VoH),
     )
 
 
 @functools.lru_cache(maxsize=None)
-def channels_for(channels_name: str):
-    """(channel wp.func (VoH, param) -> vec, vec type): a name of CHANNEL_FUNCS, or "metal" for RGB =
-    F_conductor(n_c, k_c, v.h) of the metal whose METAL_NK row is the param (metal_param)."""
-    if channels_name in CHANNEL_FUNCS:
-        return CHANNEL_FUNCS[channels_name], (wp.vec3 if channels_name in THREE_CHANNELS else wp.vec2)
-    if channels_name == "metal":
-        return channels_metal, wp.vec3
-    raise KeyError(channels_name)
+def channels_for(channels_name: str, fresnel=None):
+    """(channel wp.func (VoH, param) -> vec, vec type) of a CHANNEL_SETS name: the split-sum pairs of ``fresnel``
+    (a Fresnel record linear in f0; None: Schlick's), "F" for F(f0, v.h) of ``fresnel`` itself (specular_3d), "metal"
+    for RGB = F_conductor(n_c, k_c, v.h) of the metal whose METAL_NK row is the param (metal_param)."""
+    vec = wp.vec3 if CHANNEL_SETS[channels_name].length == 3 else wp.vec2
+    fixed = {
+        "albedo": channels_albedo,
+        "scale_bias_f82": channels_scale_bias_f82,
+        "metal": channels_metal,
+    }
+    if channels_name in fixed:
+        return fixed[channels_name], vec
+    if channels_name == "F":
+        return fresnel_channels(fresnel), vec
+    return split_channels(fresnel)[channels_name], vec
 
 
 def half_vector_integrand(lobe, vec, skip_below_horizon_h: bool):
@@ -170,11 +210,11 @@ def charlie_integrands(lobe, vec):
 
 
 @functools.lru_cache(maxsize=None)
-def weight_for(ndf_name: str, masking_name: str, form: str):
+def weight_for(nd, masking_name: str, form: str):
     """f (n.l) 4 (v.h) / F of an integrand form (``integrand_for``) at (v, h, l, v.h, alpha)."""
     if form == "microfacet":
-        D = NDFS[ndf_name].D
-        G2 = NDFS[ndf_name].G2(masking_name)
+        D = distribution(nd).D
+        G2 = distribution(nd).G2(masking_name)
 
         @wp.func
         def weight(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float):
@@ -197,19 +237,19 @@ def weight_for(ndf_name: str, masking_name: str, form: str):
 
 
 @functools.lru_cache(maxsize=None)
-def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: str = "microfacet"):
+def integrand_for(nd, masking_name: str, channels_name: str, form: str = "microfacet", fresnel=None):
     """g(h) = f(l, v) (n.l) 4 (v.h) * channels(v.h, param), 0 where n.l, v.h or n.v <= COS_EPS (back-facing).
     ``form`` (model_terms):
         microfacet         f = D G2 / (4 (n.l)(n.v)) [x F]:          g = D G2 (v.h) / (n.v)
         blinn_phong        f = (s + 8)/(8 pi) (n.h)^s [x F]:          g = (s + 8)/(8 pi) (n.h)^s 4 (n.l)(v.h)
         ashikhmin_shirley  f = (s + 1)/(8 pi) (n.h)^s / ((v.h) max(n.l, n.v)) [x F]:
                                                                       g = (s + 1)/(2 pi) (n.h)^s (n.l) / max(n.l, n.v)
-    with s = 2 / alpha^2 - 2 for the last two (ndf_name, masking_name are then unused)."""
-    charlie = charlie_pair_for(ndf_name, masking_name, channels_name)
+    with s = 2 / alpha^2 - 2 for the last two (nd, masking_name are then unused)."""
+    charlie = charlie_pair_for(nd, masking_name, channels_name)
     if charlie is not None:
         return charlie[0]
-    ch, vec = channels_for(channels_name)
-    weight = weight_for(ndf_name, masking_name, form)
+    ch, vec = channels_for(channels_name, fresnel)
+    weight = weight_for(nd, masking_name, form)
 
     @wp.func
     def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float):
@@ -218,21 +258,21 @@ def integrand_for(ndf_name: str, masking_name: str, channels_name: str, form: st
     return half_vector_integrand(lobe, vec, True)
 
 
-def charlie_pair_for(ndf_name: str, masking_name: str, channels_name: str):
+def charlie_pair_for(nd, masking_name: str, channels_name: str):
     """(g, g_sin2) of the channels with a Charlie lobe (charlie_integrands: the cloth and sheen layouts), else None."""
     if channels_name == "multiscatter_cloth":
-        return cloth_integrand_for(ndf_name, masking_name)
+        return cloth_integrand_for(nd, masking_name)
     if channels_name in SHEEN_LAYOUTS:
         return sheen_integrand_for(channels_name)
     return None
 
 
 @functools.lru_cache(maxsize=None)
-def cloth_integrand_for(ndf_name: str, masking_name: str):
+def cloth_integrand_for(nd, masking_name: str):
     """(Fc s, s, D_charlie V_ashikhmin (n.l) 4 (v.h)) with s = D G2 (v.h)/(n.v): the multiscatter
     channels plus Filament's cloth DV (DFV_Charlie_Uniform), 0 where n.l or v.h <= COS_EPS (back-facing): (g, g_sin2),
     charlie_integrands."""
-    weight = weight_for(ndf_name, masking_name, "microfacet")
+    weight = weight_for(nd, masking_name, "microfacet")
 
     @wp.func
     def lobe(v: wp.vec3, h: wp.vec3, l: wp.vec3, VoH: float, alpha: float, param: float, dch: float):
@@ -268,7 +308,7 @@ def sheen_integrand_for(layout: str):
             return wp.vec3(0.0, 0.0, ash)
         if wp.static(base == "sheen_fgd"):
             dc = d * masking.V_charlie(NoV, NoL, alpha)
-            return wp.vec3(dc * fresnel.Fc_schlick(VoH), dc, 0.0)
+            return wp.vec3(dc * fresnel_terms.Fc_schlick(VoH), dc, 0.0)
         return wp.vec3(d * wp.min(masking.V_charlie(NoV, NoL, alpha), wp.static(vmax)), ash, 0.0)
 
     return charlie_integrands(lobe, wp.vec3)
@@ -321,9 +361,9 @@ class SpecularIntegrand:
 
 
 @functools.lru_cache(maxsize=None)
-def mirror_for(channels_name: str):
+def mirror_for(channels_name: str, fresnel=None):
     """E at alpha = 0 for the microfacet form: the mirror direction l = reflect(v, n), h = n, v.h = n.v, G2 = 1."""
-    ch, vec = channels_for(channels_name)
+    ch, vec = channels_for(channels_name, fresnel)
 
     @wp.func
     def mirror(v: wp.vec3, param: float):
@@ -336,26 +376,26 @@ def mirror_for(channels_name: str):
 
 @functools.lru_cache(maxsize=None)
 def specular_integrand(
-    ndf_name: str, masking_name: str, channels_name: str, form: str = "microfacet", nch: int | None = None
+    nd, masking_name: str, channels_name: str, form: str = "microfacet", nch: int | None = None, fresnel=None
 ) -> SpecularIntegrand:
     """The integrand record of a (terms, channels, form) key, the first ``nch`` channels kept (all if None).
-    For the forms blinn_phong and ashikhmin_shirley ``ndf_name`` names the NDF the estimators sample and
+    For the forms blinn_phong and ashikhmin_shirley ``nd`` is the NDF the estimators sample and
     ``masking_name`` is ignored. The layouts with a Charlie channel (cloth, sheen) have no mirror limit."""
     if form != "microfacet":
         masking_name = "none"
-    pair = charlie_pair_for(ndf_name, masking_name, channels_name)
+    pair = charlie_pair_for(nd, masking_name, channels_name)
     charlie = pair is not None
-    vec = wp.vec3 if charlie else channels_for(channels_name)[1]
+    vec = wp.vec3 if charlie else channels_for(channels_name, fresnel)[1]
     k = vec._length_
-    mirror = mirror_for(channels_name) if form == "microfacet" and not charlie else None
+    mirror = mirror_for(channels_name, fresnel) if form == "microfacet" and not charlie else None
     return SpecularIntegrand(
-        (ndf_name, masking_name, channels_name, form),
-        integrand_for(ndf_name, masking_name, channels_name, form),
+        (distribution(nd), masking_name, channels_name, form, fresnel),
+        integrand_for(nd, masking_name, channels_name, form, fresnel),
         vec,
         wp.vec3d if k == 3 else wp.vec2d,
         k,
         nch or k,
-        NDFS[ndf_name],
+        distribution(nd),
         mirror,
         masking.LAMBDA_SHEEN_SWITCH
         if channels_name.removesuffix("_clamped") in ("sheen_albedo", "sheen_fgd")
@@ -368,7 +408,7 @@ def specular_integrand(
 
 
 def hemisphere_integral(
-    ndf_name: str,
+    nd,
     masking_name: str,
     channels_name: str,
     nov,
@@ -379,13 +419,16 @@ def hemisphere_integral(
     param=None,
     form: str = "microfacet",
     device: str = "cpu",
+    fresnel=None,
 ) -> np.ndarray:
     """Host helper (checks, tests, benchmarks): the integrand of (terms, channels, form) at texels (nov[i],
     alpha[i], param[i]) by a hemisphere estimator (lutbake.sampling.hemisphere), every kernel channel, float64
-    (N, C). alpha goes through the edge policy (lutbake.edge.effective_alpha) as in a table."""
+    (N, C). ``nd``: a Distribution or the name of one of lutbake's; ``fresnel``: the Fresnel record of the channels
+    that take one (None: Schlick's). alpha goes through the edge policy (lutbake.edge.effective_alpha) as in a
+    table."""
     from ..sampling.hemisphere import estimator_for
 
-    integrand = specular_integrand(ndf_name, masking_name, channels_name, form)
+    integrand = specular_integrand(nd, masking_name, channels_name, form, fresnel=fresnel)
     nov = np.asarray(nov, np.float32)
     param = np.zeros(len(nov), np.float32) if param is None else np.asarray(param, np.float32)
     inputs = {"nov": nov, "alpha": integrand.alpha_input(np.asarray(alpha, np.float32)), "param": param}

@@ -9,11 +9,34 @@ from pathlib import Path
 
 import numpy as np
 
-from .readers import FORMAT_NAMES, LoadedFile, read, table_view
+from ..textsafe import bounded as bounded_text
+from .readers import FORMAT_NAMES, NAME_CHARS, LoadedFile, read, table_view
 
 PROVENANCE = ("terms", "estimator", "samples", "seed", "error_estimate", "version", "warp_version")
-SHOWN = {"kind", "table", "axes", "channels", "channel_names", "reconstruction", "config", *PROVENANCE}
+SHOWN = {"kind", "table", "axes", "channels", "channel_names", "reconstruction", "config", "plugins", *PROVENANCE}
 LONG_VALUE = 200  # characters of any other attribute shown
+MAX_PLUGINS = 64  # plugin records listed
+
+
+def _plugin_lines(text: str | None) -> list[str]:
+    """The lutbake:plugins record (lutbake.registry.Record.provenance): the plugin records the table was baked with."""
+    if not text:
+        return []
+    try:
+        records = json.loads(text)
+    except ValueError:
+        return [f"  plugins: {bounded_text(text)}"]
+    if not isinstance(records, list):
+        return [f"  plugins: {bounded_text(text)}"]
+    lines = ["  plugins:"]
+    for r in records[:MAX_PLUGINS]:
+        if isinstance(r, dict):
+            r = {str(k): bounded_text(str(v), NAME_CHARS) for k, v in r.items()}
+            lines.append(
+                f"    {r.get('family', '?')} {r.get('name', '?')!r} from {r.get('origin', '?')}, "
+                f"line {r.get('line', '?')} ({r.get('functions', '')}); source sha256 {r.get('sha256', '?')}"
+            )
+    return lines
 
 
 def _fmt(x: float) -> str:
@@ -140,6 +163,7 @@ def describe(path) -> str:
     lines += [f"  {key}: {attrs[key]}" for key in PROVENANCE if key in attrs]
     if "config" in attrs:
         lines.append(f"  config: {len(attrs['config'].splitlines())} line(s) of TOML")
+    lines += _plugin_lines(attrs.get("plugins"))
     for key in sorted(set(attrs) - SHOWN):
         value = attrs[key]
         lines.append(f"  {key}: {value if len(value) <= LONG_VALUE else value[:LONG_VALUE] + ' ...'}")

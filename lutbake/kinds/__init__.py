@@ -7,6 +7,7 @@ integrand (lutbake.integrands) and estimator (lutbake.sampling); ``base.declare`
 
 from __future__ import annotations
 
+from ..registry import Record, RegistryError, family
 from .albedo import ALBEDO, ALBEDO_AVG
 from .base import Key, Kind
 from .btf import BTF
@@ -35,13 +36,21 @@ KINDS: dict[str, Kind] = {
     )
 }
 ALIASES: dict[str, str] = {alias: k.name for k in KINDS.values() for alias in k.aliases}
+KIND = family("kind", "table kinds: what a table integrates (keys, axes, channels, integrand, estimator)")
+for _k in KINDS.values():
+    KIND.add(Record("kind", _k.name, _k.description, aliases=_k.aliases, fields={"obj": _k}))
 
-__all__ = ["ALIASES", "KINDS", "Key", "Kind", "lookup_kind"]
+__all__ = ["ALIASES", "KINDS", "Key", "Kind", "kind_record", "lookup_kind"]
+
+
+def kind_record(name: str) -> Record:
+    """The record of the kind named ``name`` or one of its aliases; KeyError lists the valid names."""
+    try:
+        return KIND.lookup(name)
+    except RegistryError as e:
+        raise KeyError(f"unknown table kind {name!r}; valid kinds: {', '.join(sorted(KINDS) + sorted(ALIASES))}") from e
 
 
 def lookup_kind(name: str) -> Kind:
-    """The kind registered under ``name`` or one of its aliases; KeyError lists the valid names."""
-    key = ALIASES.get(name, name)
-    if key not in KINDS:
-        raise KeyError(f"unknown table kind {name!r}; valid kinds: {', '.join(sorted(KINDS) + sorted(ALIASES))}")
-    return KINDS[key]
+    """The kind registered under ``name`` or one of its aliases (kind_record's object)."""
+    return kind_record(name).obj

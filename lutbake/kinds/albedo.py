@@ -24,7 +24,7 @@ from ..tolerance import Tolerance, over_tolerance, tolerance_of
 from . import dfg
 from .base import Key, declare
 
-ALBEDO_KEYS = {k: v for k, v in dfg.KEYS.items() if k != "layout"}
+ALBEDO_KEYS = {k: v for k, v in dfg.KEYS.items() if k not in ("layout", "fresnel")}  # F = 1
 ALBEDO_CHANNELS = {"e": "E = ∫ f/F (n.l) dω_l: single-scattering directional albedo with F = 1"}
 ALBEDO_RECONSTRUCTION = (
     "E_v = texture(albedo, vec2(NoV, roughness)).r; E_l = texture(albedo, vec2(NoL, roughness)).r; "
@@ -57,11 +57,11 @@ AVG_CHANNELS = {"e_avg": "E_avg = 2 ∫ E(mu) mu dmu: hemispherical albedo with 
 AVG_RECONSTRUCTION = "E_avg = texture(albedo_avg, vec2(roughness, 0.5)).r (one row; x = roughness)"
 
 
-def integrand_of(o: dict):
+def integrand_of(spec):
     from ..integrands.specular import specular_integrand
 
-    form, nd, mk = dfg.terms_of(o)
-    return specular_integrand(nd, mk, "albedo", form, 1)
+    form, nd, mk = dfg.terms_of(spec)
+    return specular_integrand(nd.obj, mk, "albedo", form, 1)
 
 
 def plan_albedo(spec) -> TexelPlan:
@@ -69,14 +69,14 @@ def plan_albedo(spec) -> TexelPlan:
 
     o = spec.options
     axes = dfg.axes_for(o)
-    integrand = integrand_of(o)
+    integrand = integrand_of(spec)
     return per_texel_plan(
         integrand,
         estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
         dfg.grid_for(axes, integrand),
         channels=ALBEDO_CHANNELS,
         reconstruction=ALBEDO_RECONSTRUCTION,
-        terms=dfg.terms_record(o, "none (F = 1)"),
+        terms=dfg.terms_record(spec, "none (F = 1)"),
         extra=dfg.specular_extra(integrand),
         interpolate=o["interpolation"] == "verified",
     )
@@ -96,7 +96,7 @@ def plan_albedo_avg(spec) -> TexelPlan:
 
     o = spec.options
     rough = avg_roughness_axis(o)
-    integrand = integrand_of(o)
+    integrand = integrand_of(spec)
     tol = tolerance_of(o)
     inner = Tolerance(INNER_SHARE * tol.absolute, INNER_SHARE * tol.relative)
     estimator = estimator_for(o["estimator"], o["samples"], o["seed"], inner)
@@ -153,7 +153,7 @@ def plan_albedo_avg(spec) -> TexelPlan:
         prepare=lambda d: estimator.prepare(integrand, d),
         samples=per,
         estimator=estimator.name,
-        terms=dfg.terms_record(o, "none (F = 1)"),
+        terms=dfg.terms_record(spec, "none (F = 1)"),
         cost=float(rough.count) * per,
         extra={
             "mu_quadrature": f"Gauss-Kronrod ({order}, {2 * order + 1}) per panel from mu = 0, 0.2, 1; the worst panel "

@@ -21,8 +21,9 @@ import json
 import numpy as np
 
 from ..axes import TEXELS, Axis, sigma_alpha
-from ..catalog import DIFFUSE_MODELS, f0_factor
 from ..edge import effective_alpha
+from ..records import DIFFUSE
+from ..registry import choices
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from ..tolerance import Tolerance, tolerance_of
 from . import diffuse
@@ -56,7 +57,7 @@ KEYS = {
     "parametrisation": Key(
         "parametrisation", "str", "cosines", "what the light, view and azimuth axes hold", PARAMETRISATIONS
     ),
-    "model": Key("model", "str", "microfacet", "the diffuse BRDF tabulated", DIFFUSE_MODELS),
+    "model": Key("model", "str", "microfacet", "the diffuse BRDF tabulated", choices(DIFFUSE)),
     "f0": Key(
         "f0",
         "float",
@@ -203,13 +204,13 @@ def plan(spec) -> TexelPlan:
     terms = {
         "model": model,
         "f0": str(o["f0"]),
-        "f0_factor": f0_factor(model, ff),
+        "f0_factor": diffuse.f0_factor(spec),
         "parametrisation": o["parametrisation"],
     }
     if integrated:
         terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff, sigma_to_alpha=o["sigma_to_alpha"])
     extra = {
-        "f0_factor": f0_factor(model, ff),
+        "f0_factor": diffuse.f0_factor(spec),
         "f0": repr(o["f0"]),
         "rho": "1",
         "parametrisation": o["parametrisation"],
@@ -231,7 +232,7 @@ def plan(spec) -> TexelPlan:
         estimator = PointSobol(o["samples"] or DEFAULT_SOBOL, o["seed"], f0=o["f0"])
     block = o["size"][0] * o["size"][1]
     return per_texel_plan(
-        diffuse_integrand(model, ff),
+        diffuse_integrand(spec.records["model"], spec.records["facet_fresnel"]),
         estimator,
         grid,
         channels={"f": "the BRDF f_r(l, v) for rho = 1 at the baked f0 (1/sr; radiance = f E0 (n.l))"},

@@ -20,18 +20,11 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import MAPPINGS, ORDERS, ROUGHNESS_PARAMS, TEXELS, Axis
-from ..catalog import (
-    HEMISPHERE_ESTIMATORS,
-    MASKINGS,
-    NDF_DESCRIPTIONS,
-    SPECULAR_MODELS,
-    VNDF_NDFS,
-    masking_allowed,
-    model_terms,
-)
 from ..edge import ALPHA_MIN, alpha_policy
 from ..layouts import layouts_of, lookup_layout, summaries
 from ..layouts.base import nov_alpha_grid as texel_grid
+from ..records import FRESNEL, HEMISPHERE_ESTIMATOR, MASKING, MODEL, NDF
+from ..registry import Record, choices
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan, with_stored_channels
 from ..tolerance import tolerance_of
 from .base import Estimation, Key, declare
@@ -46,6 +39,15 @@ AXIS_ORDERS = {
 NOV_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "one_minus_t2", "square")}
 ROUGHNESS_MAPPINGS = {k: MAPPINGS[k] for k in ("linear", "texel_offset")}
 
+
+def linear_in_f0(record: Record) -> bool:
+    """A Fresnel record the split sum can factor: F = f0 + (1 - f0) Fc(c)."""
+    return bool(record.fields.get("linear_in_f0"))
+
+
+FRESNEL_LAYOUTS = ("scale_bias", "multiscatter")  # the layouts whose channels take the config's Fresnel
+
+
 INTERPOLATIONS = {
     "verified": "interpolated from the coarse texels wherever each texel's own error estimate meets the tolerance, "
     "else integrated (lutbake.sampling.interpolation)",
@@ -54,14 +56,22 @@ INTERPOLATIONS = {
 KEYS = {
     "size": Key("size", "int_pair", [128, 128], "[NoV, roughness] texel counts", minimum=1),
     "roughness": Key("roughness", "str", "perceptual", "what the roughness axis holds", ROUGHNESS_PARAMS),
-    "ndf": Key("ndf", "str", "ggx", "normal distribution function", NDF_DESCRIPTIONS),
-    "masking": Key("masking", "str", "smith_height_correlated", "masking-shadowing G2", MASKINGS),
+    "ndf": Key("ndf", "str", "ggx", "normal distribution function", choices(NDF)),
+    "masking": Key("masking", "str", "smith_height_correlated", "masking-shadowing G2", choices(MASKING)),
     "model": Key(
         "model",
         "str",
         "microfacet",
         "the BRDF's term set (lecture 003); other than microfacet, it fixes ndf and masking (leave them unset)",
-        SPECULAR_MODELS,
+        choices(MODEL),
+    ),
+    "fresnel": Key(
+        "fresnel",
+        "str",
+        "schlick",
+        "the Fresnel term, linear in f0 (F = f0 + (1 - f0) Fc): the layouts scale_bias and multiscatter store the "
+        "pair it factors into; the other layouts fix Schlick's",
+        choices(FRESNEL, linear_in_f0, "the split sum factors f0 out of Fresnel terms linear in f0 only"),
     ),
     "layout": Key("layout", "str", "scale_bias", "channel layout", LAYOUTS),
     "texel": Key("texel", "str", "center", "texel convention of both axes", TEXELS),
@@ -94,27 +104,35 @@ KEYS = {
 def check_spec(spec) -> tuple[str, str] | None:
     """Cross-key rules, checked at config load; returns (key, message) or None."""
     o = spec.options
-    model = o.get("model", "microfacet")
-    if model != "microfacet" and (o["ndf"], o["masking"]) != (KEYS["ndf"].default, KEYS["masking"].default):
+    model = spec.records["model"]
+    if model.name != "microfacet" and (o["ndf"], o["masking"]) != (KEYS["ndf"].default, KEYS["masking"].default):
         return (
             "model",
-            f"{model!r} fixes the NDF and the masking; ndf and masking are only for model = 'microfacet' "
+            f"{model.name!r} fixes the NDF and the masking; ndf and masking are only for model = 'microfacet' "
             f"(got ndf = {o['ndf']!r}, masking = {o['masking']!r})",
         )
-    form, nd, mk = terms_of(o)
-    if form == "microfacet" and not masking_allowed(nd, mk):
-        return ("masking", f"ndf {nd!r} has no Smith Lambda: use masking = 'v_cavity' with it, not {mk!r}")
-    if o["estimator"] == "sobol_vndf" and nd not in VNDF_NDFS:
+    form, nd, mk = terms_of(spec)
+    if form == "microfacet" and MASKING.lookup(mk).fields["smith"] and not nd.fields["smith"]:
+        return ("masking", f"ndf {nd.name!r} has no Smith Lambda: use masking = 'v_cavity' with it, not {mk!r}")
+    if o["estimator"] == "sobol_vndf" and not nd.fields["vndf"]:
         return (
             "estimator",
-            f"'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not ndf = {nd!r}"
-            + (f" (model {model!r})" if model != "microfacet" else ""),
+            f"'sobol_vndf' needs an NDF with a visible-normal sampler (ndf = 'ggx'), not ndf = {nd.name!r}"
+            + (f" (model {model.name!r})" if model.name != "microfacet" else ""),
         )
-    lay = lookup_layout("dfg", o.get("layout", "scale_bias"))
+    if o["estimator"] in ("sobol_ndf", "hammersley_ndf") and not nd.fields.get("sampler", True):
+        return ("estimator", f"{o['estimator']!r} samples the NDF's own CDF, which ndf {nd.name!r} does not give")
+    layout = o.get("layout", "scale_bias")
+    lay = lookup_layout("dfg", layout)
+    if o.get("fresnel", "schlick") != "schlick" and layout not in FRESNEL_LAYOUTS:
+        return (
+            "fresnel",
+            f"layout {layout!r} fixes Schlick's Fresnel; a fresnel goes with layout scale_bias or multiscatter",
+        )
     if lay.gauss_legendre_only and o["estimator"] != "gauss_legendre":
         return ("estimator", lay.gauss_legendre_only.format(layout=lay.name, estimator=o["estimator"]))
     if lay.terms.ndf is not None and (
-        model != "microfacet" or (o["ndf"], o["masking"]) != (KEYS["ndf"].default, KEYS["masking"].default)
+        model.name != "microfacet" or (o["ndf"], o["masking"]) != (KEYS["ndf"].default, KEYS["masking"].default)
     ):
         return (
             "layout",
@@ -125,17 +143,21 @@ def check_spec(spec) -> tuple[str, str] | None:
     return None
 
 
-def terms_of(o: dict) -> tuple[str, str, str]:
-    """(integrand form, ndf, masking) of a spec's options (lutbake.catalog.model_terms)."""
-    return model_terms(o.get("model", "microfacet"), o["ndf"], o["masking"])
+def terms_of(spec) -> tuple[str, Record, str]:
+    """(integrand form, NDF record, masking name) of a spec: the model's own where it fixes them (cook_torrance:
+    beckmann and v_cavity; the lobe models: the Blinn-Phong NDF their estimators sample, no masking), else the
+    config's."""
+    model = spec.records["model"]
+    nd = model.fields["ndf"] or spec.records["ndf"]
+    return model.fields["form"], nd, model.fields["masking"] or spec.options["masking"]
 
 
-def terms_record(o: dict, fresnel: str) -> dict:
+def terms_record(spec, fresnel: str) -> dict:
     """The EXR's lutbake:terms record: model, ndf, masking (as integrated) and Fresnel."""
-    form, nd, mk = terms_of(o)
-    model = o.get("model", "microfacet")
+    form, nd, mk = terms_of(spec)
+    model = spec.options.get("model", "microfacet")
     if form == "microfacet":
-        return {"model": model, "ndf": nd, "masking": mk, "fresnel": fresnel}
+        return {"model": model, "ndf": nd.name, "masking": mk, "fresnel": fresnel}
     return {
         "model": model,
         "ndf": f"{model} lobe (sampled with the blinn_phong CDF)",
@@ -213,10 +235,11 @@ def points_grid(points: dict, integrand) -> Grid:
     )
 
 
-def layout_terms(o: dict, lay) -> dict:
+def layout_terms(spec, lay) -> dict:
     """The lutbake:terms record of a spec in layout ``lay``: the layout's own (sheen) or the kind's, plus what the
     layout adds (the cloth channel, an engine's diffuse term)."""
-    terms = dict(lay.terms_record) if lay.terms_record else {**terms_record(o, "schlick"), "layout": lay.name}
+    fresnel = spec.records["fresnel"].name
+    terms = dict(lay.terms_record) if lay.terms_record else {**terms_record(spec, fresnel), "layout": lay.name}
     terms.update(lay.terms_extra)
     if lay.engine_channel is not None:
         terms["diffuse"] = lay.engine_channel.description
@@ -234,15 +257,16 @@ def plan(spec, points: dict | None = None) -> TexelPlan:
     o = spec.options
     lay = lookup_layout("dfg", o["layout"])
     axes = axes_for(o)
-    form, nd, mk = terms_of(o)
-    integrand = specular_integrand(nd, mk, lay.integrand, form, N_CHANNELS[lay.integrand])
+    form, nd, mk = terms_of(spec)
+    fresnel = spec.records["fresnel"] if lay.name in FRESNEL_LAYOUTS else None
+    integrand = specular_integrand(nd.obj, mk, lay.integrand, form, N_CHANNELS[lay.integrand], fresnel)
     plan = per_texel_plan(
         integrand,
         estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
         grid_for(axes, integrand) if points is None else points_grid(points, integrand),
         channels=lay.channels,
         reconstruction=lay.reconstruction(axes),
-        terms=layout_terms(o, lay),
+        terms=layout_terms(spec, lay),
         extra=specular_extra(integrand),
         interpolate=o["interpolation"] == "verified" and points is None,
         error_estimate=points is None,
@@ -257,6 +281,6 @@ def plan(spec, points: dict | None = None) -> TexelPlan:
 
 
 SAMPLES_DOC = "integrand evaluations per texel; omitted: the estimator's default quality"
-SPECULAR_ESTIMATION = Estimation(HEMISPHERE_ESTIMATORS, "gauss_legendre", SAMPLES_DOC)
+SPECULAR_ESTIMATION = Estimation(choices(HEMISPHERE_ESTIMATOR), "gauss_legendre", SAMPLES_DOC)
 DESCRIPTION = "split-sum specular DFG: NoV x roughness, scale/bias or multiscatter (Σ Fc·V, Σ V) channels"
 DFG = declare("dfg", DESCRIPTION, KEYS, plan, SPECULAR_ESTIMATION, aliases=("split_sum",), check=check_spec)

@@ -20,14 +20,25 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import Axis
-from ..catalog import DIELECTRIC_MASKINGS, HEMISPHERE_ESTIMATORS, MASKINGS, NDF_DESCRIPTIONS, SMITH_NDFS, VNDF_NDFS
 from ..edge import alpha_policy
 from ..layouts import exclusive_owner, layouts_of, lookup_layout, summaries
 from ..layouts.base import IOR_MAPPINGS, ior_axis, ior_values
+from ..records import HEMISPHERE_ESTIMATOR, MASKING, NDF
+from ..registry import Record, choices
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from ..tolerance import tolerance_of
 from . import dfg
 from .base import Estimation, Key, declare
+
+
+def lutbakes_smith(record: Record) -> bool:
+    """lutbake's NDFs with a closed-form Smith Lambda (the glass integrands build their G from it)."""
+    return record.plugin is None and bool(record.fields["smith"])
+
+
+def for_transmission(record: Record) -> bool:
+    return bool(record.fields["transmission"])
+
 
 # both kinds reach the tolerance that format / dtype set (lutbake.tolerance; kind dielectric_avg through its mu rule):
 # no layout keys
@@ -67,14 +78,14 @@ KEYS = {
         "str",
         "ggx",
         "normal distribution function",
-        {k: NDF_DESCRIPTIONS[k] for k in SMITH_NDFS},
+        choices(NDF, lutbakes_smith, "the rough-glass BSDF needs an NDF's Smith Lambda (lutbake's ggx, beckmann)"),
     ),
     "masking": Key(
         "masking",
         "str",
         "smith_separable",
         "Smith G2, evaluated with |n.o| on both sides",
-        {k: MASKINGS[k] for k in DIELECTRIC_MASKINGS},
+        choices(MASKING, for_transmission, "Smith forms are defined for transmission"),
     ),
     **GEOMETRY_KEYS,
 }
@@ -196,7 +207,7 @@ def plan_avg(spec) -> TexelPlan:
 def check_spec(spec) -> tuple[str, str] | None:
     o = spec.options
     nd, _ = terms_of(o)
-    if o["estimator"] == "sobol_vndf" and nd not in VNDF_NDFS:
+    if o["estimator"] == "sobol_vndf" and not NDF.lookup(nd).fields["vndf"]:
         return ("estimator", f"'sobol_vndf' needs ndf = 'ggx' (a visible-normal sampler), not {nd!r}")
     if o.get("ior_mapping") == "symmetric" and (o["ior_range"][1] <= 1.0 or o["ior_size"] % 2):
         return ("ior_mapping", "'symmetric' needs ior_range[1] > 1 (the largest eta) and an even ior_size")
@@ -232,7 +243,7 @@ SAMPLES_DOC = (
     "integrand evaluations per texel; omitted: gauss_legendre adapts to the tolerance (kind dielectric; "
     "dielectric_avg: 432 = order 12 per panel), sobol_vndf 16384"
 )
-ESTIMATION = Estimation(HEMISPHERE_ESTIMATORS, "gauss_legendre", SAMPLES_DOC)
+ESTIMATION = Estimation(choices(HEMISPHERE_ESTIMATOR), "gauss_legendre", SAMPLES_DOC)
 
 
 DIELECTRIC = declare(

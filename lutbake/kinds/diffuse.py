@@ -14,8 +14,9 @@ import json
 import numpy as np
 
 from ..axes import SIGMA_TO_ALPHA, TEXELS, Axis, sigma_alpha
-from ..catalog import DIFFUSE_MODELS, FACET_FRESNEL, f0_factor
 from ..edge import alpha_policy, effective_alpha
+from ..records import DIFFUSE, FACET_FRESNEL
+from ..registry import choices
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from .base import Estimation, Key, declare
 
@@ -24,7 +25,7 @@ CLOSED_ORDER = 24
 
 KEYS = {
     "size": Key("size", "int_pair", [64, 64], "[NoV, sigma] texel counts", minimum=1),
-    "model": Key("model", "str", "microfacet", "the diffuse model integrated", DIFFUSE_MODELS),
+    "model": Key("model", "str", "microfacet", "the diffuse model integrated", choices(DIFFUSE)),
     "f0": Key(
         "f0",
         "float",
@@ -36,7 +37,7 @@ KEYS = {
     ),
     "sigma_to_alpha": Key("sigma_to_alpha", "str", "sigma", "GGX alpha from sigma (microfacet model)", SIGMA_TO_ALPHA),
     "facet_fresnel": Key(
-        "facet_fresnel", "str", "eq6", "Fresnel transmission on each facet (microfacet model)", FACET_FRESNEL
+        "facet_fresnel", "str", "eq6", "Fresnel transmission on each facet (microfacet model)", choices(FACET_FRESNEL)
     ),
     "texel": Key("texel", "str", "center", "texel convention of both axes", TEXELS),
     "nov_range": Key("nov_range", "float_range", [0.0, 1.0], "NoV at t = 0 and t = 1", minimum=0.0, maximum=1.0),
@@ -103,6 +104,11 @@ def sigma_record(sig_axis: Axis) -> dict[str, str]:
     }
 
 
+def f0_factor(spec) -> str:
+    """How E scales with f0 (lutbake:f0_factor): the model's, or for the microfacet model its facet form's."""
+    return spec.records["model"].fields["f0_factor"] or spec.records["facet_fresnel"].fields["f0_factor"]
+
+
 def check_spec(spec) -> tuple[str, str] | None:
     o = spec.options
     if o["estimator"] == "gauss_legendre" and o["samples"] is not None and o["samples"] > MAX_GL_ORDER:
@@ -124,12 +130,12 @@ def plan(spec) -> TexelPlan:
     sigma = np.repeat(sig_axis.values(), n_nov)
     model = o["model"]
     ff = o["facet_fresnel"]
-    terms = {"model": model, "f0": str(o["f0"]), "f0_factor": f0_factor(model, ff)}
+    terms = {"model": model, "f0": str(o["f0"]), "f0_factor": f0_factor(spec)}
     if model == "microfacet":
         terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff, sigma_to_alpha=o["sigma_to_alpha"])
-    extra = {"f0_factor": f0_factor(model, ff), "f0": repr(o["f0"]), "rho": "1", **sigma_record(sig_axis)}
+    extra = {"f0_factor": f0_factor(spec), "f0": repr(o["f0"]), "rho": "1", **sigma_record(sig_axis)}
     return per_texel_plan(
-        diffuse_integrand(model, ff),
+        diffuse_integrand(spec.records["model"], spec.records["facet_fresnel"]),
         estimator_of(o),
         diffuse_grid(axes, nov, sigma, np.full(len(nov), o["f0"]), o["sigma_to_alpha"]),
         channels={

@@ -16,7 +16,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import Axis
-from ..catalog import FACET_FRESNEL, f0_factor
+from ..records import FACET_FRESNEL
+from ..registry import choices
 from ..sampling.groups import key_of, siblings_by_key
 from ..sampling.plan import TexelPlan, per_texel_plan
 from . import diffuse
@@ -29,7 +30,7 @@ KEYS = {
         "str",
         "dielectric_f0",
         "Fresnel transmission on each facet (microfacet model); the default is the form where f0 does not factor out",
-        FACET_FRESNEL,
+        choices(FACET_FRESNEL),
     ),
     "f0_size": Key("f0_size", "int", 16, "f0 slice count (z)", minimum=1, maximum=1024),
     "f0_range": Key(
@@ -69,7 +70,7 @@ def plan(spec) -> TexelPlan:
     grouped = getattr(estimator, "members", 1) > 1
     siblings = siblings_by_key(key_of(grid.inputs["nov"], grid.inputs["alpha"]), np.ones(grid.n_texels, bool))
     return per_texel_plan(
-        diffuse_integrand(model, ff),
+        diffuse_integrand(spec.records["model"], spec.records["facet_fresnel"]),
         estimator,
         grid,
         channels={
@@ -81,7 +82,7 @@ def plan(spec) -> TexelPlan:
         extra={
             "rho": "1",
             "f0_factor": "none: f0 is the z axis (per-slice lutbake:slice_value)",
-            "factoring_form": f0_factor(model, ff),
+            "factoring_form": diffuse.f0_factor(spec),
             **diffuse.sigma_record(sig_axis),
         },
         siblings=siblings if grouped else None,

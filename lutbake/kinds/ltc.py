@@ -36,9 +36,11 @@ import threading
 import numpy as np
 
 from ..axes import MAPPINGS, TEXELS, Axis
-from ..catalog import LTC_FIT_GRID, LTC_LOBES
 from ..edge import ALPHA_MIN
 from ..layouts.base import uv_of
+from ..limits import LTC_FIT_GRID
+from ..records import LTC_LOBE
+from ..registry import choices
 from ..sampling.plan import TexelPlan
 from .base import Estimation, Key, declare
 
@@ -63,7 +65,7 @@ ESTIMATORS = {
     "second, independent estimator of the integrals the fit depends on; ggx and beckmann)",
 }
 KEYS = {
-    "lobe": Key("lobe", "str", "ggx", "the lobe fitted", LTC_LOBES),
+    "lobe": Key("lobe", "str", "ggx", "the lobe fitted", choices(LTC_LOBE)),
     "size": Key("size", "int_pair", [64, 64], "[view, roughness] texel counts (ltc_code: 64 x 64)", minimum=2),
     "fit_samples": Key(
         "fit_samples",
@@ -471,7 +473,7 @@ def plan(spec) -> TexelPlan:
         m_samples = MAGNITUDE_SAMPLES.get(o["lobe"])
     terms = {
         "lobe": o["lobe"],
-        "description": lb.description,
+        "description": spec.records["lobe"].description,
         "fresnel": "schlick (1 - v.h)^5 channel"
         if lb.magnitude.startswith("dfg:") and lb.name != "charlie"
         else "none (fresnel channel = magnitude)",

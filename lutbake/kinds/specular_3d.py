@@ -17,21 +17,27 @@ import numpy as np
 
 from ..axes import Axis
 from ..metals import METALS
+from ..records import FRESNEL
+from ..registry import Record, choices
 from ..sampling.plan import TexelPlan, per_texel_plan
 from ..tolerance import tolerance_of
 from . import dfg
 from .base import Key, declare
 
-FRESNEL_CHOICES = {
-    "schlick": "f0 + (1 - f0)(1 - v.h)^5 (Schlick 1994)",
-    "schlick_sg": "spherical-Gaussian Schlick, f0 + (1 - f0) 2^((-5.55473 c - 6.98316) c) (Lagarde 2012)",
-    "improved_sg": "improved spherical Gaussian, f0 + (1 - f0) 2^(-9.60232 c^8 - 8.58092 c) (Gotanda 2014, Eq. 3)",
-    "dielectric_f0": "exact dielectric Fresnel written with f0 (Gotanda 2014, Eq. 2)",
-}
+
+def of_f0(record: Record) -> bool:
+    """A Fresnel term of f0, F(f0, c) (not of a complex index)."""
+    return record.fields["param"] == "f0"
+
+
 KEYS = {
     **{k: v for k, v in dfg.KEYS.items() if k != "layout"},
     "fresnel": Key(
-        "fresnel", "str", "dielectric_f0", "the Fresnel term integrated (ignored with metal)", FRESNEL_CHOICES
+        "fresnel",
+        "str",
+        "dielectric_f0",
+        "the Fresnel term integrated (ignored with metal)",
+        choices(FRESNEL, of_f0, "the f0 slices take a Fresnel term of f0; a complex index: metal = ..."),
     ),
     "f0_size": Key("f0_size", "int", 16, "f0 slice count (z); ignored with metal", minimum=1, maximum=1024),
     "f0_range": Key(
@@ -67,10 +73,10 @@ def plan(spec) -> TexelPlan:
     o = spec.options
     axes = axes_for(o)
     metal = o["metal"]
-    channels_name = "metal" if metal else f"F:{o['fresnel']}"
-    form, nd, mk = dfg.terms_of(o)
+    form, nd, mk = dfg.terms_of(spec)
     nch = 3 if metal else 1
-    integrand = specular_integrand(nd, mk, channels_name, form, nch)
+    fresnel = None if metal else spec.records["fresnel"]
+    integrand = specular_integrand(nd.obj, mk, "metal" if metal else "F", form, nch, fresnel)
     nz = 1 if metal else axes[0].count
     # texel t = (iz * ny + iy) * nx + ix: z (f0) slowest, then roughness, then NoV; a metal's param is its row of
     # lutbake.integrands.specular.METAL_NK
@@ -82,11 +88,11 @@ def plan(spec) -> TexelPlan:
             f"e_{c}": f"E with F_conductor({n} + {k}i) at {w:g} nm"
             for c, n, k, w in zip("rgb", m.n, m.k, m.wavelengths_nm)
         }
-        terms = {**dfg.terms_record(o, "conductor"), "metal": metal}
+        terms = {**dfg.terms_record(spec, "conductor"), "metal": metal}
         extra = {"metal_source": m.source}
     else:
         channels = {"e": f"E = ∫ f (n.l) dω_l with F = {o['fresnel']}(f0 of the slice, v.h)"}
-        terms = dfg.terms_record(o, o["fresnel"])
+        terms = dfg.terms_record(spec, o["fresnel"])
         extra = {}
     return per_texel_plan(
         integrand,

@@ -19,12 +19,18 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import Axis
-from ..catalog import ANISO_ESTIMATORS, ANISO_LAYOUTS, ANISO_MODELS, AXES_FORMULA
 from ..edge import alpha_policy
+from ..records import ANISO_ESTIMATOR, ANISO_MODEL
+from ..registry import choices
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
 from ..tolerance import tolerance_of
 from . import dfg
 from .base import Estimation, Key, declare
+
+ANISO_LAYOUTS = ("scale_bias", "multiscatter")  # the dfg layouts an anisotropic table stores
+AXES_FORMULA = (
+    "aspect = sqrt(1 - 0.9 |a|); alpha_x = alpha / aspect, alpha_y = alpha * aspect (a >= 0; swapped for a < 0)"
+)
 
 VIEW_AZIMUTHS = {
     "average": "E averaged over the view azimuth phi_v in [0, 2 pi) (default)",
@@ -44,7 +50,7 @@ AZIMUTH_RULES = {
 }
 
 KEYS = {
-    "model": Key("model", "str", "microfacet", "the anisotropic lobe", ANISO_MODELS),
+    "model": Key("model", "str", "microfacet", "the anisotropic lobe", choices(ANISO_MODEL)),
     "layout": Key(
         "layout", "str", "scale_bias", "channel layout (Schlick split sum)", {k: dfg.LAYOUTS[k] for k in ANISO_LAYOUTS}
     ),
@@ -158,5 +164,5 @@ DESCRIPTION = (
     "anisotropic split-sum: NoV x roughness x anisotropy slices (anisotropic GGX or Ashikhmin-Shirley), "
     "scale/bias or multiscatter"
 )
-ESTIMATION = Estimation(ANISO_ESTIMATORS, "gauss_legendre", dfg.SAMPLES_DOC)
+ESTIMATION = Estimation(choices(ANISO_ESTIMATOR), "gauss_legendre", dfg.SAMPLES_DOC)
 SPECULAR_ANISO = declare("specular_aniso", DESCRIPTION, KEYS, plan, ESTIMATION, aliases=("aniso",), texels=texel_count)

@@ -35,7 +35,7 @@ import functools
 import numpy as np
 import warp as wp
 
-from ..catalog import LTC_FIT_GRID
+from ..limits import LTC_FIT_GRID
 from ..runtime.memo import RowMemo
 from ..runtime.warp_runtime import MODULE_OPTIONS, load_module
 from .lobes import lobe

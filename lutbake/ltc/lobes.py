@@ -28,7 +28,6 @@ from dataclasses import dataclass
 
 import warp as wp
 
-from ..catalog import LTC_LOBES
 from ..edge import COS_EPS
 from ..terms import diffuse, masking, ndf, sheen_volume
 from ..terms.frame import reflect
@@ -193,10 +192,36 @@ def gotanda_f_pdf(v: wp.vec3, l: wp.vec3, alpha: float, tab: wp.array3d(dtype=fl
     return wp.vec2(gotanda_f_cos(v, l, alpha, tab, t), cosine_pdf(v, l, alpha))
 
 
+@functools.lru_cache(maxsize=None)
+def cosine_sampled(f_cos):
+    """(f_cos guarded, f_pdf) of a plugin's lobe (lutbake.plugins.register_brdf): 0 where n.l or n.v <= COS_EPS
+    (back-facing), sampled cosine-weighted (cosine_sample, cosine_pdf)."""
+
+    @wp.func
+    def guarded(v: wp.vec3, l: wp.vec3, x: float):
+        if l[2] <= COS_EPS or v[2] <= COS_EPS:
+            return 0.0
+        return f_cos(v, l, x)
+
+    @wp.func
+    def f_pdf(v: wp.vec3, l: wp.vec3, x: float):
+        return wp.vec2(guarded(v, l, x), cosine_pdf(v, l, x))
+
+    return guarded, f_pdf
+
+
+def custom_lobe(name: str, f_cos, roughness: str) -> Lobe:
+    """The Lobe of a plugin's cosine-weighted BRDF f(l, v)(n.l): cosine-sampled, its magnitude integrated from the
+    lobe itself; ``roughness``: Lobe.roughness ("alpha", "perceptual" or "none")."""
+    guarded, f_pdf = cosine_sampled(f_cos)
+    return Lobe(name, guarded, cosine_sample, cosine_pdf, f_pdf, "lobe", roughness)
+
+
 @dataclass(frozen=True)
 class Lobe:
+    """A lobe the ltc kind fits (its name, description and citation: its record, lutbake.records)."""
+
     name: str
-    description: str
     f_cos: object
     sample: object
     pdf: object
@@ -214,21 +239,18 @@ class Lobe:
 LOBES = {
     "ggx": Lobe(
         "ggx",
-        LTC_LOBES["ggx"],
         *GGX_FUNCS,
         "dfg:ggx",
         "perceptual",
     ),
     "beckmann": Lobe(
         "beckmann",
-        LTC_LOBES["beckmann"],
         *BECKMANN_FUNCS,
         "dfg:beckmann",
         "perceptual",
     ),
     "charlie": Lobe(
         "charlie",
-        LTC_LOBES["charlie"],
         charlie_f_cos,
         cosine_sample,
         cosine_pdf,
@@ -239,7 +261,6 @@ LOBES = {
     ),
     "lambert": Lobe(
         "lambert",
-        LTC_LOBES["lambert"],
         lambert_f_cos,
         cosine_sample,
         cosine_pdf,
@@ -249,7 +270,6 @@ LOBES = {
     ),
     "gotanda": Lobe(
         "gotanda",
-        LTC_LOBES["gotanda"],
         gotanda_f_cos,
         cosine_sample,
         gotanda_pdf,
@@ -260,7 +280,6 @@ LOBES = {
     ),
     "eon": Lobe(
         "eon",
-        LTC_LOBES["eon"],
         eon_f_cos,
         cosine_sample,
         cosine_pdf,
@@ -270,7 +289,6 @@ LOBES = {
     ),
     "zeltner": Lobe(
         "zeltner",
-        LTC_LOBES["zeltner"],
         sheen_volume.f_cos_sheen_approx,
         cosine_sample,
         cosine_pdf,

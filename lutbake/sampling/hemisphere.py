@@ -58,7 +58,7 @@ import numpy as np
 import warp as wp
 
 from .. import tolerance
-from ..catalog import HEMISPHERE_ESTIMATORS
+from ..records import HEMISPHERE_ESTIMATOR
 from ..runtime.warp_runtime import load_module, unique_kernel
 from ..terms.frame import view_dir
 from . import points
@@ -854,14 +854,14 @@ class QuasiMonteCarlo:
 
 
 def estimator_for(name: str, samples: int | None = None, seed: int = 0, tolerance=None):
-    """The hemisphere estimator ``name`` (lutbake.catalog.HEMISPHERE_ESTIMATORS) at ``samples`` per texel (None: its
-    default). gauss_legendre without ``samples`` but with a ``tolerance`` (lutbake.tolerance.Tolerance) adapts its
+    """The hemisphere estimator ``name`` (lutbake.records.HEMISPHERE_ESTIMATOR) at ``samples`` per texel (None:
+    its default). gauss_legendre without ``samples`` but with a ``tolerance`` (lutbake.tolerance.Tolerance) adapts its
     order to it."""
     budget = samples or DEFAULT_SAMPLES[name]
     if name == "gauss_legendre" and samples is None and tolerance is not None:
         return AdaptiveGaussLegendre(tolerance.absolute, tolerance.relative)
     if name == "gauss_legendre":
         return GaussLegendre(budget)
-    if name in HEMISPHERE_ESTIMATORS:
+    if name in HEMISPHERE_ESTIMATOR:
         return QuasiMonteCarlo(name, budget, seed)
     raise KeyError(name)

@@ -19,15 +19,16 @@ from dataclasses import dataclass
 
 import warp as wp
 
-from ..catalog import NDF_DESCRIPTIONS
 from ..edge import COS_EPS
 from . import masking, ndf
 
 
 @dataclass(frozen=True)
 class Distribution:
+    """An NDF's terms (module docstring); its name, description and citation are its record's (lutbake.records, or a
+    plugin's through lutbake.plugins.register_ndf)."""
+
     name: str
-    description: str
     D: object
     Lambda: object | None
     tan2_from_u: object
@@ -133,7 +134,6 @@ def _pdf_vndf(d: Distribution):
 
 GGX = Distribution(
     "ggx",
-    NDF_DESCRIPTIONS["ggx"],
     ndf.D_ggx,
     masking.Lambda_ggx,
     ndf.tan2_from_u_ggx,
@@ -142,7 +142,6 @@ GGX = Distribution(
 )
 BECKMANN = Distribution(
     "beckmann",
-    NDF_DESCRIPTIONS["beckmann"],
     ndf.D_beckmann,
     masking.Lambda_beckmann,
     ndf.tan2_from_u_beckmann,
@@ -153,10 +152,31 @@ BECKMANN = Distribution(
 # grazing view. So Blinn-Phong pairs with the V-cavity G only (Lambda = None; kinds.dfg checks it).
 BLINN_PHONG = Distribution(
     "blinn_phong",
-    NDF_DESCRIPTIONS["blinn_phong"],
     ndf.D_blinn_phong,
     None,
     ndf.tan2_from_u_blinn_phong,
     ndf.u_from_tan2_blinn_phong,
 )
 NDFS = {d.name: d for d in (GGX, BECKMANN, BLINN_PHONG)}
+
+
+@functools.lru_cache(maxsize=None)
+def theta_cdf():
+    """(tan2_from_u, u_from_tan2) of the plain polar angle, u = theta / (pi/2): the outer variable of the
+    Gauss-Legendre panels for an NDF that gives no CDF of its own (a plugin's, lutbake.plugins.register_ndf)."""
+
+    @wp.func
+    def tan2_from_u(u: wp.float64, alpha: wp.float64):
+        t = wp.tan(u * wp.float64(wp.pi / 2.0))
+        return t * t
+
+    @wp.func
+    def u_from_tan2(tan2: wp.float64, alpha: wp.float64):
+        return wp.atan(wp.sqrt(tan2)) / wp.float64(wp.pi / 2.0)
+
+    return tan2_from_u, u_from_tan2
+
+
+def distribution(ndf) -> Distribution:
+    """``ndf`` itself, or lutbake's Distribution of that name (host helpers and tests name lutbake's own)."""
+    return NDFS[ndf] if isinstance(ndf, str) else ndf

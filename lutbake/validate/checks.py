@@ -18,7 +18,6 @@ import functools
 
 import numpy as np
 
-from ..catalog import SMITH_NDFS
 from ..edge import ALPHA_MIN, NOV_MIN
 from ..integrands.specular import hemisphere_integral
 from ..sampling import points
@@ -70,6 +69,7 @@ FURNACE_ALPHAS = (1.0e-3, 1.0e-2, 0.1, 0.5, 1.0)
 ALBEDO_COUNT = 24  # texel-centre grid in n.v and perceptual roughness, plus the clamped edges
 MIRROR_NOVS = tuple(np.linspace(0.05, 1.0, 20))  # below ~0.05, Lambda(alpha = 1e-4) is not yet negligible
 ALBEDO_MASKINGS = ("smith_height_correlated", "smith_separable")
+SMITH_NDFS = tuple(n for n, d in NDFS.items() if d.Lambda is not None)  # lutbake's NDFs with a Smith Lambda
 DFG_MIRROR_PAIRS = (
     ("ggx", "smith_height_correlated"),
     ("beckmann", "smith_separable"),

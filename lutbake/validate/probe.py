@@ -34,8 +34,8 @@ import functools
 import numpy as np
 import warp as wp
 
-from ..catalog import MASKINGS
 from ..edge import COS_EPS
+from ..records import MASKING
 from ..runtime.warp_runtime import MODULE_OPTIONS
 from ..terms import fresnel, masking, ndf
 from ..terms.distributions import NDFS
@@ -145,7 +145,9 @@ def _probe_V_charlie(x: TermInputs):
     return masking.V_charlie(x.nov, x.nol, x.alpha)
 
 
-BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple((n, m) for n in NDFS for m in MASKINGS if NDFS[n].masking_allowed(m))
+BRDF_PAIRS: tuple[tuple[str, str], ...] = tuple(
+    (n, m) for n in NDFS for m in MASKING.names() if NDFS[n].masking_allowed(m)
+)
 
 _PROBES = (
     [p for n in NDFS for p in _ndf_probes(n)]
