@@ -138,11 +138,12 @@ def register_ndf(
     if (tan2_from_u is None) != (u_from_tan2 is None):
         raise RegistryError(f"ndf {name!r}: give both tan2_from_u and u_from_tan2, or neither")
     sampler = tan2_from_u is not None
-    t2u, u2t = (
-        (_need_func("tan2_from_u", tan2_from_u), _need_func("u_from_tan2", u_from_tan2)) if sampler else theta_cdf()
-    )
+    if sampler:
+        t2u, u2t, pdf = _need_func("tan2_from_u", tan2_from_u), _need_func("u_from_tan2", u_from_tan2), None
+    else:
+        t2u, u2t, pdf = theta_cdf()
     lam = None if Lambda is None else _need_func("Lambda", Lambda)
-    d = Distribution(name, _need_func("D", D), lam, t2u, u2t)
+    d = Distribution(name, _need_func("D", D), lam, t2u, u2t, polar_pdf=pdf)
     fields = {"obj": d, "smith": lam is not None, "vndf": False, "sampler": sampler}
     return _add(NDF, D, name, description, citation, aliases, fields)
 

@@ -163,6 +163,22 @@ def test_cluster_bake_is_bit_identical_to_the_thread_executor(runner):
     assert runner.stats.cancelled == 0
 
 
+def test_a_plugins_table_is_shipped_to_the_workers_and_bakes_the_same_bits(runner, tmp_path):
+    """The plugin's text travels with the spec's records (lutbake.registry.Record.__reduce__); each worker runs it
+    (lutbake.plugins) and bakes the thread executor's bits."""
+    import lutbake
+
+    plugin = tmp_path / "schlick4.py"
+    plugin.write_text((Path(__file__).parents[1] / "examples" / "custom_fresnel" / "schlick4.py").read_text())
+    lutbake.load_plugin(plugin)
+    s = validate_table({"name": "p", "kind": "dfg", "size": [16, 8], "fresnel": "schlick4"}, "<t>", 0)
+    local = bake_table(s, workers=2)[0]
+    plugin.unlink()  # the workers read the text shipped with the record, not the file
+    with deadline():
+        remote = bake_table(s, workers=2, runner=runner)[0]
+    assert np.array_equal(local.data, remote.data) and local.attributes == remote.attributes
+
+
 def test_a_killed_worker_costs_only_its_tiles(client, tmp_path):
     """SIGKILL one worker process when the first tile arrives: Dask runs its tiles again on the other
     worker, every table is baked, the files equal an undisturbed thread-executor bake."""

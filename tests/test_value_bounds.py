@@ -7,13 +7,13 @@ import pytest
 
 from lutbake import value_bounds as vb
 from lutbake.api import bake_table
-from lutbake.records import ANISO_MODEL, DIFFUSE, MODEL
-
-ANISO_MODELS, DIFFUSE_MODELS, MODELS = ANISO_MODEL.names(), DIFFUSE.names(), MODEL.names()
 from lutbake.config import validate_table
 from lutbake.io.formats import PNG_SLACK
 from lutbake.kinds import KINDS
 from lutbake.kinds.dfg import LAYOUTS
+from lutbake.records import ANISO_MODEL, DIFFUSE, MODEL
+
+ANISO_MODELS, DIFFUSE_MODELS, MODELS = ANISO_MODEL.names(), DIFFUSE.names(), MODEL.names()
 
 SMALL = {
     "dfg": {"size": [16, 16]},

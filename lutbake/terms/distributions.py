@@ -34,6 +34,7 @@ class Distribution:
     tan2_from_u: object
     u_from_tan2: object
     sample_vndf: object | None = None  # visible-normal sampler, where one exists
+    polar_pdf: object | None = None  # the solid-angle density of tan2_from_u's h where it is not D(h)(n.h) (theta_cdf)
 
     def masking_allowed(self, masking_name: str) -> bool:
         """Smith masking needs this NDF's Lambda; V-cavity goes with any NDF."""
@@ -91,7 +92,9 @@ def _G2(d: Distribution, masking_name: str):
 
 @functools.lru_cache(maxsize=None)
 def _pdf_ndf(d: Distribution):
-    """Density of h under NDF sampling: p(h) = D(h) (n.h)."""
+    """Density of h under NDF sampling: p(h) = D(h) (n.h), or the polar mapping's own (Distribution.polar_pdf)."""
+    if d.polar_pdf is not None:
+        return d.polar_pdf
     D = d.D
 
     @wp.func
@@ -162,8 +165,9 @@ NDFS = {d.name: d for d in (GGX, BECKMANN, BLINN_PHONG)}
 
 @functools.lru_cache(maxsize=None)
 def theta_cdf():
-    """(tan2_from_u, u_from_tan2) of the plain polar angle, u = theta / (pi/2): the outer variable of the
-    Gauss-Legendre panels for an NDF that gives no CDF of its own (a plugin's, lutbake.plugins.register_ndf)."""
+    """(tan2_from_u, u_from_tan2, pdf) of the plain polar angle, u = theta / (pi/2), phi = 2 pi u2: the outer variable
+    of the Gauss-Legendre panels for an NDF that gives no CDF of its own (a plugin's, lutbake.plugins.register_ndf).
+    Its solid-angle density: du dphi / (2 pi) = p dω with dω = sin(theta) dtheta dphi, so p = 1 / (pi^2 sin(theta))."""
 
     @wp.func
     def tan2_from_u(u: wp.float64, alpha: wp.float64):
@@ -174,7 +178,12 @@ def theta_cdf():
     def u_from_tan2(tan2: wp.float64, alpha: wp.float64):
         return wp.atan(wp.sqrt(tan2)) / wp.float64(wp.pi / 2.0)
 
-    return tan2_from_u, u_from_tan2
+    @wp.func
+    def pdf(v: wp.vec3, h: wp.vec3, alpha: float):
+        s = wp.sqrt(h[0] * h[0] + h[1] * h[1])
+        return 1.0 / (wp.pi * wp.pi * wp.max(s, 1.0e-30))
+
+    return tan2_from_u, u_from_tan2, pdf
 
 
 def distribution(ndf) -> Distribution:
