@@ -31,20 +31,37 @@ def _add(fam, name, description, citation, aliases=(), **fields):
     fam.add(Record(fam.name, name, description, citation, tuple(aliases), fields))
 
 
-# -- normal distributions: the object is the Distribution (lutbake.terms.distributions)
-for _name, _desc, _cite, _smith, _vndf in (
-    ("ggx", "GGX / Trowbridge-Reitz", "Walter et al. 2007, Eq. 33", True, True),
-    ("beckmann", "Beckmann, normalised with 1/pi", "Walter et al. 2007, Eq. 25", True, False),
+# -- normal distributions: D and its polar CDF pair (lutbake.terms.ndf), the Smith Lambda (lutbake.terms.masking) and,
+# for GGX, the visible-normal sampler; lutbake.terms.distributions builds one Distribution of them (the object).
+# Blinn-Phong has no closed-form Smith Lambda. Walter et al. 2007 (Sec. 5.2) suggest Beckmann's at the same alpha, but
+# that is only close for small alpha: at alpha = 1 (s = 0, D = 1/pi) it gave E(F = 1) = 1.77 at grazing view. So
+# Blinn-Phong pairs with the V-cavity G only (no Lambda; kinds.dfg checks it).
+for _name, _desc, _cite, _lambda, _vndf in (
+    ("ggx", "GGX / Trowbridge-Reitz", "Walter et al. 2007, Eq. 33", "Lambda_ggx", "sample_vndf_ggx"),
+    ("beckmann", "Beckmann, normalised with 1/pi", "Walter et al. 2007, Eq. 25", "Lambda_beckmann", None),
     (
         "blinn_phong",
         "normalized Blinn-Phong (s + 2)/(2 pi) (n.h)^s, s = 2/alpha^2 - 2 (masking = v_cavity only: no closed-form "
         "Smith Lambda)",
         "Walter et al. 2007, Eq. 30",
-        False,
-        False,
+        None,
+        None,
     ),
 ):
-    _add(NDF, _name, _desc, _cite, obj=Lazy("lutbake.terms.distributions:NDFS", _name), smith=_smith, vndf=_vndf)
+    _add(
+        NDF,
+        _name,
+        _desc,
+        _cite,
+        obj=Lazy("lutbake.terms.distributions:NDFS", _name),
+        D=Lazy(f"lutbake.terms.ndf:D_{_name}"),
+        Lambda=_lambda and Lazy(f"lutbake.terms.masking:{_lambda}"),
+        tan2_from_u=Lazy(f"lutbake.terms.ndf:tan2_from_u_{_name}"),
+        u_from_tan2=Lazy(f"lutbake.terms.ndf:u_from_tan2_{_name}"),
+        sample_vndf=_vndf and Lazy(f"lutbake.terms.ndf:{_vndf}"),
+        smith=_lambda is not None,
+        vndf=_vndf is not None,
+    )
 
 # -- masking-shadowing; ``smith``: goes only with an NDF that has a Smith Lambda (every form but the V-cavity, which
 # goes with any NDF); ``transmission``: defined for the rough-glass BSDF

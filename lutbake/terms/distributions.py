@@ -20,7 +20,8 @@ from dataclasses import dataclass
 import warp as wp
 
 from ..edge import COS_EPS
-from . import masking, ndf
+from ..records import NDF
+from . import masking
 
 
 @dataclass(frozen=True)
@@ -135,32 +136,20 @@ def _pdf_vndf(d: Distribution):
     return pdf_vndf
 
 
-GGX = Distribution(
-    "ggx",
-    ndf.D_ggx,
-    masking.Lambda_ggx,
-    ndf.tan2_from_u_ggx,
-    ndf.u_from_tan2_ggx,
-    ndf.sample_vndf_ggx,
-)
-BECKMANN = Distribution(
-    "beckmann",
-    ndf.D_beckmann,
-    masking.Lambda_beckmann,
-    ndf.tan2_from_u_beckmann,
-    ndf.u_from_tan2_beckmann,
-)
-# Blinn-Phong has no closed-form Smith Lambda. Walter et al. 2007 (Sec. 5.2) suggest Beckmann's at the same
-# alpha, but that is only close for small alpha: at alpha = 1 (s = 0, D = 1/pi) it gave E(F = 1) = 1.77 at
-# grazing view. So Blinn-Phong pairs with the V-cavity G only (Lambda = None; kinds.dfg checks it).
-BLINN_PHONG = Distribution(
-    "blinn_phong",
-    ndf.D_blinn_phong,
-    None,
-    ndf.tan2_from_u_blinn_phong,
-    ndf.u_from_tan2_blinn_phong,
-)
-NDFS = {d.name: d for d in (GGX, BECKMANN, BLINN_PHONG)}
+def from_record(record) -> Distribution:
+    """The Distribution of an NDF record's terms (lutbake.records: D, Lambda, the CDF pair, the VNDF sampler)."""
+    return Distribution(
+        record.name,
+        record["D"],
+        record.get("Lambda"),
+        record["tan2_from_u"],
+        record["u_from_tan2"],
+        record.get("sample_vndf"),
+    )
+
+
+NDFS = {r.name: from_record(r) for r in NDF if r.plugin is None}  # lutbake's own (a plugin's: its record's obj)
+GGX, BECKMANN, BLINN_PHONG = NDFS["ggx"], NDFS["beckmann"], NDFS["blinn_phong"]
 
 
 @functools.lru_cache(maxsize=None)
