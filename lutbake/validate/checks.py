@@ -586,8 +586,9 @@ def eon_albedo_is_one() -> CheckResult:
 
 def ltc_eon_r0_is_identity() -> CheckResult:
     """EON at r = 0 is Lambert: its LTC fit (lutbake.ltc.fit, the kind's seeding) is the identity at every view."""
-    from ..kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
+    from ..kinds.ltc import axes_for
     from ..ltc import fit
+    from ..ltc.magnitude import magnitude_alpha, magnitude_fresnel, texel_params
 
     axes = axes_for({"lobe": "eon", "size": [6, 6]})
     nov, r = texel_params(axes)
