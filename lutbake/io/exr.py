@@ -32,6 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..limits import MAX_EXR_CHANNELS
 from ..runtime.warp_runtime import stderr_silenced
 from ..table import CHANNEL_LETTERS, Table, metadata
 from ..table import pixels as checked_pixels
@@ -42,7 +43,6 @@ from .sidecar import LoadedFile, text_problem
 
 PREFIX = "lutbake:"
 EXR_MAGIC = b"\x76\x2f\x31\x01"
-MAX_EXR_CHANNELS = 64  # channels of one EXR part (a table has 1 to 4; other tools add a few named ones)
 EXR_TYPES = {"float32": "float", "half": "half"}
 COMPRESSION = "zip"
 PER_PART = frozenset({"slice_index", "slice_value"})

@@ -33,6 +33,7 @@ import numpy as np
 
 from ..axes import IMAGE_DIMS, MAPPINGS, ORDERS, TEXELS, Axis
 from ..errors import LutbakeError
+from ..limits import MAX_AXIS_COUNT, MAX_FILE_BYTES
 from ..textsafe import bounded as bounded_text
 from ..textsafe import shorten
 from . import bounded, dds, ktx2
@@ -55,8 +56,6 @@ from .sidecar import (
 )
 
 MAGIC_BYTES = 16  # enough to tell every format apart
-MAX_AXIS_COUNT = 1 << 20  # no lutbake axis is longer (the texel cap is 2^24 in all)
-MAX_FILE_BYTES = 4 << 30  # a table is at most 2^24 texels x 4 channels x 4 bytes = 256 MiB; headers are text
 MAX_TERMS = 32  # terms shown (lutbake records at most a dozen)
 ZIP_MAGIC = b"PK\x03\x04"  # a NumPy .npz archive
 TEXT_CONTROLS = b"\t\n\r\f"  # the control bytes a text array may hold

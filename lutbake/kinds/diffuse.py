@@ -16,6 +16,7 @@ import numpy as np
 from ..axes import SIGMA_TO_ALPHA, TEXELS, Axis, sigma_alpha
 from ..catalog import DIFFUSE_MODELS, FACET_FRESNEL, f0_factor
 from ..edge import alpha_policy, effective_alpha
+from ..limits import MAX_GL_ORDER
 from ..sampling.diffuse_table import diffuse_grid, estimator_of
 from ..sampling.plan import TexelPlan, per_texel_plan
 from .base import Estimation, Key, declare
@@ -54,7 +55,6 @@ SAMPLES_DOC = (
     "panel, 1.5 n in u and n.l where NoV < 0.1), closed forms: outer 4 n^2 directions l; omitted: 12 for "
     "microfacet, 24 otherwise. sobol_cosine: the number of cosine-weighted directions l (default 4096)"
 )
-MAX_GL_ORDER = 64
 
 
 def sigma_record(sig_axis: Axis) -> dict[str, str]:
