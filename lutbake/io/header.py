@@ -63,7 +63,7 @@ _ARRAY = re.compile(
 
 
 def read_header(path: Path) -> LoadedFile:
-    """A C header as lutbake writes it (lutbake.io.formats.header_text): size macros and one flat array
+    """A C header as lutbake writes it (header_text): size macros and one flat array
     of floats or binary16 bit patterns."""
     text = bounded.read_text(path, what="a C header")
     m = _ARRAY.search(text)
