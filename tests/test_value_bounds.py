@@ -10,7 +10,7 @@ from lutbake.api import bake_table
 from lutbake.catalog import ANISO_MODELS, DIFFUSE_MODELS
 from lutbake.catalog import SPECULAR_MODELS as MODELS
 from lutbake.config import validate_table
-from lutbake.io.formats import PNG_SLACK
+from lutbake.io.png import PNG_SLACK
 from lutbake.kinds import KINDS
 from lutbake.kinds.dfg import LAYOUTS
 
