@@ -447,9 +447,7 @@ HONESTY_TOLERANCES = (1.0e-5, 1.0e-6, 1.0e-7)
 HIGH_ORDER = 64  # the converged reference (a): orders 48, 64 and 96 agree to ~5e-9 on such texels
 NUMPY_TOLERANCES = (1.0e-5, 1.0e-6)  # (b): the numpy integral is good to ~1e-7, too coarse for 1e-7
 NUMPY_ACCURACY = 1.0e-7  # its own error, allowed on top of the estimate (measured: |numpy - order 96| <= 8.2e-8)
-TERMS_FLOOR = (
-    1.0e-7  # the estimate's float32 rounding part, relative (lutbake.sampling.hemisphere_kernels.TERMS_ROUNDING)
-)
+TERMS_FLOOR = 1.0e-7  # the estimate's float32 rounding part, relative (hemisphere_kernels.TERMS_ROUNDING)
 
 
 @functools.lru_cache(maxsize=None)
