@@ -45,8 +45,9 @@ import warp as wp  # noqa: E402
 from lutbake.api import bake_table  # noqa: E402
 from lutbake.config import load_configs  # noqa: E402
 from lutbake.integrands.diffuse import eval_brdf  # noqa: E402
-from lutbake.kinds.ltc import axes_for, lobe_parameter, magnitude_alpha, magnitude_fresnel, texel_params  # noqa: E402
+from lutbake.kinds.ltc import axes_for  # noqa: E402
 from lutbake.ltc import fit  # noqa: E402
+from lutbake.ltc.magnitude import lobe_parameter, magnitude_alpha, magnitude_fresnel, texel_params  # noqa: E402
 from lutbake.runtime.executor import default_workers  # noqa: E402
 from lutbake.validate import ltc_area  # noqa: E402
 

@@ -17,8 +17,9 @@ sys.path.insert(0, str(ROOT))
 
 from bench_ltc import AREA_TEXELS, N  # noqa: E402
 
-from lutbake.kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params  # noqa: E402
+from lutbake.kinds.ltc import axes_for  # noqa: E402
 from lutbake.ltc import fit  # noqa: E402
+from lutbake.ltc.magnitude import magnitude_alpha, magnitude_fresnel, texel_params  # noqa: E402
 
 
 def main(argv=None):

@@ -23,8 +23,9 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from lutbake.kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params  # noqa: E402
+from lutbake.kinds.ltc import axes_for  # noqa: E402
 from lutbake.ltc import fit  # noqa: E402
+from lutbake.ltc.magnitude import magnitude_alpha, magnitude_fresnel, texel_params  # noqa: E402
 
 N = 64
 

@@ -2,9 +2,10 @@
 the errors, for candidate ladders, without a kernel per candidate.
 
 Every panel of every texel is integrated once at every order of ORDERS by the kernels' own panel rules
-(lutbake.sampling.hemisphere.panel_rule_for / panel_texel for the dfg family, lutbake.sampling.dielectric for the glass
-tables). ``replay`` then runs the ladder of lutbake.sampling.ladder on those values in numpy, operation for operation:
-every panel at its first two levels, then while a channel's estimate (sum of |Q_k - Q_(k-1)| plus TERMS_ROUNDING |I|)
+(lutbake.sampling.facet_rules.panel_rule_for / horizon.panel_texel for the dfg family, lutbake.sampling.dielectric
+for the glass tables). ``replay`` then runs the ladder of lutbake.sampling.ladder on those values in numpy, operation
+for operation: every panel at its first two levels, then while a channel's estimate (sum of |Q_k - Q_(k-1)| plus
+TERMS_ROUNDING |I|)
 exceeds max(tol_abs, tol_rel |I|), that channel's worst panel one level up. It reports the cost (sum of n^2 per
 panel rule evaluated: integrand evaluations for the dfg family, where every inner interval has n nodes), the number
 of texels whose error against order 64 exceeds their estimate by more than 5e-8 (the allowance of
@@ -38,8 +39,10 @@ sys.path.insert(0, str(ROOT))
 from lutbake.api import bake_table  # noqa: E402
 from lutbake.config import load_config, preset_path, validate_table  # noqa: E402
 from lutbake.sampling import dielectric as DL  # noqa: E402
+from lutbake.sampling import facet_rules, horizon, points  # noqa: E402
 from lutbake.sampling import hemisphere as H  # noqa: E402
-from lutbake.sampling import points  # noqa: E402
+from lutbake.sampling import hemisphere_kernels as HK  # noqa: E402
+from lutbake.sampling import rules as R  # noqa: E402
 
 OUT = ROOT / "outputs" / "bench"
 ORDERS = (4, 5, 6, 7, 8, 9, 10, 11, 12, 14, 16, 20, 24, 32, 40, 48, 64)
@@ -105,13 +108,13 @@ def captured_inputs(spec, estimator_class):
 @wp.func
 def dfg_texel(tx: wp.vec3, phi_a: wp.array(dtype=wp.vec3d)):
     """The dfg family's texel and panels, the merge of a tolerance-driven bake (PEAK_MERGE)."""
-    return H.panel_texel(tx, phi_a, wp.float64(H.PEAK_MERGE), True, wp.float64(0.0), False, True)
+    return horizon.panel_texel(tx, phi_a, wp.float64(horizon.PEAK_MERGE), True, wp.float64(0.0), False, True)
 
 
 @wp.func
 def glass_texel(tx: wp.vec3, phi_a: wp.array(dtype=wp.vec3d)):
     """The glass kinds' texel and outer panels (phi_a unused)."""
-    x = DL.dielectric_texel(tx, wp.float64(H.PEAK_MERGE))
+    x = DL.dielectric_texel(tx, wp.float64(horizon.PEAK_MERGE))
     return x, x.n_panels
 
 
@@ -143,7 +146,7 @@ def panels_kernel(texel_panels, panel, first_level, nch):
             for k in range(nl):
                 v = panel(t, j, rules, levels[k][0], levels[k][1])
                 for c in range(wp.static(nch)):
-                    out[i, j * nl + k, c] = v[c] / H.PI64
+                    out[i, j * nl + k, c] = v[c] / horizon.PI64
 
     return replay_panels
 
@@ -151,7 +154,7 @@ def panels_kernel(texel_panels, panel, first_level, nch):
 def dfg_panels(integrand):
     """Every panel of the dfg family at the n x n rules (both variables at one order: the kernel's product ladder,
     lutbake.sampling.ladder.product_ladder_for, raises them one at a time; this replay raises them together)."""
-    panel_of = H.panel_rule_for(integrand)
+    panel_of = facet_rules.panel_rule_for(integrand)
 
     @wp.func
     def square(t: Any, j: int, rules: wp.array(dtype=wp.vec2d), off: int, n: int):
@@ -166,7 +169,7 @@ def glass_panels(integrand):
 
 def level_rules() -> tuple[np.ndarray, np.ndarray]:
     """The rules of LEVELS, concatenated, and (offset, nodes) per level: ORDERS' GL rules, then KRONROD's."""
-    rules, levels = H.gl_levels(ORDERS)
+    rules, levels = R.gl_levels(ORDERS)
     kronrod = [np.stack(points.gauss_kronrod(n)[:2], axis=1) for n in KRONROD]
     offsets = len(rules) + np.cumsum([0] + [len(k) for k in kronrod[:-1]])
     extra = np.stack([offsets, [len(k) for k in kronrod]], axis=1).astype(np.int32)
@@ -180,11 +183,11 @@ def nodes(level: str) -> int:
 
 def panel_values(kernel, inputs, nch):
     """(values (texels, MAX_SLOTS, len(LEVELS), nch), panel counts, first levels (texels, MAX_SLOTS))."""
-    n, texel = H._texels(inputs, "cpu")
+    n, texel = HK._texels(inputs, "cpu")
     rules, levels = level_rules()
     out = wp.zeros((n, MAX_SLOTS * len(LEVELS), nch), dtype=wp.float64)
     npan = wp.zeros((n, MAX_SLOTS + 1), dtype=wp.int32)
-    args = [texel, wp.array(rules, dtype=wp.vec2d), wp.array(H.phi_rule_a(rules), dtype=wp.vec3d)]
+    args = [texel, wp.array(rules, dtype=wp.vec2d), wp.array(R.phi_rule_a(rules), dtype=wp.vec3d)]
     wp.launch(kernel, dim=n, inputs=[*args, wp.array(levels, dtype=wp.vec2i), out, npan])
     npan = npan.numpy()
     assert npan[:, 0].max() <= MAX_SLOTS
@@ -305,7 +308,7 @@ def glass_case(preset, n_random=1500, seed=0):
 
 def main() -> None:
     wp.config.quiet = True
-    assert H.ADAPTIVE_ORDERS == (6, 9, 12, 16, 24, 32, 48, 64)  # the defaults in the candidate lists
+    assert R.ADAPTIVE_ORDERS == (6, 9, 12, 16, 24, 32, 48, 64)  # the defaults in the candidate lists
     assert DL.DIELECTRIC_ORDERS == (8, 16, 20, 24, 32, 48, 64)
     args = sys.argv[1:]
     if args and args[0] == "--glass":  # --glass N SEED: the glass presets only, N random texels each (and the grazing)

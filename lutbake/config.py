@@ -20,7 +20,7 @@ from typing import Any
 from . import arguments
 from .errors import ArgumentError, ConfigError, did_you_mean
 from .kinds import KINDS, Key, kind_record, lookup_kind
-from .limits import BAKE_PEAK_BYTES_PER_TEXEL, MAX_TEXELS  # noqa: F401  (lutbake.config.MAX_TEXELS, as before)
+from .limits import BAKE_PEAK_BYTES_PER_TEXEL, MAX_LIST, MAX_TEXELS  # noqa: F401  (lutbake.config.MAX_TEXELS, as before)
 from .preflight import config_file_problem, nesting_problem
 from .registry import Choices, Record
 from .textsafe import safe_repr
@@ -34,7 +34,6 @@ WINDOWS_RESERVED = frozenset(
     ["CON", "PRN", "AUX", "NUL"] + [f"{port}{i}" for port in ("COM", "LPT") for i in range(10)]
 )
 BYTES_PER_TEXEL = 32  # float64 x 4 channels while baking
-MAX_LIST = 1024  # entries of a float_list key
 
 
 def human_bytes(n: int) -> str:

@@ -41,11 +41,11 @@ import numpy as np
 from .io import bounded
 from .io.atomic import atomic_write_bytes, atomic_write_hashed, remove_stale_temps
 from .io.integrity import sha256_bytes
+from .limits import MAX_EXTRA_CHARS
 
 FORMAT = "lutbake-values-cache-v2"  # v2: "bytes" and "entry_sha256" (v1 entries are misses, then rewritten)
 # what lutbake.pipeline.compute records besides
 ESTIMATE_KEYS = ("error_estimate", "error_estimate_method", "over_tolerance")
-MAX_EXTRA_CHARS = 4096  # characters of one extra value (lutbake's are numbers and short descriptions)
 
 
 def entry_digest(meta: dict) -> str:

@@ -73,7 +73,7 @@ def test_three_channel_layouts_extend_the_two_channel_ones(default, bake):
     assert list(f82.channels) == ["scale", "bias", "f82"]
     assert np.all(f82.data[..., 2] >= 0) and np.all(f82.data[..., 2] < 0.1)
     # to the default tolerance (1e-6 each): the cloth layout's Charlie channel adds panels graded towards theta_h = pi/2
-    # (lutbake.sampling.hemisphere.next_toward), so at a fixed low order its GGX channels sit on other nodes
+    # (lutbake.sampling.horizon.next_toward), so at a fixed low order its GGX channels sit on other nodes
     adaptive = {k: v for k, v in BASE.items() if k != "samples"}
     cloth = bake(adaptive, layout="multiscatter_cloth")
     ms = bake(adaptive, layout="multiscatter")

@@ -12,7 +12,7 @@ from lutbake.integrands.diffuse import diffuse_integrand
 from lutbake.kinds import btf
 from lutbake.sampling.diffuse import adaptive_point_kernel, azimuth_groups, eval_points_adaptive, launch_rows
 from lutbake.sampling.facets import FACET_ORDERS
-from lutbake.sampling.hemisphere import gl_levels
+from lutbake.sampling.rules import gl_levels
 
 
 @pytest.fixture(scope="module")

@@ -16,7 +16,7 @@ from lutbake.kinds import lookup_kind
 from lutbake.layouts import lookup_layout
 from lutbake.layouts.base import ior_values
 from lutbake.sampling.dielectric_avg import mu_starts
-from lutbake.sampling.dielectric_layout import DEFAULT_SAMPLES, kernel_tolerance
+from lutbake.sampling.dielectric_layout import GLASS_SAMPLES, kernel_tolerance
 from lutbake.validate import dielectric as vd
 
 REFERENCE_ATOL = 1.0e-6  # |table - numpy reference| per channel, every texel below
@@ -65,7 +65,7 @@ def test_energies_match_numpy_integral_over_the_outgoing_sphere(texel):
     e = integrate(
         ("ggx", "smith_separable", "exact", "gauss_legendre"),
         *(np.atleast_1d(x) for x in (nov, alpha, eta)),
-        DEFAULT_SAMPLES["gauss_legendre"],
+        GLASS_SAMPLES["gauss_legendre"],
         0,
     )[0]
     er, et = ref_energies(float(nov), float(alpha), float(eta))
@@ -78,7 +78,7 @@ def test_energies_match_numpy_integral_over_the_outgoing_sphere(texel):
 )
 def test_other_terms_match_numpy_integral(ndf, masking, texel):
     nov, alpha, eta = (np.atleast_1d(x) for x in f32(*texel))
-    e = integrate((ndf, masking, "exact", "gauss_legendre"), nov, alpha, eta, DEFAULT_SAMPLES["gauss_legendre"], 0)[0]
+    e = integrate((ndf, masking, "exact", "gauss_legendre"), nov, alpha, eta, GLASS_SAMPLES["gauss_legendre"], 0)[0]
     er, et = ref.energies(float(nov[0]), float(alpha[0]), float(eta[0]), ndf, masking)
     np.testing.assert_allclose(e[:2], [er, et], rtol=0, atol=REFERENCE_ATOL)
 
@@ -88,7 +88,7 @@ def test_eevee_channels_match_numpy_integral(texel):
     """EEVEE's Schlick split-sum channels (scale, bias, transmission factor) against the reference's own weights."""
     nov, alpha, eta = (np.atleast_1d(x) for x in f32(*texel))
     e = integrate(
-        ("ggx", "smith_separable", "eevee", "gauss_legendre"), nov, alpha, eta, DEFAULT_SAMPLES["gauss_legendre"], 0
+        ("ggx", "smith_separable", "eevee", "gauss_legendre"), nov, alpha, eta, GLASS_SAMPLES["gauss_legendre"], 0
     )[0]
     np.testing.assert_allclose(
         e, ref.energies(float(nov[0]), float(alpha[0]), float(eta[0]), fresnel="eevee"), rtol=0, atol=REFERENCE_ATOL
@@ -118,7 +118,7 @@ def test_smooth_limit_is_fresnel_including_total_internal_reflection():
         ("ggx", "smith_separable", "exact", "gauss_legendre"),
         mu,
         *f32([ALPHA_MIN] * 3, [1 / 1.5] * 3),
-        DEFAULT_SAMPLES["gauss_legendre"],
+        GLASS_SAMPLES["gauss_legendre"],
         0,
     )
     np.testing.assert_allclose(e[:, :2], np.tile([1.0, 0.0], (3, 1)), rtol=0, atol=SMOOTH_ATOL)
@@ -146,7 +146,7 @@ def test_index_matched_interface_has_no_reflection_and_the_smith_transmittance()
             mu,
             alpha,
             *f32([eta] * 3),
-            DEFAULT_SAMPLES["gauss_legendre"],
+            GLASS_SAMPLES["gauss_legendre"],
             0,
         )
     np.testing.assert_allclose(at[1.0 - 1e-6][:, 2], at[1.0][:, 2], atol=1e-3)
@@ -155,7 +155,7 @@ def test_index_matched_interface_has_no_reflection_and_the_smith_transmittance()
         ("ggx", "smith_separable", "exact", "gauss_legendre"),
         mu,
         *f32([ALPHA_MIN] * 3, [1.0] * 3),
-        DEFAULT_SAMPLES["gauss_legendre"],
+        GLASS_SAMPLES["gauss_legendre"],
         0,
     )
     np.testing.assert_allclose(smooth[:, 1], 1.0, atol=1e-6)
@@ -447,7 +447,7 @@ HONESTY_TOLERANCES = (1.0e-5, 1.0e-6, 1.0e-7)
 HIGH_ORDER = 64  # the converged reference (a): orders 48, 64 and 96 agree to ~5e-9 on such texels
 NUMPY_TOLERANCES = (1.0e-5, 1.0e-6)  # (b): the numpy integral is good to ~1e-7, too coarse for 1e-7
 NUMPY_ACCURACY = 1.0e-7  # its own error, allowed on top of the estimate (measured: |numpy - order 96| <= 8.2e-8)
-TERMS_FLOOR = 1.0e-7  # the estimate's float32 rounding part, relative (lutbake.sampling.hemisphere.TERMS_ROUNDING)
+TERMS_FLOOR = 1.0e-7  # the estimate's float32 rounding part, relative (hemisphere_kernels.TERMS_ROUNDING)
 
 
 @functools.lru_cache(maxsize=None)

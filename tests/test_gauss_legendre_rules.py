@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from lutbake.sampling import points
-from lutbake.sampling.hemisphere import ADAPTIVE_ORDERS, gl_levels, phi_rule_a
+from lutbake.sampling.rules import ADAPTIVE_ORDERS, gl_levels, phi_rule_a
 
 RULE_TOLERANCE = 1e-12  # order 24 on an entire function: exact to rounding
 

@@ -22,7 +22,7 @@ from lutbake.cli import main
 from lutbake.config import MAX_TEXELS, NAME_RE, load_configs
 from lutbake.errors import ConfigError
 from lutbake.kinds import KINDS, lookup_kind
-from lutbake.kinds.base import MAX_SAMPLES
+from lutbake.limits import MAX_SAMPLES
 from lutbake.textsafe import safe_repr
 
 KEYS = KINDS["dfg"].keys

@@ -14,8 +14,9 @@ import pytest
 
 from lutbake import api
 from lutbake.config import load_configs
-from lutbake.kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
+from lutbake.kinds.ltc import axes_for
 from lutbake.ltc import fit, polygon, sphere
+from lutbake.ltc.magnitude import magnitude_alpha, magnitude_fresnel, texel_params
 from lutbake.validate import ltc_area
 
 DATA = Path(__file__).parent / "data"

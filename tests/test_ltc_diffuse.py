@@ -12,8 +12,9 @@ import pytest
 from lutbake import api
 from lutbake.config import load_configs, preset_path
 from lutbake.integrands.diffuse import albedo_gl, eval_brdf
-from lutbake.kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
+from lutbake.kinds.ltc import axes_for
 from lutbake.ltc import fit
+from lutbake.ltc.magnitude import magnitude_alpha, magnitude_fresnel, texel_params
 
 MAGNITUDE_ATOL = 1e-6  # the brief's bound: magnitude channel = the diffuse table at the same texels
 EON_ONE_ATOL = 1e-6  # EON's albedo is exactly 1 for rho = 1 (closed form, the second estimator): measured 1.0e-7

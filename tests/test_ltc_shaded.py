@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 from test_ltc import published
 
-from lutbake.kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
+from lutbake.kinds.ltc import axes_for
 from lutbake.ltc import fit, lights, polygon, shaded
+from lutbake.ltc.magnitude import magnitude_alpha, magnitude_fresnel, texel_params
 from lutbake.validate import ltc_bench
 
 N = 64

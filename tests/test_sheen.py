@@ -116,7 +116,7 @@ def test_clamped_layouts_are_the_viewers_integrand(bake_preset, charlie_referenc
 def test_charlie_visibility_estimates_bound_their_errors(charlie_reference):
     """To a tolerance, the sheen lobe with Charlie's V (HDRP's CharlieFabricLambert FGD, the spec's E): every texel's
     error estimate bounds its error against the independent reference. Estevez & Kulla's Lambda switches formula at
-    n.l = 0.5 (C1 only) and has a cusp at l = n; before the panels split there (lutbake.sampling.hemisphere.kink_band),
+    n.l = 0.5 (C1 only) and has a cusp at l = n; before the panels split there (lutbake.sampling.horizon.kink_band),
     452 of the 64² HDRP table's 12288 values exceeded their estimates, by up to 1.1e-5 (estimates ~1e-6)."""
     from lutbake.integrands.specular import specular_integrand
     from lutbake.sampling.hemisphere import AdaptiveGaussLegendre

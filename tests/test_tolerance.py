@@ -1,6 +1,6 @@
 """The ``tolerance`` keys and the adaptive gauss_legendre: its per-texel error estimate bounds the measured error.
 
-The estimate of a texel (lutbake.sampling.hemisphere.make_gauss_legendre) is the sum over its panels of
+The estimate of a texel (lutbake.sampling.hemisphere_kernels.make_gauss_legendre) is the sum over its panels of
 |Q(order k) - Q(order k-1)|; the tests hold it against (1) the independent numpy integrator over the light
 direction of test_reference_dfg (own terms, own coordinates), at its texels (grazing corners included), and
 (2) the same kernel at a fixed order 64 on every texel of a 64^2 grid.
@@ -12,7 +12,8 @@ from test_reference_dfg import reference_dfg, texels
 
 from lutbake.integrands.specular import specular_integrand
 from lutbake.kinds.dfg import axes_for, grid_for
-from lutbake.sampling.hemisphere import ADAPTIVE_ORDERS, gl_launch
+from lutbake.sampling.hemisphere_kernels import gl_launch
+from lutbake.sampling.rules import ADAPTIVE_ORDERS
 from lutbake.tolerance import QUARTER, UNORM16_QUANTUM, Tolerance, default_tolerance, tolerance_of
 
 # what neither reference resolves: the float32 BRDF terms (measured: order 48 vs 64 differ by 3e-8 on the 128^2

@@ -8,7 +8,7 @@ import pytest
 from lutbake import value_bounds as vb
 from lutbake.api import bake_table
 from lutbake.config import validate_table
-from lutbake.io.formats import PNG_SLACK
+from lutbake.io.png import PNG_SLACK
 from lutbake.kinds import KINDS
 from lutbake.kinds.dfg import LAYOUTS
 from lutbake.records import ANISO_MODEL, DIFFUSE, MODEL

@@ -131,7 +131,7 @@ def ltc_hypotheses(lobe, axes, iy, ix, nov_all, alpha_mag, mag, got) -> list[dic
     rows or columns in reverse order, axes swapped (square tables), the roughness axis read as alpha (alpha = r,
     not r^2), and the view rows in ltc_code's parameterisation before fa68f58 (theta = t pi/2 linear, NoV =
     cos theta, not sqrt(1 - NoV) = t) -- a table of one used with the other's uv."""
-    from ..kinds.ltc import magnitude_fresnel
+    from ..ltc.magnitude import magnitude_fresnel
 
     n_view, n_rough = axes[1].count, axes[2].count
     nov_row, alpha_col = nov_all[::n_rough].astype(np.float64), alpha_mag[:n_rough].astype(np.float64)
@@ -175,8 +175,9 @@ def ltc_hypotheses(lobe, axes, iy, ix, nov_all, alpha_mag, mag, got) -> list[dic
 def audit_ltc(
     path, spec, tolerance: float, metric: str, max_side: int, area_texels: int = AREA_TEXELS, error_map=None
 ) -> TableAuditReport:
-    from ..kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
+    from ..kinds.ltc import axes_for
     from ..ltc import fit, sphere
+    from ..ltc.magnitude import magnitude_alpha, magnitude_fresnel, texel_params
     from ..validate import ltc_area
 
     t1, t2 = read_ltc_pair(Path(path))

@@ -227,7 +227,7 @@ AVERAGED_NODES = {"microfacet": azimuth_nodes_np, "ashikhmin_shirley": one_node}
 @functools.lru_cache(maxsize=None)
 def averaged_integrand(model: str, layout: str):
     """The integrand record of a view-azimuth-averaged anisotropic table for the panelled Gauss-Legendre kernel
-    (lutbake.sampling.hemisphere.make_gauss_legendre): per texel (n.v, alpha = alpha_min, param = alpha_max),
+    (lutbake.sampling.hemisphere_kernels.make_gauss_legendre): per texel (n.v, alpha = alpha_min, param = alpha_max),
     g(h) = channels(v.h) x the lobe's averaged weight (AVERAGED) over AVERAGED_CHANNELS = 4 kernel channels (the
     M-node and the M/2-node averages), the first 2 kept; the panels, the horizon map and the u = CDF(theta_h)
     variable of the NDF-peak panel are those of the isotropic lobe at alpha_min (its sharpest scale): GGX, with the

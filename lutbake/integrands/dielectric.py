@@ -177,7 +177,7 @@ def dielectric_integrand(ndf_name: str, masking_name: str, mode: str, nch: int =
 def integrate(key: tuple, nov, alpha, eta, samples: int | None = None, seed: int = 0, device: str = "cpu"):
     """Host helper (checks, tests, benchmarks): float64 (len, 3) integrals of the (ndf, masking, Fresnel mode)
     integrand by ``estimator`` at texels (nov, alpha, eta); alpha through the edge policy as in a table."""
-    from ..sampling.dielectric_layout import estimator_for
+    from ..sampling.dielectric_layout import estimator_of
 
     ndf_name, masking_name, mode, estimator = key
     integrand = dielectric_integrand(ndf_name, masking_name, mode)
@@ -186,4 +186,4 @@ def integrate(key: tuple, nov, alpha, eta, samples: int | None = None, seed: int
         "alpha": integrand.alpha_input(np.asarray(alpha, np.float32)),
         "param": np.asarray(eta, np.float32),
     }
-    return estimator_for(estimator, samples, seed).evaluate(integrand, inputs, device)
+    return estimator_of(estimator, samples, seed).evaluate(integrand, inputs, device)

@@ -332,7 +332,7 @@ class SpecularIntegrand:
     half-vector domain). ``ndf_peak``: g has the lobe of ``distribution`` (False for the sheen layouts, whose GGX
     distribution only panels: no u = CDF(theta_h) variable). ``g64(v, h, alpha, param, v.h as float64)``: g given
     v.h to float64, where float32's rounding of it matters (the dielectric's refraction near total internal
-    reflection); the gauss_legendre panel rules pass it (lutbake.sampling.hemisphere.facet_rules_for), else None.
+    reflection); the gauss_legendre panel rules pass it (lutbake.sampling.facet_rules.facet_rules_for), else None.
     ``g64_parts``: (part, rest) with g64(v, h, alpha, param, c) = rest(part(v, h, alpha, c), v, h, alpha, param, c),
     ``part`` free of the param (texels that differ only in it share it per node), else None. ``g_sin2(v, h, alpha,
     param, sin^2(theta_h) as float64)``: g with its Charlie D from sin^2(theta_h) to float64 (charlie_integrands), which

@@ -28,20 +28,25 @@ import zipfile
 
 import numpy as np
 
-from ..limits import MAX_TEXELS
+from ..limits import (
+    MAX_CHANNELS,
+    MAX_EXR_ALL_HEADERS,
+    MAX_EXR_ATTRIBUTES,
+    MAX_EXR_HEADER_BYTES,
+    MAX_EXR_PARTS,
+    MAX_JSON_BYTES,
+    MAX_JSON_DEPTH,
+    MAX_READ_BYTES,
+    MAX_READ_MEMORY,
+    MAX_READ_TEXELS,
+    MAX_TEXT_BYTES,
+)
 
-MAX_READ_TEXELS = 2 * MAX_TEXELS  # texels of one file (z x y x x): the largest table a config allows, as an ltc pair
-MAX_CHANNELS = 4
-MAX_READ_BYTES = MAX_READ_TEXELS * MAX_CHANNELS * 4  # 2 GiB: float32 RGBA at MAX_READ_TEXELS texels
-MAX_TEXT_BYTES = 64 << 20  # a C/JS/WGSL/Rust array of a 1024^2 RGBA table is about 50 MiB
-MAX_JSON_BYTES = 16 << 20  # a sidecar or a cache entry is a few KiB (a listed axis: tens of KiB)
-MAX_JSON_DEPTH = 64  # lutbake's deepest JSON is 4 levels (sidecar > lutbake > axes > values)
 NPY_HEADER_LIMIT = 10000  # numpy's own default max_header_size
 # Memory: one budget for what a read and its command's work on the values take together, computed from the shape and
 # the stored dtype before anything is allocated (check_memory). Bytes per value, measured as max RSS over the values
 # of a 2048 x 2048 RGBA float32 file (KTX2, npy, EXR, PNG16; lutbake 1 GiB files alike): the reader holds the stored
 # values plus a float32 table (READ_BYTES + the stored item size); the command adds PROCESSING_BYTES.
-MAX_READ_MEMORY = 2 << 30  # 2 GiB: a 2^26-texel RGBA float32 table (the largest a config bakes) for inspect
 READ_BYTES = 4  # the float32 table beside the stored values (an EXR: OpenImageIO's float buffer is the stored copy)
 PROCESSING_BYTES = {
     "inspect": 0,
@@ -228,10 +233,6 @@ def zstd_decompress(data: bytes, size: int) -> bytes:
 # multi-part), then per part a header of attributes ``name\0 type\0 int32 size, value``, ended by a NUL; a multi-part
 # file ends its list of headers with an empty header (one more NUL)
 EXR_MULTIPART = 0x1000
-MAX_EXR_ATTRIBUTES = 1024  # of one part (lutbake writes about 20; renderers a few dozen)
-MAX_EXR_HEADER_BYTES = 1 << 20  # of one part's header (lutbake's: a few KiB, its config and axes included)
-MAX_EXR_PARTS = 4096  # a 3D table has a part per z index
-MAX_EXR_ALL_HEADERS = 16 << 20  # the headers of every part together
 EXR_NAME_BYTES = 256  # an attribute's name or type is at most 255 bytes (long names)
 
 

@@ -11,8 +11,12 @@ Always the DX10 extension header (FourCC ``DX10``), one mip level, no compressio
 from __future__ import annotations
 
 import struct
+from pathlib import Path
 
 import numpy as np
+
+from . import bounded
+from .sidecar import LoadedFile, as_table_array, with_sidecar
 
 MAGIC = b"DDS "
 DDSD_CAPS, DDSD_HEIGHT, DDSD_WIDTH, DDSD_PITCH = 0x1, 0x2, 0x4, 0x8
@@ -88,9 +92,7 @@ def decode(blob: bytes) -> tuple[np.ndarray, dict]:
     dtype, nch = FROM_DXGI[fmt]
     npdt = np.dtype("<f2" if dtype == "half" else "<f4")
     shape = ((depth,) if dim == DIM_TEXTURE3D else ()) + (height, width, nch)
-    from .bounded import check_texels
-
-    check_texels(shape, f"the DDS header ({DXGI_NAMES[fmt]})", itemsize=npdt.itemsize)
+    bounded.check_texels(shape, f"the DDS header ({DXGI_NAMES[fmt]})", itemsize=npdt.itemsize)
     need = 148 + int(np.prod(shape, dtype=object)) * npdt.itemsize
     if min(shape) < 1 or need > len(blob):
         raise ValueError(
@@ -104,3 +106,8 @@ def decode(blob: bytes) -> tuple[np.ndarray, dict]:
         "mips": mips,
         "array_size": array_size,
     }
+
+
+def read_dds(path: Path) -> LoadedFile:
+    arr, facts = decode(bounded.read_bytes(path))
+    return with_sidecar(LoadedFile(path, "dds", as_table_array(arr), {}, None, facts))

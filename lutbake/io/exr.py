@@ -27,16 +27,22 @@ File layout (the contract engines and ``lutbake inspect`` rely on):
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
 
+from ..limits import MAX_EXR_CHANNELS
+from ..runtime.warp_runtime import stderr_silenced
 from ..table import CHANNEL_LETTERS, Table, metadata
 from ..table import pixels as checked_pixels
+from . import bounded
 from .atomic import atomic_write
 from .integrity import HASH_KEY, PLACEHOLDER, seal_exr
+from .sidecar import LoadedFile, text_problem
 
 PREFIX = "lutbake:"
+EXR_MAGIC = b"\x76\x2f\x31\x01"
 EXR_TYPES = {"float32": "float", "half": "half"}
 COMPRESSION = "zip"
 PER_PART = frozenset({"slice_index", "slice_value"})
@@ -123,11 +129,89 @@ def write_exr(table: Table, path, dtype: str = "float32") -> Path:
 # --------------------------------------------------------------------------------------- reading
 
 
+def _exr_attrs(spec) -> dict[str, str]:
+    return {
+        p.name[len(PREFIX) :]: p.value if isinstance(p.value, str) else json.dumps(p.value)
+        for p in spec.extra_attribs
+        if p.name.startswith(PREFIX)
+    }
+
+
+def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
+    """Every part of an EXR: (float32 pixels (y, x, C), lutbake attributes, facts). Channels R, G, B, A
+    come in that order; any other channel names are kept in file order."""
+    import OpenImageIO as oiio  # imported here: only EXR and PNG need it
+
+    problem = bounded.exr_header_problem(path)  # before OpenImageIO parses the attributes (super-linear in their count)
+    if problem:
+        raise ValueError(problem)
+    with stderr_silenced():  # libpng / OpenEXR print their own complaints; the ReadError says it once
+        inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
+    parts = []
+    try:
+        k, texels = 0, 0
+        while inp.seek_subimage(k, 0):
+            spec = inp.spec()
+            names = list(spec.channelnames)
+            texels += spec.width * spec.height * max(spec.depth, 1)  # every part so far: checked before any read
+            if texels > bounded.MAX_READ_TEXELS or len(names) > MAX_EXR_CHANNELS:
+                raise ValueError(
+                    f"part {k} declares {spec.width} x {spec.height} texels x {len(names)} channels ({texels} texels "
+                    f"in parts 0-{k}); a table lutbake reads is at most {bounded.MAX_READ_TEXELS} texels of "
+                    f"at most {MAX_EXR_CHANNELS} channels: refused before reading"
+                )
+            bounded.check_memory((texels, len(names)), 4, f"the EXR (parts 0-{k}: texels x channels)")
+            rgba = [c for c in "RGBA" if c in names]
+            order = rgba + [c for c in names if c not in rgba] if rgba else names  # RGBA first (RGBA + Z: 5)
+            with stderr_silenced():
+                arr = inp.read_image(k, 0, 0, len(names), "float")
+            if arr is None:
+                raise ValueError(f"cannot read the pixels of part {k}: {inp.geterror()}")
+            arr = np.asarray(arr, dtype=np.float32).reshape(spec.height, spec.width, len(names))
+            if order != names:  # a copy only where the channels move (RGBA first)
+                arr = np.ascontiguousarray(arr[..., [names.index(c) for c in order]])
+            facts = {
+                "pixel_type": str(spec.format),
+                "compression": spec.getattribute("compression"),
+                "part": spec.getattribute("name") or spec.getattribute("oiio:subimagename"),
+                "channels": order,
+            }
+            parts.append((arr, _exr_attrs(spec), facts))
+            k += 1
+    finally:
+        inp.close()
+    if not parts:
+        raise ValueError("no image part")
+    return parts
+
+
+def read_any_exr(path: Path) -> LoadedFile:
+    """Any EXR (any tool's: any channels, every part; 3D: a part per z) as a LoadedFile, its lutbake attributes from
+    the header (lutbake.io.readers dispatches to it)."""
+    parts = exr_parts(path)
+    shapes = {p[0].shape for p in parts}
+    if len(shapes) != 1:
+        raise ValueError(f"its parts have different shapes {sorted(shapes)}")
+    attrs = {k: v for k, v in parts[0][1].items() if k not in ("slice_index", "slice_value")}
+    problem = text_problem(attrs)
+    if problem:
+        raise ValueError(f"its lutbake attributes: {problem}")
+    facts = {**parts[0][2], "parts": [(f["part"], a.get("slice_value")) for _, a, f in parts]}
+    if len(parts) == 1 and "slice_index" not in parts[0][1]:
+        data = parts[0][0]
+    else:
+        order = [int(a.get("slice_index", k)) for k, (_, a, _) in enumerate(parts)]
+        if sorted(order) != list(range(len(order))):
+            raise ValueError(f"slice indices {order} are not 0..{len(order) - 1}")
+        data = np.stack([parts[order.index(k)][0] for k in range(len(order))])
+    return LoadedFile(path, "exr", data, attrs, "EXR header" if attrs else None, facts)
+
+
 def _read_parts(path) -> tuple[list[np.ndarray], list[dict[str, str]], list[dict]]:
     """Every part's pixels (float32, (y, x, C), channels in R, G, B, A order), lutbake attributes,
     and file facts (pixel type, compression, part name), of an EXR lutbake wrote."""
-    from .readers import EXR_MAGIC, exr_parts
-
     path = Path(path)
     if not path.exists():
         raise FileNotFoundError(f"{path}: no such file")

@@ -29,6 +29,7 @@ import re
 import struct
 from pathlib import Path
 
+from ..limits import MAX_SIDECAR_BYTES
 from .atomic import atomic_write_bytes
 
 HASH_KEY = "data_hash"  # the EXR header attribute lutbake:data_hash
@@ -42,7 +43,6 @@ _EXR_HASH_ATTR = re.compile(
 
 
 CHUNK = 8 << 20  # files are hashed in chunks: a 1 GiB table is never read into memory at once
-MAX_SIDECAR_BYTES = 64 << 20  # a sidecar is a few KiB; anything far larger is not one (and is not read)
 _CARRY = 128  # > the length of one lutbake:data_hash attribute (name, type, size, 64 digits)
 
 

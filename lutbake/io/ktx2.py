@@ -17,11 +17,14 @@ from __future__ import annotations
 import json
 import math
 import struct
+from pathlib import Path
 
 import numpy as np
 
+from . import bounded
 from .bounded import check_texels, zstd_decompress
 from .dds import PIXEL_FORMATS, gpu_channels, layout_name
+from .sidecar import LoadedFile, ReadError, as_table_array, string_attrs, with_sidecar
 
 IDENTIFIER = bytes([0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A])
 # VkFormat values (vulkan_core.h): VK_FORMAT_R16_SFLOAT, R16G16_SFLOAT, R16G16B16A16_SFLOAT, R32_SFLOAT, ...
@@ -177,3 +180,19 @@ def decode(blob: bytes) -> tuple[np.ndarray, dict]:
         "type_size": type_size,
         "key_value": kv,
     }
+
+
+def read_ktx2(path: Path) -> LoadedFile:
+    arr, facts = decode(bounded.read_bytes(path))
+    kv = facts.pop("key_value")
+    facts.update({k: v for k, v in kv.items() if k.startswith("KTX")})
+    loaded = LoadedFile(path, "ktx2", as_table_array(arr), {}, None, facts)
+    if "lutbake:metadata" in kv:
+        try:
+            meta = bounded.loads_json(kv["lutbake:metadata"])
+        except ValueError as e:
+            raise ReadError(f"{path}: key/value lutbake:metadata is not valid JSON ({e})") from None
+        loaded.attrs = string_attrs(meta, path, "key/value lutbake:metadata")
+        loaded.meta_source = "KTX2 key/value data"
+        return loaded
+    return with_sidecar(loaded)

@@ -78,7 +78,7 @@ def _read_exr(path: Path) -> tuple[np.ndarray, dict, str]:
     """Any tool's 2D EXR: (values (y, x, C), lutbake attributes or {}, storage "half" / "float32"). Channels R, G, B,
     A in that order, also under a layer prefix (``dfg.R``, ``dfg.G``: file order is alphabetical); other names
     (``Y``, ``scale``, ``bias``) in file order. A multi-part file is a 3D table, which audit does not compare."""
-    from .readers import exr_parts
+    from .exr import exr_parts
 
     try:
         parts = exr_parts(path)

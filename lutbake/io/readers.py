@@ -1,5 +1,6 @@
-"""Read every file lutbake writes, and the tables engines ship: one reader per format, chosen by the
-file's first bytes (its magic number), never by its extension.
+"""Read every file lutbake writes, and the tables engines ship: one reader per format, each beside its writer
+(lutbake.io.exr, npy, png, dds, ktx2, header; the sidecar reader here), chosen by the file's first bytes (its magic
+number), never by its extension. What they return and the sidecar they share: lutbake.io.sidecar.
 
 | format | magic | pixels | lutbake metadata |
 | --- | --- | --- | --- |
@@ -25,30 +26,37 @@ from __future__ import annotations
 
 import json
 import math
-import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..axes import IMAGE_DIMS, MAPPINGS, ORDERS, TEXELS, Axis
-from ..errors import MESSAGE_LIMIT, LutbakeError
-from ..runtime.warp_runtime import stderr_silenced
+from ..errors import LutbakeError
+from ..limits import MAX_AXIS_COUNT, MAX_FILE_BYTES
 from ..textsafe import bounded as bounded_text
 from ..textsafe import shorten
 from . import bounded, dds, ktx2
-from .text_arrays import parse_numbers
+from .dds import read_dds
+from .exr import EXR_MAGIC, read_any_exr
+from .header import read_header
+from .ktx2 import read_ktx2
+from .npy import NPY_MAGIC, read_npy
+from .png import PNG_MAGIC, read_png
+from .sidecar import (
+    NAME_CHARS,
+    LoadedFile,
+    ReadError,
+    describes,
+    is_report,
+    load_sidecar,
+    load_sidecar_json,
+    sidecar_candidates,
+    text_problem,
+)
 
-PREFIX = "lutbake:"
 MAGIC_BYTES = 16  # enough to tell every format apart
-MAX_AXIS_COUNT = 1 << 20  # no lutbake axis is longer (the texel cap is 2^24 in all)
-MAX_FILE_BYTES = 4 << 30  # a table is at most 2^24 texels x 4 channels x 4 bytes = 256 MiB; headers are text
-NAME_CHARS = 120  # characters of a name from a file (kind, table, channel, term) shown by preview and inspect
 MAX_TERMS = 32  # terms shown (lutbake records at most a dozen)
-MAX_EXR_CHANNELS = 64  # channels of one EXR part (a table has 1 to 4; other tools add a few named ones)
-EXR_MAGIC = b"\x76\x2f\x31\x01"
-NPY_MAGIC = b"\x93NUMPY"
-PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 ZIP_MAGIC = b"PK\x03\x04"  # a NumPy .npz archive
 TEXT_CONTROLS = b"\t\n\r\f"  # the control bytes a text array may hold
 GENERIC_FORMATS = ("exr", "npy", "png16", "dds", "ktx2", "ktx2zst", "h")  # sidecar "format"s whose pixels lutbake reads
@@ -65,25 +73,6 @@ FORMAT_NAMES = {
     "sidecar": "lutbake .json sidecar",
     "report": "lutbake bake report (--report)",
 }
-
-
-class ReadError(LutbakeError, ValueError):
-    """A file lutbake cannot read, or metadata that does not fit the file: one line that names the file."""
-
-    def __init__(self, message: str):
-        line = "; ".join(part.strip() for part in str(message).splitlines() if part.strip())
-        super().__init__(shorten(line, MESSAGE_LIMIT))
-
-
-@dataclass
-class LoadedFile:
-    path: Path
-    format: str  # a key of FORMAT_NAMES
-    data: np.ndarray | None  # float32, (y, x, C) or (z, y, x, C), as stored; None: a sidecar whose data is missing
-    attrs: dict[str, str]  # lutbake attributes without the prefix; {} when the file carries none
-    meta_source: str | None  # where ``attrs`` came from ("EXR header", "sidecar dfg.json", ...)
-    facts: dict = field(default_factory=dict)  # what the container says: pixel type, texture format, parts ...
-    notes: list[str] = field(default_factory=list)  # why metadata is missing, and the like
 
 
 @dataclass
@@ -166,9 +155,9 @@ def _engine_sidecar(path: Path) -> LoadedFile | None:
     (lutbake.io.engine_files) with its sidecar's metadata, or None when no sidecar names the file with such a format."""
     for side in sidecar_candidates(path):
         if side.is_file() and side != path:
-            doc = _load_json(side)
-            if isinstance(doc, dict) and _describes(doc, path) and doc.get("format") not in GENERIC_FORMATS:
-                return _engine_values(path, _load_sidecar(side, doc), f"sidecar {side.name}")
+            doc = load_sidecar_json(side)
+            if isinstance(doc, dict) and describes(doc, path) and doc.get("format") not in GENERIC_FORMATS:
+                return _engine_values(path, load_sidecar(side, doc), f"sidecar {side.name}")
     return None
 
 
@@ -197,300 +186,13 @@ def _read_or_raise(path: Path, fmt: str) -> LoadedFile:
         raise ReadError(f"{path}: not a readable {FORMAT_NAMES[fmt]} file: {e}") from None
 
 
-# ------------------------------------------------------------------------------------------ readers
-
-
-def _as_table_array(arr: np.ndarray) -> np.ndarray:
-    """float32 (y, x, C) or (z, y, x, C): a 2D array gains a channel axis."""
-    if arr.dtype.kind not in "fiub":
-        raise ValueError(f"array of dtype {arr.dtype} holds no numbers")
-    if arr.ndim == 2:
-        arr = arr[..., None]
-    if arr.ndim not in (3, 4) or arr.shape[-1] > 4 or 0 in arr.shape:
-        raise ValueError(
-            f"array of shape {arr.shape} is not a table: lutbake reads (y, x), (y, x, C) or "
-            "(z, y, x, C) with 1 to 4 channels"
-        )
-    return np.ascontiguousarray(arr, dtype=np.float32)
-
-
-def _exr_attrs(spec) -> dict[str, str]:
-    return {
-        p.name[len(PREFIX) :]: p.value if isinstance(p.value, str) else json.dumps(p.value)
-        for p in spec.extra_attribs
-        if p.name.startswith(PREFIX)
-    }
-
-
-def exr_parts(path: Path) -> list[tuple[np.ndarray, dict[str, str], dict]]:
-    """Every part of an EXR: (float32 pixels (y, x, C), lutbake attributes, facts). Channels R, G, B, A
-    come in that order; any other channel names are kept in file order."""
-    import OpenImageIO as oiio  # imported here: only EXR and PNG need it
-
-    problem = bounded.exr_header_problem(path)  # before OpenImageIO parses the attributes (super-linear in their count)
-    if problem:
-        raise ValueError(problem)
-    with stderr_silenced():  # libpng / OpenEXR print their own complaints; the ReadError says it once
-        inp = oiio.ImageInput.open(str(path))
-    if inp is None:
-        raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
-    parts = []
-    try:
-        k, texels = 0, 0
-        while inp.seek_subimage(k, 0):
-            spec = inp.spec()
-            names = list(spec.channelnames)
-            texels += spec.width * spec.height * max(spec.depth, 1)  # every part so far: checked before any read
-            if texels > bounded.MAX_READ_TEXELS or len(names) > MAX_EXR_CHANNELS:
-                raise ValueError(
-                    f"part {k} declares {spec.width} x {spec.height} texels x {len(names)} channels ({texels} texels "
-                    f"in parts 0-{k}); a table lutbake reads is at most {bounded.MAX_READ_TEXELS} texels of "
-                    f"at most {MAX_EXR_CHANNELS} channels: refused before reading"
-                )
-            bounded.check_memory((texels, len(names)), 4, f"the EXR (parts 0-{k}: texels x channels)")
-            rgba = [c for c in "RGBA" if c in names]
-            order = rgba + [c for c in names if c not in rgba] if rgba else names  # RGBA first (RGBA + Z: 5)
-            with stderr_silenced():
-                arr = inp.read_image(k, 0, 0, len(names), "float")
-            if arr is None:
-                raise ValueError(f"cannot read the pixels of part {k}: {inp.geterror()}")
-            arr = np.asarray(arr, dtype=np.float32).reshape(spec.height, spec.width, len(names))
-            if order != names:  # a copy only where the channels move (RGBA first)
-                arr = np.ascontiguousarray(arr[..., [names.index(c) for c in order]])
-            facts = {
-                "pixel_type": str(spec.format),
-                "compression": spec.getattribute("compression"),
-                "part": spec.getattribute("name") or spec.getattribute("oiio:subimagename"),
-                "channels": order,
-            }
-            parts.append((arr, _exr_attrs(spec), facts))
-            k += 1
-    finally:
-        inp.close()
-    if not parts:
-        raise ValueError("no image part")
-    return parts
-
-
-def read_exr(path: Path) -> LoadedFile:
-    parts = exr_parts(path)
-    shapes = {p[0].shape for p in parts}
-    if len(shapes) != 1:
-        raise ValueError(f"its parts have different shapes {sorted(shapes)}")
-    attrs = {k: v for k, v in parts[0][1].items() if k not in ("slice_index", "slice_value")}
-    problem = _text_problem(attrs)
-    if problem:
-        raise ValueError(f"its lutbake attributes: {problem}")
-    facts = {**parts[0][2], "parts": [(f["part"], a.get("slice_value")) for _, a, f in parts]}
-    if len(parts) == 1 and "slice_index" not in parts[0][1]:
-        data = parts[0][0]
-    else:
-        order = [int(a.get("slice_index", k)) for k, (_, a, _) in enumerate(parts)]
-        if sorted(order) != list(range(len(order))):
-            raise ValueError(f"slice indices {order} are not 0..{len(order) - 1}")
-        data = np.stack([parts[order.index(k)][0] for k in range(len(order))])
-    return LoadedFile(path, "exr", data, attrs, "EXR header" if attrs else None, facts)
-
-
-def read_npy(path: Path) -> LoadedFile:
-    arr = bounded.load_npy(path)
-    data = _as_table_array(arr)
-    return _with_sidecar(LoadedFile(path, "npy", data, {}, None, {"dtype": str(arr.dtype), "shape": list(arr.shape)}))
-
-
-def read_png(path: Path) -> LoadedFile:
-    import OpenImageIO as oiio
-
-    with stderr_silenced():
-        inp = oiio.ImageInput.open(str(path))
-    if inp is None:
-        raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
-    try:
-        spec = inp.spec()
-        bounded.check_texels((spec.height, spec.width, spec.nchannels), "the PNG header", itemsize=spec.format.size())
-        bits = 16 if str(spec.format) == "uint16" else 8
-        with stderr_silenced():
-            arr = inp.read_image("uint16" if bits == 16 else "uint8")
-        if arr is None:
-            raise ValueError(inp.geterror())
-        codes = np.asarray(arr).reshape(spec.height, spec.width, spec.nchannels)
-    finally:
-        inp.close()
-    data = _unorm_float32(codes, (1 << bits) - 1)
-    facts = {"bit_depth": bits, "channels": list(spec.channelnames), "encoding": f"code / {(1 << bits) - 1}"}
-    return _with_sidecar(LoadedFile(path, "png", data, {}, None, facts))
-
-
-UNORM_ROWS = 256  # rows converted at a time from UNORM codes (float64 division, rounded to float32)
-
-
-def _unorm_float32(codes: np.ndarray, one: int) -> np.ndarray:
-    """float32 code / one, as the float64 division rounds it, a block of rows at a time (no float64 image)."""
-    out = np.empty(codes.shape, np.float32)
-    for r in range(0, codes.shape[0], UNORM_ROWS):
-        out[r : r + UNORM_ROWS] = codes[r : r + UNORM_ROWS] / float(one)
-    return _as_table_array(out)
-
-
-def read_dds(path: Path) -> LoadedFile:
-    arr, facts = dds.decode(bounded.read_bytes(path))
-    return _with_sidecar(LoadedFile(path, "dds", _as_table_array(arr), {}, None, facts))
-
-
-def read_ktx2(path: Path) -> LoadedFile:
-    arr, facts = ktx2.decode(bounded.read_bytes(path))
-    kv = facts.pop("key_value")
-    facts.update({k: v for k, v in kv.items() if k.startswith("KTX")})
-    loaded = LoadedFile(path, "ktx2", _as_table_array(arr), {}, None, facts)
-    if "lutbake:metadata" in kv:
-        try:
-            meta = bounded.loads_json(kv["lutbake:metadata"])
-        except ValueError as e:
-            raise ReadError(f"{path}: key/value lutbake:metadata is not valid JSON ({e})") from None
-        loaded.attrs = _string_attrs(meta, path, "key/value lutbake:metadata")
-        loaded.meta_source = "KTX2 key/value data"
-        return loaded
-    return _with_sidecar(loaded)
-
-
-# Bounded patterns (linear time on any text, issue 38): a declaration's parts are short; the array's body is found
-# with one str.find of its closing brace, never by a pattern that rescans the rest of the file from each candidate.
-_DEFINE = re.compile(r"^#define[ \t]{1,64}(\w{1,128}?)_(DEPTH|HEIGHT|WIDTH|CHANNELS)[ \t]{1,64}(\d{1,12})[ \t]*$", re.M)
-_ARRAY = re.compile(
-    r"static\s{1,64}const\s{1,64}(uint16_t|float)\s{1,64}(\w{1,128})\s{0,64}\[[^\]\n]{0,1024}\]\s{0,64}=\s{0,64}\{"
-)
-
-
-def read_header(path: Path) -> LoadedFile:
-    """A C header as lutbake writes it (lutbake.io.formats.header_text): size macros and one flat array
-    of floats or binary16 bit patterns."""
-    text = bounded.read_text(path, what="a C header")
-    m = _ARRAY.search(text)
-    if m is None:
-        raise ValueError("no 'static const float|uint16_t NAME[...] = {...}' array")
-    end = text.find("}", m.end())
-    if end < 0:
-        raise ValueError(f"array {m.group(2)} has no closing brace")
-    ctype, ident = m.groups()
-    body = text[m.end() : end]
-    dims = {k: int(v) for macro, k, v in _DEFINE.findall(text) if macro == ident.upper()}
-    if not {"HEIGHT", "WIDTH", "CHANNELS"} <= set(dims):
-        raise ValueError(f"no {ident.upper()}_HEIGHT / _WIDTH / _CHANNELS macros for array {ident}")
-    shape = tuple(dims[k] for k in ("DEPTH", "HEIGHT", "WIDTH", "CHANNELS") if k in dims)
-    bounded.check_texels(shape, f"array {ident}'s macros", itemsize=8)  # parsed as float64
-    try:
-        data, _ = parse_numbers(body, math.prod(shape), bits=ctype == "uint16_t")
-    except ValueError as e:
-        raise ValueError(f"array {ident} (its macros say {' x '.join(map(str, shape))}): {e}") from None
-    loaded = LoadedFile(
-        path,
-        "h",
-        _as_table_array(data.reshape(shape)),
-        {},
-        None,
-        {"array": ident, "element_type": ctype + (" (binary16 bits)" if ctype == "uint16_t" else "")},
-    )
-    return _with_sidecar(loaded)
-
-
-def _is_report(doc) -> bool:
-    return isinstance(doc, dict) and "lutbake" not in doc and {"lutbake_version", "tables"} <= set(doc)
-
-
-def _load_json(path: Path):
-    try:
-        return bounded.load_json(path)
-    except json.JSONDecodeError as e:
-        raise ReadError(f"{path}: sidecar is not valid JSON ({e})") from None
-    except (ValueError, UnicodeDecodeError) as e:
-        raise ReadError(f"{path}: not a readable sidecar: {e}") from None
-    except OSError as e:
-        raise ReadError(f"{path}: cannot read: {e.strerror or e}") from None
-
-
-def _load_sidecar(path: Path, doc=None) -> dict:
-    doc = _load_json(path) if doc is None else doc
-    if not isinstance(doc, dict):
-        raise ReadError(f"{path}: a sidecar is a JSON object with a 'lutbake' object, got {type(doc).__name__}")
-    if "lutbake" not in doc:
-        raise ReadError(f"{path}: JSON without a 'lutbake' object: not a lutbake sidecar")
-    doc["lutbake"] = _string_attrs(doc["lutbake"], path, "key 'lutbake'")
-    return doc
-
-
-def _string_attrs(meta, where: Path, what: str) -> dict[str, str]:
-    if not isinstance(meta, dict):
-        raise ReadError(
-            f"{where}: {what} must be a JSON object of lutbake attributes, got {type(meta).__name__} "
-            f"{json.dumps(meta)[:40]}"
-        )
-    bad = [k for k, v in meta.items() if not isinstance(v, str)]
-    if bad:
-        raise ReadError(f"{where}: {what}: attribute {bad[0]!r} must be a string, got {type(meta[bad[0]]).__name__}")
-    problem = _text_problem(meta)
-    if problem:
-        raise ReadError(f"{where}: {what}: {problem}")
-    return dict(meta)
-
-
-_SURROGATE = re.compile("[\ud800-\udfff]")  # valid in JSON ("\\ud800"), never text: no terminal or font takes it
-
-
-def _text_problem(value, where: str = "") -> str | None:
-    """Where a JSON value (its keys and strings, at any depth) holds a lone UTF-16 surrogate, or None."""
-    if isinstance(value, str):
-        m = _SURROGATE.search(value)
-        return f"{where or 'a string'} holds a lone surrogate (U+{ord(m.group()):04X}): not text" if m else None
-    items = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
-    for key, item in items:
-        name = f"{where}[{key}]" if isinstance(key, int) else f"{where}.{key}" if where else f"{key}"
-        name = bounded_text(_SURROGATE.sub("?", str(name)), NAME_CHARS)
-        problem = (_text_problem(key, f"key {name!r}") if isinstance(key, str) else None) or _text_problem(item, name)
-        if problem:
-            return problem
-    return None
-
-
-def sidecar_candidates(path: Path) -> list[Path]:
-    """Where the sidecar of a data file may be: <name>.<ext>.json, then <name>.json; for the second texture of an
-    ltc_dds pair (<stem>_2.dds), the pair's sidecar <stem>_1.dds.json (it lists both in ``files``)."""
-    out = [path.with_name(path.name + ".json"), path.with_suffix(".json")]
-    if path.name.endswith("_2.dds"):
-        out.append(path.with_name(path.name[: -len("_2.dds")] + "_1.dds.json"))
-    return out
-
-
-def _describes(doc: dict, path: Path) -> bool:
-    """Whether a sidecar names ``path`` as its data file (``file``) or one of its files (``files``)."""
-    files = doc.get("files")
-    return doc.get("file") == path.name or (isinstance(files, list) and path.name in files)
-
-
-def _with_sidecar(loaded: LoadedFile) -> LoadedFile:
-    """Attach the attributes of the sidecar that names this file (a sidecar naming another file is skipped)."""
-    for side in sidecar_candidates(loaded.path):
-        if not side.is_file() or side == loaded.path or _is_report(_load_json(side)):
-            continue
-        doc = _load_sidecar(side)
-        named = doc.get("file")
-        if named is not None and not _describes(doc, loaded.path):
-            loaded.notes.append(f"{side.name} describes {named}, not this file")
-            continue
-        loaded.attrs, loaded.meta_source = doc["lutbake"], f"sidecar {side.name}"
-        loaded.facts["sidecar_format"] = doc.get("format", "")
-        return loaded
-    if not loaded.notes:
-        loaded.notes.append(f"no sidecar ({' or '.join(p.name for p in sidecar_candidates(loaded.path))})")
-    return loaded
-
-
 def read_sidecar(path: Path) -> LoadedFile:
     """A sidecar: its attributes, with the pixels of the data file it names (beside it) when present.
     A bake report (``lutbake bake --report``) reads as format "report": facts only, no pixels."""
-    doc = _load_json(path)
-    if _is_report(doc):
+    doc = load_sidecar_json(path)
+    if is_report(doc):
         return LoadedFile(path, "report", None, {}, None, doc, ["a bake report: it lists tables and holds no pixels"])
-    doc = _load_sidecar(path, doc)
+    doc = load_sidecar(path, doc)
     named = doc.get("file")
     facts = {k: v for k, v in doc.items() if k != "lutbake"}
     generic = doc.get("format", "exr") in GENERIC_FORMATS
@@ -510,7 +212,7 @@ def read_sidecar(path: Path) -> LoadedFile:
 
 
 READERS = {
-    "exr": read_exr,
+    "exr": read_any_exr,
     "npy": read_npy,
     "png": read_png,
     "dds": read_dds,
@@ -535,7 +237,7 @@ def _json_attr(loaded: LoadedFile, key: str, kind: type, default):
         raise ReadError(f"{where} is not valid JSON ({shorten(str(e), 200)})") from None
     if not isinstance(value, kind):
         raise ReadError(f"{where} must be a JSON {'list' if kind is list else 'object'}, got {loaded.attrs[key][:60]}")
-    problem = _text_problem(value)
+    problem = text_problem(value)
     if problem:
         raise ReadError(f"{where}: {problem}")
     return value

@@ -11,9 +11,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ..io.formats import FORMATS
-
-MAX_SAMPLES = 1 << 24  # per texel; beyond this a point set alone needs > 128 MiB and a table takes days
-MAX_SEED = (1 << 64) - 1
+from ..limits import MAX_SAMPLES, MAX_SEED
 
 
 @dataclass(frozen=True)

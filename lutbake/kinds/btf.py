@@ -22,6 +22,7 @@ import numpy as np
 
 from ..axes import TEXELS, Axis, sigma_alpha
 from ..edge import effective_alpha
+from ..limits import MAX_GL_ORDER
 from ..records import DIFFUSE
 from ..registry import choices
 from ..sampling.plan import Grid, TexelPlan, per_texel_plan
@@ -128,7 +129,6 @@ def texel_count(o: dict) -> int:
 
 DEFAULT_SOBOL = 4096
 TILE_PHI_BLOCKS = 8  # phi blocks per tile of the adaptive microfacet btf
-MAX_GL_ORDER = 64
 
 
 def check_spec(spec) -> tuple[str, str] | None:

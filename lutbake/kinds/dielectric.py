@@ -191,14 +191,14 @@ def plan_avg(spec) -> TexelPlan:
     as the adaptive kernel's; ``samples`` unset: its order climbs until the probe fits the tolerance."""
     from ..integrands.dielectric import dielectric_integrand
     from ..sampling.dielectric_avg import average_plan
-    from ..sampling.dielectric_layout import estimator_for
+    from ..sampling.dielectric_layout import estimator_of
 
     o = spec.options
     lay = lookup_layout("dielectric_avg", o["layout"])
     axes, alpha, eta = avg_grid(o)
     nd, mk = terms_of(o)
     integrand = dielectric_integrand(nd, mk, lay.integrand)
-    estimator = estimator_for(o["estimator"], o["samples"], o["seed"], merged=True)
+    estimator = estimator_of(o["estimator"], o["samples"], o["seed"], merged=True)
     climb = o["samples"] is None and o["estimator"] == "gauss_legendre"
     terms = terms_record((nd, mk, lay.integrand), lay.name)
     return average_plan(integrand, estimator, axes, alpha, eta, lay, o["mu_order"], tolerance_of(o), climb, terms)

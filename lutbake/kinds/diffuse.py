@@ -15,13 +15,12 @@ import numpy as np
 
 from ..axes import SIGMA_TO_ALPHA, TEXELS, Axis, sigma_alpha
 from ..edge import alpha_policy, effective_alpha
+from ..limits import MAX_GL_ORDER
 from ..records import DIFFUSE, FACET_FRESNEL
 from ..registry import choices
-from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..sampling.diffuse_table import diffuse_grid, estimator_of
+from ..sampling.plan import TexelPlan, per_texel_plan
 from .base import Estimation, Key, declare
-
-DEFAULT_ORDER = {"microfacet": 12}  # base GL order (lutbake.sampling.swapped); closed forms: CLOSED_ORDER
-CLOSED_ORDER = 24
 
 KEYS = {
     "size": Key("size", "int_pair", [64, 64], "[NoV, sigma] texel counts", minimum=1),
@@ -57,42 +56,6 @@ SAMPLES_DOC = (
     "panel, 1.5 n in u and n.l where NoV < 0.1), closed forms: outer 4 n^2 directions l; omitted: 12 for "
     "microfacet, 24 otherwise. sobol_cosine: the number of cosine-weighted directions l (default 4096)"
 )
-MAX_GL_ORDER = 64
-DEFAULT_COSINE_SAMPLES = 4096
-
-
-def order_for(o: dict) -> int:
-    """The GL order of the table (the inner m-rule's order for sobol_cosine)."""
-    if o["estimator"] == "gauss_legendre" and o["samples"]:
-        return o["samples"]
-    return DEFAULT_ORDER.get(o["model"], CLOSED_ORDER)
-
-
-def estimator_of(o: dict, members: int = 1):
-    """gauss_legendre: the swapped integral for the microfacet model (``members``: its f0 groups, kind diffuse_3d),
-    the 2 x 2-panel rule over l otherwise; sobol_cosine: cosine-weighted Sobol' directions l
-    (lutbake.sampling.diffuse)."""
-    from ..sampling.diffuse import CosineSobol, DiffuseGaussLegendre
-    from ..sampling.swapped import SwappedGaussLegendre
-
-    order = order_for(o)
-    if o["estimator"] == "sobol_cosine":
-        return CosineSobol(o["samples"] or DEFAULT_COSINE_SAMPLES, o["seed"], inner_order=order)
-    if o["model"] == "microfacet":
-        return SwappedGaussLegendre(order, members=members)
-    return DiffuseGaussLegendre(order)
-
-
-def diffuse_grid(axes: list[Axis], nov, sigma, f0, sigma_to_alpha: str) -> Grid:
-    """Per-texel inputs of a diffuse albedo table: nov, sigma, alpha (GGX alpha of sigma, lutbake.edge policy:
-    clamped, no mirror limit) and f0."""
-    alpha = sigma_alpha(sigma, sigma_to_alpha)
-    return Grid(
-        axes,
-        {"nov": nov, "sigma": sigma, "alpha": effective_alpha(alpha, False), "f0": np.asarray(f0, np.float64)},
-        grazing=nov,
-        alpha=alpha.astype(np.float64),
-    )
 
 
 def sigma_record(sig_axis: Axis) -> dict[str, str]:

@@ -18,6 +18,7 @@ import numpy as np
 from ..axes import Axis
 from ..records import FACET_FRESNEL
 from ..registry import choices
+from ..sampling.diffuse_table import diffuse_grid, estimator_of
 from ..sampling.groups import key_of, siblings_by_key
 from ..sampling.plan import TexelPlan, per_texel_plan
 from . import diffuse
@@ -63,10 +64,10 @@ def plan(spec) -> TexelPlan:
     if model == "microfacet":
         terms.update(ndf="ggx", masking="smith_height_correlated", facet_fresnel=ff, sigma_to_alpha=o["sigma_to_alpha"])
     axes = [f0_axis, sig_axis, nov_axis]
-    grid = diffuse.diffuse_grid(axes, nov, sigma, f0, o["sigma_to_alpha"])
+    grid = diffuse_grid(axes, nov, sigma, f0, o["sigma_to_alpha"])
     # a CPU tile lies in one f0 slice: it is evaluated with the same (n.v, sigma) texels of every slice, which the
     # microfacet estimator integrates over one set of nodes (lutbake.sampling.swapped; the same bits)
-    estimator = diffuse.estimator_of(o, MEMBERS)
+    estimator = estimator_of(o, MEMBERS)
     grouped = getattr(estimator, "members", 1) > 1
     siblings = siblings_by_key(key_of(grid.inputs["nov"], grid.inputs["alpha"]), np.ones(grid.n_texels, bool))
     return per_texel_plan(

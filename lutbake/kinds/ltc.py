@@ -29,16 +29,15 @@ len = |form factor|, both endpoint (ltc_code genSphereTab).
 
 from __future__ import annotations
 
-import json
-import os
-import threading
-
 import numpy as np
 
 from ..axes import MAPPINGS, TEXELS, Axis
 from ..edge import ALPHA_MIN
 from ..layouts.base import uv_of
 from ..limits import LTC_FIT_GRID
+from ..ltc.magnitude import MAGNITUDE_SAMPLES
+from ..ltc.metadata import fit_error_stats, fit_record
+from ..ltc.table import LtcBake
 from ..records import LTC_LOBE
 from ..registry import choices
 from ..sampling.plan import TexelPlan
@@ -46,7 +45,6 @@ from .base import Estimation, Key, declare
 
 THETA_MAX = 1.57  # ltc_code fitTab: theta = min(1.57, acos(1 - x^2))
 NOV_LO = float(np.cos(np.float32(THETA_MAX)))
-MAGNITUDE_SAMPLES = {"ggx": 432, "beckmann": 432, "charlie": 3072, "lambert": 0}  # diffuse lobes: the diffuse kind's
 FORMATS = {
     "exr": "OpenEXR, two parts (slice_0 = ltc_1, slice_1 = ltc_2), lutbake:* attributes (default)",
     "npy": "NumPy (2, N, N, 4) + .json sidecar",
@@ -173,294 +171,7 @@ def axes_for(o: dict) -> list[Axis]:
     ]
 
 
-def uses_shaded_fit(o: dict) -> bool:
-    """Whether the table's texels are the shaded fit's (lutbake.ltc.shaded) or the L3 fit's."""
-    return o["fit"] == "shaded" and o["lobe"] != "lambert"  # lambert: the L3 fit is exact
-
-
-def lobe_parameter(rough: Axis) -> np.ndarray:
-    """The lobe's parameter per roughness index: the NDF alpha of the axis, or (EON) the axis value itself."""
-    a = rough.alpha()
-    return rough.values() if a is None else a
-
-
-def texel_params(axes: list[Axis], alpha_min: float = ALPHA_MIN) -> tuple[np.ndarray, np.ndarray]:
-    """Per texel of one slice, row-major (y = view slowest): (NoV, alpha) as float32, alpha >= alpha_min (the
-    alpha fitted: an LTC of a Dirac lobe is not defined)."""
-    _, view, rough = axes
-    alpha = np.maximum(lobe_parameter(rough), np.float32(alpha_min))
-    return np.repeat(view.values(), rough.count), np.tile(alpha, view.count)
-
-
-def magnitude_alpha(axes: list[Axis], alpha_min: float = ALPHA_MIN) -> np.ndarray:
-    """The alpha at which magnitude and fresnel are integrated: the axis alpha itself under lutbake's edge policy
-    (alpha -> 0: the exact mirror limit, as the ``albedo`` table), or alpha_min where a larger one is set."""
-    _, view, rough = axes
-    a = lobe_parameter(rough)
-    if alpha_min > ALPHA_MIN:
-        a = np.maximum(a, np.float32(alpha_min))
-    return np.tile(a, view.count)
-
-
-def magnitude_fresnel(
-    lobe_name: str,
-    nov: np.ndarray,
-    alpha: np.ndarray,
-    samples: int | None,
-    device: str = "cpu",
-    estimator: str = "gauss_legendre",
-    seed: int = 0,
-) -> tuple[np.ndarray, np.ndarray]:
-    """(magnitude, fresnel) per texel from lutbake's integrators (``estimator``, default Gauss-Legendre).
-    GGX / Beckmann: magnitude is the ``albedo`` kind's integrand (so it equals that table at the same texels),
-    fresnel the ``dfg`` multiscatter integrand's Fc channel; charlie: the ``dfg`` charlie layout's B channel (the
-    gltf-charlie table), fresnel = magnitude; lambert: 1; gotanda, eon: the ``diffuse`` kind's integrator and
-    integrand (its default GL order unless ``samples``; ``alpha`` = sigma resp. EON's r), fresnel = magnitude.
-    ``alpha`` goes through the integrands' edge policy (mirror limit at alpha -> 0)."""
-    from ..integrands.specular import specular_integrand
-    from ..ltc.lobes import LOBES
-    from ..sampling.hemisphere import estimator_for
-
-    lb = LOBES[lobe_name]
-    if lb.magnitude == "lambert":
-        one = np.ones(len(nov))
-        return one, one.copy()
-    if lb.magnitude == "lobe":  # no other integrator has the lobe: lutbake.ltc.fit's quadrature of f_cos
-        from ..ltc import fit
-
-        m = fit.lobe_albedo(fit.Problem(lobe_name, nov, alpha, np.zeros(len(nov)), device=device))
-        return m, m.copy()
-    if lb.magnitude.startswith("diffuse:"):
-        m = diffuse_magnitude(lb.magnitude.split(":")[1], nov, alpha, samples, device)
-        return m, m.copy()
-    if estimator == "gauss_legendre":
-        samples = samples or MAGNITUDE_SAMPLES[lobe_name]
-    est = estimator_for(estimator, samples, seed)
-    nov = np.asarray(nov, np.float32)
-    zero = np.zeros(len(nov), np.float32)
-
-    def integrate(integrand):
-        inputs = {"nov": nov, "alpha": integrand.alpha_input(alpha), "param": zero}
-        est.prepare(integrand, device)  # compiled once, whichever table asks first (tables prepare in parallel)
-        return est.evaluate(integrand, inputs, device)
-
-    _, which = lb.magnitude.split(":")
-    if which == "charlie":
-        m = integrate(specular_integrand("ggx", "smith_height_correlated", "charlie"))[:, 2]
-        return m, m.copy()
-    mag = integrate(specular_integrand(which, "smith_height_correlated", "albedo", "microfacet", 1))[:, 0]
-    fres = integrate(specular_integrand(which, "smith_height_correlated", "multiscatter"))[:, 0]
-    return mag, fres
-
-
-def diffuse_magnitude(model: str, nov, sigma, samples: int | None, device: str = "cpu") -> np.ndarray:
-    """E(n.v) = ∫ f (n.l) dω_l (rho = 1, f0 = 0) exactly as the ``diffuse`` kind integrates ``model`` at these
-    texels (its grid inputs, its Gauss-Legendre estimator and default order), so the magnitude equals that table."""
-    from ..integrands.diffuse import diffuse_integrand
-    from . import diffuse as kind_diffuse  # the diffuse kind declares its estimator; imported where needed
-
-    o = {"estimator": "gauss_legendre", "samples": samples, "model": model, "seed": 0}
-    nov = np.asarray(nov, np.float32)
-    grid = kind_diffuse.diffuse_grid([], nov, np.asarray(sigma, np.float32), np.zeros(len(nov)), "sigma")
-    est = kind_diffuse.estimator_of(o)
-    integrand = diffuse_integrand(model)
-    est.prepare(integrand, device)
-    return est.evaluate(integrand, grid.inputs, device)[:, 0]
-
-
-class LtcBake:
-    """The state one bake shares between its tiles: the problem (magnitudes, frames) and the coarse pass,
-    built once under a lock; fits are memoised per texel range (both slices' tiles of one range use one fit) and
-    per texel across tables (lutbake.ltc.fit.MEMO: a texel with the same inputs and seeds as one another table
-    of the process fitted, e.g. ltc-hdrp's beside ltc-ggx's, is that fit)."""
-
-    def __init__(self, o: dict, axes: list[Axis]):
-        self.o = o
-        self.axes = axes
-        self.nov, self.alpha = texel_params(axes, o["alpha_min"])
-        self.n_view, self.n_rough = axes[1].count, axes[2].count
-        from ..ltc import sphere
-
-        self._lock = threading.Lock()
-        self._fits: dict[tuple[int, int], tuple[threading.Lock, list]] = {}
-        self.problem = None
-        self.coarse = None
-        self.shaded = uses_shaded_fit(o)
-        self.device = "cpu"
-        self.sphere = sphere.sphere_table(self.n_rough) if self.n_view == self.n_rough else None
-
-    def prepare(self, device: str) -> None:
-        from ..ltc import fit
-
-        with self._lock:
-            if self.problem is None:
-                o = self.o
-                alpha = magnitude_alpha(self.axes, o["alpha_min"])
-                mag, fres = magnitude_fresnel(
-                    o["lobe"], self.nov, alpha, o["samples"], device, o["estimator"], o["seed"]
-                )
-                self.fresnel = fres
-                self.device = device
-                self.has_fresnel = not np.array_equal(mag, fres)  # lobes without Fresnel store fresnel = magnitude
-                # a tabulated lobe's table is built here on every available core (the executor's default; values do
-                # not depend on the thread count)
-                threads = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-                p = fit.Problem(self.o["lobe"], self.nov, self.alpha, mag, self.o["fit_samples"], device, threads)
-                nodes = self.unclamped_nodes(device, threads)
-                self.coarse = fit.coarse_pass(p, self.n_view, self.n_rough, fit.MEMO, nodes)
-                self.problem = p
-
-    def unclamped_nodes(self, device: str, threads: int):
-        """The coarse pass's own problem where ``alpha_min`` clamps a coarse texel's alpha: the coarse texels at the
-        lobe's alpha (>= lutbake's ALPHA_MIN) and magnitude, as a table without the clamp fits them; None where no
-        coarse texel is clamped. The coarse fits only seed the texels, so the table's seeds are then the unclamped
-        table's, and through the fit memo so is every texel the clamp leaves alone (ltc-hdrp, alpha_min 1e-3, fits
-        its two clamped columns of 64 beside ltc-ggx instead of the nine of the first coarse cell)."""
-        from ..ltc import fit
-
-        idx = fit.coarse_texels(self.n_view, self.n_rough)
-        nov, alpha = texel_params(self.axes)
-        if np.array_equal(alpha[idx], self.alpha[idx]):
-            return None
-        o = self.o
-        mag, _ = magnitude_fresnel(
-            o["lobe"], nov[idx], magnitude_alpha(self.axes)[idx], o["samples"], device, o["estimator"], o["seed"]
-        )
-        return fit.Problem(o["lobe"], nov[idx], alpha[idx], mag, o["fit_samples"], device, threads)
-
-    def fitted(self, start: int, stop: int) -> list:
-        """[packed ltc_1 (k, 4), relative error (k,)] of texels [start, stop) of a slice (fitted once)."""
-        from ..ltc import fit
-
-        with self._lock:
-            lock, box = self._fits.setdefault((start, stop), (threading.Lock(), []))
-        with lock:
-            if not box:
-                texel = np.arange(start, stop)
-                p = self.problem
-                m, err = fit.fit_texels(p, texel, self.n_rough, self.coarse, fit.MEMO)
-                packed, mag, fres = fit.pack_inverse(m), p.magnitude[texel], self.fresnel[texel]
-                if self.shaded:
-                    from ..ltc import shaded
-
-                    # texels the L3 fit represents exactly (EON at r = 0: Lambert) keep it: the training lights'
-                    # sampled targets would only add their noise
-                    sel = np.flatnonzero(p.relative(texel, err) >= shaded.EXACT_L3)
-                    free = self.o["magnitude"] == "fitted"
-                    exact_fres = fres[sel] if self.has_fresnel else None
-                    w = self.o["fit_f0_weight"]
-                    packed, mag, fres, err = packed.copy(), mag.copy(), fres.copy(), err.copy()
-                    packed[sel], mag[sel], fres[sel] = shaded.refine(
-                        p, texel[sel], packed[sel], exact_fres, free, self.device, f0_weight=w
-                    )
-                    err[sel] = p.error(texel[sel], np.linalg.inv(fit.unpack_inverse(packed[sel])))
-                box += [packed, p.relative(texel, err), mag, fres]
-        return box
-
-    def run_tile(self, start: int, stop: int, device: str) -> np.ndarray:
-        self.prepare(device)
-        n = self.n_view * self.n_rough
-        out = np.empty((stop - start, 4))
-        pos = start
-        while pos < stop:  # a tile may straddle the two slices
-            z, s = divmod(pos, n)
-            e = min(stop - z * n, n)
-            packed, rel, mag, fres = self.fitted(s, e)
-            rows = slice(pos - start, pos - start + e - s)
-            if z == 0:
-                out[rows] = packed
-            else:
-                sph = self.sphere.ravel()[s:e] if self.sphere is not None else np.zeros(e - s)
-                out[rows] = np.stack([mag, fres, rel, sph], axis=1)
-            pos += e - s
-        return out
-
-
-NORMAL_FRAME = (
-    "M^-1 = [[a, 0, b], [0, a, 0], [0, 0, 1]] in the normal's frame (Zeltner, Burley & Chiang 2022; tizian/ltc-sheen), "
-    "2 parameters (log(1 / a), b)"
-)
-FREE_FRAME = " turned about y by a fitted angle d (4 parameters: every LTC of a lobe symmetric about the xz-plane)"
-ROUGHNESS_AXES = {
-    "perceptual": "x = perceptual roughness r, NDF alpha = r^2 (ltc_code)",
-    "alpha": "x = alpha (the lobe's own parameter: charlie's sheenRoughness)",
-    "sigma": "x = Gotanda's sigma, GGX alpha = sigma (the diffuse kind's default sigma_to_alpha, docs/diffuse.md)",
-    "diffuse_roughness": "x = EON's roughness r (OpenPBR base_diffuse_roughness), linear in [0, 1]",
-    "none": "x unused (lambert)",
-}
-
-
-def magnitude_record(lb, estimator: str, samples) -> str:
-    if lb.magnitude == "lobe":
-        from ..ltc import fit
-
-        return (
-            f"lutbake.ltc.fit.lobe_albedo: Gauss-Legendre {fit.ALBEDO_ORDER} x {fit.ALBEDO_ORDER // 2} (theta graded "
-            "to the horizon, phi)"
-        )
-    if lb.magnitude.startswith("diffuse:"):
-        model = lb.magnitude.split(":")[1]
-        return (
-            f"the diffuse kind's gauss_legendre estimator, model {model!r}, order {samples or 'default'} (rho = 1, "
-            "f0 = 0): equal to that table at the same texels; fresnel channel = magnitude"
-        )
-    return f"{estimator}, {samples or 'default'} samples (lutbake albedo / dfg integrands)"
-
-
-def shaded_record(o: dict) -> dict:
-    if not uses_shaded_fit(o):
-        return {"fit": "l3: the matrices minimise the L3 distance; magnitude and fresnel are the exact integrals"}
-    from ..ltc import shaded
-
-    mag = (
-        "magnitude fitted with the matrix, fresnel the least-squares Schlick scale"
-        if o["magnitude"] == "fitted"
-        else "magnitude = the exact albedo (fixed), fresnel the least-squares Schlick scale"
-    )
-    return {
-        "fit": f"shaded: the l3 fit refined by Levenberg-Marquardt ({shaded.ITERATIONS} steps) to minimise the soft-L1 "
-        f"(scale {shaded.ROBUST_SCALE:g}) of (value_j - G_j) / (G_j + {shaded.ABS_WEIGHT:g} albedo) over "
-        f"{shaded.LIGHTS} training lights per texel (lutbake.ltc.lights, seed {shaded.SEED}), G_j from the lobe's "
-        f"{shaded.SAMPLES}^2 importance samples, for F = 1 and (weight {o['fit_f0_weight']:g}) f0 = "
-        f"{shaded.F0_TRAIN:g}; " + mag
-    }
-
-
-def tabulation_record(lb) -> dict:
-    if lb.tabulate is None:
-        return {}
-    from ..ltc import tabulated
-
-    return {
-        "tabulated_lobe": f"f (n.l) = G2 J, J tabulated per texel on {tabulated.TAB_THETA} theta_l (cell centres) x "
-        f"{tabulated.TAB_PHI} phi_l (endpoints, [0, pi]) by Eq. 4's GL quadrature at order {tabulated.TAB_ORDER}, "
-        "Catmull-Rom interpolated (lutbake.ltc.tabulated)"
-    }
-
-
-def fit_error_stats(data: np.ndarray) -> dict[str, str]:
-    """The lutbake:fit_error_* attributes: statistics of slice 1's z channel (relative L3 error per texel)."""
-    e = np.asarray(data)[1, ..., 2].ravel()
-    return {
-        "fit_error_max": f"{e.max():.4g}",
-        "fit_error_median": f"{np.median(e):.4g}",
-        "fit_error_p95": f"{np.quantile(e, 0.95):.4g}",
-        "fit_error": json.dumps(
-            {
-                "metric": "(E / ∫ f^3 dω)^(1/3), E = ∫ |f (n.l) - magnitude D_ltc|^3 dω by MIS "
-                "over the lobe's and the LTC's N x N stratified samples (Heitz et al. 2016, "
-                "ltc_code computeError)",
-                "max": float(e.max()),
-                "median": float(np.median(e)),
-                "p95": float(np.quantile(e, 0.95)),
-                "mean": float(e.mean()),
-            }
-        ),
-    }
-
-
 def plan(spec) -> TexelPlan:
-    from ..ltc import fit
     from ..ltc.lobes import LOBES
 
     o = spec.options
@@ -479,30 +190,8 @@ def plan(spec) -> TexelPlan:
         else "none (fresnel channel = magnitude)",
         "layout": "ltc_code (selfshadow/ltc_code fit/fitLTC.cpp packTab)",
     }
-    q_text = "log(1 / a), b" if lb.normal_frame else "log m11, log m22, m13/m11" + (", d" if lb.free_frame else "")
     extra = {
-        "ltc_fit": json.dumps(
-            {
-                "parametrisation": NORMAL_FRAME
-                if lb.normal_frame
-                else "M = [X Y Z] [[m11, 0, m13], [0, m22, 0], [0, 0, 1]], Z = lobe's average direction"
-                + (FREE_FRAME if lb.free_frame else " (ltc_code's 3 parameters)"),
-                "metric": "Heitz et al. 2016 L3 distance, MIS over lobe and LTC samples (ltc_code computeError)",
-                "fit_samples": f"{o['fit_samples']} x {o['fit_samples']} per technique",
-                "optimiser": f"Nelder-Mead (ltc_code nelder_mead.h), tol {fit.NELDER_MEAD_TOL}, "
-                f"<= {fit.NELDER_MEAD_ITERS} iterations per restart, simplex sizes {list(fit.COARSE_STEPS)} "
-                f"(coarse pass), {list(fit.FINE_STEPS)} (texels) in ({q_text})",
-                "seeding": f"coarse pass on {fit.COARSE_NODES}^2 texels from analytic guesses, at the lobe's alpha "
-                f"(>= {ALPHA_MIN:g}, unclamped by alpha_min); each texel starts "
-                "from the best of the analytic guesses and the surrounding coarse fits (no chaining)",
-                "alpha_min": o["alpha_min"],
-                "theta_max": THETA_MAX,
-                "magnitude": magnitude_record(lb, o["estimator"], m_samples),
-                **shaded_record(o),
-                "roughness_axis": ROUGHNESS_AXES[lb.roughness],
-                **tabulation_record(lb),
-            }
-        ),
+        "ltc_fit": fit_record(o, lb, m_samples, THETA_MAX),
         "ltc_texture_slices": "slice_0 = ltc_1 (inverse matrix), slice_1 = ltc_2 (magnitude, fresnel, fit_error, "
         "sphere)",
     }

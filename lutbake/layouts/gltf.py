@@ -119,6 +119,15 @@ SHEEN_ALBEDO_CLAMPED = sheen_layout(
 
 LAYOUTS = (CHARLIE, SHEEN_ALBEDO, CHARLIE_CLAMPED, SHEEN_ALBEDO_CLAMPED)
 VIEWER = "glTF-Sample-Viewer source/shaders/ibl_filtering.frag LUT(), assets/images"
+
+
+def viewer_sheen_table(preset: str, table: str, layout: str, size: int, loads: str, shader: str) -> EngineTable:
+    """A glTF Sample Viewer sheen table: kind dfg in ``layout``, size x size, alpha on the roughness axis, texel
+    centres, EXR."""
+    keys = {"size": [size, size], "roughness": "alpha", "layout": layout, "texel": "center", "format": "exr"}
+    return EngineTable("glTF Sample Viewer", preset, table, "dfg", layout, keys, VIEWER, loads, shader=shader)
+
+
 TABLES = (
     EngineTable(
         "glTF Sample Viewer",
@@ -142,26 +151,20 @@ TABLES = (
             "t = texture(u_GGXLUT, vec2(NdotV, r)).rg; k_S * t.r + t.g, k_S = F0 + (max(1 - r, F0) - F0) (1 - NdotV)^5"
         ),
     ),
-    EngineTable(
-        "glTF Sample Viewer",
+    viewer_sheen_table(
         "gltf-charlie",
         "lut_charlie",
-        "dfg",
         "charlie",
-        {"size": [128, 128], "roughness": "alpha", "layout": "charlie", "texel": "center", "format": "exr"},
-        VIEWER,
+        128,
         "assets/images/lut_charlie.png (the viewer's own is 8-bit; the integral exceeds 1: EXR)",
-        shader="texture(u_CharlieLUT, vec2(NdotV, sheenRoughness)).b",
+        "texture(u_CharlieLUT, vec2(NdotV, sheenRoughness)).b",
     ),
-    EngineTable(
-        "glTF Sample Viewer",
+    viewer_sheen_table(
         "gltf-sheen-e",
         "lut_sheen_E",
-        "dfg",
         "sheen_albedo",
-        {"size": [64, 64], "roughness": "alpha", "layout": "sheen_albedo", "texel": "center", "format": "exr"},
-        VIEWER,
+        64,
         "assets/images/lut_sheen_E.png (the sheen albedo scaling)",
-        shader="texture(u_SheenELUT, vec2(NdotV, sheenRoughness)).r",
+        "texture(u_SheenELUT, vec2(NdotV, sheenRoughness)).r",
     ),
 )

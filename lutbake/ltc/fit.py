@@ -460,7 +460,7 @@ def refine(
     return q, f
 
 
-# the ltc kind's per-texel fits (lutbake.kinds.ltc.LtcBake), shared by every table a process bakes: a texel's fit is a
+# the ltc kind's per-texel fits (lutbake.ltc.table.LtcBake), shared by every table a process bakes: a texel's fit is a
 # pure function of its own inputs (lobe, metric grid, device, n.v, alpha, magnitude) and its candidate starts
 # (texel_keys), so two tables that fit a texel with equal inputs and candidates get the same bits; the memo fits it
 # once (the ltc-hdrp preset, alpha_min 1e-3, differs from ltc-ggx only in the columns whose clamped alpha or coarse

@@ -226,7 +226,7 @@ class Lobe:
     sample: object
     pdf: object
     f_pdf: object  # (f_cos, pdf) at once, sharing the terms both need
-    magnitude: str  # how the magnitude / Fresnel channels are integrated (lutbake.kinds.ltc)
+    magnitude: str  # how the magnitude / Fresnel channels are integrated (lutbake.ltc.magnitude)
     roughness: str  # "perceptual": x = r, alpha = r^2; "alpha": x = alpha; "sigma": x = sigma, GGX alpha = sigma;
     # "diffuse_roughness": x = the model's own roughness (EON's r), passed to the lobe as its parameter; "none"
     tabulate: object = None  # host (v (n, 3), alpha (n,), device, workers) -> per-texel table, or None (closed form)

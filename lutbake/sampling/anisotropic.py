@@ -24,8 +24,9 @@ from ..runtime.warp_runtime import load_module, unique_kernel
 from ..terms import ndf
 from ..terms.frame import reflect
 from . import points
-from .arrays import Points2, Rows64
-from .hemisphere import PRODUCT_NOTE, AdaptiveGaussLegendre, gl_launch, store_row
+from .arrays import Points2, Rows64, store_row
+from .hemisphere import PRODUCT_NOTE, AdaptiveGaussLegendre
+from .hemisphere_kernels import gl_launch
 
 DEFAULT_SAMPLES = 16384
 

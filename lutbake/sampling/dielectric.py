@@ -51,28 +51,14 @@ import warp as wp
 
 from ..runtime.warp_runtime import unique_kernel
 from . import points
-from .arrays import Levels, Rows64, Rule
+from .arrays import Levels, Rows64, Rule, store_row
+from .facet_rules import OuterNode, facet_rules_for, members_of, outer_variable_for
 from .groups import group_rows, key_of, siblings_by_key
-from .hemisphere import (
-    PANEL_RATIO,
-    PEAK_MERGE,
-    PI64,
-    TERMS_ROUNDING,
-    GaussLegendre,
-    OuterNode,
-    _texels,
-    asinh64,
-    facet_rules_for,
-    gl_levels,
-    load,
-    members_of,
-    next_geometric,
-    outer_variable_for,
-    phi_b,
-    store_row,
-    texel_view,
-)
+from .hemisphere import GaussLegendre
+from .hemisphere_kernels import TERMS_ROUNDING, _texels, load
+from .horizon import PANEL_RATIO, PEAK_MERGE, PI64, asinh64, next_geometric, phi_b, texel_view
 from .ladder import greedy_ladder_for
+from .rules import gl_levels
 
 ZERO64 = wp.constant(wp.float64(0.0))
 ONE64 = wp.constant(wp.float64(1.0))
@@ -97,7 +83,7 @@ def next_theta_dielectric(
     (theta_a R^j below pi/4; pi/2 - (pi/2 - t_lo)/R up to theta_b), the kinks and the NDF-peak points
     theta_peak R^j; a peak point within a factor ``merge`` of the next other candidate or of t_lo is skipped (D is
     analytic there: a scale, not a kink; PEAK_MERGE to a tolerance, 1 at the fixed order, as
-    lutbake.sampling.hemisphere.next_theta)."""
+    lutbake.sampling.horizon.next_theta)."""
     quarter = PI64 * wp.float64(0.25)
     half = PI64 * wp.float64(0.5)
     tiny = wp.float64(1.0e-12) * (wp.float64(1.0) + t_lo)
@@ -227,7 +213,7 @@ def panel_rule_for(spec, members: int = 0):
     """``(panel_add, panel_sum)``: ``panel_add(x, j, rules, off, n, acc)`` adds the n x n product rule
     (rules[off : off + n] in both variables) over outer panel j of texel x to ``acc``, node by node (module
     docstring); ``panel_sum(x, j, rules, off, n)``: the same from 0 (the panel rule of lutbake.sampling.ladder).
-    ``members`` > 0: acc is a lutbake.sampling.hemisphere.members_of record, every member's eta on x's panels."""
+    ``members`` > 0: acc is a lutbake.sampling.facet_rules.members_of record, every member's eta on x's panels."""
     acc_type = spec.acc if members == 0 else members_of(spec.acc._length_, members)
     d = spec.distribution
     outer_range, outer_node = outer_variable_for(d.tan2_from_u, d.u_from_tan2)
@@ -398,8 +384,8 @@ def make_adaptive_dielectric(spec):
     """The kernel to a tolerance: the outer panels of the fixed-order kernel (with the peak merge) up the GL orders
     ``levels``, refined greedily (lutbake.sampling.ladder.greedy_ladder_for) until, per channel c, the estimate
     err = sum over panels of |Q_(k) - Q_(k-1)| / pi + TERMS_ROUNDING |I_c| (float32 terms, as
-    lutbake.sampling.hemisphere.make_gauss_legendre) is within max(tol_abs[c], tol_rel[c] |I_c|). Inputs: texel,
-    rules, levels (lutbake.sampling.hemisphere.gl_levels), tol_abs, tol_rel (vec3d: per kernel channel), out, err."""
+    lutbake.sampling.hemisphere_kernels.make_gauss_legendre) is within max(tol_abs[c], tol_rel[c] |I_c|). Inputs: texel,
+    rules, levels (lutbake.sampling.rules.gl_levels), tol_abs, tol_rel (vec3d: per kernel channel), out, err."""
     integrate = greedy_ladder_for(panel_rule_for(spec)[1], MAX_PANELS, spec.acc._length_)[0]
     store_texel = texel_store_for(spec)
 
@@ -451,7 +437,7 @@ def make_adaptive_members(spec):
     """make_adaptive_dielectric for groups of up to MEMBERS texels that differ only in eta >= 1: their outer panels
     and phi-breakpoints depend on (n.v, alpha) alone (module docstring: the TIR and refraction-horizon cuts exist for
     eta < 1 only), so one pass over the nodes of the first two levels serves every member (the facet, v.h, D, the
-    weights: lutbake.sampling.hemisphere.facet_rules_for with ``members``), each member's sums taking the same float
+    weights: lutbake.sampling.facet_rules.facet_rules_for with ``members``), each member's sums taking the same float
     operations in the same order as its own kernel's; each member then climbs alone (lutbake.sampling.ladder's climb).
     The same bits as make_adaptive_dielectric. Inputs: texel, groups (rows of texel indices, -1 padded), rules, levels,
     tol_abs, tol_rel, first (scratch: (groups x MEMBERS, MAX_PANELS, 2, channels) float64), out, err."""

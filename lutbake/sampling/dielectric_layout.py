@@ -6,25 +6,27 @@ by the triangle inequality), to the tolerance that format / dtype set (lutbake.t
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..tolerance import tolerance_of
 
-DEFAULT_SAMPLES = {"gauss_legendre": 3 * 12**2, "sobol_vndf": 1 << 14, "sobol_ndf": 1 << 16, "hammersley_ndf": 1 << 16}
+# the glass kinds' budgets per estimator (lutbake.sampling.hemisphere.estimator_for takes them)
+GLASS_SAMPLES = {"gauss_legendre": 3 * 12**2, "sobol_vndf": 1 << 14, "sobol_ndf": 1 << 16, "hammersley_ndf": 1 << 16}
 
 
-def estimator_for(name: str, samples: int | None = None, seed: int = 0, merged: bool = False, members: bool = True):
-    """The dielectric kinds' estimator ``name``: the panelled Gauss-Legendre of lutbake.sampling.dielectric
-    (``merged``: its NDF-peak breakpoints merged; ``members``: texels that differ only in eta >= 1 in groups), or a
-    QMC estimator of lutbake.sampling.hemisphere (the same half-vector measure)."""
+def estimator_of(name: str, samples: int | None = None, seed: int = 0, merged: bool = False, members: bool = True):
+    """The dielectric kinds' estimator ``name`` (lutbake.sampling.hemisphere.estimator_for at GLASS_SAMPLES): the
+    panelled Gauss-Legendre of lutbake.sampling.dielectric (``merged``: its NDF-peak breakpoints merged; ``members``:
+    texels that differ only in eta >= 1 in groups), or a QMC estimator of lutbake.sampling.hemisphere (the same
+    half-vector measure)."""
     from .dielectric import DielectricGaussLegendre
-    from .hemisphere import QuasiMonteCarlo
+    from .hemisphere import estimator_for
 
-    if name == "gauss_legendre":
-        return DielectricGaussLegendre(samples or DEFAULT_SAMPLES[name], merged=merged, members=members)
-    return QuasiMonteCarlo(name, samples or DEFAULT_SAMPLES[name], seed)
+    glass = functools.partial(DielectricGaussLegendre, merged=merged, members=members)
+    return estimator_for(name, samples, seed, defaults=GLASS_SAMPLES, gauss_legendre=glass)
 
 
 def kernel_tolerance(layout, tol) -> tuple[tuple[float, ...], tuple[float, ...]]:
@@ -80,7 +82,7 @@ class LayoutChannelsAdaptive(LayoutChannels):
 
 def layout_estimator(o: dict, layout, members: bool = True):
     """The estimator of a ``dielectric`` spec's options ``o`` in ``layout``: to its tolerance (lutbake.tolerance) when
-    ``samples`` is unset and the estimator is gauss_legendre, else estimator_for at ``samples``, through the layout's
+    ``samples`` is unset and the estimator is gauss_legendre, else estimator_of at ``samples``, through the layout's
     channels (``members``: the grid has texels that differ only in eta >= 1, which the gauss_legendre kernels take in
     groups)."""
     if o["estimator"] == "gauss_legendre" and o["samples"] is None:
@@ -89,4 +91,4 @@ def layout_estimator(o: dict, layout, members: bool = True):
         tol = tolerance_of(o)
         inner = DielectricAdaptive(*kernel_tolerance(layout, tol), members=members)
         return LayoutChannelsAdaptive(inner, layout, tol.absolute, tol.relative)
-    return LayoutChannels(estimator_for(o["estimator"], o["samples"], o["seed"], members=members), layout)
+    return LayoutChannels(estimator_of(o["estimator"], o["samples"], o["seed"], members=members), layout)

@@ -35,7 +35,7 @@ from .facets import (
     fd_microfacet_adaptive_for,
     fd_microfacet_sobol_for,
 )
-from .hemisphere import gl_levels
+from .rules import gl_levels
 
 PI64 = wp.constant(wp.float64(math.pi))
 REFINE_ORDER = 8  # the error estimates re-evaluate probe texels with every GL order + 8

@@ -418,7 +418,7 @@ MAX_U_PANELS = 3 * (MAX_TAIL_CUTS + 1)  # slots of u_panel: geometric panels x 3
 # estimate adds twice that
 FACET_ROUNDING = wp.constant(wp.float64(5.0e-7))
 QUADRATURE_SHARE = wp.constant(wp.float64(0.9))  # of the tolerance; the rest is left to FACET_ROUNDING
-# the orders of the ladder: from 6 (6 -> 8 or 6 -> 9, as lutbake.sampling.hemisphere.ADAPTIVE_ORDERS) two coarse rules
+# the orders of the ladder: from 6 (6 -> 8 or 6 -> 9, as lutbake.sampling.rules.ADAPTIVE_ORDERS) two coarse rules
 # agreed by coincidence on 1 % of the 16 x 32^3 btf's texels (measured: error 4.3e-5 at an estimate 8e-6); from 8
 # every estimate bounds the error against the numpy reference (tests/test_btf_tolerance.py)
 FACET_ORDERS = (8, 12, 16, 24, 32, 48, 64)

@@ -1,9 +1,9 @@
 """A texel's integral over panels, each up a ladder of Gauss-Legendre orders, refined greedily to a tolerance.
 
 The orders are ``levels`` (offset, order) into ``rules`` (the concatenated GL rules of
-lutbake.sampling.hemisphere.gl_levels). Every panel is integrated at the first two orders; a panel's value is its
+lutbake.sampling.rules.gl_levels). Every panel is integrated at the first two orders; a panel's value is its
 finer one, Q_(k), and its error estimate d = |Q_(k) - Q_(k-1)| is the error of the coarser one: with exponential
-convergence a bound of Q_(k)'s (the argument of lutbake.sampling.hemisphere.make_gauss_legendre). Then, while a
+convergence a bound of Q_(k)'s (the argument of lutbake.sampling.hemisphere_kernels.make_gauss_legendre). Then, while a
 channel's estimate sum_p d_p exceeds its target, that channel's panel with the largest d goes one order up (a panel at
 the last order stays; of several channels over their targets, the one furthest over). Against a fixed per-panel share
 of the tolerance, the texel's error budget goes where the error is: panels far below the tolerance stop at the second

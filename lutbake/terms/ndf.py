@@ -336,7 +336,7 @@ def D_charlie(h: wp.vec3, alpha: float):
 def D_charlie_sin2(sin2: wp.float64, alpha: float):
     """D_charlie from sin^2(theta_h) in float64: (2 + 1/alpha) sin2^(1/(2 alpha)) / (2 pi), the power taken in float64.
     The power multiplies sin2's relative rounding by 1 / (2 alpha): from a float32 h (D_charlie) 6e-8 becomes 3e-4
-    at alpha = 1e-4, from the quadrature node's float64 angles ~1e-12 (lutbake.sampling.hemisphere.facet_rules_for).
+    at alpha = 1e-4, from the quadrature node's float64 angles ~1e-12 (lutbake.sampling.facet_rules.facet_rules_for).
     The caller checks n.h > 0; sin2 in [0, 1]."""
     inv = wp.float64(1.0) / wp.float64(alpha)
     half = wp.float64(0.5)

@@ -2,14 +2,12 @@
 diffuse model (sigma = 0 limit, reciprocity, albedo <= 1).
 
 Each check returns a :class:`CheckResult` (measured error, tolerance, pass/fail, a one-line detail).
-``CHECKS`` maps every check name to a zero-argument callable; ``run_all()`` runs them all.
+``TABLE`` lists every check as a :class:`Check` record (name, zero-argument callable), lutbake.validate.dielectric's
+among them; ``CHECKS`` maps the names to the callables; ``run_all()`` runs them all.
 Parametrised checks carry their parameters in the name: ``weak_white_furnace[ggx]``.
 
-The host-side quadratures here are deliberately NOT the estimators of :mod:`lutbake.sampling`: they are
-composite Gauss-Legendre rules in plain spherical coordinates (no importance sampling, no change of
-variables), with panels graded geometrically towards every point where the integrand changes scale
-(the NDF peak) or loses smoothness (a cut where v.m = 0), and the term values come from the Warp
-``@wp.func``s themselves (:mod:`.probe`).
+The host-side quadratures are lutbake.validate.quadrature's (not the estimators of :mod:`lutbake.sampling`);
+the term values come from the Warp ``@wp.func``s themselves (:mod:`.probe`).
 """
 
 from __future__ import annotations
@@ -22,8 +20,10 @@ from ..edge import ALPHA_MIN, NOV_MIN
 from ..integrands.specular import hemisphere_integral
 from ..sampling import points
 from ..terms.distributions import NDFS
+from . import dielectric
 from .probe import BRDF_PAIRS, evaluate_brdfs, evaluate_terms
-from .results import CheckResult, check_result
+from .quadrature import CUT_FIRST_PANEL, GL_NODES, composite_gl, direction, graded_edges, sphere_quadrature
+from .results import Check, CheckResult, check_result
 
 # Tolerances (absolute unless said otherwise). The terms run in float32: ~1e-7 is the floor.
 PROJECTED_AREA_TOL = 1.0e-6  # |∫ D(m)(n.m) dω_m - 1|
@@ -81,44 +81,6 @@ ESTIMATOR_TEXELS = ((0.1, 0.04), (0.3, 1.0), (0.5, 0.25), (0.9, 0.64), (1.0, 0.0
 ESTIMATOR_QMC_SAMPLES = 1 << 16
 SEED = 20240607
 
-GL_NODES = 16  # Gauss-Legendre nodes per panel
-PANEL_RATIO = 2.0  # geometric panel growth away from an anchor
-CUT_FIRST_PANEL = 1.0e-6  # first panel width next to a cut (rad)
-
-
-# --- quadrature helpers --------------------------------------------------------------------------
-
-
-def _graded_edges(lo: float, hi: float, anchors: list[tuple[float, float]]) -> np.ndarray:
-    """Panel edges on [lo, hi]: the ends, every anchor a, and a +- first * PANEL_RATIO^j inside [lo, hi]
-    for each (a, first) in ``anchors``."""
-    pts = [lo, hi]
-    for a, first in anchors:
-        if not lo <= a <= hi:
-            continue
-        pts.append(a)
-        d = first
-        while d < hi - lo:
-            pts += [a - d, a + d]
-            d *= PANEL_RATIO
-    return np.unique(np.clip(np.asarray(pts, dtype=np.float64), lo, hi))
-
-
-def _composite_gl(edges: np.ndarray, n: int = GL_NODES) -> tuple[np.ndarray, np.ndarray]:
-    """Composite n-point Gauss-Legendre on the panels between ``edges`` -> (nodes, weights)."""
-    x, w = points.gauss_legendre(n)
-    a, b = edges[:-1], edges[1:]
-    return (a[:, None] + (b - a)[:, None] * x).ravel(), ((b - a)[:, None] * w).ravel()
-
-
-def _h(theta: np.ndarray, phi: np.ndarray | float = 0.0) -> np.ndarray:
-    st = np.sin(theta)
-    xyz = st * np.cos(phi), st * np.sin(phi), np.cos(theta)
-    h = np.empty(np.broadcast_shapes(*(np.shape(c) for c in xyz)) + (3,), np.result_type(*xyz))
-    h[..., 0], h[..., 1], h[..., 2] = xyz
-    return h
-
-
 # --- NDF normalisation -----------------------------------------------------------------------------
 
 
@@ -134,8 +96,8 @@ def _projected_area(term: str, grade_at) -> tuple[float, str]:
     panels graded towards grade_at(alpha) = (point, scale); and the check's detail line."""
     errors = []
     for alpha in PROJECTED_AREA_ALPHAS:
-        theta, w = _composite_gl(_graded_edges(0.0, np.pi / 2, [grade_at(alpha)]))
-        D = evaluate_terms(h=_h(theta), alpha=alpha, names=[term])[term].astype(np.float64)
+        theta, w = composite_gl(graded_edges(0.0, np.pi / 2, [grade_at(alpha)]))
+        D = evaluate_terms(h=direction(theta), alpha=alpha, names=[term])[term].astype(np.float64)
         errors.append(abs(2.0 * np.pi * np.sum(w * D * np.cos(theta) * np.sin(theta)) - 1.0))
     k = int(np.argmax(errors))
     where = f"worst at alpha={PROJECTED_AREA_ALPHAS[k]}"
@@ -164,15 +126,15 @@ def weak_white_furnace(ndf_name: str) -> CheckResult:
         sin_v = np.sqrt(max(1.0 - nov * nov, 0.0))
         theta_c = np.pi / 2 - np.arccos(nov)
         for alpha in FURNACE_ALPHAS:
-            edges = _graded_edges(0.0, np.pi / 2, [(0.0, np.arctan(alpha) / 16.0), (theta_c, CUT_FIRST_PANEL)])
-            theta, wt = _composite_gl(edges)
+            edges = graded_edges(0.0, np.pi / 2, [(0.0, np.arctan(alpha) / 16.0), (theta_c, CUT_FIRST_PANEL)])
+            theta, wt = composite_gl(edges)
             with np.errstate(divide="ignore"):
                 c = np.where(theta < theta_c, -1.0, -nov / max(sin_v, 1e-300) / np.tan(theta))
             phimax = np.arccos(np.clip(c, -1.0, 1.0))
             s, ws = points.gauss_legendre(GL_NODES)
             phi = phimax[:, None] * s
             wphi = phimax[:, None] * ws
-            h = _h(theta[:, None], phi)
+            h = direction(theta[:, None], phi)
             terms = evaluate_terms(h=h, alpha=alpha, nov=nov, names=[f"D_{ndf_name}", f"G1_smith_{ndf_name}"])
             D = terms[f"D_{ndf_name}"].astype(np.float64)
             G1 = float(terms[f"G1_smith_{ndf_name}"].ravel()[0])
@@ -199,23 +161,14 @@ def _aniso_pairs(alphas=PROJECTED_AREA_ALPHAS) -> list[tuple[float, float, float
     return out
 
 
-def _sphere_quadrature(scale: float, theta_cut: float | None = None, horizon: bool = False):
-    """Composite GL nodes in theta on [0, pi/2] graded from the pole at ``scale``, about a cut start if given,
-    and towards the horizon if ``horizon`` (where (n.h)^e with a non-integer e is not analytic)."""
-    anchors = [(0.0, np.arctan(scale) / 16.0)] + ([(np.pi / 2, CUT_FIRST_PANEL)] if horizon else [])
-    if theta_cut is not None:
-        anchors.append((theta_cut, CUT_FIRST_PANEL))
-    return _composite_gl(_graded_edges(0.0, np.pi / 2, anchors))
-
-
 def _aniso_measure(term: str, weight, horizon: bool = False) -> tuple[float, tuple]:
     """max over _aniso_pairs of |2D integral of term(m) weight(theta) over the hemisphere - 1|; the azimuth on
     [0, pi/2] (the lobes are symmetric in x and y) graded from both ends, times 4."""
     errors, where = [], []
-    phi, wphi = _composite_gl(_graded_edges(0.0, np.pi / 2, [(0.0, 1.0e-3), (np.pi / 2, 1.0e-3)]))
+    phi, wphi = composite_gl(graded_edges(0.0, np.pi / 2, [(0.0, 1.0e-3), (np.pi / 2, 1.0e-3)]))
     for alpha, a, ax, ay in _aniso_pairs():
-        theta, wt = _sphere_quadrature(min(ax, ay), horizon=horizon)
-        h = _h(theta[:, None], phi[None, :])
+        theta, wt = sphere_quadrature(min(ax, ay), horizon=horizon)
+        h = direction(theta[:, None], phi[None, :])
         D = evaluate_terms(h=h, alpha=ax, alpha_y=ay, names=[term])[term].astype(np.float64)
         val = 4.0 * np.sum((wt * weight(theta))[:, None] * wphi[None, :] * D)
         errors.append(abs(val - 1.0))
@@ -259,19 +212,19 @@ def weak_white_furnace_aniso() -> CheckResult:
     azimuths are |psi| < acos(c) (all of them below theta = pi/2 - theta_v); composite GL in theta (graded
     from the pole and about the cut start) times ANISO_PHI_PANELS equal GL panels in psi over the exact interval."""
     errors, where = [], []
-    s, ws = _composite_gl(np.linspace(-1.0, 1.0, ANISO_PHI_PANELS + 1))
+    s, ws = composite_gl(np.linspace(-1.0, 1.0, ANISO_PHI_PANELS + 1))
     for alpha, a, ax, ay in _aniso_pairs(ANISO_FURNACE_ALPHAS):
         for nov in ANISO_FURNACE_NOVS:
             sin_v = np.sqrt(max(1.0 - nov * nov, 0.0))
             theta_c = np.pi / 2 - np.arccos(nov)
-            theta, wt = _sphere_quadrature(min(ax, ay), theta_c)
+            theta, wt = sphere_quadrature(min(ax, ay), theta_c)
             with np.errstate(divide="ignore"):
                 c = np.where(theta < theta_c, -1.0, -nov / max(sin_v, 1e-300) / np.tan(theta))
             psimax = np.arccos(np.clip(c, -1.0, 1.0))
             for phi_v in ANISO_FURNACE_PHIS:
                 v = np.array([sin_v * np.cos(phi_v), sin_v * np.sin(phi_v), nov])
                 psi = psimax[:, None] * s[None, :]
-                h = _h(theta[:, None], phi_v + psi)
+                h = direction(theta[:, None], phi_v + psi)
                 D = evaluate_terms(h=h, alpha=ax, alpha_y=ay, names=["D_ggx_aniso"])["D_ggx_aniso"].astype(np.float64)
                 lam = float(evaluate_terms(v=v, alpha=ax, alpha_y=ay, names=["Lambda_ggx_aniso"])["Lambda_ggx_aniso"])
                 vom = np.maximum(h.astype(np.float32).astype(np.float64) @ v, 0.0)
@@ -586,8 +539,9 @@ def eon_albedo_is_one() -> CheckResult:
 
 def ltc_eon_r0_is_identity() -> CheckResult:
     """EON at r = 0 is Lambert: its LTC fit (lutbake.ltc.fit, the kind's seeding) is the identity at every view."""
-    from ..kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
+    from ..kinds.ltc import axes_for
     from ..ltc import fit
+    from ..ltc.magnitude import magnitude_alpha, magnitude_fresnel, texel_params
 
     axes = axes_for({"lobe": "eon", "size": [6, 6]})
     nov, r = texel_params(axes)
@@ -620,44 +574,37 @@ def ltc_area_benchmark_median() -> CheckResult:
     )
 
 
-# --- registry ------------------------------------------------------------------------------------------
+# --- the checks, in the order lutbake validate runs them ---------------------------------------------------------
 
 
-def _registry() -> dict:
-    checks = {}
-    for n in NDFS:
-        checks[f"ndf_projected_area_is_one[{n}]"] = functools.partial(ndf_projected_area_is_one, n)
-    checks["ndf_projected_area_is_one[ggx_aniso]"] = ndf_projected_area_is_one_aniso
-    checks["ndf_projected_area_is_one[charlie]"] = charlie_projected_area_is_one
-    checks["ashikhmin_shirley_density_is_one"] = ashikhmin_shirley_density_is_one
-    for n in SMITH_NDFS:
-        checks[f"weak_white_furnace[{n}]"] = functools.partial(weak_white_furnace, n)
-    checks["weak_white_furnace[ggx_aniso]"] = weak_white_furnace_aniso
-    for n in SMITH_NDFS:
-        for m in ALBEDO_MASKINGS:
-            checks[f"albedo_le_one_and_mirror_limit[{n},{m}]"] = functools.partial(albedo_le_one_and_mirror_limit, n, m)
-    for n, m in DFG_MIRROR_PAIRS:
-        checks[f"dfg_mirror_limit[{n},{m}]"] = functools.partial(dfg_mirror_limit, n, m)
-    for n, m in BRDF_PAIRS:
-        checks[f"reciprocity[{n},{m}]"] = functools.partial(reciprocity, n, m)
-    checks["fresnel_eq2_is_exact_dielectric"] = fresnel_eq2_is_exact_dielectric
-    checks["schlick_endpoints"] = schlick_endpoints
-    checks["estimators_agree"] = estimators_agree
-    checks["kulla_conty_white_furnace"] = kulla_conty_white_furnace
-    checks["diffuse_sigma0_is_lambert_eq6"] = diffuse_sigma0_is_lambert_eq6
-    checks["diffuse_reciprocity"] = diffuse_reciprocity
-    checks["diffuse_albedo_le_one"] = diffuse_albedo_le_one
-    from . import dielectric  # the rough dielectric BSDF's checks (imports _result from here)
-
-    checks.update(dielectric.CHECKS)
-    checks["ltc_sphere_table_is_snyder"] = ltc_sphere_table_is_snyder
-    checks["eon_albedo_is_one"] = eon_albedo_is_one
-    checks["ltc_eon_r0_is_identity"] = ltc_eon_r0_is_identity
-    checks["ltc_area_benchmark_median"] = ltc_area_benchmark_median
-    return checks
-
-
-CHECKS: dict = _registry()
+TABLE: tuple[Check, ...] = (
+    *(Check(f"ndf_projected_area_is_one[{n}]", functools.partial(ndf_projected_area_is_one, n)) for n in NDFS),
+    Check("ndf_projected_area_is_one[ggx_aniso]", ndf_projected_area_is_one_aniso),
+    Check("ndf_projected_area_is_one[charlie]", charlie_projected_area_is_one),
+    Check("ashikhmin_shirley_density_is_one", ashikhmin_shirley_density_is_one),
+    *(Check(f"weak_white_furnace[{n}]", functools.partial(weak_white_furnace, n)) for n in SMITH_NDFS),
+    Check("weak_white_furnace[ggx_aniso]", weak_white_furnace_aniso),
+    *(
+        Check(f"albedo_le_one_and_mirror_limit[{n},{m}]", functools.partial(albedo_le_one_and_mirror_limit, n, m))
+        for n in SMITH_NDFS
+        for m in ALBEDO_MASKINGS
+    ),
+    *(Check(f"dfg_mirror_limit[{n},{m}]", functools.partial(dfg_mirror_limit, n, m)) for n, m in DFG_MIRROR_PAIRS),
+    *(Check(f"reciprocity[{n},{m}]", functools.partial(reciprocity, n, m)) for n, m in BRDF_PAIRS),
+    Check("fresnel_eq2_is_exact_dielectric", fresnel_eq2_is_exact_dielectric),
+    Check("schlick_endpoints", schlick_endpoints),
+    Check("estimators_agree", estimators_agree),
+    Check("kulla_conty_white_furnace", kulla_conty_white_furnace),
+    Check("diffuse_sigma0_is_lambert_eq6", diffuse_sigma0_is_lambert_eq6),
+    Check("diffuse_reciprocity", diffuse_reciprocity),
+    Check("diffuse_albedo_le_one", diffuse_albedo_le_one),
+    *dielectric.TABLE,  # the rough dielectric BSDF's checks
+    Check("ltc_sphere_table_is_snyder", ltc_sphere_table_is_snyder),
+    Check("eon_albedo_is_one", eon_albedo_is_one),
+    Check("ltc_eon_r0_is_identity", ltc_eon_r0_is_identity),
+    Check("ltc_area_benchmark_median", ltc_area_benchmark_median),
+)
+CHECKS: dict = {c.name: c.run for c in TABLE}  # name -> the check's zero-argument callable
 
 
 def run_all(names=None) -> list[CheckResult]:

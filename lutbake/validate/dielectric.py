@@ -31,7 +31,7 @@ from ..terms import dielectric as td
 from ..terms import fresnel
 from ..terms.distributions import NDFS
 from ..terms.frame import reflect
-from .results import check_result
+from .results import Check, check_result
 
 SMOOTH_LIMIT_TOL = 2.0e-5  # |E_R - F|, |E_T - (1 - F)| at alpha = ALPHA_MIN, |mu - cos theta_c| >= SMOOTH_KINK_GAP
 SMOOTH_KINK_GAP = 0.02
@@ -318,11 +318,11 @@ def openpbr_reflection_ratio_reciprocity():
     )
 
 
-CHECKS = {
-    "dielectric_smooth_limit": dielectric_smooth_limit,
-    "dielectric_index_matched": dielectric_index_matched,
-    "dielectric_reciprocity": dielectric_reciprocity,
-    "dielectric_energy_le_one": dielectric_energy_le_one,
-    "dielectric_estimators_agree": dielectric_estimators_agree,
-    "openpbr_reflection_ratio_reciprocity": openpbr_reflection_ratio_reciprocity,
-}
+TABLE = (  # lutbake.validate.checks.TABLE lists them among its own
+    Check("dielectric_smooth_limit", dielectric_smooth_limit),
+    Check("dielectric_index_matched", dielectric_index_matched),
+    Check("dielectric_reciprocity", dielectric_reciprocity),
+    Check("dielectric_energy_le_one", dielectric_energy_le_one),
+    Check("dielectric_estimators_agree", dielectric_estimators_agree),
+    Check("openpbr_reflection_ratio_reciprocity", openpbr_reflection_ratio_reciprocity),
+)

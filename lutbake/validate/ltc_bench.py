@@ -214,8 +214,9 @@ def l3_texels(texels: list[tuple[int, int]], n: int = 64) -> tuple:
     """The L3 fit of ``texels`` of a GGX n x n table as the ``ltc`` kind fits them (its magnitude, its coarse pass
     and seeding): (problem, flat texel indices, packed ltc_1 (k, 4), magnitude (n^2,), fresnel (n^2,)), what
     fitted_texels refines (pass it as ``l3`` to refine one fit several ways)."""
-    from ..kinds.ltc import axes_for, magnitude_alpha, magnitude_fresnel, texel_params
+    from ..kinds.ltc import axes_for
     from ..ltc import fit
+    from ..ltc.magnitude import magnitude_alpha, magnitude_fresnel, texel_params
 
     axes = axes_for({"lobe": "ggx", "size": [n, n]})
     nov, alpha = texel_params(axes)

@@ -1,7 +1,9 @@
-"""The result of one analytic check (lutbake.validate.checks, lutbake.validate.dielectric) and the closing total."""
+"""The record of one analytic check (lutbake.validate.checks, lutbake.validate.dielectric), its result and the closing
+total."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,6 +41,15 @@ class CheckResult:
 
     def __str__(self) -> str:
         return "\n".join(self.lines())
+
+
+@dataclass(frozen=True)
+class Check:
+    """One entry of the checks' table (lutbake.validate.checks.TABLE): its name (parameters in brackets:
+    ``weak_white_furnace[ggx]``) and the zero-argument callable that measures it."""
+
+    name: str
+    run: Callable[[], CheckResult]
 
 
 def check_result(name: str, measured: float, tolerance: float, detail: str, notes: tuple[str, ...] = ()) -> CheckResult:
