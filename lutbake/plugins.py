@@ -310,14 +310,25 @@ def compile_records(records: list[Record]) -> None:
         try:
             wp.load_module(kernel.module, device="cpu")
         except Exception as e:
-            func = _first_function(record)
-            line = inspect.getsourcelines(func.func)[1] if func is not None else record.line
-            message = str(e).strip().splitlines()
+            line, why = _compile_error(record, e)
             raise PluginError(
-                record.plugin.path,
-                line,
-                f"{record.family} {record.name!r} does not compile: {message[-1] if message else type(e).__name__}",
+                record.plugin.path, line, f"{record.family} {record.name!r} does not compile: {why}"
             ) from None
+
+
+def _compile_error(record: Record, e: Exception) -> tuple[int | None, str]:
+    """(the plugin's line Warp's code generation failed at, its last words): Warp names each function it was
+    parsing as "at FILE:LINE", outermost first; the last in the plugin's file is the offending statement (else the
+    def of the record's first function)."""
+    text = str(e).strip().strip("'\"").replace("\\n", "\n")
+    lines = re.findall(re.escape(record.plugin.path) + r":(\d+)", text)
+    if lines:
+        line = int(lines[-1])
+    else:
+        func = _first_function(record)
+        line = inspect.getsourcelines(func.func)[1] + 1 if func is not None else record.line
+    why = text.split(";")[-1].strip().splitlines()
+    return line, (why[-1] if why else type(e).__name__)
 
 
 def _first_function(record: Record):

@@ -180,8 +180,8 @@ BAD_PLUGINS = {
     "compile": (
         "import warp as wp\nimport lutbake\n\n@wp.func\ndef F_bad(f0: float, c: float):\n    return f0 + nowhere\n\n"
         'lutbake.register_fresnel("bad", F_bad, description="mine", linear_in_f0=True)\n',
-        5,
-        "fresnel 'bad' does not compile",
+        6,
+        "fresnel 'bad' does not compile: Referencing undefined symbol: nowhere",
     ),
     "nothing": ("x = 1\n", None, "registers nothing"),
 }
