@@ -18,10 +18,10 @@ from types import MappingProxyType
 from typing import Any
 
 from . import arguments
+from .config_file import config_file_problem, nesting_problem
 from .errors import ArgumentError, ConfigError, did_you_mean
 from .kinds import KINDS, Key, lookup_kind
 from .limits import BAKE_PEAK_BYTES_PER_TEXEL, MAX_TEXELS  # noqa: F401  (lutbake.config.MAX_TEXELS, as before)
-from .preflight import config_file_problem, nesting_problem
 from .textsafe import safe_repr
 from .value_bounds import unit_range
 
@@ -32,7 +32,6 @@ NAME_RULE = "1-128 letters, digits, '-' or '_' (it names the output file)"
 WINDOWS_RESERVED = frozenset(
     ["CON", "PRN", "AUX", "NUL"] + [f"{port}{i}" for port in ("COM", "LPT") for i in range(10)]
 )
-BYTES_PER_TEXEL = 32  # float64 x 4 channels while baking
 MAX_LIST = 1024  # entries of a float_list key
 
 

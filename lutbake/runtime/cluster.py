@@ -54,8 +54,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..config import BYTES_PER_TEXEL, MAX_TEXELS
 from ..errors import ConfigError, LutbakeError
+from ..limits import BYTES_PER_TEXEL, MAX_TEXELS
 from ..textsafe import safe_repr
 from .worker import identity, identity_token, init_warp_quietly
 
