@@ -43,10 +43,11 @@ from .io.formats import output_path, write_table
 from .io.oserror import os_error_text
 from .kinds import lookup_kind
 from .pipeline import OVER_TOLERANCE, Computed, assemble, compute
-from .provenance import HASH_ATTRIBUTE, content_hash, read_header, sources_digest
+from .provenance import HASH_ATTRIBUTE, content_hash, read_header
 from .runtime.executor import Cancelled, Progress, default_workers
 from .runtime.warp_runtime import ModuleBusy, defer_if_busy
 from .sharing import group_by, values_key
+from .sources import sources_digest
 from .values_cache import ValuesCache, valid_extra
 
 # over_tolerance: written (baked now, or up to date from an earlier run), but texels ended over their tolerance

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from lutbake import batch, pipeline, provenance
+from lutbake import batch, pipeline, provenance, sources
 from lutbake.cli import main
 from lutbake.config import load_configs
 from lutbake.io.exr import read_exr
@@ -98,7 +98,7 @@ def test_content_hash_covers_config_version_and_kernel_sources(monkeypatch, tmp_
     assert provenance.content_hash(s, b"other sources") != h
     monkeypatch.setattr(provenance, "__version__", "9.9.9")
     assert provenance.content_hash(s) != h
-    rel = {f.relative_to(provenance.PACKAGE).as_posix() for f in provenance.source_files()}
+    rel = {f.relative_to(sources.PACKAGE).as_posix() for f in sources.source_files()}
     for f in (
         "terms/ndf.py",
         "terms/masking.py",
