@@ -21,8 +21,8 @@ from .kinds import lookup_kind
 from .layouts import reconstruction_with_engine_line
 from .provenance import attributes
 from .runtime.executor import Progress, Timer, estimate_error, execute_tiles
+from .runtime.plan import TexelPlan
 from .runtime.warp_runtime import defining
-from .sampling.plan import TexelPlan
 from .table import Table
 
 OVER_TOLERANCE = "over_tolerance"  # the lutbake:* attribute of a table whose texels end over their tolerance

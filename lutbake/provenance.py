@@ -49,7 +49,7 @@ def warp_version() -> str:
 
 
 def attributes(spec: TableSpec, plan, extra: dict[str, str] | None = None) -> dict[str, str]:
-    """The provenance of a table baked from ``spec`` by ``plan`` (lutbake.sampling.plan.TexelPlan)."""
+    """The provenance of a table baked from ``spec`` by ``plan`` (lutbake.runtime.plan.TexelPlan)."""
     return {
         "terms": json.dumps(plan.terms),
         "estimator": plan.estimator,

@@ -1,7 +1,8 @@
 """The source files that define what a table holds, and their digest: part of every content hash
 (lutbake.provenance) and of the identity a cluster worker must share with its client (lutbake.runtime.worker).
 
-``HASH_SOURCES``: terms, integrands, sampling, kinds, layouts, LTC fits, axes, edge policy, tolerances.
+``HASH_SOURCES``: terms, integrands, sampling, kinds, layouts, LTC fits, axes, edge policy, tolerances and the texel
+plan record.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ HASH_SOURCES = (
     "axes.py",
     "edge.py",
     "tolerance.py",
+    "runtime/plan.py",  # TexelPlan: a table's shape
 )
 
 

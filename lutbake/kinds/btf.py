@@ -23,7 +23,8 @@ import numpy as np
 from ..axes import TEXELS, Axis, sigma_alpha
 from ..catalog import DIFFUSE_MODELS, f0_factor
 from ..edge import effective_alpha
-from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..runtime.plan import TexelPlan
+from ..sampling.plan import Grid, per_texel_plan
 from ..tolerance import Tolerance, tolerance_of
 from . import diffuse
 from .base import Estimation, Key, declare

@@ -24,7 +24,8 @@ from ..catalog import DIELECTRIC_MASKINGS, HEMISPHERE_ESTIMATORS, MASKINGS, NDF_
 from ..edge import alpha_policy
 from ..layouts import exclusive_owner, layouts_of, lookup_layout, summaries
 from ..layouts.base import IOR_MAPPINGS, ior_axis, ior_values
-from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..runtime.plan import TexelPlan
+from ..sampling.plan import Grid, per_texel_plan
 from ..tolerance import tolerance_of
 from . import dfg
 from .base import Estimation, Key, declare

@@ -16,7 +16,8 @@ import numpy as np
 from ..axes import SIGMA_TO_ALPHA, TEXELS, Axis, sigma_alpha
 from ..catalog import DIFFUSE_MODELS, FACET_FRESNEL, f0_factor
 from ..edge import alpha_policy, effective_alpha
-from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..runtime.plan import TexelPlan
+from ..sampling.plan import Grid, per_texel_plan
 from .base import Estimation, Key, declare
 
 DEFAULT_ORDER = {"microfacet": 12}  # base GL order (lutbake.sampling.swapped); closed forms: CLOSED_ORDER

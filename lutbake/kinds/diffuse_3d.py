@@ -17,8 +17,9 @@ import numpy as np
 
 from ..axes import Axis
 from ..catalog import FACET_FRESNEL, f0_factor
+from ..runtime.plan import TexelPlan
 from ..sampling.groups import key_of, siblings_by_key
-from ..sampling.plan import TexelPlan, per_texel_plan
+from ..sampling.plan import per_texel_plan
 from . import diffuse
 from .base import Key, declare
 

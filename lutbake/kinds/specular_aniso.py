@@ -21,7 +21,8 @@ import numpy as np
 from ..axes import Axis
 from ..catalog import ANISO_ESTIMATORS, ANISO_LAYOUTS, ANISO_MODELS, AXES_FORMULA
 from ..edge import alpha_policy
-from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..runtime.plan import TexelPlan
+from ..sampling.plan import Grid, per_texel_plan
 from ..tolerance import tolerance_of
 from . import dfg
 from .base import Estimation, Key, declare

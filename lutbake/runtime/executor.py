@@ -16,9 +16,9 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from ..sampling.plan import TexelPlan
 from .devices import CPU_TILE_TEXELS as TILE_TEXELS
 from .devices import plan_tile_texels
+from .plan import TexelPlan
 from .warp_runtime import defining
 
 # progress(label, n_texels, cost) -> update(n_done_in_this_tile) or None: called once per table before its tiles run
@@ -55,7 +55,7 @@ def execute_tiles(
     runner=None,
 ) -> np.ndarray:
     """Evaluate every tile of ``plan``; returns float64 (n_texels, plan.tile_width): the values, then the aux
-    columns (lutbake.sampling.plan.TexelPlan.aux_channels).
+    columns (lutbake.runtime.plan.TexelPlan.aux_channels).
 
     ``progress``: a ``Progress`` factory; its update is called in the calling thread after each tile.
     ``cancel``: when set (by another thread), no further tile starts and Cancelled is raised.
