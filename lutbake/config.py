@@ -20,7 +20,7 @@ from typing import Any
 from . import arguments
 from .config_file import config_file_problem, nesting_problem
 from .errors import ArgumentError, ConfigError, did_you_mean
-from .kinds import KINDS, Key, lookup_kind
+from .kinds import KINDS, Key, Kind, lookup_kind
 from .limits import BAKE_PEAK_BYTES_PER_TEXEL, MAX_TEXELS  # noqa: F401  (lutbake.config.MAX_TEXELS, as before)
 from .textsafe import safe_repr
 from .value_bounds import unit_range
@@ -114,6 +114,13 @@ class TableSpec:
 
     def __reduce__(self):  # a mappingproxy does not pickle; lutbake.runtime.cluster ships specs to Dask workers
         return (_table_spec, (self.name, self.kind, dict(self.options), self.source, self.index))
+
+
+def kind_of(spec: TableSpec | str) -> Kind:
+    """The Kind record of ``spec`` (its ``kind`` resolved), or of a kind's name or alias as a user typed it
+    (``lutbake list keys``; KeyError lists the valid names): the one place outside lutbake.kinds a kind is looked up,
+    for every module above config that needs the record (its plan function, texel count, layout keys, keys)."""
+    return lookup_kind(spec if isinstance(spec, str) else spec.kind)
 
 
 def _table_spec(name: str, kind: str, options: dict, source: str, index: int) -> TableSpec:

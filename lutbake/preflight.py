@@ -266,13 +266,12 @@ def check_collisions(jobs) -> None:
 def check_outputs(jobs) -> None:
     """No two tables write one file (check_collisions). Every file a table writes (planned_files) must be a regular
     file or absent (a directory or device there fails the rename after the bake); a ``png16`` output must be a 2D
-    table (PNG has no depth: the table's shape comes from its plan, which runs no kernel)."""
-    from .kinds import lookup_kind
-
+    table (PNG has no depth: the table's shape comes from its plan, lutbake.batch.Job.plan, built once and baked
+    later; building it runs no kernel)."""
     check_collisions(jobs)
     for job in jobs:
         if job.status == "pending" and job.spec.options.get("format") == "png16":
-            shape = lookup_kind(job.spec.kind).plan(job.spec).shape
+            shape = job.plan().shape
             if len(shape) > 3:
                 raise ConfigError(
                     job.spec.source,

@@ -20,15 +20,14 @@ from __future__ import annotations
 import hashlib
 
 from . import __version__
-from .config import TableSpec
-from .kinds import lookup_kind
+from .config import TableSpec, kind_of
 
 ALWAYS_LAYOUT = ("name", "accept_over_tolerance")  # the output stem, the exit-status policy: never the values
 
 
 def layout_keys(kind: str) -> tuple[str, ...]:
     """``name`` and the kind's declared layout keys."""
-    return ALWAYS_LAYOUT + lookup_kind(kind).layout_keys
+    return ALWAYS_LAYOUT + kind_of(kind).layout_keys
 
 
 def values_toml(spec: TableSpec) -> str:

@@ -123,10 +123,10 @@ def test_a_corrupt_or_foreign_output_is_rebaked(three):
 
 def wrap_run_tile(monkeypatch, wrappers):
     """The tables named in ``wrappers`` bake with ``wrappers[name](run_tile)`` as their plan's run_tile."""
-    real = pipeline.lookup_kind
+    real = pipeline.kind_of
 
-    def lookup(name):
-        kind = real(name)
+    def lookup(spec):
+        kind = real(spec)
 
         def plan(spec):
             p = kind.plan(spec)
@@ -135,7 +135,7 @@ def wrap_run_tile(monkeypatch, wrappers):
 
         return dataclasses.replace(kind, plan=plan)
 
-    monkeypatch.setattr(pipeline, "lookup_kind", lookup)
+    monkeypatch.setattr(pipeline, "kind_of", lookup)
 
 
 def _sabotage(monkeypatch, how):

@@ -97,13 +97,14 @@ def _list_formats(width: int) -> None:
 
 
 def _list_keys(kind: str | None, width: int) -> None:
-    from ..kinds import KINDS, lookup_kind
+    from ..config import kind_of
+    from ..kinds import KINDS
     from ..kinds.reference import text
 
     if kind is None:
         fail(f"'lutbake list keys' needs a kind, e.g. 'lutbake list keys dfg'; kinds: {', '.join(KINDS)}")
     try:
-        found = lookup_kind(kind)
+        found = kind_of(kind)
     except KeyError as e:
         fail(e.args[0])
     for line in text(found):
