@@ -2,9 +2,9 @@
 below (function-level imports too: the edges are tests/test_pipeline.py's import_edges, from every module's ast).
 
 ``LAYERS`` is the one place the floors are written down (docs/architecture.md "Layers" shows them, checked below);
-nothing in the package imports it. A name covers that module, or that package and everything in it (the root package ``lutbake`` covers
-only its own __init__); the longest name that covers a module gives its floor. A module no name covers fails the
-test, so a new module is placed on purpose.
+nothing in the package imports it. A name covers that module, or that package and everything in it (the root package
+``lutbake`` covers only its own __init__); the longest name that covers a module gives its floor. A module no name
+covers fails the test, so a new module is placed on purpose.
 """
 
 from __future__ import annotations
