@@ -35,9 +35,9 @@ import warp as wp  # noqa: E402
 from lutbake.api import bake_table  # noqa: E402
 from lutbake.config import validate_table  # noqa: E402
 from lutbake.kinds import KINDS  # noqa: E402
-from lutbake.provenance import sources_digest  # noqa: E402
 from lutbake.runtime.executor import default_workers  # noqa: E402
 from lutbake.sampling import points  # noqa: E402
+from lutbake.sources import sources_digest  # noqa: E402
 
 OUT = ROOT / "outputs" / "bench"
 REF_GL_SAMPLES = 3 * 40**2  # reference order n = 40

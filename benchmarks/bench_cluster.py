@@ -40,7 +40,7 @@ from lutbake import batch  # noqa: E402
 from lutbake.config import load_configs, preset_path  # noqa: E402
 from lutbake.io.exr import read_exr  # noqa: E402
 from lutbake.io.integrity import sidecar_path  # noqa: E402
-from lutbake.kinds import lookup_kind  # noqa: E402
+from lutbake.pipeline import plan_of  # noqa: E402
 from lutbake.runtime import cluster  # noqa: E402
 from lutbake.runtime.executor import default_workers  # noqa: E402
 
@@ -60,19 +60,19 @@ class TimedRunner(cluster.DaskRunner):
         self.phase: dict[str, float] = {}
         self.estimate: dict[str, float] = {}
 
-    def execute(self, spec, plan, device, **kw):
+    def execute(self, source, plan, device, **kw):
         t0 = time.perf_counter()
         try:
-            return super().execute(spec, plan, device, **kw)
+            return super().execute(source, plan, device, **kw)
         finally:
-            self.phase[spec.name] = time.perf_counter() - t0
+            self.phase[source.name] = time.perf_counter() - t0
 
-    def estimate_error(self, spec, data, device):
+    def estimate_error(self, source, data, device):
         t0 = time.perf_counter()
         try:
-            return super().estimate_error(spec, data, device)
+            return super().estimate_error(source, data, device)
         finally:
-            self.estimate[spec.name] = time.perf_counter() - t0
+            self.estimate[source.name] = time.perf_counter() - t0
 
 
 WRITES: dict[str, float] = {}
@@ -192,7 +192,7 @@ def main(argv=None):
     n = len(tiles)
     W = sum(c for _, c in tiles)  # CPU seconds of its tile launches
     t0 = time.perf_counter()
-    lookup_kind(job.spec.kind).plan(job.spec)
+    plan_of(job.spec)
     S_parts = {
         "client_plan": time.perf_counter() - t0,
         "error_estimate_task": runner.estimate[LARGEST],

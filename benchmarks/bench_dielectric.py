@@ -32,8 +32,8 @@ from lutbake.config import validate_table  # noqa: E402
 from lutbake.integrands.dielectric import integrate  # noqa: E402
 from lutbake.kinds import dielectric as kd  # noqa: E402
 from lutbake.layouts import lookup_layout  # noqa: E402
-from lutbake.provenance import sources_digest  # noqa: E402
 from lutbake.runtime.executor import default_workers  # noqa: E402
+from lutbake.sources import sources_digest  # noqa: E402
 
 OUT = ROOT / "outputs" / "bench"
 REF_ORDER = 24

@@ -32,7 +32,7 @@ import time
 from collections import deque
 from collections.abc import Callable
 from concurrent.futures import FIRST_COMPLETED, ThreadPoolExecutor, wait
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import __version__
@@ -41,12 +41,13 @@ from .errors import LutbakeError
 from .io.atomic import atomic_write_bytes, remove_stale_temps
 from .io.formats import output_path, write_table
 from .io.oserror import os_error_text
-from .kinds import lookup_kind
-from .pipeline import OVER_TOLERANCE, Computed, assemble, compute
-from .provenance import HASH_ATTRIBUTE, content_hash, read_header, sources_digest
+from .pipeline import OVER_TOLERANCE, Computed, assemble, compute, plan_of
+from .provenance import HASH_ATTRIBUTE, content_hash, read_header
 from .runtime.executor import Cancelled, Progress, default_workers
+from .runtime.plan import TexelPlan
 from .runtime.warp_runtime import ModuleBusy, defer_if_busy
 from .sharing import group_by, values_key
+from .sources import sources_digest
 from .values_cache import ValuesCache, valid_extra
 
 # over_tolerance: written (baked now, or up to date from an earlier run), but texels ended over their tolerance
@@ -81,10 +82,18 @@ class Job:
     shape: str = ""
     table: object = None  # the baked lutbake.table.Table, once baked
     cache_error: str = ""  # why its values could not be written into the --cache (the table itself is baked)
+    _plan: TexelPlan | None = field(default=None, repr=False, compare=False)
 
     @property
     def name(self) -> str:
         return self.spec.name
+
+    def plan(self) -> TexelPlan:
+        """Its table's plan, built once (lutbake.pipeline.plan_of) and shared by the checks before the run
+        (lutbake.preflight: the shape), a --cache hit and the computation; dropped once its group is written."""
+        if self._plan is None:
+            self._plan = plan_of(self.spec)
+        return self._plan
 
     @property
     def accepted(self) -> bool:
@@ -174,7 +183,7 @@ def _cached(cache: ValuesCache | None, job: Job) -> Computed | None:
     if entry is None:
         return None
     t0 = time.thread_time()
-    plan = lookup_kind(job.spec.kind).plan(job.spec)
+    plan = job.plan()
     if plan.shape != entry[0].shape:
         return None
     after = plan.attributes_after(entry[0]) if plan.attributes_after is not None else {}
@@ -206,9 +215,20 @@ def _bake_group(
     cache: ValuesCache | None = None,
     runner=None,
 ) -> list[Job]:
-    """Compute the values of ``group`` (pending jobs with one values key, lutbake.sharing) once, or take them from
-    ``cache``, then assemble and write each job's table in its own layout; any failure is recorded on the jobs
-    it concerns, never raised."""
+    """_compute_and_write, then each finished job's plan dropped (it holds its texel grid and memos: not kept with the
+    outcome); a group set back (ModuleBusy: still pending) keeps its plans for its next try."""
+    try:
+        return _compute_and_write(group, workers, device, progress, cancel, cache, runner)
+    finally:
+        for job in group:
+            if job.status != "pending":
+                job._plan = None
+
+
+def _compute_and_write(group: list[Job], workers, device, progress, cancel, cache, runner) -> list[Job]:
+    """Compute the values of ``group`` (pending jobs with one values key, lutbake.sharing) once, from the lead job's
+    plan, or take them from ``cache``, then assemble and write each job's table in its own layout; any failure is
+    recorded on the jobs it concerns, never raised."""
     lead = group[0]
     t0 = time.perf_counter()
     try:
@@ -217,7 +237,7 @@ def _bake_group(
         computed = _cached(cache, lead)
         origin = "cache" if computed is not None else None
         if computed is None:
-            computed = compute(lead.spec, workers, device, progress, cancel=cancel, runner=runner)
+            computed = compute(lead.spec, workers, device, progress, cancel=cancel, runner=runner, plan=lead.plan())
             _store(cache, lead, computed)
     except ModuleBusy:  # before any tile ran (warp_runtime.defer_if_busy): the caller runs another group first
         raise

@@ -18,10 +18,10 @@ from types import MappingProxyType
 from typing import Any
 
 from . import arguments
+from .config_file import config_file_problem, nesting_problem
 from .errors import ArgumentError, ConfigError, did_you_mean
-from .kinds import KINDS, Key, kind_record, lookup_kind
+from .kinds import KINDS, Key, Kind, kind_record, lookup_kind
 from .limits import BAKE_PEAK_BYTES_PER_TEXEL, MAX_LIST, MAX_TEXELS  # noqa: F401  (lutbake.config.MAX_TEXELS, as before)
-from .preflight import config_file_problem, nesting_problem
 from .registry import Choices, Record
 from .textsafe import safe_repr
 from .value_bounds import unit_range
@@ -33,7 +33,6 @@ NAME_RULE = "1-128 letters, digits, '-' or '_' (it names the output file)"
 WINDOWS_RESERVED = frozenset(
     ["CON", "PRN", "AUX", "NUL"] + [f"{port}{i}" for port in ("COM", "LPT") for i in range(10)]
 )
-BYTES_PER_TEXEL = 32  # float64 x 4 channels while baking
 
 
 def human_bytes(n: int) -> str:
@@ -126,6 +125,16 @@ class TableSpec:
 
     def __reduce__(self):  # a mappingproxy does not pickle; lutbake.runtime.cluster ships specs to Dask workers
         return (_table_spec, (self.name, self.kind, dict(self.options), self.source, self.index, dict(self.records)))
+
+
+def kind_of(spec: TableSpec | str) -> Kind:
+    """The Kind of ``spec`` (the record its ``kind`` resolved to where its config was read), or of a kind's name or
+    alias as a user typed it (``lutbake list keys``; KeyError lists the valid names): the one place outside
+    lutbake.kinds a kind is reached, for every module above config that needs it (its plan function, texel count,
+    layout keys, keys)."""
+    if isinstance(spec, str):
+        return lookup_kind(spec)
+    return spec.records["kind"].obj
 
 
 def _table_spec(name: str, kind: str, options: dict, source: str, index: int, records: dict) -> TableSpec:

@@ -29,3 +29,6 @@ MAX_EXR_PARTS = 4096  # a 3D table has a part per z index
 MAX_EXR_ALL_HEADERS = 16 << 20  # the headers of every part together
 MAX_EXTRA_CHARS = 4096  # characters of one extra value in a values-cache entry (lutbake's: numbers, short descriptions)
 LTC_FIT_GRID = 32  # the LTC fit's error metric: an N x N grid per sampling technique (ltc_code's Nsample)
+BYTES_PER_TEXEL = (
+    32  # float64 x 4 channels while baking: a table's values (lutbake.runtime.cluster sizes its transfers)
+)

@@ -2,27 +2,28 @@
 
     spec (lutbake.config) -> lutbake.kinds.<kind>.plan = per_texel_plan(integrand, estimator, grid)
          -> lutbake.runtime.executor.execute -> finite check -> lutbake.table.Table (lutbake.provenance.attributes)
-``compute`` runs everything up to the values (plan, tiles, finite check, error estimate); ``compute_at`` the
-same plan at arbitrary texels (audit and size); ``assemble`` makes the Table of one spec from them (name, config,
-content hash). ``bake_table`` is both. The batch (lutbake.batch) computes once per distinct values key
-(lutbake.sharing) and assembles per table; the batch and the Python API (lutbake.api) write.
+``plan_of`` builds a spec's plan (the batch builds it once per table, lutbake.batch.Job.plan, and hands it on);
+``compute`` runs everything up to the values (tiles, finite check, error estimate); ``compute_at`` the same
+integrand and estimator at arbitrary texels (audit and size); ``assemble`` makes the Table of one spec from them
+(name, config, content hash). ``bake_table`` is both. The batch (lutbake.batch) computes once per distinct values
+key (lutbake.sharing) and assembles per table; the batch and the Python API (lutbake.api) write.
 """
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
-from .config import TableSpec
+from .config import TableSpec, kind_of
 from .errors import TableError
-from .kinds import lookup_kind
 from .layouts import reconstruction_with_engine_line
 from .provenance import attributes
 from .runtime.executor import Progress, Timer, estimate_error, execute_tiles
+from .runtime.plan import PlanSource, TexelPlan
 from .runtime.warp_runtime import defining
-from .sampling.plan import TexelPlan
 from .table import Table
 
 OVER_TOLERANCE = "over_tolerance"  # the lutbake:* attribute of a table whose texels end over their tolerance
@@ -42,6 +43,17 @@ class Computed:
     cpu_seconds: float
 
 
+def plan_of(spec: TableSpec) -> TexelPlan:
+    """The plan of ``spec``'s table, built by its kind (lutbake.config.kind_of)."""
+    with defining():  # a plan builds Warp functions (kernel factories): one table thread at a time
+        return kind_of(spec).plan(spec)
+
+
+def plan_source(spec: TableSpec) -> PlanSource:
+    """How a cluster worker builds ``spec``'s plan: its kind's plan function bound to it (picklable by reference)."""
+    return PlanSource(spec.name, f"{spec.kind}\n{spec.toml()}", functools.partial(kind_of(spec).plan, spec))
+
+
 def compute(
     spec: TableSpec,
     workers: int | None = None,
@@ -49,14 +61,16 @@ def compute(
     progress: Progress | None = None,
     cancel=None,
     runner=None,
+    plan: TexelPlan | None = None,
 ) -> Computed:
     """The values of ``spec``'s table (nothing written). Raises TableError if a value is not finite;
     executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs. ``runner``: where the
-    tiles run (lutbake.runtime.cluster.DaskRunner); None: this process' threads."""
+    tiles run (lutbake.runtime.cluster.DaskRunner, handed plan_source(spec)); None: this process' threads.
+    ``plan``: ``spec``'s plan where the caller built it already (plan_of); None: built here."""
     cpu: list[float] = []  # CPU seconds of each part, measured in the thread that ran it (time.thread_time)
     t0 = time.thread_time()
-    with defining():  # a plan builds Warp functions (kernel factories): one table thread at a time
-        plan = lookup_kind(spec.kind).plan(spec)
+    plan = plan if plan is not None else plan_of(spec)
+    source = plan_source(spec) if runner is not None else None
     cpu.append(time.thread_time() - t0)
     with Timer() as t:
         full = execute_tiles(
@@ -66,7 +80,7 @@ def compute(
             progress=progress,
             label=spec.name,
             cancel=cancel,
-            spec=spec,
+            source=source,
             cpu=cpu,
             runner=runner,
         )
@@ -76,7 +90,7 @@ def compute(
         bad = int(np.size(data) - np.count_nonzero(np.isfinite(data)))
         raise TableError(f"{spec.source}: table '{spec.name}': {bad} non-finite values; nothing written")
     extra = {}
-    estimate = estimate_error(plan, full, device, spec, runner)
+    estimate = estimate_error(plan, full, device, source, runner)
     if estimate is not None:
         err, how, *over = estimate
         extra.update(error_estimate=f"{err:.3e}", error_estimate_method=how)
@@ -94,7 +108,7 @@ def compute_at(spec: TableSpec, points: dict[str, np.ndarray], workers: int | No
     ``plan(spec, points=...)`` takes them). The reference of ``lutbake audit`` and ``lutbake size``
     (lutbake.commands.reference): the bake's own plan and tile executor, at the points those commands need."""
     with defining():
-        plan = lookup_kind(spec.kind).plan(spec, points=points)
+        plan = kind_of(spec).plan(spec, points=points)
     full = execute_tiles(plan, workers=workers, device=device)
     return full[:, : plan.n_channels]
 

@@ -1,45 +1,19 @@
 """Checks of everything a batch will touch on disk, made before any kernel runs (issue 11): what used to fail
 after the bake (an out-dir below a file, on a read-only mount or behind a dangling symlink; a --report that
 cannot be written or would overwrite an output, its sidecar or a config) is a ConfigError, exit 2, nothing
-written. A config path that is not a regular file says what it is."""
+written. (The config files' own checks, made before they are parsed, are lutbake.config_file's.)"""
 
 from __future__ import annotations
 
 import errno
 import os
-import re
-import stat
 import tempfile
 from pathlib import Path
 
+from .config_file import encoding_problem
 from .errors import ConfigError
 from .io.bounded import what_is
 from .textsafe import shorten
-
-MAX_CONFIG_BYTES = 1 << 20  # a config is a few KiB; a larger file is not one (and is not read into memory)
-
-
-def config_file_problem(path) -> str | None:
-    """Why ``path`` cannot be read as a config (says what it is), or None for a regular file of sane size."""
-    path = Path(path)
-    problem = encoding_problem(path)
-    if problem:
-        return problem
-    try:
-        st = os.stat(path)
-    except FileNotFoundError:
-        if os.path.islink(path):
-            return f"is a dangling symlink (to {os.readlink(path)!r}): no such config file"
-        return "no such config file"
-    except NotADirectoryError:
-        return "no such config file (a parent in the path is a file)"
-    except OSError as e:
-        return f"cannot read: {e.strerror or e}"
-    if not stat.S_ISREG(st.st_mode):
-        return f"is {what_is(st.st_mode)}, not a config file"
-    if st.st_size > MAX_CONFIG_BYTES:
-        return f"is {st.st_size} bytes; a config is at most {MAX_CONFIG_BYTES} bytes (is it a config file?)"
-    return None
 
 
 def directory_problem(path, attempts: int = 3) -> str | None:
@@ -100,26 +74,6 @@ def _real_key(path) -> str:
 
 def _same(a: Path, b: Path) -> bool:
     return _real_key(a) == _real_key(b)
-
-
-def encoding_problem(path) -> str | None:
-    """Why ``path`` cannot be handed to the libraries that write and record files (OpenImageIO takes UTF-8 text
-    only; the path is recorded in the file's metadata), or None: a byte that is not UTF-8 (``\\xff``) in it."""
-    try:
-        os.fsencode(str(path)).decode("utf-8")
-    except (UnicodeDecodeError, UnicodeEncodeError):
-        raw = os.fsencode(str(path))
-        bad = next(i for i in range(len(raw)) if not _utf8_prefix_ok(raw[: i + 1]))
-        return f"its name holds the byte {raw[bad : bad + 1]!r} at byte {bad}, which is not UTF-8; rename it"
-    return None
-
-
-def _utf8_prefix_ok(raw: bytes) -> bool:
-    try:
-        raw.decode("utf-8")
-    except UnicodeDecodeError as e:
-        return e.reason == "unexpected end of data"
-    return True
 
 
 def probe_directory(path, attempts=3) -> str | None:
@@ -312,13 +266,12 @@ def check_collisions(jobs) -> None:
 def check_outputs(jobs) -> None:
     """No two tables write one file (check_collisions). Every file a table writes (planned_files) must be a regular
     file or absent (a directory or device there fails the rename after the bake); a ``png16`` output must be a 2D
-    table (PNG has no depth: the table's shape comes from its plan, which runs no kernel)."""
-    from .kinds import lookup_kind
-
+    table (PNG has no depth: the table's shape comes from its plan, lutbake.batch.Job.plan, built once and baked
+    later; building it runs no kernel)."""
     check_collisions(jobs)
     for job in jobs:
         if job.status == "pending" and job.spec.options.get("format") == "png16":
-            shape = lookup_kind(job.spec.kind).plan(job.spec).shape
+            shape = job.plan().shape
             if len(shape) > 3:
                 raise ConfigError(
                     job.spec.source,
@@ -414,34 +367,6 @@ def check_report(report, jobs, configs=(), cache_dir=None) -> None:
     problem = directory_problem(report.parent)
     if problem:
         raise ConfigError("--report", "report", str(report), message=f"cannot be written: {report.parent}: {problem}")
-
-
-MAX_NESTING = 32  # arrays / inline tables inside each other; lutbake's deepest value is a list of numbers
-MAX_KEY_PARTS = 32  # parts of one dotted key; tomllib takes quadratic time on long ones (20 000 parts: ~45 s)
-_STRINGS = re.compile(r'"""[\s\S]*?"""|\'\'\'[\s\S]*?\'\'\'|"(?:[^"\\\n]|\\.)*"|\'[^\'\n]*\'')
-_COMMENT = re.compile(r"#[^\n]*")
-_NOT_BRACKET = re.compile(r"[^\[\]{}]")
-
-
-def nesting_problem(text: str) -> str | None:
-    """Why ``text`` (TOML) is too deeply nested to be a config, found in one linear pass before parsing it
-    (a RecursionError or minutes of parsing otherwise), or None."""
-    import numpy as np
-
-    bare = _COMMENT.sub("", _STRINGS.sub('""', text))
-    # the depth after each bracket, an unmatched closing one ignored (depth >= 0): the walk of +-1 steps reflected at
-    # 0 is its running sum minus the running sum's lowest value so far below 0
-    brackets = np.frombuffer(_NOT_BRACKET.sub("", bare).encode(), np.uint8)
-    walk = np.cumsum(np.where((brackets == ord("[")) | (brackets == ord("{")), 1, -1))
-    deepest = int(np.max(walk - np.minimum(np.minimum.accumulate(walk), 0), initial=0))
-    if deepest > MAX_NESTING:
-        return f"arrays or inline tables nested {deepest} deep (at most {MAX_NESTING})"
-    for line in bare.splitlines():
-        key = line.split("=", 1)[0]
-        parts = key.count(".") + 1
-        if parts > MAX_KEY_PARTS:
-            return f"a dotted key of {parts} parts (at most {MAX_KEY_PARTS})"
-    return None
 
 
 def input_files(path) -> list[Path]:

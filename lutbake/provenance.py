@@ -2,7 +2,7 @@
 
 - **Content hash.** Every output records ``lutbake:content_hash`` = sha256 of the table's canonical TOML
   (``TableSpec.toml()``), the lutbake version and the source text of the modules that define what a table holds
-  (``HASH_SOURCES``: terms, integrands, sampling, kinds, layouts, axes, edge policy). An output with the same hash is
+  (lutbake.sources: terms, integrands, sampling, kinds, layouts, axes, edge policy). An output with the same hash is
   up to date (lutbake.batch skips it); anything else (no file, unreadable file, other hash) is baked again.
 - **Provenance.** ``attributes(spec, plan)``: terms, estimator, samples, seed, config text, versions, the plan's
   own records and the content hash, written as ``lutbake:*`` (EXR header or the JSON sidecar).
@@ -17,36 +17,9 @@ from pathlib import Path
 from . import __version__
 from .config import TableSpec
 from .io.integrity import verified_attributes
+from .sources import sources_digest
 
-PACKAGE = Path(__file__).parent
-# the modules whose source defines what a table holds (kernels, terms, estimators, kinds, axes, edge policy)
-HASH_SOURCES = (
-    "terms/*.py",
-    "integrands/*.py",
-    "sampling/*.py",
-    "kinds/*.py",
-    "layouts/*.py",
-    "ltc/*.py",
-    "axes.py",
-    "edge.py",
-    "tolerance.py",
-)
 HASH_ATTRIBUTE = "content_hash"
-
-
-def source_files() -> list[Path]:
-    """The source files that enter every content hash, sorted by their path in the package."""
-    files = {f for pattern in HASH_SOURCES for f in PACKAGE.glob(pattern) if f.is_file()}
-    return sorted(files, key=lambda f: f.relative_to(PACKAGE).as_posix())
-
-
-def sources_digest() -> bytes:
-    """sha256 over (relative path, text) of every file in source_files()."""
-    h = hashlib.sha256()
-    for f in source_files():
-        data = f.read_bytes()
-        h.update(f.relative_to(PACKAGE).as_posix().encode() + b"\0" + str(len(data)).encode() + b"\0" + data)
-    return h.digest()
 
 
 def content_hash(spec: TableSpec, digest: bytes | None = None) -> str:
@@ -78,7 +51,7 @@ def warp_version() -> str:
 
 
 def attributes(spec: TableSpec, plan, extra: dict[str, str] | None = None) -> dict[str, str]:
-    """The provenance of a table baked from ``spec`` by ``plan`` (lutbake.sampling.plan.TexelPlan)."""
+    """The provenance of a table baked from ``spec`` by ``plan`` (lutbake.runtime.plan.TexelPlan)."""
     return {
         "terms": json.dumps(plan.terms),
         "estimator": plan.estimator,

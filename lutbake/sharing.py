@@ -5,7 +5,7 @@ the keys their kind declares (lutbake.kinds.base.Kind.layout_keys, e.g. ``format
 kind, whose fit reads neither). The ``values_key`` names those values:
 
     values_key = sha256(kind, canonical TOML of the options without the layout keys, lutbake version,
-                        source digest (lutbake.provenance.sources_digest))
+                        source digest (lutbake.sources.sources_digest))
 
 so it changes whenever anything that enters a table's values changes, and never with a file name or format.
 The batch (lutbake.batch) runs one pipeline.compute per distinct key and lays the result out per table
@@ -20,15 +20,14 @@ from __future__ import annotations
 import hashlib
 
 from . import __version__
-from .config import TableSpec
-from .kinds import lookup_kind
+from .config import TableSpec, kind_of
 
 ALWAYS_LAYOUT = ("name", "accept_over_tolerance")  # the output stem, the exit-status policy: never the values
 
 
 def layout_keys(kind: str) -> tuple[str, ...]:
     """``name`` and the kind's declared layout keys."""
-    return ALWAYS_LAYOUT + lookup_kind(kind).layout_keys
+    return ALWAYS_LAYOUT + kind_of(kind).layout_keys
 
 
 def values_toml(spec: TableSpec) -> str:
@@ -41,7 +40,7 @@ def values_toml(spec: TableSpec) -> str:
 
 def values_key(spec: TableSpec, digest: bytes) -> str:
     """The hex sha256 naming the values ``spec``'s table holds (module docstring); ``digest``:
-    lutbake.provenance.sources_digest()."""
+    lutbake.sources.sources_digest()."""
     h = hashlib.sha256()
     for part in (b"lutbake-values-key-v1", values_toml(spec).encode(), __version__.encode(), digest):
         h.update(str(len(part)).encode() + b"\0" + part)

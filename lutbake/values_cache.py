@@ -90,7 +90,7 @@ class ValuesCache:
     """The cache at ``directory``; ``read``: entries may be used (False under --force: computed again, written)."""
 
     directory: Path
-    sources: str  # hex of lutbake.provenance.sources_digest(): what made the entries this run can use
+    sources: str  # hex of lutbake.sources.sources_digest(): what made the entries this run can use
     read: bool = True
 
     def paths(self, key: str) -> tuple[Path, Path]:
@@ -180,6 +180,6 @@ def open_cache(directory, force: bool = False) -> ValuesCache | None:
     """The cache at ``directory`` for this lutbake's sources (None without a directory); ``force``: write only."""
     if directory is None:
         return None
-    from .provenance import sources_digest
+    from .sources import sources_digest
 
     return ValuesCache(Path(directory), sources_digest().hex(), read=not force)

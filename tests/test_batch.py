@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from lutbake import batch, pipeline, provenance
+from lutbake import batch, pipeline, provenance, sources
 from lutbake.cli import main
 from lutbake.config import load_configs
 from lutbake.io.exr import read_exr
@@ -98,7 +98,7 @@ def test_content_hash_covers_config_version_and_kernel_sources(monkeypatch, tmp_
     assert provenance.content_hash(s, b"other sources") != h
     monkeypatch.setattr(provenance, "__version__", "9.9.9")
     assert provenance.content_hash(s) != h
-    rel = {f.relative_to(provenance.PACKAGE).as_posix() for f in provenance.source_files()}
+    rel = {f.relative_to(sources.PACKAGE).as_posix() for f in sources.source_files()}
     for f in (
         "terms/ndf.py",
         "terms/masking.py",
@@ -123,10 +123,10 @@ def test_a_corrupt_or_foreign_output_is_rebaked(three):
 
 def wrap_run_tile(monkeypatch, wrappers):
     """The tables named in ``wrappers`` bake with ``wrappers[name](run_tile)`` as their plan's run_tile."""
-    real = pipeline.lookup_kind
+    real = pipeline.kind_of
 
-    def lookup(name):
-        kind = real(name)
+    def lookup(spec):
+        kind = real(spec)
 
         def plan(spec):
             p = kind.plan(spec)
@@ -135,7 +135,7 @@ def wrap_run_tile(monkeypatch, wrappers):
 
         return dataclasses.replace(kind, plan=plan)
 
-    monkeypatch.setattr(pipeline, "lookup_kind", lookup)
+    monkeypatch.setattr(pipeline, "kind_of", lookup)
 
 
 def _sabotage(monkeypatch, how):

@@ -13,7 +13,7 @@ from lutbake.axes import Axis
 from lutbake.config import validate_table
 from lutbake.runtime import devices, executor
 from lutbake.runtime.devices import CPU_TILE_TEXELS, CUDA_MEMORY_FRACTION, CUDA_TILE_MAX_EVALS, tile_texels
-from lutbake.sampling.plan import TexelPlan
+from lutbake.runtime.plan import TexelPlan
 
 GIB = 1 << 30
 # A CUDA bake evaluates the same float32 integrand with the GPU's float32 functions and FMA contraction and

@@ -4,15 +4,17 @@ engine fixes, and no layout-name branch outside the package."""
 import dataclasses
 import re
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
+from lutbake.axes import Axis
 from lutbake.config import load_config, preset_path, presets
 from lutbake.kinds import KINDS
 from lutbake.layouts import ENGINES, REGISTRY, TABLES, engine_modules, layouts_of, lookup_layout
 from lutbake.layouts.base import Layout
-from lutbake.sampling.plan import TexelPlan, with_stored_channels
+from lutbake.sampling.plan import Grid, StoredMap, per_texel_plan
 
 PACKAGE = Path(__file__).resolve().parent.parent / "lutbake"
 # Blender EEVEE's brdf_ggx reconstruction as baseline outputs recorded it before the records (uv rendered from the axes)
@@ -100,32 +102,70 @@ def test_dielectric_engine_layouts_fix_their_grid_and_terms():
     assert lookup_layout("dielectric", "energy").grid is None
 
 
+class _Rows:
+    """A fixed estimator (the per_texel_plan protocol): texel i's values are row i of ``values``; refined: itself."""
+
+    name = "rows"
+
+    def __init__(self, values):
+        self.values, self.prepared = values, []
+
+    def samples(self, inputs):
+        return np.ones(len(inputs["i"]))
+
+    def prepare(self, integrand, device):
+        self.prepared.append("estimator")
+
+    def evaluate(self, integrand, inputs, device):
+        return self.values[inputs["i"]]
+
+    def refined(self):
+        return self, "refined - nominal"
+
+
+class _RowsWithError(_Rows):
+    """_Rows as an adaptive estimator: each value's own error estimate is 1/8 of it (the tiles' aux columns)."""
+
+    absolute, relative = 1.0, 0.0
+
+    def evaluate_with_error(self, integrand, inputs, device):
+        values = self.values[inputs["i"]]
+        return values, values * 0.125
+
+
 def test_stored_channels_map_the_values_and_the_estimate_sees_the_integrals():
-    """sampling.plan.with_stored_channels: a layout's map applies to each tile's channels (aux columns kept), and the
-    error estimate receives the integrals back through the inverse."""
-    base = np.arange(12, dtype=np.float64).reshape(4, 3)  # 2 channels + 1 aux column
-    seen = []
-    plan = TexelPlan(
-        axes=[],
-        channels={"a": "", "b": ""},
-        reconstruction="",
-        n_texels=4,
-        n_channels=2,
-        run_tile=lambda s, e, d: base[s:e],
-        prepare=lambda d: None,
-        samples=1,
-        estimator="x",
-        terms={},
-        cost=1.0,
-        error_estimate=lambda data, d: (seen.append(data.copy()), (0.0, ""))[1],
-        aux_channels=1,
+    """per_texel_plan(stored=...): a layout's map, then an engine's added channel, apply to each tile's channels when
+    the plan is built (no plan patched afterwards); the error estimate receives the integrals back through the
+    inverses (a difference of 0 against the refined estimator: the stored values would differ from them)."""
+    base = np.arange(8, dtype=np.float64).reshape(4, 2) + 1.0  # 4 texels, 2 channels
+    est = _Rows(base)
+    swap = StoredMap.of_values(lambda v: v[:, ::-1], lambda v: v[:, ::-1])
+    added = StoredMap(
+        lambda v, texels, d: np.concatenate([v / 2.0, np.arange(4.0)[texels, None]], axis=1),
+        lambda t: t[:, :-1] * 2.0,
+        added=1,
+        prepare=lambda d: est.prepared.append("added"),
     )
-    swap = lambda v: v[:, ::-1]  # noqa: E731
-    plan = with_stored_channels(plan, swap, swap)
-    tile = plan.run_tile(0, 4, "cpu")
-    np.testing.assert_array_equal(tile, np.concatenate([base[:, 1::-1], base[:, 2:]], axis=1))
-    plan.error_estimate(tile, "cpu")
-    np.testing.assert_array_equal(seen[0], base)
+    grid = Grid([Axis("i", "x", 4)], {"i": np.arange(4)})
+    kw = dict(channels={"a": "", "b": "", "c": ""}, reconstruction="", terms={})
+    plan = per_texel_plan(SimpleNamespace(nch=2), est, grid, stored=(swap, added), **kw)
+    assert plan.n_channels == 3 and plan.tile_width == 3
+    tile = plan.run_tile(1, 4, "cpu")
+    np.testing.assert_array_equal(tile, np.concatenate([base[1:, ::-1] / 2.0, np.arange(1.0, 4.0)[:, None]], 1))
+    plan.prepare("cpu")
+    assert est.prepared == ["estimator", "added"]
+    err, _ = plan.error_estimate(plan.run_tile(0, 4, "cpu"), "cpu")
+    assert err == 0.0
+    plain = per_texel_plan(SimpleNamespace(nch=2), est, grid, **kw)
+    assert plain.n_channels == 2 and plain.error_estimate(swap.to_stored(base, slice(0, 4), "cpu"), "cpu")[0] > 0
+    # an adaptive estimator's aux columns (its per-texel estimates) pass untouched; its estimate sees the integrals
+    adaptive = per_texel_plan(SimpleNamespace(nch=2), _RowsWithError(base), grid, stored=(swap, added), **kw)
+    tile = adaptive.run_tile(0, 4, "cpu")
+    assert adaptive.aux_channels == 2 and tile.shape == (4, 5)
+    np.testing.assert_array_equal(tile[:, 3:], base * 0.125)
+    kw["relative_error"] = True
+    adaptive = per_texel_plan(SimpleNamespace(nch=2), _RowsWithError(base), grid, stored=(swap, added), **kw)
+    assert adaptive.error_estimate(adaptive.run_tile(0, 4, "cpu"), "cpu")[0] == 0.125
 
 
 def test_records_declare_a_range_and_its_reason():

@@ -4,7 +4,9 @@ key before any kernel runs; api.bake skips up-to-date outputs like the CLI; the 
 from __future__ import annotations
 
 import ast
+import dataclasses
 import json
+import pickle
 from pathlib import Path
 
 import numpy as np
@@ -12,8 +14,10 @@ import pytest
 from click.testing import CliRunner
 
 import lutbake
+from lutbake import pipeline
 from lutbake.cli import main
 from lutbake.kinds import KINDS
+from lutbake.runtime.executor import execute_tiles
 
 REPO = Path(__file__).resolve().parents[1]
 PACKAGE = REPO / "lutbake"
@@ -191,6 +195,40 @@ def test_api_bake_skips_up_to_date_outputs_unless_forced(spec, tmp_path):
     np.testing.assert_array_equal(forced[0].table.data, first[0].table.data)
 
 
+def test_a_table_is_planned_once_per_process(spec, monkeypatch, tmp_path):
+    """The png16 shape check before the run, the bake and a --cache hit share one plan per table
+    (lutbake.batch.Job.plan), built by its kind through lutbake.config.kind_of (lutbake.pipeline.plan_of)."""
+    real, built = pipeline.kind_of, []
+
+    def counting(s):
+        kind = real(s)
+
+        def plan(s, **kw):
+            built.append(s.name)
+            return kind.plan(s, **kw)
+
+        return dataclasses.replace(kind, plan=plan)
+
+    monkeypatch.setattr(pipeline, "kind_of", counting)
+    s = spec(kind="diffuse", size=[3, 2], model="lambert", format="png16")
+    first = lutbake.bake([s], out_dir=tmp_path / "a", cache_dir=tmp_path / "cache")
+    assert [r.status for r in first] == ["baked"] and built == ["t"]
+    again = lutbake.bake([s], out_dir=tmp_path / "b", cache_dir=tmp_path / "cache")  # its values from the cache
+    assert [r.status for r in again] == ["baked"] and built == ["t", "t"]
+
+
+def test_a_plan_source_ships_each_kinds_plan_function_by_reference(spec):
+    """A cluster worker builds a table's plan from what the client pickled (lutbake.runtime.plan.PlanSource): the
+    kind's module-level plan function bound to the spec, no kind looked up by its name there. Every kind's plan
+    function pickles by reference, and the plan built from the shipped source bakes the client's bits."""
+    for name, kind in KINDS.items():
+        assert pickle.loads(pickle.dumps(kind.plan)) is kind.plan, name
+    s = spec(kind="dfg", size=[4, 3])
+    shipped = pickle.loads(pickle.dumps(pipeline.plan_source(s)))
+    assert shipped.name == "t" and shipped.build.func is KINDS["dfg"].plan
+    np.testing.assert_array_equal(execute_tiles(shipped.build()), execute_tiles(pipeline.plan_of(s)))
+
+
 # ---- imports: no cycle, module by module ------------------------------------------------------------------------
 
 
@@ -199,36 +237,43 @@ def _module_name(path: Path, root: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
-def import_graph(root: Path = PACKAGE) -> dict[str, set[str]]:
-    """Module -> the package's modules it imports: every ``import`` / ``from ... import`` statement of the file, at
-    any depth (function-level imports too), relative or absolute; ``from pkg import mod`` is an edge to pkg.mod. An
-    import of a.b.c also runs the packages a.b and a (their __init__): edges to those, except the importer's own
-    packages (already initialised when it runs)."""
+def import_edges(root: Path = PACKAGE) -> dict[str, dict[str, int]]:
+    """Module -> {a module of the package it imports: the line of the first statement that does}: every ``import`` /
+    ``from ... import`` statement of the file, at any depth (function-level imports too), relative or absolute;
+    ``from pkg import mod`` is an edge to pkg.mod. An import of a.b.c also runs the packages a.b and a (their
+    __init__): edges to those, except the importer's own packages (already initialised when it runs)."""
     files = {_module_name(p, root): p for p in sorted(root.rglob("*.py"))}
-    graph: dict[str, set[str]] = {}
+    edges: dict[str, dict[str, int]] = {}
     for me, path in files.items():
         is_pkg = path.name == "__init__.py"
         targets = []
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             if isinstance(node, ast.Import):
-                targets += [a.name for a in node.names]
+                targets += [(a.name, node.lineno) for a in node.names]
             elif isinstance(node, ast.ImportFrom):
                 if node.level:
                     base = me.split(".")[: len(me.split(".")) - node.level + (1 if is_pkg else 0)]
                     module = ".".join(base + ([node.module] if node.module else []))
                 else:
                     module = node.module or ""
-                targets += [f"{module}.{a.name}" if f"{module}.{a.name}" in files else module for a in node.names]
-        deps = set()
-        for t in targets:
+                targets += [
+                    (f"{module}.{a.name}" if f"{module}.{a.name}" in files else module, node.lineno) for a in node.names
+                ]
+        deps: dict[str, int] = {}
+        for t, line in targets:
             while t and t not in files:
                 t = t.rpartition(".")[0]  # an attribute of a module: the module
             while t:
                 if t != me and not me.startswith(t + "."):
-                    deps.add(t)
+                    deps[t] = min(deps.get(t, line), line)
                 t = t.rpartition(".")[0]
-        graph[me] = deps
-    return graph
+        edges[me] = deps
+    return edges
+
+
+def import_graph(root: Path = PACKAGE) -> dict[str, set[str]]:
+    """Module -> the package's modules it imports (import_edges without the lines)."""
+    return {me: set(deps) for me, deps in import_edges(root).items()}
 
 
 def find_cycle(graph: dict[str, set[str]]) -> list[str] | None:

@@ -244,7 +244,7 @@ def test_an_installed_packages_entry_point_registers_its_records(tmp_path):
         "import sys; from lutbake.config import load_configs; from lutbake.cli import main\n"
         f"spec, = load_configs([{str(cfg)!r}]); r = spec.records['fresnel']\n"
         "print(r.name, r.origin, r.line)\n"
-        "try:\n    main(['list'])\nexcept SystemExit:\n    pass\n"
+        "try:\n    main(['list', 'terms'])\nexcept SystemExit:\n    pass\n"
     )
     env = {"PYTHONPATH": str(tmp_path), "PATH": "/usr/bin:/bin"}
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=tmp_path)

@@ -14,8 +14,8 @@ from lutbake import batch
 from lutbake.config import load_configs
 from lutbake.io.exr import read_exr
 from lutbake.kinds import KINDS
-from lutbake.provenance import sources_digest
 from lutbake.sharing import layout_keys, values_key
+from lutbake.sources import sources_digest
 from lutbake.values_cache import open_cache
 
 SMALL_LTC = {"kind": "ltc", "lobe": "ggx", "size": [6, 6], "fit_samples": 4}

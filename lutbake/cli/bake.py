@@ -244,13 +244,13 @@ class BatchProgress:
             click.echo(text, nl=nl, err=err)
 
     def scheduled(self, results) -> None:
-        from ..kinds import lookup_kind
+        from ..config import kind_of
 
         self.total = len(results)
         self.pending = sum(r.status == "pending" for r in results)
         for r in results:
             if r.status == "pending":
-                self.clock.plan(r.name, lookup_kind(r.spec.kind).texels(r.spec.options))
+                self.clock.plan(r.name, kind_of(r.spec).texels(r.spec.options))
 
     def texels(self, label: str, n_texels: int, cost: float):
         """lutbake.runtime.executor.Progress: a table starts (its tiles are about to run)."""

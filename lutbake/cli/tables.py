@@ -97,13 +97,14 @@ def _list_formats(width: int) -> None:
 
 
 def _list_keys(kind: str | None, width: int) -> None:
-    from ..kinds import KINDS, lookup_kind
+    from ..config import kind_of
+    from ..kinds import KINDS
     from ..kinds.reference import text
 
     if kind is None:
         fail(f"'lutbake list keys' needs a kind, e.g. 'lutbake list keys dfg'; kinds: {', '.join(KINDS)}")
     try:
-        found = lookup_kind(kind)
+        found = kind_of(kind)
     except KeyError as e:
         fail(e.args[0])
     for line in text(found):
@@ -120,6 +121,7 @@ def _terms() -> dict[str, dict[str, str]]:
     from ..kinds.diffuse import DIFFUSE_ESTIMATORS
     from ..kinds.specular_aniso import VIEW_AZIMUTHS
     from ..metals import METALS
+    from ..plugins import load_entry_points
     from ..records import (
         ANISO_ESTIMATOR,
         ANISO_MODEL,
@@ -133,6 +135,7 @@ def _terms() -> dict[str, dict[str, str]]:
     )
     from ..registry import choices
 
+    load_entry_points()  # an installed package's records are listed beside lutbake's
     return {
         "NDFs (ndf = ...)": choices(NDF),
         "Masking-shadowing (masking = ...)": choices(MASKING),

@@ -309,8 +309,8 @@ def audit_ltc(
 
 
 def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> TableAuditReport:
-    from ..kinds import lookup_kind
     from ..layouts.openpbr import OPENPBR_SIZE
+    from ..pipeline import plan_of
 
     n = OPENPBR_SIZE
     from ..io.bounded import load_npz_all
@@ -321,8 +321,8 @@ def audit_openpbr(path, specs, tolerance: float, metric: str, max_side: int) -> 
         raise ValueError(f"{path}: missing OpenPBR arrays {missing} (keys: {sorted(shipped)})")
     by_kind = {s.kind: s for s in specs}
     iz, iy = subset(n, max_side), subset(n, max_side)
-    plan3 = lookup_kind("dielectric").plan(by_kind["dielectric"])
-    plan_avg = lookup_kind("dielectric_avg").plan(by_kind["dielectric_avg"])
+    plan3 = plan_of(by_kind["dielectric"])
+    plan_avg = plan_of(by_kind["dielectric_avg"])
     ours3 = np.stack([np.stack([plan3.run_tile((z * n + y) * n, (z * n + y + 1) * n, "cpu") for y in iy]) for z in iz])
     ours_avg = np.stack([plan_avg.run_tile(z * n, (z + 1) * n, "cpu") for z in iz])  # (z, alpha, 3)
     errors, findings, judged = {}, [], []

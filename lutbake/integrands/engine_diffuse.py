@@ -28,9 +28,8 @@ import functools
 import numpy as np
 import warp as wp
 
-from ..layouts.hdrp import HDRP_UNIFORM_SCALE
 from ..runtime.warp_runtime import MODULE_OPTIONS, load_module
-from ..sampling.plan import TexelPlan
+from ..sampling.plan import StoredMap
 from ..terms.engine_diffuse import Fd_disney_hdrp, Fd_fabric_lambert_hdrp
 
 wp.set_module_options(MODULE_OPTIONS)
@@ -105,53 +104,38 @@ def fabric_lambert(perceptual_roughness: np.ndarray, device: str = "cpu") -> np.
     return out.numpy()
 
 
-def fabric_channel(base: np.ndarray, nov: np.ndarray, rough: np.ndarray, device: str = "cpu") -> np.ndarray:
-    """charlie_fabric's table from the sheen pair (n, 2) at texels (nov, perceptual roughness): R, G / 2 pi and
-    B = FabricLambertNoPI."""
-    b = fabric_lambert(rough, device)
-    return np.concatenate([base / HDRP_UNIFORM_SCALE, b[:, None]], axis=1)
+def disney_b(nov: np.ndarray, perceptual_roughness: np.ndarray, device: str = "cpu") -> np.ndarray:
+    """multiscatter_disney's channel B at texels (nov, perceptual roughness): the Disney FGD - 0.5."""
+    return disney_fgd(nov, perceptual_roughness, device) - HDRP_DIFFUSE_OFFSET
 
 
-def disney_channel(base: np.ndarray, nov: np.ndarray, rough: np.ndarray, device: str = "cpu") -> np.ndarray:
-    """multiscatter_disney's table from the multiscatter pair (n, 2): B = the Disney FGD - 0.5."""
-    b = disney_fgd(nov, rough, device) - HDRP_DIFFUSE_OFFSET
-    return np.concatenate([base, b[:, None]], axis=1)
+def fabric_b(nov: np.ndarray, perceptual_roughness: np.ndarray, device: str = "cpu") -> np.ndarray:
+    """charlie_fabric's channel B at texels (nov, perceptual roughness): FabricLambertNoPI (constant in NoV)."""
+    return fabric_lambert(perceptual_roughness, device)
 
 
-# lutbake.layouts.base.EngineChannel.name -> (the layout's table from the base channels, the Warp kernel it launches)
-CHANNELS = {"disney": (disney_channel, diffuse_kernel), "fabric": (fabric_channel, fabric_kernel)}
+# lutbake.layouts.base.EngineChannel.name -> (its channel B at texels (nov, perceptual roughness), the Warp kernel it
+# launches)
+CHANNELS = {"disney": (disney_b, diffuse_kernel), "fabric": (fabric_b, fabric_kernel)}
 
 
-def with_diffuse_channel(plan: TexelPlan, nov: np.ndarray, perceptual_roughness: np.ndarray, channel) -> TexelPlan:
-    """The plan of the base layout turned into the engine layout's (``channel``, lutbake.layouts.base.EngineChannel:
-    channel B appended by its CHANNELS function, same tiles)."""
-    base_tile = plan.run_tile
-    nch = plan.n_channels
-    compute, kernel = CHANNELS[channel.name]
+def diffuse_channel(channel, nov: np.ndarray, perceptual_roughness: np.ndarray) -> StoredMap:
+    """What the engine layout ``channel`` (lutbake.layouts.base.EngineChannel) stores of the base layout's channels,
+    texel i at (nov[i], perceptual_roughness[i]): the base channels / channel.scale (HDRP's Charlie pair / 2 pi), then
+    channel B (CHANNELS). Back, for the specular channels' error estimate: B dropped, the base channels times the scale
+    (B itself: the tests)."""
+    b_of, kernel = CHANNELS[channel.name]
 
-    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
-        """The layout's channels from the base tile's, then the base tile's aux columns (TexelPlan.aux_channels)."""
-        s = slice(start, stop)
-        base = base_tile(start, stop, device)
-        table = compute(base[:, :nch], nov[s], perceptual_roughness[s], device)
-        return np.concatenate([table, base[:, nch:]], axis=1)
+    def to_stored(values: np.ndarray, texels: slice, device: str) -> np.ndarray:
+        b = b_of(nov[texels], perceptual_roughness[texels], device)
+        return np.concatenate([values / channel.scale, b[:, None]], axis=1)
 
-    base_prepare = plan.prepare
-
-    def prepare(device: str) -> None:
-        base_prepare(device)
-        load_module(kernel().module, device=device)
-
-    base_estimate = plan.error_estimate
-
-    def base_data(data: np.ndarray) -> np.ndarray:
-        """The base layout's tile data: its channels (rescaled) and aux columns, without channel B."""
-        return np.concatenate([data[:, :nch] * channel.scale, data[:, nch + 1 :]], axis=1)
-
-    if base_estimate is not None:  # the specular channels' estimate, on the base layout's values; B: the tests
-        plan.error_estimate = lambda data, device: base_estimate(base_data(data), device)
-    plan.run_tile, plan.prepare, plan.n_channels = run_tile, prepare, nch + 1
-    return plan
+    return StoredMap(
+        to_stored,
+        lambda stored: stored[:, :-1] * channel.scale,
+        added=1,
+        prepare=lambda device: load_module(kernel().module, device=device),
+    )
 
 
 def perceptual_roughness_grid(axes) -> np.ndarray:

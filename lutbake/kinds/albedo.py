@@ -18,8 +18,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..axes import Axis
+from ..runtime.plan import TexelPlan
 from ..sampling.mu_average import mu_averages, mu_target
-from ..sampling.plan import TexelPlan, per_texel_plan
+from ..sampling.plan import per_texel_plan
 from ..tolerance import Tolerance, over_tolerance, tolerance_of
 from . import dfg
 from .base import Key, declare

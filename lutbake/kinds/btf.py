@@ -25,7 +25,8 @@ from ..edge import effective_alpha
 from ..limits import MAX_GL_ORDER
 from ..records import DIFFUSE
 from ..registry import choices
-from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..runtime.plan import TexelPlan
+from ..sampling.plan import Grid, per_texel_plan
 from ..tolerance import Tolerance, tolerance_of
 from . import diffuse
 from .base import Estimation, Key, declare

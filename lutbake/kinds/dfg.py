@@ -25,7 +25,8 @@ from ..layouts import layouts_of, lookup_layout, summaries
 from ..layouts.base import nov_alpha_grid as texel_grid
 from ..records import FRESNEL, HEMISPHERE_ESTIMATOR, MASKING, MODEL, NDF
 from ..registry import Record, choices
-from ..sampling.plan import Grid, TexelPlan, per_texel_plan, with_stored_channels
+from ..runtime.plan import TexelPlan
+from ..sampling.plan import Grid, StoredMap, per_texel_plan
 from ..tolerance import tolerance_of
 from .base import Estimation, Key, declare
 
@@ -260,7 +261,12 @@ def plan(spec, points: dict | None = None) -> TexelPlan:
     form, nd, mk = terms_of(spec)
     fresnel = spec.records["fresnel"] if lay.name in FRESNEL_LAYOUTS else None
     integrand = specular_integrand(nd.obj, mk, lay.integrand, form, N_CHANNELS[lay.integrand], fresnel)
-    plan = per_texel_plan(
+    stored = (StoredMap.of_values(lay.to_stored, lay.from_stored),) if lay.to_stored is not None else ()
+    if lay.engine_channel is not None:
+        nov = texel_grid(axes)[0] if points is None else np.asarray(points["nov"])
+        rough = engine_diffuse.perceptual_roughness_grid(axes) if points is None else np.asarray(points["rough"])
+        stored += (engine_diffuse.diffuse_channel(lay.engine_channel, nov, rough),)
+    return per_texel_plan(
         integrand,
         estimator_for(o["estimator"], o["samples"], o["seed"], tolerance_of(o)),
         grid_for(axes, integrand) if points is None else points_grid(points, integrand),
@@ -270,14 +276,8 @@ def plan(spec, points: dict | None = None) -> TexelPlan:
         extra=specular_extra(integrand),
         interpolate=o["interpolation"] == "verified" and points is None,
         error_estimate=points is None,
+        stored=stored,
     )
-    if lay.to_stored is not None:
-        plan = with_stored_channels(plan, lay.to_stored, lay.from_stored)
-    if lay.engine_channel is not None:
-        nov = texel_grid(axes)[0] if points is None else np.asarray(points["nov"])
-        rough = engine_diffuse.perceptual_roughness_grid(axes) if points is None else np.asarray(points["rough"])
-        plan = engine_diffuse.with_diffuse_channel(plan, nov, rough, lay.engine_channel)
-    return plan
 
 
 SAMPLES_DOC = "integrand evaluations per texel; omitted: the estimator's default quality"

@@ -25,7 +25,8 @@ from ..layouts import exclusive_owner, layouts_of, lookup_layout, summaries
 from ..layouts.base import IOR_MAPPINGS, ior_axis, ior_values
 from ..records import HEMISPHERE_ESTIMATOR, MASKING, NDF
 from ..registry import Record, choices
-from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..runtime.plan import TexelPlan
+from ..sampling.plan import Grid, per_texel_plan
 from ..tolerance import tolerance_of
 from . import dfg
 from .base import Estimation, Key, declare

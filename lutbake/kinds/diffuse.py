@@ -18,8 +18,9 @@ from ..edge import alpha_policy, effective_alpha
 from ..limits import MAX_GL_ORDER
 from ..records import DIFFUSE, FACET_FRESNEL
 from ..registry import choices
+from ..runtime.plan import TexelPlan
 from ..sampling.diffuse_table import diffuse_grid, estimator_of
-from ..sampling.plan import TexelPlan, per_texel_plan
+from ..sampling.plan import per_texel_plan
 from .base import Estimation, Key, declare
 
 KEYS = {

@@ -18,9 +18,10 @@ import numpy as np
 from ..axes import Axis
 from ..records import FACET_FRESNEL
 from ..registry import choices
+from ..runtime.plan import TexelPlan
 from ..sampling.diffuse_table import diffuse_grid, estimator_of
 from ..sampling.groups import key_of, siblings_by_key
-from ..sampling.plan import TexelPlan, per_texel_plan
+from ..sampling.plan import per_texel_plan
 from . import diffuse
 from .base import Key, declare
 

@@ -19,7 +19,8 @@ from ..axes import Axis
 from ..metals import METALS
 from ..records import FRESNEL
 from ..registry import Record, choices
-from ..sampling.plan import TexelPlan, per_texel_plan
+from ..runtime.plan import TexelPlan
+from ..sampling.plan import per_texel_plan
 from ..tolerance import tolerance_of
 from . import dfg
 from .base import Key, declare

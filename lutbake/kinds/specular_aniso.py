@@ -22,7 +22,8 @@ from ..axes import Axis
 from ..edge import alpha_policy
 from ..records import ANISO_ESTIMATOR, ANISO_MODEL
 from ..registry import choices
-from ..sampling.plan import Grid, TexelPlan, per_texel_plan
+from ..runtime.plan import TexelPlan
+from ..sampling.plan import Grid, per_texel_plan
 from ..tolerance import tolerance_of
 from . import dfg
 from .base import Estimation, Key, declare

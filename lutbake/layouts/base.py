@@ -32,9 +32,9 @@ class Terms:
 @dataclass(frozen=True)
 class EngineChannel:
     """A channel an engine adds to a base layout's (Unity HDRP's pre-integrated diffuse as channel B): ``name``
-    its entry in lutbake.integrands.engine_diffuse.CHANNELS (the function that computes the (n, nch + 1) table
-    from the base channels and the Warp kernel it loads; named, so that reading the records imports no Warp),
-    ``scale`` the base channels' divisor as stored, ``description`` the lutbake:terms ``diffuse`` entry."""
+    its entry in lutbake.integrands.engine_diffuse.CHANNELS (the function that computes channel B at each texel
+    and the Warp kernel it loads; named, so that reading the records imports no Warp), ``scale`` the base channels'
+    divisor as stored, ``description`` the lutbake:terms ``diffuse`` entry."""
 
     name: str
     scale: float

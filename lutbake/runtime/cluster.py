@@ -5,11 +5,12 @@ validation before any work, content hashes and skipping (lutbake.batch), the pla
 provenance, the checks for non-finite values, atomic writes, the report, and SIGINT/SIGTERM (a cancelled
 table cancels its futures and writes nothing).
 
-- **A tile task is a pure function of (table spec, tile range)**: ``bake_tile(spec, start, stop, device,
-  token)``. The client ships the TableSpec (a few hundred bytes of plain data) and the worker re-plans it
-  (``lookup_kind(spec.kind).plan(spec)``, cached per spec and device in each worker process); no closure
-  is pickled. Every texel is integrated alone, so the same tile on any worker, in any order, cut in any
-  tile size, gives the same bits: a cluster bake is bit-identical to the local thread executor.
+- **A tile task is a pure function of (table spec, tile range)**: ``bake_tile(source, start, stop, device,
+  token)``. The client ships how to build the table's plan (lutbake.runtime.plan.PlanSource: the kind's module-level
+  ``plan`` function, pickled by reference, bound to the TableSpec, a few hundred bytes of plain data) and the worker
+  builds it (``source.build()``, cached per spec and device in each worker process); no kind is looked up by its
+  name there, and no closure is pickled. Every texel is integrated alone, so the same tile on any worker, in any
+  order, cut in any tile size, gives the same bits: a cluster bake is bit-identical to the local thread executor.
 - **Fault tolerance is Dask's**: tile results are gathered by the client as they finish, so a worker
   that dies costs only the tiles it held; the scheduler runs them again elsewhere
   (``distributed.scheduler.allowed-failures`` deaths of one task before it gives up on it; the table
@@ -54,9 +55,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..config import BYTES_PER_TEXEL, MAX_TEXELS
 from ..errors import ConfigError, LutbakeError
+from ..limits import BYTES_PER_TEXEL, MAX_TEXELS
 from ..textsafe import safe_repr
+from .plan import PlanSource, TexelPlan
 from .worker import identity, identity_token, init_warp_quietly
 
 SCHEDULER_FORMS = (
@@ -295,15 +297,13 @@ def _check_token(expect: str) -> None:
         )
 
 
-def worker_plan(spec, device: str):
-    """The plan of ``spec`` in this worker process, built and its kernels loaded for ``device`` once."""
-    from ..kinds import lookup_kind
-
-    key = (spec.kind, spec.toml(), device)
+def worker_plan(source: PlanSource, device: str) -> TexelPlan:
+    """The plan ``source`` builds, in this worker process built and its kernels loaded for ``device`` once."""
+    key = (source.key, device)
     with _WORKER_LOCK:
         plan = _PLANS.get(key)
         if plan is None:
-            plan = lookup_kind(spec.kind).plan(spec)
+            plan = source.build()
             plan.prepare(device)
             _PLANS[key] = plan
             while len(_PLANS) > PLAN_CACHE_SIZE:
@@ -313,23 +313,23 @@ def worker_plan(spec, device: str):
     return plan
 
 
-def bake_tile(spec, start: int, stop: int, device: str, token: str) -> tuple[np.ndarray, float]:
-    """The Dask task: float64 values of texels [start, stop) of ``spec`` (row-major, (stop - start,
+def bake_tile(source: PlanSource, start: int, stop: int, device: str, token: str) -> tuple[np.ndarray, float]:
+    """The Dask task: float64 values of texels [start, stop) of ``source``'s table (row-major, (stop - start,
     channels)) and the CPU seconds of this thread while they ran (a Warp CPU launch runs in the calling
     thread, so this is the tile's compute time whatever else loads the host)."""
     init_warp_quietly()
     _check_token(token)
-    plan = worker_plan(spec, device)
+    plan = worker_plan(source, device)
     t0 = time.thread_time()
     data = plan.run_tile(start, stop, device)
     return data, time.thread_time() - t0
 
 
-def estimate_error_task(spec, data: np.ndarray, device: str, token: str) -> tuple:
+def estimate_error_task(source: PlanSource, data: np.ndarray, device: str, token: str) -> tuple:
     """The Dask task of the plan's error estimate (it runs kernels, so it runs where the tiles ran)."""
     init_warp_quietly()
     _check_token(token)
-    return worker_plan(spec, device).error_estimate(data, device)
+    return worker_plan(source, device).error_estimate(data, device)
 
 
 def setup_local_worker() -> None:
@@ -352,7 +352,7 @@ class Stats:
     """What a runner moved and ran, for ``make bench`` and the tests."""
 
     tiles: int = 0
-    bytes_to_workers: int = 0  # pickled task arguments (spec, range, device, token)
+    bytes_to_workers: int = 0  # pickled task arguments (plan source, range, device, token)
     bytes_from_workers: int = 0  # tile results (float64 arrays)
     bytes_estimate_inputs: int = 0  # baked tables shipped to a worker for their error estimate
     worker_seconds: float = 0.0  # the tiles' CPU time on the workers, summed
@@ -427,15 +427,16 @@ class DaskRunner:
 
     def execute(
         self,
-        spec,
-        plan,
+        source: PlanSource,
+        plan: TexelPlan,
         device: str,
         progress=None,
         label: str = "",
         cancel: threading.Event | None = None,
     ) -> np.ndarray:
         """lutbake.runtime.executor.execute_tiles() on the cluster: float64 (n_texels, plan.tile_width)
-        (``progress``: an executor.Progress factory, updated in the calling thread as tiles arrive)."""
+        of ``source``'s table, its ``plan`` built on this client (``progress``: an executor.Progress factory, updated
+        in the calling thread as tiles arrive)."""
         from .devices import plan_tile_texels
         from .executor import Cancelled, tiles
 
@@ -445,16 +446,16 @@ class DaskRunner:
         parts = tiles(
             plan.n_texels, plan_tile_texels(plan, device, self.cuda_free_bytes) if cuda else CLUSTER_TILE_TEXELS
         )
-        prefix = f"lutbake-{spec.name}-{uuid.uuid4().hex[:8]}-{device}"
+        prefix = f"lutbake-{source.name}-{uuid.uuid4().hex[:8]}-{device}"
         with self.stats.lock:
             self.tables += 1
             priority = -self.tables  # tables in submission order: each worker's plan cache stays warm
         futures = {}
         for s, e in parts:
             futures[
-                self._submit(bake_tile, spec, s, e, device, self.token, key=f"{prefix}-{s}-{e}", priority=priority)
+                self._submit(bake_tile, source, s, e, device, self.token, key=f"{prefix}-{s}-{e}", priority=priority)
             ] = (s, e)
-        sent = len(pickle.dumps((spec, 0, plan.n_texels, device, self.token), protocol=5))
+        sent = len(pickle.dumps((source, 0, plan.n_texels, device, self.token), protocol=5))
         out = np.empty((plan.n_texels, plan.tile_width), dtype=np.float64)
         pending = set(futures)
         finished: queue.Queue = queue.Queue()
@@ -481,11 +482,11 @@ class DaskRunner:
                     self.stats.bytes_to_workers += sent
                     self.stats.bytes_from_workers += data.nbytes
                     self.stats.worker_seconds += seconds
-                    self.stats.tile_seconds.append((spec.name, e - s, seconds))
+                    self.stats.tile_seconds.append((source.name, e - s, seconds))
                 if update is not None:
                     update(e - s)
                 if self.on_tile is not None:
-                    self.on_tile(spec.name, s, e)
+                    self.on_tile(source.name, s, e)
         finally:
             if pending:  # cancelled or failed: no tile of this table runs any more
                 self.client.cancel(list(pending))
@@ -493,14 +494,14 @@ class DaskRunner:
                     self.stats.cancelled += len(pending)
         return out
 
-    def estimate_error(self, spec, data: np.ndarray, device: str) -> tuple:
-        key = f"lutbake-{spec.name}-{uuid.uuid4().hex[:8]}-{device}-error-estimate"
+    def estimate_error(self, source: PlanSource, data: np.ndarray, device: str) -> tuple:
+        key = f"lutbake-{source.name}-{uuid.uuid4().hex[:8]}-{device}-error-estimate"
         import dask
 
         # the table travels inside the task (not scattered to one worker, whose death would lose it): the task
         # can then run again elsewhere like a tile; a 1024^2 table is 16 MiB, above Dask's warning threshold
         with dask.config.set({"distributed.admin.large-graph-warning-threshold": MAX_TABLE_BYTES}):
-            fut = self._submit(estimate_error_task, spec, data, device, self.token, key=key, priority=1)
+            fut = self._submit(estimate_error_task, source, data, device, self.token, key=key, priority=1)
         with self.stats.lock:
             self.stats.bytes_estimate_inputs += data.nbytes
         return fut.result()

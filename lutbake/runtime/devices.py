@@ -49,7 +49,7 @@ def tile_texels(
 
 
 def plan_tile_texels(plan, device: str = "cpu", free_bytes: int | None = None) -> int:
-    """tile_texels() of a lutbake.sampling.plan.TexelPlan (on the CPU its own tile_texels where it has one)."""
+    """tile_texels() of a lutbake.runtime.plan.TexelPlan (on the CPU its own tile_texels where it has one)."""
     if plan.tile_texels and not str(device).startswith("cuda"):
         return plan.tile_texels
     return tile_texels(plan.n_texels, plan.cost / max(1, plan.n_texels), plan.n_channels, device, free_bytes)

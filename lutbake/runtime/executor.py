@@ -16,9 +16,9 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from ..sampling.plan import TexelPlan
 from .devices import CPU_TILE_TEXELS as TILE_TEXELS
 from .devices import plan_tile_texels
+from .plan import PlanSource, TexelPlan
 from .warp_runtime import defining
 
 # progress(label, n_texels, cost) -> update(n_done_in_this_tile) or None: called once per table before its tiles run
@@ -50,22 +50,23 @@ def execute_tiles(
     progress: Progress | None = None,
     label: str = "",
     cancel: threading.Event | None = None,
-    spec=None,
+    source: PlanSource | None = None,
     cpu: list[float] | None = None,
     runner=None,
 ) -> np.ndarray:
     """Evaluate every tile of ``plan``; returns float64 (n_texels, plan.tile_width): the values, then the aux
-    columns (lutbake.sampling.plan.TexelPlan.aux_channels).
+    columns (lutbake.runtime.plan.TexelPlan.aux_channels).
 
     ``progress``: a ``Progress`` factory; its update is called in the calling thread after each tile.
     ``cancel``: when set (by another thread), no further tile starts and Cancelled is raised.
-    ``spec``: the TableSpec ``plan`` came from; with a ``runner`` (lutbake.runtime.cluster.DaskRunner, or any object
-    with its ``execute`` and ``estimate_error``) the tiles run there instead, as tasks of (spec, tile range). Tiles
+    ``source``: how another process builds ``plan`` (lutbake.runtime.plan.PlanSource); with a ``runner``
+    (lutbake.runtime.cluster.DaskRunner, or any object with its ``execute`` and ``estimate_error``) the tiles run there
+    instead, as tasks of (source, tile range). Tiles
     are TILE_TEXELS on the CPU, device-sized on CUDA (lutbake.runtime.devices). ``cpu``: a list that receives the
     CPU seconds of the kernels' preparation and of each tile, each measured in the thread that ran it
     (time.thread_time; not for tiles run on a cluster)."""
-    if runner is not None and spec is not None:
-        return runner.execute(spec, plan, device, progress=progress, label=label, cancel=cancel)
+    if runner is not None and source is not None:
+        return runner.execute(source, plan, device, progress=progress, label=label, cancel=cancel)
     workers = workers or default_workers()
     cpu = cpu if cpu is not None else []
     # tables prepare in parallel: one builds its Warp kernels at a time (warp_runtime.defining), their modules
@@ -102,14 +103,16 @@ def execute_tiles(
     return out
 
 
-def estimate_error(plan: TexelPlan, data: np.ndarray, device: str = "cpu", spec=None, runner=None) -> tuple | None:
+def estimate_error(
+    plan: TexelPlan, data: np.ndarray, device: str = "cpu", source: PlanSource | None = None, runner=None
+) -> tuple | None:
     """``plan.error_estimate`` of baked ``data`` (flat float64, (n_texels, tile_width)): (error, method[, where texels
     end over the tolerance]), None if the kind has none; with a ``runner`` (see execute_tiles) it runs on a worker, as
     the tiles did."""
     if plan.error_estimate is None:
         return None
-    if runner is not None and spec is not None:
-        return runner.estimate_error(spec, data, device)
+    if runner is not None and source is not None:
+        return runner.estimate_error(source, data, device)
     with defining():  # the refined estimator builds its kernels here
         return plan.error_estimate(data, device)
 

@@ -58,7 +58,7 @@ def identity() -> dict[str, str]:
     import warp
 
     from .. import __version__
-    from ..provenance import sources_digest
+    from ..sources import sources_digest
 
     return {
         "lutbake": __version__,

@@ -13,9 +13,10 @@ import numpy as np
 
 from ..edge import ALPHA_MIN, alpha_policy
 from ..runtime.memo import RowMemo
+from ..runtime.plan import TexelPlan
 from . import points
 from .mu_average import mu_averages, mu_target
-from .plan import Grid, TexelPlan, probe_indices
+from .plan import Grid, probe_indices
 
 # kind dielectric_avg: while a texel's mu estimate (its panels' differences between the Kronrod and the Gauss rule of
 # the mu_order pair) exceeds a quarter of its target, its worst panel is bisected, up to MU_MAX_PANELS panels. Inside

@@ -1,9 +1,7 @@
-"""One texel plan for every kind: ``per_texel_plan(integrand, estimator, grid)``.
-
-A *texel plan* (``TexelPlan``) is everything the executor needs: the axes, the channel meanings, the texel count
-and ``run_tile(start, stop, device)``, a pure function of (spec, tile bounds) that returns the float64 values of
-texels [start, stop) in row-major order (slowest axis first), so tiles can be handed to any worker, thread or
-cluster, and the result is bit-identical however they are cut.
+"""One texel plan for every kind: ``per_texel_plan(integrand, estimator, grid)``, a lutbake.runtime.plan.TexelPlan
+(everything the executor needs; its ``run_tile(start, stop, device)`` is a pure function of the spec and the tile
+bounds, so tiles can be handed to any worker, thread or cluster, and the result is bit-identical however they are
+cut).
 
 The three parts it composes stay apart, as in ``warp.fem.integrate(integrand, domain, quadrature)``:
 - the **integrand** (lutbake.integrands): what is integrated per texel, a record holding its ``@wp.func``s;
@@ -18,62 +16,17 @@ The error estimate re-evaluates one set of probe texels (``probe_indices``) with
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from ..axes import Axis
+from ..runtime.plan import TexelPlan
 from ..tolerance import over_tolerance
 
 PROBE_STRIDED = 256  # strided probe texels of the error estimate
 PROBE_EXTREME = 64  # ... plus at most this many of the most grazing and of the smallest-alpha texels
-
-
-@dataclass
-class TexelPlan:
-    axes: list[Axis]  # slowest first; image dims z, y, x
-    channels: dict[str, str]
-    reconstruction: str
-    n_texels: int
-    n_channels: int
-    run_tile: Callable[[int, int, str], np.ndarray]
-    prepare: Callable[[str], None]  # compile kernels before threads launch them
-    samples: int  # integrand evaluations per texel (nominal)
-    estimator: str
-    terms: dict[str, str]
-    cost: float  # integrand evaluations in total, for the progress bar
-    extra: dict[str, str] = field(default_factory=dict)
-    # (flat float64 tile data (n_texels, tile_width), device) -> (estimated max error, how it was estimated[, where
-    # texels end over the tolerance: lutbake.tolerance.over_tolerance, "" when none])
-    error_estimate: Callable[[np.ndarray, str], tuple[float, str]] | None = None
-    # (data of plan.shape) -> extra lutbake:* attributes known only after the bake (ltc: fit-error statistics)
-    attributes_after: Callable[[np.ndarray], dict[str, str]] | None = None
-    # columns run_tile returns after the table's channels (an adaptive estimator's per-texel error estimates):
-    # they travel with the tile, so the estimate is a pure function of the tiles wherever they ran, and are
-    # handed to error_estimate, never stored in the table
-    aux_channels: int = 0
-    # texels per CPU tile where the plan wants other than lutbake.runtime.executor.TILE_TEXELS (kind btf: whole
-    # (sigma, phi) blocks, so that a tile holds a texel and its reciprocal); any cut still gives the same values
-    tile_texels: int | None = None
-
-    @property
-    def tile_width(self) -> int:
-        """Columns of run_tile's result: n_channels values, then aux_channels."""
-        return self.n_channels + self.aux_channels
-
-    @property
-    def shape(self) -> tuple[int, ...]:
-        """(z,) y, x, C; a 1D table (one x axis) is one image row: (1, x, C). A ``y_block`` axis is
-        flattened into the rows: y = y_block count x y count (row = block * y count + y index)."""
-        counts = tuple(a.count for a in self.axes if a.dim != "y_block")
-        blocks = [a.count for a in self.axes if a.dim == "y_block"]
-        if blocks:
-            dims = [a.dim for a in self.axes if a.dim != "y_block"]
-            counts = tuple(c * blocks[0] if d == "y" else c for c, d in zip(counts, dims))
-        if len(counts) == 1:
-            counts = (1,) + counts
-        return counts + (self.n_channels,)
 
 
 @dataclass(frozen=True)
@@ -98,6 +51,48 @@ class Grid:
     def rows(self, idx) -> dict[str, Any]:
         """The inputs of texels ``idx`` (a slice or an index array)."""
         return {k: v[idx] for k, v in self.inputs.items()}
+
+
+@dataclass(frozen=True)
+class StoredMap:
+    """What a table stores of its integrand's channels where that is not the integrals themselves: a layout's map
+    (lutbake.layouts.base.Layout.to_stored / from_stored, ``StoredMap.of_values``) or an engine's added channel
+    (lutbake.integrands.engine_diffuse.diffuse_channel). ``to_stored(values, texels, device)``: the integrals (or the
+    previous map's values) of the texels ``texels`` (a slice), (n, C), -> the stored values, (n, C + added);
+    ``from_stored(stored)``: back to what it was given, (n, C), for the error estimate; ``prepare(device)``: the
+    kernels ``to_stored`` launches, loaded with the estimator's."""
+
+    to_stored: Callable[[np.ndarray, slice, str], np.ndarray]
+    from_stored: Callable[[np.ndarray], np.ndarray] | None
+    added: int = 0
+    prepare: Callable[[str], None] | None = None
+
+    @classmethod
+    def of_values(cls, to_stored: Callable, from_stored: Callable | None) -> StoredMap:
+        """The map of each texel's values alone: ``to_stored(values)``, ``from_stored(stored)``."""
+        return cls(lambda values, texels, device: to_stored(values), from_stored)
+
+
+def stored_through(stored: tuple[StoredMap, ...], nch: int, run_tile: Callable, error_estimate: Callable | None):
+    """(run_tile, error_estimate) of a plan whose table holds the ``nch`` integrals passed through ``stored`` (in
+    order), the tiles' aux columns untouched; the error estimate sees the integrals again (each map's from_stored, in
+    reverse order), as the estimator produced them."""
+    width = nch + sum(m.added for m in stored)
+
+    def run(start: int, stop: int, device: str) -> np.ndarray:
+        tile = run_tile(start, stop, device)
+        values = tile[:, :nch]
+        for m in stored:
+            values = m.to_stored(values, slice(start, stop), device)
+        return np.concatenate([values, tile[:, nch:]], axis=1)
+
+    def estimate(data: np.ndarray, device: str):
+        values = data[:, :width]
+        for m in reversed(stored):
+            values = m.from_stored(values)
+        return error_estimate(np.concatenate([values, data[:, width:]], axis=1), device)
+
+    return run, estimate if error_estimate is not None else None
 
 
 def probe_indices(grid: Grid) -> np.ndarray:
@@ -128,6 +123,7 @@ def per_texel_plan(
     tile_texels: int | None = None,
     interpolate: bool = False,
     siblings: Callable[[int, int], np.ndarray | None] | None = None,
+    stored: tuple[StoredMap, ...] = (),
 ) -> TexelPlan:
     """The texel plan of ``grid``'s texels integrated by ``estimator``: texel i = estimator.evaluate(integrand,
     grid inputs of i), the first ``integrand.nch`` channels kept.
@@ -137,7 +133,9 @@ def per_texel_plan(
     ``siblings(start, stop)``: the texels (sorted, a superset of the tile's) to evaluate in one call with tile
     [start, stop), or None for the tile alone: an estimator that shares work between texels of one call
     (lutbake.sampling.dielectric.sibling_tiles) gets them together; each texel is evaluated once per plan (a memo:
-    the tiles of its siblings take its row), and its value does not depend on its company."""
+    the tiles of its siblings take its row), and its value does not depend on its company.
+    ``stored``: what the table holds of the integrals where it is not them (StoredMap: a layout's map, an engine's
+    added channel), applied in order to each tile's channels; the error estimate sees the integrals."""
     from ..runtime.memo import RowMemo
     from . import interpolation
 
@@ -220,41 +218,31 @@ def per_texel_plan(
         return tile_rows(s, e, lambda idx: run(idx, estimator, device))
 
     run_tile = verified.run_tile if verified else run_adaptive if adaptive else run_fixed
+    error = (adaptive_estimate if adaptive else estimate) if error_estimate else None
+    if stored:
+        run_tile, error = stored_through(stored, integrand.nch, run_tile, error)
+
+    def prepare(device: str) -> None:
+        estimator.prepare(integrand, device)
+        for m in stored:
+            if m.prepare is not None:
+                m.prepare(device)
+
     samples = estimator.samples(grid.inputs)  # evaluations per texel
     return TexelPlan(
         axes=grid.axes,
         channels=channels,
         reconstruction=reconstruction,
         n_texels=grid.n_texels,
-        n_channels=integrand.nch,
+        n_channels=integrand.nch + sum(m.added for m in stored),
         run_tile=run_tile,
-        prepare=lambda d: estimator.prepare(integrand, d),
+        prepare=prepare,
         samples=int(round(np.mean(samples))),
         estimator=estimator.name,
         terms=terms,
         cost=float(np.sum(samples)),
         extra={**(extra or {}), **tolerance_record},
-        error_estimate=(adaptive_estimate if adaptive else estimate) if error_estimate else None,
+        error_estimate=error,
         aux_channels=(integrand.nch + (1 if verified else 0)) if adaptive else 0,
         tile_texels=interpolation.tile_texels(grid.axes) if verified else tile_texels,
     )
-
-
-def with_stored_channels(plan: TexelPlan, to_stored: Callable, from_stored: Callable) -> TexelPlan:
-    """``plan`` with its channels passed through ``to_stored`` (the integrals (n, C) -> the stored values (n, C), a
-    layout's map: lutbake.layouts.base.Layout.to_stored), the tiles' aux columns untouched; the error estimate sees
-    the integrals again through ``from_stored`` (its inverse), as the estimator produced them."""
-    base_tile = plan.run_tile
-    nch = plan.n_channels
-
-    def run_tile(start: int, stop: int, device: str) -> np.ndarray:
-        base = base_tile(start, stop, device)
-        return np.concatenate([to_stored(base[:, :nch]), base[:, nch:]], axis=1)
-
-    base_estimate = plan.error_estimate
-    if base_estimate is not None:
-        plan.error_estimate = lambda data, device: base_estimate(
-            np.concatenate([from_stored(data[:, :nch]), data[:, nch:]], axis=1), device
-        )
-    plan.run_tile = run_tile
-    return plan

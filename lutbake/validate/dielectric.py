@@ -289,10 +289,10 @@ def openpbr_ratio_rows():
     """{IOR index z: (n, 4) float64 rows of the openpbr dielectric_avg layout at RATIO_ALPHAS} for RATIO_ROW_PAIRS,
     baked by the kind's own plan (each tile computes its mirror row's averages itself)."""
     from ..config import validate_table
-    from ..kinds import lookup_kind
+    from ..pipeline import plan_of
 
     raw = {"name": "openpbr_ratio_check", "kind": "dielectric_avg", "layout": "openpbr"}
-    plan = lookup_kind("dielectric_avg").plan(validate_table(raw, "<openpbr_reflection_ratio_reciprocity>", 0))
+    plan = plan_of(validate_table(raw, "<openpbr_reflection_ratio_reciprocity>", 0))
     lo, hi = RATIO_ALPHAS
     rows = {}
     for pair in RATIO_ROW_PAIRS:
