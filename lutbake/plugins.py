@@ -51,7 +51,7 @@ from pathlib import Path
 
 from .errors import ConfigError
 from .records import DIFFUSE, FRESNEL, LTC_LOBE, NDF
-from .registry import _PLUGIN_LOADER, Plugin, Record, RegistryError
+from .registry import _PLUGIN_LOADER, FAMILIES, Plugin, Record, RegistryError
 
 ENTRY_POINT_GROUP = "lutbake.plugins"
 _STATE = threading.local()  # .plugin: the plugin whose code is running (load_plugin, entry points)
@@ -96,7 +96,9 @@ def _add(family, func, name: str, description: str, citation: str, aliases, fiel
     plugin, line = _caller_plugin(func)
     record = Record(family.name, name, description.strip(), citation, tuple(aliases), fields, plugin, line)
     family.add(record)
-    _STATE.__dict__.setdefault("added", []).append(record)
+    for bucket in (_STATE.__dict__.get("added"), _STATE.__dict__.get("collect")):
+        if bucket is not None:
+            bucket.append(record)
     return record
 
 
@@ -169,7 +171,8 @@ def register_brdf(
 
     if roughness not in ROUGHNESS:
         raise RegistryError(f"roughness {roughness!r}: one of {', '.join(ROUGHNESS)}")
-    lobe = custom_lobe(name, _need_func("f_cos", f_cos), roughness)
+    plugin, _ = _caller_plugin(f_cos)
+    lobe = custom_lobe(name, _need_func("f_cos", f_cos), roughness, plugin.sha256)
     return _add(LTC_LOBE, f_cos, name, description, citation, aliases, {"obj": lobe})
 
 
@@ -240,9 +243,27 @@ def load_plugin(path) -> list[Record]:
 
 
 def _load(plugin: Plugin) -> list[Record]:
-    records = _execute(plugin)
-    compile_records(records)
-    return records
+    """Run and compile a plugin; on any failure no record of it stays registered."""
+    with _rolled_back() as added:
+        _execute(plugin)
+        compile_records(added)
+    return added
+
+
+@contextlib.contextmanager
+def _rolled_back():
+    """Collect the records registered inside; if the block raises, unregister them (and re-raise)."""
+    added: list[Record] = []
+    outer = _STATE.__dict__.get("collect")
+    _STATE.collect = added
+    try:
+        yield added
+    except BaseException:
+        for record in added:
+            FAMILIES[record.family].remove(record)
+        raise
+    finally:
+        _STATE.collect = outer
 
 
 def _ship_loader(plugin: Plugin) -> None:
@@ -279,7 +300,7 @@ def load_entry_points() -> list[Record]:
             origin = spec.origin if spec is not None and spec.origin else f"module {module}"
             text = Path(origin).read_text(encoding="utf-8") if Path(origin).is_file() else ""
             plugin = Plugin(origin, text, module)
-            with _running(plugin) as added:
+            with _rolled_back() as added, _running(plugin):
                 try:
                     ep.load()
                 except RegistryError as e:
@@ -290,7 +311,7 @@ def load_entry_points() -> list[Record]:
                         _failure_line(origin, e),
                         f"cannot be imported: {type(e).__name__}: {e}",
                     ) from None
-            compile_records(added)
+                compile_records(added)
             _LOADED[origin] = plugin
             records += added
         return records

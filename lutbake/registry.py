@@ -151,6 +151,13 @@ class Family:
         self._aliases.update({a: record.name for a in record.aliases})
         return record
 
+    def remove(self, record: Record) -> None:
+        """Take ``record`` out (a plugin that failed after registering it: lutbake.plugins), if it is still held."""
+        if self._records.get(record.name) is record:
+            del self._records[record.name]
+            for a in record.aliases:
+                self._aliases.pop(a, None)
+
     def lookup(self, name: str) -> Record:
         key = self._aliases.get(name, name)
         if key not in self._records:

@@ -203,7 +203,9 @@ class FakeClock:
 def fake_result(name, status="baked", kind="dfg", size=(10, 10)):
     from types import SimpleNamespace
 
-    spec = SimpleNamespace(name=name, kind=kind, options={"size": list(size), "samples": None})
+    from lutbake.config import validate_table
+
+    spec = validate_table({"name": name, "kind": kind, "size": list(size)}, "<fake>", 0)
     return SimpleNamespace(
         name=name, spec=spec, status=status, path=f"out/{name}.exr", shape="10x10x2", seconds=1.0, samples=48,
         values_from=None, message="", cache_error=None,

@@ -15,7 +15,7 @@ import pytest
 from hemisphere_reference import hemisphere_integral
 
 import lutbake
-from lutbake.config import load_configs, validate_table
+from lutbake.config import load_configs, preset_path, validate_table
 from lutbake.errors import ConfigError
 from lutbake.io.describe import describe
 from lutbake.io.readers import read_table
@@ -251,3 +251,32 @@ def test_an_installed_packages_entry_point_registers_its_records(tmp_path):
     assert r.returncode == 0, r.stderr
     assert f"entry_sq {tmp_path / 'entry_pkg.py'} 9" in r.stdout
     assert "entry_sq" in r.stdout.split("Fresnel", 1)[1] and "[plugin" in r.stdout
+
+
+BRDF_PLUGIN = """
+import warp as wp
+import lutbake
+from lutbake.terms import diffuse
+
+@wp.func
+def f_cos_eon(v: wp.vec3, l: wp.vec3, r: float):
+    return diffuse.Fd_eon(1.0, l[2], v[2], wp.dot(l, v), r) * l[2]
+
+lutbake.register_brdf("my_eon", f_cos_eon, roughness="alpha", description="EON's terms as a whole BRDF")
+"""
+
+
+def test_a_plugin_brdf_with_eons_terms_fits_eons_ltc(tmp_path):
+    """register_brdf: the ltc kind fits a plugin's f(l, v)(n.l) as its own lobes; with EON's terms the matrices and
+    the magnitude are lutbake's eon lobe's (whose magnitude the diffuse kind integrates: E = 1, exact albedo)."""
+    (tmp_path / "eon.py").write_text(BRDF_PLUGIN)
+    lutbake.load_plugin(tmp_path / "eon.py")
+    over = ["size=[5, 5]", "fit_samples=16", 'format="exr"', 'dtype="float32"']
+    (mine,) = load_configs([preset_path("ltc-ggx")], [*over, 'lobe="my_eon"'])
+    (eon,) = load_configs([preset_path("ltc-ggx")], [*over, 'lobe="eon"'])
+    a, _, _ = lutbake.bake_table(mine)
+    b, _, _ = lutbake.bake_table(eon)
+    print("magnitudes", a.data[1, ..., 0], b.data[1, ..., 0])
+    print("max |matrix difference|", np.abs(a.data[0] - b.data[0]).max())
+    np.testing.assert_allclose(a.data[1, ..., 0], b.data[1, ..., 0], atol=1e-6)  # magnitude: EON's exact albedo
+    np.testing.assert_allclose(a.data[0], b.data[0], atol=1e-5)  # the inverse matrices

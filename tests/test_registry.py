@@ -13,30 +13,35 @@ from lutbake.sampling import hemisphere
 from lutbake.terms import distributions
 
 
+def own(fam) -> list:
+    """lutbake's own records of a family (a plugin loaded by another test in this process may add its own)."""
+    return [r for r in fam if r.plugin is None]
+
+
 def test_every_ndf_record_names_its_distribution():
-    assert NDF.names() == list(distributions.NDFS)
-    for r in NDF:
+    assert [r.name for r in own(NDF)] == list(distributions.NDFS)
+    for r in own(NDF):
         d = r.obj
         assert d is distributions.NDFS[r.name] and d.name == r.name
         assert r.fields["smith"] == (d.Lambda is not None), r.name
         assert r.fields["vndf"] == (d.sample_vndf is not None), r.name
-        for m in MASKING:
+        for m in own(MASKING):
             assert (not m.fields["smith"] or r.fields["smith"]) == d.masking_allowed(m.name), (r.name, m.name)
 
 
 def test_every_ltc_lobe_record_names_its_lobe():
-    assert LTC_LOBE.names() == list(LOBES)
-    assert all(r.obj is LOBES[r.name] for r in LTC_LOBE)
+    assert [r.name for r in own(LTC_LOBE)] == list(LOBES)
+    assert all(r.obj is LOBES[r.name] for r in own(LTC_LOBE))
 
 
 def test_fresnel_records_load_their_terms_and_linear_ones_factor_f0():
     import numpy as np
 
     c = np.linspace(0.0, 1.0, 9)
-    values = fresnel.evaluate(c, f0=0.3, n=1.5, k=2.0, a=0.5)
-    assert list(values) == FRESNEL.names()
-    zero = fresnel.evaluate(c, f0=0.0)
-    for r in FRESNEL:
+    values = fresnel.evaluate(c, f0=0.3, n=1.5, k=2.0, a=0.5, fresnels=own(FRESNEL))
+    assert list(values) == [r.name for r in own(FRESNEL)]
+    zero = fresnel.evaluate(c, f0=0.0, fresnels=own(FRESNEL))
+    for r in own(FRESNEL):
         assert callable(r["F"]) and r.fields["param"] in ("f0", "nk", "nka")
         if r.fields["linear_in_f0"]:  # F = f0 + (1 - f0) Fc, Fc = F(0, c)
             np.testing.assert_allclose(values[r.name], 0.3 + 0.7 * zero[r.name], atol=2e-7)
@@ -44,7 +49,7 @@ def test_fresnel_records_load_their_terms_and_linear_ones_factor_f0():
 
 def test_the_implementations_cover_exactly_the_records():
     assert set(diffuse.FACET_F0_SCALE) == set(FACET_FRESNEL.names())
-    assert all(r.get("Fd") is not None for r in DIFFUSE if r.name not in ("lambert", "microfacet"))
+    assert all(r.get("Fd") is not None for r in own(DIFFUSE) if r.name not in ("lambert", "microfacet"))
     assert set(hemisphere.DEFAULT_SAMPLES) == set(HEMISPHERE_ESTIMATOR.names())
     assert [hemisphere.estimator_for(r.name, 12).name for r in HEMISPHERE_ESTIMATOR] == HEMISPHERE_ESTIMATOR.names()
     assert all(r.fields["form"] in ("microfacet", "blinn_phong", "ashikhmin_shirley") for r in MODEL)
@@ -52,7 +57,7 @@ def test_the_implementations_cover_exactly_the_records():
 
 def test_every_record_has_a_description_and_a_citation():
     for fam in (NDF, MASKING, FRESNEL, MODEL, DIFFUSE, FACET_FRESNEL, LTC_LOBE, HEMISPHERE_ESTIMATOR):
-        for r in fam:
+        for r in own(fam):
             assert r.description and r.citation, (fam.name, r.name)
 
 

@@ -183,17 +183,18 @@ def audit_ltc(
     t1, t2 = read_ltc_pair(Path(path))
     n_view, n_rough = t1.shape[:2]
     o = {**spec.options, "size": [n_view, n_rough]}
-    axes = axes_for(o)
+    lobe = spec.records["lobe"].obj
+    axes = axes_for(o, lobe)
     nov_all, alpha_fit = texel_params(axes, o["alpha_min"])
     alpha_mag = magnitude_alpha(axes, o["alpha_min"])
     iy, ix = subset(n_view, max_side), subset(n_rough, max_side)
     texel = (iy[:, None] * n_rough + ix[None, :]).ravel()
     nov, a_fit, a_mag = nov_all[texel], alpha_fit[texel], alpha_mag[texel]
-    mag, fres = magnitude_fresnel(o["lobe"], nov, a_mag, None)
+    mag, fres = magnitude_fresnel(lobe, nov, a_mag, None)
     f_t2 = t2.reshape(-1, 4)[texel]
     errors, findings = {}, []
     rough = axes[2].values()
-    hyps = ltc_hypotheses(o["lobe"], axes, iy, ix, nov_all, alpha_mag, mag, f_t2[:, 0])
+    hyps = ltc_hypotheses(lobe, axes, iy, ix, nov_all, alpha_mag, mag, f_t2[:, 0])
     # judged by the median |error| (the grazing row's sampling noise dominates an RMS; see the module docstring)
     nominal, best = hyps[0], min(hyps, key=lambda h: h["median"])
     mismatch = best is not nominal and best["median"] < MISMATCH_RATIO * nominal["median"]
@@ -224,7 +225,7 @@ def audit_ltc(
         errors["sphere (t2.w)"] = stats(f_t2[:, 3] - sph)
     # the matrices: fit quality, not coefficients
     sub_ny, sub_nx = len(iy), len(ix)
-    problem = fit.Problem(o["lobe"], nov, a_fit, mag, o["fit_samples"])
+    problem = fit.Problem(lobe, nov, a_fit, mag, o["fit_samples"])
     idx = np.arange(len(texel))
     # lutbake.ltc.fit.MEMO: audits of one table size (or the bake of its preset) share their texels' fits, same bits
     coarse = fit.coarse_pass(problem, sub_ny, sub_nx, fit.MEMO)

@@ -114,6 +114,21 @@ def _diffuse_integrand(model, facet) -> DiffuseIntegrand:
     return DiffuseIntegrand(model.name, facet.name, brdf_for(model, facet), T, c, facet["F"])
 
 
+@functools.lru_cache(maxsize=None)
+def lobe_integrand(lobe) -> DiffuseIntegrand:
+    """A plugin's cosine-weighted lobe (lutbake.ltc.lobes.custom_lobe) as a diffuse BRDF for the diffuse kind's
+    estimators: f(l, v) = f_cos(v, l, x) / (n.l), x its parameter (passed as sigma), 0 where n.l <= COS_EPS."""
+    f_cos = lobe.f_cos
+
+    @wp.func
+    def brdf(l: wp.vec3, v: wp.vec3, sigma: float, alpha: float, f0: float, rule: wp.array(dtype=wp.vec2d)):
+        if l[2] <= COS_EPS:
+            return wp.float64(0.0)
+        return wp.float64(f_cos(v, l, sigma)) / wp.float64(l[2])
+
+    return DiffuseIntegrand(lobe.name, "", brdf, None, None)
+
+
 def _alpha(sigma, sigma_to_alpha: str):
     return effective_alpha(sigma_alpha(np.asarray(sigma, np.float32), sigma_to_alpha), False)
 

@@ -41,6 +41,7 @@ from ..ltc.table import LtcBake
 from ..records import LTC_LOBE
 from ..registry import choices
 from ..sampling.plan import TexelPlan
+from ..tolerance import tolerance_of
 from .base import Estimation, Key, declare
 
 THETA_MAX = 1.57  # ltc_code fitTab: theta = min(1.57, acos(1 - x^2))
@@ -152,11 +153,13 @@ CHANNELS = {
 }
 
 
-def axes_for(o: dict) -> list[Axis]:
-    from ..ltc.lobes import LOBES
+def axes_for(o: dict, lb=None) -> list[Axis]:
+    """[texture slice, NoV, roughness] axes of an ltc table fitting the Lobe ``lb`` (its roughness names the x axis;
+    None: lutbake's lobe named by ``o["lobe"]``, for host helpers and tests)."""
+    from ..ltc.lobes import lobe
 
     n_view, n_rough = o["size"]
-    lb = LOBES[o["lobe"]]
+    lb = lobe(lb if lb is not None else o["lobe"])
     rname = {"alpha": "alpha", "sigma": "sigma", "diffuse_roughness": "diffuse_roughness"}.get(
         lb.roughness, "perceptual_roughness"
     )
@@ -172,14 +175,12 @@ def axes_for(o: dict) -> list[Axis]:
 
 
 def plan(spec) -> TexelPlan:
-    from ..ltc.lobes import LOBES
-
     o = spec.options
-    axes = axes_for(o)
-    state = LtcBake(o, axes)
+    lb = spec.records["lobe"].obj
+    axes = axes_for(o, lb)
+    state = LtcBake(o, axes, lb, tolerance_of(o))
     n = axes[1].count * axes[2].count
-    lb = LOBES[o["lobe"]]
-    m_samples = 0 if lb.magnitude in ("lambert", "lobe") else o["samples"]
+    m_samples = 0 if lb.magnitude in ("lambert", "lobe", "lobe_adaptive") else o["samples"]
     if o["estimator"] == "gauss_legendre" and not m_samples:
         m_samples = MAGNITUDE_SAMPLES.get(o["lobe"])
     terms = {
@@ -208,25 +209,24 @@ def plan(spec) -> TexelPlan:
         terms=terms,
         cost=float(n) * 300 * 2 * o["fit_samples"] ** 2,
         extra=extra,
-        attributes_after=fit_error_stats,
+        attributes_after=lambda data: {**fit_error_stats(data), **state.magnitude_attributes()},
     )
 
 
 def check_spec(spec):
-    from ..ltc.lobes import LOBES
-
     o = spec.options
-    if o["estimator"] != "gauss_legendre" and LOBES[o["lobe"]].magnitude not in ("dfg:ggx", "dfg:beckmann"):
+    lb = spec.records["lobe"].obj
+    if o["estimator"] != "gauss_legendre" and lb.magnitude not in ("dfg:ggx", "dfg:beckmann"):
         return (
             "estimator",
             f"estimator {o['estimator']!r} samples the GGX / Beckmann NDF: lobe {o['lobe']!r} needs 'gauss_legendre'",
         )
-    if LOBES[o["lobe"]].magnitude.startswith("diffuse:") and o["samples"] is not None and o["samples"] > 64:
+    if lb.magnitude.startswith("diffuse:") and o["samples"] is not None and o["samples"] > 64:
         return ("samples", f"lobe {o['lobe']!r}: samples is the diffuse kind's Gauss-Legendre order, at most 64")
     if o["format"] in ("ltc_dds", "babylon_fuzz") and o["dtype"] not in ("half", "float32"):
         return ("dtype", f"{o['format']} writes RGBA16F (half) or RGBA32F (float32)")
-    if o["format"] == "babylon_fuzz" and not LOBES[o["lobe"]].normal_frame:
-        normal = ", ".join(n for n, lb in LOBES.items() if lb.normal_frame)
+    if o["format"] == "babylon_fuzz" and not lb.normal_frame:
+        normal = ", ".join(r.name for r in LTC_LOBE if r.obj.normal_frame)
         return (
             "format",
             f"babylon_fuzz stores M^-1 = [[A, 0, B], [0, A, 0], [0, 0, 1]] in the normal's frame: lobe {o['lobe']!r} "

@@ -89,9 +89,8 @@ def ltc_eval(m_inv: wp.mat33d, det_inv: wp.float64, l: wp.vec3d):
 
 
 @functools.lru_cache(maxsize=None)
-def kernels(lobe_name: str):
-    """(lobe_samples, heitz_error, lobe_values) Warp kernels for a lobe, compiled once per Warp cache."""
-    lb = lobe(lobe_name)
+def kernels(lb):
+    """(lobe_samples, heitz_error, lobe_values) Warp kernels for a Lobe, compiled once per Warp cache."""
     sample = lb.sample
     if lb.tabulate is not None:  # f takes the texel's table and index (lutbake.ltc.tabulated)
         f_cos, pdf, f_pdf = lb.f_cos, lb.pdf, lb.f_pdf
@@ -193,7 +192,7 @@ class Problem:
 
     def __init__(
         self,
-        lobe_name: str,
+        lobe_of,
         nov: np.ndarray,
         alpha: np.ndarray,
         magnitude: np.ndarray,
@@ -201,7 +200,7 @@ class Problem:
         device: str = "cpu",
         workers: int = 1,
     ):
-        self.lobe = lobe_name
+        self.lobe = lobe(lobe_of)  # a Lobe, or the name of one of lutbake's
         self.device = device
         self.nov = np.asarray(nov, np.float32)
         self.alpha = np.asarray(alpha, np.float32)
@@ -212,10 +211,10 @@ class Problem:
         self.isotropic = self.nov >= np.float32(1.0)
         self.grid_n = n_grid
         grid = stratified_grid(n_grid)
-        lobe_samples, self._heitz, self._values = kernels(lobe_name)
+        lobe_samples, self._heitz, self._values = kernels(self.lobe)
         d = device
         load_module(lobe_samples.module, d)  # the three kernels' module, compiled once when tables prepare in parallel
-        lb = lobe(lobe_name)
+        lb = self.lobe
         # a tabulated lobe's per-texel table (lutbake.ltc.tabulated, ``workers`` threads), else a 1-element placeholder
         tab = lb.tabulate(self.v, self.alpha, d, workers) if lb.tabulate else np.zeros((1, 1, 1), np.float32)
         self._texels = Texels()
@@ -471,7 +470,7 @@ MEMO = RowMemo()
 def texel_keys(problem: Problem, texel: np.ndarray, points: np.ndarray, what: str) -> list[bytes]:
     """The memo keys of ``texel``: everything its fit from ``points`` (k, c, dof) reads (``what``: the fit options,
     the texel's inputs)."""
-    head = repr((what, problem.lobe, problem.device, problem.grid_n, problem.dof))
+    head = repr((what, problem.lobe.name, problem.lobe.origin, problem.device, problem.grid_n, problem.dof))
     head = (head + repr((NELDER_MEAD_TOL, NELDER_MEAD_ITERS, ATOL_RELATIVE, M_MIN))).encode()
     points = np.ascontiguousarray(points, np.float64)
     rows = zip(problem.nov[texel], problem.alpha[texel], problem.magnitude[texel], points)

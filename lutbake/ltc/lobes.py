@@ -210,11 +210,12 @@ def cosine_sampled(f_cos):
     return guarded, f_pdf
 
 
-def custom_lobe(name: str, f_cos, roughness: str) -> Lobe:
+def custom_lobe(name: str, f_cos, roughness: str, origin: str) -> Lobe:
     """The Lobe of a plugin's cosine-weighted BRDF f(l, v)(n.l): cosine-sampled, its magnitude integrated from the
-    lobe itself; ``roughness``: Lobe.roughness ("alpha", "perceptual" or "none")."""
+    lobe itself; ``roughness``: Lobe.roughness ("alpha", "perceptual" or "none"); ``origin``: the plugin text's
+    sha256 (Lobe.origin)."""
     guarded, f_pdf = cosine_sampled(f_cos)
-    return Lobe(name, guarded, cosine_sample, cosine_pdf, f_pdf, "lobe", roughness)
+    return Lobe(name, guarded, cosine_sample, cosine_pdf, f_pdf, "lobe_adaptive", roughness, origin=origin)
 
 
 @dataclass(frozen=True)
@@ -234,6 +235,7 @@ class Lobe:
     # ltc_code's 3 with Z = the lobe's average direction
     normal_frame: bool = False  # fit Zeltner et al. 2022's M^-1 = [[a, 0, b], [0, a, 0], [0, 0, 1]] in the normal's
     # frame (2 parameters, lutbake.ltc.fit.Problem.matrices) instead of ltc_code's lobe-average frame
+    origin: str = ""  # a plugin's lobe: the sha256 of its text (fits are memoised per (name, origin): lutbake.ltc.fit)
 
 
 LOBES = {
@@ -301,7 +303,10 @@ LOBES = {
 
 
 @functools.lru_cache(maxsize=None)
-def lobe(name: str) -> Lobe:
+def lobe(name) -> Lobe:
+    """``name`` itself if it is a Lobe (a record's object: a plugin's lobe), else lutbake's lobe of that name."""
+    if isinstance(name, Lobe):
+        return name
     if name not in LOBES:
         raise KeyError(f"unknown LTC lobe {name!r}; valid: {', '.join(LOBES)}")
     return LOBES[name]

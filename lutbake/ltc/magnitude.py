@@ -43,7 +43,7 @@ def magnitude_alpha(axes: list[Axis], alpha_min: float = ALPHA_MIN) -> np.ndarra
 
 
 def magnitude_fresnel(
-    lobe_name: str,
+    lobe_of,
     nov: np.ndarray,
     alpha: np.ndarray,
     samples: int | None,
@@ -51,30 +51,33 @@ def magnitude_fresnel(
     estimator: str = "gauss_legendre",
     seed: int = 0,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(magnitude, fresnel) per texel from lutbake's integrators (``estimator``, default Gauss-Legendre).
-    GGX / Beckmann: magnitude is the ``albedo`` kind's integrand (so it equals that table at the same texels),
-    fresnel the ``dfg`` multiscatter integrand's Fc channel; charlie: the ``dfg`` charlie layout's B channel (the
-    gltf-charlie table), fresnel = magnitude; lambert: 1; gotanda, eon: the ``diffuse`` kind's integrator and
-    integrand (its default GL order unless ``samples``; ``alpha`` = sigma resp. EON's r), fresnel = magnitude.
+    """(magnitude, fresnel) per texel from lutbake's integrators (``estimator``, default Gauss-Legendre). A plugin's
+    lobe: lobe_magnitude. GGX / Beckmann: magnitude is the ``albedo`` kind's integrand (so it equals that table at the
+    same texels), fresnel the ``dfg`` multiscatter integrand's Fc channel; charlie: the ``dfg`` charlie layout's B
+    channel (the gltf-charlie table), fresnel = magnitude; lambert: 1; gotanda, eon: the ``diffuse`` kind's integrator
+    and integrand (its default GL order unless ``samples``; ``alpha`` = sigma resp. EON's r), fresnel = magnitude.
     ``alpha`` goes through the integrands' edge policy (mirror limit at alpha -> 0)."""
     from ..integrands.specular import specular_integrand
     from ..sampling.hemisphere import estimator_for
-    from .lobes import LOBES
+    from .lobes import lobe
 
-    lb = LOBES[lobe_name]
+    lb = lobe(lobe_of)  # a Lobe, or the name of one of lutbake's
     if lb.magnitude == "lambert":
         one = np.ones(len(nov))
         return one, one.copy()
+    if lb.magnitude == "lobe_adaptive":  # a plugin's lobe: the diffuse kind's rule, orders raised to the tolerance
+        m, _, _ = lobe_magnitude(lb, nov, alpha, device)
+        return m, m.copy()
     if lb.magnitude == "lobe":  # no other integrator has the lobe: lutbake.ltc.fit's quadrature of f_cos
         from . import fit
 
-        m = fit.lobe_albedo(fit.Problem(lobe_name, nov, alpha, np.zeros(len(nov)), device=device))
+        m = fit.lobe_albedo(fit.Problem(lb, nov, alpha, np.zeros(len(nov)), device=device))
         return m, m.copy()
     if lb.magnitude.startswith("diffuse:"):
         m = diffuse_magnitude(lb.magnitude.split(":")[1], nov, alpha, samples, device)
         return m, m.copy()
     if estimator == "gauss_legendre":
-        samples = samples or MAGNITUDE_SAMPLES[lobe_name]
+        samples = samples or MAGNITUDE_SAMPLES[lb.name]
     est = estimator_for(estimator, samples, seed)
     nov = np.asarray(nov, np.float32)
     zero = np.zeros(len(nov), np.float32)
@@ -91,6 +94,39 @@ def magnitude_fresnel(
     mag = integrate(specular_integrand(which, "smith_height_correlated", "albedo", "microfacet", 1))[:, 0]
     fres = integrate(specular_integrand(which, "smith_height_correlated", "multiscatter"))[:, 0]
     return mag, fres
+
+
+LOBE_ORDERS = (24, 32, 48, 64)  # lobe_magnitude's Gauss-Legendre orders per panel and dimension
+
+
+def lobe_magnitude(lb, nov, x, device: str = "cpu", tolerance=None) -> tuple[np.ndarray, float, bool]:
+    """(∫ f (n.l) dω_l per texel, its error estimate, whether it met ``tolerance``) of a plugin's lobe
+    (lutbake.integrands.diffuse.lobe_integrand) by the diffuse kind's Gauss-Legendre rule over l (2 x 2 panels split
+    at n.l = n.v and phi = pi/2), its order raised through LOBE_ORDERS until two successive agree within the
+    tolerance (a lutbake.tolerance.Tolerance: max(absolute, relative |E|); default float32's) at every texel; else
+    the last, its estimate that difference."""
+    from ..integrands.diffuse import lobe_integrand
+    from ..sampling.diffuse import DiffuseGaussLegendre
+    from ..sampling.diffuse_table import diffuse_grid
+    from ..tolerance import default_tolerance
+
+    integrand = lobe_integrand(lb)
+    inputs = diffuse_grid(
+        [], np.asarray(nov, np.float32), np.asarray(x, np.float32), np.zeros(len(nov)), "sigma"
+    ).inputs
+    tol = tolerance or default_tolerance({})
+    last = None
+    for order in LOBE_ORDERS:
+        est = DiffuseGaussLegendre(order)
+        est.prepare(integrand, device)
+        value = est.evaluate(integrand, inputs, device)[:, 0]
+        if last is not None:
+            diff = np.abs(value - last)
+            met = bool(np.all(diff <= np.maximum(tol.absolute, tol.relative * np.abs(value))))
+            if met:
+                break
+        last = value
+    return value, float(np.max(diff)), met
 
 
 def diffuse_magnitude(model: str, nov, sigma, samples: int | None, device: str = "cpu") -> np.ndarray:

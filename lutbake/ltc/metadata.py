@@ -25,6 +25,14 @@ ROUGHNESS_AXES = {
 
 
 def magnitude_record(lb, estimator: str, samples) -> str:
+    if lb.magnitude == "lobe_adaptive":
+        from .magnitude import LOBE_ORDERS
+
+        return (
+            f"lutbake.ltc.magnitude.lobe_magnitude: the diffuse kind's Gauss-Legendre rule over l (2 x 2 panels), "
+            f"orders {LOBE_ORDERS} raised until two agree within the table's tolerance at every texel (estimate: "
+            "lutbake:ltc_magnitude_error_estimate); fresnel = magnitude"
+        )
     if lb.magnitude == "lobe":
         from . import fit
 

@@ -11,7 +11,7 @@ import threading
 import numpy as np
 
 from ..axes import Axis
-from .magnitude import magnitude_alpha, magnitude_fresnel, texel_params
+from .magnitude import lobe_magnitude, magnitude_alpha, magnitude_fresnel, texel_params
 
 
 def uses_shaded_fit(o: dict) -> bool:
@@ -25,8 +25,11 @@ class LtcBake:
     per texel across tables (lutbake.ltc.fit.MEMO: a texel with the same inputs and seeds as one another table
     of the process fitted, e.g. ltc-hdrp's beside ltc-ggx's, is that fit)."""
 
-    def __init__(self, o: dict, axes: list[Axis]):
+    def __init__(self, o: dict, axes: list[Axis], lobe, tolerance=None):
         self.o = o
+        self.lobe = lobe  # the Lobe fitted (the spec's record's object)
+        self.tolerance = tolerance  # a plugin lobe's magnitude target (lobe_magnitude; a lutbake.tolerance.Tolerance)
+        self.magnitude_estimate, self.magnitude_met = None, True
         self.axes = axes
         self.nov, self.alpha = texel_params(axes, o["alpha_min"])
         self.n_view, self.n_rough = axes[1].count, axes[2].count
@@ -47,19 +50,39 @@ class LtcBake:
             if self.problem is None:
                 o = self.o
                 alpha = magnitude_alpha(self.axes, o["alpha_min"])
-                mag, fres = magnitude_fresnel(
-                    o["lobe"], self.nov, alpha, o["samples"], device, o["estimator"], o["seed"]
-                )
+                if self.lobe.magnitude == "lobe_adaptive":  # a plugin's lobe: to the table's tolerance, estimated
+                    mag, self.magnitude_estimate, self.magnitude_met = lobe_magnitude(
+                        self.lobe, self.nov, alpha, device, self.tolerance
+                    )
+                    fres = mag.copy()
+                else:
+                    mag, fres = magnitude_fresnel(
+                        self.lobe, self.nov, alpha, o["samples"], device, o["estimator"], o["seed"]
+                    )
                 self.fresnel = fres
                 self.device = device
                 self.has_fresnel = not np.array_equal(mag, fres)  # lobes without Fresnel store fresnel = magnitude
                 # a tabulated lobe's table is built here on every available core (the executor's default; values do
                 # not depend on the thread count)
                 threads = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-                p = fit.Problem(self.o["lobe"], self.nov, self.alpha, mag, self.o["fit_samples"], device, threads)
+                p = fit.Problem(self.lobe, self.nov, self.alpha, mag, self.o["fit_samples"], device, threads)
                 nodes = self.unclamped_nodes(device, threads)
                 self.coarse = fit.coarse_pass(p, self.n_view, self.n_rough, fit.MEMO, nodes)
                 self.problem = p
+
+    def magnitude_attributes(self) -> dict[str, str]:
+        """A plugin lobe's magnitude error estimate (lutbake:ltc_magnitude_error_estimate), and the over_tolerance
+        record (lutbake.pipeline.OVER_TOLERANCE) where it missed the table's tolerance; {} for lutbake's lobes."""
+        if self.magnitude_estimate is None:
+            return {}
+        est = self.magnitude_estimate
+        out = {"ltc_magnitude_error_estimate": f"{est:.3e}"}
+        if not self.magnitude_met:
+            out["over_tolerance"] = (
+                f"the magnitude (slice 1, R) of lobe {self.lobe.name!r}: the diffuse rule's orders disagree by up to "
+                f"{est:.3e}, over the tolerance (a lobe sharper than that rule resolves)"
+            )
+        return out
 
     def unclamped_nodes(self, device: str, threads: int):
         """The coarse pass's own problem where ``alpha_min`` clamps a coarse texel's alpha: the coarse texels at the
@@ -75,9 +98,9 @@ class LtcBake:
             return None
         o = self.o
         mag, _ = magnitude_fresnel(
-            o["lobe"], nov[idx], magnitude_alpha(self.axes)[idx], o["samples"], device, o["estimator"], o["seed"]
+            self.lobe, nov[idx], magnitude_alpha(self.axes)[idx], o["samples"], device, o["estimator"], o["seed"]
         )
-        return fit.Problem(o["lobe"], nov[idx], alpha[idx], mag, o["fit_samples"], device, threads)
+        return fit.Problem(self.lobe, nov[idx], alpha[idx], mag, o["fit_samples"], device, threads)
 
     def fitted(self, start: int, stop: int) -> list:
         """[packed ltc_1 (k, 4), relative error (k,)] of texels [start, stop) of a slice (fitted once)."""
