@@ -593,7 +593,8 @@ def test_avg_mu_rule_reaches_the_tolerance():
     full = plan.run_tile(0, plan.n_texels, "cpu")
     values, mu_err = full[:, :3], full[:, 3:]
     np.testing.assert_array_equal(values.astype(np.float32), table.data.reshape(-1, 3))
-    _, alpha, eta = kd.avg_grid(spec(**small).options)
+    s = spec(**small)
+    _, alpha, eta = kd.avg_grid(s.options, s.records["layout"].obj)
     mu, wt = MU_RULE
     key = ("ggx", "smith_separable", "exact_metal", "gauss_legendre")  # the kind's defaults
     for k in range(len(alpha)):
@@ -628,7 +629,8 @@ def test_avg_inner_order_climbs_to_a_tight_tolerance():
     assert estimate <= 1.0e-7
     assert "|order 16 - order 20|" in table.attributes["error_estimate_method"]
     values = table.data.reshape(-1, 3).astype(np.float64)
-    _, alpha, eta = kd.avg_grid(spec(**small).options)
+    s = spec(**small)
+    _, alpha, eta = kd.avg_grid(s.options, s.records["layout"].obj)
     mu, wt = MU_RULE
     key = ("ggx", "smith_separable", "exact_metal", "gauss_legendre")
     for k in range(0, len(alpha), 2):  # three of the six texels, both etas

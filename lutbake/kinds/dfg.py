@@ -124,7 +124,7 @@ def check_spec(spec) -> tuple[str, str] | None:
     if o["estimator"] in ("sobol_ndf", "hammersley_ndf") and not nd.fields.get("sampler", True):
         return ("estimator", f"{o['estimator']!r} samples the NDF's own CDF, which ndf {nd.name!r} does not give")
     layout = o.get("layout", "scale_bias")
-    lay = lookup_layout("dfg", layout)
+    lay = spec.records["layout"].obj if "layout" in spec.records else lookup_layout("dfg", layout)
     if o.get("fresnel", "schlick") != "schlick" and layout not in FRESNEL_LAYOUTS:
         return (
             "fresnel",
@@ -256,7 +256,7 @@ def plan(spec, points: dict | None = None) -> TexelPlan:
     from ..sampling.hemisphere import estimator_for
 
     o = spec.options
-    lay = lookup_layout("dfg", o["layout"])
+    lay = spec.records["layout"].obj
     axes = axes_for(o)
     form, nd, mk = terms_of(spec)
     fresnel = spec.records["fresnel"] if lay.name in FRESNEL_LAYOUTS else None

@@ -110,10 +110,11 @@ AVG_KEYS = {
 }
 
 
-def texel_grid(o: dict) -> tuple[list[Axis], np.ndarray, np.ndarray, np.ndarray, dict]:
+def texel_grid(o: dict, lay=None) -> tuple[list[Axis], np.ndarray, np.ndarray, np.ndarray, dict]:
     """(axes slowest first, per-texel NoV, alpha, eta in row-major order, extra metadata) of a spec: the layout's fixed
-    grid, else IOR slices of the dfg kind's NoV x roughness grid."""
-    lay = lookup_layout("dielectric", o["layout"])
+    grid, else IOR slices of the dfg kind's NoV x roughness grid. ``lay``: the spec's layout record's Layout (None:
+    the one ``o`` names, for benchmarks)."""
+    lay = lay or lookup_layout("dielectric", o["layout"])
     if lay.grid is not None:
         return lay.grid(o)
     etas = ior_values(o["ior_size"], *o["ior_range"], o["texel"], o["ior_mapping"])
@@ -128,9 +129,9 @@ def texel_grid(o: dict) -> tuple[list[Axis], np.ndarray, np.ndarray, np.ndarray,
     )
 
 
-def terms_of(o: dict) -> tuple[str, str]:
+def terms_of(o: dict, lay=None) -> tuple[str, str]:
     """(ndf, masking) integrated: EEVEE's and OpenPBR's layouts fix GGX with separable Smith (their G_V G_L)."""
-    fixed = lookup_layout("dielectric", o["layout"]).terms
+    fixed = (lay or lookup_layout("dielectric", o["layout"])).terms
     return fixed.ndf or o["ndf"], fixed.masking or o["masking"]
 
 
@@ -150,9 +151,9 @@ def plan(spec) -> TexelPlan:
     from ..sampling.dielectric_layout import layout_estimator
 
     o = spec.options
-    lay = lookup_layout("dielectric", o["layout"])
-    axes, nov, alpha, eta, extra = texel_grid(o)
-    nd, mk = terms_of(o)
+    lay = spec.records["layout"].obj
+    axes, nov, alpha, eta, extra = texel_grid(o, lay)
+    nd, mk = terms_of(o, lay)
     integrand = dielectric_integrand(nd, mk, lay.integrand, len(lay.channels))
     inputs = {
         "nov": np.asarray(nov, np.float32),
@@ -173,10 +174,9 @@ def plan(spec) -> TexelPlan:
     )
 
 
-def avg_grid(o: dict) -> tuple[list[Axis], np.ndarray, np.ndarray]:
+def avg_grid(o: dict, lay) -> tuple[list[Axis], np.ndarray, np.ndarray]:
     """(axes [ior (y), roughness (x)], alpha and eta per texel, row-major): the layout's fixed grid, else the config's
     IOR and roughness axes."""
-    lay = lookup_layout("dielectric_avg", o["layout"])
     if lay.grid is not None:
         return lay.grid(o)
     etas = ior_values(o["ior_size"], *o["ior_range"], o["texel"], o["ior_mapping"])
@@ -195,9 +195,9 @@ def plan_avg(spec) -> TexelPlan:
     from ..sampling.dielectric_layout import estimator_of
 
     o = spec.options
-    lay = lookup_layout("dielectric_avg", o["layout"])
-    axes, alpha, eta = avg_grid(o)
-    nd, mk = terms_of(o)
+    lay = spec.records["layout"].obj
+    axes, alpha, eta = avg_grid(o, lay)
+    nd, mk = terms_of(o, lay)
     integrand = dielectric_integrand(nd, mk, lay.integrand)
     estimator = estimator_of(o["estimator"], o["samples"], o["seed"], merged=True)
     climb = o["samples"] is None and o["estimator"] == "gauss_legendre"
@@ -207,12 +207,13 @@ def plan_avg(spec) -> TexelPlan:
 
 def check_spec(spec) -> tuple[str, str] | None:
     o = spec.options
-    nd, _ = terms_of(o)
+    lay = spec.records["layout"].obj
+    nd, _ = terms_of(o, lay)
     if o["estimator"] == "sobol_vndf" and not NDF.lookup(nd).fields["vndf"]:
         return ("estimator", f"'sobol_vndf' needs ndf = 'ggx' (a visible-normal sampler), not {nd!r}")
     if o.get("ior_mapping") == "symmetric" and (o["ior_range"][1] <= 1.0 or o["ior_size"] % 2):
         return ("ior_mapping", "'symmetric' needs ior_range[1] > 1 (the largest eta) and an even ior_size")
-    fixed = lookup_layout(spec.kind, o["layout"]).terms
+    fixed = lay.terms
     if fixed.ndf is not None and (o["ndf"], o["masking"]) != (fixed.ndf, fixed.masking):
         return (
             "layout",

@@ -13,6 +13,7 @@ import difflib
 import importlib
 import pkgutil
 
+from ..registry import Family, Record, choices, family
 from .base import EngineChannel, EngineTable, Layout, Storage, Terms
 
 NOT_ENGINES = ("base",)
@@ -31,6 +32,19 @@ REGISTRY: dict[tuple[str, str], Layout] = {(lay.kind, lay.name): lay for m in EN
 TABLES: tuple[EngineTable, ...] = tuple(t for m in ENGINES for t in m.TABLES)
 
 
+def layout_family(kind: str) -> Family:
+    """The registry family of ``kind``'s layouts (lutbake.registry): a config's ``layout`` resolves to its record."""
+    return family(f"{kind}_layout", f"the engine table layouts of kind {kind} (lutbake.layouts)")
+
+
+for (_kind, _name), _lay in REGISTRY.items():
+    layout_family(_kind).add(
+        Record(
+            f"{_kind}_layout", _name, _lay.summary, fields={"obj": _lay, "engine": _lay.engine, "source": _lay.source}
+        )
+    )
+
+
 def layouts_of(kind: str) -> dict[str, Layout]:
     """The layouts of ``kind``, by name, in registration order."""
     return {name: lay for (k, name), lay in REGISTRY.items() if k == kind}
@@ -47,9 +61,10 @@ def lookup_layout(kind: str, name: str) -> Layout:
         raise KeyError(f"kind {kind!r} has no layout {name!r}{hint}; layouts: {', '.join(names)}") from None
 
 
-def summaries(kind: str) -> dict[str, str]:
-    """name -> summary of the layouts of ``kind`` (the ``layout`` key's documented values)."""
-    return {name: lay.summary for name, lay in layouts_of(kind).items()}
+def summaries(kind: str):
+    """name -> summary of the layouts of ``kind``: the ``layout`` key's allowed values, each resolved to its record
+    where a config is read (lutbake.registry.Choices)."""
+    return choices(layout_family(kind), doc=f"kind {kind}'s layouts")
 
 
 def engine_table(kind: str, name: str, options: dict) -> EngineTable | None:

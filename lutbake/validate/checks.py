@@ -18,6 +18,7 @@ import numpy as np
 
 from ..edge import ALPHA_MIN, NOV_MIN
 from ..integrands.specular import hemisphere_integral
+from ..registry import Record, family
 from ..sampling import points
 from ..terms.distributions import NDFS
 from . import dielectric
@@ -604,13 +605,24 @@ TABLE: tuple[Check, ...] = (
     Check("ltc_eon_r0_is_identity", ltc_eon_r0_is_identity),
     Check("ltc_area_benchmark_median", ltc_area_benchmark_median),
 )
-CHECKS: dict = {c.name: c.run for c in TABLE}  # name -> the check's zero-argument callable
+CHECK = family("check", "analytic checks and invariants (lutbake validate)")
+
+
+def _summary(run) -> str:
+    """The first line of a check's docstring (of the function a partial binds)."""
+    doc = (getattr(run, "func", run).__doc__ or "").strip()
+    return doc.splitlines()[0] if doc else ""
+
+
+for _c in TABLE:
+    CHECK.add(Record("check", _c.name, _summary(_c.run) or _c.name, fields={"obj": _c.run}))
+CHECKS: dict = {r.name: r.obj for r in CHECK}  # name -> the check's zero-argument callable, in TABLE's order
 
 
 def run_all(names=None) -> list[CheckResult]:
-    """Run the named checks (all of ``CHECKS`` by default) in registry order."""
-    names = list(CHECKS) if names is None else list(names)
-    unknown = [n for n in names if n not in CHECKS]
+    """Run the named checks (every record of the ``check`` family by default) in TABLE's order."""
+    names = CHECK.names() if names is None else list(names)
+    unknown = [n for n in names if n not in CHECK]
     if unknown:
-        raise KeyError(f"unknown check(s) {unknown}; valid: {', '.join(CHECKS)}")
-    return [CHECKS[n]() for n in names]
+        raise KeyError(f"unknown check(s) {unknown}; valid: {', '.join(CHECK.names())}")
+    return [CHECK.lookup(n).obj() for n in names]
