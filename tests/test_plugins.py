@@ -280,3 +280,19 @@ def test_a_plugin_brdf_with_eons_terms_fits_eons_ltc(tmp_path):
     print("max |matrix difference|", np.abs(a.data[0] - b.data[0]).max())
     np.testing.assert_allclose(a.data[1, ..., 0], b.data[1, ..., 0], atol=1e-6)  # magnitude: EON's exact albedo
     np.testing.assert_allclose(a.data[0], b.data[0], atol=1e-5)  # the inverse matrices
+
+
+def test_audit_needs_the_config_that_loads_the_plugin_and_then_names_it(fresnel_example):
+    """A fresh process cannot audit the file from its recorded config alone (lutbake runs no code a file names); with
+    the config that loads the plugin it passes and names the plugin."""
+    from click.testing import CliRunner
+
+    from lutbake.cli import main
+
+    folder, result = fresnel_example
+    bare = subprocess.run([sys.executable, "-m", "lutbake", "audit", str(result.path)], capture_output=True, text=True)
+    assert bare.returncode == 2 and "baked with a plugin's records" in bare.stderr and "--config" in bare.stderr
+    cfg = folder / "dfg_schlick4.toml"
+    ok = CliRunner().invoke(main, ["audit", str(result.path), "--config", str(cfg)])
+    assert ok.exit_code == 0, ok.output
+    assert f"plugin fresnel 'schlick4' from {folder / 'schlick4.py'}" in ok.output and "PASS" in ok.output

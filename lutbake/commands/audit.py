@@ -505,7 +505,10 @@ def audit(
         conventions=f"{conv.source} (layout {conv.layout}, {conv.axes[0].name} rows "
         f"{conv.axes[0].texel}/{conv.axes[0].mapping}/{conv.axes[0].order}, "
         f"{conv.axes[1].name} columns {conv.axes[1].texel}/{conv.axes[1].mapping}/"
-        f"{conv.axes[1].order}; {storage_words})",
+        f"{conv.axes[1].order}; {storage_words})"
+        + "".join(
+            f"; plugin {r.family} {r.name!r} from {r.origin} (sha256 {r.plugin.sha256[:12]})" for r in conv.spec.plugins
+        ),
         channels=["RGBA"[c] for c in compared],
         evaluated={
             "rows": len(iy),

@@ -74,7 +74,18 @@ def declared_specs(conv_args: dict | None, recorded: dict | None = None, path=No
     if conv_args.get("config"):
         return load_config(Path(conv_args["config"]), ovr)
     if not conv_args.get("preset") and recorded and recorded.get("config"):
-        return recorded_specs(recorded["config"], f"{path} (its recorded config)", ovr)
+        try:
+            return recorded_specs(recorded["config"], f"{path} (its recorded config)", ovr)
+        except ConfigError:
+            if not recorded.get("plugins"):
+                raise
+            raise ConfigError(
+                path,
+                "plugins",
+                message="baked with a plugin's records (lutbake:plugins; lutbake inspect names them), which this "
+                "process has not loaded: give the config that loads them (--config CONFIG); lutbake runs no code a "
+                "file names",
+            ) from None
     return load_config(preset_path(conv_args.get("preset") or "default"), ovr)
 
 
