@@ -441,6 +441,7 @@ def test_every_lutbake_kernel_module_compiles_with_lutbakes_options():
     import lutbake
     from lutbake.integrands import fresnel
     from lutbake.ltc import fit
+    from lutbake.ltc.lobes import LOBES
     from lutbake.records import FRESNEL
     from lutbake.runtime import warp_runtime
 
@@ -448,7 +449,7 @@ def test_every_lutbake_kernel_module_compiles_with_lutbakes_options():
         if not m.name.endswith("__main__"):
             importlib.import_module(m.name)
     fresnel._kernel(FRESNEL.lookup("schlick"))
-    fit.kernels("ggx")
+    fit.kernels(LOBES["ggx"])
     from warp._src.context import user_modules
 
     ours = {
