@@ -296,3 +296,26 @@ def test_audit_needs_the_config_that_loads_the_plugin_and_then_names_it(fresnel_
     ok = CliRunner().invoke(main, ["audit", str(result.path), "--config", str(cfg)])
     assert ok.exit_code == 0, ok.output
     assert f"plugin fresnel 'schlick4' from {folder / 'schlick4.py'}" in ok.output and "PASS" in ok.output
+
+
+def test_specular_3d_with_the_plugins_fresnel_is_its_split_sum(fresnel_example):
+    """A Fresnel linear in f0 collapses the f0 slices of specular_3d to the dfg table: E(f0) = f0 R + G."""
+    folder, result = fresnel_example
+    lutbake.load_plugin(folder / "schlick4.py")
+    raw = {"name": "s3", "kind": "specular_3d", "size": [16, 8], "fresnel": "schlick4", "f0_size": 3}
+    table, _, _ = lutbake.bake_table(validate_table(raw, "<t>", 0))
+    dfg = read_table(result.path).data
+    f0 = table.axes[0].values()
+    for k, f in enumerate(f0):  # each table within 1e-6 of its integral: the slice, and f0 R + G within (1 + f0) 1e-6
+        np.testing.assert_allclose(table.data[k, ..., 0], f * dfg[..., 0] + dfg[..., 1], rtol=0.0, atol=3e-6)
+
+
+def test_albedo_with_a_plugin_ndf_is_lutbakes_albedo(tmp_path):
+    (tmp_path / "mine.py").write_text(
+        NDF_PLUGIN.format(name="alb_ggx", cdf=", tan2_from_u=ndf.tan2_from_u_ggx, u_from_tan2=ndf.u_from_tan2_ggx")
+    )
+    lutbake.load_plugin(tmp_path / "mine.py")
+    common = {"kind": "albedo", "size": [8, 8], "interpolation": "off"}
+    mine, _, _ = lutbake.bake_table(validate_table({"name": "m", "ndf": "alb_ggx", **common}, "<t>", 0))
+    ggx, _, _ = lutbake.bake_table(validate_table({"name": "g", **common}, "<t>", 0))
+    np.testing.assert_array_equal(mine.data, ggx.data)
