@@ -364,7 +364,10 @@ def _first_function(record: Record):
 
 
 def _probe(wp, record: Record):
-    """A kernel that calls every term of ``record`` once (never launched: loading it compiles them)."""
+    """A kernel that calls every term of ``record`` once (never launched: loading it compiles them), built with
+    lutbake's module options (lutbake.runtime.warp_runtime.unique_kernel)."""
+    from .runtime.warp_runtime import unique_kernel
+
     fam = record.family
     if fam == "fresnel":
         F = record["F"]
@@ -372,7 +375,7 @@ def _probe(wp, record: Record):
 
         with_fc = record.get("Fc") is not None
 
-        @wp.kernel(enable_backward=False, module="unique")
+        @unique_kernel
         def probe(out: wp.array(dtype=float)):
             out[0] = F(0.5, 0.5)
             if wp.static(with_fc):
@@ -385,7 +388,7 @@ def _probe(wp, record: Record):
         with_lambda = d.Lambda is not None
         Lam = d.Lambda if with_lambda else d.D  # not called without a Lambda
 
-        @wp.kernel(enable_backward=False, module="unique")
+        @unique_kernel
         def probe(out: wp.array(dtype=float)):
             out[0] = D(wp.vec3(0.0, 0.0, 1.0), 0.5) + float(t2u(wp.float64(0.5), wp.float64(0.5)))
             out[0] = out[0] + float(u2t(wp.float64(0.5), wp.float64(0.5)))
@@ -397,7 +400,7 @@ def _probe(wp, record: Record):
         Fd = record["Fd"]
         with_f0 = record.fields["with_f0"]
 
-        @wp.kernel(enable_backward=False, module="unique")
+        @unique_kernel
         def probe(out: wp.array(dtype=float)):
             if wp.static(with_f0):
                 out[0] = Fd(1.0, 0.5, 0.5, 0.25, 0.5, 0.04)
@@ -407,7 +410,7 @@ def _probe(wp, record: Record):
         return probe
     f_cos = record.obj.f_cos
 
-    @wp.kernel(enable_backward=False, module="unique")
+    @unique_kernel
     def probe(out: wp.array(dtype=float)):
         out[0] = f_cos(wp.vec3(0.0, 0.0, 1.0), wp.vec3(0.0, 0.0, 1.0), 0.5)
 
