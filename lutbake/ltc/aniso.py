@@ -247,10 +247,30 @@ def fitted_texels(grid: Grid4) -> np.ndarray:
 
 def fit_tile(nov, ax, ay, phi, magnitude, n_grid: int, device: str, frame: str) -> tuple[np.ndarray, ...]:
     """Fit one tile of texels: Nelder-Mead from the best of guesses() at lutbake.ltc.fit's COARSE_STEPS (0.5, 0.1,
-    0.02). Returns (view-frame M (k, 3, 3), Heitz's E, the relative error (E / ∫ f^3)^(1/3))."""
+    0.02), in the parameters the texel's lobe has (a symmetric one: ltc_code's (log m11, log m22, m13 / m11) and, frame
+    "free", the frame angle d1: the isotropic fit's own space, no idle directions in its simplex). Returns (view-frame
+    M (k, 3, 3), Heitz's E, the relative error (E / ∫ f^3)^(1/3))."""
     p = AnisoProblem(nov, ax, ay, phi, magnitude, n_grid, device, frame)
+    q, e = np.zeros((p.n, p.dof)), np.zeros(p.n)
+    for symmetric in (True, False):
+        t = np.flatnonzero(p.symmetric == symmetric)
+        if len(t) == 0:
+            continue
+        dims = ([0, 1, 2] + [5] * (p.dof == 7)) if symmetric else list(range(p.dof))
+
+        def fun(tt, qr, dims=dims):
+            full = np.zeros((len(qr), p.dof))
+            full[:, dims] = qr
+            return p.objective(tt, full)
+
+        cands = guesses(p, t)[:, :, dims]
+        f = fun(np.repeat(t, cands.shape[1]), cands.reshape(-1, len(dims))).reshape(len(t), -1)
+        best = np.argmin(f, axis=1)
+        qr, fr = cands[np.arange(len(t)), best], f[np.arange(len(t)), best]
+        for step in fit.COARSE_STEPS:
+            qr, fr = fit.nelder_mead(fun, t, qr, step, atol=fit.ATOL_RELATIVE**3 * p.f3[t], f_start=fr)
+        q[np.ix_(t, dims)], e[t] = qr, fr
     texel = np.arange(p.n)
-    q, e = fit.fit_from(p, texel, guesses(p, texel), fit.COARSE_STEPS)
     return p.matrices(texel, q), e, p.relative(texel, e)
 
 
@@ -325,3 +345,56 @@ def relative_error_of(grid: Grid4, magnitude: np.ndarray, m: np.ndarray, texels:
     p = AnisoProblem(np.cos(theta[k]), ax2[i, j], ay2[i, j], phi[l], magnitude.reshape(-1)[texels], n_grid)
     t = np.arange(p.n)
     return p.relative(t, p.error(t, rotate_z(np.asarray(m, np.float64), -phi[l])))
+
+
+def quadrant(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(phi folded into [0, pi/2], the reflection F (k, 3, 3) with M(phi) = F M(folded)): the paper's shader
+    (Sphere.glsl LtcMatrixAndNormalization): [pi/2, pi): pi - phi, F = diag(-1, 1, 1); [pi, 3pi/2): phi - pi,
+    diag(-1, -1, 1); [3pi/2, 2pi): 2pi - phi, diag(1, -1, 1). F changes det M's sign where it reflects: the polygon
+    integral takes its orientation from sign(det M)."""
+    p = np.mod(phi, 2.0 * np.pi)
+    q = np.minimum((p // (np.pi / 2)).astype(int), 3)
+    folded = np.choose(q, [p, np.pi - p, p - np.pi, 2.0 * np.pi - p])
+    signs = np.array([[1.0, 1.0, 1.0], [-1.0, 1.0, 1.0], [-1.0, -1.0, 1.0], [1.0, -1.0, 1.0]])[q]
+    return folded, signs[:, :, None] * np.eye(3)
+
+
+def lookup(table: np.ndarray, grid: Grid4, ax, ay, theta, phi, extra: np.ndarray | None = None):
+    """The shader's reconstruction (docs/shaders/ltc_aniso.glsl) on the host: the paper's quadrilinear interpolation
+    of M (and of ``extra`` (n_a, n_b, n_theta, n_phi, c): magnitude, fresnel) at endpoint texel coordinates
+    u = (a, b, theta / (0.9999 pi / 2), phi / (pi / 2)) * (n - 1), phi folded by ``quadrant``, alpha_x < alpha_y of an
+    alpha_lambda table by the swap S. Returns (tangent-frame M (k, 3, 3), extra (k, c) or None)."""
+    ax, ay, theta, phi = (np.atleast_1d(np.asarray(x, np.float64)) for x in (ax, ay, theta, phi))
+    folded, flip = quadrant(phi)
+    swap = (ay > ax) if grid.parametrisation == "alpha_lambda" else np.zeros(len(ax), bool)
+    a = np.where(swap, ay, ax)
+    b = np.where(swap, ax, ay)
+    if grid.parametrisation == "alpha_lambda":
+        b = b / np.maximum(a, 1e-30)
+    folded = np.where(swap, np.pi / 2 - folded, folded)
+    u = np.stack([a, b, theta / (THETA_SCALE * np.pi / 2), folded / (np.pi / 2)], axis=1)
+    u = np.clip(u, 0.0, 1.0) * (np.array(grid.n) - 1)
+    lo = np.minimum(np.floor(u).astype(int), np.array(grid.n) - 2)
+    w = u - lo
+    flat = np.concatenate([table.reshape(*grid.n, 9), *([] if extra is None else [extra])], axis=-1)
+    out = np.zeros((len(a), flat.shape[-1]))
+    for corner in np.ndindex(2, 2, 2, 2):
+        c = np.array(corner)
+        wt = np.prod(np.where(c, w, 1.0 - w), axis=1)
+        i = lo + c
+        out += wt[:, None] * flat[i[:, 0], i[:, 1], i[:, 2], i[:, 3]]
+    m = out[:, :9].reshape(-1, 3, 3)
+    s = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    m = np.where(swap[:, None, None], s @ m @ s, m)
+    return flip @ m, (out[:, 9:] if extra is not None else None)
+
+
+def texture_layout(table: np.ndarray, magnitude: np.ndarray, fresnel: np.ndarray, err: np.ndarray) -> np.ndarray:
+    """The shader's textures (docs/shaders/ltc_aniso.glsl): three RGBA 3D textures of width n_phi, height n_theta and
+    depth n_a n_b (layer = b + n_b a: the 4th axis packed into the depth, as the paper's Tex3D path), texel (x, y, z) =
+    (phi, theta, layer): t0 = (M00, M01, M02, M10), t1 = (M11, M12, M20, M21), t2 = (M22, magnitude, fresnel,
+    fit_error); shape (3, n_a n_b, n_theta, n_phi, 4), float32."""
+    na, nb, nt, nphi = table.shape[:4]
+    m = table.reshape(na, nb, nt, nphi, 9)
+    ch = np.concatenate([m, magnitude[..., None], fresnel[..., None], err[..., None]], axis=-1)
+    return np.ascontiguousarray(ch.reshape(na * nb, nt, nphi, 3, 4).transpose(3, 0, 1, 2, 4), dtype=np.float32)
