@@ -113,10 +113,10 @@ LOBES = {
     for frame in ("average", "free")
 }
 FRAMES = {
-    "free": "Z tilted from the lobe's average direction too (7 parameters; at alpha_x = alpha_y: the isotropic fit with "
-    "ltc_code's frame angle free, lutbake's free_frame)",
-    "average": "Z = the lobe's average direction (5 parameters; at alpha_x = alpha_y: ltc_code's M, lutbake's isotropic "
-    "ggx fit)",
+    "free": "Z tilted from the lobe's average direction too (7 parameters; at alpha_x = alpha_y: the isotropic fit "
+    "with ltc_code's frame angle free, lutbake's free_frame)",
+    "average": "Z = the lobe's average direction (5 parameters; at alpha_x = alpha_y: ltc_code's M, lutbake's "
+    "isotropic ggx fit)",
 }
 
 
@@ -158,7 +158,9 @@ class AnisoProblem(fit.Problem):
         tab = np.stack([ay32, np.cos(phi).astype(np.float32), np.sin(phi).astype(np.float32)], axis=1)[:, None, :]
         symmetric = (ax32 == ay32) | (np.sin(phi) == 0.0) | (np.cos(phi) < 1e-12)
         self.phi, self.alpha_y = phi, ay32
-        super().__init__(LOBES[frame], nov, ax32, magnitude, n_grid, device, tab=np.ascontiguousarray(tab), symmetric=symmetric)
+        super().__init__(
+            LOBES[frame], nov, ax32, magnitude, n_grid, device, tab=np.ascontiguousarray(tab), symmetric=symmetric
+        )
         s = self.grid_n**2
         grid = wp.array(fit.stratified_grid(self.grid_n), dtype=wp.vec2, device=device)
         wp.launch(aniso_lobe_samples, dim=(self.n, s), inputs=[self._texels, grid, self._lobe], device=device)
@@ -311,8 +313,9 @@ MAGNITUDE_SAMPLES = 1 << 16  # scrambled Sobol' points per anisotropic texel (bo
 def magnitude_fresnel(grid: Grid4, samples: int = MAGNITUDE_SAMPLES, device: str = "cpu", seed: int = 0):
     """(magnitude, fresnel) (n_a, n_b, n_theta, n_phi): ∫ f (n.l) dω and ∫ f (1 - v.h)^5 (n.l) dω, F = 1. Texels with
     alpha_x = alpha_y: the isotropic ltc kind's integrals (lutbake.ltc.magnitude: Gauss-Legendre, exact; they do not
-    depend on phi); the others: the specular_aniso kind's integrand (lutbake.integrands.anisotropic, the ``multiscatter``
-    channels (Fc, 1)) and estimator at the texel's fixed view azimuth (lutbake.sampling.anisotropic.AnisoSobol:
+    depend on phi); the others: the specular_aniso kind's integrand (lutbake.integrands.anisotropic, the
+    ``multiscatter`` channels (Fc, 1)) and estimator at the texel's fixed view azimuth
+    (lutbake.sampling.anisotropic.AnisoSobol:
     anisotropic VNDF sampling, weight G2 / G1 <= 1)."""
     from ..integrands.anisotropic import aniso_integrand
     from ..sampling.anisotropic import AnisoSobol

@@ -370,7 +370,8 @@ def normal_frame_matrices(q: np.ndarray, isotropic: np.ndarray) -> np.ndarray:
 
 
 def frame_of(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(X0, Y0) of the frame Z (k, 3): X0 = normalize(y x Z) (ltc_code's X = (Z.z, 0, -Z.x) where Z.y = 0), Y0 = Z x X0."""
+    """(X0, Y0) of the frame Z (k, 3): X0 = normalize(y x Z) (ltc_code's X = (Z.z, 0, -Z.x) where Z.y = 0),
+    Y0 = Z x X0."""
     x0 = np.stack([z[:, 2], np.zeros(len(z)), -z[:, 0]], axis=1)
     x0 /= np.linalg.norm(x0, axis=1, keepdims=True)
     return x0, np.cross(z, x0)
