@@ -37,10 +37,13 @@ import numpy as np
 import warp as wp
 
 from ..edge import COS_EPS
+from ..runtime.warp_runtime import MODULE_OPTIONS
 from ..terms import masking, ndf
 from ..terms.frame import reflect
 from . import fit
 from .lobes import Lobe, half_vector, pdf_reflected_ndf, smith_f_cos
+
+wp.set_module_options(MODULE_OPTIONS)
 
 ALPHA_FLOOR = 1.0e-4  # the paper's texels: alpha = max(i / (n - 1), 1e-4) (fit_alphax_alphay_theta_phi.py)
 THETA_SCALE = 0.9999  # the paper's texels: theta = k / (n - 1) * 0.9999 * pi / 2 ("to avoid grazing angle")
