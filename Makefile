@@ -75,6 +75,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_dielectric.py
 	$(BIN)/python benchmarks/bench_ltc.py
 	$(BIN)/python benchmarks/bench_ltc.py --lobes eon,gotanda
+	$(BIN)/python benchmarks/bench_ltc_aniso.py
 	$(BIN)/python benchmarks/bench_cluster.py
 	$(BIN)/python benchmarks/write_benchmarks_md.py
 

@@ -458,6 +458,9 @@ UNAUDITED = {
     "compared in tests/test_babylon.py; audit_ltc reads ltc_code pairs, not this (A, B, R_i) coding)",
     "ltc_sheen_tables.npz": "Zeltner et al.'s two published LTC tables (volume, approx): the references of "
     "tests/test_sheen_volume.py, no engine loads them",
+    "ltc_aniso_alphax_alphay_theta_phi.npy": "Kt et al. 2022's anisotropic GGX LTC table (8^4 matrices, no magnitude):"
+    " the reference of tests/test_ltc_aniso.py and benchmarks/bench_ltc_aniso.py; no kind writes this layout yet",
+    "ltc_aniso_alpha_lambda_theta_phi.npy": "the same paper's alpha x lambda table (tests/test_ltc_aniso.py)",
 }
 FAST_SIDE = 6  # the loop's subset (its own tests above use MAX_SIDE)
 OPENPBR_RATIO_MEAN = 2e-3  # the ratio re-baked: its averages' noise divided by them (measured mean 6.1e-4, all slices)

@@ -31,13 +31,20 @@ vec3 lutbake_ltc_edge(vec3 v1, vec3 v2) {
     return cross(v1, v2) * theta_sintheta;
 }
 
+float lutbake_ltc_polygon(mat3 Minv, vec3 p[4], bool two_sided);
+
 // Integral of the LTC over a quad light (vertices relative to the shading point, world space), normal N,
 // view V: the polygon is expressed in (T1, T2, N), T1 = normalize(V - N NoV), transformed by M^-1, clipped to the
 // horizon (Sutherland-Hodgman, up to 5 vertices), projected to the sphere and integrated edge by edge.
 float lutbake_ltc_quad(vec3 N, vec3 V, mat3 Minv, vec3 p[4], bool two_sided) {
     vec3 T1 = normalize(V - N * dot(V, N));
     vec3 T2 = cross(N, T1);
-    Minv = Minv * transpose(mat3(T1, T2, N));
+    return lutbake_ltc_polygon(Minv * transpose(mat3(T1, T2, N)), p, two_sided);
+}
+
+// The same integral for Minv already composed with the shading frame (world -> LTC space); the sum is positive for
+// vertices counter-clockwise seen from the shading point when det(Minv) > 0.
+float lutbake_ltc_polygon(mat3 Minv, vec3 p[4], bool two_sided) {
     vec3 L[4];
     for (int i = 0; i < 4; ++i) L[i] = Minv * p[i];
     vec3 C[5];

@@ -199,7 +199,12 @@ class Problem:
         n_grid: int = LTC_FIT_GRID,
         device: str = "cpu",
         workers: int = 1,
+        tab: np.ndarray | None = None,
+        symmetric: np.ndarray | None = None,
     ):
+        """``tab``: a tabulated lobe's per-texel table given by the caller (lutbake.ltc.aniso: each texel's
+        (alpha_y, cos phi, sin phi)) instead of Lobe.tabulate's; ``symmetric``: with a general_frame lobe, the texels
+        whose lobe is symmetric about the plane of incidence (fitted in ltc_code's 3 parameters)."""
         self.lobe = lobe(lobe_of)  # a Lobe, or the name of one of lutbake's
         self.device = device
         self.nov = np.asarray(nov, np.float32)
@@ -216,7 +221,8 @@ class Problem:
         load_module(lobe_samples.module, d)  # the three kernels' module, compiled once when tables prepare in parallel
         lb = self.lobe
         # a tabulated lobe's per-texel table (lutbake.ltc.tabulated, ``workers`` threads), else a 1-element placeholder
-        tab = lb.tabulate(self.v, self.alpha, d, workers) if lb.tabulate else np.zeros((1, 1, 1), np.float32)
+        if tab is None:
+            tab = lb.tabulate(self.v, self.alpha, d, workers) if lb.tabulate else np.zeros((1, 1, 1), np.float32)
         self._texels = Texels()
         self._texels.v = wp.array(self.v, dtype=wp.vec3, device=d)
         self._texels.alpha = wp.array(self.alpha, dtype=float, device=d)
@@ -237,12 +243,16 @@ class Problem:
         self.frame_z = self._frames(np.einsum("ts,tsk->tk", w, dirs))
         self.evaluations = 0
         self.normal_frame = lb.normal_frame
-        self.dof = 2 if lb.normal_frame else 4 if lb.free_frame else 3  # q's length (matrices)
+        self.general = lb.general_frame
+        self.symmetric = np.zeros(self.n, bool) if symmetric is None else np.asarray(symmetric, bool)
+        general = (7 if lb.free_frame else 5) if lb.general_frame else None
+        self.dof = 2 if lb.normal_frame else general or (4 if lb.free_frame else 3)  # q's length (matrices)
 
     def _frames(self, avg: np.ndarray) -> np.ndarray:
         """Z = normalize(average direction with y cleared); (0, 0, 1) at normal incidence (ltc_code fitTab)."""
         z = avg.copy()
-        z[:, 1] = 0.0
+        if not self.lobe.general_frame:
+            z[:, 1] = 0.0
         nrm = np.linalg.norm(z, axis=1)
         ok = nrm > 0.0
         z[ok] /= nrm[ok, None]
@@ -257,6 +267,8 @@ class Problem:
         ``normal_frame`` (``dof`` 2) normal_frame_matrices."""
         if self.normal_frame:
             return normal_frame_matrices(q, self.isotropic[texel])
+        if self.general:
+            return general_matrices(self.frame_z[texel], q, self.symmetric[texel], self.isotropic[texel])
         m11 = np.maximum(np.exp(q[:, 0]), M_MIN)
         m22 = np.maximum(np.exp(q[:, 1]), M_MIN)
         m13 = q[:, 2] * m11
@@ -355,6 +367,41 @@ def normal_frame_matrices(q: np.ndarray, isotropic: np.ndarray) -> np.ndarray:
     m[:, 0, 2] = -b / a
     m[:, 2, 2] = 1.0
     return m
+
+
+def frame_of(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(X0, Y0) of the frame Z (k, 3): X0 = normalize(y x Z) (ltc_code's X = (Z.z, 0, -Z.x) where Z.y = 0),
+    Y0 = Z x X0."""
+    x0 = np.stack([z[:, 2], np.zeros(len(z)), -z[:, 0]], axis=1)
+    x0 /= np.linalg.norm(x0, axis=1, keepdims=True)
+    return x0, np.cross(z, x0)
+
+
+def general_matrices(z: np.ndarray, q: np.ndarray, symmetric: np.ndarray, normal: np.ndarray) -> np.ndarray:
+    """M of a lobe without a plane of symmetry (lutbake.ltc.aniso), up to scale and the clamped cosine's invariance
+    under rotations about z (M ~ M R_z: Kt et al. 2022, Sec. 4): M = [X Y Z] [[m11, 0, m13], [0, m22, m23], [0, 0,
+    1]], X = cos psi X0 + sin psi Y0, Y = Z x X (frame_of(Z)); q = (log m11, log m22, m13 / m11, m23 / m22, psi) with
+    Z = the lobe's average direction ``z``, or (dof 7) q[:, 5:7] = (d1, d2) tilting it: Z = normalize(cos d1 cos d2 z
+    + sin d1 X0 + sin d2 Y0) (d2 = 0: fit.Problem's free_frame rotation by d1). Every M R_z is of the 7-parameter
+    form (a 2x2 block's SVD absorbs R_z). ``symmetric`` texels (a lobe symmetric about the xz-plane) take psi = m23 =
+    d2 = 0: ltc_code's M (with d1: the free frame); ``normal`` ones (n.v = 1) also m13 = d1 = 0. Returns M (k, 3, 3)."""
+    m11 = np.maximum(np.exp(q[:, 0]), M_MIN)
+    m22 = np.maximum(np.exp(q[:, 1]), M_MIN)
+    m13 = np.where(normal, 0.0, q[:, 2] * m11)
+    m23 = np.where(symmetric | normal, 0.0, q[:, 3] * m22)
+    psi = np.where(symmetric, 0.0, q[:, 4])
+    if q.shape[1] > 5:
+        d1 = np.where(normal, 0.0, q[:, 5])[:, None]
+        d2 = np.where(symmetric | normal, 0.0, q[:, 6])[:, None]
+        x0, y0 = frame_of(z)
+        z = np.cos(d1) * np.cos(d2) * z + np.sin(d1) * x0 + np.sin(d2) * y0
+        z /= np.linalg.norm(z, axis=1, keepdims=True)
+    x0, y0 = frame_of(z)
+    c, s = np.cos(psi)[:, None], np.sin(psi)[:, None]
+    x, y = c * x0 + s * y0, c * y0 - s * x0
+    a = np.zeros((len(q), 3, 3))
+    a[:, 0, 0], a[:, 1, 1], a[:, 0, 2], a[:, 1, 2], a[:, 2, 2] = m11, m22, m13, m23, 1.0
+    return np.stack([x, y, z], axis=2) @ a
 
 
 def nelder_mead(

@@ -236,6 +236,8 @@ class Lobe:
     normal_frame: bool = False  # fit Zeltner et al. 2022's M^-1 = [[a, 0, b], [0, a, 0], [0, 0, 1]] in the normal's
     # frame (2 parameters, lutbake.ltc.fit.Problem.matrices) instead of ltc_code's lobe-average frame
     origin: str = ""  # a plugin's lobe: the sha256 of its text (fits are memoised per (name, origin): lutbake.ltc.fit)
+    general_frame: bool = False  # a lobe not symmetric about the plane of incidence (lutbake.ltc.aniso): M fitted in
+    # the general 5-parameter form (lutbake.ltc.fit.general_matrices), the frame Z = the lobe's 3D average direction
 
 
 LOBES = {

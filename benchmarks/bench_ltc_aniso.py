@@ -1,0 +1,169 @@
+"""Anisotropic GGX LTC tables (lutbake.ltc.aniso) against the published 8^4 table of Kt, Heitz, Dupuy & Narayanan
+2022 (AakashKT/LTC-Anisotropic LUT/alphax_alphay_theta_phi.npy, tests/data), through the same reconstruction.
+
+1. lutbake's 8^4 table (the paper's texels, parametrisation alpha_x x alpha_y x theta x phi): magnitude and fresnel
+   (lutbake.ltc.aniso.magnitude_fresnel), the L3 fit (frame "free"), timed; written to outputs/bench/ltc_aniso/ in
+   the paper's .npy layout and the shader's texture layout (lutbake.ltc.aniso.texture_layout).
+2. The L3 relative error of both tables at every fitted texel (lutbake's metric).
+3. Polygon lights (lutbake.validate.ltc_area's light set) at random (alpha_x, alpha_y, theta, phi): the ground truth
+   ∫_P f (n.l) dω by anisotropic VNDF sampling (numpy, written here from Heitz 2018: independent of the Warp terms),
+   S^2 stratified samples, weight G2 / G1(v); the LTC side: lutbake.ltc.aniso.lookup (the shader's quadrilinear
+   interpolation of M and of the magnitude) then the exact polygon integral of M^-1 p (two-sided). Both tables use
+   lutbake's magnitude: the comparison is of the matrices. Per band of roughness max(alpha), anisotropy
+   min/max(alpha) and view theta: median and p90 relative error (where the truth exceeds 1e-3 x albedo) and p90
+   |error| / albedo.
+
+The paper's fitting script (fitting/fit_alphax_alphay_theta_phi.py) needs torch with CUDA ('cuda:0' is hard-coded
+in every tensor it makes); it is not run here (see the JSON's "paper_fit").
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from lutbake.ltc import aniso, polygon
+from lutbake.validate.ltc_area import GT_FLOOR, LIGHTS, hits, light_polygon
+
+ROOT = Path(__file__).resolve().parents[1]
+PUBLISHED = ROOT / "tests" / "data" / "ltc_aniso_alphax_alphay_theta_phi.npy"
+OUT = ROOT / "outputs" / "bench"
+
+
+def lambda_aniso(w: np.ndarray, ax: float, ay: float) -> np.ndarray:
+    """Heitz 2014, Eq. 86."""
+    z2 = np.maximum(w[:, 2] ** 2, 1e-30)
+    return 0.5 * (np.sqrt(1.0 + (ax * ax * w[:, 0] ** 2 + ay * ay * w[:, 1] ** 2) / z2) - 1.0)
+
+
+def vndf_samples(v: np.ndarray, ax: float, ay: float, s: int) -> tuple[np.ndarray, np.ndarray]:
+    """l and the weight f (n.l) / p = G2 / G1(v) for h by anisotropic VNDF sampling (Heitz 2018, Listing 1)."""
+    u = (np.stack(np.meshgrid(np.arange(s), np.arange(s), indexing="ij"), -1).reshape(-1, 2) + 0.5) / s
+    vh = np.array([ax * v[0], ay * v[1], v[2]])
+    vh /= np.linalg.norm(vh)
+    lensq = vh[0] ** 2 + vh[1] ** 2
+    t1 = np.array([-vh[1], vh[0], 0.0]) / np.sqrt(lensq) if lensq > 0 else np.array([1.0, 0.0, 0.0])
+    t2 = np.cross(vh, t1)
+    r, ph = np.sqrt(u[:, 0]), 2.0 * np.pi * u[:, 1]
+    p1, p2 = r * np.cos(ph), r * np.sin(ph)
+    sv = 0.5 * (1.0 + vh[2])
+    p2 = (1.0 - sv) * np.sqrt(np.maximum(1.0 - p1 * p1, 0.0)) + sv * p2
+    nh = p1[:, None] * t1 + p2[:, None] * t2 + np.sqrt(np.maximum(1.0 - p1 * p1 - p2 * p2, 0.0))[:, None] * vh
+    h = np.stack([ax * nh[:, 0], ay * nh[:, 1], np.maximum(nh[:, 2], 0.0)], axis=1)
+    h /= np.linalg.norm(h, axis=1, keepdims=True)
+    l = 2.0 * (h @ v)[:, None] * h - v
+    lam_v = lambda_aniso(v[None], ax, ay)[0]
+    w = np.where(l[:, 2] > 0, (1.0 + lam_v) / (1.0 + lam_v + lambda_aniso(l, ax, ay)), 0.0)
+    return l, w
+
+
+def ltc_integral(m: np.ndarray, poly: np.ndarray) -> float:
+    """The LTC's polygon integral: the form factor of M^-1 p (two-sided)."""
+    return abs(polygon.form_factor(poly @ np.linalg.inv(m).T))
+
+
+def band(x, edges, names):
+    return names[int(np.searchsorted(edges, x, side="right"))]
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--configs", type=int, default=240)
+    ap.add_argument("--gt", type=int, default=256, help="S: S^2 VNDF samples per configuration")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--frame", default="free", choices=sorted(aniso.FRAMES))
+    a = ap.parse_args()
+    grid = aniso.Grid4("alphax_alphay", (8, 8, 8, 8))
+    t0 = time.perf_counter()
+    mag, fres = aniso.magnitude_fresnel(grid)
+    t_mag = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    table, err = aniso.fit_table(grid, mag, workers=a.workers, frame=a.frame)
+    t_fit = time.perf_counter() - t0
+    out = OUT / "ltc_aniso"
+    out.mkdir(parents=True, exist_ok=True)
+    np.save(out / "alphax_alphay_theta_phi.npy", table.astype(np.float32))
+    np.save(out / "ltc_aniso_textures.npy", aniso.texture_layout(table, mag, fres, err))
+    published = np.load(PUBLISHED).astype(np.float64)
+    fitted = aniso.fitted_texels(grid)
+    e_pub = aniso.relative_error_of(grid, mag, published.reshape(-1, 3, 3)[fitted], fitted)
+    e_ours = err.reshape(-1)[fitted]
+
+    rng = np.random.default_rng(7)
+    lights = [light_polygon(*spec[:7]) for spec in LIGHTS]
+    extra = np.stack([mag], axis=-1)
+    rows = []
+    for _ in range(a.configs):
+        ax, ay = rng.uniform(0.05, 1.0, 2)
+        theta = np.arccos(rng.uniform(np.cos(np.radians(85.0)), 1.0))
+        phi = rng.uniform(0.0, 2.0 * np.pi)
+        v = np.array([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)])
+        l, w = vndf_samples(v, ax, ay, a.gt)
+        truth = np.array([np.sum(w[hits(l, p)]) for p in lights]) / a.gt**2
+        for name, tab in (("published", published), ("lutbake", table)):
+            m, e = aniso.lookup(tab, grid, ax, ay, theta, phi, extra)
+            est = e[0, 0] * np.array([ltc_integral(m[0], p) for p in lights])
+            for tr, es in zip(truth, est):
+                rows.append((name, ax, ay, theta, tr, es, e[0, 0]))
+    bands = {
+        "roughness max(alpha)": ([0.3, 0.6], ["<0.3", "0.3-0.6", ">0.6"], lambda r: max(r[1], r[2])),
+        "anisotropy min/max": ([0.35, 0.7], ["<0.35", "0.35-0.7", ">0.7"], lambda r: min(r[1], r[2]) / max(r[1], r[2])),
+        "view theta (deg)": ([40.0, 70.0], ["<40", "40-70", ">70"], lambda r: np.degrees(r[3])),
+    }
+
+    def stats(sel):
+        tr = np.array([r[4] for r in sel])
+        es = np.array([r[5] for r in sel])
+        alb = np.array([r[6] for r in sel])
+        ok = tr > GT_FLOOR * alb
+        rel = np.abs(es[ok] - tr[ok]) / tr[ok]
+        ea = np.abs(es - tr) / alb
+        return {
+            "n": int(len(sel)),
+            "median_rel": float(np.median(rel)),
+            "p90_rel": float(np.percentile(rel, 90)),
+            "p90_abs_over_albedo": float(np.percentile(ea, 90)),
+        }
+
+    table_rows = {}
+    for name in ("published", "lutbake"):
+        mine = [r for r in rows if r[0] == name]
+        res = {"all": stats(mine)}
+        for key, (edges, names, f) in bands.items():
+            for nm in names:
+                sel = [r for r in mine if band(f(r), edges, names) == nm]
+                if sel:
+                    res[f"{key} {nm}"] = stats(sel)
+        table_rows[name] = res
+    report = {
+        "table": "8x8x8x8 alpha_x x alpha_y x theta x phi (the paper's texels)",
+        "frame": a.frame,
+        "fit_seconds": t_fit,
+        "magnitude_seconds": t_mag,
+        "workers": a.workers,
+        "texels_fitted": int(len(fitted)),
+        "l3_relative_error": {
+            "published": {"median": float(np.median(e_pub)), "p90": float(np.percentile(e_pub, 90))},
+            "lutbake": {"median": float(np.median(e_ours)), "p90": float(np.percentile(e_ours, 90))},
+        },
+        "polygon_lights": table_rows,
+        "configs": a.configs,
+        "ground_truth_samples": a.gt**2,
+        "files": {
+            "alphax_alphay_theta_phi.npy": "the paper's layout (8, 8, 8, 8, 3, 3), M with |M e_z| = 1",
+            "ltc_aniso_textures.npy": "(3, 64, 8, 8, 4): three RGBA 3D textures 8 (phi) x 8 (theta) x 64 (alpha_y + 8 "
+            "alpha_x), docs/shaders/ltc_aniso.glsl",
+        },
+        "paper_fit": "fitting/fit_alphax_alphay_theta_phi.py: torch + CUDA ('cuda:0' hard-coded), tqdm; 10000 SGD "
+        "epochs over the 8^4 texels by default; not run here (no torch, no GPU on this machine)",
+    }
+    (OUT / "ltc_aniso.json").write_text(json.dumps(report, indent=1))
+    print(json.dumps(report, indent=1))
+
+
+if __name__ == "__main__":
+    main()
