@@ -92,5 +92,6 @@ window.furnaceDemo = async () => {
 	return result;
 
 };
+window.defaultChart = defaultChart;
 window.furnaceReady = true;
 if ( ! new URLSearchParams( location.search ).has( 'driver' ) && window.parent === window ) window.furnaceDemo();
