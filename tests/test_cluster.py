@@ -168,10 +168,13 @@ def test_a_plugins_table_is_shipped_to_the_workers_and_bakes_the_same_bits(runne
     (lutbake.plugins) and bakes the thread executor's bits."""
     import lutbake
 
-    plugin = tmp_path / "schlick4.py"
-    plugin.write_text((Path(__file__).parents[1] / "examples" / "custom_fresnel" / "schlick4.py").read_text())
+    # registered under a name of its own: a process that also runs tests/test_plugins.py (xdist puts whole modules on a
+    # worker, in any order) holds that module's "schlick4" from another file, which lutbake refuses to redefine
+    plugin = tmp_path / "schlick4_cluster.py"
+    text = (Path(__file__).parents[1] / "examples" / "custom_fresnel" / "schlick4.py").read_text()
+    plugin.write_text(text.replace('"schlick4"', '"schlick4_cluster"'))
     lutbake.load_plugin(plugin)
-    s = validate_table({"name": "p", "kind": "dfg", "size": [16, 8], "fresnel": "schlick4"}, "<t>", 0)
+    s = validate_table({"name": "p", "kind": "dfg", "size": [16, 8], "fresnel": "schlick4_cluster"}, "<t>", 0)
     local = bake_table(s, workers=2)[0]
     plugin.unlink()  # the workers read the text shipped with the record, not the file
     with deadline():
