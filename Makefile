@@ -2,6 +2,8 @@
 #   make luts      create the venv if missing, install, bake every config in configs/ and every engine
 #                  preset (PRESETS) into outputs/
 #   make test      create the venv if missing, install, run ruff (check + format --check), then the test suite
+#   make demo      bake the three.js preset into outputs/ (if not up to date) and serve the engine pages (web/) on
+#                  127.0.0.1:8049: the engine's shipped table beside lutbake's, and their difference
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
@@ -15,10 +17,10 @@ WORKERS ?=
 FORCE   ?=
 TEST_WORKERS ?= 2  # pytest-xdist processes for make test; a module's tests stay on one (its fixtures are built once)
 
-.PHONY: lint luts test validate bench clean venv help figures bench-diffuse bench-ltc bench-cluster bench-luts
+.PHONY: lint luts test validate bench clean venv help figures demo bench-diffuse bench-ltc bench-cluster bench-luts
 
 help:
-	@echo "make luts | test | validate | figures | bench | clean"
+	@echo "make luts | test | demo | validate | figures | bench | clean"
 
 venv: $(STAMP)
 
@@ -51,7 +53,15 @@ lint: $(STAMP)
 test: $(STAMP) lint
 	@$(BIN)/python -c "import moderngl; moderngl.create_standalone_context(backend='egl').release()" 2>/dev/null \
 		|| echo "note: no EGL OpenGL here; the GL consumer test will skip (Debian: apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri)"
+	@command -v chromium >/dev/null && test -d web/node_modules \
+		|| echo "note: no chromium or web/node_modules; the in-engine tests will skip (apt-get install chromium; npm ci --prefix web)"
 	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadscope --no-loadscope-reorder
+
+# the engines' npm packages (web/package-lock.json) on first use; then tests/web_harness.py serves the pages
+demo: $(STAMP)
+	test -d web/node_modules || npm ci --prefix web
+	$(BIN)/lutbake bake --preset threejs --out-dir $(OUT)
+	$(BIN)/python tests/web_harness.py --luts $(OUT)
 
 # diffuse kinds against converged references (accuracy and wall time): outputs/bench/diffuse.json
 bench-diffuse: $(STAMP)

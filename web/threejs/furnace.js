@@ -1,0 +1,97 @@
+// The white furnace, three.js (MeshStandardMaterial, its own PMREM of a uniform environment of radiance 1): one
+// camera-facing 1-pixel quad per (NoV, row); each quad's vertex normals are all (0, sin t, cos t), so NoV = cos t is
+// the same at every fragment, the normal's screen derivatives (three.js's geometryRoughness) are zero and roughness is
+// the material's. Orthographic camera, float render target, no tone mapping, linear output.
+import * as THREE from 'three';
+
+// rows: [{ roughness, metalness, color: [r, g, b] }], nov: [NoV per column]. Returns the RGBA float pixels, row 0 at
+// the bottom (row i of the result is rows[i]).
+async function furnace( { nov, rows } ) {
+
+	const width = nov.length, height = rows.length;
+	const renderer = new THREE.WebGLRenderer( { antialias: false } );
+	renderer.setSize( width, height, false );
+	renderer.toneMapping = THREE.NoToneMapping;
+	renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
+
+	const ones = new Float32Array( 8 * 4 * 4 ).fill( 1 );
+	const env = new THREE.DataTexture( ones, 8, 4, THREE.RGBAFormat, THREE.FloatType );
+	env.mapping = THREE.EquirectangularReflectionMapping;
+	env.colorSpace = THREE.LinearSRGBColorSpace;
+	env.needsUpdate = true;
+
+	const scene = new THREE.Scene();
+	scene.environment = env;
+	const camera = new THREE.OrthographicCamera( 0, width, height, 0, - 1, 1 );
+
+	rows.forEach( ( row, y ) => {
+
+		const position = [], normal = [], index = [];
+		nov.forEach( ( c, x ) => {
+
+			const s = Math.sqrt( Math.max( 0, 1 - c * c ) );
+			const base = position.length / 3;
+			position.push( x, y, 0, x + 1, y, 0, x + 1, y + 1, 0, x, y + 1, 0 );
+			for ( let k = 0; k < 4; k ++ ) normal.push( 0, s, c );
+			index.push( base, base + 1, base + 2, base, base + 2, base + 3 );
+
+		} );
+		const geometry = new THREE.BufferGeometry();
+		geometry.setAttribute( 'position', new THREE.Float32BufferAttribute( position, 3 ) );
+		geometry.setAttribute( 'normal', new THREE.Float32BufferAttribute( normal, 3 ) );
+		geometry.setIndex( index );
+		const material = new THREE.MeshStandardMaterial( {
+			color: new THREE.Color().setRGB( ...row.color, THREE.LinearSRGBColorSpace ),
+			roughness: row.roughness,
+			metalness: row.metalness,
+		} );
+		scene.add( new THREE.Mesh( geometry, material ) );
+
+	} );
+
+	const target = new THREE.WebGLRenderTarget( width, height, {
+		type: THREE.FloatType, format: THREE.RGBAFormat, depthBuffer: false,
+		minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter,
+	} );
+	renderer.setRenderTarget( target );
+	renderer.render( scene, camera );
+	const pixels = new Float32Array( width * height * 4 );
+	renderer.readRenderTargetPixels( target, 0, 0, width, height, pixels );
+	renderer.setRenderTarget( null );
+	renderer.render( scene, camera );
+	return { width, height, pixels, canvas: renderer.domElement, renderer: renderer.getContext().getParameter( renderer.getContext().RENDERER ) };
+
+}
+
+// The chart the demo shows: NoV along x, roughness up; a metal of base colour (1, 0.5, 0.2) below, a black dielectric
+// (f0 = 0.04) above.
+export function defaultChart( n = 32 ) {
+
+	const nov = Array.from( { length: n }, ( _, i ) => ( i + 0.5 ) / n );
+	const rows = [];
+	for ( const material of [ { metalness: 1, color: [ 1, 0.5, 0.2 ] }, { metalness: 0, color: [ 0, 0, 0 ] } ] ) {
+
+		for ( let j = 0; j < n / 2; j ++ ) rows.push( { ...material, roughness: 0.05 + 0.95 * j / ( n / 2 - 1 ) } );
+
+	}
+	return { nov, rows };
+
+}
+
+window.furnace = async ( spec ) => {
+
+	globalThis.lutbakeMistake = spec.mistake || 'none';
+	const result = await furnace( spec );
+	return { width: result.width, height: result.height, pixels: Array.from( result.pixels ), renderer: result.renderer };
+
+};
+window.furnaceDemo = async () => {
+
+	const result = await furnace( defaultChart() );
+	document.body.appendChild( result.canvas );
+	return result;
+
+};
+window.defaultChart = defaultChart;
+window.furnaceReady = true;
+if ( ! new URLSearchParams( location.search ).has( 'driver' ) && window.parent === window ) window.furnaceDemo();
