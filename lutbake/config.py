@@ -20,6 +20,7 @@ from typing import Any
 from . import arguments
 from .config_file import config_file_problem, nesting_problem
 from .errors import ArgumentError, ConfigError, did_you_mean
+from .io.formats import FORMAT_KINDS
 from .kinds import KINDS, Key, Kind, kind_record, lookup_kind
 from .limits import BAKE_PEAK_BYTES_PER_TEXEL, MAX_LIST, MAX_TEXELS  # noqa: F401  (lutbake.config.MAX_TEXELS, as before)
 from .registry import Choices, Record
@@ -309,6 +310,11 @@ def validate_table(raw: Mapping[str, Any], file, index: int) -> TableSpec:
             f"{human_bytes(texels * BAKE_PEAK_BYTES_PER_TEXEL)} of memory at the bake's peak "
             f"({BAKE_PEAK_BYTES_PER_TEXEL} bytes a texel, measured)",
             label,
+        )
+    if options.get("format") in FORMAT_KINDS and kind.name not in FORMAT_KINDS[options["format"]]:
+        fmt = options["format"]
+        raise ConfigError(
+            file, "format", fmt, None, f"{fmt} holds a {' or '.join(FORMAT_KINDS[fmt])} table only", label
         )
     if options.get("format") == "png16":
         reason = unit_range(spec)

@@ -63,6 +63,52 @@ def test_js_module_read_by_node(table, tmp_path, dtype):
         np.testing.assert_array_equal(np.array(out["v"], np.float32).reshape(H, W, 2), table.data)
 
 
+@pytest.mark.skipif(shutil.which("node") is None, reason="node is not installed")
+def test_threejs_dfg_module_replaces_threes_own_file(table, tmp_path):
+    """format threejs_dfg is three.js's src/renderers/shaders/DFGLUTData.js: put where three's stands (its relative
+    imports resolved to stand-ins of three's DataTexture and constants), node's getDFGLUT() builds the W x H RG16F
+    texture of the table's half bits, linear, clamped, no mipmaps."""
+    src = tmp_path / "three" / "src"
+    shaders = src / "renderers" / "shaders"
+    shaders.mkdir(parents=True)
+    (src / "textures").mkdir()
+    (src / "textures" / "DataTexture.js").write_text(
+        "export class DataTexture { constructor(data, width, height, format, type) "
+        "{ Object.assign(this, {data, width, height, format, type}); } }\n"
+    )
+    names = ("RGFormat", "HalfFloatType", "LinearFilter", "ClampToEdgeWrapping")
+    (src / "constants.js").write_text("".join(f"export const {n} = '{n}';\n" for n in names))
+    path = write_table(table, tmp_path, "threejs_dfg", "half")
+    shutil.copy(path, shaders / "DFGLUTData.js")
+    mjs = tmp_path / "read.mjs"
+    mjs.write_text(
+        f"import {{ getDFGLUT }} from '{(shaders / 'DFGLUTData.js').as_posix()}';\n"
+        "const t = getDFGLUT(); console.log(JSON.stringify({same: t === getDFGLUT(), v: Array.from(t.data), "
+        "w: t.width, h: t.height, f: t.format, ty: t.type, min: t.minFilter, mag: t.magFilter, s: t.wrapS, "
+        "t: t.wrapT, mips: t.generateMipmaps, name: t.name}));\n"
+    )
+    out = json.loads(subprocess.run(["node", str(mjs)], capture_output=True, text=True, check=True).stdout)
+    assert out["same"] and (out["w"], out["h"], out["name"], out["mips"]) == (W, H, "DFG_LUT", False)
+    assert (out["f"], out["ty"], out["min"], out["mag"], out["s"], out["t"]) == (
+        "RGFormat", "HalfFloatType", "LinearFilter", "LinearFilter", "ClampToEdgeWrapping", "ClampToEdgeWrapping"
+    )  # fmt: skip
+    got = np.array(out["v"], np.uint16).view(np.float16).astype(np.float32)
+    np.testing.assert_array_equal(got.reshape(H, W, 2), half(table.data))
+
+
+def test_threejs_dfg_is_refused_where_three_could_not_load_it(tmp_path):
+    from lutbake.config import validate_table
+    from lutbake.errors import ConfigError
+
+    with pytest.raises(ConfigError, match="threejs_dfg holds a dfg table only"):
+        validate_table({"name": "t", "kind": "albedo", "format": "threejs_dfg", "dtype": "half"}, "c.toml", 0)
+    with pytest.raises(ConfigError, match="a two-channel layout and dtype = 'half'"):
+        validate_table({"name": "t", "kind": "dfg", "format": "threejs_dfg"}, "c.toml", 0)
+    with pytest.raises(ConfigError, match="a two-channel layout"):
+        raw = {"name": "t", "kind": "dfg", "format": "threejs_dfg", "dtype": "half", "layout": "scale_bias_f82"}
+        validate_table(raw, "c.toml", 0)
+
+
 def test_wgsl_array_parsed_independently(table, tmp_path):
     text = write_table(table, tmp_path, "wgsl", "half").read_text()
     assert all(line.startswith("//") for line in text.split("const")[0].strip().splitlines())

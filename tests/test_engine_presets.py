@@ -43,7 +43,13 @@ def test_make_luts_batch_loads_with_unique_names():
         ("bevy", {"layout": "scale_bias", "dtype": "half", "format": "ktx2zst"}),
         (
             "threejs",
-            {"size": (16, 16), "axis_order": "roughness_x", "texel": "center", "dtype": "half", "format": "js"},
+            {
+                "size": (16, 16),
+                "axis_order": "roughness_x",
+                "texel": "center",
+                "dtype": "half",
+                "format": "threejs_dfg",
+            },
         ),
     ],
 )

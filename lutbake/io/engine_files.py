@@ -172,6 +172,7 @@ READERS = {
     "cs": _hdrp_cs,
     "wgsl": _code_array,
     "rs": _code_array,
+    "threejs_dfg": _code_array,
 }
 
 

@@ -78,6 +78,7 @@ WRITERS = {
     **ltc.WRITERS,  # the LTC engine layouts (kind ltc only): lutbake.io.ltc
     **code_arrays.WRITERS,  # JS / WGSL / Rust arrays and zstd KTX2 (lutbake.io.code_arrays); its js serves ltc too
 }
+FORMAT_KINDS = {"threejs_dfg": ("dfg",)}  # formats that hold one kind's tables only (the rest: any kind)
 FORMATS = {**FORMATS, **code_arrays.FORMATS}  # what a table of any kind can be written as (lutbake.kinds.base)
 ALL_FORMATS = {**FORMATS, **ltc.FORMATS}  # every format: the --format option; each kind's ``format`` key allows a
 # subset (lutbake.kinds.allowed_formats), which the config check and its message use

@@ -130,6 +130,8 @@ def check_spec(spec) -> tuple[str, str] | None:
             "fresnel",
             f"layout {layout!r} fixes Schlick's Fresnel; a fresnel goes with layout scale_bias or multiscatter",
         )
+    if o["format"] == "threejs_dfg" and (len(lay.channels) != 2 or o["dtype"] != "half"):
+        return ("format", "threejs_dfg is three.js's RG16F DFG module: a two-channel layout and dtype = 'half'")
     if lay.gauss_legendre_only and o["estimator"] != "gauss_legendre":
         return ("estimator", lay.gauss_legendre_only.format(layout=lay.name, estimator=o["estimator"]))
     if lay.terms.ndf is not None and (

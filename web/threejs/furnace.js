@@ -3,6 +3,30 @@
 // the same at every fragment, the normal's screen derivatives (three.js's geometryRoughness) are zero and roughness is
 // the material's. Orthographic camera, float render target, no tone mapping, linear output.
 import * as THREE from 'three';
+// three.js's own DFG module: furnace.html's import map points this URL at lutbake's DFGLUTData.js (?lut=lutbake), which
+// replaces three's file as it is; three's shaders and this page get the one texture getDFGLUT() makes
+import { getDFGLUT } from '/web/node_modules/three/src/renderers/shaders/DFGLUTData.js';
+
+// The table loaded wrong on purpose (the test driver only: tests/test_web_threejs.py must see each mistake): the
+// texture getDFGLUT() returns, its texels or its upload changed in place from a pristine copy.
+function loadWrong( mistake ) {
+
+	const lut = getDFGLUT();
+	const { width, height, data } = lut.image;
+	lut.userData.pristine ??= data.slice();
+	const src = lut.userData.pristine;
+	for ( let y = 0; y < height; y ++ ) for ( let x = 0; x < width; x ++ ) for ( let c = 0; c < 2; c ++ ) {
+
+		const at = ( y * width + x ) * 2;
+		if ( mistake === 'swapRG' ) data[ at + c ] = src[ at + 1 - c ];
+		else if ( mistake === 'transpose' ) data[ at + c ] = src[ ( x * width + y ) * 2 + c ];
+		else data[ at + c ] = src[ at + c ];
+
+	}
+	lut.flipY = mistake === 'flipY';
+	lut.needsUpdate = true;
+
+}
 
 // rows: [{ roughness, metalness, color: [r, g, b] }], nov: [NoV per column]. Returns the RGBA float pixels, row 0 at
 // the bottom (row i of the result is rows[i]).
@@ -80,7 +104,7 @@ export function defaultChart( n = 32 ) {
 
 window.furnace = async ( spec ) => {
 
-	globalThis.lutbakeMistake = spec.mistake || 'none';
+	loadWrong( spec.mistake || 'none' );
 	const result = await furnace( spec );
 	return { width: result.width, height: result.height, pixels: Array.from( result.pixels ), renderer: result.renderer };
 
