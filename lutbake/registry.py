@@ -203,6 +203,11 @@ class Choices(Mapping):
     def records(self) -> list[Record]:
         return [r for r in family(self.family_name) if self.where is None or self.where(r)]
 
+    def own(self) -> dict[str, str]:
+        """name -> description of lutbake's own records only (what the documentation lists: a plugin's records
+        are listed by ``lutbake list`` in the process that loaded them)."""
+        return {r.name: r.summary for r in self.records() if r.plugin is None}
+
     def resolve(self, name: str) -> Record:
         record = family(self.family_name).lookup(name)
         if self.where is not None and not self.where(record):

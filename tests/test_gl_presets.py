@@ -101,8 +101,9 @@ TABLES = texture_tables()
 def test_every_makefile_preset_is_a_texture_here_or_a_text_array_read_elsewhere():
     """The split this file relies on: a preset's table is a texture (tested here) or a text array (whose formats
     have independent readers in test_code_arrays / test_ltc_formats / test_dielectric), or Babylon's fuzz texture
-    (its coded channels, their decode and round trip: test_babylon)."""
-    text_formats = {"h", "js", "c", "cs", "openpbr_h", "wgsl", "rs"}
+    (its coded channels, their decode and round trip: test_babylon; three.js's module: node in test_code_arrays,
+    three.js itself in test_web_threejs)."""
+    text_formats = {"h", "js", "c", "cs", "openpbr_h", "wgsl", "rs", "threejs_dfg"}
     elsewhere = {"babylon_fuzz"}
     for p in makefile_presets():
         for s in load_config(preset_path(p), []):

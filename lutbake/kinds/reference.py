@@ -12,6 +12,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..registry import Choices
 from .base import Key, Kind
 
 TYPE_NAMES = {
@@ -51,10 +52,17 @@ def toml_value(value) -> str:
     return repr(value)
 
 
-def allowed_text(key: Key) -> str:
-    """The allowed values: the choices' names, or the numeric range, or "any"."""
-    if key.choices:
-        return ", ".join(key.choices)
+def documented(choices):
+    """The allowed values the documentation lists: a family's (lutbake.registry.Choices) lutbake's own records only,
+    whatever plugin this process loaded; other choices as declared."""
+    return choices.own() if isinstance(choices, Choices) else choices
+
+
+def allowed_text(key: Key, own: bool = False) -> str:
+    """The allowed values: the choices' names (``own``: lutbake's records only), or the numeric range, or "any"."""
+    choices = documented(key.choices) if own else key.choices
+    if choices:
+        return ", ".join(choices)
     lo, hi = _number(key.minimum), _number(key.maximum)
     if lo and hi:
         return f"{lo} … {hi}"
@@ -68,15 +76,16 @@ def _number(value) -> str:
     return str(int(value)) if float(value).is_integer() else f"{value:g}"
 
 
-def rows(kind: Kind) -> list[KeyRow]:
-    """Every key of ``kind`` in declaration order (the common keys first)."""
+def rows(kind: Kind, own: bool = False) -> list[KeyRow]:
+    """Every key of ``kind`` in declaration order (the common keys first); ``own``: a family's choices are lutbake's
+    records only (the documentation), else every record this process holds (``lutbake list keys``)."""
     return [
         KeyRow(
             key.name,
             TYPE_NAMES.get(key.type, key.type),
             "required" if key.required else toml_value(key.default),
-            allowed_text(key),
-            tuple((key.choices or {}).items()),
+            allowed_text(key, own),
+            tuple(((documented(key.choices) if own else key.choices) or {}).items()),
             key.doc,
         )
         for key in kind.keys.values()
@@ -113,7 +122,7 @@ def markdown(kind: Kind) -> str:
         "| key | type | default | allowed | meaning |",
         "| --- | --- | --- | --- | --- |",
     ]
-    for row in rows(kind):
+    for row in rows(kind, own=True):
         if row.choices:
             allowed = "; ".join(f"`{value}`: {_cell(meaning)}" for value, meaning in row.choices)
         else:
