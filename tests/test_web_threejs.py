@@ -17,16 +17,8 @@ import pytest
 import web_harness
 from test_gl_consumer import bilinear
 
-from lutbake.api import bake
-from lutbake.config import preset_path
-from lutbake.integrands import specular
-
 THREE = web_harness.WEB / "node_modules" / "three"
 SHIPPED = THREE / "src" / "renderers" / "shaders" / "DFGLUTData.js"
-N_NOV = 32  # columns: NoV = (i + 0.5) / 32
-N_ROUGH = 16  # rows per material: perceptual roughness 0.05 .. 1 (three.js clamps below 0.045)
-METAL = {"metalness": 1.0, "color": [1.0, 0.5, 0.2]}  # f0 = base colour per channel, f90 = 1
-DIELECTRIC = {"metalness": 0.0, "color": [0.0, 0.0, 0.0]}  # f0 = 0.04, no diffuse
 MISTAKES = ("flipY", "swapRG", "transpose")
 # three.js vs the CPU model of the same texels: GPUs weight texels with 8 fractional bits (SwiftShader too), so up to
 # 2^-8 of a texel step (<= 0.05 in a 16² table) after the compensation, and float32 through PMREM's half-float mips
@@ -36,13 +28,6 @@ SUBTEXEL = 2.0**-8 * 0.05 + 1e-5
 # RMS 0.0034 (three.js's shipped table: 0.0679, 0.0035). The upload mistakes measured max >= 0.238, RMS >= 0.054.
 LUTBAKE_MAX = 0.08
 LUTBAKE_RMS = 0.005
-
-
-def chart():
-    nov = (np.arange(N_NOV) + 0.5) / N_NOV
-    rough = 0.05 + 0.95 * np.arange(N_ROUGH) / (N_ROUGH - 1)
-    rows = [{**m, "roughness": float(r)} for m in (METAL, DIELECTRIC) for r in rough]
-    return {"nov": nov.tolist(), "rows": rows}
 
 
 def read_js_halfs(path) -> np.ndarray:
@@ -77,12 +62,6 @@ def furnace_model(dfg, spec) -> np.ndarray:
     return np.stack(out)
 
 
-def exact(rough, nov):
-    return specular.hemisphere_integral(
-        "ggx", "smith_height_correlated", "scale_bias", nov, np.asarray(rough) ** 2, "gauss_legendre", 1728
-    )[:, :2]
-
-
 def table(lut):
     return lambda rough, nov: bilinear(lut, np.stack([rough, nov], axis=1))
 
@@ -90,40 +69,27 @@ def table(lut):
 @pytest.fixture(scope="module")
 def renders(tmp_path_factory):
     """{variant: (height, width, RGB) float pixels}: shipped, lutbake, and lutbake's file under each mistake."""
-    why = web_harness.missing("three")
-    if why:
-        pytest.skip(why)
-    luts = tmp_path_factory.mktemp("threejs")
-    bake([preset_path("threejs")], out_dir=luts)
-    spec = chart()
-    out = {}
-    with web_harness.serve(luts) as url, web_harness.browser() as browser:
-        why = web_harness.webgl2_problem(browser)
-        if why:
-            pytest.skip(why)
-        for lut, variants in (("shipped", ("none",)), ("lutbake", ("none", *MISTAKES))):
-            page = web_harness.open_page(browser, f"{url}/web/threejs/furnace.html?driver&lut={lut}")
-            for mistake in variants:
-                r = page.evaluate("spec => window.furnace(spec)", {**spec, "mistake": mistake})
-                px = np.asarray(r["pixels"], np.float64).reshape(r["height"], r["width"], 4)[..., :3]
-                out[lut if mistake == "none" else mistake] = px
-            assert not page.errors, page.errors
-            page.close()
+    luts = web_harness.bake_preset(tmp_path_factory, "three", "threejs")
+    spec = web_harness.furnace_chart()
+    page = "/web/threejs/furnace.html?driver&lut="
+    mistakes = {m: {"mistake": m} for m in MISTAKES}
+    out = web_harness.render_furnaces(
+        luts, "three", [(page + "shipped", {"shipped": {}}), (page + "lutbake", {"lutbake": {}, **mistakes})], spec
+    )
     out["spec"] = spec
     out["lutbake_file"] = luts / "DFGLUTData.js"
     return out
 
 
 def errors(px, spec):
-    diff = px - furnace_model(exact, spec)
-    return np.abs(diff).max(), np.sqrt(np.mean(diff**2))
+    return web_harness.pixel_errors(px, furnace_model(web_harness.exact_scale_bias, spec))
 
 
 def test_threejs_white_metal_is_white_at_every_roughness(renders):
     # the red channel of the metal rows: f0 = f90 = 1, where Fdez-Agüera's compensation restores all energy whatever
     # the table holds; the float render target keeps it to float32 through PMREM
     for variant in ("shipped", "lutbake"):
-        np.testing.assert_allclose(renders[variant][:N_ROUGH, :, 0], 1.0, atol=1e-5)
+        np.testing.assert_allclose(renders[variant][: web_harness.N_ROUGH, :, 0], 1.0, atol=1e-5)
 
 
 def test_threejs_samples_lutbakes_file_as_its_contract_says(renders):
@@ -146,6 +112,5 @@ def test_threejs_furnace_with_lutbakes_table_is_within_its_interpolation_error(r
 
 @pytest.mark.parametrize("mistake", MISTAKES)
 def test_threejs_furnace_catches_a_wrong_load(renders, mistake):
-    worst, rms = errors(renders[mistake], renders["spec"])
-    print(f"three.js furnace, lutbake's file with {mistake}: max {worst:.4g} RMS {rms:.3g}")
-    assert worst > LUTBAKE_MAX and rms > LUTBAKE_RMS
+    exact_px = furnace_model(web_harness.exact_scale_bias, renders["spec"])
+    web_harness.assert_wrong_load_caught("three.js", mistake, renders[mistake], exact_px, LUTBAKE_MAX, LUTBAKE_RMS)

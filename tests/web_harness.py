@@ -80,6 +80,15 @@ def missing(engine_dir: str) -> str | None:
     return None
 
 
+def require(engine_dir: str) -> None:
+    """Skips the calling test (pytest) with the reason where the in-engine tests cannot run."""
+    import pytest
+
+    why = missing(engine_dir)
+    if why:
+        pytest.skip(why)
+
+
 @contextmanager
 def browser():
     """The system Chromium, headless, launched by Playwright (no browser download)."""
@@ -119,6 +128,85 @@ def open_page(b, url: str):
         raise RuntimeError(f"{url} did not load: {errors or e}") from e
     page.errors = errors
     return page
+
+
+# The white-furnace chart every engine page renders (web/furnace.js defaultChart's, at the tests' size): one pixel per
+# (NoV, row); 16 perceptual roughnesses 0.05 .. 1 (three.js clamps below 0.045) for each of two materials
+N_NOV = 32  # columns: NoV = (i + 0.5) / 32
+N_ROUGH = 16  # rows per material
+METAL = {"metalness": 1.0, "color": [1.0, 0.5, 0.2]}  # f0 = base colour per channel, f90 = 1
+DIELECTRIC = {"metalness": 0.0, "color": [0.0, 0.0, 0.0]}  # f0 = 0.04, no diffuse
+
+
+def furnace_chart() -> dict:
+    import numpy as np
+
+    nov = (np.arange(N_NOV) + 0.5) / N_NOV
+    rough = 0.05 + 0.95 * np.arange(N_ROUGH) / (N_ROUGH - 1)
+    rows = [{**m, "roughness": float(r)} for m in (METAL, DIELECTRIC) for r in rough]
+    return {"nov": nov.tolist(), "rows": rows}
+
+
+def exact_scale_bias(rough, nov):
+    """(N, 2) (scale, bias) of GGX with height-correlated Smith at perceptual ``rough``: lutbake's Gauss-Legendre
+    integral, converged to 2e-7 (the furnaces' exact answer)."""
+    import numpy as np
+
+    from lutbake.integrands import specular
+
+    return specular.hemisphere_integral(
+        "ggx", "smith_height_correlated", "scale_bias", nov, np.asarray(rough) ** 2, "gauss_legendre", 1728
+    )[:, :2]
+
+
+def bake_preset(tmp_path_factory, engine_dir: str, preset: str) -> Path:
+    """Skips the calling test where the harness cannot run for ``engine_dir``; else bakes lutbake's ``preset`` into a
+    fresh folder (served as /lut/) and returns it."""
+    from lutbake.api import bake
+    from lutbake.config import preset_path
+
+    require(engine_dir)
+    luts = tmp_path_factory.mktemp(preset)
+    bake([preset_path(preset)], out_dir=luts)
+    return luts
+
+
+def render_furnaces(luts: Path, engine_dir: str, pages, spec: dict) -> dict:
+    """{variant: (height, width, RGB) float pixels} of ``pages`` = [(URL path, {variant: extra spec})], each page
+    opened once in one browser and driven through window.furnace; skips the test (pytest) with the reason where the
+    harness cannot run."""
+    import numpy as np
+    import pytest
+
+    require(engine_dir)
+    out = {}
+    with serve(luts) as url, browser() as b:
+        why = webgl2_problem(b)
+        if why:
+            pytest.skip(why)
+        for path, variants in pages:
+            page = open_page(b, url + path)
+            for name, extra in variants.items():
+                r = page.evaluate("spec => window.furnace(spec)", {**spec, **extra})
+                out[name] = np.asarray(r["pixels"], np.float64).reshape(r["height"], r["width"], 4)[..., :3]
+            assert not page.errors, page.errors
+            page.close()
+    return out
+
+
+def pixel_errors(px, exact_px) -> tuple[float, float]:
+    """max and RMS of |pixel - exact answer| over every pixel and channel."""
+    import numpy as np
+
+    diff = np.asarray(px) - exact_px
+    return float(np.abs(diff).max()), float(np.sqrt(np.mean(diff**2)))
+
+
+def assert_wrong_load_caught(engine: str, mistake: str, px, exact_px, max_ok: float, rms_ok: float) -> None:
+    """A file loaded wrong must leave the tolerance the right load meets, in max and in RMS."""
+    worst, rms = pixel_errors(px, exact_px)
+    print(f"{engine} furnace, lutbake's file with {mistake}: max {worst:.4g} RMS {rms:.3g}")
+    assert worst > max_ok and rms > rms_ok
 
 
 def main():

@@ -3,6 +3,7 @@
 // the same at every fragment, the normal's screen derivatives (three.js's geometryRoughness) are zero and roughness is
 // the material's. Orthographic camera, float render target, no tone mapping, linear output.
 import * as THREE from 'three';
+import { expose } from '/web/furnace.js';
 // three.js's own DFG module: furnace.html's import map points this URL at lutbake's DFGLUTData.js (?lut=lutbake), which
 // replaces three's file as it is; three's shaders and this page get the one texture getDFGLUT() makes
 import { getDFGLUT } from '/web/node_modules/three/src/renderers/shaders/DFGLUTData.js';
@@ -87,35 +88,4 @@ async function furnace( { nov, rows } ) {
 
 }
 
-// The chart the demo shows: NoV along x, roughness up; a metal of base colour (1, 0.5, 0.2) below, a black dielectric
-// (f0 = 0.04) above.
-export function defaultChart( n = 32 ) {
-
-	const nov = Array.from( { length: n }, ( _, i ) => ( i + 0.5 ) / n );
-	const rows = [];
-	for ( const material of [ { metalness: 1, color: [ 1, 0.5, 0.2 ] }, { metalness: 0, color: [ 0, 0, 0 ] } ] ) {
-
-		for ( let j = 0; j < n / 2; j ++ ) rows.push( { ...material, roughness: 0.05 + 0.95 * j / ( n / 2 - 1 ) } );
-
-	}
-	return { nov, rows };
-
-}
-
-window.furnace = async ( spec ) => {
-
-	loadWrong( spec.mistake || 'none' );
-	const result = await furnace( spec );
-	return { width: result.width, height: result.height, pixels: Array.from( result.pixels ), renderer: result.renderer };
-
-};
-window.furnaceDemo = async () => {
-
-	const result = await furnace( defaultChart() );
-	document.body.appendChild( result.canvas );
-	return result;
-
-};
-window.defaultChart = defaultChart;
-window.furnaceReady = true;
-if ( ! new URLSearchParams( location.search ).has( 'driver' ) && window.parent === window ) window.furnaceDemo();
+expose( furnace, ( spec ) => loadWrong( spec.mistake || 'none' ) );
