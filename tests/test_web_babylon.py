@@ -113,4 +113,6 @@ def test_babylon_furnace_with_lutbakes_table_is_within_its_interpolation_error(r
 @pytest.mark.parametrize("mistake", MISTAKES)
 def test_babylon_furnace_catches_a_wrong_load(renders, mistake):
     exact_px = furnace_model(exact, renders["spec"])
-    web_harness.assert_wrong_load_caught("Babylon", mistake, renders[mistake], exact_px, LUTBAKE_MAX, LUTBAKE_RMS)
+    web_harness.assert_wrong_load_caught(
+        "Babylon furnace", mistake, renders[mistake], exact_px, LUTBAKE_MAX, LUTBAKE_RMS
+    )

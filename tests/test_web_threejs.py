@@ -113,4 +113,6 @@ def test_threejs_furnace_with_lutbakes_table_is_within_its_interpolation_error(r
 @pytest.mark.parametrize("mistake", MISTAKES)
 def test_threejs_furnace_catches_a_wrong_load(renders, mistake):
     exact_px = furnace_model(web_harness.exact_scale_bias, renders["spec"])
-    web_harness.assert_wrong_load_caught("three.js", mistake, renders[mistake], exact_px, LUTBAKE_MAX, LUTBAKE_RMS)
+    web_harness.assert_wrong_load_caught(
+        "three.js furnace", mistake, renders[mistake], exact_px, LUTBAKE_MAX, LUTBAKE_RMS
+    )

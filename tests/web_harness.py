@@ -138,11 +138,11 @@ METAL = {"metalness": 1.0, "color": [1.0, 0.5, 0.2]}  # f0 = base colour per cha
 DIELECTRIC = {"metalness": 0.0, "color": [0.0, 0.0, 0.0]}  # f0 = 0.04, no diffuse
 
 
-def furnace_chart() -> dict:
+def furnace_chart(n_nov: int = N_NOV, n_rough: int = N_ROUGH) -> dict:
     import numpy as np
 
-    nov = (np.arange(N_NOV) + 0.5) / N_NOV
-    rough = 0.05 + 0.95 * np.arange(N_ROUGH) / (N_ROUGH - 1)
+    nov = (np.arange(n_nov) + 0.5) / n_nov
+    rough = 0.05 + 0.95 * np.arange(n_rough) / (n_rough - 1)
     rows = [{**m, "roughness": float(r)} for m in (METAL, DIELECTRIC) for r in rough]
     return {"nov": nov.tolist(), "rows": rows}
 
@@ -205,7 +205,7 @@ def pixel_errors(px, exact_px) -> tuple[float, float]:
 def assert_wrong_load_caught(engine: str, mistake: str, px, exact_px, max_ok: float, rms_ok: float) -> None:
     """A file loaded wrong must leave the tolerance the right load meets, in max and in RMS."""
     worst, rms = pixel_errors(px, exact_px)
-    print(f"{engine} furnace, lutbake's file with {mistake}: max {worst:.4g} RMS {rms:.3g}")
+    print(f"{engine}, lutbake's file with {mistake}: max {worst:.4g} RMS {rms:.3g}")
     assert worst > max_ok and rms > rms_ok
 
 

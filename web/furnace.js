@@ -1,7 +1,7 @@
 // What every engine's white-furnace page shares: the demo chart and the window API the tests (tests/web_harness.py)
 // and web/index.html drive. An engine page calls expose( furnace, prepare ), where furnace( spec ) renders
 // spec = { nov: [NoV per column], rows: [{ roughness, metalness, color }], ... } and resolves to
-// { width, height, pixels (RGBA float, row 0 at the bottom), canvas, renderer, dispose? }, and prepare( spec ) runs
+// { width, height, pixels (RGBA float, row 0 at the bottom), canvas, renderer, info?, dispose? }, and prepare( spec ) runs
 // before each driven render (the wrong loads).
 
 // NoV along x, roughness up; a metal of base colour (1, 0.5, 0.2) below, a black dielectric (f0 = 0.04) above.
@@ -25,12 +25,15 @@ export function expose( furnace, prepare = () => {} ) {
 		await prepare( spec );
 		const result = await furnace( spec );
 		if ( result.dispose ) result.dispose();
-		return { width: result.width, height: result.height, pixels: Array.from( result.pixels ), renderer: result.renderer };
+		return { width: result.width, height: result.height, pixels: Array.from( result.pixels ), renderer: result.renderer,
+			info: result.info };
 
 	};
 	window.furnaceDemo = async () => {
 
-		const result = await furnace( defaultChart() );
+		const spec = defaultChart();
+		await prepare( spec );
+		const result = await furnace( spec );
 		document.body.appendChild( result.canvas );
 		return result;
 
