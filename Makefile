@@ -2,8 +2,9 @@
 #   make luts      create the venv if missing, install, bake every config in configs/ and every engine
 #                  preset (PRESETS) into outputs/
 #   make test      create the venv if missing, install, run ruff (check + format --check), then the test suite
-#   make demo      bake the three.js preset into outputs/ (if not up to date) and serve the engine pages (web/) on
-#                  127.0.0.1:8049: the engine's shipped table beside lutbake's, and their difference
+#   make demo      bake the presets the engine pages load (threejs, babylon, ltc-threejs) into outputs/ (if not up to
+#                  date) and serve the pages (web/) on 127.0.0.1:8049: each engine's shipped table beside lutbake's,
+#                  and their difference
 PYTHON ?= python3
 VENV   ?= .venv
 BIN    := $(VENV)/bin
@@ -60,7 +61,7 @@ test: $(STAMP) lint
 # the engines' npm packages (web/package-lock.json) on first use; then tests/web_harness.py serves the pages
 demo: $(STAMP)
 	test -d web/node_modules || npm ci --prefix web
-	$(BIN)/lutbake bake --preset threejs --out-dir $(OUT)
+	$(BIN)/lutbake bake --preset threejs --preset babylon --preset ltc-threejs --out-dir $(OUT)
 	$(BIN)/python tests/web_harness.py --luts $(OUT)
 
 # diffuse kinds against converged references (accuracy and wall time): outputs/bench/diffuse.json
