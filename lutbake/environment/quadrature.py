@@ -1,0 +1,388 @@
+"""The exact-integral quadrature of one output texel: ∫ L w dω and ∫ w dω over the sphere, L the texel-constant
+source, w a lobe of lutbake.environment.lobes, by a deterministic descent of the source's pyramid.
+
+**The tree.** The cells of the lat-long pyramid (lutbake.environment.latlong.Pyramid) nest: each cell of level k
+is four cells of level k - 1, down to the source texels (level 0) and, below them, sub-cells that split a texel for
+the weight alone (levels -1 .. -V: the radiance is the texel's, the cell is smaller). A texel's integral is a sum
+over the leaves of one cut of that tree, so every direction is counted once, whatever the cut:
+
+    ∫ L w dω = Σ_leaves L(leaf) ∫_leaf w dω,      ∫ w dω = Σ_leaves ∫_leaf w dω
+
+Descending from the roots (the coarsest level, every cell), a cell whose directions all lie behind a clip plane
+(the horizon r.l = 0, or a footprint's four planes) is dropped (its weight is exactly 0). A cell of level k >= 0
+**fixes its radiance** (L(leaf) = the cell's exact mean, for every leaf below it) when
+
+    contrast x variation <= tau,   contrast = max_c (max L_c - min L_c) / max_c mean L_c   (over its source texels)
+    variation = S rho / (d + lambda)   (1 where a clip plane crosses the cell)
+
+rho the cell's angular radius, d its least angle to r, lambda the lobe's width, S the lobe's slope
+(lutbake.environment.lobes.LOBES). The error of a fixed cell, |∫ (L - mean) w| <= (max L - min L) ∫ |w - mean w|,
+is then about tau x mean x ∫ w: the sum over cells is about tau x P x ∫ w, a relative error tau. Level 0 always
+fixes (the source is texel-constant: no error). Below a fixed cell the descent continues for the weight alone
+until rho K <= d + lambda (the weight is smooth across the cell; where a clip plane crosses the cell,
+rho K <= min(d + lambda, c): the clipped length has kinks where the planes take turns), or the floor -V, and the
+leaf's ∫ w dω is a
+G x G Gauss-Legendre rule in (phi, theta) with dω = sin theta dtheta dphi, **clipped exactly in theta**: on the
+meridian phi, p.l = A cos theta + B sin theta (A = p_y, B = p_x cos phi + p_z sin phi) changes sign at most once
+in [0, pi], at theta = atan2(-A, B) mod pi, so each node's theta interval is cut where the horizon (or a footprint
+edge) crosses it and the rule is applied on the part in front. No random numbers, no clamping: the sums are in
+float64 in a fixed order, so a texel's value does not depend on the tile or the thread.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+import warp as wp
+
+from ..runtime.warp_runtime import unique_kernel
+from .latlong import Pyramid
+from .lobes import LOBES
+
+STACK = 128  # the descent's stack: 3 entries a level below the root cells, at most 40 levels (checked by the host)
+MAX_DEPTH = 40
+NONE = 127  # a cell whose radiance is not fixed yet
+OUT_WIDTH = 5  # ∫ L w (r, g, b), ∫ w, leaves
+
+
+@functools.lru_cache(maxsize=None)
+def texel_kernel(lobe: str, planes: int, order: int):
+    """The kernel integrating each texel's lobe ``lobe`` (LOBES) clipped by ``planes`` planes per texel with an
+    ``order`` x ``order`` Gauss-Legendre rule per leaf: out[t] = (∫ L w (rgb), ∫ w, leaves)."""
+    weight, slope = LOBES[lobe]
+    stack_t = wp.types.vector(length=STACK, dtype=wp.int32)
+    breaks_t = wp.types.vector(length=2 + 4 * planes + planes * (planes - 1), dtype=wp.float64)
+    pi = wp.float64(math.pi)
+    two_pi = wp.float64(2.0 * math.pi)
+    half_pi = wp.float64(math.pi / 2)
+
+    @wp.func
+    def angle(a: wp.vec3d, b: wp.vec3d):
+        return wp.atan2(wp.length(wp.cross(a, b)), wp.dot(a, b))
+
+    @wp.func
+    def direction(theta: wp.float64, phi: wp.float64):
+        st = wp.sin(theta)
+        return wp.vec3d(st * wp.cos(phi), wp.cos(theta), st * wp.sin(phi))
+
+    @wp.func
+    def leaf_span(
+        r: wp.vec3d,
+        alpha: wp.float64,
+        plane: wp.array2d(dtype=wp.vec3d),
+        t: int,
+        th0: wp.float64,
+        th1: wp.float64,
+        ph0: wp.float64,
+        ph1: wp.float64,
+        gx: wp.array(dtype=wp.float64),
+        gw: wp.array(dtype=wp.float64),
+    ):
+        """∫ w dω over phi in [ph0, ph1] (no breakpoint inside), each meridian's theta interval clipped."""
+        total = wp.float64(0.0)
+        for a in range(wp.static(order)):
+            phi = ph0 + (ph1 - ph0) * gx[a]
+            cp = wp.cos(phi)
+            sp = wp.sin(phi)
+            lo = th0
+            hi = th1
+            for k in range(wp.static(planes)):
+                p = plane[t, k]
+                A = p[1]
+                B = p[0] * cp + p[2] * sp
+                s0 = A * wp.cos(th0) + B * wp.sin(th0)
+                s1 = A * wp.cos(th1) + B * wp.sin(th1)
+                if s0 < wp.float64(0.0) and s1 < wp.float64(0.0):
+                    hi = lo
+                elif s0 < wp.float64(0.0) or s1 < wp.float64(0.0):
+                    root = wp.atan2(-A, B)
+                    if root < wp.float64(0.0):
+                        root = root + pi
+                    if root >= pi:  # atan2(0, B < 0) = pi: the root in [0, pi) is 0 (a plane through the pole)
+                        root = root - pi
+                    root = wp.clamp(root, th0, th1)
+                    if s0 >= wp.float64(0.0):
+                        hi = wp.min(hi, root)
+                    else:
+                        lo = wp.max(lo, root)
+            if hi > lo:
+                inner = wp.float64(0.0)
+                for b in range(wp.static(order)):
+                    theta = lo + (hi - lo) * gx[b]
+                    inner += gw[b] * wp.sin(theta) * weight(r, direction(theta, phi), alpha)
+                total += gw[a] * (hi - lo) * inner
+        return total * (ph1 - ph0)
+
+    @wp.func
+    def leaf_plain(
+        r: wp.vec3d,
+        alpha: wp.float64,
+        th0: wp.float64,
+        th1: wp.float64,
+        ph0: wp.float64,
+        ph1: wp.float64,
+        gx: wp.array(dtype=wp.float64),
+        gw: wp.array(dtype=wp.float64),
+    ):
+        """∫ w dω over a cell no clip plane crosses: the order x order product rule, its sines and cosines once
+        per node row and column."""
+        total = wp.float64(0.0)
+        for b in range(wp.static(order)):
+            theta = th0 + (th1 - th0) * gx[b]
+            st = wp.sin(theta)
+            ct = wp.cos(theta)
+            inner = wp.float64(0.0)
+            for a in range(wp.static(order)):
+                phi = ph0 + (ph1 - ph0) * gx[a]
+                inner += gw[a] * weight(r, wp.vec3d(st * wp.cos(phi), ct, st * wp.sin(phi)), alpha)
+            total += gw[b] * st * inner
+        return total * (th1 - th0) * (ph1 - ph0)
+
+    @wp.func
+    def leaf_weight(
+        r: wp.vec3d,
+        alpha: wp.float64,
+        plane: wp.array2d(dtype=wp.vec3d),
+        t: int,
+        th0: wp.float64,
+        th1: wp.float64,
+        ph0: wp.float64,
+        ph1: wp.float64,
+        gx: wp.array(dtype=wp.float64),
+        gw: wp.array(dtype=wp.float64),
+    ):
+        """∫ w dω over the cell: its phi interval split where a plane's great circle crosses the cell's edge
+        theta = th0 or th1 (p.l = 0 there: sin(theta) (p_x cos phi + p_z sin phi) = -p_y cos(theta)), where the
+        clipped theta interval has a kink or a jump (a plane through the pole cuts along a meridian), and at the
+        azimuth of each corner where two planes meet (±p1 x p2); leaf_span on each piece."""
+        bp = breaks_t()
+        nb = wp.int32(1)  # dynamic (a literal is a constant to Warp)
+        bp[0] = ph0
+        for k in range(wp.static(planes)):
+            p = plane[t, k]
+            rad = wp.sqrt(p[0] * p[0] + p[2] * p[2])
+            base = wp.atan2(p[2], p[0])
+            for e in range(2):
+                edge = th0
+                if e == 1:
+                    edge = th1
+                st = wp.sin(edge)
+                if st > wp.float64(1e-12) and rad > wp.float64(1e-15):
+                    c = -p[1] * wp.cos(edge) / (st * rad)
+                    if wp.abs(c) < wp.float64(1.0):
+                        dphi = wp.acos(c)
+                        for sgn in range(2):
+                            phi = base + dphi
+                            if sgn == 1:
+                                phi = base - dphi
+                            phi = phi - two_pi * wp.floor((phi - ph0) / two_pi)
+                            if phi > ph0 and phi < ph1:
+                                bp[nb] = phi
+                                nb += 1
+        for k1 in range(wp.static(planes)):  # the corners where two planes meet: the clipped length has a kink
+            for k2 in range(k1 + 1, wp.static(planes)):
+                corner = wp.cross(plane[t, k1], plane[t, k2])
+                if wp.length(corner) > wp.float64(1e-15):
+                    for sgn in range(2):
+                        phi = wp.atan2(corner[2], corner[0])
+                        if sgn == 1:
+                            phi = wp.atan2(-corner[2], -corner[0])
+                        phi = phi - two_pi * wp.floor((phi - ph0) / two_pi)
+                        if phi > ph0 and phi < ph1:
+                            bp[nb] = phi
+                            nb += 1
+        for a in range(1, nb):  # insertion sort of the breakpoints
+            b = a
+            while b > 0 and bp[b - 1] > bp[b]:
+                tmp = bp[b]
+                bp[b] = bp[b - 1]
+                bp[b - 1] = tmp
+                b -= 1
+        total = wp.float64(0.0)
+        for q in range(nb):
+            right = ph1
+            if q + 1 < nb:
+                right = bp[q + 1]
+            if right > bp[q]:
+                total += leaf_span(r, alpha, plane, t, th0, th1, bp[q], right, gx, gw)
+        return total
+
+    @unique_kernel
+    def integrate_texels(
+        dirs: wp.array(dtype=wp.vec3d),
+        plane: wp.array2d(dtype=wp.vec3d),
+        alphas: wp.array(dtype=wp.float64),
+        lams: wp.array(dtype=wp.float64),
+        mean: wp.array(dtype=wp.vec3d),
+        low: wp.array(dtype=wp.vec3d),
+        high: wp.array(dtype=wp.vec3d),
+        heights: wp.array(dtype=wp.int32),
+        widths: wp.array(dtype=wp.int32),
+        offsets: wp.array(dtype=wp.int32),
+        top: int,
+        floor: int,
+        tau: wp.float64,
+        k_geo: wp.float64,
+        cross: wp.float64,
+        gx: wp.array(dtype=wp.float64),
+        gw: wp.array(dtype=wp.float64),
+        out: wp.array2d(dtype=wp.float64),
+    ):
+        t = wp.tid()
+        r = dirs[t]
+        alpha = alphas[t]
+        lam = lams[t]
+        acc = wp.vec3d(0.0, 0.0, 0.0)
+        wsum = wp.float64(0.0)
+        leaves = wp.int32(0)  # dynamic
+        sl = stack_t()
+        si = stack_t()
+        sj = stack_t()
+        sf = stack_t()
+        for ri in range(heights[top]):
+            for rj in range(widths[top]):
+                n = wp.int32(1)  # dynamic: the stack's depth
+                sl[0] = top
+                si[0] = ri
+                sj[0] = rj
+                sf[0] = wp.static(NONE)
+                while n > 0:
+                    n -= 1
+                    lev = sl[n]
+                    i = si[n]
+                    j = sj[n]
+                    fixed = sf[n]
+                    h = heights[0]
+                    w = widths[0]
+                    if lev >= 0:
+                        h = heights[lev]
+                        w = widths[lev]
+                    else:
+                        h = h << (-lev)
+                        w = w << (-lev)
+                    th0 = pi * wp.float64(i) / wp.float64(h)
+                    th1 = pi * wp.float64(i + 1) / wp.float64(h)
+                    ph0 = wp.float64(2.0) * pi * wp.float64(j) / wp.float64(w) - pi
+                    ph1 = wp.float64(2.0) * pi * wp.float64(j + 1) / wp.float64(w) - pi
+                    s_eq = wp.max(wp.sin(th0), wp.sin(th1))
+                    if th0 <= half_pi and th1 >= half_pi:
+                        s_eq = wp.float64(1.0)
+                    rho = wp.min(pi, wp.float64(0.5) * ((th1 - th0) + (ph1 - ph0) * s_eq))
+                    c = direction(wp.float64(0.5) * (th0 + th1), wp.float64(0.5) * (ph0 + ph1))
+                    dist = wp.max(wp.float64(0.0), angle(r, c) - rho)
+                    dropped = wp.bool(False)  # dynamic
+                    crossing = wp.bool(False)  # dynamic
+                    for k in range(wp.static(planes)):
+                        a = angle(plane[t, k], c)
+                        if a - rho > half_pi:
+                            dropped = True
+                        if a + rho > half_pi:
+                            crossing = True
+                    if dropped:
+                        continue
+                    if fixed == wp.static(NONE):
+                        if lev == 0:
+                            fixed = 0
+                        else:
+                            idx = offsets[lev] + i * w + j
+                            m = mean[idx]
+                            spread = high[idx] - low[idx]
+                            top_mean = wp.max(m[0], wp.max(m[1], m[2]))
+                            contrast = wp.float64(0.0)
+                            if top_mean > wp.float64(0.0):
+                                contrast = wp.max(spread[0], wp.max(spread[1], spread[2])) / top_mean
+                            variation = wp.float64(1.0)
+                            if not crossing:
+                                variation = wp.float64(wp.static(slope)) * rho / (dist + lam)
+                            if contrast * variation <= tau:
+                                fixed = lev
+                    scale = dist + lam
+                    if crossing:
+                        scale = wp.min(scale, cross)
+                    if fixed != wp.static(NONE) and (lev == floor or rho * k_geo <= scale):
+                        shift = fixed - lev
+                        fw = widths[fixed]
+                        L = mean[offsets[fixed] + (i >> shift) * fw + (j >> shift)]
+                        wt = wp.float64(0.0)
+                        if crossing:
+                            wt = leaf_weight(r, alpha, plane, t, th0, th1, ph0, ph1, gx, gw)
+                        else:
+                            wt = leaf_plain(r, alpha, th0, th1, ph0, ph1, gx, gw)
+                        acc += L * wt
+                        wsum += wt
+                        leaves += 1
+                    else:
+                        for q in range(4):
+                            sl[n] = lev - 1
+                            si[n] = 2 * i + q // 2
+                            sj[n] = 2 * j + q % 2
+                            sf[n] = fixed
+                            n += 1
+        out[t, 0] = acc[0]
+        out[t, 1] = acc[1]
+        out[t, 2] = acc[2]
+        out[t, 3] = wsum
+        out[t, 4] = wp.float64(leaves)
+
+    return integrate_texels
+
+
+def gl_unit(order: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss-Legendre nodes and weights on [0, 1]."""
+    x, w = np.polynomial.legendre.leggauss(order)
+    return (x + 1) / 2, w / 2
+
+
+@functools.lru_cache(maxsize=8)
+def _device_pyramid(pyr: Pyramid, device: str) -> tuple:
+    """The pyramid's arrays on ``device`` (one copy per pyramid and device)."""
+    vec = [wp.array(np.ascontiguousarray(a), dtype=wp.vec3d, device=device) for a in (pyr.mean, pyr.low, pyr.high)]
+    ints = [wp.array(a.astype(np.int32), dtype=wp.int32, device=device) for a in (pyr.heights, pyr.widths, pyr.offsets)]
+    return (*vec, *ints)
+
+
+def integrate(
+    pyr: Pyramid,
+    lobe: str,
+    dirs: np.ndarray,
+    planes: np.ndarray,
+    alpha: np.ndarray,
+    lam: np.ndarray,
+    *,
+    tau: float,
+    k_geo: float,
+    cross: float,
+    floor: int,
+    order: int,
+    device: str = "cpu",
+) -> np.ndarray:
+    """(n, OUT_WIDTH) float64: per texel ∫ L w dω (rgb), ∫ w dω and the leaf count, for directions ``dirs`` (n, 3),
+    clip ``planes`` (n, P, 3), ``alpha`` and lobe width ``lam`` (n,). ``floor`` <= 0: the lowest sub-texel level."""
+    n = len(dirs)
+    if n == 0:
+        return np.zeros((0, OUT_WIDTH))
+    depth = pyr.levels - floor
+    if depth > MAX_DEPTH:
+        raise ValueError(f"{pyr.levels} pyramid levels and {-floor} sub-texel levels exceed {MAX_DEPTH}")
+    kernel = texel_kernel(lobe, planes.shape[1], order)
+    gx, gw = (wp.array(a, dtype=wp.float64, device=device) for a in gl_unit(order))
+    out = wp.zeros((n, OUT_WIDTH), dtype=wp.float64, device=device)
+    inputs = [
+        wp.array(np.ascontiguousarray(dirs, np.float64), dtype=wp.vec3d, device=device),
+        wp.array(np.ascontiguousarray(planes, np.float64), dtype=wp.vec3d, device=device),
+        wp.array(np.ascontiguousarray(alpha, np.float64), dtype=wp.float64, device=device),
+        wp.array(np.ascontiguousarray(lam, np.float64), dtype=wp.float64, device=device),
+        *_device_pyramid(pyr, device),
+        pyr.levels - 1,
+        int(floor),
+        float(tau),
+        float(k_geo),
+        float(cross),
+        gx,
+        gw,
+        out,
+    ]
+    wp.launch(kernel, dim=n, inputs=inputs, device=device)
+    return out.numpy()
