@@ -40,8 +40,8 @@ def _filament(mip: int, mips: int) -> float:
 
 
 def _hdrp(mip: int, mips: int) -> float:
-    """r with 6 r (1.7 - 0.7 r) = mip: 0.7 r^2 - 1.7 r + mip / 6 = 0, the root in [0, 1]."""
-    c = mip / 6.0
+    """r with 6 r (1.7 - 0.7 r) = mip: 0.7 r^2 - 1.7 r + mip / 6 = 0, the root in [0, 1] (mips past 6: r = 1)."""
+    c = min(1.0, mip / 6.0)
     return (1.7 - math.sqrt(1.7 * 1.7 - 4 * 0.7 * c)) / (2 * 0.7)
 
 

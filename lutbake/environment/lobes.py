@@ -50,7 +50,7 @@ def w_footprint(r: wp.vec3d, l: wp.vec3d, alpha: wp.float64):
 
 
 # name -> (weight, relative slope S of the weight across a cell of radius rho at distance d from the peak:
-# |dw/w| ~ S rho / (d + lambda); lambda per texel from ``lobe_width``)
+# |dw/w| ~ S rho / (d + lambda), lambda per texel from ``lobe_width``)
 LOBES = {
     "ggx_nl": (w_ggx_nl, 4.0),
     "ggx": (w_ggx, 4.0),

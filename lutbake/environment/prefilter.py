@@ -32,6 +32,7 @@ from .lobes import lobe_width
 from .quadrature import OUT_WIDTH, integrate, texel_kernel
 
 PROBES = 96  # probe texels per mip of the error estimate
+TILE_TEXELS = 64  # texels per tile: a texel integrates thousands of leaves, so tiles stay small enough to share
 MAX_SUB_LEVELS = 12  # sub-texel levels below the source (a cell 1/4096 of a source texel)
 
 
@@ -41,7 +42,7 @@ class Quality:
     ``k_geo`` the cell size K per distance, ``order`` the Gauss-Legendre order per leaf and axis, ``extra_levels``
     sub-texel levels beyond those the narrowest lobe needs."""
 
-    tau: float = 1e-4
+    tau: float = 0.1
     k_geo: float = 4.0
     order: int = 3
     extra_levels: int = 0
@@ -147,6 +148,7 @@ def cube_plan(pyr: Pyramid, texels: CubeTexels, quality: Quality = Quality()) ->
         terms={"lobes": ",".join(texels.lobes)},
         cost=float(texels.n),
         aux_channels=OUT_WIDTH - 3,
+        tile_texels=TILE_TEXELS,
     )
 
 

@@ -10,14 +10,18 @@ over the leaves of one cut of that tree, so every direction is counted once, wha
 
 Descending from the roots (the coarsest level, every cell), a cell whose directions all lie behind a clip plane
 (the horizon r.l = 0, or a footprint's four planes) is dropped (its weight is exactly 0). A cell of level k >= 0
-**fixes its radiance** (L(leaf) = the cell's exact mean, for every leaf below it) when
+**fixes its radiance** (L(leaf) = the cell's linear model, lutbake.environment.latlong.Pyramid: exact integral and
+first moments over the cell, for every leaf below it) when
 
-    contrast x variation <= tau,   contrast = max_c (max L_c - min L_c) / max_c mean L_c   (over its source texels)
-    variation = S rho / (d + lambda)   (1 where a clip plane crosses the cell)
+    contrast x variation^2 <= tau,   contrast = max_c (max L_c - min L_c) / max_c mean L_c   (over its source texels)
+    variation = S rho / (d + lambda);   contrast <= tau^2 where a clip plane crosses the cell (the model knows the
+    cell, not its cut: the error of a cut cell is first order in its contrast)
 
 rho the cell's angular radius, d its least angle to r, lambda the lobe's width, S the lobe's slope
-(lutbake.environment.lobes.LOBES). The error of a fixed cell, |∫ (L - mean) w| <= (max L - min L) ∫ |w - mean w|,
-is then about tau x mean x ∫ w: the sum over cells is about tau x P x ∫ w, a relative error tau. Level 0 always
+(lutbake.environment.lobes.LOBES). The model integrates the weight's constant and linear parts exactly, so a fixed
+cell's error is the weight's curvature against the source's departure from its model, about (max L - min L) x
+variation^2 x ∫_cell w: with the criterion, about tau x mean x ∫_cell w, and over all cells tau x P x ∫ w (a
+relative error tau, an estimate, not a bound: the recorded error is measured against a finer bake). Level 0 always
 fixes (the source is texel-constant: no error). Below a fixed cell the descent continues for the weight alone
 until rho K <= d + lambda (the weight is smooth across the cell; where a clip plane crosses the cell,
 rho K <= min(d + lambda, c): the clipped length has kinks where the planes take turns), or the floor -V, and the
@@ -68,6 +72,16 @@ def texel_kernel(lobe: str, planes: int, order: int):
         return wp.vec3d(st * wp.cos(phi), wp.cos(theta), st * wp.sin(phi))
 
     @wp.func
+    def weighted(model: wp.mat33d, frame: wp.vec4d, theta: wp.float64, phi: wp.float64, wt: wp.float64):
+        """(L wt, wt) at (theta, phi): L = c0 + c_theta u + c_phi v, the fixed cell's linear model (rows of
+        ``model``; ``frame`` = (theta_c, dtheta, phi_c, dphi))."""
+        u = (theta - frame[0]) / frame[1]
+        v = (phi - frame[2]) / frame[3]
+        L = wp.vec3d(model[0, 0], model[0, 1], model[0, 2])
+        L += wp.vec3d(model[1, 0], model[1, 1], model[1, 2]) * u + wp.vec3d(model[2, 0], model[2, 1], model[2, 2]) * v
+        return wp.vec4d(L[0] * wt, L[1] * wt, L[2] * wt, wt)
+
+    @wp.func
     def leaf_span(
         r: wp.vec3d,
         alpha: wp.float64,
@@ -79,9 +93,12 @@ def texel_kernel(lobe: str, planes: int, order: int):
         ph1: wp.float64,
         gx: wp.array(dtype=wp.float64),
         gw: wp.array(dtype=wp.float64),
+        model: wp.mat33d,
+        frame: wp.vec4d,
     ):
-        """∫ w dω over phi in [ph0, ph1] (no breakpoint inside), each meridian's theta interval clipped."""
-        total = wp.float64(0.0)
+        """(∫ L w dω, ∫ w dω) over phi in [ph0, ph1] (no breakpoint inside), each meridian's theta interval
+        clipped."""
+        total = wp.vec4d(0.0, 0.0, 0.0, 0.0)
         for a in range(wp.static(order)):
             phi = ph0 + (ph1 - ph0) * gx[a]
             cp = wp.cos(phi)
@@ -108,10 +125,11 @@ def texel_kernel(lobe: str, planes: int, order: int):
                     else:
                         lo = wp.max(lo, root)
             if hi > lo:
-                inner = wp.float64(0.0)
+                inner = wp.vec4d(0.0, 0.0, 0.0, 0.0)
                 for b in range(wp.static(order)):
                     theta = lo + (hi - lo) * gx[b]
-                    inner += gw[b] * wp.sin(theta) * weight(r, direction(theta, phi), alpha)
+                    wt = gw[b] * wp.sin(theta) * weight(r, direction(theta, phi), alpha)
+                    inner += weighted(model, frame, theta, phi, wt)
                 total += gw[a] * (hi - lo) * inner
         return total * (ph1 - ph0)
 
@@ -125,18 +143,21 @@ def texel_kernel(lobe: str, planes: int, order: int):
         ph1: wp.float64,
         gx: wp.array(dtype=wp.float64),
         gw: wp.array(dtype=wp.float64),
+        model: wp.mat33d,
+        frame: wp.vec4d,
     ):
-        """∫ w dω over a cell no clip plane crosses: the order x order product rule, its sines and cosines once
-        per node row and column."""
-        total = wp.float64(0.0)
+        """(∫ L w dω, ∫ w dω) over a cell no clip plane crosses: the order x order product rule, its sines and
+        cosines once per node row and column."""
+        total = wp.vec4d(0.0, 0.0, 0.0, 0.0)
         for b in range(wp.static(order)):
             theta = th0 + (th1 - th0) * gx[b]
             st = wp.sin(theta)
             ct = wp.cos(theta)
-            inner = wp.float64(0.0)
+            inner = wp.vec4d(0.0, 0.0, 0.0, 0.0)
             for a in range(wp.static(order)):
                 phi = ph0 + (ph1 - ph0) * gx[a]
-                inner += gw[a] * weight(r, wp.vec3d(st * wp.cos(phi), ct, st * wp.sin(phi)), alpha)
+                wt = gw[a] * weight(r, wp.vec3d(st * wp.cos(phi), ct, st * wp.sin(phi)), alpha)
+                inner += weighted(model, frame, theta, phi, wt)
             total += gw[b] * st * inner
         return total * (th1 - th0) * (ph1 - ph0)
 
@@ -152,8 +173,10 @@ def texel_kernel(lobe: str, planes: int, order: int):
         ph1: wp.float64,
         gx: wp.array(dtype=wp.float64),
         gw: wp.array(dtype=wp.float64),
+        model: wp.mat33d,
+        frame: wp.vec4d,
     ):
-        """∫ w dω over the cell: its phi interval split where a plane's great circle crosses the cell's edge
+        """(∫ L w dω, ∫ w dω) over the cell: its phi interval split where a plane's great circle crosses the cell's edge
         theta = th0 or th1 (p.l = 0 there: sin(theta) (p_x cos phi + p_z sin phi) = -p_y cos(theta)), where the
         clipped theta interval has a kink or a jump (a plane through the pole cuts along a meridian), and at the
         azimuth of each corner where two planes meet (±p1 x p2); leaf_span on each piece."""
@@ -200,13 +223,13 @@ def texel_kernel(lobe: str, planes: int, order: int):
                 bp[b] = bp[b - 1]
                 bp[b - 1] = tmp
                 b -= 1
-        total = wp.float64(0.0)
+        total = wp.vec4d(0.0, 0.0, 0.0, 0.0)
         for q in range(nb):
             right = ph1
             if q + 1 < nb:
                 right = bp[q + 1]
             if right > bp[q]:
-                total += leaf_span(r, alpha, plane, t, th0, th1, bp[q], right, gx, gw)
+                total += leaf_span(r, alpha, plane, t, th0, th1, bp[q], right, gx, gw, model, frame)
         return total
 
     @unique_kernel
@@ -216,6 +239,9 @@ def texel_kernel(lobe: str, planes: int, order: int):
         alphas: wp.array(dtype=wp.float64),
         lams: wp.array(dtype=wp.float64),
         mean: wp.array(dtype=wp.vec3d),
+        offset: wp.array(dtype=wp.vec3d),
+        slope_theta: wp.array(dtype=wp.vec3d),
+        slope_phi: wp.array(dtype=wp.vec3d),
         low: wp.array(dtype=wp.vec3d),
         high: wp.array(dtype=wp.vec3d),
         heights: wp.array(dtype=wp.int32),
@@ -293,25 +319,38 @@ def texel_kernel(lobe: str, planes: int, order: int):
                             contrast = wp.float64(0.0)
                             if top_mean > wp.float64(0.0):
                                 contrast = wp.max(spread[0], wp.max(spread[1], spread[2])) / top_mean
-                            variation = wp.float64(1.0)
+                            budget = tau * tau  # a cut cell: its error is first order in its contrast
                             if not crossing:
                                 variation = wp.float64(wp.static(slope)) * rho / (dist + lam)
-                            if contrast * variation <= tau:
+                                budget = tau / (variation * variation)
+                            if contrast <= budget:
                                 fixed = lev
                     scale = dist + lam
                     if crossing:
                         scale = wp.min(scale, cross)
                     if fixed != wp.static(NONE) and (lev == floor or rho * k_geo <= scale):
                         shift = fixed - lev
+                        fi = i >> shift
+                        fj = j >> shift
+                        fh = heights[fixed]
                         fw = widths[fixed]
-                        L = mean[offsets[fixed] + (i >> shift) * fw + (j >> shift)]
-                        wt = wp.float64(0.0)
+                        idx = offsets[fixed] + fi * fw + fj
+                        model = wp.matrix_from_rows(offset[idx], slope_theta[idx], slope_phi[idx])
+                        dth = pi / wp.float64(fh)
+                        dph = wp.float64(2.0) * pi / wp.float64(fw)
+                        frame = wp.vec4d(
+                            dth * (wp.float64(fi) + wp.float64(0.5)),
+                            dth,
+                            dph * (wp.float64(fj) + wp.float64(0.5)) - pi,
+                            dph,
+                        )
+                        part = wp.vec4d(0.0, 0.0, 0.0, 0.0)
                         if crossing:
-                            wt = leaf_weight(r, alpha, plane, t, th0, th1, ph0, ph1, gx, gw)
+                            part = leaf_weight(r, alpha, plane, t, th0, th1, ph0, ph1, gx, gw, model, frame)
                         else:
-                            wt = leaf_plain(r, alpha, th0, th1, ph0, ph1, gx, gw)
-                        acc += L * wt
-                        wsum += wt
+                            part = leaf_plain(r, alpha, th0, th1, ph0, ph1, gx, gw, model, frame)
+                        acc += wp.vec3d(part[0], part[1], part[2])
+                        wsum += part[3]
                         leaves += 1
                     else:
                         for q in range(4):
@@ -338,7 +377,10 @@ def gl_unit(order: int) -> tuple[np.ndarray, np.ndarray]:
 @functools.lru_cache(maxsize=8)
 def _device_pyramid(pyr: Pyramid, device: str) -> tuple:
     """The pyramid's arrays on ``device`` (one copy per pyramid and device)."""
-    vec = [wp.array(np.ascontiguousarray(a), dtype=wp.vec3d, device=device) for a in (pyr.mean, pyr.low, pyr.high)]
+    vec = [
+        wp.array(np.ascontiguousarray(a), dtype=wp.vec3d, device=device)
+        for a in (pyr.mean, pyr.offset, pyr.slope_theta, pyr.slope_phi, pyr.low, pyr.high)
+    ]
     ints = [wp.array(a.astype(np.int32), dtype=wp.int32, device=device) for a in (pyr.heights, pyr.widths, pyr.offsets)]
     return (*vec, *ints)
 
