@@ -32,6 +32,7 @@ from .lobes import lobe_width
 from .quadrature import OUT_WIDTH, integrate, texel_kernel
 
 PROBES = 96  # probe texels per mip of the error estimate
+COARSE_TAU = 3.0  # the first pass, whose value each texel's contrast budget is measured against
 TILE_TEXELS = 64  # texels per tile: a texel integrates thousands of leaves, so tiles stay small enough to share
 MAX_SUB_LEVELS = 12  # sub-texel levels below the source (a cell 1/4096 of a source texel)
 
@@ -42,7 +43,7 @@ class Quality:
     ``k_geo`` the cell size K per distance, ``order`` the Gauss-Legendre order per leaf and axis, ``extra_levels``
     sub-texel levels beyond those the narrowest lobe needs."""
 
-    tau: float = 0.1
+    tau: float = 0.3
     k_geo: float = 4.0
     order: int = 3
     extra_levels: int = 0
@@ -104,20 +105,17 @@ def mip_values(pyr: Pyramid, texels: CubeTexels, m: int, idx: np.ndarray, qualit
         planes = dirs[:, None, :]
         cross = math.pi / 4
     lam = lobe_width(lobe, alpha)
-    return integrate(
-        pyr,
-        lobe,
-        dirs,
-        planes,
-        np.full(len(idx), alpha),
-        np.full(len(idx), lam),
-        tau=quality.tau,
-        k_geo=quality.k_geo,
-        cross=cross,
-        floor=-sub_levels(pyr, cross if lobe == "footprint" else lam, quality),
-        order=quality.order,
-        device=device,
-    )
+    common = {
+        "k_geo": quality.k_geo,
+        "cross": cross,
+        "floor": -sub_levels(pyr, cross if lobe == "footprint" else lam, quality),
+        "order": quality.order,
+        "device": device,
+    }
+    inputs = (pyr, lobe, dirs, planes, np.full(len(idx), alpha), np.full(len(idx), lam))
+    coarse = integrate(*inputs, tau=COARSE_TAU, **common)
+    reference = coarse[:, :3] / coarse[:, 3:4]
+    return integrate(*inputs, reference, tau=quality.tau, **common)
 
 
 def cube_plan(pyr: Pyramid, texels: CubeTexels, quality: Quality = Quality()) -> TexelPlan:

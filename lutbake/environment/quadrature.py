@@ -13,15 +13,19 @@ Descending from the roots (the coarsest level, every cell), a cell whose directi
 **fixes its radiance** (L(leaf) = the cell's linear model, lutbake.environment.latlong.Pyramid: exact integral and
 first moments over the cell, for every leaf below it) when
 
-    contrast x variation^2 <= tau,   contrast = max_c (max L_c - min L_c) / max_c mean L_c   (over its source texels)
+    contrast x variation^2 <= tau,   contrast = max_c (max L_c - min L_c) / P_c   (over its source texels)
     variation = S rho / (d + lambda);   contrast <= tau^2 where a clip plane crosses the cell (the model knows the
-    cell, not its cut: the error of a cut cell is first order in its contrast)
+    cell, not its cut: the error of a cut cell is first order in its contrast); a footprint's cut cells descend to
+    the source texels (contrast 0: only uniform cells fix), so the area average is exact
 
 rho the cell's angular radius, d its least angle to r, lambda the lobe's width, S the lobe's slope
-(lutbake.environment.lobes.LOBES). The model integrates the weight's constant and linear parts exactly, so a fixed
+(lutbake.environment.lobes.LOBES), P_c the texel's value from a first, coarse pass (tau = 1; in that pass, the
+cell's own mean).
+The model integrates the weight's constant and linear parts exactly, so a fixed
 cell's error is the weight's curvature against the source's departure from its model, about (max L - min L) x
-variation^2 x ∫_cell w: with the criterion, about tau x mean x ∫_cell w, and over all cells tau x P x ∫ w (a
-relative error tau, an estimate, not a bound: the recorded error is measured against a finer bake). Level 0 always
+variation^2 x ∫_cell w: with the criterion, about tau x P x ∫_cell w, and over all cells tau x P x ∫ w (a
+relative error tau per channel, the budget spent where the weight and the source's detail are, not on dark cells;
+an estimate, not a bound: the recorded error is measured against a finer bake). Level 0 always
 fixes (the source is texel-constant: no error). Below a fixed cell the descent continues for the weight alone
 until rho K <= d + lambda (the weight is smooth across the cell; where a clip plane crosses the cell,
 rho K <= min(d + lambda, c): the clipped length has kinks where the planes take turns), or the floor -V, and the
@@ -238,6 +242,7 @@ def texel_kernel(lobe: str, planes: int, order: int):
         plane: wp.array2d(dtype=wp.vec3d),
         alphas: wp.array(dtype=wp.float64),
         lams: wp.array(dtype=wp.float64),
+        reference: wp.array(dtype=wp.vec3d),
         mean: wp.array(dtype=wp.vec3d),
         offset: wp.array(dtype=wp.vec3d),
         slope_theta: wp.array(dtype=wp.vec3d),
@@ -313,13 +318,20 @@ def texel_kernel(lobe: str, planes: int, order: int):
                             fixed = 0
                         else:
                             idx = offsets[lev] + i * w + j
-                            m = mean[idx]
                             spread = high[idx] - low[idx]
-                            top_mean = wp.max(m[0], wp.max(m[1], m[2]))
+                            scale_c = reference[t]
+                            if scale_c[0] < wp.float64(0.0):  # no reference: the cell's own mean
+                                scale_c = mean[idx]
                             contrast = wp.float64(0.0)
-                            if top_mean > wp.float64(0.0):
-                                contrast = wp.max(spread[0], wp.max(spread[1], spread[2])) / top_mean
+                            for ch in range(3):
+                                if spread[ch] > wp.float64(0.0):
+                                    if scale_c[ch] > wp.float64(0.0):
+                                        contrast = wp.max(contrast, spread[ch] / scale_c[ch])
+                                    else:
+                                        contrast = wp.float64(1e300)
                             budget = tau * tau  # a cut cell: its error is first order in its contrast
+                            if wp.static(lobe == "footprint"):
+                                budget = wp.float64(0.0)  # a footprint's cut cells take the source itself
                             if not crossing:
                                 variation = wp.float64(wp.static(slope)) * rho / (dist + lam)
                                 budget = tau / (variation * variation)
@@ -392,6 +404,7 @@ def integrate(
     planes: np.ndarray,
     alpha: np.ndarray,
     lam: np.ndarray,
+    reference: np.ndarray | None = None,
     *,
     tau: float,
     k_geo: float,
@@ -401,7 +414,11 @@ def integrate(
     device: str = "cpu",
 ) -> np.ndarray:
     """(n, OUT_WIDTH) float64: per texel ∫ L w dω (rgb), ∫ w dω and the leaf count, for directions ``dirs`` (n, 3),
-    clip ``planes`` (n, P, 3), ``alpha`` and lobe width ``lam`` (n,). ``floor`` <= 0: the lowest sub-texel level."""
+    clip ``planes`` (n, P, 3), ``alpha`` and lobe width ``lam`` (n,). ``floor`` <= 0: the lowest sub-texel level.
+    ``reference`` (n, 3): the scale the contrast is measured against per texel (the texel's value from a coarser
+    pass); None: each cell's own mean."""
+    if reference is None:
+        reference = np.full((len(dirs), 3), -1.0)
     n = len(dirs)
     if n == 0:
         return np.zeros((0, OUT_WIDTH))
@@ -416,6 +433,7 @@ def integrate(
         wp.array(np.ascontiguousarray(planes, np.float64), dtype=wp.vec3d, device=device),
         wp.array(np.ascontiguousarray(alpha, np.float64), dtype=wp.float64, device=device),
         wp.array(np.ascontiguousarray(lam, np.float64), dtype=wp.float64, device=device),
+        wp.array(np.ascontiguousarray(reference, np.float64), dtype=wp.vec3d, device=device),
         *_device_pyramid(pyr, device),
         pyr.levels - 1,
         int(floor),
