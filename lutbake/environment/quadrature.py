@@ -49,10 +49,39 @@ from ..runtime.warp_runtime import unique_kernel
 from .latlong import Pyramid
 from .lobes import LOBES
 
+Nodes = wp.array(dtype=wp.float64)  # Gauss-Legendre nodes or weights on [0, 1]
+# the pyramid on the device: ``cells`` (6, N) vec3d rows and ``dims`` (3, levels) int32 rows
+CELL_ROWS = ("mean", "offset", "slope_theta", "slope_phi", "low", "high")
+DIM_ROWS = ("heights", "widths", "offsets")
+MEAN, OFFSET, SLOPE_THETA, SLOPE_PHI, LOW, HIGH = range(6)
+HEIGHT, WIDTH, START = range(3)
 STACK = 128  # the descent's stack: 3 entries a level below the root cells, at most 40 levels (checked by the host)
 MAX_DEPTH = 40
 NONE = 127  # a cell whose radiance is not fixed yet
 OUT_WIDTH = 5  # ∫ L w (r, g, b), ∫ w, leaves
+
+
+@wp.struct
+class Leaf:
+    """One leaf of the descent: the texel's direction r and alpha, the cell (theta0, theta1, phi0, phi1), the fixed
+    cell's linear model (rows c0, c_theta, c_phi) and frame (theta_c, dtheta, phi_c, dphi)."""
+
+    r: wp.vec3d
+    alpha: wp.float64
+    cell: wp.vec4d
+    model: wp.mat33d
+    frame: wp.vec4d
+
+
+@wp.struct
+class Texels:
+    """The texels of one launch: direction, clip planes (n, P), alpha, lobe width, reference value (< 0: none)."""
+
+    dirs: wp.array(dtype=wp.vec3d)
+    plane: wp.array2d(dtype=wp.vec3d)
+    alphas: wp.array(dtype=wp.float64)
+    lams: wp.array(dtype=wp.float64)
+    reference: wp.array(dtype=wp.vec3d)
 
 
 @functools.lru_cache(maxsize=None)
@@ -76,32 +105,23 @@ def texel_kernel(lobe: str, planes: int, order: int):
         return wp.vec3d(st * wp.cos(phi), wp.cos(theta), st * wp.sin(phi))
 
     @wp.func
-    def weighted(model: wp.mat33d, frame: wp.vec4d, theta: wp.float64, phi: wp.float64, wt: wp.float64):
-        """(L wt, wt) at (theta, phi): L = c0 + c_theta u + c_phi v, the fixed cell's linear model (rows of
-        ``model``; ``frame`` = (theta_c, dtheta, phi_c, dphi))."""
-        u = (theta - frame[0]) / frame[1]
-        v = (phi - frame[2]) / frame[3]
+    def weighted(leaf: Leaf, theta: wp.float64, phi: wp.float64, wt: wp.float64):
+        """(L wt, wt) at (theta, phi): L = c0 + c_theta u + c_phi v, the fixed cell's linear model."""
+        model = leaf.model
+        u = (theta - leaf.frame[0]) / leaf.frame[1]
+        v = (phi - leaf.frame[2]) / leaf.frame[3]
         L = wp.vec3d(model[0, 0], model[0, 1], model[0, 2])
         L += wp.vec3d(model[1, 0], model[1, 1], model[1, 2]) * u + wp.vec3d(model[2, 0], model[2, 1], model[2, 2]) * v
         return wp.vec4d(L[0] * wt, L[1] * wt, L[2] * wt, wt)
 
     @wp.func
     def leaf_span(
-        r: wp.vec3d,
-        alpha: wp.float64,
-        plane: wp.array2d(dtype=wp.vec3d),
-        t: int,
-        th0: wp.float64,
-        th1: wp.float64,
-        ph0: wp.float64,
-        ph1: wp.float64,
-        gx: wp.array(dtype=wp.float64),
-        gw: wp.array(dtype=wp.float64),
-        model: wp.mat33d,
-        frame: wp.vec4d,
+        leaf: Leaf, plane: wp.array2d(dtype=wp.vec3d), t: int, ph0: wp.float64, ph1: wp.float64, gx: Nodes, gw: Nodes
     ):
         """(∫ L w dω, ∫ w dω) over phi in [ph0, ph1] (no breakpoint inside), each meridian's theta interval
         clipped."""
+        th0 = leaf.cell[0]
+        th1 = leaf.cell[1]
         total = wp.vec4d(0.0, 0.0, 0.0, 0.0)
         for a in range(wp.static(order)):
             phi = ph0 + (ph1 - ph0) * gx[a]
@@ -132,58 +152,39 @@ def texel_kernel(lobe: str, planes: int, order: int):
                 inner = wp.vec4d(0.0, 0.0, 0.0, 0.0)
                 for b in range(wp.static(order)):
                     theta = lo + (hi - lo) * gx[b]
-                    wt = gw[b] * wp.sin(theta) * weight(r, direction(theta, phi), alpha)
-                    inner += weighted(model, frame, theta, phi, wt)
+                    wt = gw[b] * wp.sin(theta) * weight(leaf.r, direction(theta, phi), leaf.alpha)
+                    inner += weighted(leaf, theta, phi, wt)
                 total += gw[a] * (hi - lo) * inner
         return total * (ph1 - ph0)
 
     @wp.func
-    def leaf_plain(
-        r: wp.vec3d,
-        alpha: wp.float64,
-        th0: wp.float64,
-        th1: wp.float64,
-        ph0: wp.float64,
-        ph1: wp.float64,
-        gx: wp.array(dtype=wp.float64),
-        gw: wp.array(dtype=wp.float64),
-        model: wp.mat33d,
-        frame: wp.vec4d,
-    ):
+    def leaf_plain(leaf: Leaf, gx: Nodes, gw: Nodes):
         """(∫ L w dω, ∫ w dω) over a cell no clip plane crosses: the order x order product rule, its sines and
         cosines once per node row and column."""
+        c = leaf.cell  # theta0, theta1, phi0, phi1
         total = wp.vec4d(0.0, 0.0, 0.0, 0.0)
         for b in range(wp.static(order)):
-            theta = th0 + (th1 - th0) * gx[b]
+            theta = c[0] + (c[1] - c[0]) * gx[b]
             st = wp.sin(theta)
             ct = wp.cos(theta)
             inner = wp.vec4d(0.0, 0.0, 0.0, 0.0)
             for a in range(wp.static(order)):
-                phi = ph0 + (ph1 - ph0) * gx[a]
-                wt = gw[a] * weight(r, wp.vec3d(st * wp.cos(phi), ct, st * wp.sin(phi)), alpha)
-                inner += weighted(model, frame, theta, phi, wt)
+                phi = c[2] + (c[3] - c[2]) * gx[a]
+                wt = gw[a] * weight(leaf.r, wp.vec3d(st * wp.cos(phi), ct, st * wp.sin(phi)), leaf.alpha)
+                inner += weighted(leaf, theta, phi, wt)
             total += gw[b] * st * inner
-        return total * (th1 - th0) * (ph1 - ph0)
+        return total * (c[1] - c[0]) * (c[3] - c[2])
 
     @wp.func
-    def leaf_weight(
-        r: wp.vec3d,
-        alpha: wp.float64,
-        plane: wp.array2d(dtype=wp.vec3d),
-        t: int,
-        th0: wp.float64,
-        th1: wp.float64,
-        ph0: wp.float64,
-        ph1: wp.float64,
-        gx: wp.array(dtype=wp.float64),
-        gw: wp.array(dtype=wp.float64),
-        model: wp.mat33d,
-        frame: wp.vec4d,
-    ):
+    def leaf_weight(leaf: Leaf, plane: wp.array2d(dtype=wp.vec3d), t: int, gx: Nodes, gw: Nodes):
         """(∫ L w dω, ∫ w dω) over the cell: its phi interval split where a plane's great circle crosses the cell's edge
         theta = th0 or th1 (p.l = 0 there: sin(theta) (p_x cos phi + p_z sin phi) = -p_y cos(theta)), where the
         clipped theta interval has a kink or a jump (a plane through the pole cuts along a meridian), and at the
         azimuth of each corner where two planes meet (±p1 x p2); leaf_span on each piece."""
+        th0 = leaf.cell[0]
+        th1 = leaf.cell[1]
+        ph0 = leaf.cell[2]
+        ph1 = leaf.cell[3]
         bp = breaks_t()
         nb = wp.int32(1)  # dynamic (a literal is a constant to Warp)
         bp[0] = ph0
@@ -233,38 +234,34 @@ def texel_kernel(lobe: str, planes: int, order: int):
             if q + 1 < nb:
                 right = bp[q + 1]
             if right > bp[q]:
-                total += leaf_span(r, alpha, plane, t, th0, th1, bp[q], right, gx, gw, model, frame)
+                total += leaf_span(leaf, plane, t, bp[q], right, gx, gw)
         return total
 
     @unique_kernel
     def integrate_texels(
-        dirs: wp.array(dtype=wp.vec3d),
-        plane: wp.array2d(dtype=wp.vec3d),
-        alphas: wp.array(dtype=wp.float64),
-        lams: wp.array(dtype=wp.float64),
-        reference: wp.array(dtype=wp.vec3d),
-        mean: wp.array(dtype=wp.vec3d),
-        offset: wp.array(dtype=wp.vec3d),
-        slope_theta: wp.array(dtype=wp.vec3d),
-        slope_phi: wp.array(dtype=wp.vec3d),
-        low: wp.array(dtype=wp.vec3d),
-        high: wp.array(dtype=wp.vec3d),
-        heights: wp.array(dtype=wp.int32),
-        widths: wp.array(dtype=wp.int32),
-        offsets: wp.array(dtype=wp.int32),
-        top: int,
-        floor: int,
-        tau: wp.float64,
-        k_geo: wp.float64,
-        cross: wp.float64,
-        gx: wp.array(dtype=wp.float64),
-        gw: wp.array(dtype=wp.float64),
+        tex: Texels,
+        cells: wp.array2d(dtype=wp.vec3d),
+        dims: wp.array2d(dtype=wp.int32),
+        levels: wp.vec2i,
+        control: wp.vec3d,
+        gx: Nodes,
+        gw: Nodes,
         out: wp.array2d(dtype=wp.float64),
     ):
+        """levels = (top, floor); control = (tau, K, c)."""
         t = wp.tid()
-        r = dirs[t]
-        alpha = alphas[t]
-        lam = lams[t]
+        r = tex.dirs[t]
+        alpha = tex.alphas[t]
+        lam = tex.lams[t]
+        plane = tex.plane
+        top = levels[0]
+        floor = levels[1]
+        tau = control[0]
+        k_geo = control[1]
+        cross = control[2]
+        heights = dims[wp.static(HEIGHT)]
+        widths = dims[wp.static(WIDTH)]
+        offsets = dims[wp.static(START)]
         acc = wp.vec3d(0.0, 0.0, 0.0)
         wsum = wp.float64(0.0)
         leaves = wp.int32(0)  # dynamic
@@ -318,10 +315,10 @@ def texel_kernel(lobe: str, planes: int, order: int):
                             fixed = 0
                         else:
                             idx = offsets[lev] + i * w + j
-                            spread = high[idx] - low[idx]
-                            scale_c = reference[t]
+                            spread = cells[wp.static(HIGH), idx] - cells[wp.static(LOW), idx]
+                            scale_c = tex.reference[t]
                             if scale_c[0] < wp.float64(0.0):  # no reference: the cell's own mean
-                                scale_c = mean[idx]
+                                scale_c = cells[wp.static(MEAN), idx]
                             contrast = wp.float64(0.0)
                             for ch in range(3):
                                 if spread[ch] > wp.float64(0.0):
@@ -347,10 +344,18 @@ def texel_kernel(lobe: str, planes: int, order: int):
                         fh = heights[fixed]
                         fw = widths[fixed]
                         idx = offsets[fixed] + fi * fw + fj
-                        model = wp.matrix_from_rows(offset[idx], slope_theta[idx], slope_phi[idx])
+                        leaf = Leaf()
+                        leaf.r = r
+                        leaf.alpha = alpha
+                        leaf.cell = wp.vec4d(th0, th1, ph0, ph1)
+                        leaf.model = wp.matrix_from_rows(
+                            cells[wp.static(OFFSET), idx],
+                            cells[wp.static(SLOPE_THETA), idx],
+                            cells[wp.static(SLOPE_PHI), idx],
+                        )
                         dth = pi / wp.float64(fh)
                         dph = wp.float64(2.0) * pi / wp.float64(fw)
-                        frame = wp.vec4d(
+                        leaf.frame = wp.vec4d(
                             dth * (wp.float64(fi) + wp.float64(0.5)),
                             dth,
                             dph * (wp.float64(fj) + wp.float64(0.5)) - pi,
@@ -358,9 +363,9 @@ def texel_kernel(lobe: str, planes: int, order: int):
                         )
                         part = wp.vec4d(0.0, 0.0, 0.0, 0.0)
                         if crossing:
-                            part = leaf_weight(r, alpha, plane, t, th0, th1, ph0, ph1, gx, gw, model, frame)
+                            part = leaf_weight(leaf, plane, t, gx, gw)
                         else:
-                            part = leaf_plain(r, alpha, th0, th1, ph0, ph1, gx, gw, model, frame)
+                            part = leaf_plain(leaf, gx, gw)
                         acc += wp.vec3d(part[0], part[1], part[2])
                         wsum += part[3]
                         leaves += 1
@@ -388,13 +393,10 @@ def gl_unit(order: int) -> tuple[np.ndarray, np.ndarray]:
 
 @functools.lru_cache(maxsize=8)
 def _device_pyramid(pyr: Pyramid, device: str) -> tuple:
-    """The pyramid's arrays on ``device`` (one copy per pyramid and device)."""
-    vec = [
-        wp.array(np.ascontiguousarray(a), dtype=wp.vec3d, device=device)
-        for a in (pyr.mean, pyr.offset, pyr.slope_theta, pyr.slope_phi, pyr.low, pyr.high)
-    ]
-    ints = [wp.array(a.astype(np.int32), dtype=wp.int32, device=device) for a in (pyr.heights, pyr.widths, pyr.offsets)]
-    return (*vec, *ints)
+    """(cells, dims): the pyramid's arrays on ``device`` (CELL_ROWS, DIM_ROWS; one copy per pyramid and device)."""
+    cells = np.ascontiguousarray(np.stack([getattr(pyr, name) for name in CELL_ROWS]))
+    dims = np.ascontiguousarray(np.stack([getattr(pyr, name) for name in DIM_ROWS]).astype(np.int32))
+    return wp.array(cells, dtype=wp.vec3d, device=device), wp.array(dims, dtype=wp.int32, device=device)
 
 
 def integrate(
@@ -428,21 +430,14 @@ def integrate(
     kernel = texel_kernel(lobe, planes.shape[1], order)
     gx, gw = (wp.array(a, dtype=wp.float64, device=device) for a in gl_unit(order))
     out = wp.zeros((n, OUT_WIDTH), dtype=wp.float64, device=device)
-    inputs = [
-        wp.array(np.ascontiguousarray(dirs, np.float64), dtype=wp.vec3d, device=device),
-        wp.array(np.ascontiguousarray(planes, np.float64), dtype=wp.vec3d, device=device),
-        wp.array(np.ascontiguousarray(alpha, np.float64), dtype=wp.float64, device=device),
-        wp.array(np.ascontiguousarray(lam, np.float64), dtype=wp.float64, device=device),
-        wp.array(np.ascontiguousarray(reference, np.float64), dtype=wp.vec3d, device=device),
-        *_device_pyramid(pyr, device),
-        pyr.levels - 1,
-        int(floor),
-        float(tau),
-        float(k_geo),
-        float(cross),
-        gx,
-        gw,
-        out,
-    ]
+    tex = Texels()
+    tex.dirs = wp.array(np.ascontiguousarray(dirs, np.float64), dtype=wp.vec3d, device=device)
+    tex.plane = wp.array(np.ascontiguousarray(planes, np.float64), dtype=wp.vec3d, device=device)
+    tex.alphas = wp.array(np.ascontiguousarray(alpha, np.float64), dtype=wp.float64, device=device)
+    tex.lams = wp.array(np.ascontiguousarray(lam, np.float64), dtype=wp.float64, device=device)
+    tex.reference = wp.array(np.ascontiguousarray(reference, np.float64), dtype=wp.vec3d, device=device)
+    levels = wp.vec2i(pyr.levels - 1, int(floor))
+    control = wp.vec3d(float(tau), float(k_geo), float(cross))
+    inputs = [tex, *_device_pyramid(pyr, device), levels, control, gx, gw, out]
     wp.launch(kernel, dim=n, inputs=inputs, device=device)
     return out.numpy()

@@ -138,38 +138,11 @@ def write_cube(mips: list[np.ndarray], path, metadata: dict, fmt: str, dtype: st
         atomic_write_bytes(path.with_name(path.name + ".json"), sidecar.encode())
         return path
     if fmt == "exr":
+        from .exr import EXR_TYPES, _write_oiio
+
         parts = [
-            (f"mip_{m}", np.ascontiguousarray(a[..., :3].reshape(-1, a.shape[2], 3)))
+            (f"mip_{m}", text, np.ascontiguousarray(a[..., :3].reshape(-1, a.shape[2], 3)))
             for m, a in enumerate(rgba(mips, dtype))
         ]
-        return atomic_write(path, lambda tmp: _write_parts(tmp, parts, text, "half" if dtype == "half" else "float"))
+        return atomic_write(path, lambda tmp: _write_oiio(tmp, parts, EXR_TYPES[dtype]))
     raise ValueError(f"cube format must be ktx2, dds or exr, got {fmt!r}")
-
-
-def _write_parts(path, parts: list[tuple[str, np.ndarray]], attrs: dict[str, str], exr_type: str) -> None:
-    """A multi-part EXR, one part per (name, (rows, columns, 3) pixels), each carrying ``attrs``."""
-    from .exr import _oiio, _spec
-
-    oiio = _oiio()
-    specs = []
-    for name, pixels in parts:
-        spec = _spec(oiio, pixels.shape[1], pixels.shape[0], 3, exr_type, attrs)
-        spec.attribute("name", name)
-        # OpenEXR: every part of a file shares one displayWindow (the first mip's); each part's data window is its own
-        spec.full_width, spec.full_height = parts[0][1].shape[1], parts[0][1].shape[0]
-        specs.append(spec)
-    out = oiio.ImageOutput.create(str(path))
-    if out is None:
-        raise OSError(f"OpenImageIO cannot create an EXR writer for {path}: {oiio.geterror()}")
-    try:
-        if not out.open(str(path), specs):
-            raise OSError(f"cannot open {path} for writing: {out.geterror()}")
-        for k, (spec, (_, pixels)) in enumerate(zip(specs, parts)):
-            if k > 0 and not out.open(str(path), spec, "AppendSubimage"):
-                raise OSError(f"cannot start part {k} of {path}: {out.geterror()}")
-            if not out.write_image(pixels):
-                raise OSError(f"cannot write part {k} of {path}: {out.geterror()}")
-    finally:
-        closed = out.close()
-    if not closed:
-        raise OSError(f"cannot finish writing {path}: {out.geterror()}")
