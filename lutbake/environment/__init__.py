@@ -7,8 +7,10 @@ harmonics.
 - ``cube``: the cube-map face table (OpenGL / KTX / Vulkan; D3D's left-handed variant), direction <-> (face, s, t),
   exact texel solid angles and footprints.
 - ``curves``: the engines' roughness <-> mip curves, as records of data with their sources.
-- ``prefilter``: each output texel's integral of the texel-constant source against a lobe (GGX, cosine, the texel's
-  own footprint), by deterministic quadrature over an adaptive tree of source texels; Warp kernels, float64 sums.
+- ``lobes``: the weights a texel integrates the source against (GGX with and without n.l, cosine, a footprint).
+- ``quadrature``: one texel's exact integral of the texel-constant source against a lobe, by a deterministic descent
+  of the pyramid with exact clipping (a Warp kernel factory; float64 sums).
+- ``prefilter``: the cube's texels and mips through lutbake.runtime's executor, and the per-mip error estimate.
 - ``sh``: L2 spherical harmonics by exact integration over every source texel, and the cosine convolution.
 Docs: docs/environment.md.
 """
