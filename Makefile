@@ -78,7 +78,8 @@ clean:
 # then the Dask executor (local:2) against the thread executor on the make-luts batch, and a scaling projection:
 # outputs/bench/cluster.json (docs/cluster.md); first, `make luts` into an empty folder timed (wall, CPU, top ten
 # tables): outputs/bench/luts.json; every table that interpolates between texels against itself integrated (CPU ratio,
-# honesty): outputs/bench/interpolation.json
+# honesty): outputs/bench/interpolation.json; the prefiltered environment (a 2048 x 1024 CC0 map to a 256^2 cube and
+# its SH) against the importance-sampled prefilter: outputs/bench/environment.json (needs Debian's blender-data)
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_luts.py
 	$(BIN)/python benchmarks/bench.py
@@ -88,6 +89,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_ltc.py --lobes eon,gotanda
 	$(BIN)/python benchmarks/bench_ltc_aniso.py
 	$(BIN)/python benchmarks/bench_cluster.py
+	$(BIN)/python benchmarks/bench_environment.py
 	$(BIN)/python benchmarks/write_benchmarks_md.py
 
 # LTC fits (kind ltc): fit time per lobe at 64^2, the straight-port baseline, area-light errors (L3 and shaded fits):

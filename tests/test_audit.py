@@ -461,6 +461,10 @@ UNAUDITED = {
     "ltc_aniso_alphax_alphay_theta_phi.npy": "Kt et al. 2022's anisotropic GGX LTC table (8^4 matrices, no magnitude):"
     " the reference of tests/test_ltc_aniso.py and benchmarks/bench_ltc_aniso.py; no kind writes this layout yet",
     "ltc_aniso_alpha_lambda_theta_phi.npy": "the same paper's alpha x lambda table (tests/test_ltc_aniso.py)",
+    "env_studio_64x32.exr": "a CC0 lat-long environment (Blender's studio light, reduced): a source of "
+    "tests/test_environment.py, not a table",
+    "env_sunrise_64x32.exr": "a CC0 lat-long environment (Blender's sunrise, reduced): a source of "
+    "tests/test_environment.py, not a table",
 }
 FAST_SIDE = 6  # the loop's subset (its own tests above use MAX_SIDE)
 OPENPBR_RATIO_MEAN = 2e-3  # the ratio re-baked: its averages' noise divided by them (measured mean 6.1e-4, all slices)

@@ -40,7 +40,10 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("runtime", ("runtime",)),
     ("terms", ("terms",)),
     ("sampling", ("sampling",)),  # every quadrature and the per-texel plan
-    ("integrands", ("integrands", "ltc")),  # what is integrated (integrands read their quadratures' nodes)
+    (
+        "integrands",
+        ("integrands", "ltc", "environment"),
+    ),  # what is integrated (integrands read their quadratures' nodes)
     ("layouts", ("layouts", "value_bounds")),  # engine layouts as data; the value ranges they declare
     ("io", ("io", "table")),  # the Table record, its writers and readers (engine files read their layouts)
     ("kinds", ("kinds", "plugins")),  # the kinds' declarations; the plugins that add records a config may name

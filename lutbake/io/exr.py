@@ -67,12 +67,17 @@ def _spec(oiio, width: int, height: int, nch: int, fmt: str, attrs: dict[str, st
 
 
 def _write_oiio(path: Path, parts: list[tuple[str | None, dict[str, str], np.ndarray]], fmt: str) -> None:
-    """Write ``parts`` (part name, header attrs, (y, x, C) array) as a single- or multi-part EXR."""
+    """Write ``parts`` (part name, header attrs, (y, x, C) array) as a single- or multi-part EXR. Parts may differ in
+    size (a cube's mips, lutbake.io.cubemap): each keeps its own data window, and every part takes the first part's
+    display window (OpenEXR requires one for all parts)."""
     oiio = _oiio()
-    h, w, nch = parts[0][2].shape
+    h0, w0 = parts[0][2].shape[:2]
     specs = []
-    for name, attrs, _ in parts:
+    for name, attrs, pixels in parts:
+        h, w, nch = pixels.shape
         spec = _spec(oiio, w, h, nch, fmt, attrs)
+        if (h, w) != (h0, w0):
+            spec.full_width, spec.full_height = w0, h0
         if name is not None:
             spec.attribute("name", name)  # the EXR part name
         specs.append(spec)

@@ -1,0 +1,67 @@
+"""The weights an output texel integrates the source against, as ``@wp.func``s of (r, l, alpha): r the texel's
+direction (n = v = r, the split-sum assumption), l a unit direction with r . l >= 0 (the quadrature clips the
+horizon), in float64 with the NDF from lutbake.terms.
+
+Prefiltered radiance P(r) = ∫ L(l) w(r, l) dω / ∫ w(r, l) dω (Karis 2013, "Real Shading in Unreal Engine 4", the
+split-sum's first sum, Eq. 2 as the converged limit of its estimator): with n = v = r the GGX sampling pdf of l is
+D(h)(n.h) / (4 v.h) = D(h) / 4, so Karis' sum of L (n.l) over l drawn from it converges to ∫ L D/4 (n.l) dω /
+∫ D/4 (n.l) dω. ``ggx_nl`` is that weight, ``ggx`` the unweighted one (Filament's cmgen without n.l, glTF-IBL-Sampler
+with its n.l weighting off), ``cosine`` the irradiance lobe (E(r)/pi = ∫ L (n.l) dω / pi), ``footprint`` the
+indicator of a texel's own footprint (the area average, the alpha -> 0 mip). With n = v = r, h = (r + l)/|r + l|,
+n.h = |r + l| / 2 and |n x h| = |r - l| / 2, both exact near the peak.
+"""
+
+from __future__ import annotations
+
+import math
+
+import warp as wp
+
+from ..terms.ndf import D_ggx
+
+
+@wp.func
+def w_ggx_nl(r: wp.vec3d, l: wp.vec3d, alpha: wp.float64):
+    """D_ggx(h; alpha) / 4 * (n.l), n = v = r (Karis 2013's n.l-weighted prefilter)."""
+    c = wp.length(r + l) * wp.float64(0.5)
+    s = wp.length(r - l) * wp.float64(0.5)
+    d = D_ggx(wp.vec3(float(s), 0.0, float(c)), float(alpha))
+    return wp.float64(d) * wp.float64(0.25) * wp.dot(r, l)
+
+
+@wp.func
+def w_ggx(r: wp.vec3d, l: wp.vec3d, alpha: wp.float64):
+    """D_ggx(h; alpha) / 4 over the hemisphere r . l >= 0 (the unweighted prefilter)."""
+    c = wp.length(r + l) * wp.float64(0.5)
+    s = wp.length(r - l) * wp.float64(0.5)
+    return wp.float64(D_ggx(wp.vec3(float(s), 0.0, float(c)), float(alpha))) * wp.float64(0.25)
+
+
+@wp.func
+def w_cosine(r: wp.vec3d, l: wp.vec3d, alpha: wp.float64):
+    """n.l (the irradiance lobe; alpha unused)."""
+    return wp.dot(r, l)
+
+
+@wp.func
+def w_footprint(r: wp.vec3d, l: wp.vec3d, alpha: wp.float64):
+    """1 (the texel's footprint: the quadrature clips it to its four planes)."""
+    return wp.float64(1.0)
+
+
+# name -> (weight, relative slope S of the weight across a cell of radius rho at distance d from the peak:
+# |dw/w| ~ S rho / (d + lambda), lambda per texel from ``lobe_width``)
+LOBES = {
+    "ggx_nl": (w_ggx_nl, 4.0),
+    "ggx": (w_ggx, 4.0),
+    "cosine": (w_cosine, 2.0),
+    "footprint": (w_footprint, 0.0),
+}
+
+
+def lobe_width(lobe: str, alpha: float) -> float:
+    """lambda: the angular scale (radians, in l) over which the weight falls by about half from its peak: GGX
+    2 atan(alpha) (the h lobe's half width alpha, doubled by the reflection), cosine pi/3, footprint 0."""
+    if lobe in ("ggx_nl", "ggx"):
+        return 2.0 * math.atan(alpha)
+    return math.pi / 3 if lobe == "cosine" else 0.0
