@@ -313,8 +313,11 @@ def fit_table(grid: Grid4, magnitude, n_grid=fit.LTC_FIT_GRID, device="cpu", wor
 MAGNITUDE_SAMPLES = 1 << 16  # scrambled Sobol' points per anisotropic texel (bounded weights: spread ~1e-5)
 
 
-def magnitude_fresnel(grid: Grid4, samples: int = MAGNITUDE_SAMPLES, device: str = "cpu", seed: int = 0):
-    """(magnitude, fresnel) (n_a, n_b, n_theta, n_phi): ∫ f (n.l) dω and ∫ f (1 - v.h)^5 (n.l) dω, F = 1. Texels with
+def magnitude_fresnel(
+    grid: Grid4, samples: int = MAGNITUDE_SAMPLES, device: str = "cpu", seed: int = 0, texels: np.ndarray | None = None
+):
+    """(magnitude, fresnel) (n_a, n_b, n_theta, n_phi), or (k,) at flat ``texels``: ∫ f (n.l) dω and
+    ∫ f (1 - v.h)^5 (n.l) dω, F = 1. Texels with
     alpha_x = alpha_y: the isotropic ltc kind's integrals (lutbake.ltc.magnitude: Gauss-Legendre, exact; they do not
     depend on phi); the others: the specular_aniso kind's integrand (lutbake.integrands.anisotropic, the
     ``multiscatter`` channels (Fc, 1)) and estimator at the texel's fixed view azimuth
@@ -326,7 +329,7 @@ def magnitude_fresnel(grid: Grid4, samples: int = MAGNITUDE_SAMPLES, device: str
 
     ax2, ay2 = grid.alphas()
     _, _, theta, phi = grid.axes()
-    i, j, k, m = np.indices(grid.n).reshape(4, -1)
+    i, j, k, m = np.indices(grid.n).reshape(4, -1)[:, slice(None) if texels is None else texels]
     nov = np.cos(theta[k]).astype(np.float32)
     ax, ay = ax2[i, j], ay2[i, j]
     mag, fres = np.zeros(len(nov)), np.zeros(len(nov))
@@ -339,7 +342,7 @@ def magnitude_fresnel(grid: Grid4, samples: int = MAGNITUDE_SAMPLES, device: str
         est.prepare(integrand, device)
         out = est.evaluate(integrand, inputs, device)
         fres[~iso], mag[~iso] = out[:, 0], out[:, 1]
-    return mag.reshape(grid.n), fres.reshape(grid.n)
+    return (mag.reshape(grid.n), fres.reshape(grid.n)) if texels is None else (mag, fres)
 
 
 def relative_error_of(grid: Grid4, magnitude: np.ndarray, m: np.ndarray, texels: np.ndarray, n_grid=fit.LTC_FIT_GRID):
