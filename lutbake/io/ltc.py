@@ -29,14 +29,22 @@ from ..table import Table
 from .conventions import write_conventions, write_with_sidecar
 
 FP16_MAX = 65504.0
-EXTENSIONS = {"ltc_dds": "_1.dds", "js": ".js", "c": ".cc", "cs": ".cs", "babylon_fuzz": ".dds", "ltc_aniso_npy": ".npy"}
+EXTENSIONS = {
+    "ltc_dds": "_1.dds",
+    "js": ".js",
+    "c": ".cc",
+    "cs": ".cs",
+    "babylon_fuzz": ".dds",
+    "ltc_aniso_npy": ".npy",
+}
 FORMATS = {  # js: lutbake.io.code_arrays' format, which writes an ltc table as three.js' module (write_js)
     "ltc_dds": "ltc_code's two files <name>_1.dds, <name>_2.dds: RGBA16F (dtype half) or RGBA32F (kind ltc)",
     "c": "Blender EEVEE C arrays ltc_mat_<lobe>, ltc_mag_<lobe>, ltc_disk_integral (kind ltc)",
     "cs": "Unity HDRP C# table s_LtcMatrixData_BRDF_<LOBE>, FP16 bits of one RGBA16F slice (kind ltc)",
     "babylon_fuzz": "Babylon.js environmentFuzzBRDFTexture: one DDS, RGBA16F (half) or RGBA32F, (A, B, R_i) coded by "
     "getFuzzBRDFLookup's mix() ranges (kind ltc, normal-frame lobes: zeltner)",
-    "ltc_aniso_npy": "the anisotropic LTC paper's layout: M (N, N, N, N, 3, 3) float32 + .json sidecar (kind ltc_aniso)",
+    "ltc_aniso_npy": "the anisotropic LTC paper's layout: M (N, N, N, N, 3, 3) float32 + .json sidecar "
+    "(kind ltc_aniso)",
 }
 
 
@@ -263,6 +271,11 @@ def write_ltc_aniso_npy(table: Table, path, dtype: str = "float32") -> Path:
     return path
 
 
-WRITERS = {"ltc_dds": write_ltc_dds, "js": write_js, "c": write_c, "cs": write_cs, "babylon_fuzz": write_babylon_fuzz,
+WRITERS = {
+    "ltc_dds": write_ltc_dds,
+    "js": write_js,
+    "c": write_c,
+    "cs": write_cs,
+    "babylon_fuzz": write_babylon_fuzz,
     "ltc_aniso_npy": write_ltc_aniso_npy,
 }

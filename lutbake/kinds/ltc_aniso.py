@@ -14,8 +14,8 @@ Stored as lutbake.ltc.aniso.texture_layout's three RGBA 3D textures of width N (
 (layer = b + N a: the 4th axis packed into the depth, as the paper's Tex3D path): the table's z axis is the texture
 (t0, t1, t2), its rows the layers' theta rows stacked (y_block = layer, y = theta), its columns phi. So each z slice
 (an EXR part; npy [k]) is one 3D texture's bytes in glTexImage3D order. ``format = "ltc_aniso_npy"`` writes the
-paper's own layout instead: M as (N, N, N, N, 3, 3) float32 (its LUT/*.npy), the magnitudes beside it
-(lutbake.io.ltc.write_ltc_aniso_npy). The shader: docs/shaders/ltc_aniso.glsl.
+paper's own layout instead: M as (N, N, N, N, 3, 3) float32 (its LUT/*.npy; no magnitude, as the paper's;
+lutbake.io.ltc.write_ltc_aniso_npy). The shader: docs/shaders/ltc_aniso.glsl.
 """
 
 from __future__ import annotations
@@ -41,8 +41,8 @@ FORMATS = {
     "(row = layer N + theta index), lutbake:* attributes (default)",
     "npy": "NumPy (3, N^3, N, 4) = (texture, layer x theta, phi, RGBA) + .json sidecar: [k].reshape(N^2, N, N, 4) "
     "is texture k's (depth, height, width, RGBA)",
-    "ltc_aniso_npy": "the paper's layout (AakashKT/LTC-Anisotropic LUT/*.npy): M (N, N, N, N, 3, 3) float32 in "
-    "<name>.npy, (magnitude, fresnel, fit_error) (N, N, N, N, 3) in <name>_magnitude.npy, + .json sidecar",
+    "ltc_aniso_npy": "the paper's layout (AakashKT/LTC-Anisotropic LUT/*.npy): M[a, b, theta, phi] (N, N, N, N, 3, 3) "
+    "float32 + .json sidecar; no magnitude (the paper's renderer reads it from another table: use exr / npy)",
 }
 ESTIMATORS = {
     "sobol": "magnitude and fresnel of anisotropic texels by scrambled Sobol' points at the texel's view azimuth "
@@ -58,7 +58,11 @@ KEYS = {
         {k: v[1] for k, v in PARAMETRISATIONS.items()},
     ),
     "size": Key(
-        "size", "int", 8, "N: texels per axis (a, b, theta_v, phi_v), endpoint texels (the paper: 8)", minimum=2,
+        "size",
+        "int",
+        8,
+        "N: texels per axis (a, b, theta_v, phi_v), endpoint texels (the paper: 8)",
+        minimum=2,
         maximum=32,
     ),
     "fit_frame": Key("fit_frame", "str", "free", "the LTC's frame in the fit (lutbake.ltc.aniso)", aniso.FRAMES),

@@ -25,7 +25,10 @@ R_z and flips (their "killing rotation").
 Symmetries (the domain fitted): a reflection y -> -y maps phi to -phi, x -> -x maps phi to pi - phi, so phi in
 [0, pi/2] covers every view (the paper's table and shader); the swap S of x and y maps (alpha_x, alpha_y, phi) to
 (alpha_y, alpha_x, pi/2 - phi) with M -> S M S, so only alpha_x >= alpha_y is fitted; at theta = 0 the tangent-frame M
-does not depend on phi (fitted once). The alpha x lambda table (alpha_y = alpha lambda <= alpha_x) needs no swap.
+does not depend on phi (fitted once); at alpha_x = alpha_y the view-frame M does not (the lobe is isotropic: fitted at
+phi = 0, where the sampler's rotation is exact, and turned by R_z(phi), so the slice is the isotropic fit at every
+phi, not up to the rotation's rounding, which matters at alpha = 1e-4). The alpha x lambda table (alpha_y = alpha
+lambda <= alpha_x) needs no swap.
 """
 
 from __future__ import annotations
@@ -243,10 +246,11 @@ class Grid4:
 
 def fitted_texels(grid: Grid4) -> np.ndarray:
     """The texels fitted (flat indices into (n_a, n_b, n_theta, n_phi)): alpha_x >= alpha_y, and phi = 0 alone at
-    theta = 0 (the symmetries of the module docstring)."""
+    theta = 0 and at alpha_x = alpha_y (the symmetries of the module docstring)."""
     ax, ay = grid.alphas()
     idx = np.indices(grid.n).reshape(4, -1)
-    keep = (ax[idx[0], idx[1]] >= ay[idx[0], idx[1]]) & ((idx[2] > 0) | (idx[3] == 0))
+    ax, ay = ax[idx[0], idx[1]], ay[idx[0], idx[1]]
+    keep = (ax >= ay) & (((idx[2] > 0) & (ax != ay)) | (idx[3] == 0))
     return np.flatnonzero(keep)
 
 
@@ -299,6 +303,10 @@ def fit_table(grid: Grid4, magnitude, n_grid=fit.LTC_FIT_GRID, device="cpu", wor
     err = np.full(grid.n, np.nan)
     full[i, j, k, m] = canonical(rotate_z(mats, phi[m]))
     err[i, j, k, m] = rel
+    a, b = np.nonzero(ax2 == ay2)  # isotropic: one view-frame M for every phi (fitted at phi = 0)
+    for p in range(1, grid.n[3]):
+        full[a, b, :, p] = canonical(rotate_z(full[a, b, :, 0].reshape(-1, 3, 3), phi[p])).reshape(len(a), -1, 3, 3)
+        err[a, b, :, p] = err[a, b, :, 0]
     full[:, :, 0, :] = full[:, :, 0, :1]  # theta = 0: one M for every phi (tangent frame)
     err[:, :, 0, :] = err[:, :, 0, :1]
     if grid.parametrisation == "alphax_alphay":  # alpha_x < alpha_y: S M(alpha_y, alpha_x, pi/2 - phi) S
