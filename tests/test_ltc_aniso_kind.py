@@ -25,11 +25,11 @@ DIAGONAL_ATOL = 5e-5  # the isotropic fit's own asymmetry (Nelder-Mead stops wit
 S = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
 
 
-def baked(tmp_path, parametrisation="alphax_alphay", workers=1, fmt="exr", name="la"):
+def baked(tmp_path, parametrisation="alphax_alphay", workers=1, fmt="exr", name="la", fit="l3"):
     cfg = tmp_path / f"{name}.toml"
     cfg.write_text(
         f'[[table]]\nname = "{name}"\nkind = "ltc_aniso"\nparametrisation = "{parametrisation}"\nsize = {N}\n'
-        f'fit_samples = {FIT_SAMPLES}\nsamples = {SAMPLES}\nformat = "{fmt}"\n'
+        f'fit_samples = {FIT_SAMPLES}\nsamples = {SAMPLES}\nformat = "{fmt}"\nfit = "{fit}"\n'
     )
     bake(cfg, tmp_path / "out", workers=workers)
     ext = ".exr" if fmt == "exr" else ".npy"
@@ -123,3 +123,16 @@ def test_inspect_reads_it(tables):
     r = CliRunner().invoke(main, ["inspect", str(tables["path"])])
     assert r.exit_code == 0, r.output
     assert "kind: ltc_aniso" in r.output and "layer: y_block" in r.output and "fit_error_median" in r.output
+
+
+def test_shaded_fit_keeps_the_magnitude_and_the_symmetries(tables):
+    t = read_table(baked(tables["tmp"], name="la_shaded", fit="shaded"))
+    m, extra = unpack(t.data)
+    xy, xy_extra = unpack(tables["xy"].data)
+    assert np.all(np.isfinite(t.data)) and "then shaded" in t.attrs["ltc_aniso_fit"]
+    np.testing.assert_array_equal(extra[..., :2], xy_extra[..., :2])  # magnitude and fresnel: the exact channels
+    assert not np.array_equal(m, xy)  # refined
+    np.testing.assert_allclose(np.linalg.norm(m[..., :, 2], axis=-1), 1.0, rtol=1e-6)
+    for i in range(N):
+        for j in range(i):
+            np.testing.assert_array_equal(m[j, i], (S @ m[i, j][:, ::-1] @ S).astype(np.float32))

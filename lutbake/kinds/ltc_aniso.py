@@ -74,9 +74,25 @@ KEYS = {
         minimum=4,
         maximum=256,
     ),
+    "fit": Key(
+        "fit",
+        "str",
+        "l3",
+        "what the fit minimises",
+        {
+            "l3": "Heitz et al. 2016's L3 distance to the lobe (at alpha_x = alpha_y: lutbake's isotropic L3 fit)",
+            "shaded": "the l3 fit refined to the polygon-light integrals the shader computes, the magnitude kept "
+            "exact (lutbake.ltc.aniso_shaded: Levenberg-Marquardt in the 9 coefficients of M^-1 over 128 training "
+            "lights per texel)",
+        },
+    ),
     "format": Key("format", "str", "exr", "output file format", FORMATS),
 }
-TEXTURES = ("t0", "t1", "t2")
+SHADED = (
+    "each fitted texel's M^-1 (9 coefficients, view frame) refined by Levenberg-Marquardt to the soft-L1 of (magnitude "
+    "I_j - G_j) / (G_j + 0.4 albedo) over 128 training lights (lutbake.ltc.shaded's lights, cost and lobe-sampled "
+    "targets; lutbake.ltc.aniso_shaded), the magnitude the exact albedo; fit_error = the refined M's L3 error"
+)
 CHANNELS = {
     "x": "t0: M00; t1: M11; t2: M22 (M row-major, tangent frame, |M e_z| = 1)",
     "y": "t0: M01; t1: M12; t2: magnitude = ∫ f (n.l) dω_l with F = 1",
@@ -113,7 +129,7 @@ def plan(spec) -> TexelPlan:
     o = spec.options
     g = grid_of(o)
     samples = o["samples"] or aniso.MAGNITUDE_SAMPLES
-    state = AnisoBake(g, o["fit_frame"], o["fit_samples"], samples, o["seed"])
+    state = AnisoBake(g, o["fit_frame"], o["fit_samples"], samples, o["seed"], o["fit"] == "shaded")
     a, b, _, _ = g.axes()
     n = o["size"]
     n_fit = len(aniso.fitted_texels(g))
@@ -128,9 +144,11 @@ def plan(spec) -> TexelPlan:
         "v = (sin theta cos phi, sin theta sin phi, cos theta); phi in the other quadrants: M(pi - phi) = "
         "diag(-1, 1, 1) M(phi), M(phi + pi) = diag(-1, -1, 1) M(phi), M(-phi) = diag(1, -1, 1) M(phi)",
         "ltc_aniso_symmetries": f"{n_fit} of {n**4} texels fitted: alpha_x >= alpha_y (the others S M S at "
-        "(alpha_y, alpha_x, pi/2 - phi), S = swap(x, y)) and phi = 0 alone at theta = 0",
+        "(alpha_y, alpha_x, pi/2 - phi), S = swap(x, y)), phi = 0 alone at theta = 0 (the tangent-frame M) and "
+        "at alpha_x = alpha_y (the view-frame M, turned by R_z(phi))",
         "ltc_aniso_fit": f"L3 (Heitz et al. 2016) by Nelder-Mead per texel, frame {o['fit_frame']!r}: "
-        f"{aniso.FRAMES[o['fit_frame']]}; metric grid {o['fit_samples']}^2 per technique; lutbake.ltc.aniso.fit_tile",
+        f"{aniso.FRAMES[o['fit_frame']]}; metric grid {o['fit_samples']}^2 per technique; lutbake.ltc.aniso.fit_tile"
+        + ("" if o["fit"] == "l3" else f"; then shaded: {SHADED}"),
         "ltc_aniso_magnitude": f"alpha_x = alpha_y: Gauss-Legendre (exact, lutbake.ltc.magnitude); otherwise "
         f"scrambled Sobol' (seed {o['seed']}), {samples} points per texel at the texel's phi_v (anisotropic VNDF, "
         "weight G2 / G1 <= 1); its spread between two scramblings: lutbake:ltc_aniso_magnitude_spread (an estimate, "

@@ -287,18 +287,34 @@ def fit_table(grid: Grid4, magnitude, n_grid=fit.LTC_FIT_GRID, device="cpu", wor
     """The tangent-frame, canonical M (n_a, n_b, n_theta, n_phi, 3, 3) and the relative fit error of every texel:
     fitted_texels in tiles of TILE (threads: ``workers``; each texel's fit reads only its own inputs, so the bits do
     not depend on the worker count), the others by the symmetries."""
+    args = fitted_inputs(grid, magnitude)
+    out = in_tiles(lambda t: fit_tile(*(a[t] for a in args), n_grid, device, frame), len(args[0]), workers)
+    return completed(grid, np.concatenate([o[0] for o in out]), np.concatenate([o[2] for o in out]))
+
+
+def fitted_inputs(grid: Grid4, magnitude: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(n.v float32, alpha_x, alpha_y, phi, magnitude) of the fitted_texels, in their order."""
     ax2, ay2 = grid.alphas()
     _, _, theta, phi = grid.axes()
-    idx = np.indices(grid.n).reshape(4, -1)
     todo = fitted_texels(grid)
-    i, j, k, m = idx[:, todo]
-    nov = np.cos(theta[k]).astype(np.float32)
-    args = (nov, ax2[i, j], ay2[i, j], phi[m], magnitude.reshape(-1)[todo])
-    tiles = [slice(s, s + TILE) for s in range(0, len(todo), TILE)]
+    i, j, k, m = np.indices(grid.n).reshape(4, -1)[:, todo]
+    return np.cos(theta[k]).astype(np.float32), ax2[i, j], ay2[i, j], phi[m], magnitude.reshape(-1)[todo]
+
+
+def in_tiles(run, n: int, workers: int) -> list:
+    """run(slice) over [0, n) in tiles of TILE on ``workers`` threads, in order (tiles fixed: the same bits for any
+    worker count)."""
+    tiles = [slice(s, s + TILE) for s in range(0, n, TILE)]
     with ThreadPoolExecutor(max(1, workers)) as pool:
-        out = list(pool.map(lambda t: fit_tile(*(a[t] for a in args), n_grid, device, frame), tiles))
-    mats = np.concatenate([o[0] for o in out])
-    rel = np.concatenate([o[2] for o in out])
+        return list(pool.map(run, tiles))
+
+
+def completed(grid: Grid4, mats: np.ndarray, rel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The table (tangent-frame canonical M, relative error) from the view-frame M and errors of the fitted_texels, the
+    other texels by the symmetries (module docstring)."""
+    ax2, ay2 = grid.alphas()
+    _, _, _, phi = grid.axes()
+    i, j, k, m = np.indices(grid.n).reshape(4, -1)[:, fitted_texels(grid)]
     full = np.full((*grid.n, 3, 3), np.nan)
     err = np.full(grid.n, np.nan)
     full[i, j, k, m] = canonical(rotate_z(mats, phi[m]))

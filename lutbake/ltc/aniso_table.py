@@ -27,11 +27,12 @@ def available_threads() -> int:
 
 class AnisoBake:
     """The state one ltc_aniso bake shares between its tiles: ``grid`` (aniso.Grid4), the fit's frame and metric grid,
-    the magnitude's Sobol' budget and seed. ``texels()``: the (3 n_a n_b n_theta n_phi, 4) float64 texels, computed
+    the magnitude's Sobol' budget and seed, ``shaded``: the L3 fit refined to polygon lights
+    (lutbake.ltc.aniso_shaded). ``texels()``: the (3 n_a n_b n_theta n_phi, 4) float64 texels, computed
     once; ``matrices`` (the paper's layout, (n_a, n_b, n_theta, n_phi, 3, 3)) after it."""
 
-    def __init__(self, grid: aniso.Grid4, frame: str, fit_samples: int, samples: int, seed: int):
-        self.grid, self.frame, self.fit_samples = grid, frame, fit_samples
+    def __init__(self, grid: aniso.Grid4, frame: str, fit_samples: int, samples: int, seed: int, shaded=False):
+        self.grid, self.frame, self.fit_samples, self.shaded = grid, frame, fit_samples, shaded
         self.samples, self.seed = samples, seed
         self._lock = threading.Lock()
         self._flat = None
@@ -64,6 +65,10 @@ class AnisoBake:
                 g = self.grid
                 mag, fres = aniso.magnitude_fresnel(g, self.samples, device, self.seed)
                 m, err = aniso.fit_table(g, mag, self.fit_samples, device, available_threads(), self.frame)
+                if self.shaded:
+                    from .aniso_shaded import refine_table
+
+                    m, err = refine_table(g, mag, m, self.fit_samples, device, available_threads())
                 tex = aniso.texture_layout(m, mag, fres, err).astype(np.float64)
                 if not np.all(np.isfinite(tex)):
                     raise ValueError("ltc_aniso: a texel of the fit is not finite")
