@@ -12,6 +12,8 @@
    lutbake's magnitude: the comparison is of the matrices. Per band of roughness max(alpha), anisotropy
    min/max(alpha) and view theta: median and p90 relative error (where the truth exceeds 1e-3 x albedo) and p90
    |error| / albedo.
+4. ``--shaded``: a third table, lutbake's L3 table refined to polygon lights (lutbake.ltc.aniso_shaded, the
+   ltc_aniso kind's ``fit = "shaded"``; its training lights are lutbake.ltc.shaded's, another seed than these).
 
 The paper's fitting script (fitting/fit_alphax_alphay_theta_phi.py) needs torch with CUDA ('cuda:0' is hard-coded
 in every tensor it makes); it is not run here (see the JSON's "paper_fit").
@@ -77,6 +79,7 @@ def main():
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--frame", default="free", choices=sorted(aniso.FRAMES))
     ap.add_argument("--shaded", action="store_true", help="also the shaded refinement (lutbake.ltc.aniso_shaded)")
+    ap.add_argument("--shaded-iterations", type=int, default=aniso_shaded.ITERATIONS)
     a = ap.parse_args()
     grid = aniso.Grid4("alphax_alphay", (8, 8, 8, 8))
     t0 = time.perf_counter()
@@ -88,7 +91,9 @@ def main():
     tables = {"published": None, "lutbake": table}
     if a.shaded:
         t0 = time.perf_counter()
-        tables["lutbake_shaded"], err_shaded = aniso_shaded.refine_table(grid, mag, table, 32, workers=a.workers)
+        tables["lutbake_shaded"], err_shaded = aniso_shaded.refine_table(
+            grid, mag, table, 32, workers=a.workers, iterations=a.shaded_iterations
+        )
         t_shaded = time.perf_counter() - t0
     out = OUT / "ltc_aniso"
     out.mkdir(parents=True, exist_ok=True)
@@ -162,7 +167,7 @@ def main():
                 else {}
             ),
         },
-        **({"shaded_seconds": t_shaded} if a.shaded else {}),
+        **({"shaded_seconds": t_shaded, "shaded_iterations": a.shaded_iterations} if a.shaded else {}),
         "polygon_lights": table_rows,
         "configs": a.configs,
         "ground_truth_samples": a.gt**2,

@@ -22,7 +22,9 @@ from .aniso import AnisoProblem
 ITERATIONS = 10
 
 
-def refine_matrices(nov, ax, ay, phi, magnitude, m_view: np.ndarray, device: str = "cpu") -> np.ndarray:
+def refine_matrices(
+    nov, ax, ay, phi, magnitude, m_view: np.ndarray, device: str = "cpu", iterations: int = ITERATIONS
+) -> np.ndarray:
     """View-frame M (k, 3, 3) refined from ``m_view`` (the L3 fit's) to the training lights (module docstring)."""
     nov = np.asarray(nov, np.float64)
     k = len(nov)
@@ -44,7 +46,7 @@ def refine_matrices(nov, ax, ay, phi, magnitude, m_view: np.ndarray, device: str
     cost = np.sum(shaded.robust(z), axis=1)
     lam = np.full(k, shaded.LAMBDA0)
     eye = np.eye(9)
-    for _ in range(ITERATIONS):
+    for _ in range(iterations):
         so = np.sqrt(shaded.robust_weight(z))
         h = shaded.FD_STEP * np.maximum(np.abs(minv), 1.0)
         trials = minv[:, None, :] + h[:, :, None] * eye[None]  # (k, 9 trials, 9)
@@ -65,7 +67,9 @@ def refine_matrices(nov, ax, ay, phi, magnitude, m_view: np.ndarray, device: str
     return np.linalg.inv(minv.reshape(k, 3, 3))
 
 
-def refine_table(grid: aniso.Grid4, magnitude: np.ndarray, table: np.ndarray, n_grid: int, device="cpu", workers=1):
+def refine_table(
+    grid: aniso.Grid4, magnitude, table: np.ndarray, n_grid: int, device="cpu", workers=1, iterations=ITERATIONS
+):
     """lutbake.ltc.aniso.fit_table's (M, relative L3 error) with every fitted texel's M refined from ``table`` (the
     L3 fit) by refine_matrices, in aniso's fixed tiles (the same bits for any worker count); the error channel is the
     refined M's L3 error (metric grid ``n_grid``); the other texels by the symmetries (aniso.completed)."""
@@ -73,7 +77,7 @@ def refine_table(grid: aniso.Grid4, magnitude: np.ndarray, table: np.ndarray, n_
     m_view = aniso.rotate_z(table.reshape(-1, 3, 3)[aniso.fitted_texels(grid)], -phi)
 
     def run(t):
-        m = refine_matrices(nov[t], ax[t], ay[t], phi[t], mag[t], m_view[t], device)
+        m = refine_matrices(nov[t], ax[t], ay[t], phi[t], mag[t], m_view[t], device, iterations)
         p = AnisoProblem(nov[t], ax[t], ay[t], phi[t], mag[t], n_grid, device)
         texel = np.arange(p.n)
         return m, p.relative(texel, p.error(texel, m))
