@@ -26,8 +26,7 @@ import numpy as np
 
 from ..axes import Axis
 from ..limits import LTC_FIT_GRID
-from ..ltc import aniso
-from ..ltc.aniso_table import AnisoBake
+from ..ltc import aniso_grid as aniso
 from ..ltc.metadata import fit_error_stats
 from ..runtime.plan import TexelPlan
 from .base import Estimation, Key, declare
@@ -63,7 +62,6 @@ KEYS = {
         8,
         "N: texels per axis (a, b, theta_v, phi_v), endpoint texels (the paper: 8)",
         minimum=2,
-        maximum=32,
     ),
     "fit_frame": Key("fit_frame", "str", "free", "the LTC's frame in the fit (lutbake.ltc.aniso)", aniso.FRAMES),
     "fit_samples": Key(
@@ -126,6 +124,8 @@ def axes_for(o: dict) -> list[Axis]:
 
 
 def plan(spec) -> TexelPlan:
+    from ..ltc.aniso_table import AnisoBake
+
     o = spec.options
     g = grid_of(o)
     samples = o["samples"] or aniso.MAGNITUDE_SAMPLES

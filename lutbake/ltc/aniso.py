@@ -34,7 +34,6 @@ lambda <= alpha_x) needs no swap.
 from __future__ import annotations
 
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
 
 import numpy as np
 import warp as wp
@@ -44,18 +43,20 @@ from ..runtime.warp_runtime import MODULE_OPTIONS
 from ..terms import masking, ndf
 from ..terms.frame import reflect
 from . import fit
+from .aniso_grid import (  # noqa: F401 - aniso's names too
+    ALPHA_FLOOR,
+    FRAMES,
+    MAGNITUDE_SAMPLES,
+    PARAMETRISATIONS,
+    THETA_SCALE,
+    Grid4,
+    fitted_texels,
+)
 from .lobes import Lobe, half_vector, pdf_reflected_ndf, smith_f_cos
 
 wp.set_module_options(MODULE_OPTIONS)
 
-ALPHA_FLOOR = 1.0e-4  # the paper's texels: alpha = max(i / (n - 1), 1e-4) (fit_alphax_alphay_theta_phi.py)
-THETA_SCALE = 0.9999  # the paper's texels: theta = k / (n - 1) * 0.9999 * pi / 2 ("to avoid grazing angle")
 TILE = 64  # texels a fit call takes (fixed: the table's bits do not depend on the worker count)
-PARAMETRISATIONS = {
-    "alphax_alphay": "(alpha_x, alpha_y, theta, phi): alpha_x = max(i/(n-1), 1e-4), alpha_y = max(j/(n-1), 1e-4)",
-    "alpha_lambda": "(alpha, lambda, theta, phi): alpha_x = max(a, 1e-4), alpha_y = max(a lambda, 1e-4), "
-    "a = i/(n-1), lambda = j/(n-1)",
-}
 
 
 @wp.func
@@ -117,12 +118,6 @@ LOBES = {
         general_frame=True,
     )
     for frame in ("average", "free")
-}
-FRAMES = {
-    "free": "Z tilted from the lobe's average direction too (7 parameters; at alpha_x = alpha_y: the isotropic fit "
-    "with ltc_code's frame angle free, lutbake's free_frame)",
-    "average": "Z = the lobe's average direction (5 parameters; at alpha_x = alpha_y: ltc_code's M, lutbake's "
-    "isotropic ggx fit)",
 }
 
 
@@ -220,40 +215,6 @@ def rotate_z(m: np.ndarray, phi: np.ndarray) -> np.ndarray:
     return r @ m
 
 
-@dataclass(frozen=True)
-class Grid4:
-    """The paper's texels: axes (a, b, theta, phi) of n_a, n_b, n_theta, n_phi endpoint texels (module docstring)."""
-
-    parametrisation: str
-    n: tuple[int, int, int, int]
-
-    def axes(self) -> tuple[np.ndarray, ...]:
-        a, b = (np.arange(k) / (k - 1) for k in self.n[:2])
-        theta = np.arange(self.n[2]) / (self.n[2] - 1) * THETA_SCALE * np.pi / 2
-        phi = np.arange(self.n[3]) / (self.n[3] - 1) * np.pi / 2
-        return a, b, theta, phi
-
-    def alphas(self) -> tuple[np.ndarray, np.ndarray]:
-        """(alpha_x, alpha_y) float32 (n_a, n_b)."""
-        a, b, _, _ = self.axes()
-        if self.parametrisation == "alphax_alphay":
-            ax, ay = np.meshgrid(a, b, indexing="ij")
-        else:
-            ax, ay = np.meshgrid(a, b, indexing="ij")
-            ay = ax * ay
-        return np.maximum(ax, ALPHA_FLOOR).astype(np.float32), np.maximum(ay, ALPHA_FLOOR).astype(np.float32)
-
-
-def fitted_texels(grid: Grid4) -> np.ndarray:
-    """The texels fitted (flat indices into (n_a, n_b, n_theta, n_phi)): alpha_x >= alpha_y, and phi = 0 alone at
-    theta = 0 and at alpha_x = alpha_y (the symmetries of the module docstring)."""
-    ax, ay = grid.alphas()
-    idx = np.indices(grid.n).reshape(4, -1)
-    ax, ay = ax[idx[0], idx[1]], ay[idx[0], idx[1]]
-    keep = (ax >= ay) & (((idx[2] > 0) & (ax != ay)) | (idx[3] == 0))
-    return np.flatnonzero(keep)
-
-
 def fit_tile(nov, ax, ay, phi, magnitude, n_grid: int, device: str, frame: str) -> tuple[np.ndarray, ...]:
     """Fit one tile of texels: Nelder-Mead from the best of guesses() at lutbake.ltc.fit's COARSE_STEPS (0.5, 0.1,
     0.02), in the parameters the texel's lobe has (a symmetric one: ltc_code's (log m11, log m22, m13 / m11) and, frame
@@ -332,9 +293,6 @@ def completed(grid: Grid4, mats: np.ndarray, rel: np.ndarray) -> tuple[np.ndarra
         full[a, b] = s @ full[b, a][:, :, ::-1] @ s
         err[a, b] = err[b, a][:, :, ::-1]
     return full, err
-
-
-MAGNITUDE_SAMPLES = 1 << 16  # scrambled Sobol' points per anisotropic texel (bounded weights: spread ~1e-5)
 
 
 def magnitude_fresnel(
