@@ -27,6 +27,7 @@ import numpy as np
 from ..axes import Axis
 from ..limits import LTC_FIT_GRID
 from ..ltc import aniso_grid as aniso
+from ..ltc.aniso_grid import ALPHA_FLOOR
 from ..ltc.metadata import fit_error_stats
 from ..runtime.plan import TexelPlan
 from .base import Estimation, Key, declare
@@ -47,6 +48,8 @@ ESTIMATORS = {
     "sobol": "magnitude and fresnel of anisotropic texels by scrambled Sobol' points at the texel's view azimuth "
     "(the specular_aniso kind's integrand and QMC estimator: anisotropic VNDF sampling, weight G2 / G1 <= 1); "
     "isotropic texels (alpha_x = alpha_y) by the ltc kind's Gauss-Legendre rule (exact)",
+    "sobol_cosine": "the same with the anisotropic texels by scrambled Sobol' points of cosine-weighted l (the "
+    "specular_aniso kind's sobol_cosine: independent of the lobe's sampler, a cross-check; noisy for sharp lobes)",
 }
 KEYS = {
     "parametrisation": Key(
@@ -62,6 +65,14 @@ KEYS = {
         8,
         "N: texels per axis (a, b, theta_v, phi_v), endpoint texels (the paper: 8)",
         minimum=2,
+    ),
+    "alpha_min": Key(
+        "alpha_min",
+        "float",
+        ALPHA_FLOOR,
+        "alpha_x, alpha_y = max(axis value, alpha_min) (the paper: 1e-4)",
+        minimum=ALPHA_FLOOR,
+        maximum=0.5,
     ),
     "fit_frame": Key("fit_frame", "str", "free", "the LTC's frame in the fit (lutbake.ltc.aniso)", aniso.FRAMES),
     "fit_samples": Key(
@@ -109,7 +120,7 @@ RECONSTRUCTION = (
 
 def grid_of(o: dict) -> aniso.Grid4:
     n = o["size"]
-    return aniso.Grid4(PARAMETRISATIONS[o["parametrisation"]][0], (n, n, n, n))
+    return aniso.Grid4(PARAMETRISATIONS[o["parametrisation"]][0], (n, n, n, n), o["alpha_min"])
 
 
 def axes_for(o: dict) -> list[Axis]:
@@ -129,7 +140,7 @@ def plan(spec) -> TexelPlan:
     o = spec.options
     g = grid_of(o)
     samples = o["samples"] or aniso.MAGNITUDE_SAMPLES
-    state = AnisoBake(g, o["fit_frame"], o["fit_samples"], samples, o["seed"], o["fit"] == "shaded")
+    state = AnisoBake(g, o["fit_frame"], o["fit_samples"], samples, o["seed"], o["fit"] == "shaded", o["estimator"])
     a, b, _, _ = g.axes()
     n = o["size"]
     n_fit = len(aniso.fitted_texels(g))
@@ -149,11 +160,11 @@ def plan(spec) -> TexelPlan:
         "ltc_aniso_fit": f"L3 (Heitz et al. 2016) by Nelder-Mead per texel, frame {o['fit_frame']!r}: "
         f"{aniso.FRAMES[o['fit_frame']]}; metric grid {o['fit_samples']}^2 per technique; lutbake.ltc.aniso.fit_tile"
         + ("" if o["fit"] == "l3" else f"; then shaded: {SHADED}"),
-        "ltc_aniso_magnitude": f"alpha_x = alpha_y: Gauss-Legendre (exact, lutbake.ltc.magnitude); otherwise "
-        f"scrambled Sobol' (seed {o['seed']}), {samples} points per texel at the texel's phi_v (anisotropic VNDF, "
-        "weight G2 / G1 <= 1); its spread between two scramblings: lutbake:ltc_aniso_magnitude_spread (an estimate, "
-        "not a bound; ~1e-5 at 2^16). Not Gauss-Legendre: the specular_aniso kind's rule is azimuth-averaged only "
-        "(at a fixed view azimuth the lobe's ridge at alpha_y << alpha_x falls between the panels' nodes)",
+        "ltc_aniso_magnitude": f"{o['estimator']}: {ESTIMATORS[o['estimator']]}; {samples} points per anisotropic "
+        f"texel, seed {o['seed']} (the spread between two scramblings: lutbake:ltc_aniso_magnitude_spread, an "
+        "estimate, not a bound, ~1e-5 at 2^16 with sobol). Not Gauss-Legendre: the specular_aniso kind's rule is "
+        "azimuth-averaged only (at a fixed view azimuth the lobe's ridge at alpha_y << alpha_x falls between the "
+        "panels' nodes)",
         "ltc_aniso_shader": RECONSTRUCTION,
     }
     return TexelPlan(

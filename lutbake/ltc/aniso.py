@@ -296,7 +296,12 @@ def completed(grid: Grid4, mats: np.ndarray, rel: np.ndarray) -> tuple[np.ndarra
 
 
 def magnitude_fresnel(
-    grid: Grid4, samples: int = MAGNITUDE_SAMPLES, device: str = "cpu", seed: int = 0, texels: np.ndarray | None = None
+    grid: Grid4,
+    samples: int = MAGNITUDE_SAMPLES,
+    device: str = "cpu",
+    seed: int = 0,
+    texels: np.ndarray | None = None,
+    estimator: str = "sobol",
 ):
     """(magnitude, fresnel) (n_a, n_b, n_theta, n_phi), or (k,) at flat ``texels``: ∫ f (n.l) dω and
     ∫ f (1 - v.h)^5 (n.l) dω, F = 1. Texels with
@@ -304,7 +309,8 @@ def magnitude_fresnel(
     depend on phi); the others: the specular_aniso kind's integrand (lutbake.integrands.anisotropic, the
     ``multiscatter`` channels (Fc, 1)) and estimator at the texel's fixed view azimuth
     (lutbake.sampling.anisotropic.AnisoSobol:
-    anisotropic VNDF sampling, weight G2 / G1 <= 1)."""
+    anisotropic VNDF sampling, weight G2 / G1 <= 1); ``estimator = "sobol_cosine"``: its cosine-weighted l instead (a
+    second estimator of the anisotropic texels, independent of the lobe's sampler)."""
     from ..integrands.anisotropic import aniso_integrand
     from ..sampling.anisotropic import AnisoSobol
     from .magnitude import magnitude_fresnel as isotropic
@@ -319,7 +325,7 @@ def magnitude_fresnel(
     if iso.any():
         mag[iso], fres[iso] = isotropic("ggx", nov[iso], ax[iso], None, device)
     if (~iso).any():
-        est, integrand = AnisoSobol("sobol", samples, seed), aniso_integrand("microfacet", "multiscatter")
+        est, integrand = AnisoSobol(estimator, samples, seed), aniso_integrand("microfacet", "multiscatter")
         inputs = {"nov": nov[~iso], "alpha_x": ax[~iso], "alpha_y": ay[~iso], "phi_v": phi[m][~iso].astype(np.float32)}
         est.prepare(integrand, device)
         out = est.evaluate(integrand, inputs, device)

@@ -31,6 +31,7 @@ class Grid4:
 
     parametrisation: str
     n: tuple[int, int, int, int]
+    alpha_min: float = ALPHA_FLOOR  # alpha_x, alpha_y >= alpha_min (the paper: 1e-4)
 
     def axes(self) -> tuple[np.ndarray, ...]:
         a, b = (np.arange(k) / (k - 1) for k in self.n[:2])
@@ -46,7 +47,7 @@ class Grid4:
         else:
             ax, ay = np.meshgrid(a, b, indexing="ij")
             ay = ax * ay
-        return np.maximum(ax, ALPHA_FLOOR).astype(np.float32), np.maximum(ay, ALPHA_FLOOR).astype(np.float32)
+        return np.maximum(ax, self.alpha_min).astype(np.float32), np.maximum(ay, self.alpha_min).astype(np.float32)
 
 
 def fitted_texels(grid: Grid4) -> np.ndarray:

@@ -31,8 +31,18 @@ class AnisoBake:
     (lutbake.ltc.aniso_shaded). ``texels()``: the (3 n_a n_b n_theta n_phi, 4) float64 texels, computed
     once; ``matrices`` (the paper's layout, (n_a, n_b, n_theta, n_phi, 3, 3)) after it."""
 
-    def __init__(self, grid: aniso.Grid4, frame: str, fit_samples: int, samples: int, seed: int, shaded=False):
+    def __init__(
+        self,
+        grid: aniso.Grid4,
+        frame: str,
+        fit_samples: int,
+        samples: int,
+        seed: int,
+        shaded=False,
+        estimator: str = "sobol",
+    ):
         self.grid, self.frame, self.fit_samples, self.shaded = grid, frame, fit_samples, shaded
+        self.estimator = estimator
         self.samples, self.seed = samples, seed
         self._lock = threading.Lock()
         self._flat = None
@@ -49,8 +59,10 @@ class AnisoBake:
         if len(aniso_texels) == 0:
             return {"texels": 0, "max_abs": 0.0}
         probe = aniso_texels[:: max(1, len(aniso_texels) // PROBE)][:PROBE]
-        one = aniso.magnitude_fresnel(self.grid, self.samples, device, self.seed, probe)
-        two = aniso.magnitude_fresnel(self.grid, self.samples, device, self.seed + 1, probe)
+        one, two = (
+            aniso.magnitude_fresnel(self.grid, self.samples, device, seed, probe, self.estimator)
+            for seed in (self.seed, self.seed + 1)
+        )
         diff = max(float(np.max(np.abs(a - b))) for a, b in zip(one, two))
         return {"texels": int(len(probe)), "seeds": [self.seed, self.seed + 1], "max_abs": diff}
 
@@ -63,7 +75,7 @@ class AnisoBake:
         with self._lock:
             if self._flat is None:
                 g = self.grid
-                mag, fres = aniso.magnitude_fresnel(g, self.samples, device, self.seed)
+                mag, fres = aniso.magnitude_fresnel(g, self.samples, device, self.seed, estimator=self.estimator)
                 m, err = aniso.fit_table(g, mag, self.fit_samples, device, available_threads(), self.frame)
                 if self.shaded:
                     from .aniso_shaded import refine_table
