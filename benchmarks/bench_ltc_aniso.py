@@ -12,6 +12,8 @@
    lutbake's magnitude: the comparison is of the matrices. Per band of roughness max(alpha), anisotropy
    min/max(alpha) and view theta: median and p90 relative error (where the truth exceeds 1e-3 x albedo) and p90
    |error| / albedo.
+4. ``--shaded``: a third table, lutbake's L3 table refined to polygon lights (lutbake.ltc.aniso_shaded, the
+   ltc_aniso kind's ``fit = "shaded"``; its training lights are lutbake.ltc.shaded's, another seed than these).
 
 The paper's fitting script (fitting/fit_alphax_alphay_theta_phi.py) needs torch with CUDA ('cuda:0' is hard-coded
 in every tensor it makes); it is not run here (see the JSON's "paper_fit").
@@ -26,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lutbake.ltc import aniso, polygon
+from lutbake.ltc import aniso, aniso_shaded, polygon
 from lutbake.validate.ltc_area import GT_FLOOR, LIGHTS, hits, light_polygon
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -76,6 +78,8 @@ def main():
     ap.add_argument("--gt", type=int, default=256, help="S: S^2 VNDF samples per configuration")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--frame", default="free", choices=sorted(aniso.FRAMES))
+    ap.add_argument("--shaded", action="store_true", help="also the shaded refinement (lutbake.ltc.aniso_shaded)")
+    ap.add_argument("--shaded-iterations", type=int, default=aniso_shaded.ITERATIONS)
     a = ap.parse_args()
     grid = aniso.Grid4("alphax_alphay", (8, 8, 8, 8))
     t0 = time.perf_counter()
@@ -84,14 +88,22 @@ def main():
     t0 = time.perf_counter()
     table, err = aniso.fit_table(grid, mag, workers=a.workers, frame=a.frame)
     t_fit = time.perf_counter() - t0
+    tables = {"published": None, "lutbake": table}
+    if a.shaded:
+        t0 = time.perf_counter()
+        tables["lutbake_shaded"], err_shaded = aniso_shaded.refine_table(
+            grid, mag, table, 32, workers=a.workers, iterations=a.shaded_iterations
+        )
+        t_shaded = time.perf_counter() - t0
     out = OUT / "ltc_aniso"
     out.mkdir(parents=True, exist_ok=True)
     np.save(out / "alphax_alphay_theta_phi.npy", table.astype(np.float32))
     np.save(out / "ltc_aniso_textures.npy", aniso.texture_layout(table, mag, fres, err))
-    published = np.load(PUBLISHED).astype(np.float64)
+    published = tables["published"] = np.load(PUBLISHED).astype(np.float64)
     fitted = aniso.fitted_texels(grid)
     e_pub = aniso.relative_error_of(grid, mag, published.reshape(-1, 3, 3)[fitted], fitted)
     e_ours = err.reshape(-1)[fitted]
+    e_sh = err_shaded.reshape(-1)[fitted] if a.shaded else None
 
     rng = np.random.default_rng(7)
     lights = [light_polygon(*spec[:7]) for spec in LIGHTS]
@@ -104,7 +116,7 @@ def main():
         v = np.array([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)])
         l, w = vndf_samples(v, ax, ay, a.gt)
         truth = np.array([np.sum(w[hits(l, p)]) for p in lights]) / a.gt**2
-        for name, tab in (("published", published), ("lutbake", table)):
+        for name, tab in tables.items():
             m, e = aniso.lookup(tab, grid, ax, ay, theta, phi, extra)
             est = e[0, 0] * np.array([ltc_integral(m[0], p) for p in lights])
             for tr, es in zip(truth, est):
@@ -130,7 +142,7 @@ def main():
         }
 
     table_rows = {}
-    for name in ("published", "lutbake"):
+    for name in tables:
         mine = [r for r in rows if r[0] == name]
         res = {"all": stats(mine)}
         for key, (edges, names, f) in bands.items():
@@ -149,7 +161,13 @@ def main():
         "l3_relative_error": {
             "published": {"median": float(np.median(e_pub)), "p90": float(np.percentile(e_pub, 90))},
             "lutbake": {"median": float(np.median(e_ours)), "p90": float(np.percentile(e_ours, 90))},
+            **(
+                {"lutbake_shaded": {"median": float(np.median(e_sh)), "p90": float(np.percentile(e_sh, 90))}}
+                if a.shaded
+                else {}
+            ),
         },
+        **({"shaded_seconds": t_shaded, "shaded_iterations": a.shaded_iterations} if a.shaded else {}),
         "polygon_lights": table_rows,
         "configs": a.configs,
         "ground_truth_samples": a.gt**2,

@@ -42,6 +42,7 @@ DIFFUSE_KINDS = frozenset({"diffuse", "diffuse_3d"})
 UNBOUNDED_KINDS = {
     "btf": "btf tabulates BRDF values f, which peak above 1",
     "ltc": "ltc holds the entries of inverse LTC matrices, far above 1 at low roughness",
+    "ltc_aniso": "ltc_aniso holds the entries of LTC matrices, negative off the diagonal and above 1 where stretched",
 }
 
 

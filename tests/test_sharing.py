@@ -21,7 +21,7 @@ from lutbake.values_cache import open_cache
 SMALL_LTC = {"kind": "ltc", "lobe": "ggx", "size": [6, 6], "fit_samples": 4}
 # one small valid table per kind that declares layout keys; every value each layout key allows is tried on it
 # (dielectric_avg declares none since its mu rule reaches the tolerance that format / dtype set)
-SMALL = {"ltc": SMALL_LTC}
+SMALL = {"ltc": SMALL_LTC, "ltc_aniso": {"kind": "ltc_aniso", "size": 2, "fit_samples": 4, "samples": 256}}
 # layout values a kind's own cross-key check refuses with these small specs (they pair with other keys)
 # (babylon_fuzz: a normal-frame lobe's only, refused for ggx; tests/test_babylon.py checks the refusal)
 REFUSED: set = {("ltc", "format", "babylon_fuzz")}

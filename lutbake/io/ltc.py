@@ -13,6 +13,8 @@ formats ``ltc_dds``, ``js``, ``c`` and ``cs`` of lutbake.io.formats.
 |  |  | Texture2DArray _LtcData (R16G16B16A16_SFloat); (M^-1_00, M^-1_20, M^-1_11, M^-1_02) / M^-1_22 |
 | ``babylon_fuzz`` | <name>.dds (+ .json) | Babylon.js scene.environmentFuzzBRDFTexture: one RGBA16F (or 32F) DDS, |
 |  |  | (A, B, R_i) of a normal-frame fit coded by getFuzzBRDFLookup's mix() (lutbake.layouts.babylon) |
+| ``ltc_aniso_npy`` | <name>.npy (+ .json) | the anisotropic LTC paper's LUT/*.npy: M (N, N, N, N, 3, 3) of a kind |
+|  |  | ltc_aniso table (AakashKT/LTC-Anisotropic; lutbake.kinds.ltc_aniso) |
 Every array is row 0 first (row = view index t, column = roughness index a: element a + t N, as ltc_code's
 tab[a + t*N]); ltc_2's .z (lutbake's fit_error) is written as 0 as in ltc_code.
 """
@@ -27,13 +29,22 @@ from ..table import Table
 from .conventions import write_conventions, write_with_sidecar
 
 FP16_MAX = 65504.0
-EXTENSIONS = {"ltc_dds": "_1.dds", "js": ".js", "c": ".cc", "cs": ".cs", "babylon_fuzz": ".dds"}
+EXTENSIONS = {
+    "ltc_dds": "_1.dds",
+    "js": ".js",
+    "c": ".cc",
+    "cs": ".cs",
+    "babylon_fuzz": ".dds",
+    "ltc_aniso_npy": ".npy",
+}
 FORMATS = {  # js: lutbake.io.code_arrays' format, which writes an ltc table as three.js' module (write_js)
     "ltc_dds": "ltc_code's two files <name>_1.dds, <name>_2.dds: RGBA16F (dtype half) or RGBA32F (kind ltc)",
     "c": "Blender EEVEE C arrays ltc_mat_<lobe>, ltc_mag_<lobe>, ltc_disk_integral (kind ltc)",
     "cs": "Unity HDRP C# table s_LtcMatrixData_BRDF_<LOBE>, FP16 bits of one RGBA16F slice (kind ltc)",
     "babylon_fuzz": "Babylon.js environmentFuzzBRDFTexture: one DDS, RGBA16F (half) or RGBA32F, (A, B, R_i) coded by "
     "getFuzzBRDFLookup's mix() ranges (kind ltc, normal-frame lobes: zeltner)",
+    "ltc_aniso_npy": "the anisotropic LTC paper's layout: M (N, N, N, N, 3, 3) float32 + .json sidecar "
+    "(kind ltc_aniso)",
 }
 
 
@@ -230,4 +241,41 @@ def write_babylon_fuzz(table: Table, path, dtype: str = "half") -> Path:
     return write_with_sidecar(table, path, dds.encode(stored.astype(np_dtype)), "babylon_fuzz", extra)
 
 
-WRITERS = {"ltc_dds": write_ltc_dds, "js": write_js, "c": write_c, "cs": write_cs, "babylon_fuzz": write_babylon_fuzz}
+def aniso_matrices(table: Table) -> np.ndarray:
+    """The paper's layout of an ltc_aniso table (lutbake.kinds.ltc_aniso: slices t0, t1, t2 of (layer x theta, phi,
+    RGBA), layer = b + N a): M (N, N, N, N, 3, 3) float32, row-major from (t0.xyzw, t1.xyzw, t2.x)."""
+    if table.kind != "ltc_aniso":
+        raise ValueError(f"table {table.name!r}: ltc_aniso_npy holds kind 'ltc_aniso' tables only, not {table.kind!r}")
+    data = np.asarray(table.data, np.float32)
+    n = data.shape[2]
+    ch = data.reshape(3, n, n, n, n, 4).transpose(1, 2, 3, 4, 0, 5).reshape(n, n, n, n, 12)
+    return np.ascontiguousarray(ch[..., :9].reshape(n, n, n, n, 3, 3))
+
+
+def write_ltc_aniso_npy(table: Table, path, dtype: str = "float32") -> Path:
+    """The paper's own file (AakashKT/LTC-Anisotropic LUT/alphax_alphay_theta_phi.npy, alpha_lambda_theta_phi.npy):
+    M[a, b, theta, phi] (N, N, N, N, 3, 3) float32; magnitude, fresnel and the fit error are not in it (the paper's
+    renderer reads its amplitude from another table): they are in the texture layout (formats exr, npy)."""
+    from .atomic import atomic_write_hashed
+
+    m = aniso_matrices(table)
+    path = Path(path)
+    digest = atomic_write_hashed(path, lambda tmp: np.save(tmp, m, allow_pickle=False))
+    extra = {
+        "dtype": "float32",
+        "shape": list(m.shape),
+        "layout": "the paper's: M[a, b, theta, phi] row-major 3 x 3, tangent frame, |M e_z| = 1; magnitude, fresnel "
+        "and fit_error only in the texture layout (format exr / npy)",
+    }
+    write_conventions(table, path, "ltc_aniso_npy", extra, digests={path.name: digest})
+    return path
+
+
+WRITERS = {
+    "ltc_dds": write_ltc_dds,
+    "js": write_js,
+    "c": write_c,
+    "cs": write_cs,
+    "babylon_fuzz": write_babylon_fuzz,
+    "ltc_aniso_npy": write_ltc_aniso_npy,
+}

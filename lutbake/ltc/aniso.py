@@ -25,13 +25,15 @@ R_z and flips (their "killing rotation").
 Symmetries (the domain fitted): a reflection y -> -y maps phi to -phi, x -> -x maps phi to pi - phi, so phi in
 [0, pi/2] covers every view (the paper's table and shader); the swap S of x and y maps (alpha_x, alpha_y, phi) to
 (alpha_y, alpha_x, pi/2 - phi) with M -> S M S, so only alpha_x >= alpha_y is fitted; at theta = 0 the tangent-frame M
-does not depend on phi (fitted once). The alpha x lambda table (alpha_y = alpha lambda <= alpha_x) needs no swap.
+does not depend on phi (fitted once); at alpha_x = alpha_y the view-frame M does not (the lobe is isotropic: fitted at
+phi = 0, where the sampler's rotation is exact, and turned by R_z(phi), so the slice is the isotropic fit at every
+phi, not up to the rotation's rounding, which matters at alpha = 1e-4). The alpha x lambda table (alpha_y = alpha
+lambda <= alpha_x) needs no swap.
 """
 
 from __future__ import annotations
 
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass
 
 import numpy as np
 import warp as wp
@@ -41,18 +43,20 @@ from ..runtime.warp_runtime import MODULE_OPTIONS
 from ..terms import masking, ndf
 from ..terms.frame import reflect
 from . import fit
+from .aniso_grid import (  # noqa: F401 - aniso's names too
+    ALPHA_FLOOR,
+    FRAMES,
+    MAGNITUDE_SAMPLES,
+    PARAMETRISATIONS,
+    THETA_SCALE,
+    Grid4,
+    fitted_texels,
+)
 from .lobes import Lobe, half_vector, pdf_reflected_ndf, smith_f_cos
 
 wp.set_module_options(MODULE_OPTIONS)
 
-ALPHA_FLOOR = 1.0e-4  # the paper's texels: alpha = max(i / (n - 1), 1e-4) (fit_alphax_alphay_theta_phi.py)
-THETA_SCALE = 0.9999  # the paper's texels: theta = k / (n - 1) * 0.9999 * pi / 2 ("to avoid grazing angle")
 TILE = 64  # texels a fit call takes (fixed: the table's bits do not depend on the worker count)
-PARAMETRISATIONS = {
-    "alphax_alphay": "(alpha_x, alpha_y, theta, phi): alpha_x = max(i/(n-1), 1e-4), alpha_y = max(j/(n-1), 1e-4)",
-    "alpha_lambda": "(alpha, lambda, theta, phi): alpha_x = max(a, 1e-4), alpha_y = max(a lambda, 1e-4), "
-    "a = i/(n-1), lambda = j/(n-1)",
-}
 
 
 @wp.func
@@ -114,12 +118,6 @@ LOBES = {
         general_frame=True,
     )
     for frame in ("average", "free")
-}
-FRAMES = {
-    "free": "Z tilted from the lobe's average direction too (7 parameters; at alpha_x = alpha_y: the isotropic fit "
-    "with ltc_code's frame angle free, lutbake's free_frame)",
-    "average": "Z = the lobe's average direction (5 parameters; at alpha_x = alpha_y: ltc_code's M, lutbake's "
-    "isotropic ggx fit)",
 }
 
 
@@ -217,39 +215,6 @@ def rotate_z(m: np.ndarray, phi: np.ndarray) -> np.ndarray:
     return r @ m
 
 
-@dataclass(frozen=True)
-class Grid4:
-    """The paper's texels: axes (a, b, theta, phi) of n_a, n_b, n_theta, n_phi endpoint texels (module docstring)."""
-
-    parametrisation: str
-    n: tuple[int, int, int, int]
-
-    def axes(self) -> tuple[np.ndarray, ...]:
-        a, b = (np.arange(k) / (k - 1) for k in self.n[:2])
-        theta = np.arange(self.n[2]) / (self.n[2] - 1) * THETA_SCALE * np.pi / 2
-        phi = np.arange(self.n[3]) / (self.n[3] - 1) * np.pi / 2
-        return a, b, theta, phi
-
-    def alphas(self) -> tuple[np.ndarray, np.ndarray]:
-        """(alpha_x, alpha_y) float32 (n_a, n_b)."""
-        a, b, _, _ = self.axes()
-        if self.parametrisation == "alphax_alphay":
-            ax, ay = np.meshgrid(a, b, indexing="ij")
-        else:
-            ax, ay = np.meshgrid(a, b, indexing="ij")
-            ay = ax * ay
-        return np.maximum(ax, ALPHA_FLOOR).astype(np.float32), np.maximum(ay, ALPHA_FLOOR).astype(np.float32)
-
-
-def fitted_texels(grid: Grid4) -> np.ndarray:
-    """The texels fitted (flat indices into (n_a, n_b, n_theta, n_phi)): alpha_x >= alpha_y, and phi = 0 alone at
-    theta = 0 (the symmetries of the module docstring)."""
-    ax, ay = grid.alphas()
-    idx = np.indices(grid.n).reshape(4, -1)
-    keep = (ax[idx[0], idx[1]] >= ay[idx[0], idx[1]]) & ((idx[2] > 0) | (idx[3] == 0))
-    return np.flatnonzero(keep)
-
-
 def fit_tile(nov, ax, ay, phi, magnitude, n_grid: int, device: str, frame: str) -> tuple[np.ndarray, ...]:
     """Fit one tile of texels: Nelder-Mead from the best of guesses() at lutbake.ltc.fit's COARSE_STEPS (0.5, 0.1,
     0.02), in the parameters the texel's lobe has (a symmetric one: ltc_code's (log m11, log m22, m13 / m11) and, frame
@@ -283,22 +248,42 @@ def fit_table(grid: Grid4, magnitude, n_grid=fit.LTC_FIT_GRID, device="cpu", wor
     """The tangent-frame, canonical M (n_a, n_b, n_theta, n_phi, 3, 3) and the relative fit error of every texel:
     fitted_texels in tiles of TILE (threads: ``workers``; each texel's fit reads only its own inputs, so the bits do
     not depend on the worker count), the others by the symmetries."""
+    args = fitted_inputs(grid, magnitude)
+    out = in_tiles(lambda t: fit_tile(*(a[t] for a in args), n_grid, device, frame), len(args[0]), workers)
+    return completed(grid, np.concatenate([o[0] for o in out]), np.concatenate([o[2] for o in out]))
+
+
+def fitted_inputs(grid: Grid4, magnitude: np.ndarray) -> tuple[np.ndarray, ...]:
+    """(n.v float32, alpha_x, alpha_y, phi, magnitude) of the fitted_texels, in their order."""
     ax2, ay2 = grid.alphas()
     _, _, theta, phi = grid.axes()
-    idx = np.indices(grid.n).reshape(4, -1)
     todo = fitted_texels(grid)
-    i, j, k, m = idx[:, todo]
-    nov = np.cos(theta[k]).astype(np.float32)
-    args = (nov, ax2[i, j], ay2[i, j], phi[m], magnitude.reshape(-1)[todo])
-    tiles = [slice(s, s + TILE) for s in range(0, len(todo), TILE)]
+    i, j, k, m = np.indices(grid.n).reshape(4, -1)[:, todo]
+    return np.cos(theta[k]).astype(np.float32), ax2[i, j], ay2[i, j], phi[m], magnitude.reshape(-1)[todo]
+
+
+def in_tiles(run, n: int, workers: int) -> list:
+    """run(slice) over [0, n) in tiles of TILE on ``workers`` threads, in order (tiles fixed: the same bits for any
+    worker count)."""
+    tiles = [slice(s, s + TILE) for s in range(0, n, TILE)]
     with ThreadPoolExecutor(max(1, workers)) as pool:
-        out = list(pool.map(lambda t: fit_tile(*(a[t] for a in args), n_grid, device, frame), tiles))
-    mats = np.concatenate([o[0] for o in out])
-    rel = np.concatenate([o[2] for o in out])
+        return list(pool.map(run, tiles))
+
+
+def completed(grid: Grid4, mats: np.ndarray, rel: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The table (tangent-frame canonical M, relative error) from the view-frame M and errors of the fitted_texels, the
+    other texels by the symmetries (module docstring)."""
+    ax2, ay2 = grid.alphas()
+    _, _, _, phi = grid.axes()
+    i, j, k, m = np.indices(grid.n).reshape(4, -1)[:, fitted_texels(grid)]
     full = np.full((*grid.n, 3, 3), np.nan)
     err = np.full(grid.n, np.nan)
     full[i, j, k, m] = canonical(rotate_z(mats, phi[m]))
     err[i, j, k, m] = rel
+    a, b = np.nonzero(ax2 == ay2)  # isotropic: one view-frame M for every phi (fitted at phi = 0)
+    for p in range(1, grid.n[3]):
+        full[a, b, :, p] = canonical(rotate_z(full[a, b, :, 0].reshape(-1, 3, 3), phi[p])).reshape(len(a), -1, 3, 3)
+        err[a, b, :, p] = err[a, b, :, 0]
     full[:, :, 0, :] = full[:, :, 0, :1]  # theta = 0: one M for every phi (tangent frame)
     err[:, :, 0, :] = err[:, :, 0, :1]
     if grid.parametrisation == "alphax_alphay":  # alpha_x < alpha_y: S M(alpha_y, alpha_x, pi/2 - phi) S
@@ -310,23 +295,29 @@ def fit_table(grid: Grid4, magnitude, n_grid=fit.LTC_FIT_GRID, device="cpu", wor
     return full, err
 
 
-MAGNITUDE_SAMPLES = 1 << 16  # scrambled Sobol' points per anisotropic texel (bounded weights: spread ~1e-5)
-
-
-def magnitude_fresnel(grid: Grid4, samples: int = MAGNITUDE_SAMPLES, device: str = "cpu", seed: int = 0):
-    """(magnitude, fresnel) (n_a, n_b, n_theta, n_phi): ∫ f (n.l) dω and ∫ f (1 - v.h)^5 (n.l) dω, F = 1. Texels with
+def magnitude_fresnel(
+    grid: Grid4,
+    samples: int = MAGNITUDE_SAMPLES,
+    device: str = "cpu",
+    seed: int = 0,
+    texels: np.ndarray | None = None,
+    estimator: str = "sobol",
+):
+    """(magnitude, fresnel) (n_a, n_b, n_theta, n_phi), or (k,) at flat ``texels``: ∫ f (n.l) dω and
+    ∫ f (1 - v.h)^5 (n.l) dω, F = 1. Texels with
     alpha_x = alpha_y: the isotropic ltc kind's integrals (lutbake.ltc.magnitude: Gauss-Legendre, exact; they do not
     depend on phi); the others: the specular_aniso kind's integrand (lutbake.integrands.anisotropic, the
     ``multiscatter`` channels (Fc, 1)) and estimator at the texel's fixed view azimuth
     (lutbake.sampling.anisotropic.AnisoSobol:
-    anisotropic VNDF sampling, weight G2 / G1 <= 1)."""
+    anisotropic VNDF sampling, weight G2 / G1 <= 1); ``estimator = "sobol_cosine"``: its cosine-weighted l instead (a
+    second estimator of the anisotropic texels, independent of the lobe's sampler)."""
     from ..integrands.anisotropic import aniso_integrand
     from ..sampling.anisotropic import AnisoSobol
     from .magnitude import magnitude_fresnel as isotropic
 
     ax2, ay2 = grid.alphas()
     _, _, theta, phi = grid.axes()
-    i, j, k, m = np.indices(grid.n).reshape(4, -1)
+    i, j, k, m = np.indices(grid.n).reshape(4, -1)[:, slice(None) if texels is None else texels]
     nov = np.cos(theta[k]).astype(np.float32)
     ax, ay = ax2[i, j], ay2[i, j]
     mag, fres = np.zeros(len(nov)), np.zeros(len(nov))
@@ -334,12 +325,12 @@ def magnitude_fresnel(grid: Grid4, samples: int = MAGNITUDE_SAMPLES, device: str
     if iso.any():
         mag[iso], fres[iso] = isotropic("ggx", nov[iso], ax[iso], None, device)
     if (~iso).any():
-        est, integrand = AnisoSobol("sobol", samples, seed), aniso_integrand("microfacet", "multiscatter")
+        est, integrand = AnisoSobol(estimator, samples, seed), aniso_integrand("microfacet", "multiscatter")
         inputs = {"nov": nov[~iso], "alpha_x": ax[~iso], "alpha_y": ay[~iso], "phi_v": phi[m][~iso].astype(np.float32)}
         est.prepare(integrand, device)
         out = est.evaluate(integrand, inputs, device)
         fres[~iso], mag[~iso] = out[:, 0], out[:, 1]
-    return mag.reshape(grid.n), fres.reshape(grid.n)
+    return (mag.reshape(grid.n), fres.reshape(grid.n)) if texels is None else (mag, fres)
 
 
 def relative_error_of(grid: Grid4, magnitude: np.ndarray, m: np.ndarray, texels: np.ndarray, n_grid=fit.LTC_FIT_GRID):

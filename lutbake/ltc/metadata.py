@@ -80,9 +80,10 @@ def tabulation_record(lb) -> dict:
     }
 
 
-def fit_error_stats(data: np.ndarray) -> dict[str, str]:
-    """The lutbake:fit_error_* attributes: statistics of slice 1's z channel (relative L3 error per texel)."""
-    e = np.asarray(data)[1, ..., 2].ravel()
+def fit_error_stats(data: np.ndarray, where: tuple[int, int] = (1, 2)) -> dict[str, str]:
+    """The lutbake:fit_error_* attributes: statistics of the relative L3 error per texel, channel ``where[1]`` of
+    slice ``where[0]`` (the ltc kind: slice 1's z; ltc_aniso: slice 2's w)."""
+    e = np.asarray(data)[where[0], ..., where[1]].ravel()
     return {
         "fit_error_max": f"{e.max():.4g}",
         "fit_error_median": f"{np.median(e):.4g}",
