@@ -39,6 +39,7 @@ The signatures (float = float32 in the kernels; n = +z in the shading frame):
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import importlib
 import importlib.metadata
 import inspect
@@ -96,9 +97,9 @@ def _add(family, func, name: str, description: str, citation: str, aliases, fiel
     plugin, line = _caller_plugin(func)
     record = Record(family.name, name, description.strip(), citation, tuple(aliases), fields, plugin, line)
     family.add(record)
-    for bucket in (_STATE.__dict__.get("added"), _STATE.__dict__.get("collect")):
-        if bucket is not None:
-            bucket.append(record)
+    added = _STATE.__dict__.get("added")
+    if added is not None:
+        added.append(record)
     return record
 
 
@@ -146,7 +147,9 @@ def register_ndf(
         t2u, u2t, pdf = theta_cdf()
     lam = None if Lambda is None else _need_func("Lambda", Lambda)
     d = Distribution(name, _need_func("D", D), lam, t2u, u2t, polar_pdf=pdf)
-    fields = {"obj": d, "smith": lam is not None, "vndf": False, "sampler": sampler}
+    # the terms beside their Distribution, as lutbake's NDF records carry them (lutbake.records)
+    terms = {"D": d.D, "Lambda": lam, "tan2_from_u": t2u, "u_from_tan2": u2t}
+    fields = {"obj": d, **terms, "smith": lam is not None, "vndf": False, "sampler": sampler}
     return _add(NDF, D, name, description, citation, aliases, fields)
 
 
@@ -173,7 +176,7 @@ def register_brdf(
         raise RegistryError(f"roughness {roughness!r}: one of {', '.join(ROUGHNESS)}")
     plugin, _ = _caller_plugin(f_cos)
     lobe = custom_lobe(name, _need_func("f_cos", f_cos), roughness, plugin.sha256)
-    return _add(LTC_LOBE, f_cos, name, description, citation, aliases, {"obj": lobe})
+    return _add(LTC_LOBE, f_cos, name, description, citation, aliases, {"obj": lobe, "f_cos": f_cos})
 
 
 # ---------------------------------------------------------------------------------------------- loading plugins
@@ -181,11 +184,17 @@ def register_brdf(
 
 @contextlib.contextmanager
 def _running(plugin: Plugin):
-    """Records registered inside belong to ``plugin``; yields the list they are added to."""
+    """Records registered inside belong to ``plugin``; yields the list they are added to. If the block raises, they
+    are unregistered again: a plugin that fails leaves no record."""
     outer = getattr(_STATE, "plugin", None), _STATE.__dict__.get("added")
-    _STATE.plugin, _STATE.added = plugin, []
+    added: list[Record] = []
+    _STATE.plugin, _STATE.added = plugin, added
     try:
-        yield _STATE.added
+        yield added
+    except BaseException:
+        for record in added:
+            FAMILIES[record.family].remove(record)
+        raise
     finally:
         _STATE.plugin, _STATE.added = outer
 
@@ -204,7 +213,8 @@ def _failure_line(path: str, e: BaseException) -> int | None:
 
 def _execute(plugin: Plugin) -> list[Record]:
     """Run a plugin's text as the module ``plugin.module`` (its source served from the text, so what runs and
-    compiles is what was hashed); the records it registers; PluginError naming the line on any failure."""
+    compiles is what was hashed) and compile its terms; the records it registers. PluginError naming the line on any
+    failure; nothing stays registered then."""
     lines = plugin.text.splitlines(True)
     linecache.cache[plugin.path] = (len(plugin.text), None, lines, plugin.path)  # mtime None: never reloaded
     module = type(sys)(plugin.module)
@@ -218,8 +228,9 @@ def _execute(plugin: Plugin) -> list[Record]:
         except Exception as e:
             where = _failure_line(plugin.path, e)
             raise PluginError(plugin.path, where, f"cannot be imported: {type(e).__name__}: {e}") from None
-    if not added:
-        raise PluginError(plugin.path, None, "registers nothing (call lutbake.register_fresnel, register_ndf, ...)")
+        if not added:
+            raise PluginError(plugin.path, None, "registers nothing (call lutbake.register_fresnel, register_ndf, ...)")
+        compile_records(added)
     return added
 
 
@@ -235,35 +246,11 @@ def load_plugin(path) -> list[Record]:
         held = _LOADED.get(str(path))
         if held is not None and held.text == text:
             return [r for fam in (FRESNEL, NDF, DIFFUSE, LTC_LOBE) for r in fam if r.plugin == held]
-        plugin = Plugin(str(path), text, "")
-        plugin = Plugin(str(path), text, _module_name(str(path), plugin.sha256))
-        records = _load(plugin)
+        sha = hashlib.sha256(text.encode()).hexdigest()
+        plugin = Plugin(str(path), text, _module_name(str(path), sha))
+        records = _execute(plugin)
         _LOADED[str(path)] = plugin
         return records
-
-
-def _load(plugin: Plugin) -> list[Record]:
-    """Run and compile a plugin; on any failure no record of it stays registered."""
-    with _rolled_back() as added:
-        _execute(plugin)
-        compile_records(added)
-    return added
-
-
-@contextlib.contextmanager
-def _rolled_back():
-    """Collect the records registered inside; if the block raises, unregister them (and re-raise)."""
-    added: list[Record] = []
-    outer = _STATE.__dict__.get("collect")
-    _STATE.collect = added
-    try:
-        yield added
-    except BaseException:
-        for record in added:
-            FAMILIES[record.family].remove(record)
-        raise
-    finally:
-        _STATE.collect = outer
 
 
 def _ship_loader(plugin: Plugin) -> None:
@@ -300,7 +287,7 @@ def load_entry_points() -> list[Record]:
             origin = spec.origin if spec is not None and spec.origin else f"module {module}"
             text = Path(origin).read_text(encoding="utf-8") if Path(origin).is_file() else ""
             plugin = Plugin(origin, text, module)
-            with _rolled_back() as added, _running(plugin):
+            with _running(plugin) as added:
                 try:
                     ep.load()
                 except RegistryError as e:

@@ -108,8 +108,12 @@ class Record:
         out = {"family": self.family, "name": self.name, "origin": self.origin}
         if self.plugin is not None:
             out.update(sha256=self.plugin.sha256, line=str(self.line))
-            functions = [getattr(v, "key", getattr(v, "__name__", None)) for v in self.fields.values()]
-            out["functions"] = ", ".join(str(f) for f in functions if isinstance(f, str))
+            mine = [
+                v
+                for v in self.fields.values()
+                if getattr(getattr(v, "func", None), "__module__", 0) == self.plugin.module
+            ]
+            out["functions"] = ", ".join(v.key for v in mine)  # the plugin's own @wp.funcs (not lutbake's defaults)
         return out
 
     def __reduce__(self):
