@@ -24,6 +24,7 @@ others. It is recorded in every file lutbake writes (``face_convention``).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -123,9 +124,11 @@ def texel_centres(n: int) -> np.ndarray:
     return d / np.linalg.norm(d, axis=-1, keepdims=True)
 
 
+@functools.lru_cache(maxsize=4)
 def texel_planes(n: int) -> np.ndarray:
     """(6, n, n, 4, 3) the inward unit normals of the four great circles that bound each texel: its footprint is the
-    set of directions l with p . l >= 0 for all four (a convex spherical quadrilateral)."""
+    set of directions l with p . l >= 0 for all four (a convex spherical quadrilateral). Cached per n (every tile of
+    a mip reads it), read-only."""
     e = texel_edges(n)
     v0, u0 = np.meshgrid(e[:-1], e[:-1], indexing="ij")
     v1, u1 = v0 + 2.0 / n, u0 + 2.0 / n
@@ -138,4 +141,6 @@ def texel_planes(n: int) -> np.ndarray:
         p /= np.linalg.norm(p, axis=-1, keepdims=True)
         p *= np.sign(np.sum(p * centre, axis=-1, keepdims=True))  # inward: the centre lies on the positive side
         planes.append(p)
-    return np.stack(planes, axis=-2)
+    out = np.stack(planes, axis=-2)
+    out.flags.writeable = False
+    return out

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import warp as wp
 
 from ..terms.ndf import D_ggx
@@ -65,3 +66,25 @@ def lobe_width(lobe: str, alpha: float) -> float:
     if lobe in ("ggx_nl", "ggx"):
         return 2.0 * math.atan(alpha)
     return math.pi / 3 if lobe == "cosine" else 0.0
+
+
+def _ggx_profile(t: np.ndarray, alpha: float) -> np.ndarray:
+    """D_ggx(h) / 4 as a function of t = r.l (n = v = r: cos^2 theta_h = (1 + t) / 2), Walter et al. 2007 Eq. 33."""
+    a2 = alpha * alpha
+    return a2 / (math.pi * ((1 + t) / 2 * (a2 - 1) + 1) ** 2) / 4
+
+
+# name -> the zonal weight k(t, alpha), t = r.l, zero behind the horizon: the same weights as LOBES, in numpy, for
+# the spherical-harmonic prefilter (lutbake.environment.harmonic)
+PROFILES = {
+    "ggx_nl": lambda t, alpha: np.where(t > 0, _ggx_profile(t, alpha) * t, 0.0),
+    "ggx": lambda t, alpha: np.where(t > 0, _ggx_profile(t, alpha), 0.0),
+    "cosine": lambda t, alpha: np.maximum(t, 0.0),
+}
+# the same weights without the horizon's cut (smooth on [-1, 1]): how fast their coefficients fall says how wide
+# the lobe is; the cut's kink adds a tail that falls like l^-5/2 (lutbake.environment.harmonic.LMAX_FLOOR)
+SMOOTH_PROFILES = {
+    "ggx_nl": lambda t, alpha: _ggx_profile(t, alpha) * t,
+    "ggx": _ggx_profile,
+    "cosine": lambda t, alpha: t,
+}

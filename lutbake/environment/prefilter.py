@@ -20,6 +20,7 @@ max over probes and channels of |P - P_finer| / max(P_finer, max over the mip's 
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -34,6 +35,7 @@ from .quadrature import OUT_WIDTH, integrate, texel_kernel
 PROBES = 96  # probe texels per mip of the error estimate
 COARSE_TAU = 3.0  # the first pass, whose value each texel's contrast budget is measured against
 TILE_TEXELS = 64  # texels per tile: a texel integrates thousands of leaves, so tiles stay small enough to share
+FOOTPRINT_TILE_TEXELS = 4096  # a footprint texel integrates tens of leaves: larger tiles, less Python per texel
 MAX_SUB_LEVELS = 12  # sub-texel levels below the source (a cell 1/4096 of a source texel)
 
 
@@ -66,6 +68,18 @@ class CubeTexels:
     @property
     def n(self) -> int:
         return len(self.dirs)
+
+    def select(self, mips: list[int]) -> CubeTexels:
+        """The texels of mips ``mips`` only (in that order)."""
+        parts = [self.dirs[self.offsets[m] : self.offsets[m + 1]] for m in mips]
+        counts = [len(p) for p in parts]
+        return CubeTexels(
+            tuple(self.sizes[m] for m in mips),
+            tuple(self.lobes[m] for m in mips),
+            tuple(self.alphas[m] for m in mips),
+            np.concatenate(parts) if parts else np.zeros((0, 3)),
+            tuple(np.concatenate([[0], np.cumsum(counts)]).astype(int).tolist()),
+        )
 
     def mip_of(self, start: int, stop: int) -> list[tuple[int, int, int]]:
         """(mip, first, last + 1) of the mips that texels [start, stop) cross."""
@@ -113,6 +127,8 @@ def mip_values(pyr: Pyramid, texels: CubeTexels, m: int, idx: np.ndarray, qualit
         "device": device,
     }
     inputs = (pyr, lobe, dirs, planes, np.full(len(idx), alpha), np.full(len(idx), lam))
+    if lobe == "footprint":  # its cells fix by geometry alone (slope 0; a cut cell takes the source): no first pass
+        return integrate(*inputs, tau=quality.tau, **common)
     coarse = integrate(*inputs, tau=COARSE_TAU, **common)
     reference = coarse[:, :3] / coarse[:, 3:4]
     return integrate(*inputs, reference, tau=quality.tau, **common)
@@ -146,7 +162,7 @@ def cube_plan(pyr: Pyramid, texels: CubeTexels, quality: Quality = Quality()) ->
         terms={"lobes": ",".join(texels.lobes)},
         cost=float(texels.n),
         aux_channels=OUT_WIDTH - 3,
-        tile_texels=TILE_TEXELS,
+        tile_texels=FOOTPRINT_TILE_TEXELS if set(texels.lobes) == {"footprint"} else TILE_TEXELS,
     )
 
 
@@ -172,7 +188,8 @@ def error_estimates(pyr: Pyramid, texels: CubeTexels, values: np.ndarray, qualit
 @dataclass(frozen=True)
 class Baked:
     """A baked cube: ``mips[m]`` (6, n, n, 3) float64 (face, row t, column s, rgb), the roughness and alpha per mip,
-    the estimated relative error per mip, the leaves integrated per texel (mean, per mip)."""
+    the method of each mip (``quadrature`` or ``harmonic``), the estimated relative error per mip, the leaves the
+    quadrature integrated per texel (mean, per mip; 0 for a harmonic mip) and the harmonics' lmax (0: none)."""
 
     mips: list[np.ndarray]
     roughness: list[float]
@@ -180,6 +197,11 @@ class Baked:
     lobes: list[str]
     errors: list[float]
     leaves: list[float]
+    methods: list[str]
+    lmax: int
+
+
+METHODS = ("auto", "quadrature", "harmonic")
 
 
 def bake_cube(
@@ -191,16 +213,42 @@ def bake_cube(
     workers: int | None = None,
     device: str = "cpu",
     estimate: bool = True,
+    method: str = "auto",
 ) -> Baked:
     """The prefiltered cube of ``size``^2 faces with one mip per entry of ``roughness`` (perceptual): r = 0 is the
     area average (lobe ``footprint``), r > 0 lobe ``lobe`` at alpha = r^2. ``lobe = "cosine"``: every mip the
-    irradiance lobe (roughness ignored)."""
+    irradiance lobe (roughness ignored). ``method``: ``auto`` bakes every mip whose lobe allows it by spherical
+    harmonics (lutbake.environment.harmonic: exact convolution, seconds) and the others (the footprint, the
+    irradiance lobe, lobes narrower than its cap) by the pyramid quadrature; ``quadrature`` every mip by the
+    quadrature; ``harmonic`` refuses a mip the harmonics cannot bake."""
+    from . import harmonic
+
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {list(METHODS)}, got {method!r}")
     lobes = ["cosine" if lobe == "cosine" else "footprint" if r == 0 else lobe for r in roughness]
     alphas = [float(r) ** 2 for r in roughness]
     texels = cube_texels(size, lobes, alphas)
-    plan = cube_plan(pyr, texels, quality)
-    flat = execute_tiles(plan, workers=workers, device=device)
+    lmax, by_harmonics = harmonic.plan_lmax(lobes, alphas) if method != "quadrature" else (0, [False] * len(lobes))
+    if method == "harmonic" and not all(by_harmonics):
+        bad = [m for m, ok in enumerate(by_harmonics) if not ok]
+        raise ValueError(f"mips {bad} (lobes {[lobes[m] for m in bad]}) cannot be baked by harmonics; use 'auto'")
+    flat = np.zeros((texels.n, OUT_WIDTH))
+    quad = [m for m, h in enumerate(by_harmonics) if not h]
+    for group in ([m for m in quad if lobes[m] == "footprint"], [m for m in quad if lobes[m] != "footprint"]):
+        if group:  # the footprint mips in large tiles, the lobes' in small ones
+            sub = texels.select(group)
+            values = execute_tiles(cube_plan(pyr, sub, quality), workers=workers, device=device)
+            for j, m in enumerate(group):
+                flat[texels.offsets[m] : texels.offsets[m + 1]] = values[sub.offsets[j] : sub.offsets[j + 1]]
+    if any(by_harmonics):
+        threads = workers or os.cpu_count() or 1
+        h = harmonic.analyse(pyr.level(0), lmax, threads=threads)
+        for m in (m for m, ok in enumerate(by_harmonics) if ok):
+            g = harmonic.kernel_coefficients(lobes[m], alphas[m], lmax)
+            s, e = texels.offsets[m], texels.offsets[m + 1]
+            flat[s:e, :3] = harmonic.synthesise(h, g, texels.dirs[s:e], threads)
     mips = [flat[s:e, :3].reshape(6, n, n, 3) for n, s, e in zip(texels.sizes, texels.offsets, texels.offsets[1:])]
     leaves = [float(np.mean(flat[s:e, 4])) for s, e in zip(texels.offsets, texels.offsets[1:])]
     errors = error_estimates(pyr, texels, flat, quality, device) if estimate else []
-    return Baked(mips, list(roughness), alphas, lobes, errors, leaves)
+    methods = ["harmonic" if ok else "quadrature" for ok in by_harmonics]
+    return Baked(mips, list(roughness), alphas, lobes, errors, leaves, methods, lmax if any(by_harmonics) else 0)
