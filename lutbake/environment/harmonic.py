@@ -37,7 +37,6 @@ import numpy as np
 
 from .lobes import PROFILES, SMOOTH_PROFILES
 
-
 KERNEL_TAIL = 1e-10  # |g_l / g_0| past lmax: the truncation's share of P, before the source's contrast
 LMAX_FLOOR = 1023  # the horizon kink's g_l fall like l^-5/2: at 1023 the truncation is ~1e-5 of P (measured)
 LMAX_CAP = 1535  # the largest analysis: about 3 s on two cores for a 2048 x 1024 source
@@ -100,9 +99,7 @@ def kernel_coefficients(lobe: str, alpha: float, lmax: int, order: int = 8, smoo
     end = math.pi if smooth else math.pi / 2
     width = max(alpha, 1e-4)
     edges = np.unique(
-        np.concatenate(
-            [[0.0], np.geomspace(width * 1e-3, end, 256), np.linspace(0.0, end, 2 * lmax + 2)]
-        )
+        np.concatenate([[0.0], np.geomspace(width * 1e-3, end, 256), np.linspace(0.0, end, 2 * lmax + 2)])
     )
     x, wx = np.polynomial.legendre.leggauss(order)
     a, b = edges[:-1, None], edges[1:, None]
