@@ -199,8 +199,11 @@ def write_cube_table(table, path, fmt: str, dtype: str = "half") -> Path:
 # ------------------------------------------------------------------------------------------------- reading
 
 
-def _decoded(text: dict[str, str]) -> dict:
-    """The record from strings: JSON text of a list or an object decoded, the rest kept."""
+def _decoded(text: dict) -> dict:
+    """The record from strings: JSON text of a list or an object decoded, the rest kept (the provenance strings of a
+    KTX 2.0 record too: ``ibl``)."""
+    if not isinstance(text, dict):
+        raise ValueError("its lutbake record is not a JSON object")
     out = {}
     for k, v in text.items():
         if isinstance(v, str) and v[:1] in "[{":
@@ -282,7 +285,7 @@ def read_cube_record(path) -> dict:
             kvd = f.read(kvd_len)
         if len(kvd) != kvd_len:
             raise ValueError(f"{path}: the KTX2 key/value data runs past the file")
-        record = bounded.loads_json(_kv_pairs(kvd, 0, kvd_len).get("lutbake:metadata", "{}"))
+        record = _decoded(bounded.loads_json(_kv_pairs(kvd, 0, kvd_len).get("lutbake:metadata", "{}")))
         return _described(fmt, VK_NAMES.get(vk, f"vkFormat {vk}"), width, levels, record, "KTX2 key lutbake:metadata")
     if fmt == "dds":
         with open(path, "rb") as f:
