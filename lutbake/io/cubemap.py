@@ -231,7 +231,7 @@ def cube_kind(path) -> str | None:
     if head[:4] == b"\x76\x2f\x31\x01":
         try:
             return "exr" if _exr_parts(path)[0][0] == "mip_0" else None
-        except (ValueError, OSError, IndexError):
+        except Exception:  # noqa: BLE001 - any EXR OpenImageIO cannot list is no cube of lutbake's
             return None
     return None
 

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..textsafe import bounded as bounded_text
+from . import bounded
 from .readers import FORMAT_NAMES, NAME_CHARS, LoadedFile, ReadError, read, table_view
 
 PROVENANCE = ("terms", "estimator", "samples", "seed", "error_estimate", "version", "warp_version")
@@ -225,6 +226,34 @@ def describe_cube(path) -> str:
     return "\n".join(lines) + "\n"
 
 
+SH_KEYS = ("basis", "form", "coefficients")  # lutbake.kinds.environment's <name>_sh.json
+
+
+def _sh_document(path: Path) -> dict | None:
+    """The L2 SH document an irradiance table writes (``<name>_sh.json``), or None for any other file."""
+    if path.suffix != ".json" or not path.is_file():
+        return None
+    try:
+        doc = bounded.load_json(path)
+    except (ValueError, OSError, UnicodeDecodeError):
+        return None
+    return doc if isinstance(doc, dict) and all(k in doc for k in SH_KEYS) and "lutbake" not in doc else None
+
+
+def describe_sh(path: Path, doc: dict) -> str:
+    """What ``lutbake inspect`` prints for an irradiance table's SH document."""
+    lines = [str(path), "  format: L2 spherical harmonics (JSON) of an environment_irradiance table"]
+    lines += [f"  {k}: {_text(doc[k])}" for k in ("form", "form_meaning", "basis", "integration", "source") if k in doc]
+    lines.append(f"  source_sha256: {_text(doc.get('source_sha256', '?'))}")
+    coefficients = doc["coefficients"] if isinstance(doc["coefficients"], list) else []
+    lines.append(f"coefficients ({len(coefficients)} x RGB):")
+    lines += [f"  {k}: {_text(c)}" for k, c in enumerate(coefficients[:MAX_SH])]
+    return "\n".join(lines) + "\n"
+
+
+MAX_SH = 64  # coefficients listed (L2: 9)
+
+
 def describe(path) -> str:
     """The report ``lutbake inspect FILE`` prints (raises readers.ReadError, naming the file once); a cube file lutbake
     wrote, or its sidecar: describe_cube."""
@@ -234,6 +263,9 @@ def describe(path) -> str:
     for candidate in (path, path.with_name(path.name.removesuffix(".json"))):
         if cube_kind(candidate) is not None:
             return describe_cube(candidate)
+    sh = _sh_document(path)
+    if sh is not None:
+        return describe_sh(path, sh)
     loaded = read(path)
     lines = [str(path), f"  format: {FORMAT_NAMES[loaded.format]}, {_container(loaded)}"]
     if loaded.format == "report":

@@ -113,7 +113,9 @@ def _common() -> dict[str, Key]:
             "orientation",
             "str",
             "gl",
-            "the world direction each texel's lookup vector stands for (recorded as face_convention)",
+            "the world direction each texel's lookup vector stands for (recorded as face_convention): "
+            "d3d_left_handed for a shader that looks the cube up at (x, y, -z), as Bevy's environment_map.wgsl "
+            "(vec3(R.xy, -R.z)) and left-handed engines do",
             {name: o.doc for name, o in cube.ORIENTATIONS.items()},
         ),
         "tau": Key(
@@ -310,6 +312,11 @@ def specular_reconstruction(spec) -> str:
         "prefiltered = textureLod(cube, R, lod).rgb, R = reflect(-V, N); "
         "specular = prefiltered * (f0 * dfg.r + f90 * dfg.g) with the DFG table of the same roughness"
     )
+
+
+def reconstruction(spec) -> str:
+    """How a shader reads the cube of ``spec`` (either environment kind), before any engine's line."""
+    return specular_reconstruction(spec) if spec.kind == "environment_specular" else irradiance_reconstruction(spec)
 
 
 def irradiance_reconstruction(spec) -> str:
