@@ -148,6 +148,18 @@ def test_environment_fills_only_the_tables_that_take_it_with_the_path_made_absol
     assert {s.options["environment"] for s in specs[1:]} == {str(STUDIO)}
 
 
+def test_lutbake_bake_of_an_environment_config_writes_then_skips(tmp_path):
+    """examples/environment/studio.toml (its environment relative to itself) through the command line, at 8^2."""
+    example = DATA.parent.parent / "examples" / "environment" / "studio.toml"
+    args = ["bake", str(example), "--out-dir", str(tmp_path), "--set", "size=8"]
+    first = CliRunner().invoke(main, args)
+    assert first.exit_code == 0, first.output
+    assert "studio_specular.ktx2  6x8x8x3, 4 mips" in first.output and "samples/texel" not in first.output
+    again = CliRunner().invoke(main, args)
+    assert again.exit_code == 0 and "2 tables: 0 baked, 2 up to date, 0 failed" in again.output, again.output
+    assert json.loads((tmp_path / "studio_diffuse_sh.json").read_text())["form"] == "irradiance_over_pi"
+
+
 # --- the content hash: the environment's bytes -------------------------------------------------------------------
 
 
@@ -292,17 +304,25 @@ def test_cubes_are_bit_identical_for_one_or_two_workers():
     assert one.record == two.record and one.attributes["content_hash"] == two.attributes["content_hash"]
 
 
-def test_orientation_d3d_left_handed_is_the_gl_cube_of_the_z_mirrored_world(tmp_path):
-    """A lookup vector d stands for the world direction (d.x, d.y, -d.z): the d3d_left_handed cube of an environment
-    is the gl cube of that environment mirrored in z (its columns reversed)."""
-    image = read_latlong(SUNRISE).image
-    write_env(tmp_path / "mirrored.exr", image[:, ::-1])
-    base = {"name": "o", "kind": "environment_irradiance", "size": 4}
-    left, _ = bake_cube_table(
-        validate_table({**base, "environment": str(SUNRISE), "orientation": "d3d_left_handed"}, "<t>", 0)
-    )
-    gl, _ = bake_cube_table(validate_table({**base, "environment": str(tmp_path / "mirrored.exr")}, "<t>", 0))
-    np.testing.assert_array_equal(left.mips[0], gl.mips[0])
+HEMISPHERE_ATOL = 1e-6  # measured 2.2e-8: the source is exact (the z = 0 plane is a column edge), the rest quadrature
+
+
+@pytest.mark.parametrize("orientation, sign", [("gl", 1.0), ("d3d_left_handed", -1.0)])
+def test_the_irradiance_of_a_lit_hemisphere_is_its_closed_form_in_each_orientation(tmp_path, orientation, sign):
+    """L = 1 on the world's z > 0 half (the lat-long's columns u >= 1/2, exactly), 0 elsewhere: E / pi at a world
+    normal n is (1 + n_z) / 2. A texel's lookup vector d stands for the world direction d (gl) or (d.x, d.y, -d.z)
+    (d3d_left_handed, Bevy's vec3(N.xy, -N.z)), so its value is (1 + d_z) / 2, or (1 - d_z) / 2."""
+    from lutbake.environment import cube
+
+    image = np.zeros((32, 64, 3), np.float32)
+    image[:, 32:] = 1.0
+    write_env(tmp_path / "half.exr", image)
+    raw = {"name": "h", "kind": "environment_irradiance", "size": 4, "orientation": orientation}
+    baked, _ = bake_cube_table(validate_table({**raw, "environment": str(tmp_path / "half.exr")}, "<test>", 0))
+    d = cube.texel_centres(4).reshape(-1, 3)
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    want = np.repeat(((1 + sign * d[:, 2]) / 2)[:, None], 3, axis=1)
+    np.testing.assert_allclose(baked.mips[0].reshape(-1, 3), want, rtol=0, atol=HEMISPHERE_ATOL)
 
 
 def test_a_failing_environment_table_leaves_every_other_output_as_it_was(baked, tmp_path, monkeypatch):

@@ -49,6 +49,8 @@ def bake_environment(
 ) -> dict[str, Path]:
     """Bake and write ``<name>_specular``, ``<name>_diffuse`` (cubes) and ``<name>_diffuse_sh.json``; returns the
     paths {"specular", "diffuse", "sh"}. ``fmt``: ktx2, dds or exr (default: the engine's)."""
+    if quality.extra_levels:
+        raise ValueError("quality.extra_levels is no key of the environment kinds (tau, k_geo, order are)")
     keys = engine_keys(engine)
     common = {
         "environment": os.path.abspath(source),
