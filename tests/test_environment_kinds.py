@@ -345,6 +345,16 @@ def test_a_failing_environment_table_leaves_every_other_output_as_it_was(baked, 
     assert (copy / "dfg.exr").is_file()
 
 
+@pytest.mark.parametrize("fmt", ["ktx2", "dds", "exr"])
+def test_a_cube_half_cannot_hold_writes_no_file_of_its_unit(tmp_path, fmt):
+    from lutbake.io.cubemap import write_cube
+
+    mips = [np.full((6, 2, 2, 3), 1.0), np.full((6, 1, 1, 3), 7e4)]  # 7e4 > 65504, half's largest
+    with pytest.raises(ValueError, match="past what half holds"):
+        write_cube(mips, tmp_path / f"c.{fmt}", {}, fmt, "half", {"c_sh.json": b"{}"})
+    assert not any(tmp_path.iterdir())
+
+
 def test_every_file_of_the_batch_is_written_and_listed(baked):
     _, out, results = baked
     assert statuses(results) == {"spec": "baked", "irr": "baked", "spec_dds": "baked"}

@@ -150,15 +150,21 @@ def write_cube(
         raise ValueError(f"cube format must be ktx2, dds or exr, got {fmt!r}")
     path = Path(path)
     text = _as_text(metadata)
+    levels = rgba(mips, dtype)  # every value checked before any file of the unit is touched
+    data = b""  # an EXR is written part by part below
+    if fmt == "ktx2":
+        data = encode_ktx2_cube(mips, metadata, dtype)
+    elif fmt == "dds":
+        data = encode_dds_cube(mips, dtype)
     with unit_lock(path):
-        digests = {name: atomic_write_bytes_hashed(path.with_name(name), data) for name, data in (files or {}).items()}
+        digests = {name: atomic_write_bytes_hashed(path.with_name(name), blob) for name, blob in (files or {}).items()}
         if fmt == "exr":
             from .exr import EXR_TYPES, _write_oiio
 
             attrs = {**text, "files_sha256": json.dumps(digests, sort_keys=True), HASH_KEY: PLACEHOLDER.decode()}
             parts = [
                 (f"mip_{m}", attrs, np.ascontiguousarray(a[..., :3].reshape(-1, a.shape[2], 3)))
-                for m, a in enumerate(rgba(mips, dtype))
+                for m, a in enumerate(levels)
             ]
 
             def write(tmp):
@@ -166,7 +172,6 @@ def write_cube(
                 seal_exr(tmp)
 
             return atomic_write(path, write)
-        data = encode_ktx2_cube(mips, metadata, dtype) if fmt == "ktx2" else encode_dds_cube(mips, dtype)
         digests[path.name] = atomic_write_bytes_hashed(path, data)
         write_sidecar(path, CUBE_FORMATS[fmt], text, digests, {"files": sorted(digests)})
         return path
