@@ -13,10 +13,10 @@ from pathlib import Path
 
 from . import arguments, batch, pipeline, preflight
 from .config import TableSpec, load_configs, validate_spec
-from .errors import ConfigError, TableError
+from .errors import ArgumentError, ConfigError, TableError
 from .pipeline import OVER_TOLERANCE
 from .runtime.executor import Progress
-from .table import Table
+from .table import CubeTable, Table
 from .values_cache import open_cache
 
 __all__ = ["BakeResult", "BakeResults", "bake", "bake_table"]
@@ -30,7 +30,7 @@ class BakeResult:
     (``message``), and the table whose computation its values came from (``values_from``)."""
 
     spec: TableSpec
-    table: Table | None
+    table: Table | CubeTable | None
     path: Path | None
     seconds: float
     samples: int | None
@@ -97,11 +97,15 @@ def _result(job: batch.Job) -> BakeResult:
 
 def bake_table(spec: TableSpec, workers: int | None = None, device: str = "cpu", progress=None, **options):
     """Bake one spec into a Table, nothing written: (table, seconds, samples per texel) (lutbake.pipeline.bake_table;
-    ``options``: ``cancel``, ``runner``). ``spec`` is checked as its config would be (lutbake.config.validate_spec):
-    ConfigError for a wrong input, before any kernel runs."""
+    ``options``: ``cancel``, ``runner``); an environment kind's spec into its CubeTable: (cube, seconds, None).
+    ``spec`` is checked as its config would be (lutbake.config.validate_spec): ConfigError for a wrong input, before
+    any kernel runs."""
     spec = validate_spec(spec, "bake_table")
     arguments.workers_arg("bake_table", workers)
     arguments.device_arg("bake_table", device)
+    if pipeline.baked_whole(spec):  # an environment cube: (CubeTable, seconds, None)
+        cube, seconds = pipeline.bake_cube_table(spec, workers, device, progress, options.get("cancel"))
+        return cube, seconds, None
     return pipeline.bake_table(spec, workers, device, progress, **options)
 
 
@@ -120,15 +124,18 @@ def _check_arguments(out_dir, workers, device, flags: dict, callbacks: dict, cac
     arguments.text_arg("bake", "scheduler", scheduler, "'local:N' or a Dask address")
 
 
-def _specs(configs, overrides, fmt) -> tuple[list[TableSpec], list[Path]]:
-    """(every spec of the batch, the config paths): TableSpecs checked as a config's (validate_spec), paths loaded."""
+def _specs(configs, overrides, fmt, environment=None) -> tuple[list[TableSpec], list[Path]]:
+    """(every spec of the batch, the config paths): TableSpecs checked as a config's (validate_spec), paths loaded
+    (``environment``: the file of their environment tables, lutbake.config.load_configs)."""
     items = arguments.configs_arg("bake", "configs", configs, (TableSpec,), f"{arguments.PATH} or a TableSpec")
     overrides = arguments.overrides_arg("bake", overrides)
     if fmt is not None:
         overrides = overrides + [(None, "format", fmt, "--format")]
     specs = [validate_spec(c) for c in items if isinstance(c, TableSpec)]
     paths = [c for c in items if not isinstance(c, TableSpec)]
-    return specs + (load_configs(paths, overrides) if paths else []), paths
+    if environment is not None and not paths:
+        raise ArgumentError("bake", "environment", environment, "None when configs are TableSpecs (set their option)")
+    return specs + (load_configs(paths, overrides, environment) if paths else []), paths
 
 
 def _check_device(device: str, scheduler: str | None) -> None:
@@ -160,6 +167,7 @@ def bake(
     report=None,
     on_schedule=None,
     check: bool = True,
+    environment=None,
 ) -> BakeResults:
     """Validate every config, then bake each table and write ``out_dir/<name>.<ext>`` (key ``format``, default
     EXR) atomically; a table whose output is up to date (same content hash, lutbake.provenance) is skipped unless
@@ -189,14 +197,19 @@ def bake(
         scheduler,
         report,
     )
-    specs, paths = _specs(configs, overrides, fmt)
+    specs, paths = _specs(configs, overrides, fmt, environment)
     _check_device(device, scheduler)
     results = BakeResults()
     if not write:
         for spec in specs:
-            table, seconds, samples = pipeline.bake_table(spec, workers, device, progress)
-            over = table.attributes.get(OVER_TOLERANCE, "")
-            results.append(BakeResult(spec, table, None, seconds, samples, "over_tolerance" if over else "baked", over))
+            if pipeline.baked_whole(spec):
+                cube, seconds = pipeline.bake_cube_table(spec, workers, device, progress)
+                results.append(BakeResult(spec, cube, None, seconds, None, "baked", "", shape=cube.shape))
+            else:
+                table, seconds, samples = pipeline.bake_table(spec, workers, device, progress)
+                over = table.attributes.get(OVER_TOLERANCE, "")
+                status = "over_tolerance" if over else "baked"
+                results.append(BakeResult(spec, table, None, seconds, samples, status, over))
             if on_result:
                 on_result(results[-1])
         return results

@@ -11,6 +11,8 @@
 - **Compute once, write many.** Pending tables with the same values key (lutbake.sharing: same kind and options
   but for name and the kind's layout keys, e.g. one LTC fit written as DDS, JS and C) are computed once and
   written each in its own layout; the files are those each table gets baked alone.
+- **Cubes.** A kind baked whole (the environment cubes, lutbake.kinds.environment) is baked by its kind and written
+  by lutbake.io.cubemap; its content hash covers its environment file, and --cache holds no cube.
 - **Over tolerance.** A table whose texels end over their tolerance (the adaptive rule's last order reached; the
   plan says where: lutbake.tolerance.over_tolerance, lutbake:over_tolerance in the file) is written and marked
   ``over_tolerance``, with a message naming its texels and the worst estimate / tolerance, also when it is up to
@@ -41,7 +43,7 @@ from .errors import LutbakeError
 from .io.atomic import atomic_write_bytes, remove_stale_temps
 from .io.formats import output_path, write_table
 from .io.oserror import os_error_text
-from .pipeline import OVER_TOLERANCE, Computed, assemble, compute, plan_of
+from .pipeline import OVER_TOLERANCE, Computed, assemble, bake_cube_table, baked_whole, compute, plan_of
 from .provenance import HASH_ATTRIBUTE, content_hash, read_header
 from .runtime.executor import Cancelled, Progress, default_workers
 from .runtime.plan import TexelPlan
@@ -230,6 +232,8 @@ def _compute_and_write(group: list[Job], workers, device, progress, cancel, cach
     plan, or take them from ``cache``, then assemble and write each job's table in its own layout; any failure is
     recorded on the jobs it concerns, never raised."""
     lead = group[0]
+    if baked_whole(lead.spec):
+        return [_bake_cube(job, workers, device, progress, cancel) for job in group]
     t0 = time.perf_counter()
     try:
         if cancel.is_set():
@@ -285,6 +289,30 @@ def _write_one(job: Job, computed: Computed, values_from: str | None, cancel: th
     job.error_estimate = _float_or_none(table.attributes.get("error_estimate"))
     job.shape = "x".join(str(a.count) for a in table.axes) + f"x{len(table.channels)}"
     job.check_tolerance(table.attributes)
+
+
+def _bake_cube(job: Job, workers, device, progress, cancel: threading.Event) -> Job:
+    """Bake and write the cube of ``job``, a kind baked whole (lutbake.pipeline.bake_cube_table; its name is part of
+    its values, so it is alone in its group, and no --cache entry holds it); any failure is recorded on the job,
+    never raised, and leaves every file as it was (atomic writes: an older cube stays)."""
+    from .io.cubemap import write_cube_table
+
+    t0 = time.perf_counter()
+    try:
+        cube, seconds = bake_cube_table(job.spec, workers, device, progress, cancel)
+        if cube.attributes.get(HASH_ATTRIBUTE) != job.content_hash:  # the environment or the sources changed meanwhile
+            raise RuntimeError("its environment file or lutbake's sources changed while the batch ran; run it again")
+        if cancel.is_set():
+            raise Cancelled(job.name)
+        write_cube_table(cube, job.path, job.spec.options["format"], job.spec.options["dtype"])
+    except Exception as e:
+        _record_failure(job, e)
+        job.seconds = time.perf_counter() - t0
+        return job
+    errors = cube.record.get("error_estimate_per_mip") or []
+    job.status, job.table, job.seconds, job.shape = "baked", cube, seconds, cube.shape
+    job.error_estimate = max(errors) if errors else None
+    return job
 
 
 def run(

@@ -387,11 +387,33 @@ def parse_overrides(items: tuple[str, ...] | list[str]) -> list[tuple[str | None
     return out
 
 
-def load_config(path, overrides=()) -> list[TableSpec]:
+ENVIRONMENT_KEY = "environment"  # the key --environment fills (lutbake.kinds.environment)
+ENVIRONMENT_OPTION = "--environment"
+
+
+def environment_override(function: str, environment) -> list[tuple]:
+    """``--environment FILE`` as an override of key ``environment`` in every table whose kind has it (the environment
+    kinds; a preset names no file of its own): the path made absolute, so it is the file the user named however the
+    config's folder resolves it. [] when None."""
+    path = arguments.path_arg(function, "environment", environment, optional=True)
+    return [] if path is None else [(ENVIRONMENT_KEY, os.path.abspath(path), ENVIRONMENT_OPTION)]
+
+
+def takes_environment(raw: Mapping) -> bool:
+    """Whether a raw [[table]]'s kind (a known one) has the key ``environment``."""
+    try:
+        return ENVIRONMENT_KEY in lookup_kind(raw.get("kind")).keys
+    except (KeyError, TypeError):
+        return False
+
+
+def load_config(path, overrides=(), environment=None) -> list[TableSpec]:
     """Read and validate one TOML config; ``overrides`` (``--set`` texts, or parse_overrides() tuples) are applied
-    first. ConfigError for every wrong input (ArgumentError for an argument of the wrong type)."""
+    first. ``environment``: the file key ``environment`` names in every table that has it (``--environment``, the
+    environment kinds'). ConfigError for every wrong input (ArgumentError for an argument of the wrong type)."""
     path = arguments.path_arg("load_config", "path", path)
     overrides = _overrides("load_config", overrides)
+    fills = environment_override("load_config", environment)
     problem = config_file_problem(path)
     if problem:
         raise ConfigError(path, None, message=problem)
@@ -424,6 +446,8 @@ def load_config(path, overrides=()) -> list[TableSpec]:
             if table is None or table == raw.get("name"):
                 raw[key] = value
                 origin[key] = where[0] if where else f"--set {table + '.' if table else ''}{key}={_toml_value(value)}"
+        for key, value, where in fills if takes_environment(raw) else ():
+            raw[key], origin[key] = value, where
         try:
             specs.append(validate_table(raw, path, i))
         except ConfigError as e:
@@ -448,16 +472,18 @@ def load_plugins(config: Path, paths) -> None:
         plugins.load_plugin(file)
 
 
-def load_configs(paths, overrides=()) -> list[TableSpec]:
+def load_configs(paths, overrides=(), environment=None) -> list[TableSpec]:
     """Validate every config before anything runs; table names must be unique across the batch. ``paths``: one path
     (str or Path) or a list of them. ``overrides``: ``--set`` texts, or (table, key, value, blamed argument) tuples
-    (``--format``)."""
+    (``--format``). ``environment``: the file of every environment table (load_config); refused when no table of the
+    batch takes one."""
     paths = arguments.configs_arg("load_configs", "paths", paths)
     ovr = _overrides("load_configs", overrides)
+    environment_override("load_configs", environment)
     specs: list[TableSpec] = []
     seen: dict[str, str] = {}
     for p in paths:
-        for s in load_config(p, ovr):
+        for s in load_config(p, ovr, environment):
             if s.name in seen:
                 raise ConfigError(
                     s.source,
@@ -468,6 +494,15 @@ def load_configs(paths, overrides=()) -> list[TableSpec]:
                 )
             seen[s.name] = s.source
             specs.append(s)
+    if environment is not None and not any(ENVIRONMENT_KEY in kind_of(s).keys for s in specs):
+        raise ConfigError(
+            ENVIRONMENT_OPTION,
+            ENVIRONMENT_KEY,
+            str(environment),
+            "a batch with an environment table (kinds environment_specular, environment_irradiance; presets "
+            "bevy-ibl, gltf-ibl)",
+            "no table of the batch takes an environment",
+        )
     names = {o[0] for o in ovr if o[0] is not None}
     missing = names - set(seen)
     if missing:

@@ -7,6 +7,9 @@
 integrand and estimator at arbitrary texels (audit and size); ``assemble`` makes the Table of one spec from them
 (name, config, content hash). ``bake_table`` is both. The batch (lutbake.batch) computes once per distinct values
 key (lutbake.sharing) and assembles per table; the batch and the Python API (lutbake.api) write.
+
+A kind baked whole (the environment cubes: Kind.bake) goes through ``bake_cube_table``: its kind's bake (no texel
+plan), the finite check, then ``assemble_cube`` (the engine's shader line first, the provenance and content hash).
 """
 
 from __future__ import annotations
@@ -20,11 +23,11 @@ import numpy as np
 from .config import TableSpec, kind_of
 from .errors import TableError
 from .layouts import reconstruction_with_engine_line
-from .provenance import attributes
-from .runtime.executor import Progress, Timer, estimate_error, execute_tiles
+from .provenance import attributes, cube_attributes
+from .runtime.executor import Cancelled, Progress, Timer, estimate_error, execute_tiles
 from .runtime.plan import PlanSource, TexelPlan
 from .runtime.warp_runtime import defining
-from .table import Table
+from .table import CubeTable, Table
 
 OVER_TOLERANCE = "over_tolerance"  # the lutbake:* attribute of a table whose texels end over their tolerance
 
@@ -134,3 +137,37 @@ def bake_table(spec: TableSpec, *args, **options) -> tuple[Table, float, int]:
     finite; executor.Cancelled if the ``cancel`` event (a threading.Event) is set while it runs."""
     c = compute(spec, *args, **options)
     return assemble(spec, c), c.seconds, c.plan.samples
+
+
+def baked_whole(spec: TableSpec) -> bool:
+    """Whether ``spec``'s kind is baked whole (Kind.bake: an environment cube), not through a texel plan."""
+    return kind_of(spec).bake is not None
+
+
+def bake_cube_table(
+    spec: TableSpec, workers: int | None = None, device: str = "cpu", progress: Progress | None = None, cancel=None
+) -> tuple[CubeTable, float]:
+    """Bake one spec of a kind baked whole into its CubeTable (nothing written): (table, seconds). ``progress`` is told
+    the table's texels when it starts and when it ends (its kind's bake reports no tiles); ``cancel`` is checked
+    before it starts (executor.Cancelled). Raises TableError if a value is not finite."""
+    if cancel is not None and cancel.is_set():
+        raise Cancelled(spec.name)
+    kind = kind_of(spec)
+    texels = kind.texels(spec.options)
+    update = progress(spec.name, texels, float(texels)) if progress is not None else None
+    with Timer() as t:
+        baked = kind.bake(spec, workers, device)
+    bad = sum(int(np.size(m) - np.count_nonzero(np.isfinite(m))) for m in baked.mips)
+    if bad:
+        raise TableError(f"{spec.source}: table '{spec.name}': {bad} non-finite values; nothing written")
+    if update is not None:
+        update(texels)
+    return assemble_cube(spec, baked), t.seconds
+
+
+def assemble_cube(spec: TableSpec, baked: CubeTable) -> CubeTable:
+    """``baked`` (its kind's bake of ``spec``) with the engine's shader line first in its reconstruction and its
+    provenance: the config, versions, the engine's ibl conventions and the content hash of the inputs it read."""
+    baked.reconstruction = reconstruction_with_engine_line(spec.kind, spec.name, spec.options, baked.reconstruction)
+    baked.attributes = cube_attributes(spec, baked.inputs)
+    return baked

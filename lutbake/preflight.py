@@ -219,14 +219,17 @@ def check_path_lengths(jobs, cache_dir=None, report=None) -> None:
 
 def planned_files(job) -> list[tuple[Path, str]]:
     """Every file the bake of ``job`` writes, with what it is: the data file, a second data file (ltc_dds's
-    ``<name>_2.dds``), and the ``.json`` sidecar of each (EXR carries its metadata in its header). The one registry
-    of output paths: collisions, ``--report`` and the preview/error-map guards all read it."""
+    ``<name>_2.dds``), the files its kind writes beside them (an irradiance cube's ``<name>_sh.json``: Kind.outputs),
+    and the ``.json`` sidecar of each (EXR carries its metadata in its header). The one registry of output paths:
+    collisions, ``--report`` and the preview/error-map guards all read it."""
+    from .config import kind_of
     from .io.integrity import sidecar_path
 
     fmt = job.spec.options.get("format", "exr")
     files = [(job.path, "output")]
     if fmt == "ltc_dds":
         files.append((job.path.with_name(job.path.name.replace("_1.dds", "_2.dds")), "second texture"))
+    files += [(job.path.with_name(job.name + suffix), what) for suffix, what in kind_of(job.spec).outputs]
     # an EXR writes none, but <name>.exr.json is where readers look for one: it is claimed too
     files += [(sidecar_path(p), f"sidecar of {p.name}") for p, _ in list(files)]
     return files
@@ -310,8 +313,10 @@ def input_claims(jobs, configs=(), cache_dir=None) -> list[tuple[Path, str]]:
 
 def cache_entries(jobs, cache_dir) -> list[Path]:
     """The files of the cache entries this run may write in ``cache_dir``: one .npy and one .json per values key of
-    the pending tables (lutbake.values_cache.ValuesCache.paths)."""
-    keys = sorted({j.values_key for j in jobs if j.status == "pending" and j.values_key})
+    the pending tables (lutbake.values_cache.ValuesCache.paths); a cube (a kind baked whole) has none."""
+    from .config import kind_of
+
+    keys = sorted({j.values_key for j in jobs if j.status == "pending" and j.values_key and not kind_of(j.spec).bake})
     return [Path(cache_dir) / f"{key}{ext}" for key in keys for ext in (".npy", ".json")]
 
 

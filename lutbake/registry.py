@@ -273,4 +273,6 @@ def _resolve(family_name: str, name: str, plugin: Plugin | None) -> Record:
         importlib.import_module("lutbake.kinds")  # lutbake's kinds and layouts register on import
     elif name not in fam:
         importlib.import_module("lutbake.records")
+        if name not in fam:  # a family a kind module declares (lutbake.kinds.environment: mip_curve, ...)
+            importlib.import_module("lutbake.kinds")
     return fam.lookup(name)

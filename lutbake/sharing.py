@@ -5,7 +5,7 @@ the keys their kind declares (lutbake.kinds.base.Kind.layout_keys, e.g. ``format
 kind, whose fit reads neither). The ``values_key`` names those values:
 
     values_key = sha256(kind, canonical TOML of the options without the layout keys, lutbake version,
-                        source digest (lutbake.sources.sources_digest))
+                        source digest (lutbake.sources.sources_digest), the kind's inputs (Kind.inputs))
 
 so it changes whenever anything that enters a table's values changes, and never with a file name or format.
 The batch (lutbake.batch) runs one pipeline.compute per distinct key and lays the result out per table
@@ -21,13 +21,17 @@ import hashlib
 
 from . import __version__
 from .config import TableSpec, kind_of
+from .provenance import kind_inputs
 
 ALWAYS_LAYOUT = ("name", "accept_over_tolerance")  # the output stem, the exit-status policy: never the values
 
 
 def layout_keys(kind: str) -> tuple[str, ...]:
-    """``name`` and the kind's declared layout keys."""
-    return ALWAYS_LAYOUT + kind_of(kind).layout_keys
+    """``name`` and the kind's declared layout keys; a kind baked whole (the environment cubes) keeps its name in its
+    values (an irradiance cube's record names its SH file after it)."""
+    found = kind_of(kind)
+    always = ALWAYS_LAYOUT if found.bake is None else tuple(k for k in ALWAYS_LAYOUT if k != "name")
+    return always + found.layout_keys
 
 
 def values_toml(spec: TableSpec) -> str:
@@ -41,9 +45,11 @@ def values_toml(spec: TableSpec) -> str:
 def values_key(spec: TableSpec, digest: bytes) -> str:
     """The hex sha256 naming the values ``spec``'s table holds (module docstring); ``digest``:
     lutbake.sources.sources_digest()."""
+    inputs = kind_inputs(spec)  # an environment file's sha256 (lutbake.kinds.base.Kind.inputs); b"" for most kinds
     h = hashlib.sha256()
-    for part in (b"lutbake-values-key-v1", values_toml(spec).encode(), __version__.encode(), digest):
-        h.update(str(len(part)).encode() + b"\0" + part)
+    for part in (b"lutbake-values-key-v1", values_toml(spec).encode(), __version__.encode(), digest, inputs):
+        if part:
+            h.update(str(len(part)).encode() + b"\0" + part)
     return h.hexdigest()
 
 

@@ -1,4 +1,5 @@
-"""The baked table: one object that writers and checks see, its shape checks and its metadata record."""
+"""The baked table: one object that writers and checks see, its shape checks and its metadata record; and the baked
+cube map with mips (the environment kinds' output, written by lutbake.io.cubemap)."""
 
 from __future__ import annotations
 
@@ -29,6 +30,32 @@ class Table:
 
     def channel(self, key: str) -> np.ndarray:
         return self.data[..., list(self.channels).index(key)]
+
+
+@dataclass
+class CubeTable:
+    """A cube map with mips, the output of an environment kind (lutbake.kinds.environment): ``mips[m]`` is
+    (6, n, n, 3) float64, face +X, -X, +Y, -Y, +Z, -Z (lutbake.environment.cube), row t, column s, RGB, n = the
+    face size >> m. ``record``: what the bake holds (face convention, mip curve, roughness and alpha per mip,
+    weighting, error estimate per mip, the source's sha256 ...; JSON values); ``inputs``: what its values depend on
+    besides its config (the bytes of the environment it was baked from, as lutbake.kinds.base.Kind.inputs gives them
+    for its content hash); ``attributes``: its provenance (config, versions, content hash), strings as a Table's;
+    ``sh``: the L2 SH document an irradiance table writes beside the cube (``<name>_sh.json``), else None."""
+
+    name: str
+    kind: str
+    mips: list[np.ndarray]
+    record: dict
+    reconstruction: str
+    inputs: bytes = b""
+    attributes: dict[str, str] = field(default_factory=dict)
+    sh: dict | None = None
+
+    @property
+    def shape(self) -> str:
+        """ "6x16x16x3, 5 mips": what ``lutbake bake`` prints as a cube table's shape."""
+        n = self.mips[0].shape[1]
+        return f"6x{n}x{n}x{self.mips[0].shape[-1]}, {len(self.mips)} mip{'s' if len(self.mips) != 1 else ''}"
 
 
 CHANNEL_LETTERS = ("R", "G", "B", "A")

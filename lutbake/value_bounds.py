@@ -43,6 +43,8 @@ UNBOUNDED_KINDS = {
     "btf": "btf tabulates BRDF values f, which peak above 1",
     "ltc": "ltc holds the entries of inverse LTC matrices, far above 1 at low roughness",
     "ltc_aniso": "ltc_aniso holds the entries of LTC matrices, negative off the diagonal and above 1 where stretched",
+    "environment_specular": "an environment cube holds radiance, unbounded (the sun of a captured sky: 10^4 and more)",
+    "environment_irradiance": "an environment cube holds radiance, unbounded (E / pi of a bright sky is far above 1)",
 }
 
 

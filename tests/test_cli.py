@@ -141,6 +141,7 @@ def test_list_prints_whole_preset_descriptions_and_the_files_each_writes():
     """Issue 39: descriptions were cut at their first comment line, mid-sentence; the files were not named."""
     import tomllib
 
+    from lutbake.cli.tables import kind_outputs
     from lutbake.config import presets
     from lutbake.io.formats import written_files
 
@@ -149,7 +150,8 @@ def test_list_prints_whole_preset_descriptions_and_the_files_each_writes():
         text = path.read_text(encoding="utf-8")
         comment = " ".join(ln.lstrip("#").strip() for ln in text.splitlines()[: _leading_comments(text)])
         assert " ".join(comment.split()) in out, name
-        files = [f for t in tomllib.loads(text)["table"] for f in written_files(t["name"], t.get("format", "exr"))]
+        tables = tomllib.loads(text)["table"]
+        files = [f for t in tables for f in written_files(t["name"], t.get("format", "exr"), kind_outputs(t["kind"]))]
         assert f"Writes: {', '.join(files)}." in out, name
     assert "filament_dfg.dds, filament_dfg.dds.json" in out and "ltc_ggx_1.dds, ltc_ggx_2.dds" in out
 

@@ -23,6 +23,7 @@ PAGE_MAX_BYTES = 30 * 1024
 # the issue's check: dates, issue numbers, machine names and load figures belong to docs/benchmarks.md alone
 DIARY = re.compile(r"issue [0-9]+|20[0-9]{2}-[0-9]{2}-[0-9]{2}|EPYC|Xeon|load [0-9]", re.IGNORECASE)
 MEASURED_PAGE = DOCS / "benchmarks.md"
+ENVIRONMENT = ROOT / "tests" / "data" / "env_studio_64x32.exr"
 
 
 def test_every_kind_key_and_value_is_documented():
@@ -336,12 +337,17 @@ def rendered() -> dict[str, str]:
     the engine's line first, then the layout's), joined by newlines."""
     from lutbake.config import load_config, presets
     from lutbake.kinds import lookup_kind
+    from lutbake.kinds.environment import reconstruction
+    from lutbake.layouts import reconstruction_with_engine_line
     from lutbake.pipeline import Computed, assemble
 
     out = {}
     for name, path in presets().items():
         texts = []
-        for spec in load_config(path):
+        for spec in load_config(path, environment=ENVIRONMENT):  # the ibl presets name no environment of their own
+            if lookup_kind(spec.kind).bake is not None:  # an environment cube (lutbake.pipeline.assemble_cube)
+                texts.append(reconstruction_with_engine_line(spec.kind, spec.name, spec.options, reconstruction(spec)))
+                continue
             plan = lookup_kind(spec.kind).plan(spec)
             texts.append(assemble(spec, Computed(plan, np.zeros(plan.shape), {}, 0.0, 0.0)).reconstruction)
         out[name] = "\n".join(texts)

@@ -433,13 +433,19 @@ def test_bake_environment_writes_specular_diffuse_and_sh_with_the_record(tmp_pat
     from lutbake.io.cubemap import decode_ktx2_cube
 
     src = DATA / "env_studio_64x32.exr"
-    paths = bake_environment(src, tmp_path, "studio", engine="bevy", size=8, irradiance_size=4)
+    paths = bake_environment(
+        src, tmp_path, "studio", engine="bevy", size=8, irradiance_size=4, sh_form="irradiance_over_pi"
+    )
     mips, meta = decode_ktx2_cube(paths["specular"].read_bytes())
     assert len(mips) == 4 and meta["roughness"] == [0.0, 1 / 3, 2 / 3, 1.0]
     assert meta["source_sha256"] == json.loads((DATA / "env_studio_64x32.json").read_text())["sha256"]
     assert all(e <= 5e-4 for e in meta["error_estimate_per_mip"])
     coeffs = json.loads(paths["sh"].read_text())
-    E = sh.evaluate(np.array(coeffs["irradiance_over_pi"]), cube.texel_centres(4).reshape(-1, 3))
+    assert coeffs["form"] == "irradiance_over_pi"
+    # Bevy looks its cubes up at (x, y, -z) of the world direction (orientation d3d_left_handed): the texel whose
+    # lookup vector is d holds the world direction d * (1, 1, -1), where the SH (of world directions) is evaluated
+    world = cube.lookup_vectors(cube.texel_centres(4).reshape(-1, 3), "d3d_left_handed")
+    E = sh.evaluate(np.array(coeffs["coefficients"]), world)
     diffuse, _ = decode_ktx2_cube(paths["diffuse"].read_bytes())
     # the L2 SH irradiance against the exact irradiance cube: they differ by the band-2 truncation of the clamped
     # cosine (R&H 2001 §3): measured 0.057 against a mean of 0.34 (17%) on Blender's studio light at 64 x 32

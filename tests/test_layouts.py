@@ -17,6 +17,8 @@ from lutbake.layouts.base import Layout
 from lutbake.sampling.plan import Grid, StoredMap, per_texel_plan
 
 PACKAGE = Path(__file__).resolve().parent.parent / "lutbake"
+# the environment presets (bevy-ibl, gltf-ibl) name no environment file of their own: a test gives them this one
+ENVIRONMENT = Path(__file__).resolve().parent / "data" / "env_studio_64x32.exr"
 # Blender EEVEE's brdf_ggx reconstruction as baseline outputs recorded it before the records (uv rendered from the axes)
 EEVEE_RECONSTRUCTION = (
     "uv = vec2((roughness) * 63/64 + 0.5/64, (sqrt(1 - NoV)) * 63/64 + 0.5/64); t = texture(lut, uv).rg; specular = "
@@ -54,7 +56,7 @@ def test_engine_modules_are_found_by_existing_with_lutbakes_own_first():
 def test_each_engine_tables_preset_holds_the_keys_its_engine_fixes(table):
     """The preset named by an engine's table record bakes that table with every grid and storage key the record
     fixes (and in the record's layout)."""
-    spec = next(s for s in load_config(preset_path(table.preset)) if s.name == table.table)
+    spec = next(s for s in load_config(preset_path(table.preset), environment=ENVIRONMENT) if s.name == table.table)
     assert spec.kind == table.kind
     for key, want in table.keys.items():
         got = spec.options[key] if key != "kind" else spec.kind
@@ -67,7 +69,7 @@ def test_every_preset_table_has_an_engine_record():
     """Adding an engine is a module in lutbake/layouts with its presets: no preset table is left undeclared."""
     declared = {(t.preset, t.table) for t in TABLES}
     for name, path in presets().items():
-        for spec in load_config(path):
+        for spec in load_config(path, environment=ENVIRONMENT):
             assert (name, spec.name) in declared, (name, spec.name)
 
 

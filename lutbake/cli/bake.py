@@ -58,6 +58,14 @@ DRAW_INTERVAL = 0.5  # seconds between redraws of the progress line as tiles fin
     "`dask scheduler` (pip install 'lutbake[dask]'; docs/cluster.md). Same files as without.",
 )
 @click.option(
+    "--environment",
+    type=click.Path(path_type=Path, dir_okay=False),
+    default=None,
+    metavar="FILE",
+    help="The lat-long environment (.exr or .hdr, width = 2 x height) of every environment table (key `environment`; "
+    "a preset such as bevy-ibl or gltf-ibl names none): its cubes are baked from FILE.",
+)
+@click.option(
     "--format",
     "fmt",
     type=click.Choice(list(ALL_FORMATS)),
@@ -65,7 +73,21 @@ DRAW_INTERVAL = 0.5  # seconds between redraws of the progress line as tiles fin
     help="Output format of every table (same as --set format=...; default: each table's `format`, exr); each kind "
     "allows some of these (lutbake list; an ltc table: exr, npy, ltc_dds, js, c, cs).",
 )
-def bake(configs, presets, out_dir, overrides, workers, device, progress, force, cache_dir, report, scheduler, fmt):
+def bake(
+    configs,
+    presets,
+    out_dir,
+    overrides,
+    workers,
+    device,
+    progress,
+    force,
+    cache_dir,
+    report,
+    scheduler,
+    environment,
+    fmt,
+):
     """Bake every [[table]] of CONFIGS into OUT_DIR/<name>.<ext> (EXR unless `format` / --format says otherwise).
 
     All configs are validated before any kernel runs; a bad config exits with status 2 and writes
@@ -88,6 +110,7 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
       lutbake bake configs/dfg.toml --force --set size=[64,64] --set layout=multiscatter
       lutbake bake configs/dfg.toml --set dfg.estimator=sobol_vndf --set dfg.samples=4096
       lutbake bake --preset unreal --format dds        # -> outputs/preintegrated_gf.dds (R16G16_FLOAT)
+      lutbake bake --preset bevy-ibl --environment studio.exr   # dfg + specular and diffuse cubes, one record
       lutbake bake configs/*.toml --scheduler local:2  # tiles on 2 Dask worker processes
       lutbake bake configs/*.toml --scheduler tcp://farm:8786 --device cuda
     """
@@ -118,6 +141,7 @@ def bake(configs, presets, out_dir, overrides, workers, device, progress, force,
                 report=report,
                 on_schedule=display.scheduled,
                 check=False,
+                environment=environment,
             )
     except LutbakeError as e:  # a bad config or path, an unreachable scheduler: before any kernel ran
         display.close()
@@ -308,8 +332,9 @@ class BatchProgress:
             note = samples_note(r.spec, r.samples)
             if r.values_from is not None:
                 note = "; ".join(filter(None, (note, f"values computed once with {r.values_from}")))
+            samples = f"  {r.samples} samples/texel" if r.samples is not None else ""  # none: an environment cube
             self._write(
-                f"{count}{escape_controls(str(r.path))}  {r.shape}  {r.seconds:.2f} s  {r.samples} samples/texel"
+                f"{count}{escape_controls(str(r.path))}  {r.shape}  {r.seconds:.2f} s{samples}"
                 + (f" ({note})" if note else "")
             )
             if r.status == "over_tolerance":

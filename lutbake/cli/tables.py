@@ -159,6 +159,13 @@ def _list_terms(width: int) -> None:
         _section(width, title, items)
 
 
+def kind_outputs(kind) -> tuple[str, ...]:
+    """The suffixes of the files a table of ``kind`` writes beside its data file (lutbake.kinds.base.Kind.outputs)."""
+    from ..kinds import KINDS
+
+    return tuple(suffix for suffix, _ in KINDS[kind].outputs) if kind in KINDS else ()
+
+
 def preset_text(path: Path) -> str:
     """A preset's description (its leading comment, every line of it) and the files it writes."""
     import tomllib
@@ -173,7 +180,7 @@ def preset_text(path: Path) -> str:
         lines.append(line.lstrip("#").strip())
     # the shipped TOML read as it is (validating an ltc preset would start Warp: lutbake list imports none of it)
     tables = tomllib.loads(text)["table"]
-    files = [f for t in tables for f in written_files(t["name"], t.get("format", "exr"))]
+    files = [f for t in tables for f in written_files(t["name"], t.get("format", "exr"), kind_outputs(t.get("kind")))]
     return " ".join(filter(None, lines)) + f" Writes: {', '.join(files)}."
 
 

@@ -25,7 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .atomic import atomic_write, atomic_write_bytes
+from . import bounded
+from .atomic import atomic_write
 from .ktx2 import IDENTIFIER, _dfd, _kvd
 
 VK_RGBA = {"half": 97, "float32": 109}  # VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R32G32B32A32_SFLOAT
@@ -35,6 +36,9 @@ DDSD = 0x1 | 0x2 | 0x4 | 0x8 | 0x1000 | 0x20000  # CAPS HEIGHT WIDTH PITCH PIXEL
 DDSCAPS = 0x1000 | 0x8 | 0x400000  # TEXTURE, COMPLEX, MIPMAP
 DDSCAPS2_CUBE = 0x200 | 0xFC00  # CUBEMAP and the six faces
 DDS_MISC_TEXTURECUBE = 0x4
+VK_NAMES = {97: "VK_FORMAT_R16G16B16A16_SFLOAT", 109: "VK_FORMAT_R32G32B32A32_SFLOAT"}
+DXGI_NAMES = {10: "DXGI_FORMAT_R16G16B16A16_FLOAT", 2: "DXGI_FORMAT_R32G32B32A32_FLOAT"}
+MAX_RECORD_BYTES = 1 << 20  # lutbake's record of a cube is a few KiB
 
 
 def rgba(mips: list[np.ndarray], dtype: str) -> list[np.ndarray]:
@@ -124,25 +128,189 @@ def encode_dds_cube(mips: list[np.ndarray], dtype: str = "half") -> bytes:
     return b"DDS " + header + dx10 + data
 
 
-def write_cube(mips: list[np.ndarray], path, metadata: dict, fmt: str, dtype: str = "half") -> Path:
-    """Write a cube with mips to ``path`` in ``fmt`` (ktx2, dds, exr), atomically; dds also writes the metadata to
-    ``<path>.json``. Values that are not strings are written as JSON text in EXR attributes and the sidecar (every
-    ``lutbake:*`` value is a string), as one JSON object in KTX 2.0's ``lutbake:metadata``."""
-    path = Path(path)
-    if fmt == "ktx2":
-        return atomic_write_bytes(path, encode_ktx2_cube(mips, metadata, dtype))
-    text = {k: v if isinstance(v, str) else json.dumps(v, sort_keys=True) for k, v in metadata.items()}
-    if fmt == "dds":
-        atomic_write_bytes(path, encode_dds_cube(mips, dtype))
-        sidecar = json.dumps({"lutbake": text}, indent=1, sort_keys=True) + "\n"
-        atomic_write_bytes(path.with_name(path.name + ".json"), sidecar.encode())
-        return path
-    if fmt == "exr":
-        from .exr import EXR_TYPES, _write_oiio
+def _as_text(metadata: dict) -> dict[str, str]:
+    """The record as strings (EXR attributes, the sidecar's ``lutbake`` object): JSON text for every value that is
+    not a string."""
+    return {k: v if isinstance(v, str) else json.dumps(v, sort_keys=True) for k, v in metadata.items()}
 
-        parts = [
-            (f"mip_{m}", text, np.ascontiguousarray(a[..., :3].reshape(-1, a.shape[2], 3)))
-            for m, a in enumerate(rgba(mips, dtype))
-        ]
-        return atomic_write(path, lambda tmp: _write_oiio(tmp, parts, EXR_TYPES[dtype]))
-    raise ValueError(f"cube format must be ktx2, dds or exr, got {fmt!r}")
+
+def write_cube(
+    mips: list[np.ndarray], path, metadata: dict, fmt: str, dtype: str = "half", files: dict[str, bytes] | None = None
+) -> Path:
+    """Write a cube with mips to ``path`` in ``fmt`` (ktx2, dds, exr), atomically, as one verified unit
+    (lutbake.io.integrity): ``files`` (name -> bytes: other files of the output beside ``path``, an irradiance
+    table's SH) are written first; then the cube; then, for ktx2 and dds, the sidecar ``<path>.json`` naming the
+    sha256 of every file, written last; an EXR carries ``lutbake:data_hash`` and ``lutbake:files_sha256`` instead.
+    Values that are not strings are written as JSON text in EXR attributes and the sidecar (every ``lutbake:*`` value
+    is a string), as one JSON object in KTX 2.0's ``lutbake:metadata``."""
+    from .atomic import atomic_write_bytes_hashed, unit_lock
+    from .integrity import HASH_KEY, PLACEHOLDER, seal_exr, write_sidecar
+
+    if fmt not in CUBE_FORMATS:
+        raise ValueError(f"cube format must be ktx2, dds or exr, got {fmt!r}")
+    path = Path(path)
+    text = _as_text(metadata)
+    levels = rgba(mips, dtype)  # every value checked before any file of the unit is touched
+    data = b""  # an EXR is written part by part below
+    if fmt == "ktx2":
+        data = encode_ktx2_cube(mips, metadata, dtype)
+    elif fmt == "dds":
+        data = encode_dds_cube(mips, dtype)
+    with unit_lock(path):
+        digests = {name: atomic_write_bytes_hashed(path.with_name(name), blob) for name, blob in (files or {}).items()}
+        if fmt == "exr":
+            from .exr import EXR_TYPES, _write_oiio
+
+            attrs = {**text, "files_sha256": json.dumps(digests, sort_keys=True), HASH_KEY: PLACEHOLDER.decode()}
+            parts = [
+                (f"mip_{m}", attrs, np.ascontiguousarray(a[..., :3].reshape(-1, a.shape[2], 3)))
+                for m, a in enumerate(levels)
+            ]
+
+            def write(tmp):
+                _write_oiio(tmp, parts, EXR_TYPES[dtype])
+                seal_exr(tmp)
+
+            return atomic_write(path, write)
+        digests[path.name] = atomic_write_bytes_hashed(path, data)
+        write_sidecar(path, CUBE_FORMATS[fmt], text, digests, {"files": sorted(digests)})
+        return path
+
+
+CUBE_FORMATS = {"ktx2": "ktx2_cube", "dds": "dds_cube", "exr": "exr_cube"}  # format -> the sidecar's ``format``
+
+
+def cube_metadata(table) -> dict:
+    """Everything a cube file of ``table`` (lutbake.table.CubeTable) records: kind, table, reconstruction, the
+    bake's record, its provenance."""
+    return {
+        "kind": table.kind,
+        "table": table.name,
+        "reconstruction": table.reconstruction,
+        **table.record,
+        **table.attributes,
+    }
+
+
+def write_cube_table(table, path, fmt: str, dtype: str = "half") -> Path:
+    """Write ``table`` (lutbake.table.CubeTable) to ``path`` (write_cube), with its SH document beside it where it has
+    one (``record["sh_file"]``)."""
+    files = {}
+    if table.sh is not None:
+        files[table.record["sh_file"]] = (json.dumps(table.sh, indent=1) + "\n").encode()
+    return write_cube(table.mips, path, cube_metadata(table), fmt, dtype, files)
+
+
+# ------------------------------------------------------------------------------------------------- reading
+
+
+def _decoded(text: dict) -> dict:
+    """The record from strings: JSON text of a list or an object decoded, the rest kept (the provenance strings of a
+    KTX 2.0 record too: ``ibl``)."""
+    if not isinstance(text, dict):
+        raise ValueError("its lutbake record is not a JSON object")
+    out = {}
+    for k, v in text.items():
+        if isinstance(v, str) and v[:1] in "[{":
+            try:
+                v = bounded.loads_json(v)
+            except ValueError:
+                pass
+        out[k] = v
+    return out
+
+
+def cube_kind(path) -> str | None:
+    """ "ktx2", "dds" or "exr" where ``path`` is a cube file lutbake writes (a KTX 2.0 with faceCount 6, a DDS with
+    the cube caps, an EXR whose parts are named mip_<m>), else None: read from the first bytes (and, for an EXR, its
+    part names)."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(DDS_HEADER_BYTES)
+    except OSError:
+        return None
+    if head[:12] == IDENTIFIER and len(head) >= 48:
+        return "ktx2" if struct.unpack_from("<I", head, 36)[0] == 6 else None
+    if head[:4] == b"DDS " and len(head) >= DDS_HEADER_BYTES:
+        return "dds" if struct.unpack_from("<I", head, 4 + 108)[0] & 0x200 else None
+    if head[:4] == b"\x76\x2f\x31\x01":
+        try:
+            return "exr" if _exr_parts(path)[0][0] == "mip_0" else None
+        except Exception:  # noqa: BLE001 - any EXR OpenImageIO cannot list is no cube of lutbake's
+            return None
+    return None
+
+
+DDS_HEADER_BYTES = 4 + 124 + 20  # magic, DDS_HEADER, DDS_HEADER_DXT10
+
+
+def _exr_parts(path) -> list[tuple[str, int, str, dict[str, str]]]:
+    """(part name, face size, pixel type, lutbake attributes) of every part of an EXR, headers only."""
+    from .exr import _exr_attrs, _oiio
+
+    problem = bounded.exr_header_problem(path)
+    if problem:
+        raise ValueError(problem)
+    oiio = _oiio()
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise ValueError(oiio.geterror() or "OpenImageIO cannot open it")
+    parts = []
+    try:
+        k = 0
+        while inp.seek_subimage(k, 0):
+            spec = inp.spec()
+            name = spec.getattribute("name") or spec.getattribute("oiio:subimagename") or ""
+            parts.append((str(name), spec.width, str(spec.format), _exr_attrs(spec)))
+            k += 1
+    finally:
+        inp.close()
+    return parts
+
+
+def read_cube_record(path) -> dict:
+    """The record of a cube file lutbake wrote (KTX 2.0, DDS with its ``.json`` sidecar, EXR), and its container's
+    facts, without its pixels: ``{"format", "pixel_format", "size", "mips",
+    "record", "metadata"}``, ``record`` the lutbake record with its JSON values decoded, ``metadata`` where it was
+    read. ValueError says what is wrong."""
+    path = Path(path)
+    fmt = cube_kind(path)
+    if fmt is None:
+        raise ValueError(f"{path}: not a cube file lutbake writes (KTX 2.0 faceCount 6, DDS cube, EXR mip_<m> parts)")
+    if fmt == "ktx2":
+        from .ktx2 import _kv_pairs
+
+        with open(path, "rb") as f:
+            head = f.read(80)
+            vk, _, width, _, _, _, _, levels, _ = struct.unpack_from("<9I", head, 12)
+            kvd_off, kvd_len = struct.unpack_from("<II", head, 56)
+            if kvd_len > MAX_RECORD_BYTES:
+                raise ValueError(f"{path}: {kvd_len} bytes of KTX2 key/value data; lutbake's record is a few KiB")
+            f.seek(kvd_off)
+            kvd = f.read(kvd_len)
+        if len(kvd) != kvd_len:
+            raise ValueError(f"{path}: the KTX2 key/value data runs past the file")
+        record = _decoded(bounded.loads_json(_kv_pairs(kvd, 0, kvd_len).get("lutbake:metadata", "{}")))
+        return _described(fmt, VK_NAMES.get(vk, f"vkFormat {vk}"), width, levels, record, "KTX2 key lutbake:metadata")
+    if fmt == "dds":
+        with open(path, "rb") as f:
+            head = f.read(DDS_HEADER_BYTES)
+        _, _, height, width, _, _, mips = struct.unpack_from("<7I", head, 4)
+        dxgi = struct.unpack_from("<I", head, 128)[0]
+        from .integrity import sidecar_path
+        from .sidecar import load_sidecar_json
+
+        side = sidecar_path(path)
+        doc = load_sidecar_json(side) if side.is_file() else None
+        if not isinstance(doc, dict) or not isinstance(doc.get("lutbake"), dict):
+            raise ValueError(f"{path}: a DDS cube without lutbake's record (its sidecar {side.name} is missing)")
+        pixel = DXGI_NAMES.get(dxgi, f"DXGI {dxgi}")
+        return _described(fmt, pixel, width, mips, _decoded(doc["lutbake"]), f"sidecar {side.name}")
+    parts = _exr_parts(path)
+    return _described(fmt, parts[0][2], parts[0][1], len(parts), _decoded(parts[0][3]), "EXR header (every part)")
+
+
+def _described(fmt: str, pixel: str, size: int, mips: int, record: dict, where: str) -> dict:
+    if not isinstance(record, dict):
+        raise ValueError("its lutbake record is not a JSON object")
+    return {"format": fmt, "pixel_format": pixel, "size": size, "mips": mips, "record": record, "metadata": where}

@@ -1,6 +1,7 @@
 """``lutbake inspect FILE``: what a table file holds, in words, for every format lutbake reads
 (lutbake.io.readers). With lutbake metadata: kind, axes, channels, reconstruction, provenance and
-per-channel statistics; without (a LUT an engine ships): format, size, channels and value ranges."""
+per-channel statistics; without (a LUT an engine ships): format, size, channels and value ranges. A cube file lutbake
+writes (an environment kind's KTX 2.0, DDS or EXR, lutbake.io.cubemap): its record (``describe_cube``)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from ..textsafe import bounded as bounded_text
-from .readers import FORMAT_NAMES, NAME_CHARS, LoadedFile, read, table_view
+from . import bounded
+from .readers import FORMAT_NAMES, NAME_CHARS, LoadedFile, ReadError, read, table_view
 
 PROVENANCE = ("terms", "estimator", "samples", "seed", "error_estimate", "version", "warp_version")
 SHOWN = {"kind", "table", "axes", "channels", "channel_names", "reconstruction", "config", "plugins", *PROVENANCE}
@@ -102,9 +104,168 @@ def _report_lines(doc: dict) -> list[str]:
     return lines
 
 
-def describe(path) -> str:
-    """The report ``lutbake inspect FILE`` prints (raises readers.ReadError, naming the file once)."""
+CUBE_FORMATS = {"ktx2": "KTX 2.0 cube", "dds": "DDS cube", "exr": "OpenEXR cube (a part per mip)"}
+CUBE_SHOWN = (
+    "ndf",
+    "face_convention",
+    "orientation",
+    "weighting",
+    "mip_curve",
+    "roughness_definition",
+    "mip0",
+    "split_sum",
+    "source_convention",
+)
+IBL_ORDER = ("engine", "ndf", "masking", "roughness", "mip_curve", "lobe")  # lutbake.layouts.base.IBL.record
+CUBE_HIDDEN = {
+    "kind",
+    "table",
+    "reconstruction",
+    "ibl",
+    "roughness",
+    "alpha",
+    "lobes",
+    "error_estimate_per_mip",
+    "config",
+    "data_hash",
+    "files_sha256",
+}
+
+
+def _text(value) -> str:
+    """A record value as one bounded, escaped line (JSON for lists and objects)."""
+    return bounded_text(value if isinstance(value, str) else json.dumps(value, sort_keys=True), LONG_VALUE)
+
+
+def _mip_rows(record: dict, sizes: list[int]) -> list[str]:
+    """One line per mip: its face size, roughness r, alpha, lobe and error estimate, as far as the record has them."""
+    columns = {k: record.get(k) if isinstance(record.get(k), list) else [] for k in ("roughness", "alpha", "lobes")}
+    errors = record.get("error_estimate_per_mip") if isinstance(record.get("error_estimate_per_mip"), list) else []
+
+    def cell(values, m, fmt=_fmt):
+        return fmt(values[m]) if m < len(values) and isinstance(values[m], (int, float)) else "-"
+
+    lines = ["mips:", "  mip  size   roughness r  alpha        lobe        error estimate"]
+    for m, n in enumerate(sizes):
+        lobe = bounded_text(columns["lobes"][m], NAME_CHARS) if m < len(columns["lobes"]) else "-"
+        lines.append(
+            f"  {m:<4} {n:<6} {cell(columns['roughness'], m):<12} {cell(columns['alpha'], m):<12} {lobe:<11} "
+            f"{cell(errors, m, lambda x: f'{x:.2e}')}"
+        )
+    return lines
+
+
+def describe_cube(path) -> str:
+    """The report ``lutbake inspect`` prints for a cube file lutbake wrote: its container, whether its bytes match
+    the sha256 recorded with them, the record (kind, face convention, mip curve, roughness and alpha per mip, the
+    weighting, the error estimate per mip, the source's sha256, the engine's ibl conventions), the reconstruction
+    (the engine's shader line first) and the provenance. Pixels are not read."""
+    from .cubemap import read_cube_record
+    from .integrity import verified_attributes
+
     path = Path(path)
+    try:
+        found = read_cube_record(path)
+    except (ValueError, OSError, UnicodeDecodeError) as e:
+        raise ReadError(f"{path}: not a readable cube file: {e}") from None
+    record = found["record"]
+    size, mips = found["size"], found["mips"]
+    sizes = [max(1, size >> m) for m in range(mips)]
+    intact = verified_attributes(path) is not None
+    lines = [
+        str(path),
+        f"  format: {CUBE_FORMATS[found['format']]}, {found['pixel_format']}, {size} x {size} faces, {mips} mip(s)",
+        f"  metadata: {found['metadata']}",
+        "  integrity: "
+        + (
+            "its bytes (and its other files) match the sha256 recorded with them"
+            if intact
+            else "its bytes do not match the sha256 recorded with them (changed or half-written: a bake redoes it)"
+        ),
+        f"  kind: {_text(record.get('kind', '?'))}   table: {_text(record.get('table', path.stem))}",
+        "  faces: +X -X +Y -Y +Z -Z, each row t = 0 first, column s = 0 first (A = 1 where stored)",
+    ]
+    lines += [f"  {key}: {_text(record[key])}" for key in CUBE_SHOWN if key in record]
+    zeroed = str(record.get("source_negative_values_zeroed", "0"))
+    lines.append(
+        f"  source: {_text(record.get('source', '?'))}, sha256 {_text(record.get('source_sha256', '?'))}"
+        + (f", {_text(zeroed)} negative values set to 0" if zeroed != "0" else "")
+    )
+    ibl = record.get("ibl")
+    if isinstance(ibl, str):
+        try:
+            ibl = json.loads(ibl)
+        except ValueError:
+            pass
+    if isinstance(ibl, dict):
+        shown = [(k, ibl[k]) for k in IBL_ORDER if k in ibl]
+        lines.append(
+            "  ibl conventions (every file of the engine's run): " + ", ".join(f"{k} {_text(v)}" for k, v in shown)
+        )
+        if "source" in ibl:
+            lines.append(f"    from {_text(ibl['source'])}")
+    if "sh" in record:
+        lines.append(
+            f"  sh ({_text(record.get('sh_form', '?'))}, also in {_text(record.get('sh_file', '?'))}): "
+            + _text(record["sh"])
+        )
+    lines += _mip_rows(record, sizes)
+    lines.append("reconstruction:")
+    lines += [f"  {line}" for line in bounded_text(record.get("reconstruction", "(none recorded)")).splitlines()]
+    lines.append("provenance:")
+    shown = (
+        set(CUBE_SHOWN)
+        | CUBE_HIDDEN
+        | {"source", "source_sha256", "source_negative_values_zeroed", "sh", "sh_form", "sh_file"}
+    )
+    if isinstance(record.get("config"), str):
+        lines.append(f"  config: {len(record['config'].splitlines())} line(s) of TOML")
+    for key in sorted(set(record) - shown):
+        value = _text(record[key])
+        lines.append(f"  {bounded_text(key, NAME_CHARS)}: {value}")
+    return "\n".join(lines) + "\n"
+
+
+SH_KEYS = ("basis", "form", "coefficients")  # lutbake.kinds.environment's <name>_sh.json
+
+
+def _sh_document(path: Path) -> dict | None:
+    """The L2 SH document an irradiance table writes (``<name>_sh.json``), or None for any other file."""
+    if path.suffix != ".json" or not path.is_file():
+        return None
+    try:
+        doc = bounded.load_json(path)
+    except (ValueError, OSError, UnicodeDecodeError):
+        return None
+    return doc if isinstance(doc, dict) and all(k in doc for k in SH_KEYS) and "lutbake" not in doc else None
+
+
+def describe_sh(path: Path, doc: dict) -> str:
+    """What ``lutbake inspect`` prints for an irradiance table's SH document."""
+    lines = [str(path), "  format: L2 spherical harmonics (JSON) of an environment_irradiance table"]
+    lines += [f"  {k}: {_text(doc[k])}" for k in ("form", "form_meaning", "basis", "integration", "source") if k in doc]
+    lines.append(f"  source_sha256: {_text(doc.get('source_sha256', '?'))}")
+    coefficients = doc["coefficients"] if isinstance(doc["coefficients"], list) else []
+    lines.append(f"coefficients ({len(coefficients)} x RGB):")
+    lines += [f"  {k}: {_text(c)}" for k, c in enumerate(coefficients[:MAX_SH])]
+    return "\n".join(lines) + "\n"
+
+
+MAX_SH = 64  # coefficients listed (L2: 9)
+
+
+def describe(path) -> str:
+    """The report ``lutbake inspect FILE`` prints (raises readers.ReadError, naming the file once); a cube file lutbake
+    wrote, or its sidecar: describe_cube."""
+    from .cubemap import cube_kind
+
+    path = Path(path)
+    for candidate in (path, path.with_name(path.name.removesuffix(".json"))):
+        if cube_kind(candidate) is not None:
+            return describe_cube(candidate)
+    sh = _sh_document(path)
+    if sh is not None:
+        return describe_sh(path, sh)
     loaded = read(path)
     lines = [str(path), f"  format: {FORMAT_NAMES[loaded.format]}, {_container(loaded)}"]
     if loaded.format == "report":

@@ -89,11 +89,13 @@ def output_path(out_dir, name: str, fmt: str) -> Path:
     return Path(out_dir) / f"{name}{EXTENSIONS[fmt]}"
 
 
-def written_files(name: str, fmt: str) -> list[str]:
-    """The names of the files a table ``name`` writes in ``fmt``: its data file(s), then its sidecar (every format but
+def written_files(name: str, fmt: str, outputs: tuple[str, ...] = ()) -> list[str]:
+    """The names of the files a table ``name`` writes in ``fmt``: its data file(s), the files its kind writes beside
+    them (``outputs``: suffixes after the name, lutbake.kinds.base.Kind.outputs), then its sidecar (every format but
     EXR, whose header holds the conventions)."""
     data = output_path(".", name, fmt).name
     files = [data] + ([data.replace("_1.dds", "_2.dds")] if fmt == "ltc_dds" else [])
+    files += [name + suffix for suffix in outputs]
     return files + ([] if fmt == "exr" else [data + ".json"])
 
 

@@ -6,7 +6,9 @@ the check refuses (then the next run bakes the table again):
 
 - **EXR** (one file, one rename): the header attribute ``lutbake:data_hash`` holds the sha256 of the file's
   bytes with the 64 hex digits of that attribute (every part's copy) set to ``0``. The writer writes the file
-  with the zeros, hashes it and patches the digest in place, before the rename.
+  with the zeros, hashes it and patches the digest in place, before the rename. Where the output has other files
+  (an environment irradiance cube's SH, lutbake.io.cubemap), they are written first and ``lutbake:files_sha256``
+  names their sha256.
 - **Every other format** (npy, png16, dds, ktx2, h): the data file, then its sidecar ``<file>.json``
   (e.g. ``dfg.npy.json``: one sidecar per output file, so ``dfg.npy`` and ``dfg.h`` never share one),
   written *last*. The sidecar names the data file (``file``), the sha256 of its bytes (``data_sha256``)
@@ -202,6 +204,15 @@ def legacy_sidecar(path) -> Path | None:
 # ------------------------------------------------------------------------------------------ checking
 
 
+def _others_intact(path: Path, text: str | None) -> bool:
+    """The other files of an EXR's output (``lutbake:files_sha256``: name -> sha256, beside it; an environment
+    irradiance table's SH) hold the bytes it names; True where it names none."""
+    if text is None:
+        return True
+    named = json.loads(text)
+    return all(Path(n).name == n and sha256_file(path.with_name(n)) == d for n, d in named.items())
+
+
 def verified_attributes(path) -> dict[str, str] | None:
     """The ``lutbake:*`` attributes (prefix removed) of the output at ``path`` if the file and its metadata
     pass every integrity check; None otherwise (missing, corrupt, half-written, foreign: bake it again)."""
@@ -210,7 +221,8 @@ def verified_attributes(path) -> dict[str, str] | None:
         if not path.is_file():
             return None
         if path.suffix == ".exr":
-            return _exr_attributes(path) if exr_intact(path) else None
+            attrs = _exr_attributes(path) if exr_intact(path) else None
+            return attrs if attrs is not None and _others_intact(path, attrs.get("files_sha256")) else None
         doc = read_sidecar(path)
         if doc is None:
             return None

@@ -37,6 +37,7 @@ from ..limits import MAX_AXIS_COUNT, MAX_FILE_BYTES
 from ..textsafe import bounded as bounded_text
 from ..textsafe import shorten
 from . import bounded, dds, ktx2
+from .cubemap import cube_kind
 from .dds import read_dds
 from .exr import EXR_MAGIC, read_any_exr
 from .header import read_header
@@ -130,6 +131,12 @@ def read(path) -> LoadedFile:
     """Read any file lutbake writes (see the module docstring), dispatched by its magic bytes."""
     path = Path(path)
     fmt = sniff(path)
+    cube = cube_kind(path)  # an environment table's cube map (lutbake.io.cubemap): no (z,) y, x, C table
+    if cube is not None:
+        raise ReadError(
+            f"{path}: a cube map with mips ({FORMAT_NAMES[cube]}, an environment table): `lutbake inspect` prints "
+            "its record; this command does not read cube maps"
+        )
     size = path.stat().st_size
     if size > MAX_FILE_BYTES:
         raise ReadError(f"{path}: {size} bytes is larger than any table lutbake writes ({MAX_FILE_BYTES} bytes)")

@@ -1,6 +1,8 @@
 """What a table kind declares: its config keys (with types, defaults and docs), its estimators, and ``plan(spec)``,
 which names the kind's axes, channels, reconstruction text, integrand and estimator and hands them to
 lutbake.sampling.plan.per_texel_plan. The registry (lutbake.kinds) adds the keys every kind has (``COMMON_KEYS``).
+A kind whose output is no (z,) y, x, C table (the environment cube maps, lutbake.kinds.environment) declares
+``bake(spec, workers, device)`` instead of a plan: it returns the whole output (lutbake.table.CubeTable).
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ class Kind:
     name: str
     description: str
     keys: dict[str, Key]
-    plan: Callable[[Any], Any]
+    plan: Callable[[Any], Any] | None  # None: a kind baked whole (``bake``)
     aliases: tuple[str, ...] = ()
     check: Callable[[Any], str | tuple[str, str] | None] | None = None
     texels: Callable[[Any], int] = lambda o: math.prod(o.get("size", [1]))  # texel count, for config.MAX_TEXELS
@@ -45,6 +47,14 @@ class Kind:
     # only in these share one computation in a batch (lutbake.sharing). Not format / dtype where the storage's
     # default tolerance (lutbake.tolerance) steers the estimator.
     layout_keys: tuple[str, ...] = ()
+    # a kind baked whole, not texel by texel (``plan`` None): (spec, workers, device) -> lutbake.table.CubeTable
+    bake: Callable[..., Any] | None = None
+    # what else a table's values depend on, as bytes for its content hash and values key (lutbake.provenance,
+    # lutbake.sharing): the digests of the input files a spec names (an environment's sha256)
+    inputs: Callable[[Any], bytes] | None = None
+    # the files a table writes beside its data file and sidecar: (suffix after the name, what it is), e.g.
+    # ("_sh.json", "L2 SH coefficients") (lutbake.preflight.planned_files, lutbake.io.formats.written_files)
+    outputs: tuple[tuple[str, str], ...] = ()
 
 
 @dataclass(frozen=True)

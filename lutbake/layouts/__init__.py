@@ -14,7 +14,7 @@ import importlib
 import pkgutil
 
 from ..registry import Family, Record, choices, family
-from .base import EngineChannel, EngineTable, Layout, Storage, Terms
+from .base import IBL, EngineChannel, EngineTable, Layout, Storage, Terms
 
 NOT_ENGINES = ("base",)
 FIRST = ("plain",)  # lutbake's own layouts lead the ``layout`` keys' lists (their defaults)
@@ -92,6 +92,7 @@ __all__ = [
     "TABLES",
     "EngineChannel",
     "EngineTable",
+    "IBL",
     "Layout",
     "Storage",
     "Terms",

@@ -111,6 +111,42 @@ class Layout:
 
 
 @dataclass(frozen=True)
+class IBL:
+    """The conventions one engine's image-based lighting shares between its DFG table and its environment cubes: the
+    NDF, masking and roughness definition the DFG table is integrated with, the mip curve by which the shader turns
+    that roughness into the specular cube's mip, and the lobe the cube is prefiltered with. Recorded as
+    ``lutbake:ibl`` in every file of each of the engine's tables (lutbake.provenance.ibl_attributes), so the files
+    of one ``<engine>-ibl`` run say they belong together; tests/test_layouts.py checks the tables' keys against it."""
+
+    engine: str
+    ndf: str
+    masking: str
+    roughness: str
+    curve: str
+    lobe: str
+    source: str
+
+    def record(self) -> dict[str, str]:
+        return {
+            "engine": self.engine,
+            "ndf": self.ndf,
+            "masking": self.masking,
+            "roughness": self.roughness,
+            "mip_curve": self.curve,
+            "lobe": self.lobe,
+            "source": self.source,
+        }
+
+    def keys(self, kind: str) -> dict[str, str]:
+        """The keys a table of ``kind`` holds under these conventions (dfg: ndf, masking, roughness; the specular
+        cube: curve, lobe; the irradiance cube: none)."""
+        return {
+            "dfg": {"ndf": self.ndf, "masking": self.masking, "roughness": self.roughness},
+            "environment_specular": {"curve": self.curve, "lobe": self.lobe},
+        }.get(kind, {})
+
+
+@dataclass(frozen=True)
 class EngineTable:
     """One table an engine loads, baked by a preset: the layout it is written in, the grid and storage keys the engine
     fixes (the preset's options must hold them: tests/test_layouts.py), the engine's source, what the engine loads
@@ -120,7 +156,8 @@ class EngineTable:
     code, as the LTC arrays). ``encoding``: how the engine's shipped file stores a value (a name of
     lutbake.commands.audit_search.ENCODINGS: ``plain`` UNORM codes or floats as read, ``rgbd`` Babylon's RGBD,
     ``rgbm``, ``srgb_encoded``, ``half_bits``); ``audit --preset`` decodes a file so when its storage can hold that
-    encoding (an 8-bit RGBA PNG for RGBD), and tries every other encoding as a hypothesis."""
+    encoding (an 8-bit RGBA PNG for RGBD), and tries every other encoding as a hypothesis. ``ibl``: the engine's
+    image-based-lighting conventions where the table is part of them (its DFG table, its environment cubes)."""
 
     engine: str
     preset: str
@@ -133,6 +170,7 @@ class EngineTable:
     shipped: str | None = None
     shader: str = ""
     encoding: str = "plain"
+    ibl: IBL | None = None
 
     def holds(self, kind: str, name: str, options: dict) -> bool:
         """Whether a table ``name`` of ``kind`` with ``options`` is this engine table: its name, and every key the

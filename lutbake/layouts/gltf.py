@@ -6,11 +6,17 @@ sheen_integrand_for): ``charlie`` B = ∫ D_charlie V_ashikhmin (n.l) dω (sourc
 ``sheen_albedo`` R = E = ∫ D_charlie V_charlie (n.l) dω (the spec's albedo scaling), G = the same with V_ashikhmin;
 ``*_clamped`` clamp V to [0, 1] as the viewer's V_Ashikhmin / V_Sheen do. The roughness axis holds alpha =
 sheenRoughness itself (KHR_materials_sheen's D and Lambda fit take it as is).
+
+Preset ``gltf-ibl`` bakes lut_ggx with the viewer's environment cubes (source/Renderer/shaders/ibl.glsl): the specular
+cube u_GGXEnvSampler at lod = roughness (u_MipCount - 1), the Lambertian cube u_LambertianEnvSampler, looked up at
+u_EnvRotation * direction (orientation ``gl``).
 """
 
 from __future__ import annotations
 
-from .base import EngineTable, Layout, Terms
+from dataclasses import replace
+
+from .base import IBL, EngineTable, Layout, Terms
 
 SHEEN_TERMS = Terms(ndf="charlie", masking="ashikhmin", fresnel="none")
 SHEEN_GL_ONLY = (
@@ -128,28 +134,67 @@ def viewer_sheen_table(preset: str, table: str, layout: str, size: int, loads: s
     return EngineTable("glTF Sample Viewer", preset, table, "dfg", layout, keys, VIEWER, loads, shader=shader)
 
 
+IBL_SOURCE = "glTF-Sample-Viewer source/Renderer/shaders/ibl.glsl (getIBLRadianceGGX, getDiffuseLight)"
+IBL_CONVENTIONS = IBL(
+    "glTF Sample Viewer",
+    ndf="ggx",
+    masking="smith_height_correlated",
+    roughness="perceptual",
+    curve="linear",
+    lobe="ggx_nl",
+    source="ibl.glsl: lod = roughness * float(u_MipCount - 1); f_ab = texture(u_GGXLUT, vec2(NdotV, roughness)); "
+    "lobe ggx_nl: lutbake's choice (glTF-IBL-Sampler's weighting not compared)",
+)
+CUBE_KEYS = {"orientation": "gl", "format": "ktx2", "dtype": "half"}  # textureLod(sampler, u_EnvRotation * R, lod)
+LUT_GGX = EngineTable(
+    "glTF Sample Viewer",
+    "gltf",
+    "lut_ggx",
+    "dfg",
+    "scale_bias",
+    {
+        "size": [1024, 1024],
+        "roughness": "perceptual",
+        "masking": "smith_height_correlated",
+        "layout": "scale_bias",
+        "texel": "center",
+        "row_order": "lo_first",
+        "format": "png16",
+    },
+    VIEWER,
+    "assets/images/lut_ggx.png (16-bit linear PNG)",
+    shipped="khronos_lut_ggx_u8.npz",
+    shader=(
+        "t = texture(u_GGXLUT, vec2(NdotV, r)).rg; k_S * t.r + t.g, k_S = F0 + (max(1 - r, F0) - F0) (1 - NdotV)^5"
+    ),
+    ibl=IBL_CONVENTIONS,
+)
 TABLES = (
+    LUT_GGX,
+    replace(LUT_GGX, preset="gltf-ibl", shipped=None),  # the same table in the one-run preset (audited as "gltf")
     EngineTable(
         "glTF Sample Viewer",
-        "gltf",
-        "lut_ggx",
-        "dfg",
-        "scale_bias",
-        {
-            "size": [1024, 1024],
-            "roughness": "perceptual",
-            "masking": "smith_height_correlated",
-            "layout": "scale_bias",
-            "texel": "center",
-            "row_order": "lo_first",
-            "format": "png16",
-        },
-        VIEWER,
-        "assets/images/lut_ggx.png (16-bit linear PNG)",
-        shipped="khronos_lut_ggx_u8.npz",
-        shader=(
-            "t = texture(u_GGXLUT, vec2(NdotV, r)).rg; k_S * t.r + t.g, k_S = F0 + (max(1 - r, F0) - F0) (1 - NdotV)^5"
-        ),
+        "gltf-ibl",
+        "gltf_specular",
+        "environment_specular",
+        None,
+        {"curve": "linear", "lobe": "ggx_nl", **CUBE_KEYS},
+        IBL_SOURCE,
+        "u_GGXEnvSampler (a cube with mips)",
+        shader="lod = roughness * float(u_MipCount - 1); textureLod(u_GGXEnvSampler, u_EnvRotation * reflection, lod)",
+        ibl=IBL_CONVENTIONS,
+    ),
+    EngineTable(
+        "glTF Sample Viewer",
+        "gltf-ibl",
+        "gltf_diffuse",
+        "environment_irradiance",
+        None,
+        CUBE_KEYS,
+        IBL_SOURCE,
+        "u_LambertianEnvSampler (a cube, E / pi)",
+        shader="texture(u_LambertianEnvSampler, u_EnvRotation * n).rgb",
+        ibl=IBL_CONVENTIONS,
     ),
     viewer_sheen_table(
         "gltf-charlie",

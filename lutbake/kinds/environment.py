@@ -1,0 +1,391 @@
+"""Kinds ``environment_specular`` and ``environment_irradiance``: the split sum's other half as config tables. Each
+bakes a lat-long environment (key ``environment``, a path relative to the config) into a cube map with lutbake's
+record (lutbake.io.cubemap): the prefiltered specular cube, one perceptual roughness r per mip by the engine's curve
+(lutbake.environment.curves), alpha = r^2; or the irradiance cube E / pi and its L2 SH (``<name>_sh.json``). The
+computation is lutbake.environment.prefilter.bake_cube and lutbake.environment.sh (docs/environment.md).
+
+They are baked whole (``Kind.bake``: the output is a lutbake.table.CubeTable, no (z,) y, x, C table). The environment
+file is read and checked where the config is (missing, unreadable, not a 2:1 EXR/HDR, a NaN or an infinity:
+ConfigError before any work), and its sha256, with the sources of the prefilter (lutbake.sources.ENVIRONMENT_SOURCES),
+enters the table's content hash (``inputs``): editing the file rebakes the table, leaving it skips it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..environment import cube, curves
+from ..io.environment import read_latlong
+from ..io.integrity import sha256_file
+from ..registry import Lazy, Record, choices, family
+from ..sources import ENVIRONMENT_SOURCES, sources_digest
+from ..table import CubeTable
+from .base import Estimation, Key, Kind, common_keys
+
+MIP_CURVE = family("mip_curve", "the engines' roughness <-> mip curves of a prefiltered specular cube")
+ENVIRONMENT_LOBE = family("environment_lobe", "the weight a prefiltered specular cube integrates the source against")
+for _curve in curves.CURVES.values():
+    MIP_CURVE.add(
+        Record(
+            "mip_curve",
+            _curve.name,
+            f"{_curve.lod}, r = perceptual roughness, M = mip count",
+            _curve.source,
+            fields={"obj": Lazy("lutbake.environment.curves:CURVES", _curve.name)},
+        )
+    )
+for _name, _desc, _cite in (
+    (
+        "ggx_nl",
+        "w = D_ggx(h) (n.l) / 4, n = v = r: the n.l-weighted prefilter",
+        "Karis 2013, the split sum's first sum",
+    ),
+    (
+        "ggx",
+        "w = D_ggx(h) / 4 over r.l > 0: the unweighted prefilter",
+        "Filament cmgen without n.l; glTF-IBL-Sampler with its n.l weighting off",
+    ),
+):
+    ENVIRONMENT_LOBE.add(
+        Record("environment_lobe", _name, _desc, _cite, fields={"obj": Lazy("lutbake.environment.lobes:LOBES", _name)})
+    )
+
+FORMATS = {
+    "ktx2": "KTX 2.0 cube, every mip (RGBA16F / RGBA32F, A = 1), the record in key lutbake:metadata + .json sidecar",
+    "dds": "DDS cube (DX10 header, TEXTURECUBE), every mip (RGBA16F / RGBA32F) + .json sidecar with the record",
+    "exr": "OpenEXR, one part per mip (mip_<m>: the six faces stacked top to bottom), the record in every part",
+}
+SH_FORMS = {
+    "radiance": "L_k = ∫ L Y_k dω (three.js LightProbe / SphericalHarmonics3.getIrradianceAt)",
+    "irradiance": "Â_l L_k: E(n) = Σ c_k Y_k(n) (Ramamoorthi & Hanrahan 2001, Eq. 8)",
+    "irradiance_over_pi": "Â_l L_k / pi: E(n) / pi = Σ c_k Y_k(n) (a white Lambertian surface's radiance)",
+}
+NO_ENVIRONMENT = (
+    'no environment file: set environment = "FILE" (a lat-long .exr or .hdr, width = 2 x height, relative to the '
+    "config) or give one on the command line: lutbake bake {config} --environment FILE "
+    "(Python: lutbake.bake(..., environment=FILE))"
+)
+PRESETS = Path(__file__).resolve().parent.parent / "presets"  # lutbake.config.PRESET_DIR, named here for the message
+ESTIMATION = Estimation(
+    {
+        "quadrature": "exact quadrature over the source's pyramid (lutbake.environment.quadrature): no random sample, "
+        "float64 sums, bit-identical for any worker count"
+    },
+    "quadrature",
+    "",
+)
+MAX_MIPS = 32  # KTX 2.0's levelCount of a 2^31-texel face; the texel cap (config.MAX_TEXELS) binds long before
+ROUGHNESS = "perceptual: the curve gives r per mip, alpha = r^2 (Burley 2012; glTF, Bevy, Filament)"
+SOURCE_CONVENTION = (
+    "lat-long, row 0 = +Y, u = 0.5 + atan2(z, x) / 2pi (lutbake.environment.latlong); texel-constant radiance"
+)
+ERROR_METHOD = (
+    "max relative |P - P_finer| over <= 96 strided probe texels per mip, P_finer at tau / 8, K x 2, order + 1, one "
+    "sub-texel level more (lutbake.environment.prefilter)"
+)
+
+
+ENVIRONMENT_KEY = Key(
+    "environment",
+    "str",
+    None,
+    "the lat-long environment: an .exr or .hdr file, width = 2 x height, row 0 = +Y, a path relative to "
+    "this config (absolute paths too); read and checked when the config is (missing, unreadable, not an "
+    "image, a NaN or an infinity: refused before any work); its sha256 enters the content hash. A preset "
+    "has none: lutbake bake --preset NAME --environment FILE",
+)
+
+
+def _common() -> dict[str, Key]:
+    """The keys both environment kinds share: name and kind (lutbake.kinds.base.common_keys; the environment kinds
+    have no samples, seed or tolerance), format, dtype, estimator, environment, orientation and the quadrature's
+    controls (lutbake.environment.prefilter.Quality)."""
+    named = {k: v for k, v in common_keys(ESTIMATION).items() if k in ("name", "kind")}
+    return {
+        **named,
+        "environment": ENVIRONMENT_KEY,
+        "format": Key("format", "str", "ktx2", "output file format: <out-dir>/<name>.<ext>", FORMATS),
+        "dtype": Key("dtype", "str", "half", "pixel type written", {"half": "16-bit float", "float32": "32-bit float"}),
+        "estimator": Key(
+            "estimator", "str", ESTIMATION.default, "how each texel's integral is computed", ESTIMATION.estimators
+        ),
+        "orientation": Key(
+            "orientation",
+            "str",
+            "gl",
+            "the world direction each texel's lookup vector stands for (recorded as face_convention): "
+            "d3d_left_handed for a shader that looks the cube up at (x, y, -z), as Bevy's environment_map.wgsl "
+            "(vec3(R.xy, -R.z)) and left-handed engines do",
+            {name: o.doc for name, o in cube.ORIENTATIONS.items()},
+        ),
+        "tau": Key(
+            "tau",
+            "float",
+            0.3,
+            "the quadrature's radiance-fixing tolerance (relative): smaller spends more pyramid leaves per texel",
+            minimum=1e-4,
+            maximum=3.0,
+        ),
+        "k_geo": Key(
+            "k_geo",
+            "float",
+            4.0,
+            "the quadrature's cell size per distance K: a leaf's angular radius times K is at most its distance to "
+            "the lobe's peak plus the lobe width",
+            minimum=1.0,
+            maximum=64.0,
+        ),
+        "order": Key(
+            "order", "int", 3, "Gauss-Legendre order per pyramid leaf and axis of the weight's integral", None, 1, 8
+        ),
+    }
+
+
+def environment_path(spec) -> Path:
+    """The environment file a spec names: its ``environment`` key, relative to its config's folder."""
+    return Path(spec.source).parent / spec.options["environment"]
+
+
+def check_environment(spec) -> tuple[str, str] | None:
+    """The environment file, read as the bake will (lutbake.io.environment.read_latlong): (key, why not) or None."""
+    if spec.options.get("environment") is None:
+        source = Path(spec.source)
+        preset = source.suffix == ".toml" and source.resolve().parent == PRESETS
+        return "environment", NO_ENVIRONMENT.format(config=f"--preset {source.stem}" if preset else source)
+    try:
+        read_latlong(environment_path(spec))
+    except (ValueError, OSError) as e:
+        return "environment", f"cannot be baked: {e}"
+    return None
+
+
+def environment_inputs(spec) -> bytes:
+    """What an environment table's values depend on besides its config and lutbake's sources (Kind.inputs): the
+    environment file's sha256 (read now) and the prefilter's sources (ENVIRONMENT_SOURCES)."""
+    try:
+        digest = sha256_file(environment_path(spec))
+    except OSError as e:  # removed since the config was read: a hash that matches no file; the bake says why
+        digest = f"unreadable: {e}"
+    return inputs_of(digest)
+
+
+def inputs_of(sha256: str) -> bytes:
+    """The inputs of a table baked from an environment whose bytes have ``sha256`` (CubeTable.inputs)."""
+    return b"\0".join((b"environment", sha256.encode(), sources_digest(ENVIRONMENT_SOURCES)))
+
+
+def mip_count(options) -> int:
+    """The mips of a specular cube: ``mips``, or the full chain floor(log2 size) + 1 (the last mip 1 x 1)."""
+    full = int(options["size"]).bit_length()
+    return full if options.get("mips") is None else int(options["mips"])
+
+
+def cube_texels(size: int, mips: int) -> int:
+    """6 sum_m max(1, size >> m)^2."""
+    return 6 * sum(max(1, size >> m) ** 2 for m in range(mips))
+
+
+def specular_texels(options) -> int:
+    """6 x size^2 over every mip"""
+    return cube_texels(int(options["size"]), mip_count(options))
+
+
+def irradiance_texels(options) -> int:
+    """6 x size^2"""
+    return cube_texels(int(options["size"]), 1)
+
+
+def check_specular(spec):
+    """``mips`` within the chain ``size`` has, then the environment file."""
+    o = spec.options
+    full = int(o["size"]).bit_length()
+    if o.get("mips") is not None and o["mips"] > full:
+        return "mips", f"a {o['size']}^2 cube has at most {full} mips (the last 1 x 1): floor(log2 size) + 1"
+    return check_environment(spec)
+
+
+def quality(o):
+    from ..environment.prefilter import Quality
+
+    return Quality(o["tau"], o["k_geo"], o["order"])
+
+
+def read_source(spec):
+    """(the environment as read, its pyramid): the source turned by the spec's orientation. A lookup vector d
+    stands for the world direction d x flip (cube.ORIENTATIONS); flipping z is phi -> -phi, the columns reversed
+    (u -> 1 - u, exact for texel-constant radiance), so the cube is baked from the mirrored image."""
+    from ..environment import latlong
+
+    env = read_latlong(environment_path(spec))
+    flip = cube.ORIENTATIONS[spec.options["orientation"]].flip
+    if flip != (1.0, 1.0, -1.0) and flip != (1.0, 1.0, 1.0):
+        raise ValueError(f"orientation {spec.options['orientation']!r}: only a z flip is baked")
+    image = env.image[:, ::-1] if flip[2] < 0 else env.image
+    return env, latlong.pyramid(image)
+
+
+def base_record(spec, env, baked) -> dict:
+    """The record every environment file carries (lutbake.io.cubemap): the conventions, the source, the lobes and
+    the per-mip error estimate of ``baked`` (lutbake.environment.prefilter.Baked)."""
+    o = spec.options
+    orientation = cube.ORIENTATIONS[o["orientation"]]
+    return {
+        "face_convention": f"{orientation.name}: faces +X -X +Y -Y +Z -Z in the OpenGL / KTX / Vulkan face table "
+        "(lutbake.environment.cube)",
+        "orientation": orientation.doc,
+        "source": Path(o["environment"]).name,
+        "source_sha256": env.sha256,
+        "source_negative_values_zeroed": env.negatives,
+        "source_convention": SOURCE_CONVENTION,
+        "split_sum": "n = v = r",
+        "lobes": baked.lobes,
+        "error_estimate_per_mip": baked.errors,
+        "error_estimate_method": ERROR_METHOD,
+        "quality": {"tau": o["tau"], "k_geo": o["k_geo"], "order": o["order"]},
+    }
+
+
+def bake_specular(spec, workers: int | None = None, device: str = "cpu") -> CubeTable:
+    """The prefiltered specular cube of ``spec`` (nothing written): mip m at the curve's r_m, alpha = r_m^2; mip 0
+    (r = 0) the exact area average over each texel's footprint."""
+    from ..environment import prefilter
+
+    o = spec.options
+    curve, lobe = spec.records["curve"], spec.records["lobe"]
+    env, pyr = read_source(spec)
+    mips = mip_count(o)
+    roughness = [curve.obj.roughness(m, mips) for m in range(mips)]
+    baked = prefilter.bake_cube(pyr, o["size"], roughness, lobe.name, quality(o), workers, device=device)
+    record = base_record(spec, env, baked) | {
+        "ndf": "ggx",
+        "roughness_definition": ROUGHNESS,
+        "weighting": f"{lobe.name}: {lobe.description} ({lobe.citation})",
+        "mip_curve": f"{curve.name}: {curve.obj.lod} ({curve.obj.source})",
+        "roughness": baked.roughness,
+        "alpha": baked.alphas,
+        "mip0": "the exact area average of the source over each texel's footprint"
+        if baked.lobes[0] == "footprint"
+        else baked.lobes[0],
+    }
+    return CubeTable(spec.name, spec.kind, baked.mips, record, specular_reconstruction(spec), inputs_of(env.sha256))
+
+
+def bake_irradiance(spec, workers: int | None = None, device: str = "cpu") -> CubeTable:
+    """The irradiance cube E / pi of ``spec`` and its L2 SH (nothing written); the SH of the world's directions
+    (the orientation turns the cube only)."""
+    from ..environment import prefilter, sh
+
+    o = spec.options
+    env, pyr = read_source(spec)
+    baked = prefilter.bake_cube(pyr, o["size"], [1.0], "cosine", quality(o), workers, device=device)
+    coefficients = sh.convolve(sh.project(env.image), o["sh_form"])
+    doc = {
+        "basis": "real SH, Ramamoorthi & Hanrahan 2001 / three.js order: Y00; Y1-1 y, Y10 z, Y11 x; Y2-2 xy, "
+        "Y2-1 yz, Y20 3z^2-1, Y21 xz, Y22 x^2-y^2 (lutbake.environment.sh), on the y-up world direction",
+        "integration": "exact per source texel (closed-form theta and phi integrals), texel-constant radiance",
+        "source": Path(o["environment"]).name,
+        "source_sha256": env.sha256,
+        "form": o["sh_form"],
+        "form_meaning": SH_FORMS[o["sh_form"]],
+        "coefficients": coefficients.tolist(),
+    }
+    record = base_record(spec, env, baked) | {
+        "weighting": "cosine: (n.l)+, P = E / pi",
+        "sh_file": f"{spec.name}{SH_SUFFIX}",
+        "sh_form": o["sh_form"],
+        "sh": coefficients.tolist(),
+    }
+    return CubeTable(
+        spec.name, spec.kind, baked.mips, record, irradiance_reconstruction(spec), inputs_of(env.sha256), sh=doc
+    )
+
+
+SH_SUFFIX = "_sh.json"
+
+
+def specular_reconstruction(spec) -> str:
+    """How a shader reads the specular cube (lutbake's own text; an engine's line is put first where the table is
+    one of its records, lutbake.layouts.reconstruction_with_engine_line)."""
+    curve = spec.records["curve"].obj
+    return (
+        f"lod = {curve.lod.removeprefix('lod = ')} (M = {mip_count(spec.options)} mips, r = perceptual roughness); "
+        "prefiltered = textureLod(cube, R, lod).rgb, R = reflect(-V, N); "
+        "specular = prefiltered * (f0 * dfg.r + f90 * dfg.g) with the DFG table of the same roughness"
+    )
+
+
+def reconstruction(spec) -> str:
+    """How a shader reads the cube of ``spec`` (either environment kind), before any engine's line."""
+    return specular_reconstruction(spec) if spec.kind == "environment_specular" else irradiance_reconstruction(spec)
+
+
+def irradiance_reconstruction(spec) -> str:
+    return (
+        "irradiance_over_pi = texture(cube, N).rgb (E / pi); diffuse = albedo * irradiance_over_pi; "
+        f"SH ({spec.options['sh_form']}): {spec.name}{SH_SUFFIX}"
+    )
+
+
+COMMON = _common()
+HEAD = ("name", "kind", "environment")  # the kind's own keys follow these, then the rest of COMMON
+
+
+def _keys(own: dict[str, Key]) -> dict[str, Key]:
+    return {**{k: COMMON[k] for k in HEAD}, **own, **{k: v for k, v in COMMON.items() if k not in HEAD}}
+
+
+SPECULAR_KEYS = _keys(
+    {
+        "size": Key("size", "int", 256, "face size of mip 0 (texels a side); mip m is max(1, size >> m)", minimum=1),
+        "mips": Key(
+            "mips",
+            "int",
+            None,
+            "mip count (unset: the full chain, floor(log2 size) + 1, the last 1 x 1)",
+            minimum=1,
+            maximum=MAX_MIPS,
+        ),
+        "curve": Key(
+            "curve",
+            "str",
+            "linear",
+            "the engine's roughness -> mip curve: mip m holds the perceptual roughness the curve gives it",
+            choices(MIP_CURVE),
+        ),
+        "lobe": Key(
+            "lobe", "str", "ggx_nl", "the weight each texel integrates the source against", choices(ENVIRONMENT_LOBE)
+        ),
+    }
+)
+IRRADIANCE_KEYS = _keys(
+    {
+        "size": Key("size", "int", 32, "face size (texels a side); one mip", minimum=1),
+        "sh_form": Key("sh_form", "str", "radiance", "the L2 SH coefficients written to <name>_sh.json", SH_FORMS),
+    }
+)
+
+
+ENVIRONMENT_SPECULAR = Kind(
+    "environment_specular",
+    "prefiltered specular cube map with mips (GGX, one perceptual roughness per mip by the engine's curve) of a "
+    "lat-long environment",
+    SPECULAR_KEYS,
+    None,
+    check=check_specular,
+    texels=specular_texels,
+    texels_doc=specular_texels.__doc__,
+    bake=bake_specular,
+    inputs=environment_inputs,
+)
+ENVIRONMENT_IRRADIANCE = Kind(
+    "environment_irradiance",
+    "irradiance cube map (E / pi) and its L2 spherical harmonics (<name>_sh.json) of a lat-long environment",
+    IRRADIANCE_KEYS,
+    None,
+    check=check_environment,
+    texels=irradiance_texels,
+    texels_doc=irradiance_texels.__doc__,
+    bake=bake_irradiance,
+    inputs=environment_inputs,
+    outputs=((SH_SUFFIX, "L2 SH coefficients"),),
+)
