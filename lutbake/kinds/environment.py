@@ -68,10 +68,14 @@ NO_ENVIRONMENT = (
 PRESETS = Path(__file__).resolve().parent.parent / "presets"  # lutbake.config.PRESET_DIR, named here for the message
 ESTIMATION = Estimation(
     {
+        "auto": "each mip by spherical harmonics where its lobe allows (every GGX mip with alpha above ~0.007, the "
+        "irradiance cube), the others (the footprint mip 0, narrower lobes) by the quadrature",
+        "harmonic": "exact convolution by spherical harmonics (lutbake.environment.harmonic, ducc0): seconds; a mip "
+        "it cannot bake is refused",
         "quadrature": "exact quadrature over the source's pyramid (lutbake.environment.quadrature): no random sample, "
-        "float64 sums, bit-identical for any worker count"
+        "float64 sums, bit-identical for any worker count; minutes for a 256^2 cube of a 2048 x 1024 source",
     },
-    "quadrature",
+    "auto",
     "",
 )
 MAX_MIPS = 32  # KTX 2.0's levelCount of a 2^31-texel face; the texel cap (config.MAX_TEXELS) binds long before
@@ -239,6 +243,8 @@ def base_record(spec, env, baked) -> dict:
         "source_convention": SOURCE_CONVENTION,
         "split_sum": "n = v = r",
         "lobes": baked.lobes,
+        "method_per_mip": baked.methods,
+        "harmonic_lmax": baked.lmax,
         "error_estimate_per_mip": baked.errors,
         "error_estimate_method": ERROR_METHOD,
         "quality": {"tau": o["tau"], "k_geo": o["k_geo"], "order": o["order"]},
@@ -255,7 +261,9 @@ def bake_specular(spec, workers: int | None = None, device: str = "cpu") -> Cube
     env, pyr = read_source(spec)
     mips = mip_count(o)
     roughness = [curve.obj.roughness(m, mips) for m in range(mips)]
-    baked = prefilter.bake_cube(pyr, o["size"], roughness, lobe.name, quality(o), workers, device=device)
+    baked = prefilter.bake_cube(
+        pyr, o["size"], roughness, lobe.name, quality(o), workers, device=device, method=o["estimator"]
+    )
     record = base_record(spec, env, baked) | {
         "ndf": "ggx",
         "roughness_definition": ROUGHNESS,
@@ -277,7 +285,7 @@ def bake_irradiance(spec, workers: int | None = None, device: str = "cpu") -> Cu
 
     o = spec.options
     env, pyr = read_source(spec)
-    baked = prefilter.bake_cube(pyr, o["size"], [1.0], "cosine", quality(o), workers, device=device)
+    baked = prefilter.bake_cube(pyr, o["size"], [1.0], "cosine", quality(o), workers, device=device, method=o["estimator"])
     coefficients = sh.convolve(sh.project(env.image), o["sh_form"])
     doc = {
         "basis": "real SH, Ramamoorthi & Hanrahan 2001 / three.js order: Y00; Y1-1 y, Y10 z, Y11 x; Y2-2 xy, "
