@@ -11,6 +11,8 @@
 - **EXR**: one part per mip, named ``mip_<m>``, the six faces stacked top to bottom (+X, -X, +Y, -Y, +Z, -Z; 6n rows
   of n), RGB; every part's display window is mip 0's (OpenEXR shares it between parts), its data window its own,
   at the origin. The record: ``lutbake:*`` attributes in every part.
+- **KTX 1** (``ktx1``): Filament's image-based light, the layout cmgen writes (lutbake.io.ktx1): R11F_G11F_B10F
+  (cmgen's), RGB16F or RGB32F, level 0 first, faces +X first, with the SH Filament's shader takes as key ``sh``.
 
 Faces are written as lutbake.environment.cube's table gives them (OpenGL / KTX orientation); ``face_convention`` in
 the record says so. Values must be finite and (half) below 65504: anything else is refused, never written.
@@ -124,11 +126,19 @@ def encode_dds_cube(mips: list[np.ndarray], dtype: str = "half") -> bytes:
     return b"DDS " + header + dx10 + data
 
 
-def write_cube(mips: list[np.ndarray], path, metadata: dict, fmt: str, dtype: str = "half") -> Path:
-    """Write a cube with mips to ``path`` in ``fmt`` (ktx2, dds, exr), atomically; dds also writes the metadata to
+def write_cube(
+    mips: list[np.ndarray], path, metadata: dict, fmt: str, dtype: str = "half", sh: np.ndarray | None = None
+) -> Path:
+    """Write a cube with mips to ``path`` in ``fmt`` (ktx2, dds, exr, ktx1), atomically; dds also writes the metadata to
     ``<path>.json``. Values that are not strings are written as JSON text in EXR attributes and the sidecar (every
-    ``lutbake:*`` value is a string), as one JSON object in KTX 2.0's ``lutbake:metadata``."""
+    ``lutbake:*`` value is a string), as one JSON object in KTX 2.0's and KTX 1's ``lutbake:metadata``. ``ktx1`` is
+    Filament's IBL file (lutbake.io.ktx1: ``dtype`` r11g11b10f, half or float32; ``sh`` the (9, 3) coefficients of
+    lutbake.environment.sh form ``filament``, written as its ``sh`` key)."""
     path = Path(path)
+    if fmt == "ktx1":
+        from .ktx1 import encode_ktx1_cube
+
+        return atomic_write_bytes(path, encode_ktx1_cube(mips, dtype, sh, metadata))
     if fmt == "ktx2":
         return atomic_write_bytes(path, encode_ktx2_cube(mips, metadata, dtype))
     text = {k: v if isinstance(v, str) else json.dumps(v, sort_keys=True) for k, v in metadata.items()}
@@ -145,4 +155,4 @@ def write_cube(mips: list[np.ndarray], path, metadata: dict, fmt: str, dtype: st
             for m, a in enumerate(rgba(mips, dtype))
         ]
         return atomic_write(path, lambda tmp: _write_oiio(tmp, parts, EXR_TYPES[dtype]))
-    raise ValueError(f"cube format must be ktx2, dds or exr, got {fmt!r}")
+    raise ValueError(f"cube format must be ktx2, dds, exr or ktx1, got {fmt!r}")
