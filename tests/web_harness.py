@@ -171,10 +171,10 @@ def bake_preset(tmp_path_factory, engine_dir: str, preset: str) -> Path:
     return luts
 
 
-def render_furnaces(luts: Path, engine_dir: str, pages, spec: dict) -> dict:
+def render_furnaces(luts: Path, engine_dir: str, pages, spec: dict, infos: dict | None = None) -> dict:
     """{variant: (height, width, RGB) float pixels} of ``pages`` = [(URL path, {variant: extra spec})], each page
-    opened once in one browser and driven through window.furnace; skips the test (pytest) with the reason where the
-    harness cannot run."""
+    opened once in one browser and driven through window.furnace (``infos``, if given, gets each variant's ``info``);
+    skips the test (pytest) with the reason where the harness cannot run."""
     import numpy as np
     import pytest
 
@@ -189,6 +189,8 @@ def render_furnaces(luts: Path, engine_dir: str, pages, spec: dict) -> dict:
             for name, extra in variants.items():
                 r = page.evaluate("spec => window.furnace(spec)", {**spec, **extra})
                 out[name] = np.asarray(r["pixels"], np.float64).reshape(r["height"], r["width"], 4)[..., :3]
+                if infos is not None:
+                    infos[name] = r.get("info")
             assert not page.errors, page.errors
             page.close()
     return out
