@@ -43,12 +43,12 @@ WEB_DFG_SIZE = 64  # the DFG table Filament 1.53.4's WebGL build uploads (measur
 MIN_PERCEPTUAL_ROUGHNESS = 0.089
 DIELECTRIC_F0 = 0.04  # glTF's default IOR 1.5
 IBL_SIZE, IBL_MIN_SIZE = 64, 16  # cmgen's mips stop at 16² (IBL_DEFAULT_MIN_LOD_SIZE)
-# Filament's pixels vs the CPU model of the same texels: measured 1.7e-4 (the shader's mediump arithmetic and
-# SwiftShader's filtering of a half-float table; RMS 1.5e-5)
+# Filament's pixels vs the CPU model of the same texels: measured 1.7e-4, RMS 1.5e-5 (the mobile materials' arithmetic
+# and SwiftShader's filtering of a half-float table, not modelled: 8-bit texel weights alone do not explain it)
 TEXELS_ATOL = 4e-4
-# Filament's built-in 64² table (cmgen's 1024-point estimate, the one-texel roughness offset) against the exact answer,
-# and lutbake's `filament-corrected` at 64²: measured below (docs/presets.md); the wrong loads of lutbake's table
-# measured max >= 0.1, RMS >= 0.02
+# against the exact answer: lutbake's `filament-corrected` at 64² measured max 7.5e-3, RMS 3.9e-4 (Filament's built-in
+# table, cmgen's estimate with its one-texel roughness offset: 3.6e-2, 5.0e-3; docs/in-engines.md); the wrong loads
+# of lutbake's table measured max >= 0.85, RMS >= 0.157
 CORRECTED_MAX, CORRECTED_RMS = 1e-2, 1e-3
 DFG_MISTAKES = ("flipY", "swapRG")
 # (b), the float32 file: the smooth cube's bilinear interpolation between texel centres and the shader's arithmetic:
