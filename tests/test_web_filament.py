@@ -58,6 +58,7 @@ DFG_MISTAKES = ("flipY", "swapRG")
 ENV_A, ENV_B = 0.6, 0.35
 ENV_ATOL, ENV_RMS = 1e-3, 2e-4
 ENV_MISTAKES = ("swapX", "flipRows", "shForm")
+FILES = {"filament": "filament_dfg", "corrected": "filament_dfg_corrected"}  # the two bakes' DDS names
 R11G11B10_HALF_STEP = np.array([2.0**-7, 2.0**-7, 2.0**-6])
 
 
@@ -83,12 +84,9 @@ def env_sh(form="filament") -> np.ndarray:
 
 
 def write_ibls(luts):
-    """The KTX 1 files the page loads: the furnace's constant cube, the environment and its wrong versions."""
-    constant = np.zeros((9, 3))
-    constant[0] = 1.0  # E / pi = 1 for L = 1 (form filament: c_0 = L)
-    (luts / "filament_furnace_ibl.ktx").write_bytes(
-        encode_ktx1_cube(cube_mips(lambda d: np.ones(d.shape)), sh=constant)
-    )
+    """The KTX 1 files the page loads: the furnace's constant cube (web_harness.write_furnace_ibl, as make demo), the
+    environment and its wrong versions."""
+    web_harness.write_furnace_ibl(luts / web_harness.FILAMENT_WEB, IBL_SIZE, IBL_MIN_SIZE)
     mips = cube_mips(environment)
     files = {
         "env": (mips, env_sh(), "float32"),
@@ -181,7 +179,8 @@ def renders(tmp_path_factory):
     web_harness.require(ENGINE_DIR)
     luts = tmp_path_factory.mktemp("filament")
     size = f"size=[{WEB_DFG_SIZE},{WEB_DFG_SIZE}]"
-    bake([preset_path("filament"), preset_path("filament-corrected")], luts, [size, "row_order=lo_first"])
+    web = luts / web_harness.FILAMENT_WEB  # as make demo bakes them
+    bake([preset_path("filament"), preset_path("filament-corrected")], web, [size, "row_order=lo_first"])
     # the `filament` conventions integrated as cmgen does (1024 Hammersley points; R, G only: the QMC estimators do
     # not take the cloth channel)
     cmgen_like = ["layout=multiscatter", "estimator=hammersley_ndf", "samples=1024"]
@@ -189,7 +188,7 @@ def renders(tmp_path_factory):
     write_ibls(luts)
     spec = web_harness.furnace_chart()
     chart = env_chart()
-    lut = {"filament": "/lut/filament_dfg.dds", "corrected": "/lut/filament_dfg_corrected.dds"}
+    lut = {name: f"/lut/{web_harness.FILAMENT_WEB}/{file}.dds" for name, file in FILES.items()}
     variants = {"shipped": {}, "lutbake": {"dfg": lut["filament"]}, "corrected": {"dfg": lut["corrected"]}}
     variants.update({m: {"dfg": lut["corrected"], "mistake": m} for m in DFG_MISTAKES})
     variants.update(
@@ -238,7 +237,7 @@ def test_filament_renders_its_own_dfg_table_as_the_cpu_model(renders):
 def test_filament_samples_lutbakes_table_as_its_contract_says(renders):
     """lutbake's `filament-corrected` at 64², rows lo_first (GL order: what cmgen writes to dfg.inc), written into
     Filament's DFG texture: the pixels are the CPU model of those texels at vec2(NoV, r)."""
-    texels = read_dds(renders["luts"] / "filament_dfg_corrected.dds").data.astype(np.float64)
+    texels = read_dds(renders["luts"] / web_harness.FILAMENT_WEB / "filament_dfg_corrected.dds").data.astype(float)
     model = furnace_model(table(texels), renders["spec"])
     np.testing.assert_allclose(renders["corrected"], model, rtol=0, atol=TEXELS_ATOL)
 

@@ -9,7 +9,7 @@
 // The tables: Babylon creates scene._ltcTextures (Lights/areaLight.pure.js CreateSceneLTCTextures: two 64² RGBA
 // HALF_FLOAT RawTextures, bilinear, clamp, invertY false) and fills them from areaLightsLTC.bin, fetched through
 // Tools.GetAssetUrl: spec.assets (Tools.AssetBaseUrl) points Babylon at the folder of lutbake's file
-// (<assets>/areaLights/areaLightsLTC.bin); none: Babylon's own CDN file.
+// (<assets>/areaLights/areaLightsLTC.bin); none: Babylon's own CDN file (needs the network).
 import { Engine } from '/web/node_modules/@babylonjs/core/Engines/engine.js';
 import { Constants } from '/web/node_modules/@babylonjs/core/Engines/constants.js';
 import '/web/node_modules/@babylonjs/core/Engines/Extensions/engine.rawTexture.js';
@@ -58,7 +58,10 @@ function areaLight( scene, light ) {
 
 }
 
-async function rectArea( { nov, rows, light = LIGHT, scale = SCALE, eye = EYE_DISTANCE, assets = params.get( 'assets' ) } ) {
+// spec.assets: Tools.AssetBaseUrl ('' : Babylon's CDN); else spec.lut (the demo, ?lut=): 'shipped' (the CDN) or
+// 'lutbake' (/lut/babylon: make demo puts lutbake's areaLightsLTC.bin in outputs/babylon/areaLights/)
+async function rectArea( { nov, rows, light = LIGHT, scale = SCALE, eye = EYE_DISTANCE, lut = params.get( 'lut' ) || 'shipped',
+	assets = lut === 'lutbake' ? '/lut/babylon' : '' } ) {
 
 	const width = nov.length, height = rows.length;
 	if ( ! engine ) {
@@ -70,7 +73,7 @@ async function rectArea( { nov, rows, light = LIGHT, scale = SCALE, eye = EYE_DI
 
 	}
 	engine.setSize( width, height );
-	Tools.AssetBaseUrl = assets || '';
+	Tools.AssetBaseUrl = assets;
 	const scene = new Scene( engine );
 	scene.clearColor = new Color4( 0, 0, 0, 1 );
 	scene.imageProcessingConfiguration.applyByPostProcess = true;  // no tone mapping, no gamma: linear float out

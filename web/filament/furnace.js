@@ -8,13 +8,17 @@
 // axis, +z, at every fragment), a float RenderTarget read back through gl.js.
 //
 // The chart: spec.nov (NoV per column: normals (0, sqrt(1 - NoV²), NoV)) or spec.normals (one unit normal per pixel,
-// row 0 at the bottom), spec.rows (per row: { roughness, metalness, color }). spec.ibl: the KTX's URL. spec.dfg:
-// 'shipped' (Filament's built-in table), or the URL of a DDS (RGBA16F, rows as Filament uploads them) whose RGB is
-// written into Filament's DFG texture in place of its own (gl.js), with spec.mistake 'none', 'flipY' or 'swapRG'.
+// row 0 at the bottom), spec.rows (per row: { roughness, metalness, color }). spec.ibl: the KTX's URL (default: the
+// furnace's, make demo writes it). spec.dfg: 'shipped' (Filament's built-in table), or the URL of a DDS (RGBA16F, rows
+// as Filament uploads them) whose RGB is written into Filament's DFG texture in place of its own (gl.js), with
+// spec.mistake 'none', 'flipY' or 'swapRG'; spec.lut (the demo, ?lut=): 'shipped', or 'lutbake' for lutbake's
+// `filament-corrected` at the web build's 64² (make demo bakes it into outputs/filament-web/).
 import { expose } from '/web/furnace.js';
 
 const ready = new Promise( ( resolve ) => Filament.init( [], resolve ) );
 const CAMERA_Z = 10;
+const WEB = '/lut/filament-web';
+const LUT = new URLSearchParams( location.search ).get( 'lut' ) || 'shipped';
 let filament = null;
 
 function setUp( width, height ) {
@@ -193,13 +197,14 @@ async function furnace( spec ) {
 	const width = spec.nov ? spec.nov.length : spec.width, height = spec.rows.length;
 	if ( ! filament || filament.width !== width || filament.height !== height ) filament = setUp( width, height );
 	const state = filament;
-	const ibl = await indirectLight( state.engine, spec.ibl || '/lut/filament_furnace_ibl.ktx' );
+	const ibl = await indirectLight( state.engine, spec.ibl || `${ WEB }/filament_furnace_ibl.ktx` );
 	state.scene.setIndirectLight( ibl.light );
 	const asset = await loadAsset( state, chartGLB( spec, width, height ) );
 	state.scene.addEntities( asset.getEntities() );
 	render( state );  // the first frame uploads Filament's DFG texture (gl.js keeps its bits)
 	if ( state.shippedDFG === null ) state.shippedDFG = filamentGL.dfg.slice();
-	const dfg = spec.dfg || 'shipped';
+	const lut = spec.lut || LUT;
+	const dfg = spec.dfg || ( lut === 'lutbake' ? `${ WEB }/filament_dfg_corrected.dds` : 'shipped' );
 	filamentGL.replaceDFG( dfg === 'shipped' ? state.shippedDFG : await dfgBits( dfg, spec.mistake || 'none', filamentGL.dfgSize ) );
 	const pixels = render( state );
 	filamentGL.replaceDFG( state.shippedDFG );
