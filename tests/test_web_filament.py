@@ -53,13 +53,14 @@ CORRECTED_MAX, CORRECTED_RMS = 1e-2, 1e-3
 DFG_MISTAKES = ("flipY", "swapRG")
 # (b), the float32 file: the smooth cube's bilinear interpolation between texel centres and the shader's arithmetic:
 # measured max 3.4e-4 (metal; the dielectric 4.5e-5), RMS 3.8e-5; the wrong files measured max >= 0.47, RMS >= 0.11.
-# cmgen's R11F_G11F_B10F file adds its rounding, at most half a step: 2^-7 (R, G) and 2^-6 (B) of the value
-# (measured 0.41 % and 0.86 %)
+# The R11F_G11F_B10F (cmgen's) and RGB16F files add their rounding, at most half a step of the value: measured 0.41 %
+# (R, G) and 0.86 % (B) of it, RGB16F max 4.3e-4 (as the float32 file's)
 ENV_A, ENV_B = 0.6, 0.35
 ENV_ATOL, ENV_RMS = 1e-3, 2e-4
 ENV_MISTAKES = ("swapX", "flipRows", "shForm")
 FILES = {"filament": "filament_dfg", "corrected": "filament_dfg_corrected"}  # the two bakes' DDS names
-R11G11B10_HALF_STEP = np.array([2.0**-7, 2.0**-7, 2.0**-6])
+# the other formats' rounding, half a step of the value: cmgen's R11F_G11F_B10F (R, G: 6 mantissa bits, B: 5) and RGB16F
+ROUNDED = {"env_r11g11b10f": np.array([2.0**-7, 2.0**-7, 2.0**-6]), "env_half": np.full(3, 2.0**-11)}
 
 
 def environment(d) -> np.ndarray:
@@ -91,6 +92,7 @@ def write_ibls(luts):
     files = {
         "env": (mips, env_sh(), "float32"),
         "env_r11g11b10f": (mips, env_sh(), "r11g11b10f"),
+        "env_half": (mips, env_sh(), "half"),
         "swapX": ([m[[1, 0, 2, 3, 4, 5]] for m in mips], env_sh(), "float32"),
         "flipRows": ([m[:, ::-1] for m in mips], env_sh(), "float32"),
         "shForm": (mips, env_sh("irradiance_over_pi"), "float32"),
@@ -192,7 +194,7 @@ def renders(tmp_path_factory):
     variants = {"shipped": {}, "lutbake": {"dfg": lut["filament"]}, "corrected": {"dfg": lut["corrected"]}}
     variants.update({m: {"dfg": lut["corrected"], "mistake": m} for m in DFG_MISTAKES})
     variants.update(
-        {m: {**chart, "ibl": f"/lut/filament_{m}_ibl.ktx"} for m in ("env", "env_r11g11b10f", *ENV_MISTAKES)}
+        {m: {**chart, "ibl": f"/lut/filament_{m}_ibl.ktx"} for m in ("env", *ROUNDED, *ENV_MISTAKES)}
     )
     infos = {}
     out = web_harness.render_furnaces(luts, ENGINE_DIR, [(PAGE, variants)], spec, infos)
@@ -270,9 +272,10 @@ def test_filament_loads_lutbakes_ktx1_cube_and_sh_as_written(renders):
     assert worst < ENV_ATOL and rms < ENV_RMS
 
 
-def test_filament_loads_cmgens_r11g11b10f_format_within_its_rounding(renders):
+@pytest.mark.parametrize("variant", sorted(ROUNDED))
+def test_filament_loads_the_r11g11b10f_and_half_files_within_their_rounding(renders, variant):
     model = env_model(table(dfg_texels(renders["info"]["dfg"])), renders["chart"])
-    worst = np.abs(renders["env_r11g11b10f"] - model) - R11G11B10_HALF_STEP * model
+    worst = np.abs(renders[variant] - model) - ROUNDED[variant] * model
     assert worst.max() < ENV_ATOL
 
 
