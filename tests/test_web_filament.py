@@ -193,9 +193,7 @@ def renders(tmp_path_factory):
     lut = {name: f"/lut/{web_harness.FILAMENT_WEB}/{file}.dds" for name, file in FILES.items()}
     variants = {"shipped": {}, "lutbake": {"dfg": lut["filament"]}, "corrected": {"dfg": lut["corrected"]}}
     variants.update({m: {"dfg": lut["corrected"], "mistake": m} for m in DFG_MISTAKES})
-    variants.update(
-        {m: {**chart, "ibl": f"/lut/filament_{m}_ibl.ktx"} for m in ("env", *ROUNDED, *ENV_MISTAKES)}
-    )
+    variants.update({m: {**chart, "ibl": f"/lut/filament_{m}_ibl.ktx"} for m in ("env", *ROUNDED, *ENV_MISTAKES)})
     infos = {}
     out = web_harness.render_furnaces(luts, ENGINE_DIR, [(PAGE, variants)], spec, infos)
     out.update(spec=spec, chart=chart, info=infos["shipped"], luts=luts)
