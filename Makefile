@@ -2,7 +2,8 @@
 #   make luts      create the venv if missing, install, bake every config in configs/ and every engine
 #                  preset (PRESETS) into outputs/
 #   make test      create the venv if missing, install, run ruff (check + format --check), then the test suite
-#   make demo      bake the presets the engine pages load (threejs, babylon, ltc-threejs) into outputs/ (if not up to
+#   make demo      bake the presets the engine pages load (threejs, babylon, ltc-threejs, ltc-babylon; filament and
+#                  filament-corrected at Filament's web 64² into outputs/filament-web/) into outputs/ (if not up to
 #                  date) and serve the pages (web/) on 127.0.0.1:8049: each engine's shipped table beside lutbake's,
 #                  and their difference
 PYTHON ?= python3
@@ -61,7 +62,9 @@ test: $(STAMP) lint
 # the engines' npm packages (web/package-lock.json) on first use; then tests/web_harness.py serves the pages
 demo: $(STAMP)
 	test -d web/node_modules || npm ci --prefix web
-	$(BIN)/lutbake bake --preset threejs --preset babylon --preset ltc-threejs --out-dir $(OUT)
+	$(BIN)/lutbake bake --preset threejs --preset babylon --preset ltc-threejs --preset ltc-babylon --out-dir $(OUT)
+	$(BIN)/lutbake bake --preset filament --preset filament-corrected --set 'size=[64,64]' --set row_order=lo_first \
+		--out-dir $(OUT)/filament-web
 	$(BIN)/python tests/web_harness.py --luts $(OUT)
 
 # diffuse kinds against converged references (accuracy and wall time): outputs/bench/diffuse.json

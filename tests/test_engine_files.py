@@ -12,6 +12,7 @@ from lutbake.io.formats import write_table
 from lutbake.io.ltc import hdrp_fp16
 from lutbake.io.openpbr import METAL_SLICE, unorm16
 from lutbake.io.readers import read, read_table
+from lutbake.io.sidecar import ReadError
 from lutbake.table import Table
 
 LTC_SIZE = (5, 4)  # view x roughness: not square, so a transposed read would fail
@@ -46,6 +47,22 @@ def test_ltc_engine_layouts_read_back_as_the_two_textures(tmp_path, fmt, dtype):
         view = read_table(p)
         assert view.kind == "ltc" and view.data.shape == (2, *LTC_SIZE, 4), p
         np.testing.assert_array_equal(view.data, expected.astype(np.float32))
+
+
+def test_babylon_ltc_is_babylons_eight_halfs_per_texel_and_reads_back_through_its_sidecar(tmp_path):
+    """areaLightsLTC.bin: texel by texel (row t, column roughness) 4 FP16 of ltc_1 then 4 of ltc_2, as Babylon's
+    DecodeLTCTextureDataAsync splits them; no magic bytes, so lutbake reads it through its sidecar."""
+    table = ltc_table()
+    path = write_table(table, tmp_path, "babylon_ltc", "float32")  # always FP16, as Babylon uploads it
+    expected = engine_ltc(table.data).astype(np.float16)
+    raw = np.frombuffer(path.read_bytes(), "<f2").reshape(*LTC_SIZE, 8)
+    np.testing.assert_array_equal(raw[..., :4], expected[0])
+    np.testing.assert_array_equal(raw[..., 4:], expected[1])
+    view = read_table(path.with_name(path.name + ".json"))
+    assert view.kind == "ltc" and view.data.shape == (2, *LTC_SIZE, 4)
+    np.testing.assert_array_equal(view.data, expected.astype(np.float32))
+    with pytest.raises(ReadError, match="not a format lutbake reads"):
+        read_table(path)
 
 
 def test_hdrp_cs_reads_back_as_hdrps_texel_with_its_own_channels(tmp_path):

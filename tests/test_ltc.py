@@ -289,6 +289,7 @@ def test_ltc_presets_load_with_their_engine_layouts():
         "ltc-threejs": ("js", "ltc_threejs.js"),
         "ltc-eevee": ("c", "ltc_eevee.cc"),
         "ltc-hdrp": ("cs", "LtcData_BRDF_GGX.cs"),
+        "ltc-babylon": ("babylon_ltc", "areaLightsLTC.bin"),
     }
     for preset, (fmt, file) in want.items():
         (spec,) = load_configs([preset_path(preset)])

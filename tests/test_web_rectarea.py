@@ -10,7 +10,9 @@ lutbake's arrays written into the same textures); (b) the exact answer: the poly
 height-correlated Smith and Schlick's Fresnel at each pixel's (v, roughness, polygon), by lutbake's area-light
 benchmark's ground truth (lutbake.validate.ltc_bench.ground_truth: stratified visible-normal sampling), for three.js's
 shipped tables and lutbake's; (c) lutbake's file loaded wrong on purpose (LTC_1 and LTC_2 exchanged, flipY): each
-must fail. Skipped, with the reason, without chromium, playwright, `npm ci` in web/ or WebGL2."""
+must fail. Babylon.js's RectAreaLight with lutbake's areaLightsLTC.bin (the `ltc-babylon` preset) below, on the same
+chart, light and truth; both presets are baked in one batch (one fit). Skipped, with the reason, without chromium,
+playwright, `npm ci` in web/ or WebGL2."""
 
 from __future__ import annotations
 
@@ -21,6 +23,8 @@ import pytest
 import web_harness
 from test_gl_consumer import bilinear
 
+from lutbake.api import bake
+from lutbake.config import preset_path
 from lutbake.validate import ltc_bench
 
 SHIPPED = web_harness.WEB / "node_modules" / "three" / "examples" / "jsm" / "lights" / "RectAreaLightTexturesLib.js"
@@ -98,27 +102,35 @@ def _edge(v1, v2):
     return np.cross(v1, v2) * ts[:, None]
 
 
-def shader_model(ltc1, ltc2, spec, light=LIGHT) -> np.ndarray:
-    """three.js r187's pixel (height, width, RGB) with the tables ``ltc1``, ``ltc2`` ((t, roughness, RGBA) texels):
-    RE_Direct_RectArea_Physical, LTC_Uv, LTC_Evaluate, LTC_ClippedSphereFormFactor written out in numpy."""
-    p, n, rough, f0 = pixels(spec)
-    nov = np.clip(n @ VIEW, 0, 1)
+def ltc_shading(ltc1, ltc2, rough, p, n, v, corners) -> tuple[np.ndarray, np.ndarray]:
+    """(t2 (N, 4), the LTC integral (N,)) at shading points ``p``, normals ``n``, view vectors ``v`` (N, 3) of the
+    polygon ``corners`` (4, 3) in the shader's order: three.js's LTC_Uv and LTC_Evaluate (Babylon's LTCUv and
+    LTCEvaluate are the same code) written out in numpy, the back-of-the-light test included."""
+    nov = np.clip(np.sum(n * v, axis=1), 0, 1)
     uv = np.stack([rough, np.sqrt(1 - nov)], 1) * 63 / 64 + 0.5 / 64
     t1, t2 = bilinear(ltc1, uv), bilinear(ltc2, uv)
     minv = np.zeros((len(p), 3, 3))  # mat3(vec3(t1.x, 0, t1.y), vec3(0, 1, 0), vec3(t1.z, 0, t1.w)), columns
     minv[:, 0, 0], minv[:, 2, 0], minv[:, 0, 2], minv[:, 2, 2] = t1.T
     minv[:, 1, 1] = 1
-    tt1 = VIEW - n * nov[:, None]
+    tt1 = v - n * nov[:, None]
     tt1 /= np.linalg.norm(tt1, axis=1, keepdims=True)
     tt2 = -np.cross(n, tt1)
     frame = np.stack([tt1, tt2, n], 1)  # rows: transpose(mat3(T1, T2, N))
     mat = minv @ frame
-    corners = light_corners(light)
     coords = np.einsum("pij,kpj->kpi", mat, corners[:, None, :] - p[None])
     coords /= np.linalg.norm(coords, axis=2, keepdims=True)
     f = sum(_edge(coords[k], coords[(k + 1) % 4]) for k in range(4))
     length = np.linalg.norm(f, axis=1)
     form = np.maximum((length * length + f[:, 2]) / (length + 1), 0)
+    lit = (p - corners[0]) @ np.cross(corners[1] - corners[0], corners[3] - corners[0]) >= 0
+    return t2, np.where(lit, form, 0.0)
+
+
+def shader_model(ltc1, ltc2, spec, light=LIGHT) -> np.ndarray:
+    """three.js r187's pixel (height, width, RGB) with the tables ``ltc1``, ``ltc2`` ((t, roughness, RGBA) texels):
+    RE_Direct_RectArea_Physical, LTC_Uv, LTC_Evaluate, LTC_ClippedSphereFormFactor written out in numpy."""
+    p, n, rough, f0 = pixels(spec)
+    t2, form = ltc_shading(ltc1, ltc2, rough, p, n, np.broadcast_to(VIEW, p.shape), light_corners(light))
     fresnel = f0 * t2[:, :1] + (1 - f0) * t2[:, 1:2]
     value = light["intensity"] * fresnel * form[:, None]
     return value.reshape(len(spec["rows"]), len(spec["nov"]), 3)
@@ -144,16 +156,44 @@ def ground_truth(spec, light=LIGHT) -> np.ndarray:
 
 
 @pytest.fixture(scope="module")
-def renders(tmp_path_factory):
+def ltc_luts(tmp_path_factory):
+    """lutbake's `ltc-threejs` and `ltc-babylon` baked in one batch (one fit: the two tables share their values, the
+    costly part of this module), and Babylon's asset folders: ``<luts>/<name>/areaLights/areaLightsLTC.bin`` for
+    lutbake's file, the file with each mistake, and three.js's shipped tables in Babylon's layout."""
+    luts = tmp_path_factory.mktemp("ltc")
+    bake([preset_path("ltc-threejs"), preset_path("ltc-babylon")], luts)
+    ours = (luts / "areaLightsLTC.bin").read_bytes()
+    texels = np.frombuffer(ours, "<f2").reshape(64, 64, 8)
+    shipped = np.concatenate(ltc_arrays(SHIPPED.read_text()), axis=-1)
+    folders = {
+        "lutbake": ours,
+        "swap": np.concatenate([texels[..., 4:], texels[..., :4]], -1).tobytes(),
+        "flipY": texels[::-1].tobytes(),
+        "threejs": shipped.astype("<f2").tobytes(),
+    }
+    for name, data in folders.items():
+        (luts / f"babylon-{name}" / "areaLights").mkdir(parents=True)
+        (luts / f"babylon-{name}" / "areaLights" / "areaLightsLTC.bin").write_bytes(data)
+    return luts
+
+
+@pytest.fixture(scope="module")
+def truth():
+    """The polygon integral at every pixel of the chart (three.js's frame; Babylon's is its mirror image in z)."""
+    return ground_truth({**web_harness.furnace_chart(N_NOV, N_ROUGH), "light": LIGHT, "scale": SCALE})
+
+
+@pytest.fixture(scope="module")
+def renders(ltc_luts, truth):
     """{variant: (height, width, RGB) float pixels}: shipped, lutbake, and lutbake's file under each mistake."""
-    luts = web_harness.bake_preset(tmp_path_factory, "three", "ltc-threejs")
+    web_harness.require("three")
     spec = {**web_harness.furnace_chart(N_NOV, N_ROUGH), "light": LIGHT, "scale": SCALE}
     variants = {"shipped": {"lut": "shipped"}, "lutbake": {"lut": "lutbake"}}
     variants.update({m: {"lut": "lutbake", "mistake": m} for m in MISTAKES})
-    out = web_harness.render_furnaces(luts, "three", [("/web/threejs/rectarea.html?driver", variants)], spec)
+    out = web_harness.render_furnaces(ltc_luts, "three", [("/web/threejs/rectarea.html?driver", variants)], spec)
     out["spec"] = spec
-    out["lutbake_tables"] = ltc_arrays((luts / "ltc_threejs.js").read_text())
-    out["truth"] = ground_truth(spec)
+    out["lutbake_tables"] = ltc_arrays((ltc_luts / "ltc_threejs.js").read_text())
+    out["truth"] = truth
     return out
 
 
@@ -192,4 +232,123 @@ def test_threejs_rectarea_with_lutbakes_tables_is_as_close_to_the_polygon_integr
 def test_threejs_rectarea_catches_a_wrong_load(renders, mistake):
     web_harness.assert_wrong_load_caught(
         "three.js RectAreaLight", mistake, renders[mistake], renders["truth"], LUTBAKE_MAX, LUTBAKE_RMS
+    )
+
+
+# ---------------------------------------------------------------------------------------------------- Babylon.js
+# web/babylon/rectarea.js: the same chart, light and tables in Babylon.js 9.37.1's RectAreaLight, mirrored in z (its
+# camera looks down +z), lit by one white RectAreaLight of intensity 1 (photometric scale 1 for area lights),
+# PBRMaterial with no environment BRDF (no energy-conservation factor on the light). Babylon loads areaLightsLTC.bin
+# through Tools.GetAssetUrl; the page points Tools.AssetBaseUrl at lutbake's file. Babylon's own file is not in the npm
+# package (it comes from assets.babylonjs.com at run time): not measured here; three.js's shipped tables written in
+# Babylon's layout stand beside lutbake's. Babylon's pixel (computeAreaSpecularLighting, specularColor = the light's
+# specular = 1) is F0 t2.x times the LTC integral: its (1 - specularColor) t2.y R90 term vanishes for a white light, so
+# Babylon's area light leaves out Schlick's (F90 - F0) part wherever F0 < 1; the red channel of the metal (F0 = 1) is
+# where its Fresnel is the exact one and the tables are measured.
+BABYLON_PAGE = "/web/babylon/rectarea.html?driver"
+BABYLON_EYE = 1e4  # world units from the chart: v is within 1e-4 rad of -z everywhere (the truth is three.js's)
+# Babylon's pixels vs the numpy port on the same FP16 texels: measured 1.8e-7 (lutbake's) and 2.2e-7 (three.js's)
+BABYLON_SHADER_ATOL = 2e-5
+# the metal's red channel against the polygon integral: measured max 2.46e-2, RMS 5.7e-3 (lutbake's), 2.48e-2 and
+# 5.8e-3 (three.js's shipped, in FP16); the wrong loads measured max >= 0.999, RMS >= 0.127
+BABYLON_MAX, BABYLON_RMS = 0.035, 7e-3
+
+
+def mirrored(v) -> np.ndarray:
+    return np.asarray(v, np.float64) * [1.0, 1.0, -1.0]
+
+
+def babylon_light(light=LIGHT) -> dict:
+    """The three.js light mirrored in z for rectarea.js: position, unit x and y axes (Babylon lights the side
+    -(x cross y) faces: the mirror's flipped y keeps the chart on it), width, height, intensity."""
+    c = light_corners(light)  # pos + hw - hh, pos - hw - hh, pos - hw + hh, pos + hw + hh
+    hw, hh = (c[0] - c[1]) / 2, (c[3] - c[0]) / 2
+    return {
+        "position": mirrored(c.mean(axis=0)).tolist(),
+        "xAxis": (mirrored(hw) / np.linalg.norm(hw)).tolist(),
+        "yAxis": (-mirrored(hh) / np.linalg.norm(hh)).tolist(),
+        **{k: light[k] for k in ("width", "height", "intensity")},
+    }
+
+
+def babylon_corners(info) -> np.ndarray:
+    """The polygon Babylon's shader builds (computeAreaLightSpecularDiffuseFresnel's rectCoords) from the light's world
+    position and half extents the page read back."""
+    p, hw, hh = (np.asarray(info[k], np.float64) for k in ("position", "halfWidth", "halfHeight"))
+    return np.array([p + hw - hh, p - hw - hh, p - hw + hh, p + hw + hh])
+
+
+def babylon_model(ltc1, ltc2, spec, info) -> np.ndarray:
+    """Babylon 9.37's pixel: F0 t2.x times LTCEvaluate, at each pixel's point, mirrored normal and view vector
+    normalize(eye - P) (the page's own eye), with the polygon the page's light holds."""
+    p, n, rough, f0 = pixels(spec)
+    v = np.asarray(info["eye"], np.float64) - p
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    t2, form = ltc_shading(ltc1, ltc2, rough, p, mirrored(n), v, babylon_corners(info))
+    return (f0 * t2[:, :1] * form[:, None]).reshape(len(spec["rows"]), len(spec["nov"]), 3)
+
+
+def bin_tables(path) -> tuple[np.ndarray, np.ndarray]:
+    """Babylon's LTC1, LTC2 texels of an areaLightsLTC.bin as DecodeLTCTextureDataAsync splits them."""
+    texels = np.frombuffer(path.read_bytes(), "<f2").astype(np.float64).reshape(64, 64, 8)
+    return texels[..., :4], texels[..., 4:]
+
+
+@pytest.fixture(scope="module")
+def babylon_renders(ltc_luts, truth):
+    """{variant: pixels} of Babylon's RectAreaLight with lutbake's file, three.js's tables and the mistakes."""
+    web_harness.require("@babylonjs/core")
+    spec = {
+        **web_harness.furnace_chart(N_NOV, N_ROUGH),
+        "light": babylon_light(),
+        "scale": SCALE,
+        "eye": BABYLON_EYE,
+    }
+    variants = {name: {"assets": f"/lut/babylon-{name}"} for name in ("lutbake", "threejs", *MISTAKES)}
+    infos = {}
+    out = web_harness.render_furnaces(ltc_luts, "@babylonjs/core", [(BABYLON_PAGE, variants)], spec, infos)
+    out.update(spec=spec, info=infos["lutbake"], truth=truth, luts=ltc_luts)
+    return out
+
+
+def metal_red(px) -> np.ndarray:
+    return np.asarray(px)[:N_ROUGH, :, 0]
+
+
+def test_babylon_rectarea_light_is_the_one_the_model_shades(babylon_renders):
+    np.testing.assert_allclose(babylon_corners(babylon_renders["info"]), mirrored(light_corners(LIGHT))[[3, 2, 1, 0]])
+
+
+@pytest.mark.parametrize("name", ["lutbake", "threejs"])
+def test_babylon_rectarea_samples_the_file_as_its_contract_says(babylon_renders, name):
+    """Babylon's pixels are its shader on the file's FP16 texels: 8 per texel, LTC1 then LTC2, rows t = sqrt(1 - NoV),
+    columns roughness, endpoint texels, invertY false; the Fresnel F0 t2.x of a white light."""
+    tables = bin_tables(babylon_renders["luts"] / f"babylon-{name}" / "areaLights" / "areaLightsLTC.bin")
+    model = babylon_model(*tables, babylon_renders["spec"], babylon_renders["info"])
+    print(f"Babylon RectAreaLight vs its shader on {name}'s texels: {np.abs(babylon_renders[name] - model).max():.3g}")
+    np.testing.assert_allclose(babylon_renders[name], model, rtol=0, atol=BABYLON_SHADER_ATOL)
+
+
+def test_babylon_rectarea_with_lutbakes_tables_is_as_close_to_the_polygon_integral_as_threes(babylon_renders):
+    truth = metal_red(babylon_renders["truth"])
+    for name in ("threejs", "lutbake"):
+        worst, rms = web_harness.pixel_errors(metal_red(babylon_renders[name]), truth)
+        all_worst, all_rms = web_harness.pixel_errors(babylon_renders[name], babylon_renders["truth"])
+        print(
+            f"Babylon RectAreaLight, {name} tables vs exact: metal R (F0 = 1) max {worst:.4g} RMS {rms:.3g}; ", end=""
+        )
+        print(f"every pixel (Babylon's Fresnel) max {all_worst:.4g} RMS {all_rms:.3g}")
+    worst, rms = web_harness.pixel_errors(metal_red(babylon_renders["lutbake"]), truth)
+    assert worst < BABYLON_MAX and rms < BABYLON_RMS
+
+
+@pytest.mark.parametrize("mistake", MISTAKES)
+def test_babylon_rectarea_catches_a_wrong_file(babylon_renders, mistake):
+    web_harness.assert_wrong_load_caught(
+        "Babylon RectAreaLight",
+        mistake,
+        metal_red(babylon_renders[mistake]),
+        metal_red(babylon_renders["truth"]),
+        BABYLON_MAX,
+        BABYLON_RMS,
     )

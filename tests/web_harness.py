@@ -171,10 +171,10 @@ def bake_preset(tmp_path_factory, engine_dir: str, preset: str) -> Path:
     return luts
 
 
-def render_furnaces(luts: Path, engine_dir: str, pages, spec: dict) -> dict:
+def render_furnaces(luts: Path, engine_dir: str, pages, spec: dict, infos: dict | None = None) -> dict:
     """{variant: (height, width, RGB) float pixels} of ``pages`` = [(URL path, {variant: extra spec})], each page
-    opened once in one browser and driven through window.furnace; skips the test (pytest) with the reason where the
-    harness cannot run."""
+    opened once in one browser and driven through window.furnace (``infos``, if given, gets each variant's ``info``);
+    skips the test (pytest) with the reason where the harness cannot run."""
     import numpy as np
     import pytest
 
@@ -189,6 +189,8 @@ def render_furnaces(luts: Path, engine_dir: str, pages, spec: dict) -> dict:
             for name, extra in variants.items():
                 r = page.evaluate("spec => window.furnace(spec)", {**spec, **extra})
                 out[name] = np.asarray(r["pixels"], np.float64).reshape(r["height"], r["width"], 4)[..., :3]
+                if infos is not None:
+                    infos[name] = r.get("info")
             assert not page.errors, page.errors
             page.close()
     return out
@@ -209,11 +211,43 @@ def assert_wrong_load_caught(engine: str, mistake: str, px, exact_px, max_ok: fl
     assert worst > max_ok and rms > rms_ok
 
 
+FILAMENT_WEB = "filament-web"  # the Filament page's files under /lut/: its 64² DFG bakes and the furnace's KTX 1
+BABYLON_ASSETS = "babylon"  # Tools.AssetBaseUrl of Babylon's page: /lut/babylon/areaLights/areaLightsLTC.bin
+
+
+def write_furnace_ibl(folder: Path, size: int = 64, smallest: int = 16) -> Path:
+    """The white furnace's image-based light for Filament: a KTX 1 cube of radiance 1 (cmgen's R11F_G11F_B10F, mips
+    ``size`` down to ``smallest`` as cmgen's; 1.0 is exact there) and the SH of a constant (form ``filament``: c_0 = 1,
+    E / pi = 1), written by lutbake.io.ktx1 to ``folder/filament_furnace_ibl.ktx``."""
+    import numpy as np
+
+    from lutbake.io.ktx1 import encode_ktx1_cube
+
+    mips = [np.ones((6, n, n, 3)) for n in (size >> m for m in range(size.bit_length())) if n >= smallest]
+    sh = np.zeros((9, 3))
+    sh[0] = 1.0
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / "filament_furnace_ibl.ktx"
+    path.write_bytes(encode_ktx1_cube(mips, "r11g11b10f", sh))
+    return path
+
+
+def demo_files(luts: Path) -> None:
+    """What the pages need beside the bakes of make demo: Filament's furnace light, and Babylon's LTC file where its
+    loader fetches it (<Tools.AssetBaseUrl>/areaLights/areaLightsLTC.bin)."""
+    write_furnace_ibl(luts / FILAMENT_WEB)
+    ltc = luts / "areaLightsLTC.bin"
+    if ltc.is_file():
+        (luts / BABYLON_ASSETS / "areaLights").mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(ltc, luts / BABYLON_ASSETS / "areaLights" / ltc.name)
+
+
 def main():
     parser = argparse.ArgumentParser(description="Serve the engine pages (web/) with lutbake's tables, on 127.0.0.1.")
     parser.add_argument("--luts", type=Path, default=ROOT / "outputs", help="the folder of baked tables (make luts)")
     parser.add_argument("--port", type=int, default=8049)
     args = parser.parse_args()
+    demo_files(args.luts)
     with serve(args.luts.resolve(), args.port) as url:
         print(f"open {url}/web/  (tables from {args.luts}; Ctrl-C stops)", flush=True)
         try:

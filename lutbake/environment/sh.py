@@ -25,10 +25,19 @@ and each monomial of Y_k over a lat-long cell is a product of a theta and a phi 
 
 **Cosine convolution** (R&H 2001, Eqs. 8-9): irradiance E(n) = ∫ L (n.l)+ dω = Σ_k Â_l L_k Y_k(n), Â_0 = pi,
 Â_1 = 2 pi / 3, Â_2 = pi / 4 (exact for L of bands <= 2; the band-2 truncation of the clamped cosine leaves a
-residual of at most ~3% of E for arbitrary L, R&H §3). The three forms an engine may take:
+residual of at most ~3% of E for arbitrary L, R&H §3). The forms an engine may take:
 ``radiance`` L_k; ``irradiance`` Â_l L_k (E = Σ c_k Y_k(n)); ``irradiance_over_pi`` Â_l L_k / pi (the diffuse
 radiance of a white Lambertian surface, E / pi). three.js' ``SphericalHarmonics3.getIrradianceAt`` folds Â_l into
 its constants (0.886227 = pi x 0.282095, ...) and takes the **radiance** coefficients (``LightProbeGenerator``).
+
+``filament``: Â_l L_k K_k / pi with K_k the constant of Y_k above (``POLYNOMIAL_CONSTANTS``), so that
+E(n) / pi = Σ c_k p_k(n) over the bare polynomials p_k = 1, y, z, x, xy, yz, 3z^2 - 1, xz, x^2 - y^2: what
+Filament's shader evaluates (``Irradiance_SphericalHarmonics``: ``iblSH[0] + iblSH[1] * n.y + iblSH[2] * n.z + ...``),
+``IndirectLight::Builder::irradiance(3, sh)`` takes, and cmgen writes (``--sh-shader``, its KTX's ``sh`` and
+``sh.txt``: ``CubemapSH::preprocessSHForShader`` multiplies its coefficients by A_k = ±K_k Â_l / pi, the sign undoing
+its basis's Condon-Shortley phase, so the products are the numbers above). Checked in closed form: L = a + b.ω gives
+c = (a, 2/3 b_y, 2/3 b_z, 2/3 b_x, 0, ...); L = z^2 gives c_0 = 1/3, c_6 = 1/12. cmgen by default also windows its
+coefficients against ringing (``--sh-window``, auto); lutbake writes them unwindowed.
 """
 
 from __future__ import annotations
@@ -48,10 +57,14 @@ CONSTANTS = (
 )
 BAND = (0, 1, 1, 1, 2, 2, 2, 2, 2)
 A_HAT = (math.pi, 2 * math.pi / 3, math.pi / 4)
+# K_k: Y_k = K_k p_k(x, y, z), the constants of ``basis`` per index
+POLYNOMIAL_CONSTANTS = tuple(CONSTANTS[i] for i in (0, 1, 1, 1, 2, 2, 3, 2, 4))
 FORMS = {
     "radiance": "L_k = ∫ L Y_k dω",
     "irradiance": "Â_l L_k: E(n) = Σ c_k Y_k(n)",
     "irradiance_over_pi": "Â_l L_k / pi: E(n) / pi = Σ c_k Y_k(n)",
+    "filament": "Â_l L_k K_k / pi: E(n) / pi = Σ c_k p_k(n), p = 1, y, z, x, xy, yz, 3z^2 - 1, xz, x^2 - y^2 "
+    "(Filament's iblSH, cmgen's KTX 'sh')",
 }
 
 
@@ -142,8 +155,15 @@ def convolve(coefficients: np.ndarray, form: str = "irradiance") -> np.ndarray:
         raise ValueError(f"SH form must be one of {sorted(FORMS)}, got {form!r}")
     if form == "radiance":
         return np.array(coefficients, np.float64)
-    scale = np.array([A_HAT[b] for b in BAND]) / (math.pi if form == "irradiance_over_pi" else 1.0)
+    scale = np.array([A_HAT[b] for b in BAND]) / (1.0 if form == "irradiance" else math.pi)
+    if form == "filament":
+        scale = scale * np.array(POLYNOMIAL_CONSTANTS)
     return coefficients * scale[:, None]
+
+
+def polynomials(d: np.ndarray) -> np.ndarray:
+    """(..., 9) the bare polynomials p_k at directions ``d`` (..., 3): Y_k / K_k, what form ``filament`` multiplies."""
+    return basis(np.asarray(d, np.float64)) / np.array(POLYNOMIAL_CONSTANTS)
 
 
 def evaluate(coefficients: np.ndarray, d: np.ndarray) -> np.ndarray:

@@ -11,6 +11,8 @@
 - **EXR**: one part per mip, named ``mip_<m>``, the six faces stacked top to bottom (+X, -X, +Y, -Y, +Z, -Z; 6n rows
   of n), RGB; every part's display window is mip 0's (OpenEXR shares it between parts), its data window its own,
   at the origin. The record: ``lutbake:*`` attributes in every part.
+- **KTX 1** (``ktx1``): Filament's image-based light, the layout cmgen writes (lutbake.io.ktx1): R11F_G11F_B10F
+  (cmgen's), RGB16F or RGB32F, level 0 first, faces +X first, with the SH Filament's shader takes as key ``sh``.
 
 Faces are written as lutbake.environment.cube's table gives them (OpenGL / KTX orientation); ``face_convention`` in
 the record says so. Values must be finite and (half) below 65504: anything else is refused, never written.
@@ -135,24 +137,36 @@ def _as_text(metadata: dict) -> dict[str, str]:
 
 
 def write_cube(
-    mips: list[np.ndarray], path, metadata: dict, fmt: str, dtype: str = "half", files: dict[str, bytes] | None = None
+    mips: list[np.ndarray],
+    path,
+    metadata: dict,
+    fmt: str,
+    dtype: str = "half",
+    files: dict[str, bytes] | None = None,
+    sh: np.ndarray | None = None,
 ) -> Path:
-    """Write a cube with mips to ``path`` in ``fmt`` (ktx2, dds, exr), atomically, as one verified unit
+    """Write a cube with mips to ``path`` in ``fmt`` (ktx2, dds, exr, ktx1), atomically, as one verified unit
     (lutbake.io.integrity): ``files`` (name -> bytes: other files of the output beside ``path``, an irradiance
     table's SH) are written first; then the cube; then, for ktx2 and dds, the sidecar ``<path>.json`` naming the
     sha256 of every file, written last; an EXR carries ``lutbake:data_hash`` and ``lutbake:files_sha256`` instead.
     Values that are not strings are written as JSON text in EXR attributes and the sidecar (every ``lutbake:*`` value
-    is a string), as one JSON object in KTX 2.0's ``lutbake:metadata``."""
+    is a string), as one JSON object in KTX 2.0's and KTX 1's ``lutbake:metadata``. ``ktx1`` is Filament's IBL file
+    (lutbake.io.ktx1: ``dtype`` r11g11b10f, half or float32; ``sh`` the (9, 3) coefficients of lutbake.environment.sh
+    form ``filament``, written as its ``sh`` key)."""
     from .atomic import atomic_write_bytes_hashed, unit_lock
     from .integrity import HASH_KEY, PLACEHOLDER, seal_exr, write_sidecar
 
     if fmt not in CUBE_FORMATS:
-        raise ValueError(f"cube format must be ktx2, dds or exr, got {fmt!r}")
+        raise ValueError(f"cube format must be one of {sorted(CUBE_FORMATS)}, got {fmt!r}")
     path = Path(path)
     text = _as_text(metadata)
-    levels = rgba(mips, dtype)  # every value checked before any file of the unit is touched
+    levels = rgba(mips, "float32" if dtype == "r11g11b10f" else dtype)  # every value checked before any file
     data = b""  # an EXR is written part by part below
-    if fmt == "ktx2":
+    if fmt == "ktx1":
+        from .ktx1 import encode_ktx1_cube
+
+        data = encode_ktx1_cube(mips, dtype, sh, metadata)
+    elif fmt == "ktx2":
         data = encode_ktx2_cube(mips, metadata, dtype)
     elif fmt == "dds":
         data = encode_dds_cube(mips, dtype)
@@ -177,7 +191,7 @@ def write_cube(
         return path
 
 
-CUBE_FORMATS = {"ktx2": "ktx2_cube", "dds": "dds_cube", "exr": "exr_cube"}  # format -> the sidecar's ``format``
+CUBE_FORMATS = {"ktx2": "ktx2_cube", "dds": "dds_cube", "exr": "exr_cube", "ktx1": "ktx1_cube"}  # format -> the sidecar's ``format``
 
 
 def cube_metadata(table) -> dict:

@@ -8,6 +8,7 @@ the table's axes, channels and conventions), so ``lutbake inspect`` and ``previe
 | ``c`` | Blender EEVEE .cc | ``ltc_mat_<lobe>``, ``ltc_mag_<lobe>``, ``ltc_disk_integral`` | (2, N, N, 4) |
 | ``cs`` | Unity HDRP .cs | ``s_LtcMatrixData_BRDF_<LOBE>`` (FP16 bits) | (N, N, 4): HDRP's texel, its own channels |
 | ``babylon_fuzz`` | one DDS | r, g, b through Babylon's mix() (lutbake.layouts.babylon) | (N, N, 3): A, B, R_i |
+| ``babylon_ltc`` | Babylon's areaLightsLTC.bin | 8 FP16 per texel: ltc_1 RGBA, ltc_2 RGBA | (2, N, N, 4) |
 | ``openpbr_h`` | OpenPBR header | ``OpenPBR_*_Array`` (UNORM16 codes / 65535) | the table's (metal: tiled over IOR) |
 | ``js``, ``wgsl``, ``rs`` | code arrays | the one array, shape from its ``lutbake:shape`` line | the table's |
 
@@ -85,6 +86,15 @@ def _ltc_dds(path: Path, doc: dict, dims: dict) -> np.ndarray:
             raise ValueError(f"its second texture {name} is not beside it")
         slices.append(dds.decode(read_bytes(other))[0].astype(np.float32))
     return np.stack(slices)
+
+
+def _babylon_ltc(path: Path, doc: dict, dims: dict) -> np.ndarray:
+    shape = (dims["y"], dims["x"], 2, 4)
+    check_texels((2, *shape[:2]), "Babylon's areaLightsLTC.bin (the sidecar's axes)", channels=4, itemsize=2)
+    raw = read_bytes(path)
+    if len(raw) != 2 * int(np.prod(shape)):
+        raise ValueError(f"{len(raw)} bytes, the sidecar's axes need {2 * int(np.prod(shape))} (8 FP16 per texel)")
+    return np.frombuffer(raw, "<f2").reshape(shape).transpose(2, 0, 1, 3)
 
 
 def _ltc_js(path: Path, doc: dict, dims: dict) -> np.ndarray:
@@ -167,6 +177,7 @@ def _babylon_fuzz_attrs(attrs: dict, doc: dict) -> str:
 
 READERS = {
     "babylon_fuzz": _babylon_fuzz,
+    "babylon_ltc": _babylon_ltc,
     "ltc_dds": _ltc_dds,
     "c": _ltc_c,
     "cs": _hdrp_cs,
@@ -193,6 +204,7 @@ def read_engine(path: Path, doc: dict) -> tuple[np.ndarray, dict[str, str], str]
             "ltc_dds": f"slices {' and '.join(doc.get('files') or [])}",
             "c": "ltc_mat, ltc_mag and ltc_disk_integral as ltc_2 = (magnitude, fresnel, 0, disk)",
             "cs": "HDRP's texel (M^-1_00, M^-1_20, M^-1_11, M^-1_02) / M^-1_22 of ltc_1; ltc_2 is not in this file",
+            "babylon_ltc": "Babylon's LTC1 and LTC2 texels (FP16)",
         }.get(fmt, "its array, shaped by lutbake:shape")
     else:
         raise ValueError(f"lutbake cannot read values of the engine format {fmt!r}")

@@ -13,6 +13,9 @@ formats ``ltc_dds``, ``js``, ``c`` and ``cs`` of lutbake.io.formats.
 |  |  | Texture2DArray _LtcData (R16G16B16A16_SFloat); (M^-1_00, M^-1_20, M^-1_11, M^-1_02) / M^-1_22 |
 | ``babylon_fuzz`` | <name>.dds (+ .json) | Babylon.js scene.environmentFuzzBRDFTexture: one RGBA16F (or 32F) DDS, |
 |  |  | (A, B, R_i) of a normal-frame fit coded by getFuzzBRDFLookup's mix() (lutbake.layouts.babylon) |
+| ``babylon_ltc`` | <name>.bin (+ .json) | Babylon.js areaLightsLTC.bin (Lights/LTC/ltcTextureTool.js |
+|  |  | DecodeLTCTextureDataAsync): per texel 8 FP16 values, ltc_1 RGBA then ltc_2 RGBA, split into |
+|  |  | scene._ltcTextures LTC1 / LTC2 (RawTexture RGBA, HALF_FLOAT, bilinear, clamp, invertY false) |
 | ``ltc_aniso_npy`` | <name>.npy (+ .json) | the anisotropic LTC paper's LUT/*.npy: M (N, N, N, N, 3, 3) of a kind |
 |  |  | ltc_aniso table (AakashKT/LTC-Anisotropic; lutbake.kinds.ltc_aniso) |
 Every array is row 0 first (row = view index t, column = roughness index a: element a + t N, as ltc_code's
@@ -35,6 +38,7 @@ EXTENSIONS = {
     "c": ".cc",
     "cs": ".cs",
     "babylon_fuzz": ".dds",
+    "babylon_ltc": ".bin",
     "ltc_aniso_npy": ".npy",
 }
 FORMATS = {  # js: lutbake.io.code_arrays' format, which writes an ltc table as three.js' module (write_js)
@@ -43,6 +47,8 @@ FORMATS = {  # js: lutbake.io.code_arrays' format, which writes an ltc table as 
     "cs": "Unity HDRP C# table s_LtcMatrixData_BRDF_<LOBE>, FP16 bits of one RGBA16F slice (kind ltc)",
     "babylon_fuzz": "Babylon.js environmentFuzzBRDFTexture: one DDS, RGBA16F (half) or RGBA32F, (A, B, R_i) coded by "
     "getFuzzBRDFLookup's mix() ranges (kind ltc, normal-frame lobes: zeltner)",
+    "babylon_ltc": "Babylon.js RectAreaLight's areaLightsLTC.bin: per texel ltc_1 RGBA then ltc_2 RGBA, always FP16 "
+    "(kind ltc)",
     "ltc_aniso_npy": "the anisotropic LTC paper's layout: M (N, N, N, N, 3, 3) float32 + .json sidecar "
     "(kind ltc_aniso)",
 }
@@ -241,6 +247,26 @@ def write_babylon_fuzz(table: Table, path, dtype: str = "half") -> Path:
     return write_with_sidecar(table, path, dds.encode(stored.astype(np_dtype)), "babylon_fuzz", extra)
 
 
+def babylon_ltc_bytes(table: Table) -> bytes:
+    """Babylon's areaLightsLTC.bin: texel by texel (row t = sqrt(1 - NoV) index, column a = roughness index, element
+    a + t N as ltc_code), the 4 FP16 values of ltc_1 then the 4 of ltc_2, little-endian; DecodeLTCTextureDataAsync
+    copies values 0-3 of each 8 into LTC1's texel and 4-7 into LTC2's. Always FP16 (Babylon uploads the values as
+    HALF_FLOAT textures), whatever ``dtype``; ValueError where a value is past FP16."""
+    t1, t2 = engine_textures(table)
+    both = np.concatenate([t1, t2], axis=-1)
+    if not np.all(np.isfinite(both)) or np.abs(both).max() > FP16_MAX:
+        raise ValueError(f"table {table.name!r}: an LTC value is past FP16's 65504; babylon_ltc writes FP16 only")
+    return both.astype("<f2").tobytes()
+
+
+def write_babylon_ltc(table: Table, path, dtype: str = "half") -> Path:
+    extra = {
+        "layout": "per texel (element a + t N) 8 FP16: ltc_1 RGBA, ltc_2 RGBA (Babylon.js areaLightsLTC.bin)",
+        "load": "Tools.AssetBaseUrl = <folder>: Babylon fetches <folder>/areaLights/areaLightsLTC.bin",
+    }
+    return write_with_sidecar(table, path, babylon_ltc_bytes(table), "babylon_ltc", extra)
+
+
 def aniso_matrices(table: Table) -> np.ndarray:
     """The paper's layout of an ltc_aniso table (lutbake.kinds.ltc_aniso: slices t0, t1, t2 of (layer x theta, phi,
     RGBA), layer = b + N a): M (N, N, N, N, 3, 3) float32, row-major from (t0.xyzw, t1.xyzw, t2.x)."""
@@ -277,5 +303,6 @@ WRITERS = {
     "c": write_c,
     "cs": write_cs,
     "babylon_fuzz": write_babylon_fuzz,
+    "babylon_ltc": write_babylon_ltc,
     "ltc_aniso_npy": write_ltc_aniso_npy,
 }

@@ -54,6 +54,8 @@ FORMATS = {
     "c": "Blender EEVEE C arrays ltc_mat_<lobe>[N][N][4], ltc_mag_<lobe>[N][N][2], ltc_disk_integral[N][N][1]",
     "cs": "Unity HDRP C# table s_LtcMatrixData_BRDF_<LOBE> (ushort FP16 bits, one RGBA16F slice of _LtcData): "
     "(M^-1_00, M^-1_20, M^-1_11, M^-1_02) / M^-1_22",
+    "babylon_ltc": "Babylon.js RectAreaLight's areaLightsLTC.bin: per texel ltc_1 RGBA then ltc_2 RGBA, always FP16 "
+    "(Babylon uploads it as HALF_FLOAT)",
     "babylon_fuzz": "Babylon.js scene.environmentFuzzBRDFTexture: one DDS, RGBA16F (half) or RGBA32F, (A, B, R_i) of "
     "a normal-frame fit (lobe zeltner) coded by getFuzzBRDFLookup's mix() ranges (lutbake.layouts.babylon)",
 }

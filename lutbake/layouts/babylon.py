@@ -227,4 +227,15 @@ TABLES = (
         ),
         encoding="rgbd",
     ),
+    EngineTable(
+        "Babylon.js",
+        "ltc-babylon",
+        "areaLightsLTC",
+        "ltc",
+        None,
+        {"lobe": "ggx", "size": [64, 64], "dtype": "half", "format": "babylon_ltc"},
+        "@babylonjs/core 9.37.1 Lights/LTC/ltcTextureTool.js, Lights/areaLight.pure.js, "
+        "Shaders/ShadersInclude/ltcHelperFunctions.js",
+        "areaLightsLTC.bin, fetched through Tools.GetAssetUrl (Tools.AssetBaseUrl = its folder's parent)",
+    ),
 )
