@@ -137,7 +137,7 @@ def test_ktx1_decoder_names_what_does_not_fit():
 def test_write_cube_writes_filaments_ktx1(tmp_path):
     mips = mips_of(lambda d: 1 + d * 0.5)
     path = write_cube(
-        mips, tmp_path / "env_ibl.ktx", {"kind": "environment_specular"}, "ktx1", "r11g11b10f", np.eye(9, 3)
+        mips, tmp_path / "env_ibl.ktx", {"kind": "environment_specular"}, "ktx1", "r11g11b10f", sh=np.eye(9, 3)
     )
     got, fmt, pairs = decode_ktx1_cube(path.read_bytes())
     assert fmt == "r11g11b10f" and len(got) == 3 and '"kind": "environment_specular"' in pairs["lutbake:metadata"]
