@@ -1,10 +1,12 @@
-"""Prefiltered environment: lutbake's exact quadrature against the importance-sampled prefilter every peer uses
-(issue 48, item 8), wall and CPU time, error against a converged reference.
+"""Prefiltered environment: lutbake's exact prefilter (estimator ``auto``: spherical harmonics for the rough mips and
+the irradiance cube, the pyramid quadrature for the footprint mip 0) against the importance-sampled prefilter every
+peer uses, wall and CPU time, error against a converged reference.
 
 Source: Blender's CC0 ``sunrise.exr`` (Debian blender-data, 1024 x 512, a sun of 33 664), each texel split into
 2 x 2 to give the issue's 2048 x 1024 (the same texel-constant function); ``--source`` names another lat-long EXR/HDR.
 Output: a 256^2 cube, 9 mips, roughness r = m / 8 (the glTF Sample Viewer / Bevy curve), GGX with n.l weighting,
-n = v = r; and the L2 SH (exact per-texel integrals).
+n = v = r; a 32^2 irradiance cube; and the L2 SH (exact per-texel integrals). Timed: the pyramid, the cube, the
+irradiance cube, the SH (their sum is lutbake's time), and the footprint mip 0 alone (the quadrature's share).
 
 Baseline (written here, a Warp kernel): the glTF-IBL-Sampler / cmgen algorithm: Hammersley points, GGX importance
 sampling of h (cos^2 theta_h = (1 - u) / (1 + (alpha^2 - 1) u)), l = reflect(-v, h), n = v = r, sum L(l) (n.l) /
@@ -13,11 +15,12 @@ sampling level lod = 0.5 log2(Omega_s / Omega_p) + 1 (Krivanek & Colbert 2008; O
 Omega_p a level-0 texel's solid angle at the equator), texel-constant, clamped to the pyramid. Mip 0 of both is the
 exact area average (lutbake's), so the comparison is of the rough mips.
 
-Error: max and RMS over probe texels (strided, 64 per mip) of |P - P_ref| / P_ref (max over channels), P_ref the exact
-quadrature at tau = 1e-3, K = 8, order 4 on those texels. The baseline runs with filtered importance sampling (as the
-peers ship it: biased) and without (every sample reads the source: unbiased). "Equal time": the baseline's sample
-count whose wall time matches lutbake's; "equal error": the sample count at which the baseline's RMS error would
-equal lutbake's, from a / sqrt(N) fitted at 256, 1024, 4096 samples (meaningful without FIS only).
+Error: max and RMS over probe texels (strided, 32 per mip) of |P - P_ref| / P_ref (max over channels), P_ref the
+pyramid quadrature (an independent method) at tau / 64, K x 4, order + 2 on those texels. The baseline runs with
+filtered importance sampling (as the peers ship it: biased) and without (every sample reads the source: unbiased).
+"Equal time": the baseline's sample count whose wall time matches lutbake's; "equal error": the sample count at
+which the baseline's RMS error would equal lutbake's, from a / sqrt(N) fitted at 256, 1024, 4096 samples
+(meaningful without FIS only).
 Run: .venv/bin/python benchmarks/bench_environment.py [--size 256] [--source PATH]
 (writes outputs/bench/environment.json)
 """
@@ -47,7 +50,8 @@ DEFAULT_SOURCES = (
     Path("/usr/share/blender/datafiles/studiolights/world/sunrise.exr"),
     Path("/tmp/envsrc/x/usr/share/blender/datafiles/studiolights/world/sunrise.exr"),
 )
-PROBES_PER_MIP = 64
+PROBES_PER_MIP = 32
+REFERENCE = prefilter.Quality().finer().finer()  # the quadrature at tau / 64, K x 4, order + 2, two sub-texel levels
 
 
 @wp.func
@@ -159,7 +163,7 @@ def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--size", type=int, default=256)
     parser.add_argument("--source", type=Path, default=None)
-    parser.add_argument("--tau", type=float, default=prefilter.Quality().tau)
+    parser.add_argument("--tau", type=float, default=prefilter.Quality().tau)  # the footprint mip's quadrature
     args = parser.parse_args()
     OUT.mkdir(parents=True, exist_ok=True)
     source = args.source or next((p for p in DEFAULT_SOURCES if p.is_file()), None)
@@ -178,28 +182,33 @@ def main() -> None:
     rough = [curves.CURVES["linear"].roughness(m, mips) for m in range(mips)]
     quality = prefilter.Quality(tau=args.tau)
 
-    t0, c0 = time.perf_counter(), time.process_time()
-    pyr = latlong.pyramid(image)
-    t_pyr = time.perf_counter() - t0
-    baked = prefilter.bake_cube(pyr, args.size, rough, quality=quality, estimate=False)
-    t_cube = time.perf_counter() - t0
-    coefficients = sh.project(image)
-    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
-    t_sh = wall - t_cube
+    def timed(fn):
+        t, c = time.perf_counter(), time.process_time()
+        out = fn()
+        return out, time.perf_counter() - t, time.process_time() - c
+
+    pyr, t_pyr, c_pyr = timed(lambda: latlong.pyramid(image))
+    baked, t_cube, c_cube = timed(lambda: prefilter.bake_cube(pyr, args.size, rough, quality=quality, estimate=False))
+    irr, t_irr, c_irr = timed(lambda: prefilter.bake_cube(pyr, 32, [1.0], "cosine", quality=quality, estimate=False))
+    coefficients, t_sh, c_sh = timed(lambda: sh.project(image))
+    wall = t_pyr + t_cube + t_irr + t_sh
+    cpu = c_pyr + c_cube + c_irr + c_sh
+    # the footprint mip 0 alone (the quadrature's share of the cube)
+    _, t_mip0, c_mip0 = timed(lambda: prefilter.bake_cube(pyr, args.size, [0.0], quality=quality, estimate=False))
 
     texels = prefilter.cube_texels(args.size, baked.lobes, baked.alphas)
     probes = {}
     for m in range(1, mips):
         s, e = texels.offsets[m], texels.offsets[m + 1]
         probes[m] = np.arange(s, e, max(1, (e - s) // PROBES_PER_MIP))
-    ref_quality = prefilter.Quality(tau=1e-3, k_geo=8.0, order=4)
+    ref_quality = REFERENCE
     ref = {}
     for m, idx in probes.items():
         o = prefilter.mip_values(pyr, texels, m, idx, ref_quality, "cpu")
         ref[m] = o[:, :3] / o[:, 3:4]
     flat = np.concatenate([x.reshape(-1, 3) for x in baked.mips])
     exact_err = errors({m: flat[idx] for m, idx in probes.items()}, ref)
-    estimate = prefilter.error_estimates(pyr, texels, flat, quality)
+    estimate = prefilter.error_estimates(pyr, texels, np.concatenate([flat, np.ones((len(flat), 2))], 1), quality)
 
     def run(n: int, fis: bool) -> dict:
         mips_s, w, c = sampled_cube(pyr, texels, n, fis)
@@ -232,15 +241,19 @@ def main() -> None:
         "lutbake": {
             "wall_s": wall,
             "cpu_s": cpu,
-            "pyramid_s": t_pyr,
-            "cube_s": t_cube - t_pyr,
-            "sh_s": t_sh,
+            "pyramid": {"wall_s": t_pyr, "cpu_s": c_pyr},
+            "cube": {"wall_s": t_cube, "cpu_s": c_cube, "methods": baked.methods, "lmax": baked.lmax},
+            "mip0_footprint_alone": {"wall_s": t_mip0, "cpu_s": c_mip0},
+            "irradiance_32": {"wall_s": t_irr, "cpu_s": c_irr, "methods": irr.methods},
+            "sh": {"wall_s": t_sh, "cpu_s": c_sh},
             "quality": {"tau": quality.tau, "k_geo": quality.k_geo, "order": quality.order},
-            "leaves_per_texel": baked.leaves,
             "error": exact_err,
             "error_estimate_per_mip": estimate,
             "sh_coefficient_0": coefficients[0].tolist(),
         },
+        "reference": f"the pyramid quadrature at tau {REFERENCE.tau:g}, K {REFERENCE.k_geo:g}, order "
+        f"{REFERENCE.order}, {REFERENCE.extra_levels} extra sub-texel levels, on {PROBES_PER_MIP} strided probe "
+        "texels per rough mip",
         "sampled": baselines,
     }
     (OUT / "environment.json").write_text(json.dumps(result, indent=1) + "\n")

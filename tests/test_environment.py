@@ -333,6 +333,26 @@ def test_mip_curves_put_r_0_at_mip_0_and_r_1_at_the_last(name):
     assert r == sorted(r)
 
 
+@pytest.mark.parametrize(
+    "name, lod",
+    [
+        ("linear", lambda r, n: r * (n - 1)),
+        ("filament", lambda r, n: (n - 1) * r * (2 - r)),
+        ("hdrp", lambda r, n: 6 * r * (1.7 - 0.7 * r)),
+        ("godot", lambda r, n: math.sqrt(r) * (n - 1)),
+        ("babylon", lambda r, n: 0.8 * math.log2(2 ** (n - 1) * r * r)),  # getLodFromAlphaG, lodGenerationScale 0.8
+    ],
+)
+def test_each_mip_holds_the_roughness_the_engines_shader_reads_there(name, lod):
+    """The shader's own lod(r), written here from each engine's line, gives back mip m at the curve's r_m (where
+    r_m < 1)."""
+    mips = 7 if name == "hdrp" else 9
+    for m in range(1, mips):
+        r = curves.CURVES[name].roughness(m, mips)
+        if r < 1:
+            assert math.isclose(lod(r, mips), m, abs_tol=1e-12), (m, r)
+
+
 @pytest.mark.parametrize("name", ["sunrise", "studio"])
 def test_real_environments_match_their_provenance(name):
     note = json.loads((DATA / f"env_{name}_64x32.json").read_text())

@@ -10,7 +10,11 @@ record per curve; ``roughness(mip, mips)`` inverts the shader's lod(r) at intege
 - ``hdrp``: lod = 6 r (1.7 - 0.7 r) (Unity HDRP ``PerceptualRoughnessToMipmapLevel``, UNITY_SPECCUBE_LOD_STEPS = 6,
   as the issue quotes it).
 - ``godot``: lod = sqrt(r) (M - 1) (as the issue quotes it).
-Babylon.js' log2(size alpha)-based curve is not recorded yet.
+- ``babylon``: lod = log2(size alpha) s + o, alpha = r^2, s = lodGenerationScale = 0.8, o = lodGenerationOffset = 0
+  (Babylon.js ``pbrBlockReflection`` ``getLodFromAlphaG(vReflectionMicrosurfaceInfos.x, alphaG) *
+  vReflectionMicrosurfaceInfos.y + vReflectionMicrosurfaceInfos.z``; its own prefilter ``HDRFiltering`` bakes mip m at
+  alphaG = 2^((m - o) / s) / size, mip 0 at 0; @babylonjs/core 9.37.1, read). size = 2^(M - 1) (the full chain); r
+  past 1 (alphaG > 1, mips the shader's roughness <= 1 never reaches but by trilinear blending) is clamped to 1.
 """
 
 from __future__ import annotations
@@ -18,6 +22,9 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
+
+
+BABYLON_LOD_SCALE = 0.8  # Babylon.js BaseTexture.lodGenerationScale's default
 
 
 @dataclass(frozen=True)
@@ -60,6 +67,12 @@ CURVES = {
         MipCurve("hdrp", "lod = 6 * r * (1.7 - 0.7 r)", "Unity HDRP ImageBasedLighting.hlsl", _hdrp),
         MipCurve(
             "godot", "lod = sqrt(r) * (M - 1)", "Godot scene_forward_clustered.glsl", lambda m, n: (m / (n - 1)) ** 2
+        ),
+        MipCurve(
+            "babylon",
+            "lod = 0.8 * log2(size * r^2), size = 2^(M - 1)",
+            "Babylon.js pbrBlockReflection getLodFromAlphaG, HDRFiltering (lodGenerationScale 0.8)",
+            lambda m, n: 0.0 if m == 0 else math.sqrt(2.0 ** (m / BABYLON_LOD_SCALE) / 2.0 ** (n - 1)),
         ),
     )
 }
