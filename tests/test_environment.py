@@ -114,15 +114,16 @@ def test_pyramid_keeps_the_integral_at_every_level():
 
 
 @pytest.mark.parametrize("method", ["auto", "quadrature"])
-@pytest.mark.parametrize("lobe", ["ggx_nl", "ggx", "cosine"])
+@pytest.mark.parametrize("lobe", ["ggx_nl", "ggx", "charlie", "cosine"])
 def test_uniform_environment_gives_the_constant_in_every_texel_of_every_mip(lobe, method):
     colour = np.array([0.25, 1.0, 40.0])
     pyr = latlong.pyramid(np.broadcast_to(colour, (16, 32, 3)))
     rough = [curves.CURVES["linear"].roughness(m, 4) for m in range(4)]
     baked = prefilter.bake_cube(pyr, 8, rough, lobe=lobe, estimate=False, method=method)
-    assert set(baked.methods) == ({"quadrature"} if method == "quadrature" else {"harmonic", "quadrature"}) or (
-        lobe == "cosine" and baked.methods == ["harmonic"] * 4
-    )
+    if method == "quadrature":
+        assert set(baked.methods) == {"quadrature"}
+    else:
+        assert "harmonic" in baked.methods
     for m in baked.mips:
         np.testing.assert_allclose(m, np.broadcast_to(colour, m.shape), rtol=UNIFORM_RTOL)
 
@@ -234,6 +235,21 @@ def test_harmonic_and_quadrature_agree_on_a_real_environment():
     quad = prefilter.bake_cube(pyr, 8, rough, quality=fine, estimate=False, method="quadrature")
     assert auto.methods == ["quadrature", "harmonic", "harmonic", "harmonic"]
     for a, b in zip(auto.mips[1:], quad.mips[1:]):
+        assert float(np.max(np.abs(a - b) / b)) <= HARMONIC_RTOL
+
+
+def test_the_charlie_lobe_by_harmonics_is_the_quadratures_and_its_alpha_is_r():
+    """The sheen prefilter (alpha = r, glTF-IBL-Sampler's D_Charlie(sheenRoughness)): harmonics against the
+    quadrature two steps finer on a real environment (8e-7 measured); r = 1 (D ~ sin theta_h: a cone at l = r, its
+    coefficients fall like l^-3) is left to the quadrature."""
+    pyr = latlong.pyramid(real_environment("sunrise"))
+    rough = [0.0, 0.25, 0.5, 1.0]
+    auto = prefilter.bake_cube(pyr, 8, rough, "charlie", estimate=False)
+    quad = prefilter.bake_cube(
+        pyr, 8, rough[:3], "charlie", quality=prefilter.Quality().finer().finer(), estimate=False, method="quadrature"
+    )
+    assert auto.alphas == rough and auto.methods == ["quadrature", "harmonic", "harmonic", "quadrature"]
+    for a, b in zip(auto.mips[1:3], quad.mips[1:3]):
         assert float(np.max(np.abs(a - b) / b)) <= HARMONIC_RTOL
 
 

@@ -118,7 +118,7 @@ def test_a_bad_environment_is_refused_at_config_time_naming_file_and_key(tmp_pat
     "line, key, fragment",
     [
         ('curve = "linaer"', "curve", "did you mean 'linear'?"),
-        ('lobe = "charlie"', "lobe", "allowed: ggx_nl, ggx"),
+        ('lobe = "phong"', "lobe", "allowed: ggx_nl, ggx, charlie"),
         ('format = "png16"', "format", "allowed: ktx2, dds, exr"),
         ('orientation = "d3d"', "orientation", "allowed: gl, d3d_left_handed"),
         ("mips = 5", "mips", "at most 4 mips"),  # an 8^2 cube: 8, 4, 2, 1

@@ -18,7 +18,7 @@ import math
 import numpy as np
 import warp as wp
 
-from ..terms.ndf import D_ggx
+from ..terms.ndf import D_charlie_sin2, D_ggx
 
 
 @wp.func
@@ -39,6 +39,14 @@ def w_ggx(r: wp.vec3d, l: wp.vec3d, alpha: wp.float64):
 
 
 @wp.func
+def w_charlie(r: wp.vec3d, l: wp.vec3d, alpha: wp.float64):
+    """D_charlie(h; alpha) / 4 * (n.l), n = v = r: the sheen prefilter (glTF-IBL-Sampler's Charlie distribution, its
+    n.l-weighted sum; Estevez & Kulla 2017, Eq. 2), sin^2 theta_h = |r - l|^2 / 4."""
+    s = wp.length(r - l) * wp.float64(0.5)
+    return wp.float64(D_charlie_sin2(s * s, float(alpha))) * wp.float64(0.25) * wp.dot(r, l)
+
+
+@wp.func
 def w_cosine(r: wp.vec3d, l: wp.vec3d, alpha: wp.float64):
     """n.l (the irradiance lobe; alpha unused)."""
     return wp.dot(r, l)
@@ -55,6 +63,7 @@ def w_footprint(r: wp.vec3d, l: wp.vec3d, alpha: wp.float64):
 LOBES = {
     "ggx_nl": (w_ggx_nl, 4.0),
     "ggx": (w_ggx, 4.0),
+    "charlie": (w_charlie, 8.0),
     "cosine": (w_cosine, 2.0),
     "footprint": (w_footprint, 0.0),
 }
@@ -62,10 +71,22 @@ LOBES = {
 
 def lobe_width(lobe: str, alpha: float) -> float:
     """lambda: the angular scale (radians, in l) over which the weight falls by about half from its peak: GGX
-    2 atan(alpha) (the h lobe's half width alpha, doubled by the reflection), cosine pi/3, footprint 0."""
+    2 atan(alpha) (the h lobe's half width alpha, doubled by the reflection), cosine pi/3, Charlie (rising from 0 at
+    l = r to the horizon, its log-slope 1 / (alpha tan theta_h)) pi/3 with the slope 8 in LOBES, footprint 0."""
     if lobe in ("ggx_nl", "ggx"):
         return 2.0 * math.atan(alpha)
-    return math.pi / 3 if lobe == "cosine" else 0.0
+    return math.pi / 3 if lobe in ("cosine", "charlie") else 0.0
+
+
+def alpha_of(lobe: str, r: float) -> float:
+    """The NDF's alpha at perceptual roughness r: r^2 (GGX: Burley 2012), r for Charlie (glTF-IBL-Sampler passes the
+    mip's roughness to D_Charlie as its sheenRoughness, and the viewer reads lod = sheenRoughness (M - 1))."""
+    return float(r) if lobe == "charlie" else float(r) ** 2
+
+
+def _charlie_profile(t: np.ndarray, alpha: float) -> np.ndarray:
+    """D_charlie(h) / 4 as a function of t = r.l: sin^2 theta_h = (1 - t) / 2 (Estevez & Kulla 2017, Eq. 2)."""
+    return (2 + 1 / alpha) * np.maximum((1 - t) / 2, 0.0) ** (0.5 / alpha) / (2 * math.pi) / 4
 
 
 def _ggx_profile(t: np.ndarray, alpha: float) -> np.ndarray:
@@ -79,6 +100,7 @@ def _ggx_profile(t: np.ndarray, alpha: float) -> np.ndarray:
 PROFILES = {
     "ggx_nl": lambda t, alpha: np.where(t > 0, _ggx_profile(t, alpha) * t, 0.0),
     "ggx": lambda t, alpha: np.where(t > 0, _ggx_profile(t, alpha), 0.0),
+    "charlie": lambda t, alpha: np.where(t > 0, _charlie_profile(t, alpha) * t, 0.0),
     "cosine": lambda t, alpha: np.maximum(t, 0.0),
 }
 # the same weights without the horizon's cut (smooth on [-1, 1]): how fast their coefficients fall says how wide
@@ -86,5 +108,6 @@ PROFILES = {
 SMOOTH_PROFILES = {
     "ggx_nl": lambda t, alpha: _ggx_profile(t, alpha) * t,
     "ggx": _ggx_profile,
+    "charlie": lambda t, alpha: _charlie_profile(t, alpha) * t,
     "cosine": lambda t, alpha: t,
 }

@@ -29,7 +29,7 @@ from ..runtime.executor import execute_tiles
 from ..runtime.plan import TexelPlan
 from . import cube
 from .latlong import Pyramid
-from .lobes import lobe_width
+from .lobes import alpha_of, lobe_width
 from .quadrature import OUT_WIDTH, integrate, texel_kernel
 
 PROBES = 96  # probe texels per mip of the error estimate
@@ -216,7 +216,7 @@ def bake_cube(
     method: str = "auto",
 ) -> Baked:
     """The prefiltered cube of ``size``^2 faces with one mip per entry of ``roughness`` (perceptual): r = 0 is the
-    area average (lobe ``footprint``), r > 0 lobe ``lobe`` at alpha = r^2. ``lobe = "cosine"``: every mip the
+    area average (lobe ``footprint``), r > 0 lobe ``lobe`` at alpha = lobes.alpha_of(lobe, r) (r^2; Charlie r). ``lobe = "cosine"``: every mip the
     irradiance lobe (roughness ignored). ``method``: ``auto`` bakes every mip whose lobe allows it by spherical
     harmonics (lutbake.environment.harmonic: exact convolution, seconds) and the others (the footprint, the
     irradiance lobe, lobes narrower than its cap) by the pyramid quadrature; ``quadrature`` every mip by the
@@ -226,7 +226,7 @@ def bake_cube(
     if method not in METHODS:
         raise ValueError(f"method must be one of {list(METHODS)}, got {method!r}")
     lobes = ["cosine" if lobe == "cosine" else "footprint" if r == 0 else lobe for r in roughness]
-    alphas = [float(r) ** 2 for r in roughness]
+    alphas = [alpha_of(lobe, r) for r in roughness]
     texels = cube_texels(size, lobes, alphas)
     lmax, by_harmonics = harmonic.plan_lmax(lobes, alphas) if method != "quadrature" else (0, [False] * len(lobes))
     if method == "harmonic" and not all(by_harmonics):

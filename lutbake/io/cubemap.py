@@ -191,7 +191,12 @@ def write_cube(
         return path
 
 
-CUBE_FORMATS = {"ktx2": "ktx2_cube", "dds": "dds_cube", "exr": "exr_cube", "ktx1": "ktx1_cube"}  # format -> the sidecar's ``format``
+CUBE_FORMATS = {
+    "ktx2": "ktx2_cube",
+    "dds": "dds_cube",
+    "exr": "exr_cube",
+    "ktx1": "ktx1_cube",
+}  # format -> the sidecar's ``format``
 
 
 def cube_metadata(table) -> dict:

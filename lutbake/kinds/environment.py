@@ -45,6 +45,11 @@ for _name, _desc, _cite in (
         "w = D_ggx(h) / 4 over r.l > 0: the unweighted prefilter",
         "Filament cmgen without n.l; glTF-IBL-Sampler with its n.l weighting off",
     ),
+    (
+        "charlie",
+        "w = D_charlie(h) (n.l) / 4, n = v = r, alpha = r: the sheen prefilter",
+        "Estevez & Kulla 2017, Eq. 2; glTF-IBL-Sampler's Charlie distribution (KHR_materials_sheen)",
+    ),
 ):
     ENVIRONMENT_LOBE.add(
         Record("environment_lobe", _name, _desc, _cite, fields={"obj": Lazy("lutbake.environment.lobes:LOBES", _name)})
@@ -79,7 +84,10 @@ ESTIMATION = Estimation(
     "",
 )
 MAX_MIPS = 32  # KTX 2.0's levelCount of a 2^31-texel face; the texel cap (config.MAX_TEXELS) binds long before
-ROUGHNESS = "perceptual: the curve gives r per mip, alpha = r^2 (Burley 2012; glTF, Bevy, Filament)"
+ROUGHNESS = {
+    "ggx": "perceptual: the curve gives r per mip, alpha = r^2 (Burley 2012; glTF, Bevy, Filament)",
+    "charlie": "sheen roughness: the curve gives r per mip, alpha = r (glTF-IBL-Sampler's D_Charlie(sheenRoughness))",
+}
 SOURCE_CONVENTION = (
     "lat-long, row 0 = +Y, u = 0.5 + atan2(z, x) / 2pi (lutbake.environment.latlong); texel-constant radiance"
 )
@@ -258,6 +266,7 @@ def bake_specular(spec, workers: int | None = None, device: str = "cpu") -> Cube
 
     o = spec.options
     curve, lobe = spec.records["curve"], spec.records["lobe"]
+    ndf = "charlie" if lobe.name == "charlie" else "ggx"
     env, pyr = read_source(spec)
     mips = mip_count(o)
     roughness = [curve.obj.roughness(m, mips) for m in range(mips)]
@@ -265,8 +274,8 @@ def bake_specular(spec, workers: int | None = None, device: str = "cpu") -> Cube
         pyr, o["size"], roughness, lobe.name, quality(o), workers, device=device, method=o["estimator"]
     )
     record = base_record(spec, env, baked) | {
-        "ndf": "ggx",
-        "roughness_definition": ROUGHNESS,
+        "ndf": ndf,
+        "roughness_definition": ROUGHNESS[ndf],
         "weighting": f"{lobe.name}: {lobe.description} ({lobe.citation})",
         "mip_curve": f"{curve.name}: {curve.obj.lod} ({curve.obj.source})",
         "roughness": baked.roughness,
@@ -285,7 +294,9 @@ def bake_irradiance(spec, workers: int | None = None, device: str = "cpu") -> Cu
 
     o = spec.options
     env, pyr = read_source(spec)
-    baked = prefilter.bake_cube(pyr, o["size"], [1.0], "cosine", quality(o), workers, device=device, method=o["estimator"])
+    baked = prefilter.bake_cube(
+        pyr, o["size"], [1.0], "cosine", quality(o), workers, device=device, method=o["estimator"]
+    )
     coefficients = sh.convolve(sh.project(env.image), o["sh_form"])
     doc = {
         "basis": "real SH, Ramamoorthi & Hanrahan 2001 / three.js order: Y00; Y1-1 y, Y10 z, Y11 x; Y2-2 xy, "
