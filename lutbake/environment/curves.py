@@ -23,7 +23,6 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
-
 BABYLON_LOD_SCALE = 0.8  # Babylon.js BaseTexture.lodGenerationScale's default
 
 

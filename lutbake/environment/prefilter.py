@@ -216,11 +216,11 @@ def bake_cube(
     method: str = "auto",
 ) -> Baked:
     """The prefiltered cube of ``size``^2 faces with one mip per entry of ``roughness`` (perceptual): r = 0 is the
-    area average (lobe ``footprint``), r > 0 lobe ``lobe`` at alpha = lobes.alpha_of(lobe, r) (r^2; Charlie r). ``lobe = "cosine"``: every mip the
-    irradiance lobe (roughness ignored). ``method``: ``auto`` bakes every mip whose lobe allows it by spherical
-    harmonics (lutbake.environment.harmonic: exact convolution, seconds) and the others (the footprint, the
-    irradiance lobe, lobes narrower than its cap) by the pyramid quadrature; ``quadrature`` every mip by the
-    quadrature; ``harmonic`` refuses a mip the harmonics cannot bake."""
+    area average (lobe ``footprint``), r > 0 lobe ``lobe`` at alpha = lobes.alpha_of(lobe, r) (r^2; Charlie r).
+    ``lobe = "cosine"``: every mip the irradiance lobe (roughness ignored). ``method``: ``auto`` bakes every mip
+    whose lobe's coefficients fall fast enough (harmonic.plan_lmax) by spherical harmonics (lutbake.environment.
+    harmonic: exact convolution, seconds) and the others (the footprint, lobes narrower than its cap) by the pyramid
+    quadrature; ``quadrature`` every mip by the quadrature; ``harmonic`` refuses a mip the harmonics cannot bake."""
     from . import harmonic
 
     if method not in METHODS:
