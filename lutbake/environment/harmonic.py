@@ -30,7 +30,10 @@ bits (tested).
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import math
+import threading
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,12 +64,32 @@ def m_of_index(lmax: int) -> np.ndarray:
     return np.concatenate([np.full(lmax + 1 - m, m) for m in range(lmax + 1)])
 
 
+_ANALYSES: dict[tuple, Harmonics] = {}  # the last few analyses, by the image's sha256, lmax and order
+_ANALYSES_KEPT = 2
+_LOCK = threading.Lock()
+
+
 def analyse(image: np.ndarray, lmax: int, order: int = SUB_RINGS, threads: int = 1) -> Harmonics:
     """a_lm (l <= lmax) of the texel-constant lat-long ``image`` (H, W, 3), lutbake.environment.latlong's
-    convention: colatitude theta from +Y, longitude phi = atan2(z, x) + pi in [0, 2 pi)."""
+    convention: colatitude theta from +Y, longitude phi = atan2(z, x) + pi in [0, 2 pi). The last analyses are kept
+    (a specular and an irradiance cube of one source share one; the same bits for any ``threads``)."""
+    image = np.ascontiguousarray(image, np.float64)
+    key = (hashlib.sha256(image.data).hexdigest(), image.shape, lmax, order)
+    with _LOCK:
+        if key in _ANALYSES:
+            return _ANALYSES[key]
+    out = _analyse(image, lmax, order, threads)
+    out.alm.flags.writeable = False
+    with _LOCK:
+        _ANALYSES[key] = out
+        while len(_ANALYSES) > _ANALYSES_KEPT:
+            del _ANALYSES[next(iter(_ANALYSES))]
+    return out
+
+
+def _analyse(image: np.ndarray, lmax: int, order: int, threads: int) -> Harmonics:
     from ducc0.sht.experimental import adjoint_synthesis
 
-    image = np.asarray(image, np.float64)
     h, w = image.shape[:2]
     order += 3 * math.ceil(lmax / h) - 3  # rows wider than a period of P_lm: more sub-rings
     x, wx = np.polynomial.legendre.leggauss(order)
@@ -91,6 +114,7 @@ def analyse(image: np.ndarray, lmax: int, order: int = SUB_RINGS, threads: int =
     return Harmonics(alm * box, lmax)
 
 
+@functools.lru_cache(maxsize=64)
 def kernel_coefficients(lobe: str, alpha: float, lmax: int, order: int = 8, smooth: bool = False) -> np.ndarray:
     """g_l / g_0 for l = 0..lmax of the zonal weight PROFILES[lobe](t, alpha) (module docstring); ``smooth``: of
     SMOOTH_PROFILES[lobe], the weight without the horizon's cut, over the whole sphere, / max |g_l| (its g_0 may
@@ -114,7 +138,9 @@ def kernel_coefficients(lobe: str, alpha: float, lmax: int, order: int = 8, smoo
     for n in range(1, lmax):
         p_prev, p = p, ((2 * n + 1) * t * p - n * p_prev) / (n + 1)
         g[n + 1] = f @ p
-    return g / (np.abs(g).max() if smooth else g[0])
+    g /= np.abs(g).max() if smooth else g[0]
+    g.flags.writeable = False  # cached
+    return g
 
 
 def needed_lmax(g: np.ndarray) -> int | None:
