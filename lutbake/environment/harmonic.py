@@ -12,7 +12,7 @@ so P(r) = Σ_l (g_l / g_0) Σ_m a_lm Y_lm(r) (a uniform source gives P = L). Thr
    relative for l up to the source's row count (a row spans at most half an oscillation of P_lm there). ducc0's
    ring transform (Reinecke & Seljebotn 2013, "Libsharp", A&A 554 A112) does the sums.
 2. **The kernel's coefficients** (``kernel_coefficients``): g_l by composite Gauss–Legendre in theta (panels graded
-   geometrically from the lobe's width, and at least two per half-oscillation of P_l, ending at the horizon where
+   geometrically from the lobe's width, and at least one per half-oscillation of P_l, ending at the horizon where
    the weight has its kink), P_l by the three-term recurrence.
 3. **Synthesis** (``synthesise``) at the cube texels' centre directions: ducc0's NUFFT-based evaluation at arbitrary
    points (epsilon 1e-11).
@@ -123,7 +123,9 @@ def kernel_coefficients(lobe: str, alpha: float, lmax: int, order: int = 8, smoo
     end = math.pi if smooth else math.pi / 2
     width = max(alpha, 1e-4)
     edges = np.unique(
-        np.concatenate([[0.0], np.geomspace(width * 1e-3, end, 256), np.linspace(0.0, end, 2 * lmax + 2)])
+        np.concatenate(
+            [[0.0], np.geomspace(width * 1e-3, end, 256), np.linspace(0.0, end, int(lmax * end / math.pi) + 2)]
+        )
     )
     x, wx = np.polynomial.legendre.leggauss(order)
     a, b = edges[:-1, None], edges[1:, None]
@@ -131,12 +133,16 @@ def kernel_coefficients(lobe: str, alpha: float, lmax: int, order: int = 8, smoo
     t = np.cos(theta)
     f = profile(t, alpha) * (0.5 * (b - a) * wx).ravel() * np.sin(theta)
     g = np.empty(lmax + 1)
-    p_prev, p = np.ones_like(t), t.copy()
+    p_prev, p, tmp = np.ones_like(t), t.copy(), np.empty_like(t)
     g[0] = f.sum()
     if lmax > 0:
         g[1] = f @ p
-    for n in range(1, lmax):
-        p_prev, p = p, ((2 * n + 1) * t * p - n * p_prev) / (n + 1)
+    for n in range(1, lmax):  # P_{n+1} = ((2n + 1) t P_n - n P_{n-1}) / (n + 1), in place
+        np.multiply(t, p, out=tmp)
+        tmp *= (2 * n + 1) / (n + 1)
+        p_prev *= n / (n + 1)
+        tmp -= p_prev
+        p_prev, p, tmp = p, tmp, p_prev
         g[n + 1] = f @ p
     g /= np.abs(g).max() if smooth else g[0]
     g.flags.writeable = False  # cached
