@@ -55,6 +55,15 @@ FORMATS = {
     "dds": "DDS cube (DX10 header, TEXTURECUBE), every mip (RGBA16F / RGBA32F) + .json sidecar with the record",
     "exr": "OpenEXR, one part per mip (mip_<m>: the six faces stacked top to bottom), the record in every part",
 }
+DTYPES = {
+    "half": "16-bit float (RGBA16F, A = 1)",
+    "float32": "32-bit float (RGBA32F, A = 1)",
+    "rgb9e5": "RGB9E5: three 9-bit mantissas and a shared 5-bit exponent, 32 bits a texel (VK_FORMAT_E5B9G9R9_UFLOAT_"
+    "PACK32, DXGI R9G9B9E5_SHAREDEXP; EXT_texture_shared_exponent's exact rounding; max 65408); ktx2 and dds only",
+    "b10g11r11": "unsigned 11-, 11- and 10-bit floats, 32 bits a texel (VK_FORMAT_B10G11R11_UFLOAT_PACK32, DXGI "
+    "R11G11B10_FLOAT; rounded to nearest, ties to even; max 65024 / 64512); ktx2 and dds only",
+}
+PACKED_FORMATS = ("ktx2", "dds")  # the formats that hold rgb9e5 and b10g11r11
 SH_FORMS = {
     "radiance": "L_k = ∫ L Y_k dω (three.js LightProbe / SphericalHarmonics3.getIrradianceAt)",
     "irradiance": "Â_l L_k: E(n) = Σ c_k Y_k(n) (Ramamoorthi & Hanrahan 2001, Eq. 8)",
@@ -109,7 +118,7 @@ def _common() -> dict[str, Key]:
         **named,
         "environment": ENVIRONMENT_KEY,
         "format": Key("format", "str", "ktx2", "output file format: <out-dir>/<name>.<ext>", FORMATS),
-        "dtype": Key("dtype", "str", "half", "pixel type written", {"half": "16-bit float", "float32": "32-bit float"}),
+        "dtype": Key("dtype", "str", "half", "pixel type written", DTYPES),
         "estimator": Key(
             "estimator", "str", ESTIMATION.default, "how each texel's integral is computed", ESTIMATION.estimators
         ),
@@ -151,7 +160,11 @@ def environment_path(spec) -> Path:
 
 
 def check_environment(spec) -> tuple[str, str] | None:
-    """The environment file, read as the bake will (lutbake.io.environment.read_latlong): (key, why not) or None."""
+    """The storage (a packed dtype needs a format that holds it), then the environment file, read as the bake will
+    (read_environment): (key, why not) or None."""
+    o = spec.options
+    if o.get("dtype") in ("rgb9e5", "b10g11r11") and o.get("format") not in PACKED_FORMATS:
+        return "dtype", f"{o['dtype']} is written in {' and '.join(PACKED_FORMATS)} cubes only, not {o.get('format')}"
     if spec.options.get("environment") is None:
         source = Path(spec.source)
         preset = source.suffix == ".toml" and source.resolve().parent == PRESETS
