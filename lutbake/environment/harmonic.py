@@ -188,7 +188,8 @@ def needed_lmax(g: np.ndarray) -> int | None:
 
 
 def synthesise(h: Harmonics, g: np.ndarray, dirs: np.ndarray, threads: int = 1) -> np.ndarray:
-    """(n, 3): Σ_l g_l Σ_m a_lm Y_lm at unit directions ``dirs`` (n, 3), l <= min(h.lmax, len(g) - 1). One ducc0
+    """(n, C): Σ_l g_l Σ_m a_lm Y_lm at unit directions ``dirs`` (n, 3), l <= min(h.lmax, len(g) - 1), C the
+    channels of ``h`` (3, or 1 for a combination of them). One ducc0
     thread per channel (its multi-threaded NUFFT sums in an order that depends on the thread count), the channels
     on ``threads`` Python threads: the same bits for any ``threads``."""
     from concurrent.futures import ThreadPoolExecutor
@@ -204,8 +205,8 @@ def synthesise(h: Harmonics, g: np.ndarray, dirs: np.ndarray, threads: int = 1) 
     def channel(c: int) -> np.ndarray:
         return synthesis_general(alm=alm[c : c + 1], spin=0, lmax=lmax, loc=loc, epsilon=EPSILON, nthreads=1)[0]
 
-    with ThreadPoolExecutor(max(1, min(3, threads))) as pool:
-        return np.stack(list(pool.map(channel, range(3))), axis=1)
+    with ThreadPoolExecutor(max(1, min(len(alm), threads))) as pool:
+        return np.stack(list(pool.map(channel, range(len(alm)))), axis=1)
 
 
 def plan_lmax(lobes: list[str], alphas: list[float]) -> tuple[int, list[bool]]:
