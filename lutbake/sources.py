@@ -26,7 +26,13 @@ HASH_SOURCES = (
     "tolerance.py",
     "runtime/plan.py",  # TexelPlan: a table's shape
 )
-ENVIRONMENT_SOURCES = ("environment/*.py", "io/environment.py", "io/cubemap.py")
+ENVIRONMENT_SOURCES = (
+    "environment/*.py",
+    "io/environment.py",
+    "io/cubemap.py",
+    "io/cube_read.py",
+    "io/encodings.py",
+)
 
 
 def source_files(patterns: tuple[str, ...] = HASH_SOURCES) -> list[Path]:
