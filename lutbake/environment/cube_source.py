@@ -30,6 +30,7 @@ import os
 import numpy as np
 
 from . import cube, harmonic, sh
+from .lobes import alpha_of
 from .prefilter import PROBES, Baked, cube_texels
 
 SH_ORDER = 6  # Gauss–Legendre points per axis and texel for the L2 SH (degree-2 polynomials over the face plane)
@@ -100,7 +101,7 @@ def bake_from_cube(
     texel-constant cube source ``faces`` (6, n, n, 3) (module docstring). ValueError for a mip it cannot bake."""
     faces = np.asarray(faces, np.float64)
     lobes = ["cosine" if lobe == "cosine" else "footprint" if r == 0 else lobe for r in roughness]
-    alphas = [float(r) ** 2 for r in roughness]
+    alphas = [alpha_of(lobe, r) for r in roughness]
     texels = cube_texels(size, lobes, alphas)
     lmax, by_harmonics = harmonic.plan_lmax(lobes, alphas)
     narrow = [m for m, (lb, ok) in enumerate(zip(lobes, by_harmonics)) if lb != "footprint" and not ok]

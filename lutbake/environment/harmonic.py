@@ -154,26 +154,37 @@ def analyse_cube(
     wsub = np.tile(wx / n, n)
     v, u = np.meshgrid(sub, sub, indexing="ij")  # rows: v (t), columns: u (s)
     area = np.outer(wsub, wsub) * (1.0 + u * u + v * v) ** -1.5
-    alm = np.zeros((3, (lmax + 1) * (lmax + 2) // 2), np.complex128)
     rows_per_chunk = max(1, CUBE_CHUNK // (n * order))
+    locs = []
     for f in range(6):
         d = face_directions(np.full(u.shape, f), u, v) * np.asarray(flip, np.float64)
         d /= np.linalg.norm(d, axis=-1, keepdims=True)
-        loc = np.stack([np.arccos(np.clip(d[..., 1], -1.0, 1.0)), np.arctan2(d[..., 2], d[..., 0]) + math.pi], -1)
-        radiance = np.repeat(np.repeat(faces[f], order, axis=0), order, axis=1)  # each node its texel's value
-        for r0 in range(0, n * order, rows_per_chunk):
-            rows = slice(r0, r0 + rows_per_chunk)
-            points = (radiance[rows] * area[rows][..., None]).reshape(-1, 3).T
-            where = np.ascontiguousarray(loc[rows].reshape(-1, 2))
-            for c in range(3):  # spin 0: one component a call
-                alm[c] += adjoint_synthesis_general(
-                    map=np.ascontiguousarray(points[c : c + 1]),
+        locs.append(
+            np.stack([np.arccos(np.clip(d[..., 1], -1.0, 1.0)), np.arctan2(d[..., 2], d[..., 0]) + math.pi], -1)
+        )
+
+    def channel(c: int) -> np.ndarray:
+        """One channel's a_lm: single-threaded ducc0 calls summed in a fixed order (its multi-threaded adjoint
+        NUFFT spreads in an order that changes from run to run), so the bits never depend on ``threads``."""
+        out = np.zeros((lmax + 1) * (lmax + 2) // 2, np.complex128)
+        for f in range(6):
+            radiance = np.repeat(np.repeat(faces[f, ..., c], order, axis=0), order, axis=1)  # each node its texel's
+            for r0 in range(0, n * order, rows_per_chunk):
+                rows = slice(r0, r0 + rows_per_chunk)
+                out += adjoint_synthesis_general(
+                    map=(radiance[rows] * area[rows]).reshape(1, -1),
                     spin=0,
                     lmax=lmax,
-                    loc=where,
+                    loc=np.ascontiguousarray(locs[f][rows].reshape(-1, 2)),
                     epsilon=EPSILON,
-                    nthreads=threads,
+                    nthreads=1,
                 )[0]
+        return out
+
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max(1, min(3, threads))) as pool:
+        alm = np.stack(list(pool.map(channel, range(3))))
     return Harmonics(alm, lmax)
 
 
