@@ -73,7 +73,12 @@ def test_babylon_f82_layout_round_trips_blenders_three_integrals():
 
 
 def test_babylon_presets_are_its_engine_tables():
-    assert {t.preset for t in TABLES if t.engine == "Babylon.js"} == {"babylon", "babylon-openpbr", "babylon-fuzz"}
+    assert {t.preset for t in TABLES if t.engine == "Babylon.js"} == {
+        "babylon",
+        "babylon-openpbr",
+        "babylon-fuzz",
+        "ltc-babylon",
+    }
 
 
 @pytest.fixture(scope="module")
@@ -199,7 +204,9 @@ def test_every_engine_table_names_a_storage_encoding_audit_knows():
     from lutbake.commands.audit_search import ENCODINGS
 
     assert {t.encoding for t in TABLES} <= set(ENCODINGS)
-    assert {t.encoding for t in TABLES if t.engine == "Babylon.js"} == {"rgbd"}
+    # the environment BRDF tables ship as 8-bit RGBD PNGs, the area-light LTC tables as half floats (areaLightsLTC.bin)
+    encodings = {t.preset: t.encoding for t in TABLES if t.engine == "Babylon.js"}
+    assert encodings == {"babylon": "rgbd", "babylon-openpbr": "rgbd", "babylon-fuzz": "rgbd", "ltc-babylon": "plain"}
 
 
 def test_audit_of_babylons_shipped_rgbd_png_decodes_rgbd_and_reports_the_real_error(tmp_path):
