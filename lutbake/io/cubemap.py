@@ -29,6 +29,7 @@ import numpy as np
 
 from . import bounded
 from .atomic import atomic_write
+from .ktx1 import IDENTIFIER as KTX1_IDENTIFIER
 from .ktx2 import IDENTIFIER, _dfd, _kvd
 
 VK_RGBA = {"half": 97, "float32": 109}  # VK_FORMAT_R16G16B16A16_SFLOAT, VK_FORMAT_R32G32B32A32_SFLOAT
@@ -213,11 +214,13 @@ def cube_metadata(table) -> dict:
 
 def write_cube_table(table, path, fmt: str, dtype: str = "half") -> Path:
     """Write ``table`` (lutbake.table.CubeTable) to ``path`` (write_cube), with its SH document beside it where it has
-    one (``record["sh_file"]``)."""
+    one (``record["sh_file"]``); a ktx1 cube carries its record's SH of form ``filament`` as its key ``sh``."""
     files = {}
     if table.sh is not None:
         files[table.record["sh_file"]] = (json.dumps(table.sh, indent=1) + "\n").encode()
-    return write_cube(table.mips, path, cube_metadata(table), fmt, dtype, files)
+    filament = fmt == "ktx1" and table.record.get("sh_form") == "filament"  # the KTX 1's key sh (lutbake.io.ktx1)
+    sh = np.asarray(table.record["sh"], np.float64) if filament else None
+    return write_cube(table.mips, path, cube_metadata(table), fmt, dtype, files, sh)
 
 
 # ------------------------------------------------------------------------------------------------- reading
@@ -240,9 +243,9 @@ def _decoded(text: dict) -> dict:
 
 
 def cube_kind(path) -> str | None:
-    """ "ktx2", "dds" or "exr" where ``path`` is a cube file lutbake writes (a KTX 2.0 with faceCount 6, a DDS with
-    the cube caps, an EXR whose parts are named mip_<m>), else None: read from the first bytes (and, for an EXR, its
-    part names)."""
+    """ "ktx2", "dds", "exr" or "ktx1" where ``path`` is a cube file lutbake writes (a KTX 2.0 or KTX 1.1 with
+    numberOfFaces 6, a DDS with the cube caps, an EXR whose parts are named mip_<m>), else None: read from the first
+    bytes (and, for an EXR, its part names)."""
     try:
         with open(path, "rb") as f:
             head = f.read(DDS_HEADER_BYTES)
@@ -250,6 +253,8 @@ def cube_kind(path) -> str | None:
         return None
     if head[:12] == IDENTIFIER and len(head) >= 48:
         return "ktx2" if struct.unpack_from("<I", head, 36)[0] == 6 else None
+    if head[:12] == KTX1_IDENTIFIER and len(head) >= 64:
+        return "ktx1" if struct.unpack_from("<I", head, 52)[0] == 6 else None
     if head[:4] == b"DDS " and len(head) >= DDS_HEADER_BYTES:
         return "dds" if struct.unpack_from("<I", head, 4 + 108)[0] & 0x200 else None
     if head[:4] == b"\x76\x2f\x31\x01":
@@ -311,6 +316,8 @@ def read_cube_record(path) -> dict:
             raise ValueError(f"{path}: the KTX2 key/value data runs past the file")
         record = _decoded(bounded.loads_json(_kv_pairs(kvd, 0, kvd_len).get("lutbake:metadata", "{}")))
         return _described(fmt, VK_NAMES.get(vk, f"vkFormat {vk}"), width, levels, record, "KTX2 key lutbake:metadata")
+    if fmt == "ktx1":
+        return _ktx1_described(path)
     if fmt == "dds":
         with open(path, "rb") as f:
             head = f.read(DDS_HEADER_BYTES)
@@ -327,6 +334,20 @@ def read_cube_record(path) -> dict:
         return _described(fmt, pixel, width, mips, _decoded(doc["lutbake"]), f"sidecar {side.name}")
     parts = _exr_parts(path)
     return _described(fmt, parts[0][2], parts[0][1], len(parts), _decoded(parts[0][3]), "EXR header (every part)")
+
+
+def _ktx1_described(path: Path) -> dict:
+    """read_cube_record of a KTX 1.1 cube (lutbake.io.ktx1): the header and key/value data only."""
+    from .ktx1 import FORMATS, HEADER, key_values
+
+    with open(path, "rb") as f:
+        fields = HEADER.unpack(f.read(HEADER.size))
+        if fields[13] > MAX_RECORD_BYTES:
+            raise ValueError(f"{path}: {fields[13]} bytes of KTX1 key/value data; lutbake's record is a few KiB")
+        kv = f.read(fields[13])
+    record = _decoded(bounded.loads_json(key_values(kv).get("lutbake:metadata", "{}")))
+    pixel = next((f"{name} (glInternalFormat {f[3]:#x})" for name, f in FORMATS.items() if f[3] == fields[5]), "?")
+    return _described("ktx1", pixel, fields[7], fields[12], record, "KTX1 key lutbake:metadata")
 
 
 def _described(fmt: str, pixel: str, size: int, mips: int, record: dict, where: str) -> dict:

@@ -104,7 +104,12 @@ def _report_lines(doc: dict) -> list[str]:
     return lines
 
 
-CUBE_FORMATS = {"ktx2": "KTX 2.0 cube", "dds": "DDS cube", "exr": "OpenEXR cube (a part per mip)"}
+CUBE_FORMATS = {
+    "ktx2": "KTX 2.0 cube",
+    "dds": "DDS cube",
+    "exr": "OpenEXR cube (a part per mip)",
+    "ktx1": "KTX 1.1 cube",
+}
 CUBE_SHOWN = (
     "ndf",
     "face_convention",
@@ -205,10 +210,8 @@ def describe_cube(path) -> str:
         if "source" in ibl:
             lines.append(f"    from {_text(ibl['source'])}")
     if "sh" in record:
-        lines.append(
-            f"  sh ({_text(record.get('sh_form', '?'))}, also in {_text(record.get('sh_file', '?'))}): "
-            + _text(record["sh"])
-        )
+        where = record.get("sh_file") or f"the file's key {str(record.get('sh_key', '?')).split(':')[0]}"
+        lines.append(f"  sh ({_text(record.get('sh_form', '?'))}, also in {_text(where)}): " + _text(record["sh"]))
     lines += _mip_rows(record, sizes)
     lines.append("reconstruction:")
     lines += [f"  {line}" for line in bounded_text(record.get("reconstruction", "(none recorded)")).splitlines()]
@@ -216,7 +219,7 @@ def describe_cube(path) -> str:
     shown = (
         set(CUBE_SHOWN)
         | CUBE_HIDDEN
-        | {"source", "source_sha256", "source_negative_values_zeroed", "sh", "sh_form", "sh_file"}
+        | {"source", "source_sha256", "source_negative_values_zeroed", "sh", "sh_form", "sh_file", "sh_key"}
     )
     if isinstance(record.get("config"), str):
         lines.append(f"  config: {len(record['config'].splitlines())} line(s) of TOML")

@@ -68,6 +68,7 @@ FORMAT_NAMES = {
     "png": "PNG",
     "dds": "DDS",
     "ktx2": "KTX 2.0",
+    "ktx1": "KTX 1.1",
     "h": "C header",
     "npz": "NumPy .npz archive",
     "text": "text array (JS, TS, WGSL, Rust or C source)",
