@@ -26,7 +26,14 @@ HASH_SOURCES = (
     "tolerance.py",
     "runtime/plan.py",  # TexelPlan: a table's shape
 )
-ENVIRONMENT_SOURCES = ("environment/*.py", "io/environment.py", "io/cubemap.py", "io/ktx1.py")
+ENVIRONMENT_SOURCES = (
+    "environment/*.py",
+    "io/environment.py",
+    "io/cubemap.py",
+    "io/cube_read.py",
+    "io/encodings.py",
+    "io/ktx1.py",
+)
 
 
 def source_files(patterns: tuple[str, ...] = HASH_SOURCES) -> list[Path]:

@@ -465,6 +465,10 @@ UNAUDITED = {
     "tests/test_environment.py, not a table",
     "env_sunrise_64x32.exr": "a CC0 lat-long environment (Blender's sunrise, reduced): a source of "
     "tests/test_environment.py, not a table",
+    "bevy_pisa_diffuse_rgb9e5_zstd.ktx2": "a cube map (Bevy's irradiance cube): audited by "
+    "lutbake.commands.audit_cube in tests/test_cube_audit.py",
+    "filament_pillars_2k_ibl_mips1-4.ktx": "a cube map (Filament's prefiltered IBL, mips 1-4): audited by "
+    "lutbake.commands.audit_cube in tests/test_cube_audit.py",
 }
 FAST_SIDE = 6  # the loop's subset (its own tests above use MAX_SIDE)
 OPENPBR_RATIO_MEAN = 2e-3  # the ratio re-baked: its averages' noise divided by them (measured mean 6.1e-4, all slices)

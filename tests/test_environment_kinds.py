@@ -348,9 +348,10 @@ def test_bake_environment_for_filament_writes_its_one_ktx1(tmp_path, monkeypatch
     [
         (SPECULAR + '\ndtype = "r11g11b10f"', "dtype", "written in format ktx1 only, not ktx2"),
         (SPECULAR.replace("mips = 3", 'mips = 4\nformat = "ktx1"\ndtype = "half"'), "mips", "1 x 1 (6 bytes"),
+        (SPECULAR + '\nformat = "ktx1"\ndtype = "rgb9e5"', "dtype", "format ktx1 takes dtype r11g11b10f, half"),
         (IRRADIANCE.replace('"exr"', '"ktx1"'), "format", "allowed: ktx2, dds, exr"),  # its SH: the specular KTX
     ],
-    ids=["r11g11b10f_in_ktx2", "half_1x1_in_ktx1", "irradiance_ktx1"],
+    ids=["r11g11b10f_in_ktx2", "half_1x1_in_ktx1", "rgb9e5_in_ktx1", "irradiance_ktx1"],
 )
 def test_filaments_ktx1_storage_is_refused_where_it_cannot_be_written(tmp_path, table, key, fragment):
     write_env(tmp_path / "env.exr", np.ones((4, 8, 3), np.float32))

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import click
 
+from ..environment.curves import CURVES as CURVE_NAMES
+from ..io.cubemap import cube_kind
 from .options import (
     FiniteFloat,
     conventions_of,
@@ -70,10 +72,18 @@ def _shape(text: str | None):
     metavar="PNG",
     help="Write |file - converged| per channel with labelled axes.",
 )
+@click.option(
+    "--curve",
+    type=click.Choice(sorted(CURVE_NAMES)),
+    default=None,
+    help="A cube map's roughness -> mip curve (default: the preset's, the file's record, else linear).",
+)
 @json_option("report (for CI)")
 @workers_option
 @force_png_option("--error-map")
-def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, error_map, as_json, workers, force):
+def audit(
+    file, preset, config, overrides, tolerance, metric, max_side, shape, error_map, curve, as_json, workers, force
+):
     """Compare the LUT FILE with a converged re-bake under declared conventions and diagnose mistakes.
 
     Reports max/mean/percentile |file - converged| per channel and where the maximum sits, tests each usual
@@ -82,9 +92,16 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
     explains the data, the storage quantisation and the Monte-Carlo noise (estimated sample count).
     Exit 0 when within --tolerance, 1 otherwise, 2 on a bad option, file or config.
 
+    A prefiltered cube map (KTX 2.0, KTX 1.1, DDS, EXR cube) is checked against lutbake's exact prefilter of its own
+    mip 0: the GGX alpha fitted per mip against the curve's (--curve, or the preset's: --preset bevy-ibl), a gamma
+    mistake, misplaced faces, the noise; an irradiance cube (one mip) against a Lambertian convolution. Exit 0 when
+    nothing is named, 1 otherwise.
+
     \b
     Examples:
       lutbake audit dfg.dds --preset filament
+      lutbake audit pisa_specular.ktx2 --preset bevy-ibl
+      lutbake audit default_env_ibl.ktx --curve filament
       lutbake audit lut_ggx.png --preset gltf --error-map lut_ggx.err.png --json
       lutbake audit brdf.h --set texel=endpoint --set axis_order=roughness_x --shape 64x64x3
     """
@@ -93,6 +110,8 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
     from ..errors import ConfigError
 
     conventions = conventions_of(preset, config, overrides)
+    if cube_kind(file) is not None:
+        _audit_cube(file, preset, curve, overrides, as_json, workers)
     quiet_warp()
     try:
         from ..preflight import check_image_output, input_files
@@ -111,6 +130,20 @@ def audit(file, preset, config, overrides, tolerance, metric, max_side, shape, e
     except (ConfigError, OSError, ValueError) as e:
         fail(e)
     click.echo(report_json(report) if as_json else report.text())
+    sys.exit(0 if report.passed else 1)
+
+
+def _audit_cube(file, preset, curve, overrides, as_json, workers):
+    """``lutbake audit`` of a cube map (lutbake.commands.audit_cube): print, exit 0 when nothing is named, else 1."""
+    import json
+
+    from ..commands.audit_cube import audit_cube
+
+    try:
+        report = audit_cube(file, preset, curve, overrides, threads=workers)
+    except (OSError, ValueError) as e:
+        fail(e)
+    click.echo(json.dumps(report.as_dict(), indent=1, default=str) if as_json else report.text(), nl=not as_json)
     sys.exit(0 if report.passed else 1)
 
 

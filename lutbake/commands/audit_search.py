@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..io.encodings import srgb_eotf, srgb_oetf
 from .audit_report import MISMATCH_RATIO  # a combination must leave at most this x the RMS of one with fewer mistakes
 
 EXACT_RMS = 1e-6  # a residual below this is the reference's own convergence (lutbake.commands.reference: 1e-7)
@@ -50,18 +51,6 @@ RGBD_RANGE = 255.0  # Babylon's rgbdMaxRange (Shaders/ShadersInclude/helperFunct
 BABYLON_GAMMA = 2.2  # Babylon's toLinearSpace = pow(x, 2.2) (ToLinearSpace, Maths/math.constants)
 RGBM_RANGE = 8.0  # PlayCanvas decodeRGBM: ((8 a) rgb)^2 (src/scene/shader-lib/chunks/common/frag/decode.js)
 CODE8 = 255.0
-
-
-def srgb_eotf(v):
-    """sRGB decoding (IEC 61966-2-1): what a sampler returns for a texture stored as sRGB."""
-    v = np.clip(v, 0.0, None)
-    return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
-
-
-def srgb_oetf(v):
-    """sRGB encoding (IEC 61966-2-1), the inverse of srgb_eotf."""
-    v = np.clip(v, 0.0, None)
-    return np.where(v <= 0.0031308, 12.92 * v, 1.055 * v ** (1 / 2.4) - 0.055)
 
 
 def _gamma(v):

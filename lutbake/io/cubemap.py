@@ -1,13 +1,15 @@
 """Cube maps with mips, the environment's files: KTX 2.0, DDS and EXR, each with lutbake's record of the bake
 (face convention, mip curve, roughness and alpha per mip, weighting, error estimate per mip, the source's sha256).
 
-- **KTX 2.0**: faceCount 6, levelCount M, VK_FORMAT_R16G16B16A16_SFLOAT (A = 1) or R32G32B32A32_SFLOAT; the level
-  index lists level 0 first, the level images are stored smallest first (KTX 2.0 §3.9, §3.10); inside a level the
-  faces +X, -X, +Y, -Y, +Z, -Z, each row 0 first. The record: key ``lutbake:metadata`` (JSON); ``KTXorientation``
-  ``rd``.
-- **DDS**: DX10 header, DXGI_FORMAT_R16G16B16A16_FLOAT / R32G32B32A32_FLOAT, TEXTURE2D with
-  DDS_RESOURCE_MISC_TEXTURECUBE, arraySize 1, mipMapCount M, DDSCAPS2_CUBEMAP and the six face bits; data face by
-  face (+X first), each face's mips largest first (Direct3D's subresource order). The record: ``<file>.json``.
+- **KTX 2.0**: faceCount 6, levelCount M, VK_FORMAT_R16G16B16A16_SFLOAT (A = 1), R32G32B32A32_SFLOAT, or the
+  packed E5B9G9R9_UFLOAT_PACK32 (``rgb9e5``) and B10G11R11_UFLOAT_PACK32 (``b10g11r11``), encoded exactly
+  (lutbake.io.encodings); the level index lists level 0 first, the level images are stored smallest first (KTX 2.0
+  §3.9, §3.10); inside a level the faces +X, -X, +Y, -Y, +Z, -Z, each row 0 first. The record: key
+  ``lutbake:metadata`` (JSON); ``KTXorientation`` ``rd``.
+- **DDS**: DX10 header, DXGI_FORMAT_R16G16B16A16_FLOAT / R32G32B32A32_FLOAT / R9G9B9E5_SHAREDEXP /
+  R11G11B10_FLOAT, TEXTURE2D with DDS_RESOURCE_MISC_TEXTURECUBE, arraySize 1, mipMapCount M, DDSCAPS2_CUBEMAP and
+  the six face bits; data face by face (+X first), each face's mips largest first (Direct3D's subresource order). The
+  record: ``<file>.json``.
 - **EXR**: one part per mip, named ``mip_<m>``, the six faces stacked top to bottom (+X, -X, +Y, -Y, +Z, -Z; 6n rows
   of n), RGB; every part's display window is mip 0's (OpenEXR shares it between parts), its data window its own,
   at the origin. The record: ``lutbake:*`` attributes in every part.
@@ -15,7 +17,9 @@
   (cmgen's), RGB16F or RGB32F, level 0 first, faces +X first, with the SH Filament's shader takes as key ``sh``.
 
 Faces are written as lutbake.environment.cube's table gives them (OpenGL / KTX orientation); ``face_convention`` in
-the record says so. Values must be finite and (half) below 65504: anything else is refused, never written.
+the record says so. Values must be finite and within the format's range (half 65504, RGB9E5 65408, B10G11R11 65024 /
+64512; the packed formats store a negative value as 0): anything else is refused, never written. lutbake.io.cube_read
+reads the pixels back (``read_cube``).
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ import numpy as np
 
 from . import bounded
 from .atomic import atomic_write
+from .encodings import ENCODERS
 from .ktx1 import IDENTIFIER as KTX1_IDENTIFIER
 from .ktx2 import IDENTIFIER, _dfd, _kvd
 
@@ -39,8 +44,28 @@ DDSD = 0x1 | 0x2 | 0x4 | 0x8 | 0x1000 | 0x20000  # CAPS HEIGHT WIDTH PITCH PIXEL
 DDSCAPS = 0x1000 | 0x8 | 0x400000  # TEXTURE, COMPLEX, MIPMAP
 DDSCAPS2_CUBE = 0x200 | 0xFC00  # CUBEMAP and the six faces
 DDS_MISC_TEXTURECUBE = 0x4
-VK_NAMES = {97: "VK_FORMAT_R16G16B16A16_SFLOAT", 109: "VK_FORMAT_R32G32B32A32_SFLOAT"}
-DXGI_NAMES = {10: "DXGI_FORMAT_R16G16B16A16_FLOAT", 2: "DXGI_FORMAT_R32G32B32A32_FLOAT"}
+VK_PACKED = {"rgb9e5": 123, "b10g11r11": 122}  # VK_FORMAT_E5B9G9R9_UFLOAT_PACK32, VK_FORMAT_B10G11R11_UFLOAT_PACK32
+DXGI_PACKED = {"rgb9e5": 67, "b10g11r11": 26}  # DXGI_FORMAT_R9G9B9E5_SHAREDEXP, DXGI_FORMAT_R11G11B10_FLOAT
+VK_NAMES = {
+    97: "VK_FORMAT_R16G16B16A16_SFLOAT",
+    109: "VK_FORMAT_R32G32B32A32_SFLOAT",
+    123: "VK_FORMAT_E5B9G9R9_UFLOAT_PACK32",
+    122: "VK_FORMAT_B10G11R11_UFLOAT_PACK32",
+}
+DXGI_NAMES = {
+    10: "DXGI_FORMAT_R16G16B16A16_FLOAT",
+    2: "DXGI_FORMAT_R32G32B32A32_FLOAT",
+    67: "DXGI_FORMAT_R9G9B9E5_SHAREDEXP",
+    26: "DXGI_FORMAT_R11G11B10_FLOAT",
+}
+# KDF 1.3 basic descriptor samples (bitOffset, bitLength - 1, channel | qualifiers, lower, upper) of the packed
+# formats: E5B9G9R9 (KDF 1.3 §5.19's shared-exponent example: a mantissa and an EXPONENT (0x20) sample per channel,
+# as `ktx create` writes Bevy's pisa_*_rgb9e5_zstd.ktx2) and B10G11R11 (KTX-Software lib/dfdutils/createdfd.c
+# createDFDPacked, s_UFLOAT: FLOAT (0x80), lower 0.0f, upper 1.0f)
+PACKED_SAMPLES = {
+    "rgb9e5": [s for c in range(3) for s in ((9 * c, 8, c, 0, 8448), (27, 4, c | 0x20, 15, 31))],
+    "b10g11r11": [(0, 10, 0x80, 0, 0x3F800000), (11, 10, 0x81, 0, 0x3F800000), (22, 9, 0x82, 0, 0x3F800000)],
+}
 MAX_RECORD_BYTES = 1 << 20  # lutbake's record of a cube is a few KiB
 
 
@@ -59,19 +84,48 @@ def rgba(mips: list[np.ndarray], dtype: str) -> list[np.ndarray]:
     return out
 
 
+def level_texels(mips: list[np.ndarray], dtype: str) -> list[np.ndarray]:
+    """Each mip as the texels stored: (6, n, n, 4) half / float32 with A = 1 (``rgba``), or (6, n, n) uint32 of a
+    packed format (``rgb9e5``, ``b10g11r11``: lutbake.io.encodings); ValueError for a value the format cannot hold."""
+    if dtype not in ENCODERS:
+        return rgba(mips, dtype)
+    out = []
+    for m, a in enumerate(mips):
+        a = np.asarray(a, np.float64)
+        if a.ndim != 4 or a.shape[0] != 6 or a.shape[1] != a.shape[2] or a.shape[3] != 3:
+            raise ValueError(f"mip {m}: a cube mip is (6, n, n, 3), got {a.shape}")
+        try:
+            out.append(ENCODERS[dtype](a))
+        except ValueError as e:
+            raise ValueError(f"mip {m}: {e}") from None
+    return out
+
+
+def packed_dfd(dtype: str) -> bytes:
+    """The basic data format descriptor of a packed 32-bit format (PACKED_SAMPLES), prefixed by dfdTotalSize; RGBSDA,
+    BT.709, linear."""
+    samples = PACKED_SAMPLES[dtype]
+    block = 24 + 16 * len(samples)
+    words = [0, 2 | (block << 16), 1 | (1 << 8) | (1 << 16), 0, 4, 0]
+    for offset, length, channel, lower, upper in samples:
+        words += [offset | (length << 16) | (channel << 24), 0, lower, upper]
+    body = struct.pack(f"<{len(words)}I", *words)
+    return struct.pack("<I", 4 + len(body)) + body
+
+
 def encode_ktx2_cube(mips: list[np.ndarray], metadata: dict, dtype: str = "half") -> bytes:
     """KTX 2.0 bytes of a cube with ``len(mips)`` levels (module docstring)."""
-    levels = rgba(mips, dtype)
+    levels = level_texels(mips, dtype)
     size = levels[0].shape[1]
-    type_size = 2 if dtype == "half" else 4
-    dfd = _dfd(4, type_size)
+    type_size = 2 if dtype == "half" else 4  # a packed format's typeSize is its 32-bit word's (KTX 2.0 §3.3)
+    dfd = packed_dfd(dtype) if dtype in VK_PACKED else _dfd(4, type_size)
     kvd = _kvd(
         {"KTXorientation": "rd", "KTXwriter": "lutbake", "lutbake:metadata": json.dumps(metadata, sort_keys=True)}
     )
     header_len = 12 + 13 * 4 + 2 * 8 + 3 * 8 * len(levels)
     kvd_off = header_len + len(dfd)
     pos = kvd_off + len(kvd)
-    align = math.lcm(4 * type_size, 4)
+    align = 4 if dtype in VK_PACKED else math.lcm(4 * type_size, 4)
     blobs, offsets, body = [], {}, b""
     for m in reversed(range(len(levels))):  # smallest level first in the file
         pad = -pos % align
@@ -82,7 +136,8 @@ def encode_ktx2_cube(mips: list[np.ndarray], metadata: dict, dtype: str = "half"
         body += data
         pos += len(data)
         blobs.append(data)
-    head = IDENTIFIER + struct.pack("<9I", VK_RGBA[dtype], type_size, size, size, 0, 0, 6, len(levels), 0)
+    vk = VK_PACKED.get(dtype) or VK_RGBA[dtype]
+    head = IDENTIFIER + struct.pack("<9I", vk, type_size, size, size, 0, 0, 6, len(levels), 0)
     head += struct.pack("<IIIIQQ", header_len, len(dfd), kvd_off, len(kvd), 0, 0)
     for m in range(len(levels)):
         off, n = offsets[m]
@@ -118,13 +173,13 @@ def decode_ktx2_cube(blob: bytes) -> tuple[list[np.ndarray], dict]:
 
 def encode_dds_cube(mips: list[np.ndarray], dtype: str = "half") -> bytes:
     """DDS bytes of a cube with ``len(mips)`` mips (module docstring)."""
-    levels = rgba(mips, dtype)
+    levels = level_texels(mips, dtype)
     size = levels[0].shape[1]
-    pitch = size * 4 * np.dtype(NUMPY[dtype]).itemsize
+    pitch = size * levels[0][0, 0].nbytes
     pixelformat = struct.pack("<II4sIIIII", 32, 0x4, b"DX10", 0, 0, 0, 0, 0)
     header = struct.pack("<IIIIIII", 124, DDSD, size, size, pitch, 0, len(levels)) + b"\0" * 44 + pixelformat
     header += struct.pack("<IIIII", DDSCAPS, DDSCAPS2_CUBE, 0, 0, 0)
-    dx10 = struct.pack("<IIIII", DXGI_RGBA[dtype], 3, DDS_MISC_TEXTURECUBE, 1, 0)
+    dx10 = struct.pack("<IIIII", DXGI_PACKED.get(dtype) or DXGI_RGBA[dtype], 3, DDS_MISC_TEXTURECUBE, 1, 0)
     data = b"".join(
         levels[m][f].astype(levels[m].dtype.newbyteorder("<")).tobytes() for f in range(6) for m in range(len(levels))
     )
@@ -161,7 +216,9 @@ def write_cube(
         raise ValueError(f"cube format must be one of {sorted(CUBE_FORMATS)}, got {fmt!r}")
     path = Path(path)
     text = _as_text(metadata)
-    levels = rgba(mips, "float32" if dtype == "r11g11b10f" else dtype)  # every value checked before any file
+    if dtype in ENCODERS and fmt not in ("ktx2", "dds"):
+        raise ValueError(f"dtype {dtype!r} is written in ktx2 and dds cubes only, not {fmt}")
+    levels = level_texels(mips, "float32" if dtype == "r11g11b10f" else dtype)  # every value checked before any file
     data = b""  # an EXR is written part by part below
     if fmt == "ktx1":
         from .ktx1 import encode_ktx1_cube

@@ -161,18 +161,74 @@ def _mip_rows(record: dict, sizes: list[int]) -> list[str]:
 
 
 def describe_cube(path) -> str:
-    """The report ``lutbake inspect`` prints for a cube file lutbake wrote: its container, whether its bytes match
-    the sha256 recorded with them, the record (kind, face convention, mip curve, roughness and alpha per mip, the
-    weighting, the error estimate per mip, the source's sha256, the engine's ibl conventions), the reconstruction
-    (the engine's shader line first) and the provenance. Pixels are not read."""
+    """The report ``lutbake inspect`` prints for a cube file: its container and pixel format, and, for one lutbake
+    wrote, whether its bytes match the sha256 recorded with them, the record (kind, face convention, mip curve,
+    roughness and alpha per mip, the weighting, the error estimate per mip, the source's sha256, the engine's ibl
+    conventions), the reconstruction (the engine's shader line first) and the provenance; then each mip's pixel
+    statistics (lutbake.io.cube_read), or why its pixels cannot be read."""
+    from .cube_read import read_cube
     from .cubemap import read_cube_record
-    from .integrity import verified_attributes
 
     path = Path(path)
     try:
         found = read_cube_record(path)
     except (ValueError, OSError, UnicodeDecodeError) as e:
-        raise ReadError(f"{path}: not a readable cube file: {e}") from None
+        found, why = None, e
+    try:
+        cube, unread = read_cube(path), None
+    except (ValueError, OSError) as e:
+        cube, unread = None, e
+    if found is None and cube is None:
+        raise ReadError(f"{path}: not a readable cube file: {why}") from None
+    lines = _record_lines(path, found) if found and found["record"] else _foreign_lines(path, cube)
+    lines.append("pixels (linear RGB as a shader reads them; mean weighted by texel solid angle):")
+    if cube is None:
+        lines.append(f"  not read: {bounded_text(str(unread), LONG_VALUE)}")
+    else:
+        lines += _pixel_lines(cube)
+    return "\n".join(lines) + "\n"
+
+
+def _foreign_lines(path: Path, cube) -> list[str]:
+    """The head of the report of a cube file without lutbake's record (an engine's)."""
+    facts = ", ".join(f"{k} {_text(v)}" for k, v in sorted(cube.facts.items()) if k != "sh")
+    lines = [
+        str(path),
+        f"  format: {CUBE_FORMATS.get(cube.container, cube.container)}, {cube.pixel_format}"
+        f"{' (sRGB-decoded)' if cube.transfer == 'srgb' else ''}, {cube.size} x {cube.size} faces, "
+        f"{len(cube.mips)} mip(s)",
+        "  no lutbake record (a file lutbake did not write): roughness per mip, curve and orientation unknown "
+        "(lutbake audit FILE --curve NAME fits them)",
+        "  faces: +X -X +Y -Y +Z -Z, each row t = 0 first, column s = 0 first (the KTX / GL / D3D face table)",
+    ]
+    if facts:
+        lines.append(f"  container: {facts}")
+    if "sh" in cube.facts:
+        lines.append(f"  sh (its 'sh' key, Filament's irradiance form): {_text(' '.join(cube.facts['sh'].split()))}")
+    return lines
+
+
+def _pixel_lines(cube) -> list[str]:
+    """Per mip and channel: min, max and the solid-angle-weighted mean."""
+    from ..environment.cube import texel_solid_angles
+
+    lines = ["  mip  size   channel  min          max          mean"]
+    for m, mip in enumerate(cube.mips):
+        w = texel_solid_angles(mip.shape[1])[None, :, :, None]
+        mean = (mip * w).sum(axis=(0, 1, 2)) / (6 * w.sum())
+        for c, letter in enumerate("RGB"):
+            head = f"  {m:<4} {mip.shape[1]:<6}" if c == 0 else " " * 13
+            lines.append(
+                f"{head} {letter:<8} {_fmt(mip[..., c].min()):<12} {_fmt(mip[..., c].max()):<12} {_fmt(mean[c])}"
+            )
+    return lines
+
+
+def _record_lines(path: Path, found: dict) -> list[str]:
+    """The head of the report of a cube file lutbake wrote: container, integrity, record, mips, reconstruction,
+    provenance."""
+    from .integrity import verified_attributes
+
     record = found["record"]
     size, mips = found["size"], found["mips"]
     sizes = [max(1, size >> m) for m in range(mips)]
@@ -226,7 +282,7 @@ def describe_cube(path) -> str:
     for key in sorted(set(record) - shown):
         value = _text(record[key])
         lines.append(f"  {bounded_text(key, NAME_CHARS)}: {value}")
-    return "\n".join(lines) + "\n"
+    return lines
 
 
 SH_KEYS = ("basis", "form", "coefficients")  # lutbake.kinds.environment's <name>_sh.json

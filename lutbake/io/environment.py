@@ -1,6 +1,8 @@
-"""Read a lat-long (equirectangular) environment: EXR or Radiance HDR through OpenImageIO, refused cleanly when
-hostile (not a regular file, too large for the memory budget, EXR headers past the caps, not 2:1, non-finite or
-negative radiance) before or right after the pixels are read.
+"""Read an environment: a lat-long (equirectangular) EXR or Radiance HDR through OpenImageIO, or a cube map (a KTX 2.0,
+KTX 1.1, DDS or lutbake EXR cube: lutbake.io.cube_read, its mip 0), refused cleanly when hostile (not a regular file,
+too large for the memory budget, EXR headers past the caps, not 2:1, non-finite or negative radiance) before or right
+after the pixels are read. ``read_environment`` tells them apart by the file's first bytes (lutbake.io.cubemap.
+cube_kind), never by its name.
 
 The image is taken as it is stored: row 0 the top (+Y, lutbake.environment.latlong's convention), its first three
 channels as linear RGB radiance (one channel: grey). Its bytes' sha256 is what a content hash covers.
@@ -79,3 +81,51 @@ def read_latlong(path) -> LatLong:
     negative = img < 0
     most = float(img.min()) if negative.any() else 0.0
     return LatLong(np.maximum(img, 0), digest, int(negative.sum()), most)
+
+
+@dataclass(frozen=True)
+class CubeEnvironment:
+    """A cube map read as an environment: ``faces`` its mip 0 (6, n, n, 3) float64 >= 0 in lutbake.environment.cube's
+    face table, texel-constant; ``orientation`` the world its lookup vectors stand for (``d3d_left_handed`` where
+    lutbake's record says so, else ``gl``); the sha256 of the file's bytes; the negative values set to 0 (count and
+    the most negative); the container and pixel format; the mips the file holds (only mip 0 is the source)."""
+
+    faces: np.ndarray
+    sha256: str
+    negatives: int
+    most_negative: float
+    container: str
+    pixel_format: str
+    orientation: str
+    mips: int
+
+
+def read_environment(path) -> LatLong | CubeEnvironment:
+    """The environment in ``path``: a cube map (``CubeEnvironment``) where its first bytes say so, else a lat-long
+    (read_latlong). ValueError says why not."""
+    from .cubemap import cube_kind
+
+    problem = bounded.regular_file_problem(path)
+    if problem:
+        raise ValueError(f"{path}: {problem}")
+    if cube_kind(path) is None:
+        return read_latlong(path)
+    from .cube_read import read_cube
+    from .integrity import sha256_file
+
+    cube = read_cube(path)
+    faces = cube.mips[0]
+    if not np.all(np.isfinite(faces)):
+        raise ValueError(f"{path}: its mip 0 holds a NaN or an infinite radiance")
+    negative = faces < 0
+    convention = str((cube.record or {}).get("face_convention", ""))
+    return CubeEnvironment(
+        np.maximum(faces, 0.0),
+        sha256_file(path),
+        int(negative.sum()),
+        float(faces.min()) if negative.any() else 0.0,
+        cube.container,
+        cube.pixel_format,
+        "d3d_left_handed" if convention.startswith("d3d_left_handed") else "gl",
+        len(cube.mips),
+    )

@@ -41,6 +41,7 @@ from .cubemap import cube_kind
 from .dds import read_dds
 from .exr import EXR_MAGIC, read_any_exr
 from .header import read_header
+from .ktx1 import IDENTIFIER as KTX1_IDENTIFIER
 from .ktx2 import read_ktx2
 from .npy import NPY_MAGIC, read_npy
 from .png import PNG_MAGIC, read_png
@@ -110,6 +111,7 @@ def sniff(path: Path) -> str:
         (PNG_MAGIC, "png"),
         (dds.MAGIC, "dds"),
         (ktx2.IDENTIFIER, "ktx2"),
+        (KTX1_IDENTIFIER, "ktx1"),
         (ZIP_MAGIC, "npz"),
     ):
         if head.startswith(magic):
@@ -135,8 +137,8 @@ def read(path) -> LoadedFile:
     cube = cube_kind(path)  # an environment table's cube map (lutbake.io.cubemap): no (z,) y, x, C table
     if cube is not None:
         raise ReadError(
-            f"{path}: a cube map with mips ({FORMAT_NAMES[cube]}, an environment table): `lutbake inspect` prints "
-            "its record; this command does not read cube maps"
+            f"{path}: a cube map with mips ({FORMAT_NAMES[cube]}), no (z,) y, x, C table: `lutbake inspect` describes "
+            "it, `lutbake audit` checks a prefiltered one, Python reads its pixels with lutbake.io.cube_read.read_cube"
         )
     size = path.stat().st_size
     if size > MAX_FILE_BYTES:

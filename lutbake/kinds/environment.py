@@ -16,7 +16,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..environment import cube, curves
-from ..io.environment import read_latlong
+from ..io.environment import CubeEnvironment, read_environment
 from ..io.integrity import sha256_file
 from ..registry import Lazy, Record, choices, family
 from ..sources import ENVIRONMENT_SOURCES, sources_digest
@@ -61,13 +61,25 @@ FORMATS = {
     "dds": "DDS cube (DX10 header, TEXTURECUBE), every mip (RGBA16F / RGBA32F) + .json sidecar with the record",
     "exr": "OpenEXR, one part per mip (mip_<m>: the six faces stacked top to bottom), the record in every part",
 }
+DTYPES = {
+    "half": "16-bit float (RGBA16F, A = 1)",
+    "float32": "32-bit float (RGBA32F, A = 1)",
+    "rgb9e5": "RGB9E5: three 9-bit mantissas and a shared 5-bit exponent, 32 bits a texel (VK_FORMAT_E5B9G9R9_UFLOAT_"
+    "PACK32, DXGI R9G9B9E5_SHAREDEXP; EXT_texture_shared_exponent's exact rounding; max 65408); ktx2 and dds only",
+    "b10g11r11": "unsigned 11-, 11- and 10-bit floats, 32 bits a texel (VK_FORMAT_B10G11R11_UFLOAT_PACK32, DXGI "
+    "R11G11B10_FLOAT; rounded to nearest, ties to even; max 65024 / 64512); ktx2 and dds only",
+}
+PACKED_FORMATS = ("ktx2", "dds")  # the formats that hold rgb9e5 and b10g11r11
 # environment_specular's own format and dtype: Filament's KTX 1 (its irradiance is the SH in the file)
 KTX1_FORMAT = (
     "KTX 1.1 cube as Filament's cmgen writes it (<name>.ktx: R11F_G11F_B10F / RGB16F / RGB32F, level 0 first), the "
     "environment's L2 SH (form filament) in its key sh: the one file Filament's Engine.createIblFromKtx1 loads "
     "(lutbake.io.ktx1)"
 )
-R11G11B10F = "unsigned 11-, 11- and 10-bit floats, rounded as cmgen rounds (max 64512); ktx1 only"
+R11G11B10F = (
+    "GL R11F_G11F_B10F (the bits of b10g11r11), rounded as cmgen rounds (a tie up: Filament math "
+    "fp<0, 5, M>::fromf; max 64512); ktx1 only"
+)
 KTX1_DTYPES = ("r11g11b10f", "half", "float32")  # lutbake.io.ktx1.FORMATS
 SH_FORMS = {
     "radiance": "L_k = ∫ L Y_k dω (three.js LightProbe / SphericalHarmonics3.getIrradianceAt)",
@@ -110,10 +122,12 @@ ENVIRONMENT_KEY = Key(
     "environment",
     "str",
     None,
-    "the lat-long environment: an .exr or .hdr file, width = 2 x height, row 0 = +Y, a path relative to "
-    "this config (absolute paths too); read and checked when the config is (missing, unreadable, not an "
-    "image, a NaN or an infinity: refused before any work); its sha256 enters the content hash. A preset "
-    "has none: lutbake bake --preset NAME --environment FILE",
+    "the environment: a lat-long .exr or .hdr file (width = 2 x height, row 0 = +Y) or a cube map (KTX 2.0, "
+    "KTX 1.1, DDS or lutbake's EXR cube: its mip 0, texel-constant on the faces; baked by spherical harmonics, "
+    "mip 0 the exact box average where one size divides the other), a path relative to this config (absolute "
+    "paths too); read and checked when the config is (missing, unreadable, not an image, a NaN or an infinity: "
+    "refused before any work); its sha256 enters the content hash. A preset has none: lutbake bake --preset NAME "
+    "--environment FILE",
 )
 
 
@@ -126,7 +140,7 @@ def _common() -> dict[str, Key]:
         **named,
         "environment": ENVIRONMENT_KEY,
         "format": Key("format", "str", "ktx2", "output file format: <out-dir>/<name>.<ext>", FORMATS),
-        "dtype": Key("dtype", "str", "half", "pixel type written", {"half": "16-bit float", "float32": "32-bit float"}),
+        "dtype": Key("dtype", "str", "half", "pixel type written", DTYPES),
         "estimator": Key(
             "estimator", "str", ESTIMATION.default, "how each texel's integral is computed", ESTIMATION.estimators
         ),
@@ -168,15 +182,28 @@ def environment_path(spec) -> Path:
 
 
 def check_environment(spec) -> tuple[str, str] | None:
-    """The environment file, read as the bake will (lutbake.io.environment.read_latlong): (key, why not) or None."""
+    """The storage (a packed dtype needs a format that holds it), then the environment file, read as the bake will
+    (read_environment): (key, why not) or None."""
+    o = spec.options
+    if o.get("dtype") in ("rgb9e5", "b10g11r11") and o.get("format") not in PACKED_FORMATS:
+        return "dtype", f"{o['dtype']} is written in {' and '.join(PACKED_FORMATS)} cubes only, not {o.get('format')}"
     if spec.options.get("environment") is None:
         source = Path(spec.source)
         preset = source.suffix == ".toml" and source.resolve().parent == PRESETS
         return "environment", NO_ENVIRONMENT.format(config=f"--preset {source.stem}" if preset else source)
     try:
-        read_latlong(environment_path(spec))
+        env = read_environment(environment_path(spec))
     except (ValueError, OSError) as e:
         return "environment", f"cannot be baked: {e}"
+    if isinstance(env, CubeEnvironment):
+        if o.get("estimator") == "quadrature":
+            return "estimator", "a cube map environment is baked by spherical harmonics (auto or harmonic)"
+        n, size = env.faces.shape[1], int(o.get("size", 1))
+        if spec.kind == "environment_specular" and n % size and size % n:
+            return "size", (
+                f"mip 0 from a {n}^2 cube environment is its exact box average: size must divide {n} or be a "
+                f"multiple of it, got {size}"
+            )
     return None
 
 
@@ -254,10 +281,13 @@ def quality(o):
 def read_source(spec):
     """(the environment as read, its pyramid): the source turned by the spec's orientation. A lookup vector d
     stands for the world direction d x flip (cube.ORIENTATIONS); flipping z is phi -> -phi, the columns reversed
-    (u -> 1 - u, exact for texel-constant radiance), so the cube is baked from the mirrored image."""
+    (u -> 1 - u, exact for texel-constant radiance), so the cube is baked from the mirrored image. A cube map
+    environment has no pyramid (None): lutbake.environment.cube_source turns it."""
     from ..environment import latlong
 
-    env = read_latlong(environment_path(spec))
+    env = read_environment(environment_path(spec))
+    if isinstance(env, CubeEnvironment):
+        return env, None
     flip = cube.ORIENTATIONS[spec.options["orientation"]].flip
     if flip != (1.0, 1.0, -1.0) and flip != (1.0, 1.0, 1.0):
         raise ValueError(f"orientation {spec.options['orientation']!r}: only a z flip is baked")
@@ -270,6 +300,16 @@ def base_record(spec, env, baked) -> dict:
     the per-mip error estimate of ``baked`` (lutbake.environment.prefilter.Baked)."""
     o = spec.options
     orientation = cube.ORIENTATIONS[o["orientation"]]
+    source_convention, error_method = SOURCE_CONVENTION, ERROR_METHOD
+    if isinstance(env, CubeEnvironment):
+        from ..environment.cube_source import ERROR_METHOD as error_method
+
+        n = env.faces.shape[1]
+        source_convention = (
+            f"cube: mip 0 of a {n}^2 {env.container} {env.pixel_format} cube (of {env.mips} mips), faces +X -X +Y -Y "
+            f"+Z -Z in the face table of lutbake.environment.cube, orientation {env.orientation}; texel-constant "
+            "radiance over each texel's footprint (lutbake.environment.cube_source)"
+        )
     return {
         "face_convention": f"{orientation.name}: faces +X -X +Y -Y +Z -Z in the OpenGL / KTX / Vulkan face table "
         "(lutbake.environment.cube)",
@@ -277,13 +317,13 @@ def base_record(spec, env, baked) -> dict:
         "source": Path(o["environment"]).name,
         "source_sha256": env.sha256,
         "source_negative_values_zeroed": env.negatives,
-        "source_convention": SOURCE_CONVENTION,
+        "source_convention": source_convention,
         "split_sum": "n = v = r",
         "lobes": baked.lobes,
         "method_per_mip": baked.methods,
         "harmonic_lmax": baked.lmax,
         "error_estimate_per_mip": baked.errors,
-        "error_estimate_method": ERROR_METHOD,
+        "error_estimate_method": error_method,
         "quality": {"tau": o["tau"], "k_geo": o["k_geo"], "order": o["order"]},
     }
 
@@ -291,7 +331,6 @@ def base_record(spec, env, baked) -> dict:
 def bake_specular(spec, workers: int | None = None, device: str = "cpu") -> CubeTable:
     """The prefiltered specular cube of ``spec`` (nothing written): mip m at the curve's r_m, alpha = r_m^2; mip 0
     (r = 0) the exact area average over each texel's footprint."""
-    from ..environment import prefilter
 
     o = spec.options
     curve, lobe = spec.records["curve"], spec.records["lobe"]
@@ -299,9 +338,7 @@ def bake_specular(spec, workers: int | None = None, device: str = "cpu") -> Cube
     env, pyr = read_source(spec)
     mips = mip_count(o)
     roughness = [curve.obj.roughness(m, mips) for m in range(mips)]
-    baked = prefilter.bake_cube(
-        pyr, o["size"], roughness, lobe.name, quality(o), workers, device=device, method=o["estimator"]
-    )
+    baked = bake_lobe(spec, env, pyr, roughness, lobe.name, workers, device)
     record = base_record(spec, env, baked) | {
         "ndf": ndf,
         "roughness_definition": ROUGHNESS[ndf],
@@ -314,34 +351,33 @@ def bake_specular(spec, workers: int | None = None, device: str = "cpu") -> Cube
         else baked.lobes[0],
     }
     if o["format"] == "ktx1":
-        record |= filament_sh(env.image)
+        record |= filament_sh(env)
     return CubeTable(spec.name, spec.kind, baked.mips, record, specular_reconstruction(spec), inputs_of(env.sha256))
 
 
-def filament_sh(image) -> dict:
-    """What a ktx1 cube records of the environment's L2 SH (lutbake.environment.sh form ``filament``, of the world's
-    directions: the orientation turns the cube only), also written as the file's key ``sh`` (lutbake.io.ktx1)."""
+def filament_sh(env) -> dict:
+    """What a ktx1 cube records of the environment's L2 SH (lutbake.environment.sh form ``filament`` of source_sh, the
+    world's directions: the orientation turns the cube only), also written as the file's key ``sh``
+    (lutbake.io.ktx1)."""
     from ..environment import sh
 
     return {
         "sh_form": "filament",
         "sh_form_meaning": sh.FORMS["filament"],
         "sh_key": "sh: the KTX 1 key, 9 lines 'r g b' (float32), what IndirectLight.Builder.irradiance(3, sh) takes",
-        "sh": sh.convolve(sh.project(image), "filament").tolist(),
+        "sh": sh.convolve(source_sh(env), "filament").tolist(),
     }
 
 
 def bake_irradiance(spec, workers: int | None = None, device: str = "cpu") -> CubeTable:
     """The irradiance cube E / pi of ``spec`` and its L2 SH (nothing written); the SH of the world's directions
     (the orientation turns the cube only)."""
-    from ..environment import prefilter, sh
+    from ..environment import sh
 
     o = spec.options
     env, pyr = read_source(spec)
-    baked = prefilter.bake_cube(
-        pyr, o["size"], [1.0], "cosine", quality(o), workers, device=device, method=o["estimator"]
-    )
-    coefficients = sh.convolve(sh.project(env.image), o["sh_form"])
+    baked = bake_lobe(spec, env, pyr, [1.0], "cosine", workers, device)
+    coefficients = sh.convolve(source_sh(env), o["sh_form"])
     doc = {
         "basis": "real SH, Ramamoorthi & Hanrahan 2001 / three.js order: Y00; Y1-1 y, Y10 z, Y11 x; Y2-2 xy, "
         "Y2-1 yz, Y20 3z^2-1, Y21 xz, Y22 x^2-y^2 (lutbake.environment.sh), on the y-up world direction",
@@ -364,6 +400,32 @@ def bake_irradiance(spec, workers: int | None = None, device: str = "cpu") -> Cu
 
 
 SH_SUFFIX = "_sh.json"
+
+
+def bake_lobe(spec, env, pyr, roughness: list[float], lobe: str, workers, device: str):
+    """prefilter.bake_cube of a lat-long source (its pyramid ``pyr``), or cube_source.bake_from_cube of a cube map
+    environment, at the spec's size, orientation and estimator."""
+    from ..environment import cube_source, prefilter
+
+    o = spec.options
+    if isinstance(env, CubeEnvironment):
+        flip = cube.ORIENTATIONS[o["orientation"]].flip
+        source_flip = cube.ORIENTATIONS[env.orientation].flip
+        return cube_source.bake_from_cube(env.faces, o["size"], roughness, lobe, source_flip, flip, workers)
+    return prefilter.bake_cube(
+        pyr, o["size"], roughness, lobe, quality(o), workers, device=device, method=o["estimator"]
+    )
+
+
+def source_sh(env):
+    """(9, 3) radiance coefficients of the world's radiance: of the lat-long image, or of a cube map environment
+    turned to the world (its lookup vector d is the world direction d x flip)."""
+    from ..environment import cube_source, sh
+
+    if isinstance(env, CubeEnvironment):
+        flip = cube.ORIENTATIONS[env.orientation].flip
+        return cube_source.project_cube(cube_source.remap(env.faces, flip))
+    return sh.project(env.image)
 
 
 def specular_reconstruction(spec) -> str:
