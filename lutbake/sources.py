@@ -32,6 +32,7 @@ ENVIRONMENT_SOURCES = (
     "io/cubemap.py",
     "io/cube_read.py",
     "io/encodings.py",
+    "io/ktx1.py",
 )
 
 

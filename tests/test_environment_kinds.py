@@ -243,7 +243,11 @@ def test_bevy_ibl_writes_the_dfg_and_both_cubes_with_one_set_of_conventions(bevy
     assert sh["coefficients"] == cubes[1]["sh"] and sh["source_sha256"] == specular["source_sha256"]
 
 
-@pytest.mark.parametrize("preset", ["bevy-ibl", "gltf-ibl"])
+ALL_KINDS = {"dfg", "environment_specular", "environment_irradiance"}
+IBL_KINDS = {"bevy-ibl": ALL_KINDS, "gltf-ibl": ALL_KINDS, "filament-ibl": ALL_KINDS - {"environment_irradiance"}}
+
+
+@pytest.mark.parametrize("preset", sorted(IBL_KINDS))
 def test_each_ibl_presets_tables_hold_the_conventions_their_engine_records(preset):
     """Every table of an ibl preset is an engine table with the engine's IBL conventions, and holds the keys those
     conventions fix (dfg: ndf, masking, roughness; the specular cube: curve, lobe)."""
@@ -256,7 +260,103 @@ def test_each_ibl_presets_tables_hold_the_conventions_their_engine_records(prese
     for spec, table in zip(specs, tables):
         for key, want in table.ibl.keys(spec.kind).items():
             assert spec.options[key] == want, (preset, spec.name, key)
-    assert {t.kind for t in TABLES if t.preset == preset} == {"dfg", "environment_specular", "environment_irradiance"}
+    assert {t.kind for t in TABLES if t.preset == preset} == IBL_KINDS[preset]
+
+
+# Filament's: the DFG table and one KTX 1 (the cube 8^2 to 2^2 by the quadrature; the harmonics' fixed cost: ~10 CPU s)
+SMALL_FILAMENT = ["filament_specular.size=8", "filament_specular.mips=3", "filament_specular.estimator=quadrature"]
+# cmgen's R11F_G11F_B10F rounds to a nearest code: half a step, 2^-(M+1) of the value (M = 6, 6, 5 mantissa bits),
+# below 2^-14 within one subnormal step 2^-14 / 2^M (tests/test_filament_ibl.py)
+R11G11B10F_HALF_STEP = np.array([2.0**-7, 2.0**-7, 2.0**-6])
+R11G11B10F_SUBNORMAL = np.array([2.0**-20, 2.0**-20, 2.0**-19])
+
+
+@pytest.fixture(scope="module")
+def filament_ibl(tmp_path_factory):
+    out = tmp_path_factory.mktemp("filament_ibl")
+    results = lutbake.bake([preset_path("filament-ibl")], out_dir=out, overrides=SMALL_FILAMENT, environment=STUDIO)
+    return out, results
+
+
+def test_filament_ibl_writes_the_dfg_and_one_ktx1_with_one_set_of_conventions(filament_ibl):
+    out, results = filament_ibl
+    assert statuses(results) == {"filament_dfg_corrected": "baked", "filament_specular": "baked"}
+    names = {"filament_dfg_corrected.dds", "filament_specular.ktx"}
+    assert names | {n + ".json" for n in names} == {p.name for p in out.iterdir()}
+    found = read_cube_record(out / "filament_specular.ktx")
+    assert (found["format"], found["size"], found["mips"]) == ("ktx1", 8, 3)
+    record = found["record"]
+    ibl = json.loads(verified_attributes(out / "filament_dfg_corrected.dds")["ibl"])
+    assert record["ibl"] == ibl and ibl["engine"] == "Filament"
+    assert (ibl["ndf"], ibl["masking"], ibl["roughness"], ibl["mip_curve"], ibl["lobe"]) == (
+        "ggx",
+        "smith_height_correlated",
+        "perceptual",
+        "filament",
+        "ggx_nl",
+    )
+    # cmgen's level m of M: lodToPerceptualRoughness(m / (M - 1)) = 1 - sqrt(1 - m / (M - 1)), alpha = r^2
+    np.testing.assert_allclose(record["roughness"], [0.0, 1 - np.sqrt(0.5), 1.0], rtol=0, atol=1e-15)
+    assert record["alpha"] == [r * r for r in record["roughness"]]
+    assert record["face_convention"].startswith("gl") and record["weighting"].startswith("ggx_nl")
+    assert record["reconstruction"].startswith("Filament: lod = iblRoughnessOneLevel * r * (2.0 - r)")
+
+
+def test_filament_ibl_ktx1_holds_the_cube_within_its_rounding_and_the_sources_sh(filament_ibl):
+    from lutbake.environment import sh
+    from lutbake.io.ktx1 import decode_ktx1_cube
+
+    out, results = filament_ibl
+    cube = next(r.table for r in results if r.name == "filament_specular")
+    mips, fmt, pairs = decode_ktx1_cube((out / "filament_specular.ktx").read_bytes())
+    assert fmt == "r11g11b10f" and [m.shape for m in mips] == [(6, n, n, 3) for n in (8, 4, 2)]
+    for got, want in zip(mips, cube.mips, strict=True):
+        assert np.all(np.abs(got - want) <= R11G11B10F_HALF_STEP * want + R11G11B10F_SUBNORMAL)
+    # the key sh: the filament form of the source's SH (Filament's iblSH), as written to 9 digits, and in the record
+    want = sh.convolve(sh.project(read_latlong(STUDIO).image), "filament")
+    np.testing.assert_allclose(np.array(pairs["sh"].split(), float).reshape(9, 3), want, rtol=1e-7, atol=1e-9)
+    np.testing.assert_allclose(cube.record["sh"], want, rtol=1e-14, atol=0)
+    assert cube.record["sh_form"] == "filament"
+
+
+def test_inspect_shows_filaments_ktx1_and_its_conventions(filament_ibl):
+    out, _ = filament_ibl
+    r = CliRunner().invoke(main, ["inspect", str(out / "filament_specular.ktx")])
+    assert r.exit_code == 0, r.output
+    text = " ".join(r.output.split())
+    assert "KTX 1.1 cube, r11g11b10f (glInternalFormat 0x8c3a), 8 x 8 faces, 3 mip(s)" in text
+    assert "bytes (and its other files) match" in text and "sh (filament, also in the file's key sh)" in text
+    assert "ibl conventions (every file of the engine's run): engine Filament, ndf ggx" in text
+    assert "mip_curve: filament: lod = (M - 1) * r * (2 - r)" in text
+
+
+def test_bake_environment_for_filament_writes_its_one_ktx1(tmp_path, monkeypatch):
+    """No irradiance cube: the SH is the KTX 1's key (the cube by the quadrature, for the test's time)."""
+    from lutbake.commands.environment import bake_environment
+    from lutbake.environment import prefilter
+
+    real = prefilter.bake_cube
+    monkeypatch.setattr(prefilter, "bake_cube", lambda *a, **k: real(*a, **{**k, "method": "quadrature"}))
+    paths = bake_environment(STUDIO, tmp_path, "studio", engine="filament", size=4)
+    assert set(paths) == {"specular"} and paths["specular"].name == "studio_specular.ktx"
+    found = read_cube_record(paths["specular"])
+    assert found["pixel_format"].startswith("r11g11b10f") and found["record"]["sh_form"] == "filament"
+
+
+@pytest.mark.parametrize(
+    "table, key, fragment",
+    [
+        (SPECULAR + '\ndtype = "r11g11b10f"', "dtype", "written in format ktx1 only, not ktx2"),
+        (SPECULAR.replace("mips = 3", 'mips = 4\nformat = "ktx1"\ndtype = "half"'), "mips", "1 x 1 (6 bytes"),
+        (SPECULAR + '\nformat = "ktx1"\ndtype = "rgb9e5"', "dtype", "format ktx1 takes dtype r11g11b10f, half"),
+        (IRRADIANCE.replace('"exr"', '"ktx1"'), "format", "allowed: ktx2, dds, exr"),  # its SH: the specular KTX
+    ],
+    ids=["r11g11b10f_in_ktx2", "half_1x1_in_ktx1", "rgb9e5_in_ktx1", "irradiance_ktx1"],
+)
+def test_filaments_ktx1_storage_is_refused_where_it_cannot_be_written(tmp_path, table, key, fragment):
+    write_env(tmp_path / "env.exr", np.ones((4, 8, 3), np.float32))
+    msg = refusal(tmp_path, table)
+    assert "c.toml" in msg and f"key '{key}'" in msg and fragment in msg, msg
 
 
 def test_inspect_prints_the_record_of_each_cube_format(baked, bevy_ibl):

@@ -20,9 +20,16 @@ radiance at the reflected direction: f0 = 1 makes E times its energy compensatio
 the SH (diffuse) and the cube's last mip at their normal (specular). The same file with its ±X faces swapped, its rows
 flipped, or its SH in another form must fail.
 
+(c) Preset ``filament-ibl``'s KTX 1 (the studio light's specular cube at 32² to 8², its key ``sh``) on (b)'s chart: each
+pixel against the CPU model of Filament's lookup of the file's own texels (trilinear at lod = (M - 1) r (2 - r), the
+SH polynomials of the key), at the pixels whose lookups stay inside one face (seamless filtering at face edges is the
+GL implementation's, not modelled).
+
 Skipped, with the reason, without chromium, playwright, `npm ci` in web/ or WebGL2."""
 
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -59,6 +66,15 @@ ENV_A, ENV_B = 0.6, 0.35
 ENV_ATOL, ENV_RMS = 1e-3, 2e-4
 ENV_MISTAKES = ("swapX", "flipRows", "shForm")
 FILES = {"filament": "filament_dfg", "corrected": "filament_dfg_corrected"}  # the two bakes' DDS names
+# (c): preset filament-ibl with the studio light (tests/data), its cube 32² to 8² (the quadrature: seconds)
+STUDIO = Path(__file__).parent / "data" / "env_studio_64x32.exr"
+PRESET_CUBE = ["filament_specular.size=32", "filament_specular.mips=3", "filament_specular.estimator=quadrature"]
+PRESET_KTX = "filament-ibl/filament_specular.ktx"
+PRESET_SWAPPED = "/lut/filament_preset_swapX_ibl.ktx"  # the same file with its ±X faces exchanged: must fail
+# (c) against the lookup model: measured max 2.2e-2 on values up to 38 (0.53 %), at most 1.2e-3 of the spread of the
+# texels a pixel reads, RMS 1.1e-3, at 91 % of the pixels: consistent with filter weights rounded to 8 bits (up to 2^-9
+# of the spread); allowed 2^-8 of it plus the shader's arithmetic (dielectric pixels, spread ~0: measured 2.8e-5)
+FILTER_STEP, PRESET_ATOL = 2.0**-8, 2e-4
 # the other formats' rounding, half a step of the value: cmgen's R11F_G11F_B10F (R, G: 6 mantissa bits, B: 5) and RGB16F
 ROUNDED = {"env_r11g11b10f": np.array([2.0**-7, 2.0**-7, 2.0**-6]), "env_half": np.full(3, 2.0**-11)}
 
@@ -155,10 +171,11 @@ def furnace_model(xy, spec) -> np.ndarray:
     return np.stack(out)
 
 
-def env_model(xy, chart) -> np.ndarray:
-    """(b)'s pixel: metal rows L(mix(r, n, α²)) (α = MIN_PERCEPTUAL_ROUGHNESS², getSpecularDominantDirection);
-    dielectric rows (r = 1: the dominant direction is n) E ec L(n) + (1 - E) SH(n), SH(n) = A + 2/3 B n (the cosine
-    convolution of a linear L, R&H 2001)."""
+def lit_model(xy, chart, radiance, irradiance) -> np.ndarray:
+    """Filament's pixel on (b)'s chart: metal rows radiance(mix(r, n, α²), r) (α = MIN_PERCEPTUAL_ROUGHNESS²,
+    getSpecularDominantDirection; f0 = 1 makes E times its energy compensation 1); dielectric rows (r = 1: the
+    dominant direction is n) E ec radiance(n, 1) + (1 - E) irradiance(n). ``radiance(d, r)`` the cube's value at
+    unit directions d for perceptual roughness r, ``irradiance(n)`` E / pi (the SH)."""
     rows = len(chart["rows"]) // 2
     n = np.asarray(chart["normals"]).reshape(2 * rows, -1, 3)
     metal = n[:rows]
@@ -166,13 +183,58 @@ def env_model(xy, chart) -> np.ndarray:
     r = 2 * nov * metal - [0, 0, 1]
     alpha = MIN_PERCEPTUAL_ROUGHNESS**2
     dominant = r + alpha**2 * (metal - r)
-    out_metal = environment(dominant / np.linalg.norm(dominant, axis=-1, keepdims=True))
+    out_metal = radiance(dominant / np.linalg.norm(dominant, axis=-1, keepdims=True), MIN_PERCEPTUAL_ROUGHNESS)
     d = n[rows:].reshape(-1, 3)
     x, y = xy(np.ones(len(d)), d[:, 2]).T
     e = (1 - DIELECTRIC_F0) * x + DIELECTRIC_F0 * y
     ec = 1 + DIELECTRIC_F0 * (1 / y - 1)
-    out = (e * ec)[:, None] * environment(d) + (1 - e)[:, None] * (ENV_A + 2 / 3 * ENV_B * d)
+    out = (e * ec)[:, None] * radiance(d, 1.0) + (1 - e)[:, None] * irradiance(d)
     return np.concatenate([out_metal, out.reshape(n[rows:].shape)])
+
+
+def env_model(xy, chart) -> np.ndarray:
+    """(b)'s pixel: the smooth environment (every mip the same function) and its SH's closed form, A + 2/3 B n (the
+    cosine convolution of a linear L, R&H 2001)."""
+    return lit_model(xy, chart, lambda d, r: environment(d), lambda n: ENV_A + 2 / 3 * ENV_B * n)
+
+
+def face_taps(mip: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(texels (4, ..., 3), bilinear weights (4, ..., 1), inside) of a cube mip (6, n, n, 3) at lookup vectors d
+    (..., 3): GL's bilinear filter between the texel centres of the face d picks (lutbake.environment.cube.face_st;
+    row t, column s); ``inside``: the four texels are all in that face (elsewhere seamless filtering takes texels of
+    the next face: not modelled)."""
+    n = mip.shape[1]
+    face, s, t = cube.face_st(d)
+    x, y = s * n - 0.5, t * n - 0.5
+    inside = (x >= 0) & (x < n - 1) & (y >= 0) & (y < n - 1)
+    x0 = np.clip(np.floor(x).astype(int), 0, n - 2)
+    y0 = np.clip(np.floor(y).astype(int), 0, n - 2)
+    fx, fy = (x - x0)[..., None], (y - y0)[..., None]
+    texels = np.stack([mip[face, y0 + i, x0 + j] for i in (0, 1) for j in (0, 1)])
+    weights = np.stack([(1 - fy) * (1 - fx), (1 - fy) * fx, fy * (1 - fx), fy * fx])
+    return texels, weights, inside
+
+
+def lookup_model(xy, chart, mips, coefficients) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(c)'s (pixels, inside, spread): Filament's lookup of a KTX 1's own texels, trilinear at
+    lod = (M - 1) r (2 - r) (light_indirect.fs perceptualRoughnessToLod, M = the file's levels), and of its key sh,
+    E / pi = max(Σ c_k p_k(n), 0) (Irradiance_SphericalHarmonics); ``inside``: every texel a pixel reads is in one
+    face; ``spread``: max - min of the texels it reads (what a rounded filter weight can move the pixel by)."""
+    masks, spreads = [], []
+
+    def radiance(d, r):
+        lod = (len(mips) - 1) * r * (2 - r)
+        lo = min(int(lod), len(mips) - 1)
+        hi, f = min(lo + 1, len(mips) - 1), lod - lo
+        (ta, wa, in_a), (tb, wb, in_b) = face_taps(mips[lo], d), face_taps(mips[hi], d)
+        masks.append(in_a & in_b)
+        both = np.concatenate([ta, tb])
+        spreads.append(both.max(axis=0) - both.min(axis=0))
+        return (1 - f) * (wa * ta).sum(axis=0) + f * (wb * tb).sum(axis=0)
+
+    px = lit_model(xy, chart, radiance, lambda n: np.maximum(sh.polynomials(n) @ coefficients, 0.0))
+    inside = np.concatenate([masks[0], masks[1].reshape(masks[0].shape)])
+    return px, inside, np.concatenate([spreads[0], spreads[1].reshape(spreads[0].shape)])
 
 
 @pytest.fixture(scope="module")
@@ -188,12 +250,18 @@ def renders(tmp_path_factory):
     cmgen_like = ["layout=multiscatter", "estimator=hammersley_ndf", "samples=1024"]
     bake(preset_path("filament"), luts / "cmgen", [size, "row_order=lo_first", *cmgen_like])
     write_ibls(luts)
+    bake([preset_path("filament-ibl")], luts / "filament-ibl", PRESET_CUBE, environment=STUDIO)
+    mips, _, pairs = decode_ktx1_cube((luts / PRESET_KTX).read_bytes())
+    c = np.array(pairs["sh"].split(), float).reshape(9, 3)
+    swapped = encode_ktx1_cube([m[[1, 0, 2, 3, 4, 5]] for m in mips], "r11g11b10f", c)
+    (luts / "filament_preset_swapX_ibl.ktx").write_bytes(swapped)
     spec = web_harness.furnace_chart()
     chart = env_chart()
     lut = {name: f"/lut/{web_harness.FILAMENT_WEB}/{file}.dds" for name, file in FILES.items()}
     variants = {"shipped": {}, "lutbake": {"dfg": lut["filament"]}, "corrected": {"dfg": lut["corrected"]}}
     variants.update({m: {"dfg": lut["corrected"], "mistake": m} for m in DFG_MISTAKES})
     variants.update({m: {**chart, "ibl": f"/lut/filament_{m}_ibl.ktx"} for m in ("env", *ROUNDED, *ENV_MISTAKES)})
+    variants.update(preset={**chart, "ibl": f"/lut/{PRESET_KTX}"}, preset_swapX={**chart, "ibl": PRESET_SWAPPED})
     infos = {}
     out = web_harness.render_furnaces(luts, ENGINE_DIR, [(PAGE, variants)], spec, infos)
     out.update(spec=spec, chart=chart, info=infos["shipped"], luts=luts)
@@ -292,3 +360,32 @@ def test_the_env_files_hold_what_the_model_assumes(renders):
     expected[0] = ENV_A
     expected[[3, 1, 2], [0, 1, 2]] = 2 / 3 * ENV_B  # x -> R, y -> G, z -> B
     np.testing.assert_allclose(c, expected, atol=1e-4)
+
+
+def preset_lookup(renders):
+    mips, fmt, pairs = decode_ktx1_cube((renders["luts"] / PRESET_KTX).read_bytes())
+    assert fmt == "r11g11b10f" and [m.shape[1] for m in mips] == [32, 16, 8]
+    c = np.array(pairs["sh"].split(), float).reshape(9, 3)
+    return lookup_model(table(dfg_texels(renders["info"]["dfg"])), renders["chart"], mips, c)
+
+
+def test_filament_loads_the_filament_ibl_presets_ktx1_as_its_lookup_model(renders):
+    model, inside, spread = preset_lookup(renders)
+    diff = np.abs(renders["preset"] - model)[inside]
+    spread_inside = spread[inside]
+    varied = spread_inside > 1e-2
+    print(
+        f"Filament, preset filament-ibl's KTX1 vs the lookup model at {inside.mean():.0%} of the pixels: max "
+        f"{diff.max():.3g}, RMS {np.sqrt(np.mean(diff**2)):.3g}; of the texels' spread (where > 1e-2) at most "
+        f"{(diff[varied] / spread_inside[varied]).max():.2g}"
+    )
+    assert inside.mean() > 0.5
+    assert np.all(diff <= FILTER_STEP * spread_inside + PRESET_ATOL)
+
+
+def test_filament_with_the_presets_ktx1_faces_exchanged_fails_its_model(renders):
+    model, inside, spread = preset_lookup(renders)
+    diff = np.abs(renders["preset_swapX"] - model)[inside]
+    outside = np.mean(diff > FILTER_STEP * spread[inside] + PRESET_ATOL)
+    print(f"Filament, preset filament-ibl's KTX1 with ±X exchanged: max {diff.max():.3g}, {outside:.0%} out of bounds")
+    assert outside > 0.1

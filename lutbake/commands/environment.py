@@ -1,8 +1,9 @@
 """Bake an environment's half of the split sum from Python, for one engine: the prefiltered specular cube (one
 roughness per mip by the engine's curve), the irradiance cube (E / pi) and its L2 SH, written as KTX 2.0, DDS or EXR
-cubes with lutbake's record. It bakes the tables of kinds environment_specular and environment_irradiance
-(lutbake.kinds.environment) with the keys the engine's records fix (lutbake.layouts: the tables of preset
-``<engine>-ibl``), exactly as a config or ``lutbake bake --preset bevy-ibl --environment studio.exr`` does.
+cubes with lutbake's record (Filament: the specular cube only, as its KTX 1 with the SH in its key ``sh``). It bakes
+the tables of kinds environment_specular and environment_irradiance (lutbake.kinds.environment) with the keys the
+engine's records fix (lutbake.layouts: the tables of preset ``<engine>-ibl``), exactly as a config or
+``lutbake bake --preset bevy-ibl --environment studio.exr`` does.
 
     from lutbake.commands.environment import bake_environment
     bake_environment("studio.exr", "outputs", "studio", engine="bevy")
@@ -41,20 +42,22 @@ def bake_environment(
     size: int = 256,
     irradiance_size: int = 32,
     lobe: str = "ggx_nl",
-    dtype: str = "half",
+    dtype: str | None = None,
     fmt: str | None = None,
     quality: Quality = Quality(),
     workers: int | None = None,
     sh_form: str = "radiance",
 ) -> dict[str, Path]:
     """Bake and write ``<name>_specular``, ``<name>_diffuse`` (cubes) and ``<name>_diffuse_sh.json``; returns the
-    paths {"specular", "diffuse", "sh"}. ``fmt``: ktx2, dds or exr (default: the engine's)."""
+    paths {"specular", "diffuse", "sh"}; for an engine without an irradiance cube (filament: the SH is the KTX 1's
+    key ``sh``) {"specular"}. ``fmt``, ``dtype``: default the engine's (ktx2, dds, exr, ktx1; half, float32,
+    r11g11b10f)."""
     if quality.extra_levels:
         raise ValueError("quality.extra_levels is no key of the environment kinds (tau, k_geo, order are)")
     keys = engine_keys(engine)
     common = {
         "environment": os.path.abspath(source),
-        "dtype": dtype,
+        **({} if dtype is None else {"dtype": dtype}),
         "tau": quality.tau,
         "k_geo": quality.k_geo,
         "order": quality.order,
@@ -69,7 +72,7 @@ def bake_environment(
             "lobe": lobe,
         },
         "diffuse": {
-            **keys["environment_irradiance"],
+            **keys.get("environment_irradiance", {}),
             **common,
             "name": f"{name}_diffuse",
             "kind": "environment_irradiance",
@@ -77,6 +80,8 @@ def bake_environment(
             "sh_form": sh_form,
         },
     }
+    if "environment_irradiance" not in keys:
+        del tables["diffuse"]
     paths = {}
     for index, (role, raw) in enumerate(tables.items()):
         if fmt is not None:
@@ -85,5 +90,6 @@ def bake_environment(
         cube, _ = bake_cube_table(spec, workers)
         path = output_path(out_dir, spec.name, spec.options["format"])
         paths[role] = write_cube_table(cube, path, spec.options["format"], spec.options["dtype"])
-    paths["sh"] = Path(out_dir) / f"{name}_diffuse{SH_SUFFIX}"
+    if "diffuse" in paths:
+        paths["sh"] = Path(out_dir) / f"{name}_diffuse{SH_SUFFIX}"
     return paths

@@ -271,11 +271,13 @@ def cube_metadata(table) -> dict:
 
 def write_cube_table(table, path, fmt: str, dtype: str = "half") -> Path:
     """Write ``table`` (lutbake.table.CubeTable) to ``path`` (write_cube), with its SH document beside it where it has
-    one (``record["sh_file"]``)."""
+    one (``record["sh_file"]``); a ktx1 cube carries its record's SH of form ``filament`` as its key ``sh``."""
     files = {}
     if table.sh is not None:
         files[table.record["sh_file"]] = (json.dumps(table.sh, indent=1) + "\n").encode()
-    return write_cube(table.mips, path, cube_metadata(table), fmt, dtype, files)
+    filament = fmt == "ktx1" and table.record.get("sh_form") == "filament"  # the KTX 1's key sh (lutbake.io.ktx1)
+    sh = np.asarray(table.record["sh"], np.float64) if filament else None
+    return write_cube(table.mips, path, cube_metadata(table), fmt, dtype, files, sh)
 
 
 # ------------------------------------------------------------------------------------------------- reading
@@ -372,22 +374,7 @@ def read_cube_record(path) -> dict:
         record = _decoded(bounded.loads_json(_kv_pairs(kvd, 0, kvd_len).get("lutbake:metadata", "{}")))
         return _described(fmt, VK_NAMES.get(vk, f"vkFormat {vk}"), width, levels, record, "KTX2 key lutbake:metadata")
     if fmt == "ktx1":
-        from .ktx1 import FORMATS, HEADER
-
-        with open(path, "rb") as f:
-            fields = HEADER.unpack(f.read(HEADER.size))
-            if fields[13] > MAX_RECORD_BYTES:
-                raise ValueError(f"{path}: {fields[13]} bytes of KTX1 key/value data; lutbake's record is a few KiB")
-            kv = f.read(fields[13])
-        pairs, pos = {}, 0
-        while pos + 4 <= len(kv):
-            (n,) = struct.unpack_from("<I", kv, pos)
-            key, _, value = kv[pos + 4 : pos + 4 + n].partition(b"\0")
-            pairs[key.decode("utf-8", "replace")] = value.rstrip(b"\0").decode("utf-8", "replace")
-            pos += 4 + n + (-n % 4)
-        record = _decoded(bounded.loads_json(pairs.get("lutbake:metadata", "{}")))
-        pixel = next((name for name, f in FORMATS.items() if f[0] == fields[2] and f[3] == fields[5]), "?")
-        return _described(fmt, pixel, fields[7], fields[12], record, "KTX1 key lutbake:metadata")
+        return _ktx1_described(path)
     if fmt == "dds":
         with open(path, "rb") as f:
             head = f.read(DDS_HEADER_BYTES)
@@ -404,6 +391,20 @@ def read_cube_record(path) -> dict:
         return _described(fmt, pixel, width, mips, _decoded(doc["lutbake"]), f"sidecar {side.name}")
     parts = _exr_parts(path)
     return _described(fmt, parts[0][2], parts[0][1], len(parts), _decoded(parts[0][3]), "EXR header (every part)")
+
+
+def _ktx1_described(path: Path) -> dict:
+    """read_cube_record of a KTX 1.1 cube (lutbake.io.ktx1): the header and key/value data only."""
+    from .ktx1 import FORMATS, HEADER, key_values
+
+    with open(path, "rb") as f:
+        fields = HEADER.unpack(f.read(HEADER.size))
+        if fields[13] > MAX_RECORD_BYTES:
+            raise ValueError(f"{path}: {fields[13]} bytes of KTX1 key/value data; lutbake's record is a few KiB")
+        kv = f.read(fields[13])
+    record = _decoded(bounded.loads_json(key_values(kv).get("lutbake:metadata", "{}")))
+    pixel = next((f"{name} (glInternalFormat {f[3]:#x})" for name, f in FORMATS.items() if f[3] == fields[5]), "?")
+    return _described("ktx1", pixel, fields[7], fields[12], record, "KTX1 key lutbake:metadata")
 
 
 def _described(fmt: str, pixel: str, size: int, mips: int, record: dict, where: str) -> dict:

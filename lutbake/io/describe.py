@@ -266,10 +266,8 @@ def _record_lines(path: Path, found: dict) -> list[str]:
         if "source" in ibl:
             lines.append(f"    from {_text(ibl['source'])}")
     if "sh" in record:
-        lines.append(
-            f"  sh ({_text(record.get('sh_form', '?'))}, also in {_text(record.get('sh_file', '?'))}): "
-            + _text(record["sh"])
-        )
+        where = record.get("sh_file") or f"the file's key {str(record.get('sh_key', '?')).split(':')[0]}"
+        lines.append(f"  sh ({_text(record.get('sh_form', '?'))}, also in {_text(where)}): " + _text(record["sh"]))
     lines += _mip_rows(record, sizes)
     lines.append("reconstruction:")
     lines += [f"  {line}" for line in bounded_text(record.get("reconstruction", "(none recorded)")).splitlines()]
@@ -277,7 +275,7 @@ def _record_lines(path: Path, found: dict) -> list[str]:
     shown = (
         set(CUBE_SHOWN)
         | CUBE_HIDDEN
-        | {"source", "source_sha256", "source_negative_values_zeroed", "sh", "sh_form", "sh_file"}
+        | {"source", "source_sha256", "source_negative_values_zeroed", "sh", "sh_form", "sh_file", "sh_key"}
     )
     if isinstance(record.get("config"), str):
         lines.append(f"  config: {len(record['config'].splitlines())} line(s) of TOML")

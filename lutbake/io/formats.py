@@ -43,6 +43,7 @@ EXTENSIONS = {
     "ktx2": ".ktx2",
     "h": ".h",
     "openpbr_h": ".h",
+    "ktx1": ".ktx",  # the environment_specular kind's Filament KTX 1 (lutbake.io.cubemap), no table format
 }
 
 

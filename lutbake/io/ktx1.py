@@ -151,6 +151,24 @@ def encode_ktx1_cube(
     return head + kv + b"".join(levels)
 
 
+def key_values(data: bytes) -> dict[str, str]:
+    """The pairs of KTX 1.1 key/value data (§2.10, ``_kv``): each entry's size checked against ``data``; a value's
+    trailing NULs dropped (other writers end a value with one); ValueError says what is wrong."""
+    pairs, pos = {}, 0
+    while pos < len(data):
+        if pos + 4 > len(data):
+            raise ValueError(f"KTX1 key/value entry at byte {pos} runs past the key/value data")
+        (n,) = struct.unpack_from("<I", data, pos)
+        if pos + 4 + n > len(data):
+            raise ValueError(f"KTX1 key/value entry at byte {pos} runs past the key/value data")
+        key, sep, value = data[pos + 4 : pos + 4 + n].partition(b"\0")
+        if not sep:
+            raise ValueError(f"KTX1 key/value entry at byte {pos} has no NUL after its key")
+        pairs[key.decode("utf-8", "replace")] = value.rstrip(b"\0").decode("utf-8", "replace")
+        pos += 4 + n + (-n % 4)
+    return pairs
+
+
 def decode_ktx1_cube(blob: bytes) -> tuple[list[np.ndarray], str, dict[str, str]]:
     """(mips as (6, n, n, 3) float64, format, key/value pairs) of a KTX 1.1 cube in one of ``FORMATS`` (what
     ``encode_ktx1_cube`` and cmgen write); every size is checked against the file's length; ValueError says what is
@@ -168,16 +186,7 @@ def decode_ktx1_cube(blob: bytes) -> tuple[list[np.ndarray], str, dict[str, str]
         )
     if not 1 <= levels <= 32 or HEADER.size + kv_len > len(blob):
         raise ValueError(f"KTX1 numberOfMipmapLevels {levels} or bytesOfKeyValueData {kv_len} does not fit the file")
-    pairs, pos = {}, HEADER.size
-    while pos < HEADER.size + kv_len:
-        (n,) = struct.unpack_from("<I", blob, pos)
-        if pos + 4 + n > HEADER.size + kv_len:
-            raise ValueError(f"KTX1 key/value entry at byte {pos} runs past the key/value data")
-        key, sep, value = blob[pos + 4 : pos + 4 + n].partition(b"\0")
-        if not sep:
-            raise ValueError(f"KTX1 key/value entry at byte {pos} has no NUL after its key")
-        pairs[key.decode("utf-8", "replace")] = value.decode("utf-8", "replace")
-        pos += 4 + n + (-n % 4)
+    pairs, pos = key_values(blob[HEADER.size : HEADER.size + kv_len]), HEADER.size + kv_len
     texel = FORMATS[fmt][5]
     mips = []
     for m in range(levels):

@@ -12,6 +12,7 @@ enters the table's content hash (``inputs``): editing the file rebakes the table
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 from ..environment import cube, curves
@@ -43,7 +44,7 @@ for _name, _desc, _cite in (
     (
         "ggx",
         "w = D_ggx(h) / 4 over r.l > 0: the unweighted prefilter",
-        "Filament cmgen without n.l; glTF-IBL-Sampler with its n.l weighting off",
+        "glTF-IBL-Sampler with its n.l weighting off",
     ),
     (
         "charlie",
@@ -69,6 +70,17 @@ DTYPES = {
     "R11G11B10_FLOAT; rounded to nearest, ties to even; max 65024 / 64512); ktx2 and dds only",
 }
 PACKED_FORMATS = ("ktx2", "dds")  # the formats that hold rgb9e5 and b10g11r11
+# environment_specular's own format and dtype: Filament's KTX 1 (its irradiance is the SH in the file)
+KTX1_FORMAT = (
+    "KTX 1.1 cube as Filament's cmgen writes it (<name>.ktx: R11F_G11F_B10F / RGB16F / RGB32F, level 0 first), the "
+    "environment's L2 SH (form filament) in its key sh: the one file Filament's Engine.createIblFromKtx1 loads "
+    "(lutbake.io.ktx1)"
+)
+R11G11B10F = (
+    "GL R11F_G11F_B10F (the bits of b10g11r11), rounded as cmgen rounds (a tie up: Filament math "
+    "fp<0, 5, M>::fromf; max 64512); ktx1 only"
+)
+KTX1_DTYPES = ("r11g11b10f", "half", "float32")  # lutbake.io.ktx1.FORMATS
 SH_FORMS = {
     "radiance": "L_k = ∫ L Y_k dω (three.js LightProbe / SphericalHarmonics3.getIrradianceAt)",
     "irradiance": "Â_l L_k: E(n) = Σ c_k Y_k(n) (Ramamoorthi & Hanrahan 2001, Eq. 8)",
@@ -232,12 +244,32 @@ def irradiance_texels(options) -> int:
 
 
 def check_specular(spec):
-    """``mips`` within the chain ``size`` has, then the environment file."""
+    """``mips`` within the chain ``size`` has, the storage (check_ktx1), then the environment file."""
     o = spec.options
     full = int(o["size"]).bit_length()
     if o.get("mips") is not None and o["mips"] > full:
         return "mips", f"a {o['size']}^2 cube has at most {full} mips (the last 1 x 1): floor(log2 size) + 1"
-    return check_environment(spec)
+    return check_ktx1(spec) or check_environment(spec)
+
+
+def check_ktx1(spec) -> tuple[str, str] | None:
+    """Filament's KTX 1 (format ktx1) holds the cube in one of KTX1_DTYPES, and r11g11b10f is written in it only; a
+    half face of odd size (a 1 x 1 is 6 bytes) needs KTX padding Filament's Ktx1Bundle does not read
+    (lutbake.io.ktx1)."""
+    o = spec.options
+    fmt, dtype = o.get("format"), o.get("dtype")
+    if fmt == "ktx1" and dtype not in KTX1_DTYPES:
+        return "dtype", f"format ktx1 takes dtype {', '.join(KTX1_DTYPES)}, not {dtype!r}"
+    if dtype == "r11g11b10f" and fmt != "ktx1":
+        return "dtype", f"r11g11b10f (cmgen's R11F_G11F_B10F) is written in format ktx1 only, not {fmt}"
+    odd = [n for n in (max(1, int(o["size"]) >> m) for m in range(mip_count(o))) if n % 2] if fmt == "ktx1" else []
+    if dtype == "half" and odd:
+        return "mips", (
+            f"a ktx1 half face of {odd[0]} x {odd[0]} ({6 * odd[0] ** 2} bytes, not a multiple of 4) needs KTX "
+            "padding Filament's Ktx1Bundle does not read: a size and mips whose every mip is even (the last 2 x 2 "
+            "or larger), or dtype r11g11b10f / float32"
+        )
+    return None
 
 
 def quality(o):
@@ -318,7 +350,23 @@ def bake_specular(spec, workers: int | None = None, device: str = "cpu") -> Cube
         if baked.lobes[0] == "footprint"
         else baked.lobes[0],
     }
+    if o["format"] == "ktx1":
+        record |= filament_sh(env)
     return CubeTable(spec.name, spec.kind, baked.mips, record, specular_reconstruction(spec), inputs_of(env.sha256))
+
+
+def filament_sh(env) -> dict:
+    """What a ktx1 cube records of the environment's L2 SH (lutbake.environment.sh form ``filament`` of source_sh, the
+    world's directions: the orientation turns the cube only), also written as the file's key ``sh``
+    (lutbake.io.ktx1)."""
+    from ..environment import sh
+
+    return {
+        "sh_form": "filament",
+        "sh_form_meaning": sh.FORMS["filament"],
+        "sh_key": "sh: the KTX 1 key, 9 lines 'r g b' (float32), what IndirectLight.Builder.irradiance(3, sh) takes",
+        "sh": sh.convolve(source_sh(env), "filament").tolist(),
+    }
 
 
 def bake_irradiance(spec, workers: int | None = None, device: str = "cpu") -> CubeTable:
@@ -384,11 +432,14 @@ def specular_reconstruction(spec) -> str:
     """How a shader reads the specular cube (lutbake's own text; an engine's line is put first where the table is
     one of its records, lutbake.layouts.reconstruction_with_engine_line)."""
     curve = spec.records["curve"].obj
-    return (
+    text = (
         f"lod = {curve.lod.removeprefix('lod = ')} (M = {mip_count(spec.options)} mips, r = perceptual roughness); "
         "prefiltered = textureLod(cube, R, lod).rgb, R = reflect(-V, N); "
         "specular = prefiltered * (f0 * dfg.r + f90 * dfg.g) with the DFG table of the same roughness"
     )
+    if spec.options["format"] == "ktx1":
+        text += "; irradiance_over_pi = sh[0] + sh[1] N.y + sh[2] N.z + sh[3] N.x + ... (form filament, key sh)"
+    return text
 
 
 def reconstruction(spec) -> str:
@@ -408,7 +459,9 @@ HEAD = ("name", "kind", "environment")  # the kind's own keys follow these, then
 
 
 def _keys(own: dict[str, Key]) -> dict[str, Key]:
-    return {**{k: COMMON[k] for k in HEAD}, **own, **{k: v for k, v in COMMON.items() if k not in HEAD}}
+    """HEAD, the kind's own keys, then the rest of COMMON (an own key of a common name replaces it in its place)."""
+    fresh = {k: v for k, v in own.items() if k not in COMMON}
+    return {**{k: COMMON[k] for k in HEAD}, **fresh, **{k: own.get(k, v) for k, v in COMMON.items() if k not in HEAD}}
 
 
 SPECULAR_KEYS = _keys(
@@ -432,6 +485,8 @@ SPECULAR_KEYS = _keys(
         "lobe": Key(
             "lobe", "str", "ggx_nl", "the weight each texel integrates the source against", choices(ENVIRONMENT_LOBE)
         ),
+        "format": replace(COMMON["format"], choices={**COMMON["format"].choices, "ktx1": KTX1_FORMAT}),
+        "dtype": replace(COMMON["dtype"], choices={**COMMON["dtype"].choices, "r11g11b10f": R11G11B10F}),
     }
 )
 IRRADIANCE_KEYS = _keys(
