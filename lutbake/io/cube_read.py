@@ -43,7 +43,7 @@ class Pixels:
 
     name: str
     size: int
-    layout: str  # "f16x4", "f16x3", "f32x4", "f32x3", "rgb9e5", "b10g11r11", "u8x4"
+    packing: str  # "f16x4", "f16x3", "f32x4", "f32x3", "rgb9e5", "b10g11r11", "u8x4"
     srgb: bool = False
     bgr: bool = False  # the first three channels in memory are B, G, R
 
@@ -109,14 +109,14 @@ class CubeFile:
 
 def decode_pixels(raw, count: int, pixels: Pixels) -> np.ndarray:
     """(count, 3) float64 linear RGB of ``count`` texels of ``pixels`` in the bytes ``raw``."""
-    if pixels.layout in ("rgb9e5", "b10g11r11"):
+    if pixels.packing in ("rgb9e5", "b10g11r11"):
         words = np.frombuffer(raw, "<u4", count)
-        return decode_rgb9e5(words) if pixels.layout == "rgb9e5" else decode_b10g11r11(words)
-    if pixels.layout == "u8x4":
+        return decode_rgb9e5(words) if pixels.packing == "rgb9e5" else decode_b10g11r11(words)
+    if pixels.packing == "u8x4":
         codes = np.frombuffer(raw, np.uint8, 4 * count).reshape(count, 4)[:, :3].astype(np.float64) / 255.0
         codes = codes[:, ::-1] if pixels.bgr else codes
         return srgb_eotf(codes) if pixels.srgb else codes
-    kind, channels = pixels.layout.split("x")
+    kind, channels = pixels.packing.split("x")
     values = np.frombuffer(raw, "<f2" if kind == "f16" else "<f4", int(channels) * count)
     return values.reshape(count, int(channels))[:, :3].astype(np.float64)
 
