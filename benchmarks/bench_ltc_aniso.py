@@ -22,7 +22,7 @@
    magnitude = the ground truth's albedo: the LTC's own error under lutbake's shaded objective).
 
 The paper's fitting script (fitting/fit_alphax_alphay_theta_phi.py) needs torch with CUDA ('cuda:0' is hard-coded
-in every tensor it makes); it is not run here (see the JSON's "paper_fit").
+in every tensor it makes); it is not run here (see the JSON's "paper_fit"; its time on the CPU: docs/ltc_aniso.md).
 """
 
 from __future__ import annotations
@@ -257,7 +257,8 @@ def main():
             "alpha_x), docs/shaders/ltc_aniso.glsl",
         },
         "paper_fit": "fitting/fit_alphax_alphay_theta_phi.py: torch + CUDA ('cuda:0' hard-coded), tqdm; 10000 SGD "
-        "epochs over the 8^4 texels by default; not run here (no torch, no GPU on this machine)",
+        "epochs over the 8^4 texels by default; not run by this benchmark (on one CPU core with its device strings "
+        "changed: ~110 s per epoch, docs/ltc_aniso.md)",
     }
     (OUT / "ltc_aniso.json").write_text(json.dumps(report, indent=1))
     print(json.dumps(report, indent=1))
