@@ -356,6 +356,18 @@ def quadrant(phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return folded, signs[:, :, None] * np.eye(3)
 
 
+def corner_weights(u: np.ndarray, n) -> tuple[np.ndarray, np.ndarray]:
+    """The quadrilinear interpolation of a table of endpoint texels n (4,) at table coordinates u (k, 4) in [0, 1]
+    (clamped): the 16 corner texels' indices (k, 16, 4) and weights (k, 16), corners in np.ndindex(2, 2, 2, 2) order
+    (the shader's: docs/shaders/ltc_aniso.glsl)."""
+    s = np.clip(u, 0.0, 1.0) * (np.array(n) - 1)
+    lo = np.minimum(np.floor(s).astype(int), np.array(n) - 2)
+    w = s - lo
+    corners = np.array(list(np.ndindex(2, 2, 2, 2)))
+    weight = np.prod(np.where(corners[None], w[:, None, :], 1.0 - w[:, None, :]), axis=2)
+    return lo[:, None, :] + corners[None], weight
+
+
 def lookup(table: np.ndarray, grid: Grid4, ax, ay, theta, phi, extra: np.ndarray | None = None):
     """The shader's reconstruction (docs/shaders/ltc_aniso.glsl) on the host: the paper's quadrilinear interpolation
     of M (and of ``extra`` (n_a, n_b, n_theta, n_phi, c): magnitude, fresnel) at endpoint texel coordinates
@@ -370,16 +382,12 @@ def lookup(table: np.ndarray, grid: Grid4, ax, ay, theta, phi, extra: np.ndarray
         b = b / np.maximum(a, 1e-30)
     folded = np.where(swap, np.pi / 2 - folded, folded)
     u = np.stack([a, b, theta / (THETA_SCALE * np.pi / 2), folded / (np.pi / 2)], axis=1)
-    u = np.clip(u, 0.0, 1.0) * (np.array(grid.n) - 1)
-    lo = np.minimum(np.floor(u).astype(int), np.array(grid.n) - 2)
-    w = u - lo
+    index, weight = corner_weights(u, grid.n)
     flat = np.concatenate([table.reshape(*grid.n, 9), *([] if extra is None else [extra])], axis=-1)
     out = np.zeros((len(a), flat.shape[-1]))
-    for corner in np.ndindex(2, 2, 2, 2):
-        c = np.array(corner)
-        wt = np.prod(np.where(c, w, 1.0 - w), axis=1)
-        i = lo + c
-        out += wt[:, None] * flat[i[:, 0], i[:, 1], i[:, 2], i[:, 3]]
+    for c in range(16):
+        i = index[:, c]
+        out += weight[:, c, None] * flat[i[:, 0], i[:, 1], i[:, 2], i[:, 3]]
     m = out[:, :9].reshape(-1, 3, 3)
     s = np.array([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     m = np.where(swap[:, None, None], s @ m @ s, m)
