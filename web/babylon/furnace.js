@@ -24,6 +24,9 @@ import { VertexData } from '/web/node_modules/@babylonjs/core/Meshes/mesh.vertex
 import { PBRMaterial } from '/web/node_modules/@babylonjs/core/Materials/PBR/pbrMaterial.js';
 import { Texture } from '/web/node_modules/@babylonjs/core/Materials/Textures/texture.js';
 import { RawCubeTexture } from '/web/node_modules/@babylonjs/core/Materials/Textures/rawCubeTexture.js';
+import { CubeTexture } from '/web/node_modules/@babylonjs/core/Materials/Textures/cubeTexture.js';
+import '/web/node_modules/@babylonjs/core/Engines/Extensions/engine.cubeTexture.js';
+import '/web/node_modules/@babylonjs/core/Engines/Extensions/engine.prefilteredCubeTexture.js';
 import { RenderTargetTexture } from '/web/node_modules/@babylonjs/core/Materials/Textures/renderTargetTexture.js';
 import { RGBDTextureTools } from '/web/node_modules/@babylonjs/core/Misc/rgbdTextureTools.js';
 import { expose } from '/web/furnace.js';
@@ -83,11 +86,28 @@ async function lutbakeTexture( scene, mistake ) {
 
 }
 
+// a prefiltered environment cube as Babylon loads one (CubeTexture of a .dds with prefiltered true: gammaSpace false,
+// createPrefilteredCubeTexture, lodGenerationScale = lodScale (Babylon's default 0.8), lodGenerationOffset 0)
+async function prefilteredCube( scene, url, lodScale ) {
+
+	return await new Promise( ( resolve, reject ) => {
+
+		const t = new CubeTexture( url, scene, { prefiltered: true, forcedExtension: '.dds', lodScale, lodOffset: 0,
+			createPolynomials: true, onLoad: () => resolve( t ), onError: ( m, e ) => reject( new Error( `${ m } ${ e }` ) ) } );
+
+	} );
+
+}
+
 let engine = null;
 
 // rows: [{ roughness, metalness, color: [r, g, b] }], nov: [NoV per column]. Returns the RGBA float pixels, row 0 at
 // the bottom (row i of the result is rows[i]).
-async function furnace( { nov, rows, lut = LUT, mistake = 'none', anisotropy = 1 } ) {
+// environment: null (radiance 1 everywhere) or the URL of a prefiltered DDS cube (lodScale: its lodGenerationScale);
+// mixIrradiance: PBRMaterial's brdf.mixIblRadianceWithIrradiance (Babylon's default true: the shader's radiance is
+// mix(prefiltered radiance, SH irradiance, alphaG), pbrBlockReflection MIX_IBL_RADIANCE_WITH_IRRADIANCE)
+async function furnace( { nov, rows, lut = LUT, mistake = 'none', anisotropy = 1, environment = null, lodScale = 0.8,
+	mixIrradiance = true } ) {
 
 	const width = nov.length, height = rows.length;
 	if ( ! engine ) {
@@ -104,10 +124,9 @@ async function furnace( { nov, rows, lut = LUT, mistake = 'none', anisotropy = 1
 	scene.imageProcessingConfiguration.applyByPostProcess = true;  // no tone mapping, no gamma: linear float out
 
 	const face = () => new Float32Array( 4 * 4 * 4 ).fill( 1 );
-	const environment = new RawCubeTexture( scene, [ face(), face(), face(), face(), face(), face() ], 4,
+	scene.environmentTexture = environment ? await prefilteredCube( scene, environment, lodScale ) : new RawCubeTexture( scene, [ face(), face(), face(), face(), face(), face() ], 4,
 		Constants.TEXTUREFORMAT_RGBA, Constants.TEXTURETYPE_FLOAT, false, false, Texture.BILINEAR_SAMPLINGMODE );
-	environment.gammaSpace = false;
-	scene.environmentTexture = environment;
+	scene.environmentTexture.gammaSpace = false;
 
 	// the environment BRDF: set before the materials (PBRMaterial takes scene.environmentBRDFTexture, or Babylon's own
 	// from BRDFTextureTools.GetEnvironmentBRDFTexture, when it is made)
@@ -153,6 +172,7 @@ async function furnace( { nov, rows, lut = LUT, mistake = 'none', anisotropy = 1
 		material.backFaceCulling = false;
 		material.useRadianceOcclusion = false;
 		material.useHorizonOcclusion = false;
+		material.brdf.mixIblRadianceWithIrradiance = mixIrradiance;
 		mesh.material = material;
 		return mesh;
 
