@@ -27,6 +27,8 @@ import { RawCubeTexture } from '/web/node_modules/@babylonjs/core/Materials/Text
 import { CubeTexture } from '/web/node_modules/@babylonjs/core/Materials/Textures/cubeTexture.js';
 import '/web/node_modules/@babylonjs/core/Engines/Extensions/engine.cubeTexture.js';
 import '/web/node_modules/@babylonjs/core/Engines/Extensions/engine.prefilteredCubeTexture.js';
+import '/web/node_modules/@babylonjs/core/Engines/Extensions/engine.renderTargetCube.js';
+import { HDRCubeTexture } from '/web/node_modules/@babylonjs/core/Materials/Textures/hdrCubeTexture.js';
 import { RenderTargetTexture } from '/web/node_modules/@babylonjs/core/Materials/Textures/renderTargetTexture.js';
 import { RGBDTextureTools } from '/web/node_modules/@babylonjs/core/Misc/rgbdTextureTools.js';
 import { expose } from '/web/furnace.js';
@@ -99,15 +101,25 @@ async function prefilteredCube( scene, url, lodScale ) {
 
 }
 
+// Babylon's own prefilter of a lat-long Radiance .hdr: HDRCubeTexture (size² faces, mips, harmonics, linear) with
+// prefilterOnLoad, i.e. HDRFiltering (GGX importance sampling, 4096 samples, mip m at alphaG = 2^(m / 0.8) / size);
+// the scene's whenReadyAsync waits for the prefilter
+function babylonPrefiltered( scene, url, size ) {
+
+	return new HDRCubeTexture( url, scene, size, false, true, false, true );
+
+}
+
 let engine = null;
 
 // rows: [{ roughness, metalness, color: [r, g, b] }], nov: [NoV per column]. Returns the RGBA float pixels, row 0 at
 // the bottom (row i of the result is rows[i]).
-// environment: null (radiance 1 everywhere) or the URL of a prefiltered DDS cube (lodScale: its lodGenerationScale);
+// environment: null (radiance 1 everywhere), the URL of a prefiltered DDS cube (lodScale: its lodGenerationScale) or
+// of a lat-long .hdr that Babylon prefilters itself into hdrSize² faces;
 // mixIrradiance: PBRMaterial's brdf.mixIblRadianceWithIrradiance (Babylon's default true: the shader's radiance is
 // mix(prefiltered radiance, SH irradiance, alphaG), pbrBlockReflection MIX_IBL_RADIANCE_WITH_IRRADIANCE)
 async function furnace( { nov, rows, lut = LUT, mistake = 'none', anisotropy = 1, environment = null, lodScale = 0.8,
-	mixIrradiance = true } ) {
+	mixIrradiance = true, hdrSize = 32 } ) {
 
 	const width = nov.length, height = rows.length;
 	if ( ! engine ) {
@@ -124,7 +136,9 @@ async function furnace( { nov, rows, lut = LUT, mistake = 'none', anisotropy = 1
 	scene.imageProcessingConfiguration.applyByPostProcess = true;  // no tone mapping, no gamma: linear float out
 
 	const face = () => new Float32Array( 4 * 4 * 4 ).fill( 1 );
-	scene.environmentTexture = environment ? await prefilteredCube( scene, environment, lodScale ) : new RawCubeTexture( scene, [ face(), face(), face(), face(), face(), face() ], 4,
+	const hdr = environment && environment.endsWith( '.hdr' );
+	scene.environmentTexture = hdr ? babylonPrefiltered( scene, environment, hdrSize )
+		: environment ? await prefilteredCube( scene, environment, lodScale ) : new RawCubeTexture( scene, [ face(), face(), face(), face(), face(), face() ], 4,
 		Constants.TEXTUREFORMAT_RGBA, Constants.TEXTURETYPE_FLOAT, false, false, Texture.BILINEAR_SAMPLINGMODE );
 	scene.environmentTexture.gammaSpace = false;
 
