@@ -1,6 +1,7 @@
 // The white furnace, Babylon.js (PBRMaterial, metallic/roughness, the engine's defaults: height-correlated Smith, its
 // multiscatter energy conservation) under a uniform environment of radiance 1: a float RawCubeTexture of ones, one
-// level, bilinear, so every LOD the reflection block asks for reads 1 (no prefiltering to approximate). One 1-pixel quad
+// level, bilinear, so every LOD the reflection block asks for reads 1 (no prefiltering to approximate); or, with
+// spec.environment, a prefiltered cube (lutbake's DDS, or Babylon's own prefilter of a .hdr). One 1-pixel quad
 // per (NoV, row); each quad's vertex normals are the one unit vector whose dot with the view direction at the pixel's
 // centre (Babylon's viewDirectionW = normalize(vEyePosition - vPositionW), also under an orthographic camera) is that
 // column's NoV. Float render target, image processing off (applyByPostProcess with no post-process: linear output).
