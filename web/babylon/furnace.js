@@ -1,6 +1,7 @@
 // The white furnace, Babylon.js (PBRMaterial, metallic/roughness, the engine's defaults: height-correlated Smith, its
 // multiscatter energy conservation) under a uniform environment of radiance 1: a float RawCubeTexture of ones, one
-// level, bilinear, so every LOD the reflection block asks for reads 1 (no prefiltering to approximate). One 1-pixel quad
+// level, bilinear, so every LOD the reflection block asks for reads 1 (no prefiltering to approximate); or, with
+// spec.environment, a prefiltered cube (lutbake's DDS, or Babylon's own prefilter of a .hdr). One 1-pixel quad
 // per (NoV, row); each quad's vertex normals are the one unit vector whose dot with the view direction at the pixel's
 // centre (Babylon's viewDirectionW = normalize(vEyePosition - vPositionW), also under an orthographic camera) is that
 // column's NoV. Float render target, image processing off (applyByPostProcess with no post-process: linear output).
@@ -24,6 +25,11 @@ import { VertexData } from '/web/node_modules/@babylonjs/core/Meshes/mesh.vertex
 import { PBRMaterial } from '/web/node_modules/@babylonjs/core/Materials/PBR/pbrMaterial.js';
 import { Texture } from '/web/node_modules/@babylonjs/core/Materials/Textures/texture.js';
 import { RawCubeTexture } from '/web/node_modules/@babylonjs/core/Materials/Textures/rawCubeTexture.js';
+import { CubeTexture } from '/web/node_modules/@babylonjs/core/Materials/Textures/cubeTexture.js';
+import '/web/node_modules/@babylonjs/core/Engines/Extensions/engine.cubeTexture.js';
+import '/web/node_modules/@babylonjs/core/Engines/Extensions/engine.prefilteredCubeTexture.js';
+import '/web/node_modules/@babylonjs/core/Engines/Extensions/engine.renderTargetCube.js';
+import { HDRCubeTexture } from '/web/node_modules/@babylonjs/core/Materials/Textures/hdrCubeTexture.js';
 import { RenderTargetTexture } from '/web/node_modules/@babylonjs/core/Materials/Textures/renderTargetTexture.js';
 import { RGBDTextureTools } from '/web/node_modules/@babylonjs/core/Misc/rgbdTextureTools.js';
 import { expose } from '/web/furnace.js';
@@ -83,11 +89,38 @@ async function lutbakeTexture( scene, mistake ) {
 
 }
 
+// a prefiltered environment cube as Babylon loads one (CubeTexture of a .dds with prefiltered true: gammaSpace false,
+// createPrefilteredCubeTexture, lodGenerationScale = lodScale (Babylon's default 0.8), lodGenerationOffset 0)
+async function prefilteredCube( scene, url, lodScale ) {
+
+	return await new Promise( ( resolve, reject ) => {
+
+		const t = new CubeTexture( url, scene, { prefiltered: true, forcedExtension: '.dds', lodScale, lodOffset: 0,
+			createPolynomials: true, onLoad: () => resolve( t ), onError: ( m, e ) => reject( new Error( `${ m } ${ e }` ) ) } );
+
+	} );
+
+}
+
+// Babylon's own prefilter of a lat-long Radiance .hdr: HDRCubeTexture (size² faces, mips, harmonics, linear) with
+// prefilterOnLoad, i.e. HDRFiltering (GGX importance sampling, 4096 samples, mip m at alphaG = 2^(m / 0.8) / size);
+// the scene's whenReadyAsync waits for the prefilter
+function babylonPrefiltered( scene, url, size ) {
+
+	return new HDRCubeTexture( url, scene, size, false, true, false, true );
+
+}
+
 let engine = null;
 
 // rows: [{ roughness, metalness, color: [r, g, b] }], nov: [NoV per column]. Returns the RGBA float pixels, row 0 at
 // the bottom (row i of the result is rows[i]).
-async function furnace( { nov, rows, lut = LUT, mistake = 'none', anisotropy = 1 } ) {
+// environment: null (radiance 1 everywhere), the URL of a prefiltered DDS cube (lodScale: its lodGenerationScale) or
+// of a lat-long .hdr that Babylon prefilters itself into hdrSize² faces;
+// mixIrradiance: PBRMaterial's brdf.mixIblRadianceWithIrradiance (Babylon's default true: the shader's radiance is
+// mix(prefiltered radiance, SH irradiance, alphaG), pbrBlockReflection MIX_IBL_RADIANCE_WITH_IRRADIANCE)
+async function furnace( { nov, rows, lut = LUT, mistake = 'none', anisotropy = 1, environment = null, lodScale = 0.8,
+	mixIrradiance = true, hdrSize = 32 } ) {
 
 	const width = nov.length, height = rows.length;
 	if ( ! engine ) {
@@ -104,10 +137,11 @@ async function furnace( { nov, rows, lut = LUT, mistake = 'none', anisotropy = 1
 	scene.imageProcessingConfiguration.applyByPostProcess = true;  // no tone mapping, no gamma: linear float out
 
 	const face = () => new Float32Array( 4 * 4 * 4 ).fill( 1 );
-	const environment = new RawCubeTexture( scene, [ face(), face(), face(), face(), face(), face() ], 4,
+	const hdr = environment && environment.endsWith( '.hdr' );
+	scene.environmentTexture = hdr ? babylonPrefiltered( scene, environment, hdrSize )
+		: environment ? await prefilteredCube( scene, environment, lodScale ) : new RawCubeTexture( scene, [ face(), face(), face(), face(), face(), face() ], 4,
 		Constants.TEXTUREFORMAT_RGBA, Constants.TEXTURETYPE_FLOAT, false, false, Texture.BILINEAR_SAMPLINGMODE );
-	environment.gammaSpace = false;
-	scene.environmentTexture = environment;
+	scene.environmentTexture.gammaSpace = false;
 
 	// the environment BRDF: set before the materials (PBRMaterial takes scene.environmentBRDFTexture, or Babylon's own
 	// from BRDFTextureTools.GetEnvironmentBRDFTexture, when it is made)
@@ -153,6 +187,7 @@ async function furnace( { nov, rows, lut = LUT, mistake = 'none', anisotropy = 1
 		material.backFaceCulling = false;
 		material.useRadianceOcclusion = false;
 		material.useHorizonOcclusion = false;
+		material.brdf.mixIblRadianceWithIrradiance = mixIrradiance;
 		mesh.material = material;
 		return mesh;
 
