@@ -45,7 +45,7 @@ def test_help_and_version_import_nothing_heavy():
 
 def test_list_and_every_commands_help_import_nothing_heavy():
     """`lutbake list` prints every kind, NDF, model and estimator from warp-free records (lutbake.records)."""
-    commands = ("validate", "audit", "inspect", "preview", "size", "fit", "plot")
+    commands = ("validate", "audit", "inspect", "preview", "size", "fit", "plot", "spheres")
     lists = (
         ["list"],
         ["list", "kinds"],

@@ -1,7 +1,7 @@
 """The ``lutbake`` command line: a thin layer over the public Python API. Each command parses its options (the
 shared ones declared once: lutbake.cli.options), calls the function a Python user would call (``bake``:
-lutbake.api.bake; ``audit``, ``size``, ``fit``, ``preview``: lutbake.commands.*; ``inspect``: lutbake.io.describe;
-``validate``: lutbake.validate) and prints."""
+lutbake.api.bake; ``audit``, ``size``, ``fit``, ``preview``, ``spheres``: lutbake.commands.*; ``inspect``:
+lutbake.io.describe; ``validate``: lutbake.validate) and prints."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import click
 from .. import __version__
 from .bake import bake
 from .engines import audit, fit, size
+from .environment import spheres
 from .tables import inspect, list_, plot, preview, validate
 
 
@@ -31,6 +32,7 @@ def main(verbose):
       lutbake bake --preset default --set samples=2048 --set dtype=half --out-dir outputs/examples
       lutbake inspect outputs/dfg.exr
       lutbake preview outputs/dfg.exr                # -> outputs/dfg.preview.png
+      lutbake spheres studio.exr                     # the split sum vs the ground truth, as spheres
       lutbake audit outputs/filament_dfg.dds         # against the file's own recorded conventions
       lutbake list
       lutbake validate
@@ -43,5 +45,5 @@ def main(verbose):
         os.environ[VERBOSE_ENV] = "1"
 
 
-for _command in (bake, list_, inspect, plot, validate, preview, audit, size, fit):
+for _command in (bake, list_, inspect, plot, validate, preview, audit, size, fit, spheres):
     main.add_command(_command)

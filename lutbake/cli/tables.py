@@ -283,7 +283,8 @@ def preview(file, out, force):
     """Render a PNG of a table file (any format lutbake writes; see inspect): 1D tables as curves, 2D
     tables as colour-mapped channels with labelled axes, 3D tables as labelled slice grids, btf tables as
     light x view images per sigma and phi; and, where the table has a split-sum reconstruction, a row of
-    spheres shaded with it.
+    spheres shaded with it. An environment's cube map (KTX 2.0, DDS, EXR): every mip's faces as a cross,
+    and for an irradiance cube its SH and the cube on a sphere.
 
     \b
     Example:

@@ -28,7 +28,6 @@ from pathlib import Path
 import numpy as np
 
 from ..axes import Axis
-from ..errors import LutbakeError
 from ..io.bounded import reading_for
 from ..io.readers import TableView, read_table
 from ..textsafe import bounded, shorten
@@ -515,24 +514,19 @@ def figure(path):
 
 
 def render(path, out=None, dpi: int = 100, force: bool = False) -> Path:
-    """Write the preview PNG of the table at ``path`` (default: <path stem>.preview.png beside it). ``out`` is
-    checked before anything is read (lutbake.preflight.check_image_output): never the table, its sidecar or a
-    config, a ``.png`` unless ``force``, in a directory that takes files."""
-    import matplotlib.pyplot as plt
-
-    from ..io.atomic import atomic_write
-    from ..io.oserror import os_error_text
+    """Write the preview PNG of the table at ``path`` (default: <path stem>.preview.png beside it); a cube map
+    (an environment table's KTX 2.0, DDS or EXR) is drawn by lutbake.commands.preview_cube. ``out`` is checked
+    before anything is read (lutbake.preflight.check_image_output): never the table, its sidecar or a config, a
+    ``.png`` unless ``force``, in a directory that takes files."""
+    from ..io.cubemap import cube_kind
     from ..preflight import check_image_output, input_files
+    from .figure_file import save_figure
 
     path = Path(path)
+    if cube_kind(path) is not None:
+        from .preview_cube import render_cube
+
+        return render_cube(path, out, dpi, force)
     out = Path(out) if out else path.with_name(path.stem + ".preview.png")
     check_image_output(out, input_files(path), force, "--out")
-    fig = figure(path)
-    try:
-        atomic_write(out, lambda tmp: fig.savefig(tmp, format="png", dpi=dpi))
-    except OSError as e:  # the directory changed since the check: name the PNG, not the temporary file
-        e.filename = None
-        raise LutbakeError(f"cannot write {shorten(str(out))}: {os_error_text(e, out.parent)}") from None
-    finally:
-        plt.close(fig)
-    return out
+    return save_figure(figure(path), out, dpi)
