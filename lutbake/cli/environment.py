@@ -30,6 +30,13 @@ from .options import fail, force_png_option, out_file_option, quiet_warp, worker
     show_default=True,
     help="How the cubes are prefiltered (the environment kinds' estimator key).",
 )
+@click.option(
+    "--lobe",
+    type=click.Choice(["ggx_nl", "ggx"]),
+    default="ggx_nl",
+    show_default=True,
+    help="The weight the specular cube is prefiltered with (the environment_specular kind's lobe key).",
+)
 @click.option("--no-diffuse", is_flag=True, help="Leave out the diffuse models' spheres (<stem>_diffuse.png).")
 @click.option(
     "--microfacet",
@@ -39,7 +46,7 @@ from .options import fail, force_png_option, out_file_option, quiet_warp, worker
 )
 @force_png_option("the PNG")
 @workers_option
-def spheres(environment, out, size, height, cube_size, estimator, no_diffuse, microfacet, force, workers):
+def spheres(environment, out, size, height, cube_size, estimator, lobe, no_diffuse, microfacet, force, workers):
     """Spheres of roughness r = 0 ... 1 (gold, and a dielectric f0 = 0.04 over a Lambert base) under a lat-long
     ENVIRONMENT (.exr or .hdr, width = 2 x height), shaded by the ground truth (the BRDF against every texel of the
     environment) and by lutbake's split sum (its prefiltered and irradiance cubes, its DFG table), and their
@@ -63,14 +70,14 @@ def spheres(environment, out, size, height, cube_size, estimator, no_diffuse, mi
         fail(e)
     quiet_warp()
     image = sp.reduce(env.image, height)
-    light = sp.lighting(image, cube_size=cube_size, workers=workers, method=estimator)
+    light = sp.lighting(image, cube_size=cube_size, lobe=lobe, workers=workers, method=estimator)
     renders = sp.render_spheres(light, size=size)
     diffuse = None
     if not no_diffuse:
         models = sp.DIFFUSE_MODELS + ((("microfacet", 1.0),) if microfacet else ())
         diffuse = sp.render_diffuse(light, size=max(8, size * 3 // 4), models=models, workers=workers)
     h, w = image.shape[:2]
-    title = f"{shorten(environment.name)} at {w} x {h}, cube {cube_size}² (ggx_nl, linear curve), DFG of preset bevy"
+    title = f"{shorten(environment.name)} at {w} x {h}, cube {cube_size}² ({lobe}, linear curve), DFG of preset bevy"
     try:
         paths = sp.write(renders, out, diffuse, title)
     except (LutbakeError, OSError) as e:
@@ -79,6 +86,9 @@ def spheres(environment, out, size, height, cube_size, estimator, no_diffuse, mi
         click.echo(line)
     if diffuse is not None:
         for (model, sigma), e, t in zip(diffuse.models, diffuse.errors(), diffuse.truth_error):
-            click.echo(f"diffuse {model:<11} sigma {sigma:<4g} max {e[0]:>8.2%} RMS {e[1]:>8.2%} truth ±{t:.1e}")
+            click.echo(
+                f"diffuse {model:<11} sigma {sigma:<4g} max {sp.share(e[0])[1:]:>7} RMS {sp.share(e[1])[1:]:>7} "
+                f"mean {sp.share(e[2]):>7} truth ±{t:.1e}"
+            )
     for p in paths:
         click.echo(str(p))

@@ -107,7 +107,8 @@ def cube_figure(table: CubeTable, title: str | None = None):
         head = title or f"{table.kind} table '{table.name}'"
         lines = [
             head,
-            render.DISPLAY.format(k=exposure) + "; faces as stored, +Y above +Z, -X +Z +X -Z across, -Y below",
+            render.DISPLAY.format(k=exposure),
+            "faces as stored (row 0 at the top): +Y above +Z; -X +Z +X -Z across; -Y below",
             f"face convention: {table.record.get('face_convention', 'gl')}",
         ]
         if irradiance:

@@ -10,8 +10,8 @@ texel-constant lat-long environment:
   times lutbake's DFG table of preset ``bevy``'s conventions (scale_bias: E = f0 scale + bias; 64^2, perceptual
   roughness, GGX, height-correlated Smith), plus the irradiance cube (E / pi) times the albedo;
 - their difference, split sum - ground truth (luminance, signed).
-Per sphere: max and RMS over its pixels and channels of |split - truth|, divided by the sphere's mean ground-truth
-luminance (``SphereRenders.errors``).
+Per sphere: max and RMS over its pixels and channels of |split - truth|, and the mean of split - truth (its bias),
+each divided by the sphere's mean ground-truth luminance (``SphereRenders.errors``).
 
 **Diffuse** (``render_diffuse``): a diffuse model's ground truth (its BRDF, rho = 1, f0 = 0, against every texel) vs
 the split-sum style irradiance_over_pi(n) E_d(n.v, sigma), E_d from lutbake's ``diffuse`` table of the model (the
@@ -52,7 +52,6 @@ MATERIALS = (
 )
 ROUGHNESS = (0.0, 0.2, 0.4, 0.6, 0.8, 1.0)
 DIFFUSE_MODELS = (("lambert", 0.0), ("oren_nayar", 1.0), ("fitted", 1.0))  # (model, sigma)
-DIFFUSE_QUALITY = Quality(8.0, 0)  # a diffuse lobe is broad: one node per texel away from the horizon
 CUBE_SIZE, IRRADIANCE_SIZE = 64, 16
 DFG_PRESET, CURVE, LOBE = "bevy", "linear", "ggx_nl"
 DIFFUSE_TABLE_SIZE = [64, 16]  # [NoV, sigma]
@@ -150,11 +149,16 @@ def default_view(image: np.ndarray) -> np.ndarray:
     return render.camera_direction(phi + VIEW_TURN, VIEW_ELEVATION)
 
 
-def _relative(values: np.ndarray, reference: np.ndarray) -> tuple[float, float]:
-    """(max, RMS) of |values| over pixels and channels, / the mean luminance of ``reference`` (N, 3)."""
+def share(x: float) -> str:
+    """A relative error as text: a percentage below 10, a factor from there (the sun's pixels reach thousands)."""
+    return f"{x:+.1%}" if abs(x) < 10 else f"{x:+.0f}x"
+
+
+def _relative(values: np.ndarray, reference: np.ndarray) -> tuple[float, float, float]:
+    """(max |values|, RMS, mean) over pixels and channels, / the mean luminance of ``reference`` (N, 3)."""
     scale = float(np.mean(reference @ render.LUMINANCE))
     scale = scale if scale > 0 else 1.0
-    return float(np.max(np.abs(values))) / scale, float(np.sqrt(np.mean(values**2))) / scale
+    return tuple(float(x) / scale for x in (np.max(np.abs(values)), np.sqrt(np.mean(values**2)), np.mean(values)))
 
 
 @dataclass
@@ -171,7 +175,8 @@ class SphereRenders:
     truth_error: np.ndarray
 
     def errors(self) -> np.ndarray:
-        """(M, R, 2): max and RMS |split - truth| per sphere, / its mean truth luminance."""
+        """(M, R, 3): max |split - truth|, its RMS and the mean of split - truth per sphere, / its mean truth
+        luminance."""
         return np.array(
             [
                 [_relative(self.split[m, k] - self.truth[m, k], self.truth[m, k]) for k in range(len(self.roughness))]
@@ -232,7 +237,7 @@ class DiffuseRenders:
     truth_error: np.ndarray
 
     def errors(self) -> np.ndarray:
-        """(K, 2): max and RMS |approx - truth| per sphere, / its mean truth luminance."""
+        """(K, 3): max |approx - truth|, its RMS and mean per sphere, / its mean truth luminance."""
         return np.array([_relative(a - t, t) for a, t in zip(self.approx, self.truth)])
 
 
@@ -251,7 +256,7 @@ def render_diffuse(
     size: int = 48,
     models=DIFFUSE_MODELS,
     toward_camera=None,
-    quality: Quality = DIFFUSE_QUALITY,
+    quality: Quality = Quality(),
     probe_stride: int = PROBE_STRIDE,
     workers: int | None = None,
     device: str = "cpu",
@@ -280,7 +285,7 @@ def render_diffuse(
 
 def _row(fig, axes, view, spheres, exposure: float, label: str) -> None:
     for ax, values in zip(axes, spheres):
-        ax.imshow(render.tone_map(view.image(values), exposure))
+        ax.imshow(render.tone_map(view.image(values), exposure), interpolation="nearest")
         ax.set_xticks([])
         ax.set_yticks([])
     axes[0].set_ylabel(label, fontsize=8)
@@ -293,7 +298,7 @@ def _difference_row(fig, axes, view, diffs, titles, label: str) -> None:
     every = np.abs(np.concatenate([x[view.inside] for x in lum]))
     top = max(float(np.percentile(every, CLIP_PERCENTILE)), 1e-30)
     for ax, image, title in zip(axes, lum, titles):
-        im = ax.imshow(image, cmap="RdBu_r", vmin=-top, vmax=top)
+        im = ax.imshow(image, cmap="RdBu_r", vmin=-top, vmax=top, interpolation="nearest")
         ax.set_title(title, fontsize=7)
         ax.set_xticks([])
         ax.set_yticks([])
@@ -301,7 +306,7 @@ def _difference_row(fig, axes, view, diffs, titles, label: str) -> None:
     bar = fig.colorbar(im, ax=list(axes), fraction=0.02, pad=0.01)
     bar.ax.tick_params(labelsize=7)
     clipped = float(every.max()) > top
-    bar.set_label(f"Δ luminance{f' (clipped at {CLIP_PERCENTILE:g}th pct.)' if clipped else ''}", fontsize=7)
+    bar.set_label(f"Δ luminance{f', {CLIP_PERCENTILE:g}th pct. clip' if clipped else ''}", fontsize=6)
 
 
 def spheres_figure(renders: SphereRenders, title: str = ""):
@@ -315,7 +320,7 @@ def spheres_figure(renders: SphereRenders, title: str = ""):
     exposure = render.exposure_for(renders.truth)
     errors = renders.errors()
     with matplotlib.rc_context({"text.parse_math": False}):
-        fig = plt.figure(figsize=(1.45 * R + 1.2, 1.5 * 3 * M + 1.3), dpi=100, layout="constrained")
+        fig = plt.figure(figsize=(1.3 * R + 1.3, 1.35 * 3 * M + 1.3), dpi=100, layout="constrained")
         axes = fig.subplots(3 * M, R, squeeze=False)
         for k, r in enumerate(renders.roughness):
             axes[0, k].set_title(f"r = {r:.2g} (α = {r * r:.2g})", fontsize=8)
@@ -324,7 +329,8 @@ def spheres_figure(renders: SphereRenders, title: str = ""):
             _row(fig, axes[3 * m], view, renders.truth[m], exposure, f"{mat.name}\nground truth")
             _row(fig, axes[3 * m + 1], view, renders.split[m], exposure, f"{mat.name}\nsplit sum")
             titles = [
-                f"max {e[0]:.1%} RMS {e[1]:.1%}\ntruth ±{t:.0e}" for e, t in zip(errors[m], renders.truth_error[m])
+                f"max {share(e[0])[1:]} RMS {share(e[1])[1:]}\nmean {share(e[2])} truth ±{t:.0e}"
+                for e, t in zip(errors[m], renders.truth_error[m])
             ]
             _difference_row(fig, axes[3 * m + 2], view, renders.split[m] - renders.truth[m], titles, "split - truth")
         fig.suptitle(
@@ -356,7 +362,10 @@ def diffuse_figure(renders: DiffuseRenders, title: str = ""):
         _row(fig, axes[1], view, renders.approx, exposure, "irradiance × E_d")
         for k, (model, sigma) in enumerate(renders.models):
             axes[0, k].set_title(f"{model}" + (f"\nσ = {sigma:g}" if model != "lambert" else ""), fontsize=8)
-        titles = [f"max {e[0]:.1%} RMS {e[1]:.1%}\ntruth ±{t:.0e}" for e, t in zip(errors, renders.truth_error)]
+        titles = [
+            f"max {e[0]:.1%} RMS {e[1]:.1%}\nmean {e[2]:+.1%} truth ±{t:.0e}"
+            for e, t in zip(errors, renders.truth_error)
+        ]
         _difference_row(fig, axes[2], view, renders.approx - renders.truth, titles, "approx - truth")
         fig.suptitle(
             (title + "\n" if title else "")
@@ -378,14 +387,14 @@ def arrays(renders: SphereRenders, diffuse: DiffuseRenders | None = None) -> dic
         "albedo": np.array([m.albedo for m in renders.materials]),
         "truth": np.array([[view.image(s) for s in per] for per in renders.truth]),
         "split_sum": np.array([[view.image(s) for s in per] for per in renders.split]),
-        "split_sum_error_max_rms": renders.errors(),
+        "split_sum_error_max_rms_mean": renders.errors(),
         "truth_error": renders.truth_error,
     }
     if diffuse is not None:
         out["diffuse_models"] = np.array([f"{m}:{s:g}" for m, s in diffuse.models])
         out["diffuse_truth"] = np.array([diffuse.view.image(s) for s in diffuse.truth])
         out["diffuse_approx"] = np.array([diffuse.view.image(s) for s in diffuse.approx])
-        out["diffuse_error_max_rms"] = diffuse.errors()
+        out["diffuse_error_max_rms_mean"] = diffuse.errors()
         out["diffuse_truth_error"] = diffuse.truth_error
     return out
 
@@ -408,11 +417,12 @@ def write(renders: SphereRenders, out, diffuse: DiffuseRenders | None = None, ti
 
 def table_lines(renders: SphereRenders) -> list[str]:
     """The split sum's error per material and roughness, one line each (what the CLI prints)."""
-    lines = [f"{'material':<12}{'r':>6}{'max':>9}{'RMS':>9}{'truth ±':>10}"]
+    errors = renders.errors()
+    lines = [f"{'material':<12}{'r':>6}{'max':>10}{'RMS':>9}{'mean':>9}{'truth ±':>10}"]
     for m, mat in enumerate(renders.materials):
         for k, r in enumerate(renders.roughness):
-            e = renders.errors()[m, k]
-            lines.append(f"{mat.name:<12}{r:>6.2f}{e[0]:>9.2%}{e[1]:>9.2%}{renders.truth_error[m, k]:>10.1e}")
+            e, t = errors[m, k], renders.truth_error[m, k]
+            lines.append(f"{mat.name:<12}{r:>6.2f}{share(e[0])[1:]:>10}{share(e[1])[1:]:>9}{share(e[2]):>9}{t:>10.1e}")
     return lines
 
 

@@ -7,14 +7,18 @@ Each texel's integral is a q x q Gauss–Legendre product rule in (cos theta, ph
 (lutbake.environment.latlong's convention: dω = d(cos theta) dphi, so the weights are the cell's exact measure and
 q = 1 gives its exact solid angle). q grows where the weight varies across the texel: with Δ = pi / H the texel's
 angular size, d the angle from its centre to the lobe's peak (the mirror direction R for the specular lobe, n for the
-diffuse ones), λ the lobe's width (lutbake.environment.lobes.lobe_width: 2 atan(alpha) for GGX, pi / 3 for a diffuse
-lobe) and K the geometric factor,
+diffuse ones), λ the lobe's width and S its relative slope (lutbake.environment.lobes: λ = 2 atan(alpha), S = 4 for
+GGX; π / 3, 2 for a diffuse lobe) and K the geometric factor,
 
-    q = min(1 + floor(K Δ / (max(d - Δ, 0) + λ)), Q_MAX) + extra,   at least 2 + extra where the texel meets the horizon
+    q = min(1 + floor(K S Δ / (max(d - Δ, 0) + λ)), Q_MAX) + extra,   (at least 2 where the texel may meet the horizon)
 
-so the rule resolves the lobe's peak and the horizon's kink, and a texel far from both takes one node. Sums in
-float64, in a fixed order: the same bits on every run. **Error**: ``estimate_error`` evaluates probe pixels again
-with K x 2 and one node more per axis in every texel (``Quality.refined``); the pictures state the difference.
+so the rule resolves the lobe's peak, and a texel far from it takes one node (two with the default extra = 1). The
+horizon n.l = 0 is no kink inside a rule: on each meridian phi of a node the cos theta interval is clipped exactly
+where n.l changes sign (``visible``), and a cell the horizon may cross is split in phi where it crosses the cell's
+edges (``horizon_breaks``), so every piece's clipped length is smooth in phi. Sums in float64, in a fixed order: the
+same bits on every run. **Error**: evaluate probe pixels again with ``Quality.refined()`` (K x 2, one node more per
+axis in every texel; lutbake.commands.spheres does, every 4th pixel, and the pictures state the difference). A lobe
+narrower than K S Δ / Q_MAX is under-resolved at its peak, and the refined rule shows it.
 
 **Lobes** (each returns (a, b) per direction, summed separately):
 - ``specular``: GGX D (Walter et al. 2007, Eq. 33), height-correlated Smith G2 (Heitz 2014, Eq. 99), Schlick's F
