@@ -297,3 +297,23 @@ def test_the_spheres_command_writes_the_pictures_and_arrays(tmp_path):
     assert out.with_name("s_diffuse.png").is_file()
     bad = CliRunner().invoke(main, ["spheres", str(tmp_path / "none.exr"), "-o", str(tmp_path / "x.png")])
     assert bad.exit_code == 2 and "none.exr" in bad.output
+
+
+def test_the_spheres_of_baked_cube_tables_in_either_orientation_are_those_of_the_bake_here(cubes):
+    """spheres.lighting_of reads a CubeTable's curve and orientation from its record: the kinds' gl and
+    d3d_left_handed cubes of the sunrise give the split sum spheres.lighting bakes here (the same prefilter)."""
+    from lutbake.io.environment import read_latlong
+
+    tables, _ = cubes
+    image = read_latlong(SUNRISE).image
+    here = spheres.lighting(image, cube_size=8, irradiance_size=4, method="quadrature")
+    d3d = {}
+    for kind, size in (("environment_specular", 8), ("environment_irradiance", 4)):
+        raw = {"name": "d", "kind": kind, "environment": str(SUNRISE), "size": size, "estimator": "quadrature"}
+        d3d[kind] = bake_cube_table(validate_table(raw | {"orientation": "d3d_left_handed"}, "<test>", 0))[0]
+    want = spheres.render_spheres(here, size=6, roughness=(0.5,), probe_stride=1000)
+    for cubes_of in (tables, d3d):
+        light = spheres.lighting_of(image, cubes_of["environment_specular"], cubes_of["environment_irradiance"])
+        got = spheres.render_spheres(light, size=6, roughness=(0.5,), probe_stride=1000)
+        np.testing.assert_allclose(got.split, want.split, rtol=1e-9)
+        np.testing.assert_array_equal(got.truth, want.truth)

@@ -24,8 +24,8 @@ solid-angle-weighted means) to at most ``height`` rows.
 
 from __future__ import annotations
 
+import functools
 import io
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -82,16 +82,19 @@ def reduce(image: np.ndarray, height: int = MAX_HEIGHT) -> np.ndarray:
     return pyr.level(level)
 
 
+@functools.lru_cache(maxsize=4)
 def bake_dfg(preset: str = DFG_PRESET, workers: int | None = None):
-    """The DFG table of ``preset`` (its first dfg table), baked with lutbake's pipeline; ValueError unless its layout
-    is scale_bias (E = f0 scale + bias)."""
+    """The DFG table of ``preset`` (its first dfg table), baked with lutbake's pipeline, once per process (its data
+    read-only); ValueError unless its layout is scale_bias (E = f0 scale + bias)."""
     from ..config import load_configs, preset_path
     from ..pipeline import bake_table
 
     spec = next(s for s in load_configs([preset_path(preset)]) if s.kind == "dfg")
     if spec.options["layout"] != "scale_bias":
         raise ValueError(f"preset {preset!r}: its dfg table's layout is {spec.options['layout']}, not scale_bias")
-    return bake_table(spec, workers)[0]
+    table = bake_table(spec, workers)[0]
+    table.data.flags.writeable = False
+    return table
 
 
 def lighting(
@@ -121,6 +124,24 @@ def lighting(
         render.CubeSampler(specular.mips),
         mip_curve,
         render.CubeSampler(diffuse.mips),
+        bake_dfg(dfg_preset, workers),
+    )
+
+
+def lighting_of(image: np.ndarray, specular, irradiance, dfg_preset: str = DFG_PRESET, workers=None) -> Lighting:
+    """The Lighting of cubes baked already (lutbake.table.CubeTable, e.g. lutbake.commands.preview_cube.read_cube_file
+    of a bevy-ibl output): each looked up in its record's orientation, the specular cube at its record's curve. They
+    must have been baked from ``image`` (the ground truth's environment) for the difference to be the split sum's."""
+    from .preview_cube import orientation_of
+
+    name = str(specular.record.get("mip_curve", CURVE)).split(":", 1)[0]
+    if name not in CURVES:
+        raise ValueError(f"the specular cube's record names the curve {name!r}; lutbake knows {sorted(CURVES)}")
+    return Lighting(
+        np.asarray(image, np.float64),
+        render.CubeSampler(specular.mips, orientation_of(specular.record)),
+        CURVES[name],
+        render.CubeSampler(irradiance.mips, orientation_of(irradiance.record)),
         bake_dfg(dfg_preset, workers),
     )
 
@@ -424,8 +445,3 @@ def table_lines(renders: SphereRenders) -> list[str]:
             e, t = errors[m, k], renders.truth_error[m, k]
             lines.append(f"{mat.name:<12}{r:>6.2f}{share(e[0])[1:]:>10}{share(e[1])[1:]:>9}{share(e[2]):>9}{t:>10.1e}")
     return lines
-
-
-def angle_degrees(d: np.ndarray) -> tuple[float, float]:
-    """(azimuth, elevation) in degrees of a direction (lutbake.environment.latlong's frame)."""
-    return math.degrees(math.atan2(d[2], d[0])), math.degrees(math.asin(max(-1.0, min(1.0, d[1]))))
