@@ -270,6 +270,18 @@ def test_the_preview_of_a_cube_file_has_its_size_and_is_not_blank(cubes, kind, f
     assert pixels[..., :3].std() > 0.1  # faces, spheres and text, not one colour
 
 
+@pytest.mark.parametrize("name", ["bevy_pisa_diffuse_rgb9e5_zstd.ktx2", "filament_pillars_2k_ibl_mips1-4.ktx"])
+def test_the_preview_of_an_engines_cube_draws_its_mips(name, tmp_path):
+    """Bevy's RGB9E5 irradiance cube (1 mip) and cmgen's KTX 1.1 mips 1-4: no lutbake record, crosses only."""
+    import matplotlib.image
+
+    png = tmp_path / "e.png"
+    r = CliRunner().invoke(main, ["preview", str(SUNRISE.parent / name), "-o", str(png)])
+    assert r.exit_code == 0, r.output
+    rows, cols = (1, 1) if "bevy" in name else (2, 3)
+    assert matplotlib.image.imread(png).shape[:2] == (round((2.6 * rows + 1.2) * 100), round(3.2 * cols * 100))
+
+
 def test_the_preview_of_a_cube_table_from_python(cubes, tmp_path):
     import matplotlib.image
 

@@ -9,8 +9,8 @@ across, -Y below: in OpenGL's face table (lutbake.environment.cube) every shared
 usual picture of a GL cube map (the environment seen from inside, mirrored).
 
 From Python: ``cube_figure(table)`` of a lutbake.table.CubeTable (what ``bake_table`` returns for an environment
-kind), ``render_cube(table_or_path, out)``. From a file (KTX 2.0, DDS, EXR as lutbake.io.cubemap writes them):
-``read_cube_file``.
+kind), ``render_cube(table_or_path, out)``. From a file: ``read_cube_file`` (any cube lutbake.io.cube_read reads:
+lutbake's KTX 2.0, DDS, EXR and an engine's KTX 2.0, KTX 1.1 or DDS, RGB9E5, B10G11R11 or 8-bit included).
 """
 
 from __future__ import annotations
@@ -104,12 +104,14 @@ def cube_figure(table: CubeTable, title: str | None = None):
         if irradiance:
             axes = [fig.add_subplot(rows, cols, cols - 2 + k) for k in range(3)]
             _irradiance_spheres(fig, axes, table, exposure)
-        head = title or f"{table.kind} table '{table.name}'"
+        head = title or f"{table.kind or 'cube map'} '{table.name}'"
+        if "stored" in table.record:  # a file lutbake did not write
+            head += f" (no lutbake record; {table.record['stored']})"
         lines = [
             head,
             render.DISPLAY.format(k=exposure),
             "faces as stored (row 0 at the top): +Y above +Z; -X +Z +X -Z across; -Y below",
-            f"face convention: {table.record.get('face_convention', 'gl')}",
+            f"face convention: {table.record.get('face_convention', 'the GL face table (the file records none)')}",
         ]
         if irradiance:
             lines.append(f"spheres seen from +Z (y up), orthographic, {SPHERE_SIZE}² pixels")
@@ -121,57 +123,16 @@ def cube_figure(table: CubeTable, title: str | None = None):
 # ----------------------------------------------------------------------------------------------- files
 
 
-def _dds_mips(blob: bytes, levels: int, size: int) -> list[np.ndarray]:
-    """The mips of a DDS cube lutbake writes (lutbake.io.cubemap: DX10 header, face by face, each face's mips
-    largest first, RGBA16F or RGBA32F)."""
-    from ..io.cubemap import DDS_HEADER_BYTES, DXGI_RGBA
-
-    dxgi = int(np.frombuffer(blob, "<u4", 1, 128)[0])
-    dtype = {DXGI_RGBA["half"]: np.dtype("<f2"), DXGI_RGBA["float32"]: np.dtype("<f4")}.get(dxgi)
-    if dtype is None:
-        raise ValueError(f"DXGI format {dxgi}: lutbake's DDS cubes are RGBA16F or RGBA32F")
-    sides = [max(1, size >> m) for m in range(levels)]
-    need = DDS_HEADER_BYTES + 6 * sum(4 * s * s for s in sides) * dtype.itemsize
-    if len(blob) != need:
-        raise ValueError(f"{len(blob)} bytes, a {size}² cube of {levels} mips holds {need}")
-    mips = [np.empty((6, s, s, 3)) for s in sides]
-    pos = DDS_HEADER_BYTES
-    for face in range(6):
-        for m, s in enumerate(sides):
-            mips[m][face] = np.frombuffer(blob, dtype, 4 * s * s, pos).reshape(s, s, 4)[..., :3]
-            pos += 4 * s * s * dtype.itemsize
-    return mips
-
-
 def read_cube_file(path) -> CubeTable:
-    """The CubeTable of a cube file lutbake wrote (KTX 2.0, DDS with its sidecar, EXR): its mips (float64 RGB) and
-    record (lutbake.io.cubemap.read_cube_record). ValueError says what is wrong."""
-    from ..io import bounded
-    from ..io.cubemap import decode_ktx2_cube, read_cube_record
+    """The CubeTable of a cube file (lutbake.io.cube_read.read_cube: KTX 2.0, KTX 1.1, DDS, lutbake's EXR cube;
+    lutbake's or an engine's): its mips (float64 linear RGB) and lutbake's record ({} for an engine's file, whose
+    container and pixel format go into the record's ``stored`` instead). ValueError says what is wrong."""
+    from ..io.cube_read import read_cube
 
-    path = Path(path)
-    info = read_cube_record(path)
-    fmt = info["format"]
-    if fmt == "exr":
-        from ..io.exr import exr_parts
-
-        mips = [
-            np.asarray(p[0][..., :3], np.float64).reshape(6, p[0].shape[1], p[0].shape[1], 3) for p in exr_parts(path)
-        ]
-    else:
-        blob = bounded.read_bytes(path, what="a cube file")
-        if fmt == "ktx2":
-            mips = [np.asarray(m[..., :3], np.float64) for m in decode_ktx2_cube(blob)[0]]
-        else:
-            mips = _dds_mips(blob, info["mips"], info["size"])
-    record = info["record"]
-    return CubeTable(
-        str(record.get("table", path.stem)),
-        str(record.get("kind", "")),
-        mips,
-        record,
-        str(record.get("reconstruction", "")),
-    )
+    cube = read_cube(path)
+    record = dict(cube.record) if cube.record else {"stored": f"{cube.container}, {cube.pixel_format}, {cube.transfer}"}
+    name = str(record.get("table", Path(path).stem))
+    return CubeTable(name, str(record.get("kind", "")), cube.mips, record, str(record.get("reconstruction", "")))
 
 
 def render_cube(source, out, dpi: int = 100, force: bool = False) -> Path:
@@ -193,6 +154,6 @@ def render_cube(source, out, dpi: int = 100, force: bool = False) -> Path:
     check_image_output(out, input_files(path), force, "--out")
     try:
         table = read_cube_file(path)
-    except ValueError as e:
-        raise LutbakeError(f"{shorten(str(path))}: {e}") from None
-    return save_figure(cube_figure(table, f"{shorten(path.name)}: {table.kind} table '{table.name}'"), out, dpi)
+    except ValueError as e:  # read_cube names the file
+        raise LutbakeError(str(e)) from None
+    return save_figure(cube_figure(table, f"{shorten(path.name)}: {table.kind or 'cube map'} '{table.name}'"), out, dpi)
