@@ -302,7 +302,9 @@ def _decoded(text: dict) -> dict:
 def cube_kind(path) -> str | None:
     """ "ktx2", "dds", "exr" or "ktx1" where ``path`` is a cube file lutbake writes (a KTX 2.0 or KTX 1.1 with
     numberOfFaces 6, a DDS with the cube caps, an EXR whose parts are named mip_<m>), else None: read from the first
-    bytes (and, for an EXR, its part names)."""
+    bytes (and, for an EXR, its part names). A path that is no regular file (a FIFO would block the open) is None."""
+    if bounded.regular_file_problem(path):
+        return None
     try:
         with open(path, "rb") as f:
             head = f.read(DDS_HEADER_BYTES)
