@@ -225,6 +225,9 @@ def test_harmonic_analysis_of_one_texel_is_scipys_integral_of_the_harmonic():
         assert abs(got - complex(*want)) <= 1e-10, (n, m, got, want)
 
 
+METHODS = ("harmonic", "quadrature")
+
+
 def test_harmonic_and_quadrature_agree_on_a_real_environment():
     """The two independent estimators of every rough mip of a real HDR (Blender's sunrise, a sun of ~3e4 times the
     sky): the spherical harmonics against the pyramid quadrature two steps finer."""
@@ -236,6 +239,9 @@ def test_harmonic_and_quadrature_agree_on_a_real_environment():
     assert auto.methods == ["quadrature", "harmonic", "harmonic", "harmonic"]
     for a, b in zip(auto.mips[1:], quad.mips[1:]):
         assert float(np.max(np.abs(a - b) / b)) <= HARMONIC_RTOL
+    irradiance = [prefilter.bake_cube(pyr, 4, [1.0], "cosine", quality=fine, estimate=False, method=m) for m in METHODS]
+    assert [i.methods for i in irradiance] == [["harmonic"], ["quadrature"]]
+    np.testing.assert_allclose(irradiance[0].mips[0], irradiance[1].mips[0], rtol=HARMONIC_RTOL)
 
 
 def test_the_charlie_lobe_by_harmonics_is_the_quadratures_and_its_alpha_is_r():
