@@ -90,9 +90,9 @@ def bake_dfg(preset: str = DFG_PRESET, workers: int | None = None):
     from ..pipeline import bake_table
 
     spec = next(s for s in load_configs([preset_path(preset)]) if s.kind == "dfg")
-    if spec.options["layout"] != "scale_bias":
-        raise ValueError(f"preset {preset!r}: its dfg table's layout is {spec.options['layout']}, not scale_bias")
     table = bake_table(spec, workers)[0]
+    if list(table.channels)[:2] != ["scale", "bias"]:
+        raise ValueError(f"preset {preset!r}: its dfg table holds {list(table.channels)}, not (scale, bias)")
     table.data.flags.writeable = False
     return table
 

@@ -81,8 +81,9 @@ WRITERS = {
 }
 FORMAT_KINDS = {"threejs_dfg": ("dfg",)}  # formats that hold one kind's tables only (the rest: any kind)
 FORMATS = {**FORMATS, **code_arrays.FORMATS}  # what a table of any kind can be written as (lutbake.kinds.base)
-ALL_FORMATS = {**FORMATS, **ltc.FORMATS}  # every format: the --format option; each kind's ``format`` key allows a
-# subset (lutbake.kinds.allowed_formats), which the config check and its message use
+CUBE_ONLY_FORMATS = {"ktx1": "KTX 1 cube as Filament's cmgen writes it (environment_specular only: lutbake.io.ktx1)"}
+ALL_FORMATS = {**FORMATS, **ltc.FORMATS, **CUBE_ONLY_FORMATS}  # every format: the --format option; each kind's
+# ``format`` key allows a subset (lutbake.kinds.allowed_formats), which the config check and its message use
 EXTENSIONS = {**EXTENSIONS, **ltc.EXTENSIONS, **code_arrays.EXTENSIONS}
 
 
