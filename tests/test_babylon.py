@@ -78,6 +78,7 @@ def test_babylon_presets_are_its_engine_tables():
         "babylon-openpbr",
         "babylon-fuzz",
         "ltc-babylon",
+        "babylon-ibl",
     }
 
 
@@ -205,8 +206,9 @@ def test_every_engine_table_names_a_storage_encoding_audit_knows():
 
     assert {t.encoding for t in TABLES} <= set(ENCODINGS)
     # the environment BRDF tables ship as 8-bit RGBD PNGs, the area-light LTC tables as half floats (areaLightsLTC.bin)
-    encodings = {t.preset: t.encoding for t in TABLES if t.engine == "Babylon.js"}
-    assert encodings == {"babylon": "rgbd", "babylon-openpbr": "rgbd", "babylon-fuzz": "rgbd", "ltc-babylon": "plain"}
+    babylon = [t for t in TABLES if t.engine == "Babylon.js"]
+    assert {t.encoding for t in babylon if t.kind == "dfg"} == {"rgbd"}
+    assert {t.encoding for t in babylon if t.kind not in ("dfg", "environment_specular")} == {"plain"}
 
 
 def test_audit_of_babylons_shipped_rgbd_png_decodes_rgbd_and_reports_the_real_error(tmp_path):

@@ -244,7 +244,12 @@ def test_bevy_ibl_writes_the_dfg_and_both_cubes_with_one_set_of_conventions(bevy
 
 
 ALL_KINDS = {"dfg", "environment_specular", "environment_irradiance"}
-IBL_KINDS = {"bevy-ibl": ALL_KINDS, "gltf-ibl": ALL_KINDS, "filament-ibl": ALL_KINDS - {"environment_irradiance"}}
+IBL_KINDS = {
+    "bevy-ibl": ALL_KINDS,
+    "gltf-ibl": ALL_KINDS,
+    "filament-ibl": ALL_KINDS - {"environment_irradiance"},
+    "babylon-ibl": ALL_KINDS - {"environment_irradiance"},
+}
 
 
 @pytest.mark.parametrize("preset", sorted(IBL_KINDS))

@@ -27,11 +27,11 @@ lutbake's presets write float tables (DDS RGBA16F) Babylon loads with ``isRGBD =
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .base import EngineTable, Layout
+from .base import IBL, EngineTable, Layout
 from .eevee import SCALE_BIAS_F82
 
 BRDF_Z_SCALE = 16.0  # pbrBRDFFunctions: the F82 term is stored times 16 (its largest value is 1/16 of E's)
@@ -156,28 +156,57 @@ BABYLON_FUZZ = LtcCoding(
 )
 
 LAYOUTS = (BABYLON_F82,)
+REFLECTION = "@babylonjs/core 9.37.1 Shaders/ShadersInclude/pbrBlockReflection (getLodFromAlphaG), Materials/Textures"
+IBL_CONVENTIONS = IBL(
+    "Babylon.js",
+    ndf="ggx",
+    masking="smith_height_correlated",
+    roughness="perceptual",
+    curve="babylon",
+    lobe="ggx_nl",
+    source="pbrBlockReflection: reflectionLOD = log2(size * alphaG) * lodGenerationScale (0.8) + lodGenerationOffset "
+    "(0), alphaG = r^2; environmentBrdfSampler at vec2(NdotV, perceptualRoughness); lobe ggx_nl: lutbake's choice "
+    "(Babylon's HDRFiltering measured apart: docs/in-engines.md)",
+)
+DFG = EngineTable(
+    "Babylon.js",
+    "babylon",
+    "babylon_environment_brdf",
+    "dfg",
+    "multiscatter_cloth",
+    {
+        "size": [256, 256],
+        "roughness": "perceptual",
+        "masking": "smith_height_correlated",
+        "layout": "multiscatter_cloth",
+        "texel": "center",
+        "row_order": "lo_first",
+        "dtype": "half",
+        "format": "dds",
+    },
+    SOURCE,
+    "scene.environmentBRDFTexture (isRGBD = false, invertY = false)",
+    shipped="babylon_environment_brdf.npz",
+    shader="t = texture(environmentBrdfSampler, vec2(NdotV, perceptualRoughness)).rgb; (R90 - R0) * t.x + R0 * t.y",
+    encoding="rgbd",  # the shipped PNG (Misc/brdfTextureTools.js loadBRDFTexture: isRGBD = true)
+    ibl=IBL_CONVENTIONS,
+)
 TABLES = (
+    DFG,
+    replace(DFG, preset="babylon-ibl", shipped=None),  # the same table in the one-run preset (audited as "babylon")
     EngineTable(
         "Babylon.js",
-        "babylon",
-        "babylon_environment_brdf",
-        "dfg",
-        "multiscatter_cloth",
-        {
-            "size": [256, 256],
-            "roughness": "perceptual",
-            "masking": "smith_height_correlated",
-            "layout": "multiscatter_cloth",
-            "texel": "center",
-            "row_order": "lo_first",
-            "dtype": "half",
-            "format": "dds",
-        },
-        SOURCE,
-        "scene.environmentBRDFTexture (isRGBD = false, invertY = false)",
-        shipped="babylon_environment_brdf.npz",
-        shader="t = texture(environmentBrdfSampler, vec2(NdotV, perceptualRoughness)).rgb; (R90 - R0) * t.x + R0 * t.y",
-        encoding="rgbd",  # the shipped PNG (Misc/brdfTextureTools.js loadBRDFTexture: isRGBD = true)
+        "babylon-ibl",
+        "babylon_specular",
+        "environment_specular",
+        None,
+        {"curve": "babylon", "lobe": "ggx_nl", "orientation": "gl", "format": "dds", "dtype": "half"},
+        REFLECTION,
+        "scene.environmentTexture = new CubeTexture(url, scene, {prefiltered: true, forcedExtension: '.dds'}) "
+        "(lodGenerationScale 0.8, offset 0; its spherical polynomial, the irradiance, Babylon computes from the cube)",
+        shader="reflectionLOD = getLodFromAlphaG(vReflectionMicrosurfaceInfos.x, alphaG) * 0.8 + 0.0; "
+        "sampleReflectionLod(reflectionSampler, reflectionCoords, reflectionLOD)",
+        ibl=IBL_CONVENTIONS,
     ),
     EngineTable(
         "Babylon.js",
