@@ -207,8 +207,8 @@ def test_every_engine_table_names_a_storage_encoding_audit_knows():
     assert {t.encoding for t in TABLES} <= set(ENCODINGS)
     # the environment BRDF tables ship as 8-bit RGBD PNGs, the area-light LTC tables as half floats (areaLightsLTC.bin)
     babylon = [t for t in TABLES if t.engine == "Babylon.js"]
-    assert {t.encoding for t in babylon if t.kind == "dfg"} == {"rgbd"}
-    assert {t.encoding for t in babylon if t.kind not in ("dfg", "environment_specular")} == {"plain"}
+    assert {t.encoding for t in babylon if t.preset == "ltc-babylon"} == {"plain"}
+    assert {t.encoding for t in babylon if t.preset != "ltc-babylon" and t.kind != "environment_specular"} == {"rgbd"}
 
 
 def test_audit_of_babylons_shipped_rgbd_png_decodes_rgbd_and_reports_the_real_error(tmp_path):
