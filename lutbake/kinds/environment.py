@@ -12,6 +12,7 @@ enters the table's content hash (``inputs``): editing the file rebakes the table
 
 from __future__ import annotations
 
+import threading
 from dataclasses import replace
 from pathlib import Path
 
@@ -291,8 +292,19 @@ def read_source(spec):
     flip = cube.ORIENTATIONS[spec.options["orientation"]].flip
     if flip != (1.0, 1.0, -1.0) and flip != (1.0, 1.0, 1.0):
         raise ValueError(f"orientation {spec.options['orientation']!r}: only a z flip is baked")
-    image = env.image[:, ::-1] if flip[2] < 0 else env.image
-    return env, latlong.pyramid(image)
+    key = (env.sha256, flip[2] < 0)
+    with _PYRAMID_LOCK:
+        pyr = _PYRAMID.get(key)
+    if pyr is None:  # a preset's specular and irradiance tables of one source share one pyramid
+        pyr = latlong.pyramid(env.image[:, ::-1] if flip[2] < 0 else env.image)
+        with _PYRAMID_LOCK:
+            _PYRAMID.clear()
+            _PYRAMID[key] = pyr
+    return env, pyr
+
+
+_PYRAMID: dict = {}  # the last source's pyramid, by (sha256, mirrored): it is read-only
+_PYRAMID_LOCK = threading.Lock()
 
 
 def base_record(spec, env, baked) -> dict:
