@@ -44,10 +44,11 @@ def rotation_z(phi: np.ndarray) -> np.ndarray:
     return aniso.rotate_z(np.broadcast_to(np.eye(3), (len(phi), 3, 3)).copy(), phi)
 
 
-def training_set(n: int, count: int, seed: int) -> dict:
+def training_set(n: int, count: int, seed: int, extra: np.ndarray | None = None) -> dict:
     """n configurations uniform in table coordinates (phi in [0, pi/2]: the other quadrants are its reflections),
-    ``count`` lights each (tangent frame), their lobe integrals G (n, count), albedo A (n,), and the texels' flat
-    indices (n, 16) and weights (n, 16) of the interpolation."""
+    ``count`` lights each (tangent frame; ``extra`` (e, 4, 3) view-frame lights added to every configuration's), their
+    lobe integrals G (n, count + e), albedo A (n,), and the texels' flat indices (n, 16) and weights (n, 16) of the
+    interpolation."""
     rng = np.random.default_rng(seed)
     u = rng.random((n, 4))
     ax, ay = np.maximum(u[:, 0], GRID.alpha_min), np.maximum(u[:, 1], GRID.alpha_min)
@@ -57,7 +58,9 @@ def training_set(n: int, count: int, seed: int) -> dict:
     uniforms = rng.random((n, 2 * count + 16, ltc_lights.UNIFORMS))
     lit = ltc_lights.from_uniforms(uniforms, v[:, None, :], np.sqrt(ax * ay)[:, None])
     polys = ltc_lights.first_lit(lit, count)  # view frame
-    g, albedo = np.zeros((n, count)), np.zeros(n)
+    if extra is not None:
+        polys = np.concatenate([polys, np.broadcast_to(extra, (n, *extra.shape))], axis=1)
+    g, albedo = np.zeros(polys.shape[:2]), np.zeros(n)
     for s in range(0, n, CHUNK):
         t = slice(s, s + CHUNK)
         p = AnisoProblem(nov[t], ax[t].astype(np.float32), ay[t].astype(np.float32), phi[t], np.ones(len(nov[t])), 48)

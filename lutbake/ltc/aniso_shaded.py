@@ -40,31 +40,53 @@ def refine_matrices(
         t = np.tile(local, len(minv) // k)
         return (a[t, None] * shaded.integrals(minv.reshape(-1, 3, 3), t, polys, device) - g[t]) * sw[t]
 
-    minv = np.linalg.inv(m_view).reshape(k, 9)
-    minv /= np.linalg.norm(minv, axis=1, keepdims=True)
-    z = residuals(minv)
+    minv = levenberg_marquardt(np.linalg.inv(m_view).reshape(k, 9), residuals, unit_blocks(1), iterations)
+    return np.linalg.inv(minv.reshape(k, 3, 3))
+
+
+def unit_blocks(lobes: int):
+    """x (k, P) -> the same with its first ``lobes`` blocks of 9 coefficients (each lobe's M^-1) scaled to unit
+    norm: the polygon integral does not see an M^-1's scale. The coefficients after them are left as they are."""
+
+    def normalise(x: np.ndarray) -> np.ndarray:
+        b = x[:, : 9 * lobes].reshape(len(x), lobes, 9)
+        out = x.copy()
+        out[:, : 9 * lobes] = (b / np.linalg.norm(b, axis=2, keepdims=True)).reshape(len(x), -1)
+        return out
+
+    return normalise
+
+
+def levenberg_marquardt(x: np.ndarray, residuals, normalise, iterations: int) -> np.ndarray:
+    """k independent least-squares problems of the soft-L1 cost Σ_j ρ(z_j) (lutbake.ltc.shaded.robust), x (k, P) ->
+    z (k, L) = residuals(x); residuals of (r k, P) are r blocks of the k problems, in order. Levenberg-Marquardt with
+    the IRLS weights of ρ, forward-difference Jacobian, damping relative to diag(J^T J), each step mapped by
+    ``normalise``; a step is kept only where it lowers the problem's cost. Problems are independent: the same bits
+    for any grouping."""
+    k, n = x.shape
+    x = normalise(x)
+    z = residuals(x)
     cost = np.sum(shaded.robust(z), axis=1)
     lam = np.full(k, shaded.LAMBDA0)
-    eye = np.eye(9)
+    eye = np.eye(n)
     for _ in range(iterations):
         so = np.sqrt(shaded.robust_weight(z))
-        h = shaded.FD_STEP * np.maximum(np.abs(minv), 1.0)
-        trials = minv[:, None, :] + h[:, :, None] * eye[None]  # (k, 9 trials, 9)
-        zt = residuals(trials.transpose(1, 0, 2).reshape(-1, 9)).reshape(9, k, -1)
-        jac = ((zt - z[None]) / h.T[:, :, None]).transpose(1, 2, 0) * so[:, :, None]  # (k, L, 9)
+        h = shaded.FD_STEP * np.maximum(np.abs(x), 1.0)
+        trials = x[:, None, :] + h[:, :, None] * eye[None]  # (k, n trials, n)
+        zt = residuals(trials.transpose(1, 0, 2).reshape(-1, n)).reshape(n, k, -1)
+        jac = ((zt - z[None]) / h.T[:, :, None]).transpose(1, 2, 0) * so[:, :, None]  # (k, L, n)
         jtj = np.einsum("kla,klb->kab", jac, jac)
         jtr = np.einsum("kla,kl->ka", jac, z * so)
         d = np.einsum("kaa->ka", jtj).copy()
         d[d <= 0.0] = 1.0
         step = -np.linalg.solve(jtj + lam[:, None, None] * d[:, :, None] * eye[None], jtr[:, :, None])[..., 0]
-        cand = minv + step
-        cand /= np.linalg.norm(cand, axis=1, keepdims=True)
+        cand = normalise(x + step)
         z_new = residuals(cand)
         c_new = np.sum(shaded.robust(z_new), axis=1)
         ok = np.isfinite(c_new) & (c_new < cost)
-        minv[ok], z[ok], cost[ok] = cand[ok], z_new[ok], c_new[ok]
+        x[ok], z[ok], cost[ok] = cand[ok], z_new[ok], c_new[ok]
         lam = np.where(ok, lam / 3.0, lam * 4.0)
-    return np.linalg.inv(minv.reshape(k, 3, 3))
+    return x
 
 
 def refine_table(
