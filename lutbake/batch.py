@@ -143,7 +143,7 @@ def schedule(specs: list[TableSpec], out_dir, force: bool = False) -> list[Job]:
     digest = sources_digest()
     jobs = []
     for spec in specs:
-        path = output_path(out_dir, spec.name, spec.options.get("format", "exr"))
+        path = output_path(out_dir, spec.name, spec.options.get("format", "exr"), spec.kind)
         job = Job(spec, path, content_hash(spec, digest), values_key(spec, digest))
         header = None if force else read_header(job.path)
         if header is not None and header.get(HASH_ATTRIBUTE) == job.content_hash:

@@ -218,17 +218,19 @@ def check_path_lengths(jobs, cache_dir=None, report=None) -> None:
 
 
 def planned_files(job) -> list[tuple[Path, str]]:
-    """Every file the bake of ``job`` writes, with what it is: the data file, a second data file (ltc_dds's
-    ``<name>_2.dds``), the files its kind writes beside them (an irradiance cube's ``<name>_sh.json``: Kind.outputs),
-    and the ``.json`` sidecar of each (EXR carries its metadata in its header). The one registry of output paths:
-    collisions, ``--report`` and the preview/error-map guards all read it."""
+    """Every file the bake of ``job`` writes, with what it is: the data file, the other files of a file set (ltc_dds's
+    ``<name>_2.dds``, an ltc_aniso table's ``<name>_t1.ktx2``: lutbake.io.file_sets), the files its kind writes beside
+    them (an irradiance cube's ``<name>_sh.json``: Kind.outputs), and the ``.json`` sidecar of each (EXR carries its
+    metadata in its header). The one registry of output paths: collisions, ``--report`` and the preview/error-map
+    guards all read it."""
     from .config import kind_of
+    from .io.file_sets import set_files
     from .io.integrity import sidecar_path
 
     fmt = job.spec.options.get("format", "exr")
     files = [(job.path, "output")]
-    if fmt == "ltc_dds":
-        files.append((job.path.with_name(job.path.name.replace("_1.dds", "_2.dds")), "second texture"))
+    others = (set_files(job.name, job.spec.kind, fmt) or [])[1:]
+    files += [(job.path.with_name(name), f"{nth} texture") for nth, name in zip(("second", "third"), others)]
     files += [(job.path.with_name(job.name + suffix), what) for suffix, what in kind_of(job.spec).outputs]
     # an EXR writes none, but <name>.exr.json is where readers look for one: it is claimed too
     files += [(sidecar_path(p), f"sidecar of {p.name}") for p, _ in list(files)]
@@ -375,19 +377,19 @@ def check_report(report, jobs, configs=(), cache_dir=None) -> None:
 
 
 def input_files(path) -> list[Path]:
-    """The files reading ``path`` touches: itself, its sidecars, the data file a sidecar names, an ltc_dds pair's
-    other texture (what ``preview -o`` / ``audit --error-map`` must never overwrite)."""
+    """The files reading ``path`` touches: itself, its sidecars, the data file a sidecar names, the other files of a
+    file set (an ltc_dds pair's other texture, lutbake.io.file_sets) (what ``preview -o`` / ``audit --error-map`` must
+    never overwrite)."""
+    from .io.file_sets import members
     from .io.readers import sidecar_candidates
 
     path = Path(path)
     files = [path, *sidecar_candidates(path)]
-    name = path.name
-    for a, b in (("_1.dds", "_2.dds"), ("_2.dds", "_1.dds")):
-        if name.endswith(a):
-            other = path.with_name(name[: -len(a)] + b)
+    for other in members(path):
+        if other != path:
             files += [other, *sidecar_candidates(other)]
-    if name.endswith(".json"):
-        files.append(path.with_name(name[: -len(".json")]))
+    if path.name.endswith(".json"):
+        files.append(path.with_name(path.name[: -len(".json")]))
     return files
 
 

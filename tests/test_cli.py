@@ -151,9 +151,11 @@ def test_list_prints_whole_preset_descriptions_and_the_files_each_writes():
         comment = " ".join(ln.lstrip("#").strip() for ln in text.splitlines()[: _leading_comments(text)])
         assert " ".join(comment.split()) in out, name
         tables = tomllib.loads(text)["table"]
-        files = [f for t in tables for f in written_files(t["name"], t.get("format", "exr"), kind_outputs(t["kind"]))]
+        fmts = [(t["name"], t.get("format", "exr"), t["kind"]) for t in tables]
+        files = [f for n, fmt, kind in fmts for f in written_files(n, fmt, kind_outputs(kind), kind)]
         assert f"Writes: {', '.join(files)}." in out, name
     assert "filament_dfg.dds, filament_dfg.dds.json" in out and "ltc_ggx_1.dds, ltc_ggx_2.dds" in out
+    assert "ltc_aniso_t0.ktx2, ltc_aniso_t1.ktx2, ltc_aniso_t2.ktx2, ltc_aniso_t0.ktx2.json" in out
 
 
 def _leading_comments(text: str) -> int:

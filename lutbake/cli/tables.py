@@ -180,7 +180,11 @@ def preset_text(path: Path) -> str:
         lines.append(line.lstrip("#").strip())
     # the shipped TOML read as it is (validating an ltc preset would start Warp: lutbake list imports none of it)
     tables = tomllib.loads(text)["table"]
-    files = [f for t in tables for f in written_files(t["name"], t.get("format", "exr"), kind_outputs(t.get("kind")))]
+    files = [
+        f
+        for t in tables
+        for f in written_files(t["name"], t.get("format", "exr"), kind_outputs(t.get("kind")), t.get("kind"))
+    ]
     return " ".join(filter(None, lines)) + f" Writes: {', '.join(files)}."
 
 

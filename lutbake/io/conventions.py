@@ -33,6 +33,19 @@ def write_with_sidecar(table: Table, path, data: bytes, fmt: str, extra: dict | 
     return path
 
 
+def write_set_with_sidecar(table: Table, path, files: dict[str, bytes], fmt: str, extra: dict | None = None) -> Path:
+    """An output of several files (lutbake.io.file_sets): ``files`` (name -> bytes, beside ``path``, ``path.name``
+    among them) each written atomically, ``path`` last, then the sidecar of ``path`` listing every file (``files``,
+    in the order given) with the sha256 of each: one unit, as a cube and its SH (lutbake.io.cubemap.write_cube)."""
+    path = Path(path)
+    if path.name not in files:
+        raise ValueError(f"table {table.name!r}: the file set {sorted(files)} lacks its first file {path.name}")
+    digests = {n: atomic_write_bytes_hashed(path.with_name(n), blob) for n, blob in files.items() if n != path.name}
+    digests[path.name] = atomic_write_bytes_hashed(path, files[path.name])
+    write_conventions(table, path, fmt, {"files": list(files), **(extra or {})}, digests=digests)
+    return path
+
+
 def c_ident(name: str) -> str:
     """``name`` as a C/JS/Rust identifier: other characters become _, a leading digit gets a _ before it."""
     s = re.sub(r"[^A-Za-z0-9_]", "_", name)

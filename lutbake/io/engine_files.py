@@ -4,6 +4,7 @@ the table's axes, channels and conventions), so ``lutbake inspect`` and ``previe
 | sidecar ``format`` | file | values read | table shape (as the EXR) |
 | --- | --- | --- | --- |
 | ``ltc_dds`` | <name>_1.dds + <name>_2.dds | both DDS textures (lutbake.io.dds) | (2, N, N, 4): ltc_1, ltc_2 |
+| ``ltc_aniso_dds`` | <name>_t0.dds, _t1, _t2 | the file's 3D texture (lutbake.io.ltc_aniso_textures) | (N², N, N, 4) |
 | ``js`` (kind ltc) | three.js module | ``LTC_MAT_1``, ``LTC_MAT_2`` | (2, N, N, 4) |
 | ``c`` | Blender EEVEE .cc | ``ltc_mat_<lobe>``, ``ltc_mag_<lobe>``, ``ltc_disk_integral`` | (2, N, N, 4) |
 | ``cs`` | Unity HDRP .cs | ``s_LtcMatrixData_BRDF_<LOBE>`` (FP16 bits) | (N, N, 4): HDRP's texel, its own channels |
@@ -28,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from .bounded import check_texels, read_bytes, read_text
+from .ltc_aniso_textures import SIDECAR_FORMATS, member_view
 from .text_arrays import literal_values, parse_text_array, strip_comments
 
 HDRP_CHANNELS = {
@@ -191,6 +193,9 @@ def read_engine(path: Path, doc: dict) -> tuple[np.ndarray, dict[str, str], str]
     """(float32 data (y, x, C) or (z, y, x, C), attributes to show, a note) of an engine-layout file whose sidecar
     ``doc`` (format, lutbake attributes) names it; ValueError when the file does not hold what the sidecar says."""
     fmt, attrs = doc.get("format"), dict(doc["lutbake"])
+    if fmt in SIDECAR_FORMATS:  # one of an ltc_aniso table's three 3D textures, shown alone with its own record
+        data, attrs, note = member_view(path, doc)
+        return np.ascontiguousarray(data, dtype=np.float32), attrs, note
     dims = _dims(attrs)
     if fmt == "openpbr_h":
         data = _openpbr_h(path, doc, dims, attrs)

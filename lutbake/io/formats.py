@@ -9,7 +9,9 @@
 | ``ktx2`` | <name>.ktx2 + <name>.ktx2.json | VK_FORMAT_R16G16_SFLOAT, ... | key/value data (lutbake.io.ktx2) |
 | ``h`` | <name>.h + <name>.h.json | half-float bits (uint16_t) or float | the conventions in a comment block |
 Row 0 of every file is table row 0 (no flip); column 0 is x index 0. Every write is atomic; the sidecar
-``<file>.json`` is written last and names the sha256 of the data file (lutbake.io.integrity).
+``<file>.json`` is written last and names the sha256 of the data file (lutbake.io.integrity). An output of several
+files (ltc_dds's pair; ``ktx2`` / ``dds`` of kind ltc_aniso: three 3D textures, ``KIND_WRITERS``) has one sidecar
+naming every file's sha256 (lutbake.io.file_sets).
 """
 
 from __future__ import annotations
@@ -18,10 +20,11 @@ from pathlib import Path
 
 from ..table import Table, metadata
 from ..table import pixels as checked_pixels
-from . import code_arrays, dds, ktx2, ltc, openpbr
+from . import code_arrays, dds, ktx2, ltc, ltc_aniso_textures, openpbr
 from .atomic import unit_lock
 from .conventions import write_with_sidecar
 from .exr import write_exr
+from .file_sets import set_files
 from .header import write_header
 from .npy import write_npy
 from .png import write_png16
@@ -87,26 +90,38 @@ ALL_FORMATS = {**FORMATS, **ltc.FORMATS, **CUBE_ONLY_FORMATS}  # every format: t
 EXTENSIONS = {**EXTENSIONS, **ltc.EXTENSIONS, **code_arrays.EXTENSIONS}
 
 
-def output_path(out_dir, name: str, fmt: str) -> Path:
-    return Path(out_dir) / f"{name}{EXTENSIONS[fmt]}"
+KIND_WRITERS = {  # (kind, format) -> its writer where a kind writes a format its own way (lutbake.io.file_sets)
+    ("ltc_aniso", "ktx2"): ltc_aniso_textures.write_ktx2_textures,
+    ("ltc_aniso", "dds"): ltc_aniso_textures.write_dds_textures,
+}
 
 
-def written_files(name: str, fmt: str, outputs: tuple[str, ...] = ()) -> list[str]:
-    """The names of the files a table ``name`` writes in ``fmt``: its data file(s), the files its kind writes beside
-    them (``outputs``: suffixes after the name, lutbake.kinds.base.Kind.outputs), then its sidecar (every format but
-    EXR, whose header holds the conventions)."""
-    data = output_path(".", name, fmt).name
-    files = [data] + ([data.replace("_1.dds", "_2.dds")] if fmt == "ltc_dds" else [])
-    files += [name + suffix for suffix in outputs]
-    return files + ([] if fmt == "exr" else [data + ".json"])
+def data_files(name: str, fmt: str, kind: str | None = None) -> list[str]:
+    """The data files a table ``name`` of ``kind`` writes in ``fmt``: ``<name><ext>``, or a file set's members
+    (lutbake.io.file_sets: ltc_dds's pair, an ltc_aniso table's three textures), the first the one its sidecar
+    describes."""
+    return set_files(name, kind, fmt) or [f"{name}{EXTENSIONS[fmt]}"]
+
+
+def output_path(out_dir, name: str, fmt: str, kind: str | None = None) -> Path:
+    """The file whose metadata says whether the output is up to date: the data file, a file set's first member."""
+    return Path(out_dir) / data_files(name, fmt, kind)[0]
+
+
+def written_files(name: str, fmt: str, outputs: tuple[str, ...] = (), kind: str | None = None) -> list[str]:
+    """The names of the files a table ``name`` of ``kind`` writes in ``fmt``: its data file(s), the files its kind
+    writes beside them (``outputs``: suffixes after the name, lutbake.kinds.base.Kind.outputs), then its sidecar
+    (every format but EXR, whose header holds the conventions)."""
+    files = data_files(name, fmt, kind)
+    return files + [name + suffix for suffix in outputs] + ([] if fmt == "exr" else [files[0] + ".json"])
 
 
 def write_table(table: Table, out_dir, fmt: str = "exr", dtype: str = "float32") -> Path:
-    """Write ``table`` to ``out_dir/<name>.<ext>`` in ``fmt`` (FORMATS), atomically, under the output's unit lock
-    (lutbake.io.atomic.unit_lock: a concurrent writer of the same path never slips between its data and its sidecar).
-    Returns the path."""
+    """Write ``table`` to ``out_dir/<name>.<ext>`` in ``fmt`` (FORMATS; a file set: output_path), atomically, under
+    the output's unit lock (lutbake.io.atomic.unit_lock: a concurrent writer of the same path never slips between its
+    data and its sidecar). Returns the path."""
     if fmt not in WRITERS:
         raise ValueError(f"table {table.name!r}: unknown format {fmt!r}; valid: {', '.join(WRITERS)}")
-    path = output_path(out_dir, table.name, fmt)
+    path = output_path(out_dir, table.name, fmt, table.kind)
     with unit_lock(path):
-        return WRITERS[fmt](table, path, dtype=dtype)
+        return KIND_WRITERS.get((table.kind, fmt), WRITERS[fmt])(table, path, dtype=dtype)

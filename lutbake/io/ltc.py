@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from ..table import Table
-from .conventions import write_conventions, write_with_sidecar
+from .conventions import write_conventions, write_set_with_sidecar, write_with_sidecar
 
 FP16_MAX = 65504.0
 EXTENSIONS = {
@@ -73,26 +73,17 @@ def _flat(a: np.ndarray, fmt: str = "{:.9g}") -> str:
 
 def write_ltc_dds(table: Table, path, dtype: str = "half") -> Path:
     from . import dds
-    from .atomic import atomic_write_bytes_hashed
 
     t1, t2 = engine_textures(table)
     path = Path(path)
-    second = path.with_name(path.name.replace("_1.dds", "_2.dds"))
+    second = path.name.replace("_1.dds", "_2.dds")
     np_dtype = np.float16 if dtype == "half" else np.float32
-    digests = {second.name: atomic_write_bytes_hashed(second, dds.encode(t2.astype(np_dtype)))}
-    digests[path.name] = atomic_write_bytes_hashed(path, dds.encode(t1.astype(np_dtype)))
-    write_conventions(
-        table,
-        path,
-        "ltc_dds",
-        {
-            "files": [path.name, second.name],
-            "dxgi_format": "R16G16B16A16_FLOAT" if dtype == "half" else "R32G32B32A32_FLOAT",
-            "ltc_2_z": "0 (lutbake's fit_error is in the EXR only)",
-        },
-        digests=digests,
-    )
-    return path
+    files = {path.name: dds.encode(t1.astype(np_dtype)), second: dds.encode(t2.astype(np_dtype))}
+    extra = {
+        "dxgi_format": "R16G16B16A16_FLOAT" if dtype == "half" else "R32G32B32A32_FLOAT",
+        "ltc_2_z": "0 (lutbake's fit_error is in the EXR only)",
+    }
+    return write_set_with_sidecar(table, path, files, "ltc_dds", extra)
 
 
 def js_text(table: Table) -> str:

@@ -16,6 +16,7 @@ from ..errors import MESSAGE_LIMIT, LutbakeError
 from ..textsafe import bounded as bounded_text
 from ..textsafe import shorten
 from . import bounded
+from .file_sets import members
 
 NAME_CHARS = 120  # characters of a name from a file (kind, table, channel, term) shown by preview and inspect
 
@@ -112,11 +113,13 @@ def text_problem(value, where: str = "") -> str | None:
 
 
 def sidecar_candidates(path: Path) -> list[Path]:
-    """Where the sidecar of a data file may be: <name>.<ext>.json, then <name>.json; for the second texture of an
-    ltc_dds pair (<stem>_2.dds), the pair's sidecar <stem>_1.dds.json (it lists both in ``files``)."""
+    """Where the sidecar of a data file may be: <name>.<ext>.json, then <name>.json; for a later file of a file set
+    (lutbake.io.file_sets: ltc_dds's <stem>_2.dds, an ltc_aniso table's <stem>_t1.ktx2), the set's sidecar
+    <stem>_1.dds.json, <stem>_t0.ktx2.json (it lists every file in ``files``)."""
     out = [path.with_name(path.name + ".json"), path.with_suffix(".json")]
-    if path.name.endswith("_2.dds"):
-        out.append(path.with_name(path.name[: -len("_2.dds")] + "_1.dds.json"))
+    first = members(path)[:1]
+    if first and first[0] != path:
+        out.append(first[0].with_name(first[0].name + ".json"))
     return out
 
 

@@ -13,9 +13,10 @@ magnitude = ∫ f (n.l) dω with F = 1 and fresnel = ∫ f (1 - v.h)^5 (n.l) dω
 Stored as lutbake.ltc.aniso.texture_layout's three RGBA 3D textures of width N (phi), height N (theta) and depth N^2
 (layer = b + N a: the 4th axis packed into the depth, as the paper's Tex3D path): the table's z axis is the texture
 (t0, t1, t2), its rows the layers' theta rows stacked (y_block = layer, y = theta), its columns phi. So each z slice
-(an EXR part; npy [k]) is one 3D texture's bytes in glTexImage3D order. ``format = "ltc_aniso_npy"`` writes the
-paper's own layout instead: M as (N, N, N, N, 3, 3) float32 (its LUT/*.npy; no magnitude, as the paper's;
-lutbake.io.ltc.write_ltc_aniso_npy). The shader: docs/shaders/ltc_aniso.glsl.
+(an EXR part; npy [k]) is one 3D texture's bytes in glTexImage3D order. ``format = "ktx2"`` / ``"dds"`` write the
+three textures as 3D texture files <name>_t0, _t1, _t2 (lutbake.io.ltc_aniso_textures), the same bytes;
+``format = "ltc_aniso_npy"`` the paper's own layout instead: M as (N, N, N, N, 3, 3) float32 (its LUT/*.npy; no
+magnitude, as the paper's; lutbake.io.ltc.write_ltc_aniso_npy). The shader: docs/shaders/ltc_aniso.glsl.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ import json
 import numpy as np
 
 from ..axes import Axis
+from ..io.ltc_aniso_textures import TEXTURES
 from ..limits import LTC_FIT_GRID
 from ..ltc import aniso_grid as aniso
 from ..ltc.aniso_grid import ALPHA_FLOOR
@@ -43,6 +45,12 @@ FORMATS = {
     "is texture k's (depth, height, width, RGBA)",
     "ltc_aniso_npy": "the paper's layout (AakashKT/LTC-Anisotropic LUT/*.npy): M[a, b, theta, phi] (N, N, N, N, 3, 3) "
     "float32 + .json sidecar; no magnitude (the paper's renderer reads it from another table: use exr / npy)",
+    "ktx2": "three KTX 2.0 3D textures <name>_t0.ktx2, _t1.ktx2, _t2.ktx2 (pixelDepth N^2, "
+    "VK_FORMAT_R16G16B16A16_SFLOAT / R32G32B32A32_SFLOAT, each file's record in its key/value data) + the sidecar "
+    "<name>_t0.ktx2.json naming the sha256 of all three (lutbake.io.ltc_aniso_textures)",
+    "dds": "three DDS volume textures <name>_t0.dds, _t1.dds, _t2.dds (DX10, TEXTURE3D, depth N^2, "
+    "DXGI_FORMAT_R16G16B16A16_FLOAT / R32G32B32A32_FLOAT) + the sidecar <name>_t0.dds.json naming the sha256 of all "
+    "three",
 }
 ESTIMATORS = {
     "sobol": "magnitude and fresnel of anisotropic texels by scrambled Sobol' points at the texel's view azimuth "
@@ -148,8 +156,10 @@ def plan(spec) -> TexelPlan:
         "ltc_aniso_parametrisation": f"{o['parametrisation']}: {PARAMETRISATIONS[o['parametrisation']][1]}",
         "ltc_aniso_layer": f"layer = b + {n} a (a, b the parametrisation's first two indices; the y_block axis): "
         f"a = b = i / {n - 1}, a in {[round(float(x), 6) for x in a]}",
-        "ltc_aniso_textures": "slice 0 = t0 (M00, M01, M02, M10), slice 1 = t1 (M11, M12, M20, M21), slice 2 = t2 "
-        "(M22, magnitude, fresnel, fit_error); each a 3D texture (width phi, height theta, depth layer)",
+        "ltc_aniso_textures": ", ".join(
+            f"slice {k} = {t} ({', '.join(ch)})" for k, (t, ch) in enumerate(TEXTURES.items())
+        )
+        + "; each a 3D texture (width phi, height theta, depth layer)",
         "ltc_aniso_conventions": "M maps the clamped cosine to the lobe (w = M w_o / |M w_o|), tangent frame T = +x, "
         "B = +y, n = +z, |M e_z| = 1, M R_z chosen closest to the identity (lutbake.ltc.aniso.canonical); "
         "v = (sin theta cos phi, sin theta sin phi, cos theta); phi in the other quadrants: M(pi - phi) = "

@@ -120,4 +120,14 @@ TABLES = (
         "Turquin 2019",
         "a 2D texture (roughness, IOR) of the averages",
     ),
+    EngineTable(
+        "lutbake",
+        "ltc-aniso",
+        "ltc_aniso",
+        "ltc_aniso",
+        None,
+        {"parametrisation": "alphax_alphay", "size": 8, "dtype": "half", "format": "ktx2"},
+        "Kt, Heitz, Dupuy & Narayanan 2022, Bringing Linearly Transformed Cosines to Anisotropic GGX",
+        "docs/shaders/ltc_aniso.glsl's sampler3D t0, t1, t2: three KTX 2.0 3D textures 8 x 8 x 64, RGBA16F",
+    ),
 )
