@@ -82,7 +82,8 @@ clean:
 # outputs/bench/cluster.json (docs/cluster.md); first, `make luts` into an empty folder timed (wall, CPU, top ten
 # tables): outputs/bench/luts.json; every table that interpolates between texels against itself integrated (CPU ratio,
 # honesty): outputs/bench/interpolation.json; the prefiltered environment (a 2048 x 1024 CC0 map to a 256^2 cube and
-# its SH) against the importance-sampled prefilter: outputs/bench/environment.json (needs Debian's blender-data)
+# its SH) against the importance-sampled prefilter: outputs/bench/environment.json (needs Debian's blender-data); sums of
+# anisotropic GGX LTCs per texel (docs/ltc_aniso.md): outputs/bench/ltc_aniso_lobes.json
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_luts.py
 	$(BIN)/python benchmarks/bench.py
@@ -91,6 +92,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_ltc.py
 	$(BIN)/python benchmarks/bench_ltc.py --lobes eon,gotanda
 	$(BIN)/python benchmarks/bench_ltc_aniso.py
+	$(BIN)/python benchmarks/ltc_aniso_lobes.py
 	$(BIN)/python benchmarks/bench_cluster.py
 	$(BIN)/python benchmarks/bench_environment.py
 	$(BIN)/python benchmarks/write_benchmarks_md.py
