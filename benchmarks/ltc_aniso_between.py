@@ -135,6 +135,19 @@ def block_cg(a: sps.csr_matrix, rhs: np.ndarray, blocks: np.ndarray) -> np.ndarr
     return x
 
 
+def damped_step(model, x: np.ndarray, x0: np.ndarray, reg: float, cost: float, lam: float, step_for):
+    """Levenberg-Marquardt's inner loop: x + step_for(lam) tried at up to 6 dampings (lam x 4 each) until the model's
+    cost + reg |x - x0|^2 falls below ``cost``; (x, lam, the last cost tried)."""
+    c_new = np.inf
+    for _ in range(6):
+        cand = x + step_for(lam).reshape(x.shape)
+        c_new = model.cost(cand) + reg * np.sum((cand - x0) ** 2)
+        if np.isfinite(c_new) and c_new < cost:
+            return cand, lam / 3.0, c_new
+        lam *= 4.0
+    return x, lam, c_new
+
+
 def fit(x0: np.ndarray, ts: dict, iterations: int, mu: float, log=print) -> np.ndarray:
     """Levenberg-Marquardt from x0 on the training set's cost + reg |x - x0|^2, reg = mu mean(diag J^T J) at x0."""
     model = Between(ts)
@@ -146,15 +159,12 @@ def fit(x0: np.ndarray, ts: dict, iterations: int, mu: float, log=print) -> np.n
         jtz, c = jtz + reg * (x - x0).ravel(), c + reg * np.sum((x - x0) ** 2)
         d = jtj.diagonal() + reg
         d = np.where(d > 0.0, d, d[d > 0.0].mean())
-        for _ in range(6):
-            damped = jtj + sps.diags(reg + lam * d)
+
+        def step_for(lam, reg=reg, d=d, jtj=jtj, jtz=jtz, diag=diag):
             blocks = diag + (reg + lam * d.reshape(-1, PARAMS))[:, :, None] * np.eye(PARAMS)
-            cand = x + block_cg(damped.tocsr(), -jtz, blocks).reshape(x.shape)
-            c_new = model.cost(cand) + reg * np.sum((cand - x0) ** 2)
-            if np.isfinite(c_new) and c_new < c:
-                x, lam = cand, lam / 3.0
-                break
-            lam *= 4.0
+            return block_cg((jtj + sps.diags(reg + lam * d)).tocsr(), -jtz, blocks)
+
+        x, lam, c_new = damped_step(model, x, x0, reg, c, lam, step_for)
         log(f"iteration {it}: cost {c:.6g} -> {c_new:.6g}, damping {lam:.2e}, {time.perf_counter() - t0:.1f} s")
     return x
 

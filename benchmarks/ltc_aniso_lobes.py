@@ -34,7 +34,7 @@ import numpy as np
 import scipy.sparse as sps
 import scipy.sparse.linalg as spla
 from bench_ltc_aniso import OUT, configuration, configuration_fit, nearest_texel, shade, statistics, truth_and_albedo
-from ltc_aniso_between import GRID, Between, training_set
+from ltc_aniso_between import GRID, Between, damped_step, training_set
 
 from lutbake.ltc import aniso, aniso_shaded, shaded
 from lutbake.ltc.aniso import AnisoProblem
@@ -138,24 +138,20 @@ def fit_between(x0: np.ndarray, model: BetweenLobes, iterations: int, mu: float,
         grad = model.spread @ np.einsum("nla,nl->na", jac, r) + reg * (x - x0)
         c += reg * np.sum((x - x0) ** 2)
         d = np.where(d > 0.0, d, d[d > 0.0].mean())
-        c_new = np.inf
-        for _ in range(6):
+
+        def step_for(lam, reg=reg, d=d, jac=jac, grad=grad):
             damp = reg + lam * d
 
-            def normal(v, damp=damp):
+            def normal(v):
                 v = v.reshape(x.shape)
                 jv = np.einsum("nla,na->nl", jac, model.gather @ v)
                 return (model.spread @ np.einsum("nla,nl->na", jac, jv) + damp * v).ravel()
 
             a = spla.LinearOperator((x.size, x.size), matvec=normal)
             pre = spla.LinearOperator((x.size, x.size), matvec=lambda v, p=(d + damp).ravel(): v / p)
-            step, _ = spla.cg(a, -grad.ravel(), M=pre, maxiter=150, rtol=1e-5)
-            cand = x + step.reshape(x.shape)
-            c_new = model.cost(cand) + reg * np.sum((cand - x0) ** 2)
-            if np.isfinite(c_new) and c_new < c:
-                x, lam = cand, lam / 3.0
-                break
-            lam *= 4.0
+            return spla.cg(a, -grad.ravel(), M=pre, maxiter=150, rtol=1e-5)[0]
+
+        x, lam, c_new = damped_step(model, x, x0, reg, c, lam, step_for)
         log(f"iteration {it}: cost {c:.6g} -> {c_new:.6g}, damping {lam:.2e}, {time.perf_counter() - t0:.1f} s")
     return x
 
