@@ -171,8 +171,8 @@ def main():
     ap.add_argument("--gt", type=int, default=256)
     ap.add_argument("--iterations", type=int, default=40, help="Levenberg-Marquardt steps of fit_lobes")
     ap.add_argument("--configs", type=int, default=20000, help="training configurations of fit_between")
-    ap.add_argument("--between-iterations", type=int, default=10)
-    ap.add_argument("--mu", type=float, default=0.01)
+    ap.add_argument("--between-iterations", type=int, default=20)
+    ap.add_argument("--mu", type=float, default=0.001)
     a = ap.parse_args()
     seconds = {}
     t0 = time.perf_counter()
