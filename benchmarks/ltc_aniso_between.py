@@ -28,72 +28,27 @@ import scipy.sparse.linalg as spla
 from bench_ltc_aniso import OUT, PUBLISHED, configuration, shade, statistics, truth_and_albedo
 
 from lutbake.ltc import aniso, aniso_shaded, shaded
-from lutbake.ltc import lights as ltc_lights
-from lutbake.ltc.aniso import AnisoProblem
+from lutbake.ltc.aniso_lobes import BetweenLobes, damped_step, training_set
 from lutbake.validate.ltc_area import LIGHTS, light_polygon
 
 GRID = aniso.Grid4("alphax_alphay", (8, 8, 8, 8))
 PARAMS = 10  # per texel: M (9, row-major, tangent frame) and magnitude
-CHUNK = 1024  # configurations per AnisoProblem (its lobe samples: CHUNK x 48^2 directions)
 CG_ITERATIONS = 200
 CG_RTOL = 1e-5
 
 
-def rotation_z(phi: np.ndarray) -> np.ndarray:
-    """R_z(phi) (k, 3, 3)."""
-    return aniso.rotate_z(np.broadcast_to(np.eye(3), (len(phi), 3, 3)).copy(), phi)
-
-
-def training_set(n: int, count: int, seed: int, extra: np.ndarray | None = None) -> dict:
-    """n configurations uniform in table coordinates (phi in [0, pi/2]: the other quadrants are its reflections),
-    ``count`` lights each (tangent frame; ``extra`` (e, 4, 3) view-frame lights added to every configuration's), their
-    lobe integrals G (n, count + e), albedo A (n,), and the texels' flat indices (n, 16) and weights (n, 16) of the
-    interpolation."""
-    rng = np.random.default_rng(seed)
-    u = rng.random((n, 4))
-    ax, ay = np.maximum(u[:, 0], GRID.alpha_min), np.maximum(u[:, 1], GRID.alpha_min)
-    theta, phi = u[:, 2] * aniso.THETA_SCALE * np.pi / 2, u[:, 3] * np.pi / 2
-    nov = np.cos(theta)
-    v = np.stack([np.sin(theta), np.zeros(n), nov], axis=1)
-    uniforms = rng.random((n, 2 * count + 16, ltc_lights.UNIFORMS))
-    lit = ltc_lights.from_uniforms(uniforms, v[:, None, :], np.sqrt(ax * ay)[:, None])
-    polys = ltc_lights.first_lit(lit, count)  # view frame
-    if extra is not None:
-        polys = np.concatenate([polys, np.broadcast_to(extra, (n, *extra.shape))], axis=1)
-    g, albedo = np.zeros(polys.shape[:2]), np.zeros(n)
-    for s in range(0, n, CHUNK):
-        t = slice(s, s + CHUNK)
-        p = AnisoProblem(nov[t], ax[t].astype(np.float32), ay[t].astype(np.float32), phi[t], np.ones(len(nov[t])), 48)
-        g[t], _ = shaded.targets(p, np.arange(p.n), polys[t])
-        _, f, pdf = p.lobe_sample_arrays(slice(None))
-        albedo[t] = np.mean(np.where(pdf > 0.0, f / np.where(pdf > 0.0, pdf, 1.0), 0.0), axis=1)
-    index, weight = aniso.corner_weights(u, GRID.n)
-    flat = np.ravel_multi_index(tuple(index.transpose(2, 0, 1)), GRID.n)
-    polys_t = np.einsum("nij,nlvj->nlvi", rotation_z(phi), polys)
-    return {"polys": polys_t, "G": g, "A": albedo, "texel": flat, "weight": weight}
-
-
-class Between:
-    """The shaded cost of a table x (texels, PARAMS) through the interpolation, on one training set."""
+class Between(BetweenLobes):
+    """The shaded cost of a table x (texels, PARAMS) through the interpolation, on one training set: one lobe,
+    its normal equations assembled per pair of texels."""
 
     def __init__(self, ts: dict):
-        self.ts = ts
-        self.n = len(ts["A"])
-        self.scale = 1.0 / np.maximum(ts["G"] + shaded.ABS_WEIGHT * ts["A"][:, None], shaded.TINY)
-
-    def integrals(self, m: np.ndarray) -> np.ndarray:
-        """I of every configuration's lights through M (r n, 3, 3): r blocks of the n configurations, in order."""
-        t = np.tile(np.arange(self.n), len(m) // self.n)
-        return shaded.integrals(np.linalg.inv(m), t, self.ts["polys"])
+        super().__init__(ts, int(np.prod(GRID.n)), 1)
 
     def residuals(self, x: np.ndarray) -> tuple[np.ndarray, ...]:
         """(z (n, L), I (n, L), the interpolated x (n, PARAMS))."""
         xi = np.einsum("nc,nck->nk", self.ts["weight"], x[self.ts["texel"]])
         i = self.integrals(xi[:, :9].reshape(-1, 3, 3))
         return (xi[:, 9:] * i - self.ts["G"]) * self.scale, i, xi
-
-    def cost(self, x: np.ndarray) -> float:
-        return float(np.sum(shaded.robust(self.residuals(x)[0])))
 
     def normal_equations(self, x: np.ndarray) -> tuple[sps.csr_matrix, np.ndarray, np.ndarray, float]:
         """(J^T J, J^T z, its diagonal 10 x 10 blocks (texels, 10, 10), cost) of the IRLS model of the soft-L1."""
@@ -133,19 +88,6 @@ def block_cg(a: sps.csr_matrix, rhs: np.ndarray, blocks: np.ndarray) -> np.ndarr
     pre = spla.LinearOperator(a.shape, matvec=lambda v: np.einsum("nab,nb->na", inv, v.reshape(n, PARAMS)).ravel())
     x, _ = spla.cg(a, rhs, M=pre, maxiter=CG_ITERATIONS, rtol=CG_RTOL)
     return x
-
-
-def damped_step(model, x: np.ndarray, x0: np.ndarray, reg: float, cost: float, lam: float, step_for):
-    """Levenberg-Marquardt's inner loop: x + step_for(lam) tried at up to 6 dampings (lam x 4 each) until the model's
-    cost + reg |x - x0|^2 falls below ``cost``; (x, lam, the last cost tried)."""
-    c_new = np.inf
-    for _ in range(6):
-        cand = x + step_for(lam).reshape(x.shape)
-        c_new = model.cost(cand) + reg * np.sum((cand - x0) ** 2)
-        if np.isfinite(c_new) and c_new < cost:
-            return cand, lam / 3.0, c_new
-        lam *= 4.0
-    return x, lam, c_new
 
 
 def fit(x0: np.ndarray, ts: dict, iterations: int, mu: float, log=print) -> np.ndarray:
@@ -200,7 +142,7 @@ def main():
     start, _ = aniso_shaded.refine_table(GRID, mag, l3, 32)
     t_start = time.perf_counter() - t0
     t0 = time.perf_counter()
-    ts, held = training_set(a.configs, a.lights, 1000), training_set(a.held_out, a.lights, 2000)
+    ts, held = training_set(GRID, a.configs, a.lights, 1000), training_set(GRID, a.held_out, a.lights, 2000)
     t_sets = time.perf_counter() - t0
     x0 = np.concatenate([start.reshape(-1, 9), mag.reshape(-1, 1)], axis=1)
     t0 = time.perf_counter()
