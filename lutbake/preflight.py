@@ -217,6 +217,9 @@ def check_path_lengths(jobs, cache_dir=None, report=None) -> None:
             raise ConfigError(option, option.lstrip("-"), shorten(str(value)), message=problem)
 
 
+ORDINALS = ("second", "third", "fourth", "fifth", "sixth")  # a file set's later members (lutbake.io.file_sets)
+
+
 def planned_files(job) -> list[tuple[Path, str]]:
     """Every file the bake of ``job`` writes, with what it is: the data file, the other files of a file set (ltc_dds's
     ``<name>_2.dds``, an ltc_aniso table's ``<name>_t1.ktx2``: lutbake.io.file_sets), the files its kind writes beside
@@ -229,8 +232,8 @@ def planned_files(job) -> list[tuple[Path, str]]:
 
     fmt = job.spec.options.get("format", "exr")
     files = [(job.path, "output")]
-    others = (set_files(job.name, job.spec.kind, fmt) or [])[1:]
-    files += [(job.path.with_name(name), f"{nth} texture") for nth, name in zip(("second", "third"), others)]
+    others = (set_files(job.name, job.spec.kind, fmt, job.spec.options) or [])[1:]
+    files += [(job.path.with_name(name), f"{ORDINALS[k]} texture") for k, name in enumerate(others)]
     files += [(job.path.with_name(job.name + suffix), what) for suffix, what in kind_of(job.spec).outputs]
     # an EXR writes none, but <name>.exr.json is where readers look for one: it is claimed too
     files += [(sidecar_path(p), f"sidecar of {p.name}") for p, _ in list(files)]

@@ -183,7 +183,7 @@ def preset_text(path: Path) -> str:
     files = [
         f
         for t in tables
-        for f in written_files(t["name"], t.get("format", "exr"), kind_outputs(t.get("kind")), t.get("kind"))
+        for f in written_files(t["name"], t.get("format", "exr"), kind_outputs(t.get("kind")), t.get("kind"), t)
     ]
     return " ".join(filter(None, lines)) + f" Writes: {', '.join(files)}."
 

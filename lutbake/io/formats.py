@@ -96,11 +96,11 @@ KIND_WRITERS = {  # (kind, format) -> its writer where a kind writes a format it
 }
 
 
-def data_files(name: str, fmt: str, kind: str | None = None) -> list[str]:
+def data_files(name: str, fmt: str, kind: str | None = None, options: dict | None = None) -> list[str]:
     """The data files a table ``name`` of ``kind`` writes in ``fmt``: ``<name><ext>``, or a file set's members
-    (lutbake.io.file_sets: ltc_dds's pair, an ltc_aniso table's three textures), the first the one its sidecar
-    describes."""
-    return set_files(name, kind, fmt) or [f"{name}{EXTENSIONS[fmt]}"]
+    (lutbake.io.file_sets: ltc_dds's pair, an ltc_aniso table's three textures per lobe of its ``options``), the
+    first the one its sidecar describes."""
+    return set_files(name, kind, fmt, options) or [f"{name}{EXTENSIONS[fmt]}"]
 
 
 def output_path(out_dir, name: str, fmt: str, kind: str | None = None) -> Path:
@@ -108,11 +108,13 @@ def output_path(out_dir, name: str, fmt: str, kind: str | None = None) -> Path:
     return Path(out_dir) / data_files(name, fmt, kind)[0]
 
 
-def written_files(name: str, fmt: str, outputs: tuple[str, ...] = (), kind: str | None = None) -> list[str]:
-    """The names of the files a table ``name`` of ``kind`` writes in ``fmt``: its data file(s), the files its kind
-    writes beside them (``outputs``: suffixes after the name, lutbake.kinds.base.Kind.outputs), then its sidecar
-    (every format but EXR, whose header holds the conventions)."""
-    files = data_files(name, fmt, kind)
+def written_files(
+    name: str, fmt: str, outputs: tuple[str, ...] = (), kind: str | None = None, options: dict | None = None
+) -> list[str]:
+    """The names of the files a table ``name`` of ``kind`` (its ``options``) writes in ``fmt``: its data file(s), the
+    files its kind writes beside them (``outputs``: suffixes after the name, lutbake.kinds.base.Kind.outputs), then
+    its sidecar (every format but EXR, whose header holds the conventions)."""
+    files = data_files(name, fmt, kind, options)
     return files + [name + suffix for suffix in outputs] + ([] if fmt == "exr" else [files[0] + ".json"])
 
 

@@ -1,10 +1,11 @@
-"""An ``ltc_aniso`` table (lutbake.kinds.ltc_aniso) as the three 3D textures its shader samples, one file each:
-``format = "ktx2"`` -> <name>_t0.ktx2, <name>_t1.ktx2, <name>_t2.ktx2; ``format = "dds"`` -> <name>_t0.dds, ...
-(lutbake.io.file_sets), written as one unit: the other two files, then <name>_t0.*, then the sidecar
-<name>_t0.<ext>.json naming the sha256 of all three (lutbake.io.integrity), so a missing or edited texture makes the
-output not up to date.
+"""An ``ltc_aniso`` table (lutbake.kinds.ltc_aniso) as the 3D textures its shader samples, three per lobe, one file
+each: ``format = "ktx2"`` -> <name>_t0.ktx2, <name>_t1.ktx2, <name>_t2.ktx2 (``lobes = 2``: to <name>_t5.ktx2);
+``format = "dds"`` -> <name>_t0.dds, ... (lutbake.io.file_sets), written as one unit: the other files, then
+<name>_t0.*, then the sidecar <name>_t0.<ext>.json naming the sha256 of all of them (lutbake.io.integrity), so a
+missing or edited texture makes the output not up to date.
 
-Texture k (t0 = (M00, M01, M02, M10), t1 = (M11, M12, M20, M21), t2 = (M22, magnitude, fresnel, fit_error)) is
+Texture k (t0 = (M00, M01, M02, M10), t1 = (M11, M12, M20, M21), t2 = (M22, magnitude, fresnel, fit_error); two
+lobes: (t0, t1, t2) lobe 1's and (t3, t4, t5) lobe 2's, t2 and t5 = (M22, weight, weight_fresnel, sum_error)) is
 width N (phi_v), height N (theta_v), depth N^2 (layer = b + N a), RGBA, one level:
 - **KTX 2.0** (lutbake.io.ktx2.encode): pixelDepth N^2, layerCount 0, faceCount 1, levelCount 1,
   VK_FORMAT_R16G16B16A16_SFLOAT (dtype half) / R32G32B32A32_SFLOAT (float32), the basic DFD (RGBSDA, BT.709, linear),
@@ -30,7 +31,7 @@ from ..table import Table, metadata
 from ..table import pixels as checked_pixels
 from . import bounded, dds, ktx2
 from .conventions import write_set_with_sidecar
-from .file_sets import file_set, members
+from .file_sets import MAX_LOBES, TEXTURES_PER_LOBE, file_set, members
 from .sidecar import ReadError, load_sidecar
 
 KIND = "ltc_aniso"
@@ -39,18 +40,28 @@ TEXTURES = {  # the shader's sampler -> its RGBA (docs/shaders/ltc_aniso.glsl; l
     "t1": ("M11", "M12", "M20", "M21"),
     "t2": ("M22", "magnitude", "fresnel", "fit_error"),
 }
+LOBE_TEXTURES = (TEXTURES["t0"], TEXTURES["t1"], ("M22", "weight", "weight_fresnel", "sum_error"))  # two lobes' sets
 CONTAINERS = {"ktx2": "KTX 2.0", "dds": "DDS"}
 SIDECAR_FORMATS = {file_set(KIND, fmt)[1]: fmt for fmt in CONTAINERS}  # ltc_aniso_ktx2 -> ktx2, ...
+SET_SIZES = tuple(TEXTURES_PER_LOBE * k for k in range(1, MAX_LOBES + 1))  # files of a set: three per lobe
+
+
+def texture_names(count: int) -> dict[str, tuple[str, ...]]:
+    """Each texture's RGBA names of a table of ``count`` textures: 3 (one lobe) TEXTURES, 6 (two lobes) LOBE_TEXTURES
+    twice (t0..t2 lobe 1, t3..t5 lobe 2)."""
+    if count == len(TEXTURES):
+        return TEXTURES
+    return {f"t{k}": LOBE_TEXTURES[k % len(LOBE_TEXTURES)] for k in range(count)}
 
 
 def textures(table: Table, dtype: str) -> np.ndarray:
-    """The three textures of ``table``, (3, N^2, N, N, 4) (texture, layer, theta, phi, RGBA) of ``dtype``, every
+    """The textures of ``table``, (3 lobes, N^2, N, N, 4) (texture, layer, theta, phi, RGBA) of ``dtype``, every
     value checked (lutbake.table.pixels: finite, within half's range); ValueError names the table."""
     if table.kind != KIND:
         raise ValueError(f"table {table.name!r}: 3D texture files hold kind {KIND!r} tables, not {table.kind!r}")
     data = checked_pixels(table, dtype)
     layers = next(a.count for a in table.axes if a.dim == "y_block")
-    return data.reshape(3, layers, data.shape[1] // layers, data.shape[2], 4)
+    return data.reshape(len(data), layers, data.shape[1] // layers, data.shape[2], 4)
 
 
 def texture_record(attrs: dict[str, str], k: int, files: list[str]) -> dict[str, str]:
@@ -61,7 +72,7 @@ def texture_record(attrs: dict[str, str], k: int, files: list[str]) -> dict[str,
         for d in json.loads(attrs["axes"])
         if d["dim"] != "z"
     ]
-    names = TEXTURES[f"t{k}"]
+    names = texture_names(len(files))[f"t{k}"]
     meanings, table_names = json.loads(attrs["channels"]), json.loads(attrs["channel_names"])
     meanings = {c: meanings[c].removeprefix(f"{table_names[c]}: ") for c in "RGBA"}  # "t0: M00; t1: M11; ..."
     record = dict(attrs)
@@ -70,7 +81,7 @@ def texture_record(attrs: dict[str, str], k: int, files: list[str]) -> dict[str,
     record["channels"] = json.dumps({c: f"{n}: {meanings[c]}" for c, n in zip("RGBA", names)}, ensure_ascii=False)
     record["ltc_aniso_texture"] = (
         f"t{k} = ({', '.join(names)}): the shader's sampler3D t{k} (docs/shaders/ltc_aniso.glsl), width phi_v, height "
-        f"theta_v, depth layer; the table's three textures: {', '.join(files)}"
+        f"theta_v, depth layer; the table's {len(files)} textures: {', '.join(files)}"
     )
     return record
 
@@ -81,8 +92,8 @@ def _write(table: Table, path, dtype: str, container: str) -> Path:
     path = Path(path)
     suffixes, sidecar_format = file_set(KIND, container)
     stem = path.name[: -len(suffixes[0])]
-    names = [stem + s for s in suffixes]
     data = textures(table, dtype)
+    names = [stem + s for s in suffixes[: len(data)]]
     attrs = metadata(table)
     if container == "ktx2":
         blobs = [
@@ -92,18 +103,21 @@ def _write(table: Table, path, dtype: str, container: str) -> Path:
     else:
         blobs = [dds.encode(t) for t in data]
         extra = {"dxgi_format": dds.DXGI_NAMES[dds.DXGI[(dtype, 4)]], "dimension": "TEXTURE3D"}
-    extra["textures"] = {name: f"t{k} = ({', '.join(TEXTURES[f't{k}'])})" for k, name in enumerate(names)}
+    channels = texture_names(len(names))
+    extra["textures"] = {name: f"t{k} = ({', '.join(channels[f't{k}'])})" for k, name in enumerate(names)}
     extra["texture_size"] = {"width": data.shape[3], "height": data.shape[2], "depth": data.shape[1]}
     return write_set_with_sidecar(table, path, dict(zip(names, blobs)), sidecar_format, extra)
 
 
 def write_ktx2_textures(table: Table, path, dtype: str = "float32") -> Path:
-    """<name>_t0.ktx2, _t1.ktx2, _t2.ktx2 and the sidecar (module docstring); ``path`` the first."""
+    """<name>_t0.ktx2, _t1.ktx2, _t2.ktx2 (two lobes: to _t5.ktx2) and the sidecar (module docstring); ``path`` the
+    first."""
     return _write(table, path, dtype, "ktx2")
 
 
 def write_dds_textures(table: Table, path, dtype: str = "float32") -> Path:
-    """<name>_t0.dds, _t1.dds, _t2.dds and the sidecar (module docstring); ``path`` the first."""
+    """<name>_t0.dds, _t1.dds, _t2.dds (two lobes: to _t5.dds) and the sidecar (module docstring); ``path`` the
+    first."""
     return _write(table, path, dtype, "dds")
 
 
@@ -112,8 +126,8 @@ def write_dds_textures(table: Table, path, dtype: str = "float32") -> Path:
 
 @dataclass
 class TextureSet:
-    """The three textures read back: ``data`` (3, N^2, N, N, 4) as stored (float16 / float32), ``record`` the
-    table's (the sidecar's ``lutbake`` object), ``files`` the three paths, ``container`` ktx2 or dds."""
+    """The textures read back: ``data`` (3 lobes, N^2, N, N, 4) as stored (float16 / float32), ``record`` the
+    table's (the sidecar's ``lutbake`` object), ``files`` their paths, ``container`` ktx2 or dds."""
 
     data: np.ndarray
     record: dict[str, str]
@@ -122,17 +136,22 @@ class TextureSet:
 
 
 def _set_of(path: Path) -> tuple[list[Path], dict]:
-    """(the three files, the sidecar document) of the texture set ``path`` (any of its files) belongs to."""
+    """(the files, the sidecar document) of the texture set ``path`` (any of its files) belongs to: as many as the
+    sidecar lists (three per lobe)."""
     files = members(path)
-    if len(files) != 3 or not any(files[0].name.endswith(file_set(KIND, c)[0][0]) for c in CONTAINERS):
-        raise ReadError(f"{path}: not one of an ltc_aniso table's textures (<name>_t0, _t1, _t2 .ktx2 or .dds)")
+    if not files or not any(files[0].name.endswith(file_set(KIND, c)[0][0]) for c in CONTAINERS):
+        raise ReadError(f"{path}: not one of an ltc_aniso table's textures (<name>_t0, _t1, ... .ktx2 or .dds)")
     side = files[0].with_name(files[0].name + ".json")
     if not side.is_file():
-        raise ReadError(f"{path}: its set's sidecar {side.name} is missing (it lists the three textures)")
+        raise ReadError(f"{path}: its set's sidecar {side.name} is missing (it lists the textures)")
     doc = load_sidecar(side)
-    if doc.get("format") not in SIDECAR_FORMATS or doc.get("files") != [f.name for f in files]:
-        raise ReadError(f"{side}: not the sidecar of an ltc_aniso texture set {[f.name for f in files]}")
-    return files, doc
+    listed = doc.get("files")
+    count = len(listed) if isinstance(listed, list) else 0
+    if doc.get("format") not in SIDECAR_FORMATS or count not in SET_SIZES or listed != [f.name for f in files[:count]]:
+        raise ReadError(f"{side}: not the sidecar of an ltc_aniso texture set {[f.name for f in files[:3]]} ...")
+    if path.name not in listed:
+        raise ReadError(f"{path}: not one of the textures its set's sidecar {side.name} lists ({', '.join(listed)})")
+    return files[:count], doc
 
 
 def texture_shape(record: dict[str, str]) -> tuple[int, int, int, int]:
@@ -160,7 +179,7 @@ def decode_texture(path: Path, container: str, shape: tuple[int, ...]) -> tuple[
 
 
 def read_textures(path) -> TextureSet:
-    """The three textures of the set ``path`` belongs to (any of <name>_t0/_t1/_t2 .ktx2 / .dds), each checked against
+    """The textures of the set ``path`` belongs to (any of <name>_t0, _t1, ... .ktx2 / .dds), each checked against
     the sidecar's axes (3D, N^2 x N x N x RGBA) and, for KTX2, its own record (the same bake: ``content_hash``);
     ReadError names the file that is wrong."""
     files, doc = _set_of(Path(path))
@@ -186,6 +205,6 @@ def member_view(path: Path, doc: dict) -> tuple[np.ndarray, dict[str, str], str]
     container = SIDECAR_FORMATS[doc["format"]]
     arr, _ = decode_texture(path, container, texture_shape(doc["lutbake"]))
     note = (
-        f"texture t{k} of {', '.join(files)} (one 3D texture; all three: lutbake.io.ltc_aniso_textures.read_textures)"
+        f"texture t{k} of {', '.join(files)} (one 3D texture; all of them: lutbake.io.ltc_aniso_textures.read_textures)"
     )
     return arr, texture_record(doc["lutbake"], k, files), note

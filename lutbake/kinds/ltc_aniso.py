@@ -26,11 +26,11 @@ import json
 import numpy as np
 
 from ..axes import Axis
-from ..io.ltc_aniso_textures import TEXTURES
+from ..io.ltc_aniso_textures import texture_names
 from ..limits import LTC_FIT_GRID
 from ..ltc import aniso_grid as aniso
 from ..ltc.aniso_grid import ALPHA_FLOOR
-from ..ltc.metadata import fit_error_stats
+from ..ltc.metadata import L3_METRIC, fit_error_stats
 from ..runtime.plan import TexelPlan
 from .base import Estimation, Key, declare
 
@@ -103,6 +103,31 @@ KEYS = {
             "lights per texel)",
         },
     ),
+    "lobes": Key(
+        "lobes",
+        "int",
+        1,
+        "LTCs per texel: 1, or 2 (a sum w_1 I(M_1) + w_2 I(M_2), six textures, two polygon integrals in the shader; "
+        "fit = 'shaded' only, not format ltc_aniso_npy; lutbake.ltc.aniso_lobes)",
+        minimum=1,
+        maximum=2,
+    ),
+    "between_configs": Key(
+        "between_configs",
+        "int",
+        aniso.BETWEEN_CONFIGS,
+        "lobes = 2: training configurations (uniform in table coordinates) of the fit between the texels",
+        minimum=16,
+        maximum=100000,
+    ),
+    "between_iterations": Key(
+        "between_iterations",
+        "int",
+        aniso.BETWEEN_ITERATIONS,
+        "lobes = 2: Levenberg-Marquardt steps of the fit between the texels (0: each texel fitted at itself only)",
+        minimum=0,
+        maximum=200,
+    ),
     "format": Key("format", "str", "exr", "output file format", FORMATS),
 }
 SHADED = (
@@ -116,6 +141,26 @@ CHANNELS = {
     "z": "t0: M02; t1: M20; t2: fresnel = ∫ f (1 - v.h)^5 (n.l) dω_l",
     "w": "t0: M10; t1: M21; t2: fit_error = (E / ∫ f^3 dω)^(1/3), E = Heitz's L3 metric of the texel's fit",
 }
+LOBES_CHANNELS = {  # lobes = 2: (t0, t1, t2) lobe 1's, (t3, t4, t5) lobe 2's (lutbake.ltc.aniso_lobes)
+    "x": "t0/t3: M00; t1/t4: M11; t2/t5: M22 (lobe 1's / lobe 2's M row-major, tangent frame, as the between fit "
+    "leaves it: not scaled to |M e_z| = 1)",
+    "y": "t0/t3: M01; t1/t4: M12; t2/t5: weight w_k (value = Σ_k w_k I(M_k) with F = 1)",
+    "z": "t0/t3: M02; t1/t4: M20; t2/t5: weight_fresnel = w_k fresnel / magnitude (the lobe's Schlick part)",
+    "w": "t0/t3: M10; t1/t4: M21; t2/t5: sum_error = the sum's relative RMS shaded residual at the texel over its "
+    "137 lights (lutbake.ltc.aniso_lobes.sum_error; the same in t2 and t5)",
+}
+SUM_ERROR_METRIC = (
+    "sqrt(mean_j z_j^2), z_j = (Σ_k w_k I_j(M_k) - G_j) / (G_j + 0.4 magnitude) over the texel's 128 training lights "
+    "and 9 hemisphere lights, G_j from 48^2 lobe samples, at the texel itself (lutbake.ltc.aniso_lobes.sum_error)"
+)
+LOBES_FIT = (
+    "two lobes (lutbake.ltc.aniso_lobes): each fitted texel's sum w_1 I(M_1) + w_2 I(M_2) by Levenberg-Marquardt "
+    "(40 steps) to the shaded cost over 128 training lights + 9 hemisphere lights, targets from 128^2 lobe samples, "
+    "from the shaded M (lobe 2 broadened twice, weights 0.8 / 0.2 albedo), the other texels by the symmetries; then "
+    "every texel's 2 x (M, w) fitted between the texels: the interpolated sum's shaded cost at {configs} "
+    "configurations uniform in table coordinates x (32 lights + 9 hemisphere lights), + 0.001 mean(diag J^T J) "
+    "|x - x0|^2 towards the per-texel table, {iterations} Levenberg-Marquardt steps"
+)
 RECONSTRUCTION = (
     "docs/shaders/ltc_aniso.glsl lutbake_ltc_aniso_specular(t0, t1, t2, N, T, V, alpha_x, alpha_y, f0, p, Li, "
     "two_sided): slice k = a sampler3D of width N (phi_v / (pi/2)), height N (theta_v / (0.9999 pi/2)), depth N^2 "
@@ -126,6 +171,14 @@ RECONSTRUCTION = (
 )
 
 
+LOBES_RECONSTRUCTION = (
+    "docs/shaders/ltc_aniso.glsl lutbake_ltc_aniso_specular_two_lobes(t0, t1, t2, t3, t4, t5, N, T, V, alpha_x, "
+    "alpha_y, f0, p, Li, two_sided) = lutbake_ltc_aniso_specular on (t0, t1, t2) + on (t3, t4, t5): each set as the "
+    "one-lobe table's (its M, t2.y = w_k, t2.z = w_k fresnel / magnitude: specular = Σ_k Li I_k (f0 t2.y + "
+    "(1 - f0) t2.z))"
+)
+
+
 def grid_of(o: dict) -> aniso.Grid4:
     n = o["size"]
     return aniso.Grid4(PARAMETRISATIONS[o["parametrisation"]][0], (n, n, n, n), o["alpha_min"])
@@ -133,9 +186,18 @@ def grid_of(o: dict) -> aniso.Grid4:
 
 def axes_for(o: dict) -> list[Axis]:
     """[texture (z), layer (y_block), theta_v (y), phi_v (x)]: the textures' texel order."""
-    n = o["size"]
+    n, count = o["size"], 3 * o["lobes"]
     return [
-        Axis("texture", "z", 3, 0.0, 2.0, texel="endpoint", mapping="listed", listed=(0.0, 1.0, 2.0)),
+        Axis(
+            "texture",
+            "z",
+            count,
+            0.0,
+            float(count - 1),
+            texel="endpoint",
+            mapping="listed",
+            listed=tuple(float(k) for k in range(count)),
+        ),
         Axis("layer", "y_block", n * n, 0.0, float(n * n - 1), texel="endpoint"),
         Axis("theta_v", "y", n, 0.0, aniso.THETA_SCALE * np.pi / 2, texel="endpoint"),
         Axis("phi_v", "x", n, 0.0, np.pi / 2, texel="endpoint"),
@@ -148,7 +210,18 @@ def plan(spec) -> TexelPlan:
     o = spec.options
     g = grid_of(o)
     samples = o["samples"] or aniso.MAGNITUDE_SAMPLES
-    state = AnisoBake(g, o["fit_frame"], o["fit_samples"], samples, o["seed"], o["fit"] == "shaded", o["estimator"])
+    state = AnisoBake(
+        g,
+        o["fit_frame"],
+        o["fit_samples"],
+        samples,
+        o["seed"],
+        o["fit"] == "shaded",
+        o["estimator"],
+        o["lobes"],
+        (o["between_configs"], o["between_iterations"]),
+    )
+    two = o["lobes"] == 2
     a, b, _, _ = g.axes()
     n = o["size"]
     n_fit = len(aniso.fitted_texels(g))
@@ -157,7 +230,7 @@ def plan(spec) -> TexelPlan:
         "ltc_aniso_layer": f"layer = b + {n} a (a, b the parametrisation's first two indices; the y_block axis): "
         f"a = b = i / {n - 1}, a in {[round(float(x), 6) for x in a]}",
         "ltc_aniso_textures": ", ".join(
-            f"slice {k} = {t} ({', '.join(ch)})" for k, (t, ch) in enumerate(TEXTURES.items())
+            f"slice {k} = {t} ({', '.join(ch)})" for k, (t, ch) in enumerate(texture_names(3 * o["lobes"]).items())
         )
         + "; each a 3D texture (width phi, height theta, depth layer)",
         "ltc_aniso_conventions": "M maps the clamped cosine to the lobe (w = M w_o / |M w_o|), tangent frame T = +x, "
@@ -169,19 +242,29 @@ def plan(spec) -> TexelPlan:
         "at alpha_x = alpha_y (the view-frame M, turned by R_z(phi))",
         "ltc_aniso_fit": f"L3 (Heitz et al. 2016) by Nelder-Mead per texel, frame {o['fit_frame']!r}: "
         f"{aniso.FRAMES[o['fit_frame']]}; metric grid {o['fit_samples']}^2 per technique; lutbake.ltc.aniso.fit_tile"
-        + ("" if o["fit"] == "l3" else f"; then shaded: {SHADED}"),
+        + ("" if o["fit"] == "l3" else f"; then shaded: {SHADED}")
+        + (
+            f"; then {LOBES_FIT.format(configs=o['between_configs'], iterations=o['between_iterations'])}"
+            if two
+            else ""
+        ),
         "ltc_aniso_magnitude": f"{o['estimator']}: {ESTIMATORS[o['estimator']]}; {samples} points per anisotropic "
         f"texel, seed {o['seed']} (the spread between two scramblings: lutbake:ltc_aniso_magnitude_spread, an "
         "estimate, not a bound, ~1e-5 at 2^16 with sobol). Not Gauss-Legendre: the specular_aniso kind's rule is "
         "azimuth-averaged only (at a fixed view azimuth the lobe's ridge at alpha_y << alpha_x falls between the "
         "panels' nodes)",
-        "ltc_aniso_shader": RECONSTRUCTION,
+        "ltc_aniso_shader": LOBES_RECONSTRUCTION if two else RECONSTRUCTION,
     }
+    if two:
+        extra["ltc_aniso_lobes"] = (
+            "2: value = w_1 I(M_1) + w_2 I(M_2); textures t0, t1, t2 lobe 1's and t3, t4, t5 lobe 2's, each set laid "
+            "out as a one-lobe table's with t2/t5 = (M22, w_k, w_k fresnel / magnitude, sum_error)"
+        )
     return TexelPlan(
         axes=axes_for(o),
-        channels=CHANNELS,
-        reconstruction=RECONSTRUCTION,
-        n_texels=3 * n**4,
+        channels=LOBES_CHANNELS if two else CHANNELS,
+        reconstruction=LOBES_RECONSTRUCTION if two else RECONSTRUCTION,
+        n_texels=texel_count(o),
         n_channels=4,
         run_tile=state.run_tile,
         prepare=state.prepare,
@@ -193,24 +276,35 @@ def plan(spec) -> TexelPlan:
             "layout": "lutbake 3D textures (docs/shaders/ltc_aniso.glsl); the paper's: format ltc_aniso_npy",
             "parametrisation": o["parametrisation"],
         },
-        cost=float(n_fit) * 300 * 2 * o["fit_samples"] ** 2 + float(n**4) * samples,
+        cost=float(n_fit) * 300 * 2 * o["fit_samples"] ** 2
+        + float(n**4) * samples
+        + two * (float(n_fit) * 40 * 137 * 20 + o["between_configs"] * o["between_iterations"] * 41 * 30),
         extra=extra,
         attributes_after=lambda data: {
-            **fit_error_stats(data, (2, 3)),
+            **fit_error_stats(data, (2, 3), SUM_ERROR_METRIC if two else L3_METRIC),
             "ltc_aniso_magnitude_spread": json.dumps(state.spread),
         },
     )
 
 
 def check_spec(spec):
+    o = spec.options
+    if o["lobes"] == 2 and o["fit"] != "shaded":
+        return ("fit", "lobes = 2 starts from the shaded one-lobe fit: fit 'shaded' (allowed with lobes = 2: shaded)")
+    if o["lobes"] == 2 and o["format"] == "ltc_aniso_npy":
+        return (
+            "format",
+            "ltc_aniso_npy is the paper's layout of one M per texel, no room for lobes = 2: format exr, npy, ktx2 or "
+            "dds (lobes = 2 writes six textures)",
+        )
     if spec.options["format"] == "ltc_aniso_npy" and spec.options["dtype"] != "float32":
         return ("dtype", "ltc_aniso_npy is the paper's float32 array: dtype 'float32'")
     return None
 
 
 def texel_count(o: dict) -> int:
-    """3 x size^4 (three textures)"""
-    return 3 * o["size"] ** 4
+    """3 x lobes x size^4 (three textures per lobe)"""
+    return 3 * o.get("lobes", 1) * o["size"] ** 4
 
 
 ESTIMATION = Estimation(

@@ -5,7 +5,8 @@ The whole 4D table is one computation (the symmetries fill the texels not fitted
 the magnitudes (lutbake.ltc.aniso.magnitude_fresnel) and the fit (lutbake.ltc.aniso.fit_table, in tiles of
 aniso.TILE texels on a thread pool: the bits do not depend on the thread count) run once, under a lock, the first
 time a tile is asked for; every tile then reads its rows of lutbake.ltc.aniso.texture_layout, the three RGBA 3D
-textures flattened (texture, layer, theta, phi) row-major, which is the table's texel order.
+textures (two lobes: six, lutbake.ltc.aniso_lobes.two_lobe_textures) flattened (texture, layer, theta, phi)
+row-major, which is the table's texel order.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import threading
 import numpy as np
 
 from . import aniso
+from .aniso_grid import BETWEEN_CONFIGS, BETWEEN_ITERATIONS
 
 PROBE = 64  # anisotropic texels (strided) whose magnitude a second scrambling re-estimates
 
@@ -28,8 +30,10 @@ def available_threads() -> int:
 class AnisoBake:
     """The state one ltc_aniso bake shares between its tiles: ``grid`` (aniso.Grid4), the fit's frame and metric grid,
     the magnitude's Sobol' budget and seed, ``shaded``: the L3 fit refined to polygon lights
-    (lutbake.ltc.aniso_shaded). ``texels()``: the (3 n_a n_b n_theta n_phi, 4) float64 texels, computed
-    once; ``matrices`` (the paper's layout, (n_a, n_b, n_theta, n_phi, 3, 3)) after it."""
+    (lutbake.ltc.aniso_shaded); ``lobes`` 2: then two lobes per texel, fitted per texel and ``between`` = (training
+    configurations, steps) between the texels (lutbake.ltc.aniso_lobes). ``texels()``: the (3 lobes n_a n_b n_theta
+    n_phi, 4) float64 texels, computed once; ``matrices`` (the one-lobe M in the paper's layout, (n_a, n_b, n_theta,
+    n_phi, 3, 3)) after it."""
 
     def __init__(
         self,
@@ -40,9 +44,11 @@ class AnisoBake:
         seed: int,
         shaded=False,
         estimator: str = "sobol",
+        lobes: int = 1,
+        between: tuple[int, int] = (BETWEEN_CONFIGS, BETWEEN_ITERATIONS),
     ):
         self.grid, self.frame, self.fit_samples, self.shaded = grid, frame, fit_samples, shaded
-        self.estimator = estimator
+        self.estimator, self.lobes, self.between = estimator, lobes, between
         self.samples, self.seed = samples, seed
         self._lock = threading.Lock()
         self._flat = None
@@ -81,7 +87,14 @@ class AnisoBake:
                     from .aniso_shaded import refine_table
 
                     m, err = refine_table(g, mag, m, self.fit_samples, device, available_threads())
-                tex = aniso.texture_layout(m, mag, fres, err).astype(np.float64)
+                if self.lobes == 2:
+                    from . import aniso_lobes
+
+                    per_texel = aniso_lobes.per_texel_table(g, mag, m, 2, available_threads())
+                    lm, lw = aniso_lobes.between_table(g, mag, per_texel, *self.between)
+                    tex = aniso_lobes.two_lobe_textures(g, mag, fres, lm, lw).astype(np.float64)
+                else:
+                    tex = aniso.texture_layout(m, mag, fres, err).astype(np.float64)
                 if not np.all(np.isfinite(tex)):
                     raise ValueError("ltc_aniso: a texel of the fit is not finite")
                 self.matrices = m

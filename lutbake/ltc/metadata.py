@@ -80,9 +80,15 @@ def tabulation_record(lb) -> dict:
     }
 
 
-def fit_error_stats(data: np.ndarray, where: tuple[int, int] = (1, 2)) -> dict[str, str]:
-    """The lutbake:fit_error_* attributes: statistics of the relative L3 error per texel, channel ``where[1]`` of
-    slice ``where[0]`` (the ltc kind: slice 1's z; ltc_aniso: slice 2's w)."""
+L3_METRIC = (
+    "(E / ∫ f^3 dω)^(1/3), E = ∫ |f (n.l) - magnitude D_ltc|^3 dω by MIS over the lobe's and the LTC's N x N "
+    "stratified samples (Heitz et al. 2016, ltc_code computeError)"
+)
+
+
+def fit_error_stats(data: np.ndarray, where: tuple[int, int] = (1, 2), metric: str = L3_METRIC) -> dict[str, str]:
+    """The lutbake:fit_error_* attributes: statistics of the error per texel (``metric``: the relative L3 error),
+    channel ``where[1]`` of slice ``where[0]`` (the ltc kind: slice 1's z; ltc_aniso: slice 2's w)."""
     e = np.asarray(data)[where[0], ..., where[1]].ravel()
     return {
         "fit_error_max": f"{e.max():.4g}",
@@ -90,9 +96,7 @@ def fit_error_stats(data: np.ndarray, where: tuple[int, int] = (1, 2)) -> dict[s
         "fit_error_p95": f"{np.quantile(e, 0.95):.4g}",
         "fit_error": json.dumps(
             {
-                "metric": "(E / ∫ f^3 dω)^(1/3), E = ∫ |f (n.l) - magnitude D_ltc|^3 dω by MIS "
-                "over the lobe's and the LTC's N x N stratified samples (Heitz et al. 2016, "
-                "ltc_code computeError)",
+                "metric": metric,
                 "max": float(e.max()),
                 "median": float(np.median(e)),
                 "p95": float(np.quantile(e, 0.95)),
