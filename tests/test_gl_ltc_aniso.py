@@ -74,9 +74,16 @@ def host_specular(tex: np.ndarray, points: list[tuple]) -> np.ndarray:
     return np.array(want)
 
 
+SPECULAR = {  # textures -> the shader's function (docs/shaders/ltc_aniso.glsl)
+    3: "lutbake_ltc_aniso_specular(t0, t1, t2, ",
+    6: "lutbake_ltc_aniso_specular_two_lobes(t0, t1, t2, t3, t4, t5, ",
+}
+
+
 def gl_specular(ctx, blobs: list[bytes], size: tuple[int, int, int], dtype: str, points: list[tuple]):  # noqa: F811
-    """docs/shaders/ltc_aniso.glsl at ``points``, its t0, t1, t2 uploaded from ``blobs`` (each a 3D texture's texels
-    in glTexImage3D order, ``size`` = (width, height, depth), moderngl ``dtype`` f2 or f4)."""
+    """docs/shaders/ltc_aniso.glsl at ``points``, its t0, t1, t2 (six blobs: to t5, the two-lobe function) uploaded
+    from ``blobs`` (each a 3D texture's texels in glTexImage3D order, ``size`` = (width, height, depth), moderngl
+    ``dtype`` f2 or f4)."""
     import moderngl
 
     n = len(points)
@@ -96,19 +103,23 @@ def gl_specular(ctx, blobs: list[bytes], size: tuple[int, int, int], dtype: str,
         + (SHADERS / "lutbake_ltc.glsl").read_text()
         + (SHADERS / "ltc_aniso.glsl").read_text()
         + """
-            uniform sampler3D t0; uniform sampler3D t1; uniform sampler3D t2;
+            """
+        + "".join(f"uniform sampler3D t{k}; " for k in range(len(blobs)))
+        + """
             flat in vec3 v; flat in vec3 p0; flat in vec3 p1; flat in vec3 p2; flat in vec3 p3; flat in vec3 a;
             out vec4 color;
             void main() {
                 vec3 p[4] = vec3[4](p0, p1, p2, p3);
-                vec3 s = lutbake_ltc_aniso_specular(t0, t1, t2, vec3(0, 0, 1), vec3(1, 0, 0), v, a.x, a.y, vec3(a.z),
+                vec3 s = """
+        + SPECULAR[len(blobs)]
+        + """vec3(0, 0, 1), vec3(1, 0, 0), v, a.x, a.y, vec3(a.z),
                                                     p, vec3(1.0), true);
                 color = vec4(s, 1.0);
             }""",
     )
     target = ctx.texture((n, 1), 4, dtype="f4")
     fbo = ctx.framebuffer(color_attachments=[target])
-    for k in range(3):
+    for k in range(len(blobs)):
         prog[f"t{k}"].value = k
         textures[k].use(k)
     rows = [np.concatenate([v, q.ravel(), [ax, ay, f0], [i]]) for i, (v, q, ax, ay, f0, _, _) in enumerate(points)]
@@ -183,3 +194,19 @@ def test_half_textures_shade_within_1e_3_of_float32(published):
     rel = np.abs(half - full)[lit] / full[lit]
     print(f"half vs float32: max {rel.max():.2e}, median {np.median(rel):.2e} relative over {lit.sum()} lit points")
     assert lit.sum() > N_POINTS // 3 and rel.max() < HALF_MAX_RTOL and np.median(rel) < HALF_MEDIAN_RTOL
+
+
+def test_gl_two_lobes_are_the_sum_of_the_two_one_lobe_sets(ctx, published):  # noqa: F811
+    """lobes = 2 (lutbake.ltc.aniso_lobes.two_lobe_textures' layout, six textures): the shader's two-lobe function
+    equals the host reconstruction of (t0, t1, t2) plus that of (t3, t4, t5). Lobe 2: the published M broadened
+    twice in x and y (not normalised: the layout does not need |M e_z| = 1), other weights."""
+    g = aniso.Grid4("alphax_alphay", (N,) * 4)
+    m = np.load(DATA / "ltc_aniso_alphax_alphay_theta_phi.npy").astype(np.float64)
+    a, b, th, _ = np.meshgrid(*g.axes(), indexing="ij")
+    second = aniso.texture_layout(m @ np.diag([2.0, 2.0, 1.0]), 0.2 + 0.1 * a, 0.02 + 0.03 * b * th, np.zeros(g.n))
+    six = np.concatenate([published, second])
+    points = shading_points()
+    want = host_specular(published, points) + host_specular(second, points)
+    got = gl_specular(ctx, [np.ascontiguousarray(t).tobytes() for t in six], (N, N, N * N), "f4", points)
+    assert np.abs(host_specular(second, points)).max() > 10 * GL_ATOL  # lobe 2 is seen
+    np.testing.assert_allclose(got, want, rtol=GL_RTOL, atol=GL_ATOL)

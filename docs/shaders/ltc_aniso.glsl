@@ -59,3 +59,14 @@ vec3 lutbake_ltc_aniso_specular(sampler3D t0, sampler3D t1, sampler3D t2, vec3 N
                                                    : lutbake_ltc_polygon(Minv, p, true) - lutbake_ltc_polygon(Minv, p, false);
     return Li * I * (f0 * c2.y + (1.0 - f0) * c2.z);
 }
+
+// Two lobes (kind ltc_aniso, lobes = 2: files <name>_t0 .. _t5): value = w_1 I(M_1) + w_2 I(M_2), (t0, t1, t2) lobe
+// 1's and (t3, t4, t5) lobe 2's, each set laid out as a one-lobe table with t2.y = w_k and t2.z = w_k fresnel /
+// magnitude (lutbake.ltc.aniso_lobes), so the specular is the one-lobe function on each set, added. Two fetches per
+// texture and two polygon integrals per light.
+vec3 lutbake_ltc_aniso_specular_two_lobes(sampler3D t0, sampler3D t1, sampler3D t2, sampler3D t3, sampler3D t4,
+                                          sampler3D t5, vec3 N, vec3 T, vec3 V, float alpha_x, float alpha_y,
+                                          vec3 f0, vec3 p[4], vec3 Li, bool two_sided) {
+    return lutbake_ltc_aniso_specular(t0, t1, t2, N, T, V, alpha_x, alpha_y, f0, p, Li, two_sided) +
+           lutbake_ltc_aniso_specular(t3, t4, t5, N, T, V, alpha_x, alpha_y, f0, p, Li, two_sided);
+}

@@ -186,7 +186,7 @@ def grid_of(o: dict) -> aniso.Grid4:
 
 def axes_for(o: dict) -> list[Axis]:
     """[texture (z), layer (y_block), theta_v (y), phi_v (x)]: the textures' texel order."""
-    n, count = o["size"], 3 * o["lobes"]
+    n, count = o["size"], 3 * o.get("lobes", 1)
     return [
         Axis(
             "texture",
