@@ -1,8 +1,9 @@
-"""Anisotropic GGX LTC investigation (docs/ltc_aniso.md, "More than one lobe"; the fit: lutbake.ltc.aniso_lobes, as
-the kind's ``lobes = 2``): bench_ltc_aniso --breakdown finds the error of the 8^4 tables to be one LTC's own (an LTC fitted
-at each configuration is no better than the table). Does a sum of K LTCs, value(P) = Σ_k w_k I_P(M_k) (Heitz et al.
-2016, Eq. 11 per lobe; w_k free, M_k general; the shader's cost K polygon integrals), reach the goal (at most half the published table's median relative error and a third of
-its p90 |error| / albedo), and does it survive the table's interpolation?
+"""Anisotropic GGX LTC investigation (docs/ltc_aniso.md, "More than one lobe"; the fit: lutbake.ltc.aniso_lobes, as the
+kind's ``lobes = 2``): bench_ltc_aniso --breakdown finds the error of the 8^4 tables to be one LTC's own (an LTC
+fitted at each configuration is no better than the table). Does a sum of K LTCs, value(P) = Σ_k w_k I_P(M_k) (Heitz
+et al. 2016, Eq. 11 per lobe; w_k free, M_k general; the shader's cost K polygon integrals), reach the goal (at most
+half the published table's median relative error and a third of its p90 |error| / albedo), and does it survive the
+table's interpolation?
 
 Fit (``fit_lobes``): lutbake.ltc.aniso_shaded.levenberg_marquardt on lutbake.ltc.shaded's cost (soft-L1 of
 (value_j - G_j) / (G_j + 0.4 A)) over lutbake.ltc.shaded.texel_lights' 128 training lights plus HEMISPHERE's 9 (the

@@ -3,7 +3,7 @@
 // docs/shaders/lutbake_ltc.glsl (lutbake_ltc_polygon, lutbake_ltc_edge) included first. GLSL 3.30.
 //
 // Files: kind ltc_aniso, format ktx2 or dds: <name>_t0, _t1, _t2 (.ktx2 / .dds), one 3D texture each (preset
-// ltc-aniso: RGBA16F KTX 2.0). Tables (lutbake.ltc.aniso.texture_layout; benchmarks/bench_ltc_aniso.py writes
+// ltc-aniso: RGBA16F KTX 2.0); lobes = 2: <name>_t0 .. _t5, lutbake_ltc_aniso_specular_two_lobes (at the end). Tables (lutbake.ltc.aniso.texture_layout; benchmarks/bench_ltc_aniso.py writes
 // ltc_aniso_textures.npy): three RGBA
 // 3D textures, linear filtering, clamp to edge, of width N_PHI (x = view azimuth phi from the tangent, [0, pi/2]),
 // height N_THETA (y = theta_v / (0.9999 pi / 2)) and depth N_A * N_B (z = layer b + N_B a: the 4th axis packed, as
