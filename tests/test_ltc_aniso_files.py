@@ -255,13 +255,14 @@ def test_inspect_shows_each_textures_own_record(baked, file, texture):
     assert all(f"{c} = {n}:" in out for c, n in zip("RGBA", names))
 
 
-def test_a_config_plans_every_texture_and_refuses_a_table_writing_one_of_them(tmp_path):
-    """The other textures are the output's files (lutbake.preflight.planned_files): a table whose file is one of
-    them is refused before any kernel runs."""
+@pytest.mark.parametrize("lobes, texture, nth", [(1, "t2", "third"), (2, "t5", "sixth")])
+def test_a_config_plans_every_texture_and_refuses_a_table_writing_one_of_them(tmp_path, lobes, texture, nth):
+    """The other textures are the output's files (lutbake.preflight.planned_files; three per lobe): a table whose
+    file is one of them is refused before any kernel runs."""
     cfg = tmp_path / "c.toml"
     cfg.write_text(
-        '[[table]]\nname = "a"\nkind = "ltc_aniso"\nsize = 2\nformat = "ktx2"\n\n'
-        '[[table]]\nname = "a_t2"\nkind = "dfg"\nsize = [4, 4]\nformat = "ktx2"\n'
+        f'[[table]]\nname = "a"\nkind = "ltc_aniso"\nsize = 2\nfit = "shaded"\nlobes = {lobes}\nformat = "ktx2"\n\n'
+        f'[[table]]\nname = "a_{texture}"\nkind = "dfg"\nsize = [4, 4]\nformat = "ktx2"\n'
     )
-    with pytest.raises(ConfigError, match="third texture of table 'a'"):
+    with pytest.raises(ConfigError, match=f"{nth} texture of table 'a'"):
         bake(cfg, tmp_path / "out")

@@ -136,13 +136,3 @@ def test_six_texture_files_round_trip_and_inspect(baked):
     r = CliRunner().invoke(main, ["inspect", str(out / "twok_t5.ktx2")])
     assert r.exit_code == 0, r.output
     assert "t5 = (M22, weight, weight_fresnel, sum_error)" in r.output
-
-
-def test_a_config_plans_six_textures(tmp_path):
-    cfg = tmp_path / "c.toml"
-    cfg.write_text(
-        '[[table]]\nname = "a"\nkind = "ltc_aniso"\nsize = 2\nfit = "shaded"\nlobes = 2\nformat = "ktx2"\n\n'
-        '[[table]]\nname = "a_t5"\nkind = "dfg"\nsize = [4, 4]\nformat = "ktx2"\n'
-    )
-    with pytest.raises(ConfigError, match="sixth texture of table 'a'"):
-        bake(cfg, tmp_path / "out")
