@@ -4,7 +4,7 @@ the table's axes, channels and conventions), so ``lutbake inspect`` and ``previe
 | sidecar ``format`` | file | values read | table shape (as the EXR) |
 | --- | --- | --- | --- |
 | ``ltc_dds`` | <name>_1.dds + <name>_2.dds | both DDS textures (lutbake.io.dds) | (2, N, N, 4): ltc_1, ltc_2 |
-| ``ltc_aniso_dds`` | <name>_t0.dds, _t1, _t2 | the file's 3D texture (lutbake.io.ltc_aniso_textures) | (N², N, N, 4) |
+| ``ltc_aniso_dds`` | <name>_t0.dds, _t1, ... | the file's 3D texture (lutbake.io.ltc_aniso_textures) | (N², N, N, 4) |
 | ``js`` (kind ltc) | three.js module | ``LTC_MAT_1``, ``LTC_MAT_2`` | (2, N, N, 4) |
 | ``c`` | Blender EEVEE .cc | ``ltc_mat_<lobe>``, ``ltc_mag_<lobe>``, ``ltc_disk_integral`` | (2, N, N, 4) |
 | ``cs`` | Unity HDRP .cs | ``s_LtcMatrixData_BRDF_<LOBE>`` (FP16 bits) | (N, N, 4): HDRP's texel, its own channels |

@@ -17,6 +17,9 @@ Stored as lutbake.ltc.aniso.texture_layout's three RGBA 3D textures of width N (
 three textures as 3D texture files <name>_t0, _t1, _t2 (lutbake.io.ltc_aniso_textures), the same bytes;
 ``format = "ltc_aniso_npy"`` the paper's own layout instead: M as (N, N, N, N, 3, 3) float32 (its LUT/*.npy; no
 magnitude, as the paper's; lutbake.io.ltc.write_ltc_aniso_npy). The shader: docs/shaders/ltc_aniso.glsl.
+``lobes = 2`` (fit shaded only; not ltc_aniso_npy): two LTCs per texel, value = w_1 I(M_1) + w_2 I(M_2), fitted per
+texel and between the texels (lutbake.ltc.aniso_lobes), as six textures: (t0, t1, t2) lobe 1's, (t3, t4, t5) lobe
+2's, each set a one-lobe table's layout with t2 = (M22, w_k, w_k fresnel / magnitude, sum_error).
 """
 
 from __future__ import annotations
@@ -278,6 +281,7 @@ def plan(spec) -> TexelPlan:
         },
         cost=float(n_fit) * 300 * 2 * o["fit_samples"] ** 2
         + float(n**4) * samples
+        # two lobes: 40 steps x 137 lights x 20 unknowns per fitted texel; per between step ~30 integrals per light
         + two * (float(n_fit) * 40 * 137 * 20 + o["between_configs"] * o["between_iterations"] * 41 * 30),
         extra=extra,
         attributes_after=lambda data: {

@@ -19,8 +19,8 @@ than one lobe").
    preconditioner. M_k are left as the fit leaves them (not scaled to |M e_z| = 1 per texel: that would change the
    interpolated M the fit chose; the polygon integral does not see a matrix's scale).
 ``sum_error``: the per-texel relative RMS of the sum's shaded residual at the texel itself. Cost at the paper's 8^4
-(one core): the per-texel fit ~3 min, the between fit ~5 min at 20000 configurations and 20 steps
-(outputs/bench/ltc_aniso_lobes.json's seconds on two threads: 92 s and 323 s).
+(outputs/bench/ltc_aniso_lobes.json's seconds, two threads): the per-texel fit 92 s, the between fit 323 s at 20000
+configurations and 20 steps.
 """
 
 from __future__ import annotations
