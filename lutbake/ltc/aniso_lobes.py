@@ -176,6 +176,13 @@ class BetweenLobes:
     def cost(self, x: np.ndarray) -> float:
         return float(np.sum(shaded.robust(self.residuals(x)[0])))
 
+    def nonnegative_weights(self, x: np.ndarray) -> np.ndarray:
+        """x with every w_k >= 0: a negative lobe would shade a light that holds only it below zero (the interpolated
+        w_k of non-negative texels stay non-negative)."""
+        out = x.copy()
+        out[:, 9 * self.lobes :] = np.maximum(out[:, 9 * self.lobes :], 0.0)
+        return out
+
     def jacobian(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
         """(J (n, L, 10 K) of the IRLS model per configuration w.r.t. its interpolated x, the weighted z, cost)."""
         z, lobe, xi = self.residuals(x)
@@ -192,12 +199,14 @@ class BetweenLobes:
         return np.ascontiguousarray(jac.transpose(1, 2, 0)), z * so, float(np.sum(shaded.robust(z)))
 
 
-def damped_step(model, x: np.ndarray, x0: np.ndarray, reg: float, cost: float, lam: float, step_for):
-    """Levenberg-Marquardt's inner loop: x + step_for(lam) tried at up to 6 dampings (lam x 4 each) until the model's
-    cost + reg |x - x0|^2 falls below ``cost``; (x, lam, the last cost tried)."""
+def damped_step(model, x: np.ndarray, x0: np.ndarray, reg: float, cost: float, lam: float, step_for, project=None):
+    """Levenberg-Marquardt's inner loop: x + step_for(lam) (mapped by ``project`` onto the feasible set, if given: a
+    projected Levenberg-Marquardt step) tried at up to 6 dampings (lam x 4 each) until the model's cost +
+    reg |x - x0|^2 falls below ``cost``; (x, lam, the last cost tried)."""
     c_new = np.inf
     for _ in range(6):
         cand = x + step_for(lam).reshape(x.shape)
+        cand = cand if project is None else project(cand)
         c_new = model.cost(cand) + reg * np.sum((cand - x0) ** 2)
         if np.isfinite(c_new) and c_new < cost:
             return cand, lam / 3.0, c_new
@@ -230,7 +239,7 @@ def fit_between(x0: np.ndarray, model: BetweenLobes, iterations: int, mu: float 
             pre = spla.LinearOperator((x.size, x.size), matvec=lambda v, p=(d + damp).ravel(): v / p)
             return spla.cg(a, -grad.ravel(), M=pre, maxiter=CG_ITERATIONS, rtol=CG_RTOL)[0]
 
-        x, lam, c_new = damped_step(model, x, x0, reg, c, lam, step_for)
+        x, lam, c_new = damped_step(model, x, x0, reg, c, lam, step_for, model.nonnegative_weights)
         if log is not None:
             log(f"iteration {it}: cost {c:.6g} -> {c_new:.6g}, damping {lam:.2e}, {time.perf_counter() - t0:.1f} s")
     return x
