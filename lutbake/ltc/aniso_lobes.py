@@ -100,7 +100,9 @@ def fit_lobes(nov, ax, ay, phi, albedo, m_view, lobes: int, iterations: int) -> 
     start = [(np.diag([2.0**-j, 2.0**-j, 1.0]) @ minv).reshape(k, 9) for j in range(lobes)]
     weights = [0.8] + [0.2 / (lobes - 1)] * (lobes - 1) if lobes > 1 else [1.0]
     x0 = np.concatenate(start + [np.full((k, 1), np.log(w)) for w in weights], axis=1)
-    x = aniso_shaded.levenberg_marquardt(x0, residuals, aniso_shaded.unit_blocks(lobes), iterations)
+    # a trial's log-weight may overflow: its cost is then not finite and levenberg_marquardt refuses the step
+    with np.errstate(over="ignore", invalid="ignore"):
+        x = aniso_shaded.levenberg_marquardt(x0, residuals, aniso_shaded.unit_blocks(lobes), iterations)
     return np.linalg.inv(x[:, : 9 * lobes].reshape(k, lobes, 3, 3)), albedo[:, None] * np.exp(x[:, 9 * lobes :])
 
 
