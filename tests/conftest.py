@@ -12,10 +12,17 @@
 - ``terminal_sigint``: SIGINT raises KeyboardInterrupt during the test, also under ``make test &``.
 """
 
+import os
 import signal
 from pathlib import Path
 
-import numpy as np
+# One OpenBLAS thread in the xdist workers and the processes tests start (they inherit this; numpy is already loaded
+# in this process by a plugin, so it keeps its pool). With every core busy, a threaded dot of ~1e4 elements waits for
+# its helper thread to be scheduled: harmonic.kernel_coefficients' 1535 dots took 16 s instead of 0.3 s beside two
+# busy cores, in both workers of `make test`. The values are those of any thread count to the dot's rounding.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402 - after the environment the workers inherit
 import pytest
 import warp as wp
 
