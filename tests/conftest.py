@@ -38,13 +38,15 @@ DATA = Path(__file__).resolve().parent / "data"
 sys.dont_write_bytecode = False
 
 
-# The modules with the most test time, longest first. `make test` runs whole modules per xdist worker in
-# collection order (--dist loadscope --no-loadscope-reorder), so the long ones start first and both workers
-# finish together (longest-processing-time-first); every other module keeps its file order after them.
+# The modules with the most test time, longest first (measured with `make test`'s invocation on 2 cores: the web
+# modules' time is mostly Chromium's). `make test` runs whole modules per xdist worker in collection order (--dist
+# loadscope --no-loadscope-reorder), each worker taking the next module as it finishes one, so the long ones start
+# first and both workers finish together (longest-processing-time-first); every other module keeps its file order.
 SLOW_FIRST = (
-    "test_dielectric", "test_audit", "test_outputs", "test_cluster", "test_validate", "test_ltc", "test_quiet_lazy",
-    "test_pipeline", "test_ltc_shaded", "test_babylon", "test_interpolation", "test_batch", "test_integrity",
-    "test_preflight", "test_hostile",
+    "test_web_rectarea", "test_audit", "test_outputs", "test_environment", "test_web_threejs", "test_dielectric",
+    "test_web_filament", "test_cluster", "test_environment_kinds", "test_validate", "test_web_babylon_environment",
+    "test_integrity", "test_web_babylon", "test_interpolation", "test_ltc", "test_pipeline", "test_cube_audit",
+    "test_babylon", "test_quiet_lazy", "test_environment_render", "test_ltc_shaded", "test_batch",
 )  # fmt: skip
 
 
