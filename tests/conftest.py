@@ -12,8 +12,16 @@
 - ``terminal_sigint``: SIGINT raises KeyboardInterrupt during the test, also under ``make test &``.
 """
 
+import os
 import signal
+import sys
 from pathlib import Path
+
+# One OpenBLAS thread in the xdist workers and the processes tests start (they inherit this; numpy is already loaded
+# in this process by a plugin, so it keeps its pool). With every core busy, a threaded dot of ~1e4 elements waits for
+# its helper thread to be scheduled: harmonic.kernel_coefficients' 1535 dots took 16 s instead of 0.3 s beside two
+# busy cores, in both workers of `make test`. The values are those of any thread count to the dot's rounding.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import numpy as np
 import pytest
@@ -24,14 +32,21 @@ from lutbake.config import load_config, parse_overrides, preset_path, validate_t
 
 DATA = Path(__file__).resolve().parent / "data"
 
+# pytest keeps each test module's assertion-rewritten bytecode in tests/__pycache__ (gitignored), unless bytecode is
+# not written (PYTHONDONTWRITEBYTECODE=1); without it every xdist worker rewrites and compiles all ~90 test modules
+# again in every run: ~4 s of each worker's ~8 s collection. Written atomically, read back only while up to date.
+sys.dont_write_bytecode = False
 
-# The modules with the most test time, longest first. `make test` runs whole modules per xdist worker in
-# collection order (--dist loadscope --no-loadscope-reorder), so the long ones start first and both workers
-# finish together (longest-processing-time-first); every other module keeps its file order after them.
+
+# The modules with the most test time, longest first (measured with `make test`'s invocation on 2 cores: the web
+# modules' time is mostly Chromium's). `make test` runs whole modules per xdist worker in collection order (--dist
+# loadscope --no-loadscope-reorder), each worker taking the next module as it finishes one, so the long ones start
+# first and both workers finish together (longest-processing-time-first); every other module keeps its file order.
 SLOW_FIRST = (
-    "test_dielectric", "test_audit", "test_outputs", "test_cluster", "test_validate", "test_ltc", "test_quiet_lazy",
-    "test_pipeline", "test_ltc_shaded", "test_babylon", "test_interpolation", "test_batch", "test_integrity",
-    "test_preflight", "test_hostile",
+    "test_web_rectarea", "test_audit", "test_outputs", "test_environment", "test_web_threejs", "test_dielectric",
+    "test_web_filament", "test_cluster", "test_environment_kinds", "test_validate", "test_web_babylon_environment",
+    "test_integrity", "test_web_babylon", "test_interpolation", "test_ltc", "test_pipeline", "test_cube_audit",
+    "test_babylon", "test_quiet_lazy", "test_environment_render", "test_ltc_shaded", "test_batch",
 )  # fmt: skip
 
 

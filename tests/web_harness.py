@@ -31,7 +31,7 @@ PAGE_TIMEOUT_MS = 60_000  # a page's first render compiles three.js's / Babylon'
 
 
 class _Handler(http.server.SimpleHTTPRequestHandler):
-    """Serves the repo root and, under /lut/, the folder of baked tables; no caching (each test bakes its own)."""
+    """Serves the repo root and, under /lut/, the folder of baked tables (never cached: each test bakes its own)."""
 
     luts: Path = ROOT / "outputs"
 
@@ -42,7 +42,10 @@ class _Handler(http.server.SimpleHTTPRequestHandler):
         return super().translate_path(path)
 
     def end_headers(self):
-        self.send_header("Cache-Control", "no-store")
+        # the engines' pinned npm files may be cached by the browser (a module's second page loads them once);
+        # everything else, lutbake's tables above all, never
+        immutable = self.path.startswith("/web/node_modules/")
+        self.send_header("Cache-Control", "max-age=3600, immutable" if immutable else "no-store")
         super().end_headers()
 
     def log_message(self, format, *args):  # noqa: A002 - the stdlib's name

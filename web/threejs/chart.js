@@ -41,11 +41,17 @@ export function chartScene( { nov, rows }, scale = 1 ) {
 
 }
 
+// One WebGLRenderer for every render of the page (as Babylon's pages keep one Engine): three.js compiles a material's
+// program once per renderer, so a page's later renders (the tests' variants) reuse the first one's programs; what
+// differs between them (the tables' texels, flipY, the textures bound) three.js uploads on needsUpdate / binds per
+// render as it would in a fresh renderer
+let renderer = null;
+
 // Renders into a float target and reads it back: { width, height, pixels (RGBA, row 0 at the bottom), canvas, renderer
 // (the GL renderer's name), webgl (three.js's WebGLRenderer) }; the canvas shows the same render.
 export function renderFloat( { scene, camera, width, height } ) {
 
-	const renderer = new THREE.WebGLRenderer( { antialias: false } );
+	renderer ??= new THREE.WebGLRenderer( { antialias: false } );
 	renderer.setSize( width, height, false );
 	renderer.toneMapping = THREE.NoToneMapping;
 	renderer.outputColorSpace = THREE.LinearSRGBColorSpace;
@@ -58,6 +64,7 @@ export function renderFloat( { scene, camera, width, height } ) {
 	const pixels = new Float32Array( width * height * 4 );
 	renderer.readRenderTargetPixels( target, 0, 0, width, height, pixels );
 	renderer.setRenderTarget( null );
+	target.dispose();
 	renderer.render( scene, camera );
 	const gl = renderer.getContext();
 	return { width, height, pixels, canvas: renderer.domElement, renderer: gl.getParameter( gl.RENDERER ), webgl: renderer };

@@ -28,16 +28,28 @@ function loadWrong( mistake ) {
 
 }
 
+// The uniform environment, one texture for the page: three.js's renderer keeps its PMREM per texture, so the page's
+// renders (chart.js: one renderer) prefilter it once (~4 s in SwiftShader) and the tests' variants, which change only
+// the DFG table, reuse it
+let env = null;
+
+function uniformEnvironment() {
+
+	if ( env ) return env;
+	const ones = new Float32Array( 8 * 4 * 4 ).fill( 1 );
+	env = new THREE.DataTexture( ones, 8, 4, THREE.RGBAFormat, THREE.FloatType );
+	env.mapping = THREE.EquirectangularReflectionMapping;
+	env.colorSpace = THREE.LinearSRGBColorSpace;
+	env.needsUpdate = true;
+	return env;
+
+}
+
 // spec: { nov, rows } (chart.js). Returns the RGBA float pixels, row 0 at the bottom (row i of the result is rows[i]).
 async function furnace( spec ) {
 
 	const chart = chartScene( spec );
-	const ones = new Float32Array( 8 * 4 * 4 ).fill( 1 );
-	const env = new THREE.DataTexture( ones, 8, 4, THREE.RGBAFormat, THREE.FloatType );
-	env.mapping = THREE.EquirectangularReflectionMapping;
-	env.colorSpace = THREE.LinearSRGBColorSpace;
-	env.needsUpdate = true;
-	chart.scene.environment = env;
+	chart.scene.environment = uniformEnvironment();
 	return renderFloat( chart );
 
 }
