@@ -143,3 +143,16 @@ def test_six_texture_files_round_trip_and_inspect(baked):
     r = CliRunner().invoke(main, ["inspect", str(out / "twok_t5.ktx2")])
     assert r.exit_code == 0, r.output
     assert "t5 = (M22, weight, weight_fresnel, sum_error)" in r.output
+
+
+def test_narrow_first_orders_each_texels_lobes_by_their_spread_whatever_the_scale():
+    """spread(diag(a, a, 1) s) = a^2 for any scale s; narrow_first swaps M and w together, texel by texel."""
+    from lutbake.ltc.aniso_lobes import narrow_first, spread
+
+    broad, narrow = np.diag([2.0, 2.0, 1.0]), np.diag([0.5, 0.5, 1.0])
+    assert spread(7.0 * broad) == pytest.approx(4.0) and spread(0.1 * narrow) == pytest.approx(0.25)
+    m = np.array([[3.0 * broad, narrow], [narrow, 0.2 * broad]])
+    w = np.array([[0.3, 0.7], [0.6, 0.4]])
+    got_m, got_w = narrow_first(m, w)
+    np.testing.assert_array_equal(got_m[:, 0], [narrow, narrow])
+    np.testing.assert_array_equal(got_w, [[0.7, 0.3], [0.6, 0.4]])
