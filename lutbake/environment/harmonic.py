@@ -209,15 +209,17 @@ def kernel_coefficients(lobe: str, alpha: float, lmax: int, order: int = 8, smoo
     g = np.empty(lmax + 1)
     p_prev, p, tmp = np.ones_like(t), t.copy(), np.empty_like(t)
     g[0] = f.sum()
+    # np.sum's pairwise sum, not f @ p: BLAS's dot splits the sum by its thread count (other last bits on another
+    # machine) and, threaded beside busy cores, waits for its helper threads
     if lmax > 0:
-        g[1] = f @ p
+        g[1] = np.sum(f * p)
     for n in range(1, lmax):  # P_{n+1} = ((2n + 1) t P_n - n P_{n-1}) / (n + 1), in place
         np.multiply(t, p, out=tmp)
         tmp *= (2 * n + 1) / (n + 1)
         p_prev *= n / (n + 1)
         tmp -= p_prev
         p_prev, p, tmp = p, tmp, p_prev
-        g[n + 1] = f @ p
+        g[n + 1] = np.sum(f * p)
     g /= np.abs(g).max() if smooth else g[0]
     g.flags.writeable = False  # cached
     return g
