@@ -16,7 +16,8 @@ log(w_k / A); start: lobe 1 the one-lobe shaded fit, lobe k > 1 its M broadened 
    the symmetries, each lobe on its own: lutbake.ltc.aniso.completed), at its nodes (each configuration moved to its
    nearest texel, the ground truth recomputed there) and interpolated (each lobe's M and w quadrilinear,
    lutbake.ltc.aniso.lookup: the shader's).
-3. The same table fitted between its texels (``fit_between``): all 8^4 x 2 x (9 + 1) unknowns so that the
+3. The same table fitted between its texels (lutbake.ltc.aniso_lobes.between_table, the kind's ``lobes = 2``: each
+   texel's lobes put narrowest first, then fit_between): all 8^4 x 2 x (9 + 1) unknowns so that the
    interpolated sum minimises the shaded cost at ``--configs`` configurations uniform in table coordinates
    (lutbake.ltc.aniso_lobes.training_set, 32 lights + HEMISPHERE each), plus mu |x - x0|^2 towards the per-texel table
    (x0's weights limited to the texel's magnitude: a larger one belongs to a lobe with almost no mass above the
@@ -40,8 +41,9 @@ from lutbake.ltc.aniso_lobes import (
     HEMISPHERE,
     TARGET_SAMPLES,
     BetweenLobes,
-    fit_between,
+    between_table,
     fit_lobes,
+    narrow_first,
     per_texel_table,
     training_set,
 )
@@ -78,15 +80,14 @@ def main():
     seconds["two_lobe_table"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    ts = training_set(GRID, a.configs, 32, 1000, HEMISPHERE)
-    held = training_set(GRID, 2000, 32, 2000, HEMISPHERE)
-    x0 = np.concatenate([per_texel[0].reshape(-1, 18), np.minimum(per_texel[1], mag.reshape(-1, 1))], axis=1)
-    model = BetweenLobes(ts, len(x0), 2)
-    x = fit_between(x0, model, a.between_iterations, a.mu, log=print)
-    between = (x[:, :18].reshape(-1, 2, 3, 3), x[:, 18:])
-    held_model = BetweenLobes(held, len(x0), 2)
-    held_cost = {"two_per_texel": held_model.cost(x0), "two_between": held_model.cost(x)}
+    between = between_table(GRID, mag, per_texel, a.configs, a.between_iterations, a.mu)  # the kind's
     seconds["between_fit"] = time.perf_counter() - t0
+    held = BetweenLobes(training_set(GRID, 2000, 32, 2000, HEMISPHERE), int(np.prod(GRID.n)), 2)
+    start = narrow_first(per_texel[0], np.minimum(per_texel[1], mag.reshape(-1, 1)))
+    held_cost = {
+        name: held.cost(np.concatenate([m.reshape(len(m), -1), w], axis=1))
+        for name, (m, w) in (("two_per_texel", start), ("two_between", between))
+    }
 
     rng = np.random.default_rng(7)
     lights = [light_polygon(*spec[:7]) for spec in LIGHTS]
