@@ -41,9 +41,10 @@ from lutbake.ltc.aniso_lobes import (
     HEMISPHERE,
     TARGET_SAMPLES,
     BetweenLobes,
+    between_start,
     between_table,
     fit_lobes,
-    narrow_first,
+    packed,
     per_texel_table,
     training_set,
 )
@@ -83,10 +84,9 @@ def main():
     between = between_table(GRID, mag, per_texel, a.configs, a.between_iterations, a.mu)  # the kind's
     seconds["between_fit"] = time.perf_counter() - t0
     held = BetweenLobes(training_set(GRID, 2000, 32, 2000, HEMISPHERE), int(np.prod(GRID.n)), 2)
-    start = narrow_first(per_texel[0], np.minimum(per_texel[1], mag.reshape(-1, 1)))
     held_cost = {
-        name: held.cost(np.concatenate([m.reshape(len(m), -1), w], axis=1))
-        for name, (m, w) in (("two_per_texel", start), ("two_between", between))
+        name: held.cost(packed(*table))
+        for name, table in (("two_per_texel", between_start(mag, per_texel)), ("two_between", between))
     }
 
     rng = np.random.default_rng(7)

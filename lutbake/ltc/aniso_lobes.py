@@ -282,6 +282,17 @@ def narrow_first(m: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.take_along_axis(m, order[:, :, None, None], axis=1), np.take_along_axis(w, order, axis=1)
 
 
+def between_start(magnitude: np.ndarray, per_texel: tuple) -> tuple[np.ndarray, np.ndarray]:
+    """The between fit's start: per_texel_table's (M, w), the weights limited to the texel's magnitude (a larger one
+    belongs to a lobe with almost no mass above the horizon), the lobes in ``narrow_first`` order."""
+    return narrow_first(per_texel[0], np.minimum(per_texel[1], magnitude.reshape(-1, 1)))
+
+
+def packed(m: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """x (texels, 10 K) = (M_1..M_K row-major, w_1..w_K): BetweenLobes' unknowns."""
+    return np.concatenate([m.reshape(len(m), -1), w], axis=1)
+
+
 def between_table(
     grid: aniso.Grid4,
     magnitude: np.ndarray,
@@ -290,14 +301,14 @@ def between_table(
     iterations: int = BETWEEN_ITERATIONS,
     mu: float = MU,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(M (texels, K, 3, 3), w (texels, K)) of fit_between from ``per_texel`` (per_texel_table's, its lobes put in
-    ``narrow_first`` order) on ``configs`` training configurations (BETWEEN_LIGHTS lights + HEMISPHERE each, seed
-    BETWEEN_SEED), ``iterations`` steps (0: the per-texel table, its weights limited to the magnitude)."""
-    m, w = narrow_first(per_texel[0], np.minimum(per_texel[1], magnitude.reshape(-1, 1)))
+    """(M (texels, K, 3, 3), w (texels, K)) of fit_between from ``between_start`` (of per_texel_table's table) on
+    ``configs`` training configurations (BETWEEN_LIGHTS lights + HEMISPHERE each, seed BETWEEN_SEED), ``iterations``
+    steps (0: the start itself)."""
+    m, w = between_start(magnitude, per_texel)
     if iterations == 0:
         return m, w
     lobes = m.shape[1]
-    x0 = np.concatenate([m.reshape(len(m), -1), w], axis=1)
+    x0 = packed(m, w)
     ts = training_set(grid, configs, BETWEEN_LIGHTS, BETWEEN_SEED, HEMISPHERE)
     x = fit_between(x0, BetweenLobes(ts, len(x0), lobes), iterations, mu)
     return x[:, : 9 * lobes].reshape(-1, lobes, 3, 3), x[:, 9 * lobes :]
