@@ -366,6 +366,40 @@ def test_modules_load_in_parallel_each_once(monkeypatch):
     assert b0[0] < max(a0[1], a1[1]) and min(a0[0], a1[0]) < b0[1]  # another module: at the same time
 
 
+def test_a_kernel_factory_builds_once_whatever_the_threads():
+    """warp_runtime.kernel_factory: threads that ask for the same kernels at once get one build's objects (functools'
+    cache let each build its own, defining into a Warp module another thread was loading: Warp's KeyError), another
+    argument builds its own; and lutbake.ltc.aniso's fit tiles (worker threads) share one set of fit kernels."""
+    import threading
+
+    from lutbake.ltc import aniso, fit
+    from lutbake.runtime import warp_runtime
+
+    builds, start = [], threading.Barrier(6)
+
+    @warp_runtime.kernel_factory
+    def slow_factory(name):
+        builds.append(name)
+        time.sleep(0.2)  # a build long enough for every thread to ask meanwhile
+        return object()
+
+    got = {}
+
+    def ask(i):
+        start.wait(5)
+        got[i] = slow_factory("a" if i < 5 else "b")
+
+    threads = [threading.Thread(target=ask, args=(i,)) for i in range(6)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert sorted(builds) == ["a", "b"]
+    assert len({id(got[i]) for i in range(5)}) == 1 and got[5] is not got[0]
+    assert fit.kernels.__code__ is slow_factory.__code__  # the fit's kernels are built by a kernel_factory
+    assert fit.kernels(aniso.LOBES["free"]) is fit.kernels(aniso.LOBES["free"])
+
+
 def test_a_busy_module_defers_only_the_first_load_of_an_armed_thread(monkeypatch):
     """warp_runtime.defer_if_busy: while another thread loads module a, this thread's first load_module of a raises
     ModuleBusy (it may do other work) instead of waiting; a load outside the context, or a later one inside it, waits

@@ -40,7 +40,7 @@ import numpy as np
 import warp as wp
 
 from ..edge import ALPHA_MIN, COS_EPS
-from ..runtime.warp_runtime import load_module, unique_kernel
+from ..runtime.warp_runtime import kernel_factory, load_module, unique_kernel
 from ..sampling import points
 from ..terms.fresnel import Fc_schlick
 from ..terms.masking import G2_smith_height_correlated, Lambda_ggx
@@ -82,7 +82,7 @@ def ggx_pair(
     return wp.vec2d(common * (wp.float64(1.0) - fc), common * fc)
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def diffuse_pair(brdf):
     """The lobe (f (n.l), 0) of a diffuse BRDF ``brdf(l, v, sigma, alpha, f0, rule)`` (shading frame, n = +z;
     lutbake.integrands.diffuse.brdf_for) at sigma = p[1], alpha = p[0], f0 = p[2]."""
@@ -182,7 +182,7 @@ def horizon_breaks(mu_lo: wp.float64, mu_hi: wp.float64, phi0: wp.float64, phi1:
     return bp, count
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def truth_kernel(pair):
     """The kernel summing ``pair`` (ggx_pair or a diffuse_pair) against every texel per pixel: out[i] = (Σ L a,
     Σ L b) as 6 float64 (module docstring)."""

@@ -45,7 +45,7 @@ import math
 import numpy as np
 import warp as wp
 
-from ..runtime.warp_runtime import unique_kernel
+from ..runtime.warp_runtime import kernel_factory, unique_kernel
 from .latlong import Pyramid
 from .lobes import LOBES
 
@@ -84,7 +84,7 @@ class Texels:
     reference: wp.array(dtype=wp.vec3d)
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def texel_kernel(lobe: str, planes: int, order: int):
     """The kernel integrating each texel's lobe ``lobe`` (LOBES) clipped by ``planes`` planes per texel with an
     ``order`` x ``order`` Gauss-Legendre rule per leaf: out[t] = (∫ L w (rgb), ∫ w, leaves)."""

@@ -20,13 +20,13 @@ The channels are those of the dfg layouts scale_bias / multiscatter (lutbake.int
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import numpy as np
 import warp as wp
 
 from ..edge import ALPHA_MIN
+from ..runtime.warp_runtime import kernel_factory
 from ..terms import masking, ndf
 from .specular import channels_for
 
@@ -95,7 +95,7 @@ class AnisoIntegrand:
     nch: int = 2
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def aniso_integrand(model: str, layout: str) -> AnisoIntegrand:
     sample, weight, f_cos = LOBES[model]
     return AnisoIntegrand(model, layout, channels_for(layout)[0], sample, weight, f_cos, model == "microfacet")
@@ -224,7 +224,7 @@ def one_node(alpha_max: np.ndarray, alpha_min: np.ndarray) -> np.ndarray:
 AVERAGED_NODES = {"microfacet": azimuth_nodes_np, "ashikhmin_shirley": one_node}  # per texel, for the nominal cost
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def averaged_integrand(model: str, layout: str):
     """The integrand record of a view-azimuth-averaged anisotropic table for the panelled Gauss-Legendre kernel
     (lutbake.sampling.hemisphere_kernels.make_gauss_legendre): per texel (n.v, alpha = alpha_min, param = alpha_max),

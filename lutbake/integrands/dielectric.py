@@ -27,13 +27,12 @@ eta^2 - 1 + (v.h)^2 cancels and float32's rounding of v.h reaches cos theta_t am
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 import warp as wp
 
 from ..edge import COS_EPS
 from ..records import MASKING
+from ..runtime.warp_runtime import kernel_factory
 from ..terms import fresnel
 from ..terms.dielectric import F_dielectric64, cos_transmitted, cos_transmitted64
 from ..terms.distributions import NDFS
@@ -57,7 +56,7 @@ class Facet:
     w_r: float
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def integrand_for(ndf_name: str, masking_name: str, mode: str):
     """``(g, g64, facet64, lobes64)``: ``g(v, h, alpha, eta) -> wp.vec3`` (module docstring; 0 for v.h, n.v <= COS_EPS
     or n.h <= 0) and ``g64(v, h, alpha, eta, v.h as float64)``, the same given v.h to float64 (the panel rules know
@@ -129,7 +128,7 @@ def integrand_for(ndf_name: str, masking_name: str, mode: str):
     return integrand, integrand64, facet64, lobes64
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def mirror_for(mode: str):
     """The exact alpha -> 0 limit (lutbake.edge): D -> delta about n, so h = n, v.h = mu, G2 -> 1, and each lobe
     keeps its Fresnel weight at mu: E_R = F(mu, eta), E_T = 1 - F(mu, eta) (0 under total internal reflection)."""
@@ -155,7 +154,7 @@ def mirror_for(mode: str):
     return mirror
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def dielectric_integrand(ndf_name: str, masking_name: str, mode: str, nch: int = 3) -> SpecularIntegrand:
     """The integrand record (lutbake.integrands.specular.SpecularIntegrand: g, vec, distribution, mirror) of a
     (terms, Fresnel mode) key; the kernels' per-texel ``param`` is the relative IOR eta."""

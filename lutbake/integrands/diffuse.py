@@ -16,7 +16,6 @@ F_facet = c(f0) T(m.l) T(m.v) (``transmission`` = T, ``f0_scale`` = c), which th
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,6 +24,7 @@ import warp as wp
 from ..axes import sigma_alpha
 from ..edge import COS_EPS, effective_alpha
 from ..records import DIFFUSE, FACET_FRESNEL
+from ..runtime.warp_runtime import kernel_factory
 from ..sampling.diffuse import DiffuseGaussLegendre, eval_points
 from ..sampling.facets import fd_microfacet_for
 from ..sampling.swapped import integrate_swapped
@@ -47,7 +47,7 @@ def facet_record(facet_fresnel):
     return FACET_FRESNEL.lookup(facet_fresnel) if isinstance(facet_fresnel, str) else facet_fresnel
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def brdf_for(model, facet):
     """``brdf(l, v, sigma, alpha, f0, rule) -> float64``: the BRDF of a diffuse record for rho = 1 (closed forms,
     the record's ``Fd(rho, NoL, NoV, LoV, sigma[, f0])``, ignore alpha and the GL rule (node, weight) of the
@@ -106,7 +106,7 @@ def diffuse_integrand(model, facet_fresnel="eq6") -> DiffuseIntegrand:
     return _diffuse_integrand(diffuse_record(model), facet_record(facet_fresnel))
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def _diffuse_integrand(model, facet) -> DiffuseIntegrand:
     if model.name != "microfacet":
         return DiffuseIntegrand(model.name, facet.name, brdf_for(model, facet), None, None)
@@ -114,7 +114,7 @@ def _diffuse_integrand(model, facet) -> DiffuseIntegrand:
     return DiffuseIntegrand(model.name, facet.name, brdf_for(model, facet), T, c, facet["F"])
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def lobe_integrand(lobe) -> DiffuseIntegrand:
     """A plugin's cosine-weighted lobe (lutbake.ltc.lobes.custom_lobe) as a diffuse BRDF for the diffuse kind's
     estimators: f(l, v) = f_cos(v, l, x) / (n.l), x its parameter (passed as sigma), 0 where n.l <= COS_EPS."""

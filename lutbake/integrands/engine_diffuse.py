@@ -23,12 +23,10 @@ The layouts' names, channels and reconstruction text are declared in lutbake.lay
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 import warp as wp
 
-from ..runtime.warp_runtime import MODULE_OPTIONS, load_module
+from ..runtime.warp_runtime import MODULE_OPTIONS, kernel_factory, load_module
 from ..sampling.plan import StoredMap
 from ..terms.engine_diffuse import Fd_disney_hdrp, Fd_fabric_lambert_hdrp
 
@@ -38,7 +36,7 @@ DIFFUSE_ORDER = 24  # Gauss-Legendre nodes per dimension (mu, phi)
 HDRP_DIFFUSE_OFFSET = 0.5  # HDRP stores the Disney FGD minus 0.5 (range [0.5, 1.5] -> [0, 1] for its UNORM target)
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def diffuse_kernel():
     @wp.kernel(enable_backward=False)
     def disney_fgd(
@@ -86,7 +84,7 @@ def disney_fgd(nov: np.ndarray, perceptual_roughness: np.ndarray, device: str = 
     return out.numpy()
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def fabric_kernel():
     @wp.kernel(enable_backward=False)
     def fabric_lambert(r: wp.array(dtype=float), out: wp.array(dtype=wp.float64)):

@@ -9,18 +9,16 @@ Fresnel uses it: F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)).
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 import warp as wp
 
 from ..metals import LAZANYI_ALPHA
 from ..records import FRESNEL
-from ..runtime.warp_runtime import unique_kernel
+from ..runtime.warp_runtime import kernel_factory, unique_kernel
 from ..sampling.arrays import Floats
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def _kernel(fresnel):
     """out[i] = F(c[i]) of a Fresnel record, reading f0 (param "f0"), n and k ("nk") or n, k and Lazanyi's a ("nka")."""
     F, param = fresnel["F"], fresnel.fields["param"]

@@ -15,7 +15,6 @@ in the same measure is D_charlie V_ashikhmin (n.l) 4 (v.h) (Filament's DFV_Charl
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,6 +22,7 @@ import warp as wp
 
 from .. import metals
 from ..edge import COS_EPS, effective_alpha
+from ..runtime.warp_runtime import kernel_factory
 from ..terms import fresnel as fresnel_terms
 from ..terms import masking, ndf
 from ..terms.distributions import Distribution, distribution
@@ -48,7 +48,7 @@ def fc_of(fresnel):
     return Fc
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def split_channels(fresnel=None) -> dict:
     """The split-sum channel sets of a Fresnel linear in f0, F = f0 (1 - Fc) + Fc (Karis 2013):
     scale_bias (1 - Fc, Fc) -> E = f0 scale + bias; multiscatter (Fc, 1) -> E = mix(R, G, f0)."""
@@ -71,7 +71,7 @@ def channels_albedo(VoH: float, f0: float):
     return wp.vec2(1.0, 0.0)
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def fresnel_channels(fresnel):
     """specular_3d: R = F(f0, v.h) of the Fresnel record for the texel's f0 (the kernel's per-texel param); G unused
     (0)."""
@@ -153,7 +153,7 @@ def channels_metal(VoH: float, row: float):
     )
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def channels_for(channels_name: str, fresnel=None):
     """(channel wp.func (VoH, param) -> vec, vec type) of a CHANNEL_SETS name: the split-sum pairs of ``fresnel``
     (a Fresnel record linear in f0; None: Schlick's), "F" for F(f0, v.h) of ``fresnel`` itself (specular_3d), "metal"
@@ -209,7 +209,7 @@ def charlie_integrands(lobe, vec):
     return half_vector_integrand(lobe32, vec, False), g_sin2
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def weight_for(nd, masking_name: str, form: str):
     """f (n.l) 4 (v.h) / F of an integrand form (``integrand_for``) at (v, h, l, v.h, alpha)."""
     if form == "microfacet":
@@ -236,7 +236,7 @@ def weight_for(nd, masking_name: str, form: str):
     return weight
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def integrand_for(nd, masking_name: str, channels_name: str, form: str = "microfacet", fresnel=None):
     """g(h) = f(l, v) (n.l) 4 (v.h) * channels(v.h, param), 0 where n.l, v.h or n.v <= COS_EPS (back-facing).
     ``form`` (model_terms):
@@ -267,7 +267,7 @@ def charlie_pair_for(nd, masking_name: str, channels_name: str):
     return None
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def cloth_integrand_for(nd, masking_name: str):
     """(Fc s, s, D_charlie V_ashikhmin (n.l) 4 (v.h)) with s = D G2 (v.h)/(n.v): the multiscatter
     channels plus Filament's cloth DV (DFV_Charlie_Uniform), 0 where n.l or v.h <= COS_EPS (back-facing): (g, g_sin2),
@@ -282,7 +282,7 @@ def cloth_integrand_for(nd, masking_name: str):
     return charlie_integrands(lobe, wp.vec3)
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def sheen_integrand_for(layout: str):
     """The sheen lobe f = D_charlie(h; alpha) V (KHR_materials_sheen, no Fresnel) alone, as g(h) = f (n.l) 4 (v.h):
         charlie       (0, 0, D_charlie V_ashikhmin (n.l) 4 (v.h))   the glTF Sample Viewer's lut_charlie (read .b)
@@ -360,7 +360,7 @@ class SpecularIntegrand:
         return effective_alpha(alpha, self.mirror is not None)
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def mirror_for(channels_name: str, fresnel=None):
     """E at alpha = 0 for the microfacet form: the mirror direction l = reflect(v, n), h = n, v.h = n.v, G2 = 1."""
     ch, vec = channels_for(channels_name, fresnel)
@@ -374,7 +374,7 @@ def mirror_for(channels_name: str, fresnel=None):
     return mirror
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def specular_integrand(
     nd, masking_name: str, channels_name: str, form: str = "microfacet", nch: int | None = None, fresnel=None
 ) -> SpecularIntegrand:

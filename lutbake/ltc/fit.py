@@ -30,14 +30,12 @@ for any tiling or worker count (ltc_code instead chains each texel off the previ
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 import warp as wp
 
 from ..limits import LTC_FIT_GRID
 from ..runtime.memo import RowMemo
-from ..runtime.warp_runtime import MODULE_OPTIONS, load_module
+from ..runtime.warp_runtime import MODULE_OPTIONS, kernel_factory, load_module
 from .lobes import lobe
 
 wp.set_module_options(MODULE_OPTIONS)
@@ -88,7 +86,7 @@ def ltc_eval(m_inv: wp.mat33d, det_inv: wp.float64, l: wp.vec3d):
     return z * wp.float64(0.3183098861837907) * det_inv / (n * n * n)
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def kernels(lb):
     """(lobe_samples, heitz_error, lobe_values) Warp kernels for a Lobe, compiled once per Warp cache."""
     sample = lb.sample

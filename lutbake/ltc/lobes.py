@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import warp as wp
 
 from ..edge import COS_EPS
+from ..runtime.warp_runtime import kernel_factory
 from ..terms import diffuse, masking, ndf, sheen_volume
 from ..terms.frame import reflect
 from .tabulated import gotanda_f_cos, tabulate_gotanda
@@ -192,7 +193,7 @@ def gotanda_f_pdf(v: wp.vec3, l: wp.vec3, alpha: float, tab: wp.array3d(dtype=fl
     return wp.vec2(gotanda_f_cos(v, l, alpha, tab, t), cosine_pdf(v, l, alpha))
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def cosine_sampled(f_cos):
     """(f_cos guarded, f_pdf) of a plugin's lobe (lutbake.plugins.register_brdf): 0 where n.l or n.v <= COS_EPS
     (back-facing), sampled cosine-weighted (cosine_sample, cosine_pdf)."""

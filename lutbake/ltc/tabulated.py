@@ -21,14 +21,13 @@ against the direct quadrature at GL order 12 on cosine-distributed directions.
 
 from __future__ import annotations
 
-import functools
 from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import warp as wp
 
 from ..edge import COS_EPS
-from ..runtime.warp_runtime import MODULE_OPTIONS, load_module
+from ..runtime.warp_runtime import MODULE_OPTIONS, kernel_factory, load_module
 from ..sampling.diffuse import gl_rule
 from ..sampling.facets import fd_microfacet_for
 from ..terms import masking
@@ -56,7 +55,7 @@ def G2_ggx(NoL: float, NoV: float, alpha: float):
     return masking.G2_smith_height_correlated(masking.Lambda_ggx(NoV, alpha), masking.Lambda_ggx(NoL, alpha))
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def tabulate_kernel():
     fd = fd_microfacet_for(F_facet_eq6)
 

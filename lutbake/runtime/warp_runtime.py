@@ -8,6 +8,7 @@ everything Warp says.
 from __future__ import annotations
 
 import contextlib
+import functools
 import logging
 import os
 import sys
@@ -113,6 +114,24 @@ def defining():
             yield
         finally:
             _DEFINING.held = False
+
+
+_FACTORY = threading.RLock()
+
+
+def kernel_factory(build):
+    """functools.cache for a function that builds Warp functions or kernels (a kernel factory), safe across threads:
+    one thread builds at a time and a second caller of the same arguments gets the first one's objects. Worker threads
+    of one table call factories too (lutbake.ltc.aniso's tiles); two of them missing functools' cache at once both
+    defined the kernels, adding to a module while the other loaded it (Warp: ``KeyError`` in Module.load)."""
+    cached = functools.lru_cache(maxsize=None)(build)
+
+    @functools.wraps(build)
+    def built(*args, **kwargs):
+        with _FACTORY:
+            return cached(*args, **kwargs)
+
+    return built
 
 
 def load_module(module, device: str = "cpu") -> None:

@@ -12,7 +12,6 @@ alpha_x = alpha_y = 0 (the lobe's mirror limit, lutbake.edge): E = channels(n.v)
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -20,7 +19,7 @@ import numpy as np
 import warp as wp
 
 from ..edge import COS_EPS
-from ..runtime.warp_runtime import load_module, unique_kernel
+from ..runtime.warp_runtime import kernel_factory, load_module, unique_kernel
 from ..terms import ndf
 from ..terms.frame import reflect
 from . import points
@@ -37,7 +36,7 @@ def view_at(nov: float, phi_v: float):
     return wp.vec3(s * wp.cos(phi_v), s * wp.sin(phi_v), nov)
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def aniso_kernel(lobe, cosine: bool):
     """QMC kernel over texels (nov, alpha_x, alpha_y, phi_v; phi_v < 0: averaged) with 3D points (module docstring)."""
     ch, sample, weight, f_cos = lobe.channels, lobe.sample, lobe.weight, lobe.f_cos

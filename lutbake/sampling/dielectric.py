@@ -49,7 +49,7 @@ from typing import Any
 import numpy as np
 import warp as wp
 
-from ..runtime.warp_runtime import unique_kernel
+from ..runtime.warp_runtime import kernel_factory, unique_kernel
 from . import points
 from .arrays import Levels, Rows64, Rule, store_row
 from .facet_rules import OuterNode, facet_rules_for, members_of, outer_variable_for
@@ -208,7 +208,7 @@ def dielectric_texel(t: wp.vec3, merge: wp.float64):
     return DielectricTexel(v, a, eta_f, a64, cos_v, sin_v, eps_l, cos_c, theta_peak, n_panels, edges)  # field order
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def panel_rule_for(spec, members: int = 0):
     """``(panel_add, panel_sum)``: ``panel_add(x, j, rules, off, n, acc)`` adds the n x n product rule
     (rules[off : off + n] in both variables) over outer panel j of texel x to ``acc``, node by node (module
@@ -361,7 +361,7 @@ def make_gauss_legendre_members(spec):
     return gauss_legendre_members_kernel
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def texel_store_for(spec):
     """``store_texel(x, i, total, e, out, err)``: texel i's values (total / pi, or the mirror limit at alpha = 0) and
     estimates (e / pi plus TERMS_ROUNDING |value|) of the kernels to a tolerance."""
@@ -412,7 +412,7 @@ def make_adaptive_dielectric(spec):
 MEMBERS = 16
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def member_params_for(nch: int):
     """``member_params(texel, groups, g) -> (acc, count)``: group g's accumulator (members_of), zero sums and row k's
     param the eta of member k (of the first member in an unused row), and its member count."""

@@ -17,14 +17,13 @@ The microfacet model's albedo by default uses the swapped integral (lutbake.samp
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass, replace
 
 import numpy as np
 import warp as wp
 
-from ..runtime.warp_runtime import load_module, unique_kernel
+from ..runtime.warp_runtime import kernel_factory, load_module, unique_kernel
 from ..terms.frame import view_dir
 from . import points
 from .arrays import Floats, Levels, LightView, Points2, Rows64, Rule, Values64
@@ -41,7 +40,7 @@ PI64 = wp.constant(wp.float64(math.pi))
 REFINE_ORDER = 8  # the error estimates re-evaluate probe texels with every GL order + 8
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def albedo_kernel(brdf):
     """Kernel: E(v) = ∫ f (n.l) dω_l per texel (n.v, sigma, alpha, f0); outer GL rule_o on 2 x 2 panels, inner GL
     rule for the microfacet integral (``brdf``: lutbake.integrands.diffuse)."""
@@ -75,7 +74,7 @@ def albedo_kernel(brdf):
     return albedo_gl_kernel
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def brdf_kernel(brdf):
     """Kernel: f(l, v) at direction pairs lv[i] = (l, v) with sa[i] = (sigma, alpha) (tests, plots, BTF slices)."""
 
@@ -87,7 +86,7 @@ def brdf_kernel(brdf):
     return brdf_point_kernel
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def cosine_kernel(brdf):
     """Kernel: E(v) = (pi / N) sum_k f(l_k, v), l_k cosine-weighted from the 2D points ``pts``."""
 
@@ -239,7 +238,7 @@ class PointEvaluation:
         return replace(self, extra=e), f"orders - orders + {e}"
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def sobol_point_kernel(facet):
     """Kernel: the microfacet f(l, v) at lv[i] = (l, v) with its m-integral by the 2D points ``pts``."""
     f = fd_microfacet_sobol_for(facet)
@@ -274,7 +273,7 @@ class PointSobol(ScrambledSobol):
         return launch_rows(sobol_point_kernel(integrand.facet), arrays, len(lv), device, (len(lv),))[:, None]
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def adaptive_point_kernel(facet):
     """Kernel: the microfacet f(l, v) at lv[i] = (l, v) to the tolerance ``tol`` (absolute, relative), and its error
     estimate (lutbake.sampling.facets.fd_microfacet_adaptive_for)."""
@@ -292,7 +291,7 @@ def adaptive_point_kernel(facet):
     return brdf_adaptive_kernel
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def adaptive_azimuths_kernel(facet):
     """Kernel: ``adaptive_point_kernel`` for groups of texels that differ only in the azimuth of l, one thread per
     group (texels start[g] .. start[g + 1] - 1): the u nodes are computed once per group

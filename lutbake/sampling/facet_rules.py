@@ -6,11 +6,11 @@ panel's product rule (panel_rule_for). Shared with the dielectric kernels (lutba
 
 from __future__ import annotations
 
-import functools
 from typing import Any
 
 import warp as wp
 
+from ..runtime.warp_runtime import kernel_factory
 from .arrays import Rule
 from .horizon import PI64, PanelTexel, asinh64, kink_cos_phi, phi_b
 
@@ -29,7 +29,7 @@ class OuterNode:
     wk: wp.float64
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def outer_variable_for(tan2_from_u, u_from_tan2):
     """The outer variable of the Gauss-Legendre kernels: u = CDF(theta_h) on panels inside the NDF peak (``in_u``),
     theta_h itself beyond. ``outer_range(t_lo, t_hi, in_u, alpha) -> (x_lo, dx)``; ``outer_node(x, w, in_u, alpha)
@@ -55,7 +55,7 @@ def outer_variable_for(tan2_from_u, u_from_tan2):
     return outer_range, outer_node
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def over_pdf_for(pdf):
     """``over_pdf(g, v, h, alpha, in_u)``: g / p(h) where the outer variable is the NDF's CDF u (D cancels; 0 where
     p = 0), g where it is theta_h itself."""
@@ -80,7 +80,7 @@ def over_p(g: Any, p: float, in_u: bool):
     return g
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def facet_weight_for(integrand, pdf):
     """``facet_weight(v, h, alpha, param, in_u)``: g(h) / p(h) (over_pdf_for)."""
     over_pdf = over_pdf_for(pdf)
@@ -95,7 +95,7 @@ def facet_weight_for(integrand, pdf):
 UNROLL = 4  # members per unrolled block of a members rule (facet_rules_for); members_of's size is a multiple
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def members_of(nch: int, size: int):
     """The accumulator of ``size`` texels that share every node of their panel rules and differ only in the
     integrand's param (the dielectric tables' eta >= 1 at one (n.v, alpha): lutbake.sampling.dielectric): a float64
@@ -105,7 +105,7 @@ def members_of(nch: int, size: int):
     return wp.types.matrix(shape=(size, nch + 1), dtype=wp.float64)
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def facet_rules_for(spec, members: int = 0):
     """``(add_facet, sinh_piece, plain_piece)``: the inner rule's pieces for an integrand record (the panel rules of
     this module and of lutbake.sampling.dielectric). ``add_facet(acc, f, cos phi, sin phi, w)`` adds w g / p at the
@@ -199,7 +199,7 @@ def facet_rules_for(spec, members: int = 0):
     return add_facet, sinh_piece, plain_piece
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def panel_rule_for(spec):
     """``panel_of(t, j, rules, off, n, off_i, n_i)`` of make_gauss_legendre's ladder for an integrand record: the
     product of the outer rule rules[off : off + n] and the inner rules[off_i : off_i + n_i] over panel j of texel t

@@ -25,11 +25,10 @@ node's theta_m and arc half-widths (fd_microfacet_adaptive_azimuths_for, the sam
 
 from __future__ import annotations
 
-import functools
-
 import warp as wp
 
 from ..edge import COS_EPS
+from ..runtime.warp_runtime import kernel_factory
 from ..terms import masking
 from ..terms.distributions import GGX
 from .arrays import Floats, Levels, LightView, Rows64, Rule
@@ -49,7 +48,7 @@ from .panels import (
 )
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def fd_microfacet_for(F_facet):
     """The microfacet diffuse BRDF ``fd_microfacet(l, v, alpha, f0, rule) -> float64`` (rho = 1), Eq. 4,
     integrated as in the module docstring with the n-point GL rule ``rule`` (node, weight) on [0, 1];
@@ -132,7 +131,7 @@ def fd_microfacet_for(F_facet):
     return fd_microfacet
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def fd_microfacet_sobol_for(F_facet):
     """Eq. 4 by sampling m from GGX's D(m)(n.m) (inverse CDF, lutbake.terms.distributions.GGX.sample_ndf) at the
     2D points ``pts``: f = G2 / (pi (n.l)(n.v)) (1/N) sum_k (m.l)+ (m.v)+ F_facet / (n.m)
@@ -297,7 +296,7 @@ def end_cos_sin(x: wp.float64, ends: ArcEnds):
     return wp.vec2d(ends.c[k], ends.s[k])
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def phi_row_for(F_facet):
     """``phi_row(l, v, azl, azv, node, f0, rules, off, n)``: the n-point rule in phi_m at the u node ``node``
     (u_node; azl, azv: ``azimuth`` of l, v): the sum of w (m.l)+ (m.v)+ F_facet over the pieces between the arcs'
@@ -354,7 +353,7 @@ def phi_row_for(F_facet):
     return phi_row
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def facet_panel_for(F_facet):
     """``facet_panel(pair, j, rules, off, n)``: the n x n product rule (rules[off : off + n]) over u panel j
     (``u_panel``): the sum of w (m.l)+ (m.v)+ F_facet / (n.m) over its nodes (times G2 / (2 pi^2 (n.l)(n.v)) it is
@@ -376,7 +375,7 @@ def facet_panel_for(F_facet):
     return facet_panel
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def facet_panel_azimuths_for(F_facet):
     """``facet_panel_azimuths(pair, lv, azl, first, end, j, rules, off, n, out, col)``: ``facet_panel`` for every
     texel first .. end - 1 of lv (l, v): texels that differ from ``pair``'s only in the azimuth of l (azl[t]), so
@@ -438,7 +437,7 @@ def facet_estimate(scale: wp.float64, qe: wp.vec2d):
     return wp.vec2d(f, scale * qe[1] + FACET_ROUNDING * wp.abs(f))
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def fd_microfacet_adaptive_for(F_facet):
     """``fd_microfacet_adaptive(l, v, alpha, f0, rules, levels, tol) -> vec2d(f, error estimate)``: Eq. 4 on the
     panels of ``fd_microfacet_for``, each u panel (with its phi pieces) at GL orders ``levels``, refined greedily
@@ -469,7 +468,7 @@ def fd_microfacet_adaptive_for(F_facet):
     return fd_microfacet_adaptive
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def fd_microfacet_adaptive_azimuths_for(F_facet):
     """``fd_microfacet_adaptive_azimuths(lv, alpha, f0, rules, levels, tol, first, end, azl, panels, out)``:
     ``fd_microfacet_adaptive`` of the texels first .. end - 1 of lv (l, v), which differ only in the azimuth of l

@@ -14,13 +14,11 @@ closed-form mirror limit ``mirror(v, param)`` instead of a quadrature.
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 import warp as wp
 
 from .. import tolerance
-from ..runtime.warp_runtime import load_module, unique_kernel
+from ..runtime.warp_runtime import kernel_factory, load_module, unique_kernel
 from ..terms.frame import view_dir
 from .arrays import PhiRule, Points2, Rows64, Rule, Values64, store_row
 from .facet_rules import panel_rule_for
@@ -137,12 +135,12 @@ def make_qmc(spec, vndf: bool):
     return qmc_kernel
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def gl_kernel(spec):
     return make_gauss_legendre(spec)
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def qmc_kernel(spec, vndf: bool):
     return make_qmc(spec, vndf)
 

@@ -20,11 +20,11 @@ every channel refined to its own target. (No ``from __future__ import annotation
 types, local to the factory, from the annotations.)
 """
 
-import functools
 from typing import Any
 
 import warp as wp
 
+from ..runtime.warp_runtime import kernel_factory
 from .arrays import Levels, Rule
 
 
@@ -59,7 +59,7 @@ FLOOR_REACH = wp.constant(wp.float64(0.1))
 FLOOR_GIVE_UP = wp.constant(wp.float64(0.5))
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def furthest_over_for(nch: int):
     """``furthest_over(total, err, target_abs, target_rel, floor)``: the channel c whose estimate err_c is furthest
     over its target max(target_abs_c, target_rel_c |total_c|) - floor |total_c| (where that is FLOOR_REACH floors
@@ -83,7 +83,7 @@ def furthest_over_for(nch: int):
     return furthest_over
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def totals_for(Sums, nch: int):
     """``totals(q, d, d2, w2, n_panels) -> (total, err)``: per channel, the sum of the panels' values q and of their
     estimates d + w2 d2 (float64 matrices max_panels x nch; w2 = 0: d alone)."""
@@ -101,7 +101,7 @@ def totals_for(Sums, nch: int):
     return totals
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def greedy_ladder_for(panel_sum, max_panels: int, nch: int = 1, first_level=None):
     """``(integrate, climb, Panels, Sums, Orders)``: ``integrate(ctx, n_panels, rules, levels, target_abs, target_rel,
     floor) -> (total, err)`` (``Sums``: float64 vectors of nch, the targets per channel too): every panel at the
@@ -215,7 +215,7 @@ def outer_bound(d_coarse: wp.float64, d_check: wp.float64):
     return d
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def product_ladder_for(panel_sum, max_panels: int, nch: int = 1, check: bool = False):
     """``integrate(ctx, n_panels, rules, levels, target_abs, target_rel, floor) -> (total, err)`` as
     greedy_ladder_for's, for a panel rule that is a product of two one-dimensional rules (an outer variable and an

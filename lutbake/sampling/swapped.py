@@ -31,13 +31,12 @@ view), and the error estimate re-integrates probe texels with every order + 8.
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass, replace
 
 import numpy as np
 import warp as wp
 
-from ..runtime.warp_runtime import load_module, unique_kernel
+from ..runtime.warp_runtime import kernel_factory, load_module, unique_kernel
 from ..terms.masking import Lambda_ggx64
 from . import points
 from .groups import group_rows, key_of
@@ -55,7 +54,7 @@ from .panels import (
 )
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def swapped_kernel(T, members: int = 1):
     """Kernel: E(nov[g]) / c(f0) for alpha[g] and ``members`` values f0[g, k] (a group of texels that share (n.v,
     alpha) and orders, lutbake.sampling.groups: every node, its cosines and the f0-free factors once; the facet
@@ -192,7 +191,7 @@ MEMBERS = 16  # texels per group (diffuse_3d: the 16 f0 slices of a (n.v, sigma)
 GRAZING_NOV = 0.1
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def rules(device: str):
     """GL rules of orders 0..MAX_ORDER as rows of (MAX_ORDER + 1, MAX_ORDER) arrays (row n = order n)."""
     xs = np.zeros((MAX_ORDER + 1, MAX_ORDER))

@@ -14,13 +14,13 @@ have it (lutbake.integrands.specular), not by a quadrature.
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import warp as wp
 
 from ..edge import COS_EPS
 from ..records import NDF
+from ..runtime.warp_runtime import kernel_factory
 from . import masking
 
 
@@ -57,7 +57,7 @@ class Distribution:
         return _pdf_vndf(self)
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def _G2(d: Distribution, masking_name: str):
     """The composed masking-shadowing ``G2(NoV, NoL, NoH, VoH, alpha)`` of ``d`` and a masking form."""
     Lam = d.Lambda
@@ -91,7 +91,7 @@ def _G2(d: Distribution, masking_name: str):
     return G2
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def _pdf_ndf(d: Distribution):
     """Density of h under NDF sampling: p(h) = D(h) (n.h), or the polar mapping's own (Distribution.polar_pdf)."""
     if d.polar_pdf is not None:
@@ -105,7 +105,7 @@ def _pdf_ndf(d: Distribution):
     return pdf_ndf
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def _sample_ndf(d: Distribution):
     """h from the NDF's inverse CDF: tan^2 theta = CDF^-1(u1) (float64), phi = 2 pi u2; density ``pdf_ndf``."""
     t2u = d.tan2_from_u
@@ -121,7 +121,7 @@ def _sample_ndf(d: Distribution):
     return sample_ndf
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def _pdf_vndf(d: Distribution):
     """Density of h under visible-normal sampling (``sample_vndf``): p(h) = G1(v) max(0, v.h) D(h) / (n.v)."""
     D, Lam = d.D, d.Lambda
@@ -152,7 +152,7 @@ NDFS = {r.name: from_record(r) for r in NDF if r.plugin is None}  # lutbake's ow
 GGX, BECKMANN, BLINN_PHONG = NDFS["ggx"], NDFS["beckmann"], NDFS["blinn_phong"]
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def theta_cdf():
     """(tan2_from_u, u_from_tan2, pdf) of the plain polar angle, u = theta / (pi/2), phi = 2 pi u2: the outer variable
     of the Gauss-Legendre panels for an NDF that gives no CDF of its own (a plugin's, lutbake.plugins.register_ndf).

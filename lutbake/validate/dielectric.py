@@ -20,13 +20,11 @@
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 import warp as wp
 
 from ..edge import ALPHA_MIN
-from ..runtime.warp_runtime import unique_kernel
+from ..runtime.warp_runtime import kernel_factory, unique_kernel
 from ..terms import dielectric as td
 from ..terms import fresnel
 from ..terms.distributions import NDFS
@@ -117,7 +115,7 @@ def dielectric_index_matched():
     )
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def _bsdf_kernel(masking: str):
     D = NDFS["ggx"].D
     G2 = NDFS["ggx"].G2(masking)

@@ -29,14 +29,12 @@ Host API (inputs broadcast against each other; ``h``, ``l``, ``v`` carry a trail
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 import warp as wp
 
 from ..edge import COS_EPS
 from ..records import MASKING
-from ..runtime.warp_runtime import MODULE_OPTIONS
+from ..runtime.warp_runtime import MODULE_OPTIONS, kernel_factory
 from ..terms import fresnel, masking, ndf
 from ..terms.distributions import NDFS
 
@@ -203,7 +201,7 @@ def _terms_kernel(
 # --- full specular BRDFs ------------------------------------------------------------------------
 
 
-@functools.lru_cache(maxsize=None)
+@kernel_factory
 def specular_brdf_for(ndf_name: str, masking_name: str):
     """``f(l, v, alpha, f0)``: the Cook-Torrance specular BRDF of one (NDF, masking) pair with Schlick F,
     assembled from the terms exactly as tables assemble it (module docstring)."""
