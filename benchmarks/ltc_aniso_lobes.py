@@ -83,10 +83,17 @@ def main():
     t0 = time.perf_counter()
     between = between_table(GRID, mag, per_texel, a.configs, a.between_iterations, a.mu)  # the kind's
     seconds["between_fit"] = time.perf_counter() - t0
-    held = BetweenLobes(training_set(GRID, 2000, 32, 2000, HEMISPHERE), int(np.prod(GRID.n)), 2)
+    t0 = time.perf_counter()
+    three = between_table(GRID, mag, per_texel, a.configs, a.between_iterations, a.mu, lobes=3)  # lobes = 3
+    seconds["between_fit_three_lobes"] = time.perf_counter() - t0
+    held_set = training_set(GRID, 2000, 32, 2000, HEMISPHERE)
     held_cost = {
-        name: held.cost(packed(*table))
-        for name, table in (("two_per_texel", between_start(mag, per_texel)), ("two_between", between))
+        name: BetweenLobes(held_set, int(np.prod(GRID.n)), table[1].shape[1]).cost(packed(*table))
+        for name, table in (
+            ("two_per_texel", between_start(mag, per_texel)),
+            ("two_between", between),
+            ("three_between", three),
+        )
     }
 
     rng = np.random.default_rng(7)
@@ -102,6 +109,7 @@ def main():
             ("table, one lobe (the shaded fit)", shade(m[0], e[0, 0], lights)),
             ("table, two lobes per texel", shade_lobes(*per_texel, cfg, lights)),
             ("table, two lobes between texels", shade_lobes(*between, cfg, lights)),
+            ("table, three lobes between texels", shade_lobes(*three, cfg, lights)),
         ):
             rows.extend((name, *cfg[:3], tr, es, e[0, 0]) for tr, es in zip(truth, est))
         node = nearest_texel(GRID, *cfg)

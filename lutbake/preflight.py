@@ -217,7 +217,8 @@ def check_path_lengths(jobs, cache_dir=None, report=None) -> None:
             raise ConfigError(option, option.lstrip("-"), shorten(str(value)), message=problem)
 
 
-ORDINALS = ("second", "third", "fourth", "fifth", "sixth")  # a file set's later members (lutbake.io.file_sets)
+# a file set's later members (lutbake.io.file_sets: at most MAX_LOBES x 3 files)
+ORDINALS = ("second", "third", "fourth", "fifth", "sixth", "seventh", "eighth", "ninth")
 
 
 def planned_files(job) -> list[tuple[Path, str]]:

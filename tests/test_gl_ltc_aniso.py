@@ -77,13 +77,14 @@ def host_specular(tex: np.ndarray, points: list[tuple]) -> np.ndarray:
 SPECULAR = {  # textures -> the shader's function (docs/shaders/ltc_aniso.glsl)
     3: "lutbake_ltc_aniso_specular(t0, t1, t2, ",
     6: "lutbake_ltc_aniso_specular_two_lobes(t0, t1, t2, t3, t4, t5, ",
+    9: "lutbake_ltc_aniso_specular_three_lobes(t0, t1, t2, t3, t4, t5, t6, t7, t8, ",
 }
 
 
 def gl_specular(ctx, blobs: list[bytes], size: tuple[int, int, int], dtype: str, points: list[tuple]):  # noqa: F811
-    """docs/shaders/ltc_aniso.glsl at ``points``, its t0, t1, t2 (six blobs: to t5, the two-lobe function) uploaded
-    from ``blobs`` (each a 3D texture's texels in glTexImage3D order, ``size`` = (width, height, depth), moderngl
-    ``dtype`` f2 or f4)."""
+    """docs/shaders/ltc_aniso.glsl at ``points``, its t0, t1, t2 (six or nine blobs: to t5 or t8, the two- or three-lobe
+    function) uploaded from ``blobs`` (each a 3D texture's texels in glTexImage3D order, ``size`` = (width, height,
+    depth), moderngl ``dtype`` f2 or f4)."""
     import moderngl
 
     n = len(points)
@@ -196,17 +197,22 @@ def test_half_textures_shade_within_1e_3_of_float32(published):
     assert lit.sum() > N_POINTS // 3 and rel.max() < HALF_MAX_RTOL and np.median(rel) < HALF_MEDIAN_RTOL
 
 
-def test_gl_two_lobes_are_the_sum_of_the_two_one_lobe_sets(ctx, published):  # noqa: F811
-    """lobes = 2 (lutbake.ltc.aniso_lobes.two_lobe_textures' layout, six textures): the shader's two-lobe function
-    equals the host reconstruction of (t0, t1, t2) plus that of (t3, t4, t5). Lobe 2: the published M broadened
-    twice in x and y (not normalised: the layout does not need |M e_z| = 1), other weights."""
+@pytest.mark.parametrize("lobes", [2, 3])
+def test_gl_lobes_are_the_sum_of_the_one_lobe_sets(ctx, published, lobes):  # noqa: F811
+    """lobes = 2 and 3 (lutbake.ltc.aniso_lobes.lobe_textures' layout, 3 K textures): the shader's two- and three-lobe
+    functions equal the host reconstruction of (t0, t1, t2) plus that of (t3, t4, t5) (plus (t6, t7, t8)). Lobe k > 1:
+    the published M broadened k times in x and y (not normalised: the layout does not need |M e_z| = 1), other
+    weights."""
     g = aniso.Grid4("alphax_alphay", (N,) * 4)
     m = np.load(DATA / "ltc_aniso_alphax_alphay_theta_phi.npy").astype(np.float64)
     a, b, th, _ = np.meshgrid(*g.axes(), indexing="ij")
-    second = aniso.texture_layout(m @ np.diag([2.0, 2.0, 1.0]), 0.2 + 0.1 * a, 0.02 + 0.03 * b * th, np.zeros(g.n))
-    six = np.concatenate([published, second])
+    more = [
+        aniso.texture_layout(m @ np.diag([k, k, 1.0]), 0.2 / k + 0.1 * a, 0.02 + 0.03 * b * th / k, np.zeros(g.n))
+        for k in range(2, lobes + 1)
+    ]
     points = shading_points()
-    want = host_specular(published, points) + host_specular(second, points)
-    got = gl_specular(ctx, [np.ascontiguousarray(t).tobytes() for t in six], (N, N, N * N), "f4", points)
-    assert np.abs(host_specular(second, points)).max() > 10 * GL_ATOL  # lobe 2 is seen
+    want = host_specular(published, points) + sum(host_specular(t, points) for t in more)
+    blobs = [np.ascontiguousarray(t).tobytes() for t in np.concatenate([published, *more])]
+    got = gl_specular(ctx, blobs, (N, N, N * N), "f4", points)
+    assert min(np.abs(host_specular(t, points)).max() for t in more) > 10 * GL_ATOL  # every lobe is seen
     np.testing.assert_allclose(got, want, rtol=GL_RTOL, atol=GL_ATOL)

@@ -255,7 +255,7 @@ def test_inspect_shows_each_textures_own_record(baked, file, texture):
     assert all(f"{c} = {n}:" in out for c, n in zip("RGBA", names))
 
 
-@pytest.mark.parametrize("lobes, texture, nth", [(1, "t2", "third"), (2, "t5", "sixth")])
+@pytest.mark.parametrize("lobes, texture, nth", [(1, "t2", "third"), (2, "t5", "sixth"), (3, "t8", "ninth")])
 def test_a_config_plans_every_texture_and_refuses_a_table_writing_one_of_them(tmp_path, lobes, texture, nth):
     """The other textures are the output's files (lutbake.preflight.planned_files; three per lobe): a table whose
     file is one of them is refused before any kernel runs."""

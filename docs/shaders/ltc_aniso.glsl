@@ -3,8 +3,9 @@
 // docs/shaders/lutbake_ltc.glsl (lutbake_ltc_polygon, lutbake_ltc_edge) included first. GLSL 3.30.
 //
 // Files: kind ltc_aniso, format ktx2 or dds: <name>_t0, _t1, _t2 (.ktx2 / .dds), one 3D texture each (preset
-// ltc-aniso: RGBA16F KTX 2.0); lobes = 2: <name>_t0 .. _t5, lutbake_ltc_aniso_specular_two_lobes (at the end). Tables (lutbake.ltc.aniso.texture_layout; benchmarks/bench_ltc_aniso.py writes
-// ltc_aniso_textures.npy): three RGBA
+// ltc-aniso: RGBA16F KTX 2.0); lobes = 2: <name>_t0 .. _t5, lutbake_ltc_aniso_specular_two_lobes, lobes = 3:
+// <name>_t0 .. _t8, lutbake_ltc_aniso_specular_three_lobes (at the end). Tables (lutbake.ltc.aniso.texture_layout;
+// benchmarks/bench_ltc_aniso.py writes ltc_aniso_textures.npy): three RGBA
 // 3D textures, linear filtering, clamp to edge, of width N_PHI (x = view azimuth phi from the tangent, [0, pi/2]),
 // height N_THETA (y = theta_v / (0.9999 pi / 2)) and depth N_A * N_B (z = layer b + N_B a: the 4th axis packed, as
 // the paper's Tex3D path; a = alpha_x, b = alpha_y, both i / (N - 1), endpoint texels):
@@ -69,4 +70,14 @@ vec3 lutbake_ltc_aniso_specular_two_lobes(sampler3D t0, sampler3D t1, sampler3D 
                                           vec3 f0, vec3 p[4], vec3 Li, bool two_sided) {
     return lutbake_ltc_aniso_specular(t0, t1, t2, N, T, V, alpha_x, alpha_y, f0, p, Li, two_sided) +
            lutbake_ltc_aniso_specular(t3, t4, t5, N, T, V, alpha_x, alpha_y, f0, p, Li, two_sided);
+}
+
+// Three lobes (lobes = 3: files <name>_t0 .. _t8): the two-lobe function's sum with (t6, t7, t8) lobe 3's set added.
+vec3 lutbake_ltc_aniso_specular_three_lobes(sampler3D t0, sampler3D t1, sampler3D t2, sampler3D t3, sampler3D t4,
+                                            sampler3D t5, sampler3D t6, sampler3D t7, sampler3D t8, vec3 N, vec3 T,
+                                            vec3 V, float alpha_x, float alpha_y, vec3 f0, vec3 p[4], vec3 Li,
+                                            bool two_sided) {
+    return lutbake_ltc_aniso_specular_two_lobes(t0, t1, t2, t3, t4, t5, N, T, V, alpha_x, alpha_y, f0, p, Li,
+                                                two_sided) +
+           lutbake_ltc_aniso_specular(t6, t7, t8, N, T, V, alpha_x, alpha_y, f0, p, Li, two_sided);
 }

@@ -3,13 +3,13 @@
 The first file of a set is the one the output's sidecar ``<first>.json`` describes (``file``); the sidecar lists
 every file (``files``) and names the sha256 of the others (``files_sha256``, lutbake.io.integrity), so a missing or
 edited member makes the output not up to date. A set is chosen by (kind, format): ``format = "ktx2"`` of a kind
-``ltc_aniso`` table is three 3D textures per lobe (its ``lobes`` option: 3 or 6 files), of any other kind one file.
+``ltc_aniso`` table is three 3D textures per lobe (its ``lobes`` option: 3, 6 or 9 files), of any other kind one file.
 
 | kind | format | files | sidecar ``format`` |
 | --- | --- | --- | --- |
 | any (``ltc`` only) | ``ltc_dds`` | <name>_1.dds, <name>_2.dds | ``ltc_dds`` |
-| ``ltc_aniso`` | ``ktx2`` | <name>_t0.ktx2 ... _t2.ktx2 (``lobes = 2``: ... _t5.ktx2) | ``ltc_aniso_ktx2`` |
-| ``ltc_aniso`` | ``dds`` | <name>_t0.dds ... _t2.dds (``lobes = 2``: ... _t5.dds) | ``ltc_aniso_dds`` |
+| ``ltc_aniso`` | ``ktx2`` | <name>_t0.ktx2 ... _t2.ktx2 (2, 3 lobes: _t5, _t8.ktx2) | ``ltc_aniso_ktx2`` |
+| ``ltc_aniso`` | ``dds`` | <name>_t0.dds ... _t2.dds (2, 3 lobes: _t5, _t8.dds) | ``ltc_aniso_dds`` |
 
 A set's suffixes are the most it may hold; ``set_size`` the count a table's options choose (the first that many).
 """
@@ -20,7 +20,7 @@ from pathlib import Path
 
 ANY_KIND = None
 TEXTURES_PER_LOBE = 3  # an ltc_aniso table's 3D textures per lobe (lutbake.io.ltc_aniso_textures)
-MAX_LOBES = 2
+MAX_LOBES = 3  # the most lobes an ltc_aniso table has (its ``lobes`` key's maximum)
 
 
 def texture_suffixes(ext: str) -> tuple[str, ...]:
@@ -57,7 +57,7 @@ def set_files(name: str, kind: str | None, fmt: str, options: dict | None = None
 
 def members(path) -> list[Path]:
     """Every file of the set a data file ``path`` may belong to, judged by its name alone (``foo_t1.ktx2`` ->
-    ``foo_t0.ktx2`` ... ``foo_t5.ktx2``: the most its set may hold), the first the one whose sidecar lists them; []
+    ``foo_t0.ktx2`` ... ``foo_t8.ktx2``: the most its set may hold), the first the one whose sidecar lists them; []
     when its name ends in no set's suffix. A plain table named ``foo_t1`` matches too: readers check the sidecar's
     ``files``, which names the set's own."""
     path = Path(path)

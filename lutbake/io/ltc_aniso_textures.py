@@ -1,11 +1,12 @@
 """An ``ltc_aniso`` table (lutbake.kinds.ltc_aniso) as the 3D textures its shader samples, three per lobe, one file
-each: ``format = "ktx2"`` -> <name>_t0.ktx2, <name>_t1.ktx2, <name>_t2.ktx2 (``lobes = 2``: to <name>_t5.ktx2);
+each: ``format = "ktx2"`` -> <name>_t0.ktx2, <name>_t1.ktx2, <name>_t2.ktx2 (2, 3 lobes: to _t5, _t8);
 ``format = "dds"`` -> <name>_t0.dds, ... (lutbake.io.file_sets), written as one unit: the other files, then
 <name>_t0.*, then the sidecar <name>_t0.<ext>.json naming the sha256 of all of them (lutbake.io.integrity), so a
 missing or edited texture makes the output not up to date.
 
 Texture k (t0 = (M00, M01, M02, M10), t1 = (M11, M12, M20, M21), t2 = (M22, magnitude, fresnel, fit_error); two
-lobes: (t0, t1, t2) lobe 1's and (t3, t4, t5) lobe 2's, t2 and t5 = (M22, weight, weight_fresnel, sum_error)) is
+or three lobes: (t0, t1, t2) lobe 1's, (t3, t4, t5) lobe 2's, (t6, t7, t8) lobe 3's, t2, t5, t8 = (M22, weight,
+weight_fresnel, sum_error)) is
 width N (phi_v), height N (theta_v), depth N^2 (layer = b + N a), RGBA, one level:
 - **KTX 2.0** (lutbake.io.ktx2.encode): pixelDepth N^2, layerCount 0, faceCount 1, levelCount 1,
   VK_FORMAT_R16G16B16A16_SFLOAT (dtype half) / R32G32B32A32_SFLOAT (float32), the basic DFD (RGBSDA, BT.709, linear),
@@ -40,15 +41,19 @@ TEXTURES = {  # the shader's sampler -> its RGBA (docs/shaders/ltc_aniso.glsl; l
     "t1": ("M11", "M12", "M20", "M21"),
     "t2": ("M22", "magnitude", "fresnel", "fit_error"),
 }
-LOBE_TEXTURES = (TEXTURES["t0"], TEXTURES["t1"], ("M22", "weight", "weight_fresnel", "sum_error"))  # two lobes' sets
+LOBE_TEXTURES = (
+    TEXTURES["t0"],
+    TEXTURES["t1"],
+    ("M22", "weight", "weight_fresnel", "sum_error"),
+)  # the sets of K > 1 lobes
 CONTAINERS = {"ktx2": "KTX 2.0", "dds": "DDS"}
 SIDECAR_FORMATS = {file_set(KIND, fmt)[1]: fmt for fmt in CONTAINERS}  # ltc_aniso_ktx2 -> ktx2, ...
 SET_SIZES = tuple(TEXTURES_PER_LOBE * k for k in range(1, MAX_LOBES + 1))  # files of a set: three per lobe
 
 
 def texture_names(count: int) -> dict[str, tuple[str, ...]]:
-    """Each texture's RGBA names of a table of ``count`` textures: 3 (one lobe) TEXTURES, 6 (two lobes) LOBE_TEXTURES
-    twice (t0..t2 lobe 1, t3..t5 lobe 2)."""
+    """Each texture's RGBA names of a table of ``count`` textures: 3 (one lobe) TEXTURES, 3 K (K lobes) LOBE_TEXTURES
+    K times (t0..t2 lobe 1, t3..t5 lobe 2, ...)."""
     if count == len(TEXTURES):
         return TEXTURES
     return {f"t{k}": LOBE_TEXTURES[k % len(LOBE_TEXTURES)] for k in range(count)}
@@ -110,13 +115,13 @@ def _write(table: Table, path, dtype: str, container: str) -> Path:
 
 
 def write_ktx2_textures(table: Table, path, dtype: str = "float32") -> Path:
-    """<name>_t0.ktx2, _t1.ktx2, _t2.ktx2 (two lobes: to _t5.ktx2) and the sidecar (module docstring); ``path`` the
+    """<name>_t0.ktx2, _t1.ktx2, _t2.ktx2 (2, 3 lobes: to _t5, _t8) and the sidecar (module docstring); ``path`` the
     first."""
     return _write(table, path, dtype, "ktx2")
 
 
 def write_dds_textures(table: Table, path, dtype: str = "float32") -> Path:
-    """<name>_t0.dds, _t1.dds, _t2.dds (two lobes: to _t5.dds) and the sidecar (module docstring); ``path`` the
+    """<name>_t0.dds, _t1.dds, _t2.dds (2, 3 lobes: to _t5, _t8) and the sidecar (module docstring); ``path`` the
     first."""
     return _write(table, path, dtype, "dds")
 

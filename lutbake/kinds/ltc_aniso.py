@@ -17,9 +17,10 @@ Stored as lutbake.ltc.aniso.texture_layout's three RGBA 3D textures of width N (
 three textures as 3D texture files <name>_t0, _t1, _t2 (lutbake.io.ltc_aniso_textures), the same bytes;
 ``format = "ltc_aniso_npy"`` the paper's own layout instead: M as (N, N, N, N, 3, 3) float32 (its LUT/*.npy; no
 magnitude, as the paper's; lutbake.io.ltc.write_ltc_aniso_npy). The shader: docs/shaders/ltc_aniso.glsl.
-``lobes = 2`` (fit shaded only; not ltc_aniso_npy): two LTCs per texel, value = w_1 I(M_1) + w_2 I(M_2), fitted per
-texel and between the texels (lutbake.ltc.aniso_lobes), as six textures: (t0, t1, t2) lobe 1's, (t3, t4, t5) lobe
-2's, each set a one-lobe table's layout with t2 = (M22, w_k, w_k fresnel / magnitude, sum_error).
+``lobes = 2`` or ``3`` (fit shaded only; not ltc_aniso_npy): K LTCs per texel, value = Σ_k w_k I(M_k), fitted per
+texel and between the texels (three split from two; lutbake.ltc.aniso_lobes), as 3 K textures: (t0, t1, t2) lobe 1's,
+(t3, t4, t5) lobe 2's, (t6, t7, t8) lobe 3's, each set a one-lobe table's layout with t2 = (M22, w_k,
+w_k fresnel / magnitude, sum_error).
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ import json
 import numpy as np
 
 from ..axes import Axis
+from ..io.file_sets import MAX_LOBES
 from ..io.ltc_aniso_textures import texture_names
 from ..limits import LTC_FIT_GRID
 from ..ltc import aniso_grid as aniso
@@ -110,16 +112,17 @@ KEYS = {
         "lobes",
         "int",
         1,
-        "LTCs per texel: 1, or 2 (a sum w_1 I(M_1) + w_2 I(M_2), six textures, two polygon integrals in the shader; "
-        "fit = 'shaded' only, not format ltc_aniso_npy; lutbake.ltc.aniso_lobes)",
+        "LTCs per texel: 1, 2 or 3 (a sum Σ_k w_k I(M_k), 3 K textures, K polygon integrals in the shader; "
+        "fit = 'shaded' only, not format ltc_aniso_npy; three: the two-lobe table's narrow lobe split in two and "
+        "refitted; lutbake.ltc.aniso_lobes)",
         minimum=1,
-        maximum=2,
+        maximum=MAX_LOBES,
     ),
     "between_configs": Key(
         "between_configs",
         "int",
         aniso.BETWEEN_CONFIGS,
-        "lobes = 2: training configurations (uniform in table coordinates) of the fit between the texels",
+        "lobes >= 2: training configurations (uniform in table coordinates) of the fit between the texels",
         minimum=16,
         maximum=100000,
     ),
@@ -127,7 +130,8 @@ KEYS = {
         "between_iterations",
         "int",
         aniso.BETWEEN_ITERATIONS,
-        "lobes = 2: Levenberg-Marquardt steps of the fit between the texels (0: each texel fitted at itself only)",
+        "lobes >= 2: Levenberg-Marquardt steps of the fit between the texels (0: each texel fitted at itself only; "
+        "three lobes: as many again after the split)",
         minimum=0,
         maximum=200,
     ),
@@ -144,14 +148,21 @@ CHANNELS = {
     "z": "t0: M02; t1: M20; t2: fresnel = ∫ f (1 - v.h)^5 (n.l) dω_l",
     "w": "t0: M10; t1: M21; t2: fit_error = (E / ∫ f^3 dω)^(1/3), E = Heitz's L3 metric of the texel's fit",
 }
-LOBES_CHANNELS = {  # lobes = 2: (t0, t1, t2) lobe 1's, (t3, t4, t5) lobe 2's (lutbake.ltc.aniso_lobes)
-    "x": "t0/t3: M00; t1/t4: M11; t2/t5: M22 (lobe 1's / lobe 2's M row-major, tangent frame, as the between fit "
-    "leaves it: not scaled to |M e_z| = 1)",
-    "y": "t0/t3: M01; t1/t4: M12; t2/t5: weight w_k (value = Σ_k w_k I(M_k) with F = 1)",
-    "z": "t0/t3: M02; t1/t4: M20; t2/t5: weight_fresnel = w_k fresnel / magnitude (the lobe's Schlick part)",
-    "w": "t0/t3: M10; t1/t4: M21; t2/t5: sum_error = the sum's relative RMS shaded residual at the texel over its "
-    "137 lights (lutbake.ltc.aniso_lobes.sum_error; the same in t2 and t5)",
-}
+
+
+def lobes_channels(lobes: int) -> dict[str, str]:
+    """The channels of a table of ``lobes`` > 1: lobe k's set t(3k-3), t(3k-2), t(3k-1) (lutbake.ltc.aniso_lobes)."""
+    t0, t1, t2 = ("/".join(f"t{3 * k + i}" for k in range(lobes)) for i in range(3))
+    return {
+        "x": f"{t0}: M00; {t1}: M11; {t2}: M22 (lobe k's M row-major, tangent frame, as the between fit leaves it: not "
+        "scaled to |M e_z| = 1)",
+        "y": f"{t0}: M01; {t1}: M12; {t2}: weight w_k (value = Σ_k w_k I(M_k) with F = 1)",
+        "z": f"{t0}: M02; {t1}: M20; {t2}: weight_fresnel = w_k fresnel / magnitude (the lobe's Schlick part)",
+        "w": f"{t0}: M10; {t1}: M21; {t2}: sum_error = the sum's relative RMS shaded residual at the texel over its "
+        "137 lights (lutbake.ltc.aniso_lobes.sum_error; the same in every set)",
+    }
+
+
 SUM_ERROR_METRIC = (
     "sqrt(mean_j z_j^2), z_j = (Σ_k w_k I_j(M_k) - G_j) / (G_j + 0.4 magnitude) over the texel's 128 training lights "
     "and 9 hemisphere lights, G_j from 48^2 lobe samples, at the texel itself (lutbake.ltc.aniso_lobes.sum_error)"
@@ -163,6 +174,10 @@ LOBES_FIT = (
     "every texel's 2 x (M, w) fitted between the texels: the interpolated sum's shaded cost at {configs} "
     "configurations uniform in table coordinates x (32 lights + 9 hemisphere lights), + 0.001 mean(diag J^T J) "
     "|x - x0|^2 towards the per-texel table, {iterations} Levenberg-Marquardt steps"
+)
+SPLIT_FIT = (
+    "; three lobes: the narrow lobe split into M_1 diag(0.85, 0.85, 1) (lobe 1) and M_1 diag(1.15, 1.15, 1) (lobe "
+    "3), half its weight each, then the three lobes fitted between the texels as above ({iterations} steps)"
 )
 RECONSTRUCTION = (
     "docs/shaders/ltc_aniso.glsl lutbake_ltc_aniso_specular(t0, t1, t2, N, T, V, alpha_x, alpha_y, f0, p, Li, "
@@ -176,9 +191,9 @@ RECONSTRUCTION = (
 
 LOBES_RECONSTRUCTION = (
     "docs/shaders/ltc_aniso.glsl lutbake_ltc_aniso_specular_two_lobes(t0, t1, t2, t3, t4, t5, N, T, V, alpha_x, "
-    "alpha_y, f0, p, Li, two_sided) = lutbake_ltc_aniso_specular on (t0, t1, t2) + on (t3, t4, t5): each set as the "
-    "one-lobe table's (its M, t2.y = w_k, t2.z = w_k fresnel / magnitude: specular = Σ_k Li I_k (f0 t2.y + "
-    "(1 - f0) t2.z))"
+    "alpha_y, f0, p, Li, two_sided) = lutbake_ltc_aniso_specular on (t0, t1, t2) + on (t3, t4, t5) (three lobes: "
+    "lutbake_ltc_aniso_specular_three_lobes, + on (t6, t7, t8)): each set as the one-lobe table's (its M, t2.y = w_k, "
+    "t2.z = w_k fresnel / magnitude: specular = Σ_k Li I_k (f0 t2.y + (1 - f0) t2.z))"
 )
 
 
@@ -224,7 +239,7 @@ def plan(spec) -> TexelPlan:
         o["lobes"],
         (o["between_configs"], o["between_iterations"]),
     )
-    two = o["lobes"] == 2
+    two = o["lobes"] > 1
     a, b, _, _ = g.axes()
     n = o["size"]
     n_fit = len(aniso.fitted_texels(g))
@@ -248,6 +263,7 @@ def plan(spec) -> TexelPlan:
         + ("" if o["fit"] == "l3" else f"; then shaded: {SHADED}")
         + (
             f"; then {LOBES_FIT.format(configs=o['between_configs'], iterations=o['between_iterations'])}"
+            + (SPLIT_FIT.format(iterations=o["between_iterations"]) if o["lobes"] == 3 else "")
             if two
             else ""
         ),
@@ -259,13 +275,14 @@ def plan(spec) -> TexelPlan:
         "ltc_aniso_shader": LOBES_RECONSTRUCTION if two else RECONSTRUCTION,
     }
     if two:
+        sets = ", ".join(f"t{3 * k}, t{3 * k + 1}, t{3 * k + 2} lobe {k + 1}'s" for k in range(o["lobes"]))
         extra["ltc_aniso_lobes"] = (
-            "2: value = w_1 I(M_1) + w_2 I(M_2); textures t0, t1, t2 lobe 1's and t3, t4, t5 lobe 2's, each set laid "
-            "out as a one-lobe table's with t2/t5 = (M22, w_k, w_k fresnel / magnitude, sum_error)"
+            f"{o['lobes']}: value = Σ_k w_k I(M_k); textures {sets}, each set laid out as a one-lobe table's with its "
+            "third texture = (M22, w_k, w_k fresnel / magnitude, sum_error)"
         )
     return TexelPlan(
         axes=axes_for(o),
-        channels=LOBES_CHANNELS if two else CHANNELS,
+        channels=lobes_channels(o["lobes"]) if two else CHANNELS,
         reconstruction=LOBES_RECONSTRUCTION if two else RECONSTRUCTION,
         n_texels=texel_count(o),
         n_channels=4,
@@ -282,7 +299,9 @@ def plan(spec) -> TexelPlan:
         cost=float(n_fit) * 300 * 2 * o["fit_samples"] ** 2
         + float(n**4) * samples
         # two lobes: 40 steps x 137 lights x 20 unknowns per fitted texel; per between step ~30 integrals per light
-        + two * (float(n_fit) * 40 * 137 * 20 + o["between_configs"] * o["between_iterations"] * 41 * 30),
+        # (three lobes: the between fit again, ~45 integrals per light)
+        + two * (float(n_fit) * 40 * 137 * 20 + o["between_configs"] * o["between_iterations"] * 41 * 30)
+        + (o["lobes"] == 3) * o["between_configs"] * o["between_iterations"] * 41 * 45,
         extra=extra,
         attributes_after=lambda data: {
             **fit_error_stats(data, (2, 3), SUM_ERROR_METRIC if two else L3_METRIC),
@@ -293,13 +312,17 @@ def plan(spec) -> TexelPlan:
 
 def check_spec(spec):
     o = spec.options
-    if o["lobes"] == 2 and o["fit"] != "shaded":
-        return ("fit", "lobes = 2 starts from the shaded one-lobe fit: fit 'shaded' (allowed with lobes = 2: shaded)")
-    if o["lobes"] == 2 and o["format"] == "ltc_aniso_npy":
+    k = o["lobes"]
+    if k > 1 and o["fit"] != "shaded":
+        return (
+            "fit",
+            f"lobes = {k} starts from the shaded one-lobe fit: fit 'shaded' (allowed with lobes = {k}: shaded)",
+        )
+    if k > 1 and o["format"] == "ltc_aniso_npy":
         return (
             "format",
-            "ltc_aniso_npy is the paper's layout of one M per texel, no room for lobes = 2: format exr, npy, ktx2 or "
-            "dds (lobes = 2 writes six textures)",
+            f"ltc_aniso_npy is the paper's layout of one M per texel, no room for lobes = {k}: format exr, npy, ktx2 "
+            f"or dds (lobes = {k} writes {3 * k} textures)",
         )
     if spec.options["format"] == "ltc_aniso_npy" and spec.options["dtype"] != "float32":
         return ("dtype", "ltc_aniso_npy is the paper's float32 array: dtype 'float32'")

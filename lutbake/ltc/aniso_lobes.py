@@ -1,7 +1,7 @@
-"""Two-lobe anisotropic GGX LTC tables (kind ltc_aniso, ``lobes = 2``): a sum of K LTCs per texel, value(P) =
-Σ_k w_k I_P(M_k) (Heitz et al. 2016, Eq. 11 per lobe; w_k free, M_k general; the shader's cost K polygon integrals),
-fitted per texel and then between the texels, as benchmarks/ltc_aniso_lobes.py measures (docs/ltc_aniso.md, "More
-than one lobe").
+"""Anisotropic GGX LTC tables of two or three lobes (kind ltc_aniso, ``lobes = 2`` / ``3``): a sum of K LTCs per texel,
+value(P) = Σ_k w_k I_P(M_k) (Heitz et al. 2016, Eq. 11 per lobe; w_k free, M_k general; the shader's cost K polygon
+integrals), fitted per texel and then between the texels, as benchmarks/ltc_aniso_lobes.py measures (docs/ltc_aniso.md,
+"More than one lobe").
 
 1. Per texel (``fit_lobes``): lutbake.ltc.aniso_shaded.levenberg_marquardt on lutbake.ltc.shaded's cost (soft-L1 of
    (value_j - G_j) / (G_j + 0.4 A)) over lutbake.ltc.shaded.texel_lights' 128 training lights plus ``HEMISPHERE``'s
@@ -18,6 +18,11 @@ than one lobe").
    dense 16-corner Jacobians and a sparse (texel x configuration) weight matrix, conjugate gradients with the Jacobi
    preconditioner. M_k are left as the fit leaves them (not scaled to |M e_z| = 1 per texel: that would change the
    interpolated M the fit chose; the polygon integral does not see a matrix's scale).
+3. Three lobes (``split_narrow``): the two-lobe between table's narrow lobe split in two, then the between fit again
+   with three lobes. Three lobes fitted per texel (1.) are no start: their lobes trade roles from texel to texel, and
+   the between fit from them ended worse than two lobes (benchmarks/ltc_aniso_lobes.py's set: 0.041 / 0.0124 against
+   0.029 / 0.0069, median relative / p90 |error| / albedo); split from two lobes every lobe varies across the texels
+   as the two-lobe table's do (0.027 / 0.0060).
 ``sum_error``: the per-texel relative RMS of the sum's shaded residual at the texel itself. Cost at the paper's 8^4
 (outputs/bench/ltc_aniso_lobes.json's seconds, two threads): the per-texel fit 92 s, the between fit 323 s at 20000
 configurations and 20 steps.
@@ -41,6 +46,7 @@ LOBE_ITERATIONS = 40  # fit_lobes' Levenberg-Marquardt steps
 BETWEEN_LIGHTS = 32  # training lights per configuration (+ HEMISPHERE)
 BETWEEN_SEED = 1000  # the training set's random numbers
 BETWEEN_SAMPLES = 48  # the training set's lobe samples per configuration: 48^2 stratified
+SPLIT = (0.85, 1.15)  # three lobes: the narrow lobe's M x diag(s, s, 1) for each s, half its weight each
 MU = 0.001  # the between fit's pull towards the per-texel table, relative to mean(diag J^T J) at the start
 CHUNK = 1024  # configurations per AnisoProblem (its lobe samples: CHUNK x 48^2 directions)
 CG_ITERATIONS = 150
@@ -293,6 +299,15 @@ def packed(m: np.ndarray, w: np.ndarray) -> np.ndarray:
     return np.concatenate([m.reshape(len(m), -1), w], axis=1)
 
 
+def split_narrow(m: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Three lobes from two (M (texels, 2, 3, 3) narrowest first, w (texels, 2)): lobe 1 split into M_1 diag(s, s, 1)
+    for s in SPLIT (first and last), half its weight each, lobe 2 between them: the sum nearly unchanged, and each lobe
+    as smooth across the texels as the two-lobe table's."""
+    narrow, broad = (np.diag([s, s, 1.0]) for s in SPLIT)
+    half = 0.5 * w[:, 0]
+    return np.stack([m[:, 0] @ narrow, m[:, 1], m[:, 0] @ broad], 1), np.stack([half, w[:, 1], half], 1)
+
+
 def between_table(
     grid: aniso.Grid4,
     magnitude: np.ndarray,
@@ -300,18 +315,21 @@ def between_table(
     configs: int = BETWEEN_CONFIGS,
     iterations: int = BETWEEN_ITERATIONS,
     mu: float = MU,
+    lobes: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """(M (texels, K, 3, 3), w (texels, K)) of fit_between from ``between_start`` (of per_texel_table's table) on
     ``configs`` training configurations (BETWEEN_LIGHTS lights + HEMISPHERE each, seed BETWEEN_SEED), ``iterations``
-    steps (0: the start itself)."""
+    steps (0: the start itself); ``lobes`` 3 from a two-lobe per-texel table: then split_narrow and ``iterations``
+    steps more with three lobes (module docstring, 3.)."""
     m, w = between_start(magnitude, per_texel)
-    if iterations == 0:
-        return m, w
-    lobes = m.shape[1]
-    x0 = packed(m, w)
-    ts = training_set(grid, configs, BETWEEN_LIGHTS, BETWEEN_SEED, HEMISPHERE)
-    x = fit_between(x0, BetweenLobes(ts, len(x0), lobes), iterations, mu)
-    return x[:, : 9 * lobes].reshape(-1, lobes, 3, 3), x[:, 9 * lobes :]
+    ts = training_set(grid, configs, BETWEEN_LIGHTS, BETWEEN_SEED, HEMISPHERE) if iterations else None
+    for count in sorted({m.shape[1], lobes or m.shape[1]}):
+        if count > m.shape[1]:
+            m, w = split_narrow(m, w)
+        if iterations:
+            x = fit_between(packed(m, w), BetweenLobes(ts, len(m), count), iterations, mu)
+            m, w = x[:, : 9 * count].reshape(-1, count, 3, 3), x[:, 9 * count :]
+    return m, w
 
 
 def sum_error(grid: aniso.Grid4, magnitude: np.ndarray, m: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -335,8 +353,8 @@ def sum_error(grid: aniso.Grid4, magnitude: np.ndarray, m: np.ndarray, w: np.nda
     return np.sqrt(np.mean(z * z, axis=1)).reshape(grid.n)
 
 
-def two_lobe_textures(grid: aniso.Grid4, magnitude, fresnel, m: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """Six RGBA 3D textures (6, n_a n_b, n_theta, n_phi, 4): lobe k's lutbake.ltc.aniso.texture_layout with
+def lobe_textures(grid: aniso.Grid4, magnitude, fresnel, m: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """3 K RGBA 3D textures (3 K, n_a n_b, n_theta, n_phi, 4): lobe k's lutbake.ltc.aniso.texture_layout with
     (M_k, w_k, w_k fresnel / magnitude, sum_error) in place of (M, magnitude, fresnel, fit_error), so that
     f0 t2.y + (1 - f0) t2.z of each set is lobe k's share of the one-lobe shader's Schlick term."""
     err = sum_error(grid, magnitude, m, w)

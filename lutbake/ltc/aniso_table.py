@@ -5,7 +5,7 @@ The whole 4D table is one computation (the symmetries fill the texels not fitted
 the magnitudes (lutbake.ltc.aniso.magnitude_fresnel) and the fit (lutbake.ltc.aniso.fit_table, in tiles of
 aniso.TILE texels on a thread pool: the bits do not depend on the thread count) run once, under a lock, the first
 time a tile is asked for; every tile then reads its rows of lutbake.ltc.aniso.texture_layout, the three RGBA 3D
-textures (two lobes: six, lutbake.ltc.aniso_lobes.two_lobe_textures) flattened (texture, layer, theta, phi)
+textures (K lobes: 3 K, lutbake.ltc.aniso_lobes.lobe_textures) flattened (texture, layer, theta, phi)
 row-major, which is the table's texel order.
 """
 
@@ -29,11 +29,11 @@ def available_threads() -> int:
 
 class AnisoBake:
     """The state one ltc_aniso bake shares between its tiles: ``grid`` (aniso.Grid4), the fit's frame and metric grid,
-    the magnitude's Sobol' budget and seed, ``shaded``: the L3 fit refined to polygon lights
-    (lutbake.ltc.aniso_shaded); ``lobes`` 2: then two lobes per texel, fitted per texel and ``between`` = (training
-    configurations, steps) between the texels (lutbake.ltc.aniso_lobes). ``texels()``: the (3 lobes n_a n_b n_theta
-    n_phi, 4) float64 texels, computed once; ``matrices`` (the one-lobe M in the paper's layout, (n_a, n_b, n_theta,
-    n_phi, 3, 3)) after it."""
+    the magnitude's Sobol' budget and seed, ``shaded``: the L3 fit refined to polygon lights (lutbake.ltc.aniso_shaded);
+    ``lobes`` 2 or 3: then two lobes fitted per texel and ``between`` = (training configurations, steps) between the
+    texels, three split from two (lutbake.ltc.aniso_lobes). ``texels()``: the (3 lobes n_a n_b n_theta n_phi, 4) float64
+    texels, computed once; ``matrices`` (the one-lobe M in the paper's layout, (n_a, n_b, n_theta, n_phi, 3, 3)) after
+    it."""
 
     def __init__(
         self,
@@ -87,12 +87,12 @@ class AnisoBake:
                     from .aniso_shaded import refine_table
 
                     m, err = refine_table(g, mag, m, self.fit_samples, device, available_threads())
-                if self.lobes == 2:
+                if self.lobes > 1:
                     from . import aniso_lobes
 
                     per_texel = aniso_lobes.per_texel_table(g, mag, m, 2, available_threads())
-                    lm, lw = aniso_lobes.between_table(g, mag, per_texel, *self.between)
-                    tex = aniso_lobes.two_lobe_textures(g, mag, fres, lm, lw).astype(np.float64)
+                    lm, lw = aniso_lobes.between_table(g, mag, per_texel, *self.between, lobes=self.lobes)
+                    tex = aniso_lobes.lobe_textures(g, mag, fres, lm, lw).astype(np.float64)
                 else:
                     tex = aniso.texture_layout(m, mag, fres, err).astype(np.float64)
                 if not np.all(np.isfinite(tex)):
