@@ -37,15 +37,19 @@ from bench_ltc_aniso import OUT, configuration, configuration_fit, nearest_texel
 from ltc_aniso_between import GRID
 
 from lutbake.ltc import aniso, aniso_shaded
+from lutbake.ltc.aniso_grid import BETWEEN_CONFIGS
 from lutbake.ltc.aniso_lobes import (
+    BETWEEN_LIGHTS,
+    BETWEEN_SEED,
     HEMISPHERE,
     TARGET_SAMPLES,
     BetweenLobes,
+    between_fit,
     between_start,
-    between_table,
     fit_lobes,
     packed,
     per_texel_table,
+    split_narrow,
     training_set,
 )
 from lutbake.validate.ltc_area import LIGHTS, light_polygon
@@ -65,7 +69,7 @@ def main():
     ap.add_argument("--bench-configs", type=int, default=240)
     ap.add_argument("--gt", type=int, default=256)
     ap.add_argument("--iterations", type=int, default=40, help="Levenberg-Marquardt steps of fit_lobes")
-    ap.add_argument("--configs", type=int, default=20000, help="training configurations of fit_between")
+    ap.add_argument("--configs", type=int, default=BETWEEN_CONFIGS, help="training configurations of fit_between")
     ap.add_argument("--between-iterations", type=int, default=20)
     ap.add_argument("--mu", type=float, default=0.001)
     a = ap.parse_args()
@@ -81,10 +85,12 @@ def main():
     seconds["two_lobe_table"] = time.perf_counter() - t0
 
     t0 = time.perf_counter()
-    between = between_table(GRID, mag, per_texel, a.configs, a.between_iterations, a.mu)  # the kind's
+    # the kind's between_table (lobes = 2, then 3), its two-lobe table kept: one training set, two fits
+    ts = training_set(GRID, a.configs, BETWEEN_LIGHTS, BETWEEN_SEED, HEMISPHERE)
+    between = between_fit(ts, *between_start(mag, per_texel), a.between_iterations, a.mu)
     seconds["between_fit"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    three = between_table(GRID, mag, per_texel, a.configs, a.between_iterations, a.mu, lobes=3)  # lobes = 3
+    three = between_fit(ts, *split_narrow(*between), a.between_iterations, a.mu)  # lobes = 3
     seconds["between_fit_three_lobes"] = time.perf_counter() - t0
     held_set = training_set(GRID, 2000, 32, 2000, HEMISPHERE)
     held_cost = {

@@ -21,7 +21,7 @@ FRAMES = {
     "average": "Z = the lobe's average direction (5 parameters; at alpha_x = alpha_y: ltc_code's M, lutbake's "
     "isotropic ggx fit)",
 }
-BETWEEN_CONFIGS = 20000  # two lobes: training configurations of the fit between the texels (lutbake.ltc.aniso_lobes)
+BETWEEN_CONFIGS = 40000  # lobes > 1: training configurations of the fit between the texels (lutbake.ltc.aniso_lobes)
 BETWEEN_ITERATIONS = 20  # two lobes: its Levenberg-Marquardt steps
 MAGNITUDE_SAMPLES = 1 << 16  # scrambled Sobol' points per anisotropic texel (bounded weights: spread ~1e-5)
 

@@ -21,11 +21,10 @@ integrals), fitted per texel and then between the texels, as benchmarks/ltc_anis
 3. Three lobes (``split_narrow``): the two-lobe between table's narrow lobe split in two, then the between fit again
    with three lobes. Three lobes fitted per texel (1.) are no start: their lobes trade roles from texel to texel, and
    the between fit from them ended worse than two lobes (benchmarks/ltc_aniso_lobes.py's set: 0.041 / 0.0124 against
-   0.029 / 0.0069, median relative / p90 |error| / albedo); split from two lobes every lobe varies across the texels
-   as the two-lobe table's do (0.027 / 0.0060).
-``sum_error``: the per-texel relative RMS of the sum's shaded residual at the texel itself. Cost at the paper's 8^4
-(outputs/bench/ltc_aniso_lobes.json's seconds, two threads): the per-texel fit 92 s, the between fit 323 s at 20000
-configurations and 20 steps.
+   0.029 / 0.0069, median relative / p90 |error| / albedo, at 20000 configurations); split from two lobes every lobe
+   varies across the texels as the two-lobe table's do.
+``sum_error``: the per-texel relative RMS of the sum's shaded residual at the texel itself. Cost at the paper's 8^4:
+outputs/bench/ltc_aniso_lobes.json's seconds.
 """
 
 from __future__ import annotations
@@ -308,6 +307,14 @@ def split_narrow(m: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.stack([m[:, 0] @ narrow, m[:, 1], m[:, 0] @ broad], 1), np.stack([half, w[:, 1], half], 1)
 
 
+def between_fit(ts: dict, m: np.ndarray, w: np.ndarray, iterations: int, mu: float = MU) -> tuple[np.ndarray, ...]:
+    """(M (texels, K, 3, 3), w (texels, K)) of fit_between from (m, w) on the training set ``ts``, ``iterations``
+    steps."""
+    count = m.shape[1]
+    x = fit_between(packed(m, w), BetweenLobes(ts, len(m), count), iterations, mu)
+    return x[:, : 9 * count].reshape(-1, count, 3, 3), x[:, 9 * count :]
+
+
 def between_table(
     grid: aniso.Grid4,
     magnitude: np.ndarray,
@@ -317,18 +324,17 @@ def between_table(
     mu: float = MU,
     lobes: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(M (texels, K, 3, 3), w (texels, K)) of fit_between from ``between_start`` (of per_texel_table's table) on
+    """(M (texels, K, 3, 3), w (texels, K)): between_fit from ``between_start`` (of per_texel_table's table) on
     ``configs`` training configurations (BETWEEN_LIGHTS lights + HEMISPHERE each, seed BETWEEN_SEED), ``iterations``
-    steps (0: the start itself); ``lobes`` 3 from a two-lobe per-texel table: then split_narrow and ``iterations``
-    steps more with three lobes (module docstring, 3.)."""
+    steps (0: the start itself); ``lobes`` 3 from a two-lobe per-texel table: then split_narrow and between_fit again,
+    ``iterations`` steps with three lobes on the same configurations (module docstring, 3.)."""
     m, w = between_start(magnitude, per_texel)
     ts = training_set(grid, configs, BETWEEN_LIGHTS, BETWEEN_SEED, HEMISPHERE) if iterations else None
     for count in sorted({m.shape[1], lobes or m.shape[1]}):
         if count > m.shape[1]:
             m, w = split_narrow(m, w)
         if iterations:
-            x = fit_between(packed(m, w), BetweenLobes(ts, len(m), count), iterations, mu)
-            m, w = x[:, : 9 * count].reshape(-1, count, 3, 3), x[:, 9 * count :]
+            m, w = between_fit(ts, m, w, iterations, mu)
     return m, w
 
 
