@@ -176,7 +176,7 @@ LOBES_FIT = (
     "|x - x0|^2 towards the per-texel table, {iterations} Levenberg-Marquardt steps"
 )
 SPLIT_FIT = (
-    "; three lobes: the narrow lobe split into M_1 diag(0.85, 0.85, 1) (lobe 1) and M_1 diag(1.15, 1.15, 1) (lobe "
+    "; three lobes: the narrow lobe split into M_1 diag({0:g}, {0:g}, 1) (lobe 1) and M_1 diag({1:g}, {1:g}, 1) (lobe "
     "3), half its weight each, then the three lobes fitted between the texels as above ({iterations} steps)"
 )
 RECONSTRUCTION = (
@@ -239,7 +239,7 @@ def plan(spec) -> TexelPlan:
         o["lobes"],
         (o["between_configs"], o["between_iterations"]),
     )
-    two = o["lobes"] > 1
+    several = o["lobes"] > 1
     a, b, _, _ = g.axes()
     n = o["size"]
     n_fit = len(aniso.fitted_texels(g))
@@ -263,8 +263,8 @@ def plan(spec) -> TexelPlan:
         + ("" if o["fit"] == "l3" else f"; then shaded: {SHADED}")
         + (
             f"; then {LOBES_FIT.format(configs=o['between_configs'], iterations=o['between_iterations'])}"
-            + (SPLIT_FIT.format(iterations=o["between_iterations"]) if o["lobes"] == 3 else "")
-            if two
+            + (SPLIT_FIT.format(*aniso.SPLIT, iterations=o["between_iterations"]) if o["lobes"] == 3 else "")
+            if several
             else ""
         ),
         "ltc_aniso_magnitude": f"{o['estimator']}: {ESTIMATORS[o['estimator']]}; {samples} points per anisotropic "
@@ -272,9 +272,9 @@ def plan(spec) -> TexelPlan:
         "estimate, not a bound, ~1e-5 at 2^16 with sobol). Not Gauss-Legendre: the specular_aniso kind's rule is "
         "azimuth-averaged only (at a fixed view azimuth the lobe's ridge at alpha_y << alpha_x falls between the "
         "panels' nodes)",
-        "ltc_aniso_shader": LOBES_RECONSTRUCTION if two else RECONSTRUCTION,
+        "ltc_aniso_shader": LOBES_RECONSTRUCTION if several else RECONSTRUCTION,
     }
-    if two:
+    if several:
         sets = ", ".join(f"t{3 * k}, t{3 * k + 1}, t{3 * k + 2} lobe {k + 1}'s" for k in range(o["lobes"]))
         extra["ltc_aniso_lobes"] = (
             f"{o['lobes']}: value = Σ_k w_k I(M_k); textures {sets}, each set laid out as a one-lobe table's with its "
@@ -282,8 +282,8 @@ def plan(spec) -> TexelPlan:
         )
     return TexelPlan(
         axes=axes_for(o),
-        channels=lobes_channels(o["lobes"]) if two else CHANNELS,
-        reconstruction=LOBES_RECONSTRUCTION if two else RECONSTRUCTION,
+        channels=lobes_channels(o["lobes"]) if several else CHANNELS,
+        reconstruction=LOBES_RECONSTRUCTION if several else RECONSTRUCTION,
         n_texels=texel_count(o),
         n_channels=4,
         run_tile=state.run_tile,
@@ -300,11 +300,11 @@ def plan(spec) -> TexelPlan:
         + float(n**4) * samples
         # two lobes: 40 steps x 137 lights x 20 unknowns per fitted texel; per between step ~30 integrals per light
         # (three lobes: the between fit again, ~45 integrals per light)
-        + two * (float(n_fit) * 40 * 137 * 20 + o["between_configs"] * o["between_iterations"] * 41 * 30)
+        + several * (float(n_fit) * 40 * 137 * 20 + o["between_configs"] * o["between_iterations"] * 41 * 30)
         + (o["lobes"] == 3) * o["between_configs"] * o["between_iterations"] * 41 * 45,
         extra=extra,
         attributes_after=lambda data: {
-            **fit_error_stats(data, (2, 3), SUM_ERROR_METRIC if two else L3_METRIC),
+            **fit_error_stats(data, (2, 3), SUM_ERROR_METRIC if several else L3_METRIC),
             "ltc_aniso_magnitude_spread": json.dumps(state.spread),
         },
     )

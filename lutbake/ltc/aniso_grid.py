@@ -22,7 +22,8 @@ FRAMES = {
     "isotropic ggx fit)",
 }
 BETWEEN_CONFIGS = 40000  # lobes > 1: training configurations of the fit between the texels (lutbake.ltc.aniso_lobes)
-BETWEEN_ITERATIONS = 20  # two lobes: its Levenberg-Marquardt steps
+BETWEEN_ITERATIONS = 20  # lobes > 1: its Levenberg-Marquardt steps
+SPLIT = (0.85, 1.15)  # three lobes: the narrow lobe's M x diag(s, s, 1) for each s, half its weight each
 MAGNITUDE_SAMPLES = 1 << 16  # scrambled Sobol' points per anisotropic texel (bounded weights: spread ~1e-5)
 
 

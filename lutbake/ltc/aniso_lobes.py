@@ -20,9 +20,9 @@ integrals), fitted per texel and then between the texels, as benchmarks/ltc_anis
    interpolated M the fit chose; the polygon integral does not see a matrix's scale).
 3. Three lobes (``split_narrow``): the two-lobe between table's narrow lobe split in two, then the between fit again
    with three lobes. Three lobes fitted per texel (1.) are no start: their lobes trade roles from texel to texel, and
-   the between fit from them ended worse than two lobes (benchmarks/ltc_aniso_lobes.py's set: 0.041 / 0.0124 against
-   0.029 / 0.0069, median relative / p90 |error| / albedo, at 20000 configurations); split from two lobes every lobe
-   varies across the texels as the two-lobe table's do.
+   the between fit from them ended worse than two lobes (on benchmarks/ltc_aniso_lobes.py's configurations: 0.041 /
+   0.0124 against 0.029 / 0.0069, median relative / p90 |error| / albedo, at 20000 configurations); split from two
+   lobes every lobe varies across the texels as the two-lobe table's do.
 ``sum_error``: the per-texel relative RMS of the sum's shaded residual at the texel itself. Cost at the paper's 8^4:
 outputs/bench/ltc_aniso_lobes.json's seconds.
 """
@@ -38,14 +38,13 @@ import scipy.sparse.linalg as spla
 from . import aniso, aniso_shaded, shaded
 from . import lights as ltc_lights
 from .aniso import AnisoProblem
-from .aniso_grid import BETWEEN_CONFIGS, BETWEEN_ITERATIONS
+from .aniso_grid import BETWEEN_CONFIGS, BETWEEN_ITERATIONS, SPLIT
 
 TARGET_SAMPLES = 128  # fit_lobes' lobe samples per texel: TARGET_SAMPLES^2 stratified
 LOBE_ITERATIONS = 40  # fit_lobes' Levenberg-Marquardt steps
 BETWEEN_LIGHTS = 32  # training lights per configuration (+ HEMISPHERE)
 BETWEEN_SEED = 1000  # the training set's random numbers
 BETWEEN_SAMPLES = 48  # the training set's lobe samples per configuration: 48^2 stratified
-SPLIT = (0.85, 1.15)  # three lobes: the narrow lobe's M x diag(s, s, 1) for each s, half its weight each
 MU = 0.001  # the between fit's pull towards the per-texel table, relative to mean(diag J^T J) at the start
 CHUNK = 1024  # configurations per AnisoProblem (its lobe samples: CHUNK x 48^2 directions)
 CG_ITERATIONS = 150
@@ -329,10 +328,11 @@ def between_table(
     steps (0: the start itself); ``lobes`` 3 from a two-lobe per-texel table: then split_narrow and between_fit again,
     ``iterations`` steps with three lobes on the same configurations (module docstring, 3.)."""
     m, w = between_start(magnitude, per_texel)
-    ts = training_set(grid, configs, BETWEEN_LIGHTS, BETWEEN_SEED, HEMISPHERE) if iterations else None
-    for count in sorted({m.shape[1], lobes or m.shape[1]}):
-        if count > m.shape[1]:
-            m, w = split_narrow(m, w)
+    if iterations:
+        ts = training_set(grid, configs, BETWEEN_LIGHTS, BETWEEN_SEED, HEMISPHERE)
+        m, w = between_fit(ts, m, w, iterations, mu)
+    if lobes == 3:
+        m, w = split_narrow(m, w)
         if iterations:
             m, w = between_fit(ts, m, w, iterations, mu)
     return m, w
